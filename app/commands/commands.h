@@ -1,0 +1,12 @@
+// Each subcommand of `arbci` registers itself on the root CLI11 app. A command's callback stores
+// its exit code in `exit_code`; errors are thrown as CliError.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace arbci::app {
+
+void addGlInfoCommand(CLI::App& root, int& exit_code);
+void addScreenshotCommand(CLI::App& root, int& exit_code);
+
+}  // namespace arbci::app

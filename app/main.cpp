@@ -1,0 +1,39 @@
+// arbci: the experimenter workstation and its batch commands.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "commands/commands.h"
+#include "support/cli_error.h"
+
+int main(int argc, char** argv) {
+  CLI::App root{"ARBCI: augmented-reality BCI experimenter workstation.\n"
+                "Markers, EEG, P300 classification and a robot arm, in one cycle.",
+                "arbci"};
+  root.set_version_flag("--version", std::string("arbci ") + ARBCI_VERSION);
+  root.require_subcommand(0, 1);
+  root.failure_message([](const CLI::App*, const CLI::Error& error) {
+    return std::string("arbci: ") + error.what() + " (see arbci --help)\n";
+  });
+
+  int exit_code = 0;
+  arbci::app::addGlInfoCommand(root, exit_code);
+  arbci::app::addScreenshotCommand(root, exit_code);
+
+  try {
+    root.parse(argc, argv);
+    if (root.get_subcommands().empty()) {
+      std::cout << root.help();
+      return 0;
+    }
+  } catch (const CLI::ParseError& error) {
+    return root.exit(error);
+  } catch (const arbci::app::CliError& error) {
+    std::cerr << "arbci: " << error.what() << "\n";
+    return error.exitCode();
+  } catch (const std::exception& error) {
+    std::cerr << "arbci: " << error.what() << "\n";
+    return 1;
+  }
+  return exit_code;
+}

@@ -1,0 +1,38 @@
+// An offscreen framebuffer object (RGBA8 colour texture + depth/stencil) owned RAII-style.
+#pragma once
+
+#include "arbci/render/gl_context.h"
+#include "arbci/render/rgba_image.h"
+
+namespace arbci::render {
+
+class Framebuffer {
+ public:
+  // Needs a current GL context. Throws GlError if the framebuffer is incomplete.
+  explicit Framebuffer(Size size);
+  ~Framebuffer();
+  Framebuffer(const Framebuffer&) = delete;
+  Framebuffer& operator=(const Framebuffer&) = delete;
+
+  void resize(Size size);
+  unsigned int id() const { return fbo_; }
+  unsigned int colorTexture() const { return color_; }
+  Size size() const { return size_; }
+
+ private:
+  void create();
+  void destroy();
+  Size size_;
+  unsigned int fbo_ = 0;
+  unsigned int color_ = 0;
+  unsigned int depth_ = 0;
+};
+
+// Binds `framebuffer` (0 = default) as the draw target, sets the viewport to `size` and clears
+// colour and depth.
+void clearFramebuffer(unsigned int framebuffer, Size size, const float (&rgba)[4]);
+
+// Reads the colour attachment of `framebuffer` (0 = default) into a top-down RGBA image.
+RgbaImage readPixels(unsigned int framebuffer, Size size);
+
+}  // namespace arbci::render

@@ -1,0 +1,97 @@
+#include "arbci/render/window_context.h"
+
+#include <GLFW/glfw3.h>
+
+#include <cstdlib>
+#include <string>
+
+namespace arbci::render {
+namespace {
+
+std::string lastGlfwError() {
+  const char* description = nullptr;
+  glfwGetError(&description);
+  return description ? description : "unknown GLFW error";
+}
+
+// GLFW is initialised once per process while windows exist.
+int g_windows = 0;
+
+void acquireGlfw() {
+  if (g_windows == 0 && !glfwInit()) {
+    throw GlError("cannot open a window: " + lastGlfwError() +
+                  " (no X display? use --headless, or run under xvfb-run)");
+  }
+  ++g_windows;
+}
+
+void releaseGlfw() {
+  if (--g_windows == 0) glfwTerminate();
+}
+
+}  // namespace
+
+bool displayAvailable() {
+  const char* display = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  return (display && *display) || (wayland && *wayland);
+}
+
+WindowContext::WindowContext(const WindowOptions& options) {
+  acquireGlfw();
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_VISIBLE, options.visible ? GLFW_TRUE : GLFW_FALSE);
+  GLFWmonitor* monitor = nullptr;
+  Size size = options.size;
+  if (options.fullscreen_monitor >= 0) {
+    int count = 0;
+    GLFWmonitor** monitors = glfwGetMonitors(&count);
+    if (options.fullscreen_monitor < count) {
+      monitor = monitors[options.fullscreen_monitor];
+      const GLFWvidmode* mode = glfwGetVideoMode(monitor);
+      size = {mode->width, mode->height};
+    }
+  }
+  window_ = glfwCreateWindow(size.width, size.height, options.title.c_str(), monitor,
+                             options.share_with);
+  if (!window_) {
+    const std::string reason = lastGlfwError();
+    releaseGlfw();
+    throw GlError("cannot create an OpenGL 3.3 core window: " + reason);
+  }
+  makeCurrent();
+  glfwSwapInterval(options.vsync ? 1 : 0);
+}
+
+WindowContext::~WindowContext() {
+  glfwDestroyWindow(window_);
+  releaseGlfw();
+}
+
+void WindowContext::makeCurrent() { glfwMakeContextCurrent(window_); }
+
+Size WindowContext::framebufferSize() const {
+  Size size;
+  glfwGetFramebufferSize(window_, &size.width, &size.height);
+  return size;
+}
+
+void WindowContext::present() { glfwSwapBuffers(window_); }
+
+bool WindowContext::shouldClose() const { return glfwWindowShouldClose(window_); }
+
+void WindowContext::requestClose() { glfwSetWindowShouldClose(window_, GLFW_TRUE); }
+
+void WindowContext::pollEvents() { glfwPollEvents(); }
+
+int WindowContext::monitorCount() {
+  if (g_windows == 0) return 0;
+  int count = 0;
+  glfwGetMonitors(&count);
+  return count;
+}
+
+}  // namespace arbci::render

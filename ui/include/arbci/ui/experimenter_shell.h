@@ -1,0 +1,41 @@
+// The experimenter window shell: menu bar, a panel area laid out in columns, and a status bar
+// with the frame time.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "arbci/render/gl_context.h"
+#include "arbci/ui/panel.h"
+
+namespace arbci::ui {
+
+struct ShellStatus {
+  float frame_ms = 0.0f;       // time of the last displayed frame
+  std::string session_state;   // e.g. "idle", "phase 1: sequence 3/10"
+  std::string message;         // the latest notice for the experimenter
+};
+
+class ExperimenterShell {
+ public:
+  // Panels are shown in order; the shell does not own them.
+  void addPanel(Panel& panel, bool open = true);
+  void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
+  // Draws the whole shell for one frame; call between ImGuiLayer::beginFrame and endFrame.
+  void draw(render::Size display, const ShellStatus& status);
+
+ private:
+  struct Entry {
+    Panel* panel;
+    bool open;
+  };
+  void drawMenuBar();
+  void drawPanels(render::Size display, float top, float bottom);
+  void drawStatusBar(render::Size display, float height, const ShellStatus& status);
+  std::vector<Entry> panels_;
+  std::function<void()> on_quit_;
+  bool show_about_ = false;
+};
+
+}  // namespace arbci::ui

@@ -1,0 +1,93 @@
+#include "arbci/ui/experimenter_shell.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace arbci::ui {
+namespace {
+constexpr ImGuiWindowFlags kBarFlags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                                       ImGuiWindowFlags_NoSavedSettings |
+                                       ImGuiWindowFlags_NoBringToFrontOnFocus;
+}
+
+void ExperimenterShell::addPanel(Panel& panel, bool open) { panels_.push_back({&panel, open}); }
+
+void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
+  drawMenuBar();
+  const float menu_height = ImGui::GetFrameHeight();
+  const float status_height = ImGui::GetFrameHeight() + 6.0f;
+  drawPanels(display, menu_height, static_cast<float>(display.height) - status_height);
+  drawStatusBar(display, status_height, status);
+  if (show_about_) {
+    ImGui::OpenPopup("About ARBCI");
+    show_about_ = false;
+  }
+  if (ImGui::BeginPopupModal("About ARBCI", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::Text("ARBCI %s", ARBCI_VERSION);
+    ImGui::TextUnformatted("Augmented-reality BCI experimenter workstation.");
+    if (ImGui::Button("Close")) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+  }
+}
+
+void ExperimenterShell::drawMenuBar() {
+  if (!ImGui::BeginMainMenuBar()) return;
+  if (ImGui::BeginMenu("File")) {
+    if (ImGui::MenuItem("Quit", "Ctrl+Q") && on_quit_) on_quit_();
+    ImGui::EndMenu();
+  }
+  if (ImGui::BeginMenu("Panels")) {
+    for (Entry& entry : panels_) ImGui::MenuItem(entry.panel->title(), nullptr, &entry.open);
+    ImGui::EndMenu();
+  }
+  if (ImGui::BeginMenu("Help")) {
+    if (ImGui::MenuItem("About")) show_about_ = true;
+    ImGui::EndMenu();
+  }
+  ImGui::EndMainMenuBar();
+}
+
+void ExperimenterShell::drawPanels(render::Size display, float top, float bottom) {
+  // Default layout (first run): open panels side by side in up to three columns, two rows.
+  std::vector<Entry*> open;
+  for (Entry& entry : panels_) {
+    if (entry.open) open.push_back(&entry);
+  }
+  if (open.empty()) return;
+  const int count = static_cast<int>(open.size());
+  const int columns = std::min(count, 3);
+  const int rows = (count + columns - 1) / columns;
+  const float width = static_cast<float>(display.width) / static_cast<float>(columns);
+  const float height = (bottom - top) / static_cast<float>(rows);
+  for (int i = 0; i < count; ++i) {
+    const float x = width * static_cast<float>(i % columns);
+    const float y = top + height * static_cast<float>(i / columns);
+    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_FirstUseEver);
+    if (ImGui::Begin(open[i]->panel->title(), &open[i]->open)) open[i]->panel->draw();
+    ImGui::End();
+  }
+}
+
+void ExperimenterShell::drawStatusBar(render::Size display, float height,
+                                      const ShellStatus& status) {
+  ImGui::SetNextWindowPos(ImVec2(0.0f, static_cast<float>(display.height) - height));
+  ImGui::SetNextWindowSize(ImVec2(static_cast<float>(display.width), height));
+  if (ImGui::Begin("##status", nullptr, kBarFlags)) {
+    const float fps = status.frame_ms > 0.0f ? 1000.0f / status.frame_ms : 0.0f;
+    ImGui::Text("frame %.1f ms (%.0f fps)", status.frame_ms, std::round(fps));
+    if (!status.session_state.empty()) {
+      ImGui::SameLine(0.0f, 30.0f);
+      ImGui::Text("session: %s", status.session_state.c_str());
+    }
+    if (!status.message.empty()) {
+      ImGui::SameLine(0.0f, 30.0f);
+      ImGui::TextUnformatted(status.message.c_str());
+    }
+  }
+  ImGui::End();
+}
+
+}  // namespace arbci::ui

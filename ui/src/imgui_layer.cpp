@@ -1,0 +1,72 @@
+#include "arbci/ui/imgui_layer.h"
+
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "arbci/render/window_context.h"
+
+namespace arbci::ui {
+namespace {
+constexpr const char* kUiFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+}
+
+ImGuiLayer::ImGuiLayer(render::GlContext& context, const std::string& ini_path)
+    : context_(context), ini_path_(ini_path) {
+  if (ImGui::GetCurrentContext() != nullptr) {
+    throw std::logic_error("only one ImGuiLayer may exist at a time");
+  }
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = ini_path_.empty() ? nullptr : ini_path_.c_str();
+  if (std::filesystem::exists(kUiFont)) {
+    io.Fonts->AddFontFromFileTTF(kUiFont, 15.0f);
+  } else {
+    io.Fonts->AddFontDefault();
+  }
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().WindowRounding = 3.0f;
+
+  context_.makeCurrent();
+  if (auto* window = dynamic_cast<render::WindowContext*>(&context_)) {
+    ImGui_ImplGlfw_InitForOpenGL(window->window(), true);
+    glfw_backend_ = true;
+  }
+  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
+    if (glfw_backend_) ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    throw render::GlError("Dear ImGui's OpenGL3 backend failed to initialise");
+  }
+}
+
+ImGuiLayer::~ImGuiLayer() {
+  context_.makeCurrent();
+  ImGui_ImplOpenGL3_Shutdown();
+  if (glfw_backend_) ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+void ImGuiLayer::beginFrame(float delta_seconds) {
+  ImGui_ImplOpenGL3_NewFrame();
+  if (glfw_backend_) {
+    ImGui_ImplGlfw_NewFrame();
+  } else {
+    const render::Size size = context_.framebufferSize();
+    ImGuiIO& io = ImGui::GetIO();
+    io.DisplaySize = ImVec2(static_cast<float>(size.width), static_cast<float>(size.height));
+    io.DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
+    io.DeltaTime = delta_seconds > 0.0f ? delta_seconds : 1.0f / 60.0f;
+  }
+  ImGui::NewFrame();
+}
+
+void ImGuiLayer::endFrame() {
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+}  // namespace arbci::ui
