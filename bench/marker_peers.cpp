@@ -1,0 +1,113 @@
+#include "marker_peers.h"
+
+#include <apriltag.h>
+#include <tag36h11.h>
+
+#include <opencv2/aruco.hpp>
+
+#include "arbci/vision/marker_detector.h"
+
+namespace arbci::bench {
+namespace {
+
+class ArbciTracker final : public MarkerDetectorUnderTest {
+ public:
+  ArbciTracker() : detector_(config()) {}
+  std::string name() const override { return "ARBCI (BCH, adaptive)"; }
+  test::MarkerFamily family() const override { return test::MarkerFamily::ArbciBch; }
+  bool orderedCorners() const override { return true; }
+  std::vector<test::FoundMarker> detect(const cv::Mat& gray) override {
+    std::vector<test::FoundMarker> found;
+    for (const vision::MarkerDetection& m : detector_.detect(gray).markers) found.push_back({m.id, m.corners});
+    return found;
+  }
+
+ private:
+  static vision::DetectorConfig config() {
+    vision::DetectorConfig c;
+    c.kind = vision::MarkerKind::Bch;
+    c.border = 0.125;
+    c.threshold.mode = vision::ThresholdMode::Adaptive;
+    return c;
+  }
+  vision::MarkerDetector detector_;
+};
+
+class AprilTag final : public MarkerDetectorUnderTest {
+ public:
+  explicit AprilTag(float decimate) : decimate_(decimate) {
+    family_ = tag36h11_create();
+    detector_ = apriltag_detector_create();
+    apriltag_detector_add_family(detector_, family_);
+    detector_->quad_decimate = decimate;
+  }
+  ~AprilTag() override {
+    apriltag_detector_destroy(detector_);
+    tag36h11_destroy(family_);
+  }
+  std::string name() const override {
+    return "AprilTag 3 (36h11, decimate " + std::to_string(static_cast<int>(decimate_)) + ")";
+  }
+  test::MarkerFamily family() const override { return test::MarkerFamily::AprilTag36h11; }
+  bool orderedCorners() const override { return false; }
+  std::vector<test::FoundMarker> detect(const cv::Mat& gray) override {
+    image_u8_t image{gray.cols, gray.rows, static_cast<int32_t>(gray.step), gray.data};
+    zarray_t* detections = apriltag_detector_detect(detector_, &image);
+    std::vector<test::FoundMarker> found;
+    for (int i = 0; i < zarray_size(detections); ++i) {
+      apriltag_detection_t* d = nullptr;
+      zarray_get(detections, i, &d);
+      test::FoundMarker m;
+      m.id = d->id;
+      // libapriltag's pixel centres are at +0.5 of OpenCV's.
+      for (int k = 0; k < 4; ++k) {
+        m.corners[k] = cv::Point2f(static_cast<float>(d->p[k][0] - 0.5), static_cast<float>(d->p[k][1] - 0.5));
+      }
+      found.push_back(m);
+    }
+    apriltag_detections_destroy(detections);
+    return found;
+  }
+
+ private:
+  float decimate_;
+  apriltag_family_t* family_;
+  apriltag_detector_t* detector_;
+};
+
+class Aruco final : public MarkerDetectorUnderTest {
+ public:
+  Aruco()
+      : dictionary_(cv::aruco::getPredefinedDictionary(cv::aruco::DICT_6X6_250)),
+        parameters_(cv::aruco::DetectorParameters::create()) {}
+  std::string name() const override { return "OpenCV ArUco (6x6_250)"; }
+  test::MarkerFamily family() const override { return test::MarkerFamily::Aruco6x6; }
+  bool orderedCorners() const override { return true; }
+  std::vector<test::FoundMarker> detect(const cv::Mat& gray) override {
+    std::vector<std::vector<cv::Point2f>> corners;
+    std::vector<int> ids;
+    cv::aruco::detectMarkers(gray, dictionary_, corners, ids, parameters_);
+    std::vector<test::FoundMarker> found;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      test::FoundMarker m;
+      m.id = ids[i];
+      for (int k = 0; k < 4; ++k) m.corners[k] = corners[i][k];
+      found.push_back(m);
+    }
+    return found;
+  }
+
+ private:
+  cv::Ptr<cv::aruco::Dictionary> dictionary_;
+  cv::Ptr<cv::aruco::DetectorParameters> parameters_;
+};
+
+}  // namespace
+
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker() { return std::make_unique<ArbciTracker>(); }
+std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate) {
+  return std::make_unique<AprilTag>(decimate);
+}
+std::unique_ptr<MarkerDetectorUnderTest> makeAruco() { return std::make_unique<Aruco>(); }
+
+}  // namespace arbci::bench

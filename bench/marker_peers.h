@@ -1,0 +1,28 @@
+// The peers the tracker is measured against, behind one interface: libapriltag 3 (tag36h11) and
+// OpenCV 4.6's ArUco (DICT_6X6_250), each at its library's default settings.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "support/marker_scoring.h"
+
+namespace arbci::bench {
+
+class MarkerDetectorUnderTest {
+ public:
+  virtual ~MarkerDetectorUnderTest() = default;
+  virtual std::string name() const = 0;
+  virtual test::MarkerFamily family() const = 0;
+  virtual bool orderedCorners() const = 0;
+  virtual std::vector<test::FoundMarker> detect(const cv::Mat& gray) = 0;
+};
+
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker();
+std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate);
+std::unique_ptr<MarkerDetectorUnderTest> makeAruco();
+
+}  // namespace arbci::bench

@@ -1,0 +1,71 @@
+// Synthetic camera frames of square markers with exact ground truth, for tests and benchmarks.
+// A layout (marker and decoy poses, background, lighting) is drawn once and rendered with each
+// marker family, so every detector sees the same scene with its own markers. Every family is drawn
+// as 10 x 10 cells: an 8-cell black square (1-cell black border, 6 x 6 code) inside a 1-cell white
+// quiet zone; a marker's size is the side of its black square.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+namespace arbci::test {
+
+enum class MarkerFamily { ArbciBch, Aruco6x6, AprilTag36h11 };
+enum class Condition { Clean, Blur, Noise, UnevenLight, Combined };
+
+std::string toString(MarkerFamily family);
+std::string toString(Condition condition);
+
+using Corners = std::array<cv::Point2f, 4>;  // TL, TR, BR, BL of the black square, OpenCV pixels
+
+struct LayoutOptions {
+  cv::Size size{640, 480};
+  int markers = 3;
+  int decoys = 2;
+  float min_side_px = 20.0f;   // face-on size of the smallest marker
+  float max_side_px = 110.0f;
+  float max_tilt_deg = 60.0f;
+};
+
+struct SceneLayout {
+  cv::Size size;
+  std::vector<Corners> markers;  // poses of the markers (black square corners)
+  std::vector<Corners> decoys;
+  std::vector<int> decoy_styles;
+  std::uint32_t seed = 0;  // background and lighting
+};
+
+struct RenderedScene {
+  cv::Mat image;                 // 8-bit grey
+  std::vector<int> ids;          // per layout marker
+  std::vector<Corners> markers;  // ground truth, same order
+};
+
+// Random poses (tilt up to max_tilt_deg, any in-plane rotation), not overlapping each other.
+SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed);
+
+// Draws the layout with `family`'s markers (ids drawn from the seed) under `condition`.
+RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condition condition);
+
+// A frame of `size` with background and decoys only (no markers), under `condition`.
+cv::Mat renderMarkerFree(const SceneLayout& layout, Condition condition);
+
+// The printed marker image of `family` and `id`, 10 x 10 cells of `cell_px` pixels each
+// (quiet zone included).
+cv::Mat markerImage(MarkerFamily family, int id, int cell_px);
+
+// Ids a family offers for the benchmark: BCH ids whose rotations stay at least 5 bits from any
+// other codeword (the ARToolKitPlus notes list the hazardous ones), ArUco 6x6_250's 250 and
+// AprilTag 36h11's 587.
+const std::vector<int>& usableIds(MarkerFamily family);
+
+// Warps `patch` (with `alpha`, both of the same size) into `frame` so that the patch's corners
+// (0,0), (w,0), (w,h), (0,h) -- in pixel-area coordinates -- land on `quad` (OpenCV pixel
+// coordinates), anti-aliased by 4x supersampling.
+void drawWarped(cv::Mat& frame, const cv::Mat& patch, const Corners& quad);
+
+}  // namespace arbci::test

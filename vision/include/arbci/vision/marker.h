@@ -1,0 +1,47 @@
+// What the tracker reports: markers with ID, corners, orientation and confidence, per frame.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/types.hpp>
+
+namespace arbci::vision {
+
+enum class MarkerKind { Bch, Simple, Template, Aruco, AprilTag };
+
+std::string toString(MarkerKind kind);
+// Parses "bch", "simple", "template", "aruco", "apriltag"; throws std::invalid_argument.
+MarkerKind markerKindFromString(const std::string& text);
+
+struct MarkerDetection {
+  int id = -1;
+  MarkerKind kind = MarkerKind::Bch;
+  // Corners of the printed marker: top-left, top-right, bottom-right, bottom-left, in image
+  // pixels with OpenCV's convention (pixel centres at integer coordinates).
+  std::array<cv::Point2f, 4> corners;
+  // ARToolKitPlus's `dir`: clockwise quarter turns from the sampled grid to the printed one.
+  int orientation = 0;
+  // 1.0 for a clean decode; lower for corrected bits (ARToolKitPlus's scale) or weaker matches.
+  float confidence = 0.0f;
+  int corrected_bits = 0;
+  // The identity was carried over from earlier frames because this frame's decode failed.
+  bool from_history = false;
+};
+
+// Microseconds spent in each stage of one frame.
+struct StageTimes {
+  double convert = 0, smooth = 0, threshold = 0, label = 0, quads = 0, decode = 0, total = 0;
+};
+
+struct DetectionResult {
+  std::vector<MarkerDetection> markers;
+  int threshold = 0;           // the global threshold used (adaptive: the median local threshold)
+  std::string threshold_mode;  // how it was chosen this frame
+  int candidates = 0;          // square candidates examined
+  int threshold_attempts = 1;  // > 1 when a random re-acquisition threshold was tried
+  StageTimes timing;
+};
+
+}  // namespace arbci::vision

@@ -1,0 +1,77 @@
+// The square-marker tracker for one camera: pixel format conversion, thresholding, connected
+// components, contour tracing, quad fitting with sub-pixel edges, pattern normalisation and ID
+// decoding (BCH and simple IDs as ARToolKitPlus, trained templates), or OpenCV's ArUco/AprilTag
+// dictionaries. It keeps the automatic threshold between frames; one detector per camera.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "arbci/vision/marker.h"
+#include "arbci/vision/pixel_format.h"
+#include "arbci/vision/template_pattern.h"
+#include "arbci/vision/threshold.h"
+
+namespace arbci::vision {
+
+enum class Smoothing { Auto, Always, Never };
+
+struct DetectorConfig {
+  MarkerKind kind = MarkerKind::Bch;
+  // Border width as a fraction of the marker side: 0.125 (thin) or 0.25 (standard), or any other
+  // value in (0, 0.4] for square kinds.
+  double border = 0.125;
+  ThresholdSettings threshold;
+  // 3x3 binomial blur before binarising: Auto smooths frames whose estimated noise exceeds 2.5
+  // grey levels (sensor noise), and leaves clean frames sharp.
+  Smoothing smoothing = Smoothing::Auto;
+  float min_side_px = 8;  // smaller squares are ignored
+  // BCH only: when ARToolKitPlus's hard decoding (at most 2 corrected bits) fails, try Chase
+  // decoding on the least reliable cells (recovers blurred markers; see code_decoder.h).
+  bool soft_decoding = true;
+  std::vector<TemplatePattern> templates;  // MarkerKind::Template
+  TemplateMatchLimits template_limits;
+  // MarkerKind::Aruco / AprilTag: an OpenCV predefined dictionary name; empty for the kind's
+  // default (DICT_6X6_250, DICT_APRILTAG_36h11).
+  std::string dictionary;
+};
+
+using SquareCorners = std::array<cv::Point2f, 4>;
+
+class MarkerDetector {
+ public:
+  // Throws std::invalid_argument naming the field when the configuration is unusable.
+  explicit MarkerDetector(DetectorConfig config);
+  ~MarkerDetector();
+  MarkerDetector(MarkerDetector&&) noexcept;
+  MarkerDetector& operator=(MarkerDetector&&) noexcept;
+
+  // A gray, BGR or BGRA 8-bit image; an empty image gives no markers.
+  DetectionResult detect(const cv::Mat& image);
+  // A frame in any supported pixel format.
+  DetectionResult detect(const ImageView& image);
+
+  const DetectorConfig& config() const;
+  void setThreshold(const ThresholdSettings& settings);
+  // The global threshold the next frame starts from (automatic and constant modes).
+  int currentThreshold() const;
+  // Every square outline of the last frame, decoded or not (clockwise on screen).
+  const std::vector<SquareCorners>& lastSquares() const;
+  // The last frame's binary image: 255 where a pixel counted as dark.
+  cv::Mat lastBinaryImage() const;
+  // The luminance image of the last frame (shares memory with the detector; copy to keep).
+  const cv::Mat& lastGrayImage() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The OpenCV predefined dictionary names accepted for the ArUco and AprilTag kinds.
+std::vector<std::string> dictionaryNames();
+
+}  // namespace arbci::vision

@@ -1,0 +1,26 @@
+// Private: reads the sampled 6x6 cells as a simple or BCH ID in all four rotations and keeps the
+// unambiguous best, as ARToolKitPlus (fewest corrected bits; a tie between rotations is rejected
+// rather than guessed). For BCH IDs, when that hard decoding fails, a Chase decoder may try
+// again: the least reliable cells (closest to their threshold) are flipped in every combination,
+// each trial is hard-decoded, and the codeword whose disagreements with the cells weigh least
+// (summed reliability) wins if it is clearly better than any other.
+#pragma once
+
+#include <optional>
+
+#include "arbci/vision/marker.h"
+#include "marker_sampler.h"
+
+namespace arbci::vision {
+
+struct CodeDecode {
+  int id = -1;
+  int orientation = 0;  // clockwise quarter turns from the sampled grid to the printed grid
+  int corrected_bits = 0;
+  float confidence = 0.0f;
+};
+
+std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& samples,
+                                     bool soft_decoding);
+
+}  // namespace arbci::vision

@@ -1,0 +1,334 @@
+#include "arbci/vision/marker_detector.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "code_decoder.h"
+#include "contour_trace.h"
+#include "dictionary_detector.h"
+#include "marker_sampler.h"
+#include "quad_fit.h"
+#include "run_labeling.h"
+#include "smoothing.h"
+#include "tile_thresholds.h"
+
+namespace arbci::vision {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kSmoothAboveNoise = 2.5;  // grey levels of estimated noise
+
+double microseconds(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::micro>(to - from).count();
+}
+
+bool isSquareKind(MarkerKind kind) {
+  return kind == MarkerKind::Bch || kind == MarkerKind::Simple || kind == MarkerKind::Template;
+}
+
+bool insideConvex(const SquareCorners& quad, cv::Point2f p) {
+  float sign = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f e = quad[(k + 1) % 4] - quad[k];
+    const cv::Point2f d = p - quad[k];
+    const float cross = e.x * d.y - e.y * d.x;
+    if (sign == 0.0f) sign = cross;
+    if (cross * sign < 0.0f) return false;
+  }
+  return true;
+}
+
+float quadArea(const SquareCorners& q) {
+  float area = 0.0f;
+  for (int k = 0; k < 4; ++k) area += q[k].x * q[(k + 1) % 4].y - q[(k + 1) % 4].x * q[k].y;
+  return std::abs(area) * 0.5f;
+}
+
+cv::Point2f centre(const SquareCorners& q) { return (q[0] + q[1] + q[2] + q[3]) * 0.25f; }
+
+void validate(const DetectorConfig& config) {
+  if (isSquareKind(config.kind) && !(config.border > 0.0 && config.border <= 0.4)) {
+    throw std::invalid_argument("border must be in (0, 0.4] of the marker side, got " +
+                                std::to_string(config.border));
+  }
+  if (config.kind == MarkerKind::Template && config.templates.empty()) {
+    throw std::invalid_argument("the template kind needs at least one trained pattern");
+  }
+  const int value = config.threshold.value;
+  if (value < 0 || value > 255) {
+    throw std::invalid_argument("threshold value must be 0..255, got " + std::to_string(value));
+  }
+  if (config.threshold.retries_per_frame < 0 || config.threshold.retries_per_frame > 10) {
+    throw std::invalid_argument("threshold retries per frame must be 0..10");
+  }
+  if (config.min_side_px < 4) throw std::invalid_argument("min_side_px must be at least 4");
+}
+
+}  // namespace
+
+struct MarkerDetector::Impl {
+  DetectorConfig config;
+  int dictionary = -1;
+  int threshold = 100;  // global threshold carried between frames (automatic modes)
+  std::mt19937 random;
+  // `gray` is a read-only view: of the caller's pixels for grey input, else of `converted`.
+  // `converted` and `smoothed` are written only by this detector and never shared with callers,
+  // so reusing their buffers can never write into a caller's image.
+  cv::Mat gray, converted, smoothed;
+  const cv::Mat* binarised = nullptr;  // `gray` or `smoothed`
+  TileThresholds tiles;
+  AdaptiveThresholder adaptive;
+  cv::Mat limits;
+  RunLabeler labels;
+  std::vector<cv::Point> contour;
+  std::vector<Quad> quads;
+  std::vector<SquareCorners> squares;
+
+  explicit Impl(DetectorConfig c) : config(std::move(c)) {
+    validate(config);
+    if (config.kind == MarkerKind::Aruco || config.kind == MarkerKind::AprilTag) {
+      const std::string name = !config.dictionary.empty() ? config.dictionary
+                               : config.kind == MarkerKind::Aruco ? "DICT_6X6_250"
+                                                                  : "DICT_APRILTAG_36h11";
+      dictionary = dictionaryId(name);
+    }
+    resetThreshold();
+  }
+
+  void resetThreshold() {
+    threshold = config.threshold.value;
+    random.seed(config.threshold.random_seed);
+  }
+
+  int randomThreshold() { return std::uniform_int_distribution<int>(10, 239)(random); }
+
+  void binarise(StageTimes& time, DetectionResult& result, int global, double noise_sigma) {
+    const auto start = Clock::now();
+    if (config.threshold.mode == ThresholdMode::Adaptive) {
+      int contrast = config.threshold.min_contrast;
+      if (contrast <= 0) {
+        // Ask for 6 sigma of the noise left in the binarised image (0.375 of it after smoothing).
+        const double sigma = noise_sigma * (binarised == &smoothed ? 0.375 : 1.0);
+        contrast = std::max(8, static_cast<int>(std::lround(6.0 * sigma)));
+      }
+      adaptive.fill(*binarised, contrast, tiles);
+      result.threshold = tiles.median();
+      result.threshold_mode = "adaptive (contrast >= " + std::to_string(contrast) + ")";
+    } else {
+      const auto& vignetting =
+          config.threshold.mode == ThresholdMode::Adaptive ? std::nullopt : config.threshold.vignetting;
+      fillGlobalThresholds(gray.size(), global, vignetting, tiles);
+      result.threshold = global;
+      result.threshold_mode = toString(config.threshold.mode) + (vignetting ? " + vignetting" : "");
+    }
+    interpolateLimits(tiles, gray.size(), limits);
+    const auto mid = Clock::now();
+    labels.label(*binarised, limits);
+    const auto end = Clock::now();
+    time.threshold += microseconds(start, mid);
+    time.label += microseconds(mid, end);
+  }
+
+  void findQuads(StageTimes& time) {
+    const auto start = Clock::now();
+    quads.clear();
+    const int width = gray.cols, height = gray.rows;
+    const float min_side = config.min_side_px;
+    const int min_area = std::max(12, static_cast<int>(0.2f * min_side * min_side));
+    QuadFitParams params;
+    params.min_side = min_side;
+    for (const DarkComponent& c : labels.components()) {
+      if (c.area < min_area || c.touchesBorder(width, height)) continue;
+      const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
+      if (std::max(w, h) < min_side || std::min(w, h) < 3) continue;
+      const int max_length = 4 * (w + h) + 64;
+      if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
+      if (auto quad = fitQuad(contour, {c.first_x, c.first_y}, *binarised, params)) {
+        quads.push_back(*quad);
+      }
+    }
+    time.quads += microseconds(start, Clock::now());
+  }
+
+  // Decodes every quad; returns the samples' extremes and the first marker's median for the
+  // automatic thresholds.
+  void decode(StageTimes& time, std::vector<MarkerDetection>& markers, float& lowest,
+              float& highest, float& marker_median) {
+    const auto start = Clock::now();
+    for (const Quad& quad : quads) {
+      const MarkerSamples samples = sampleMarker(gray, quad, config.border);
+      lowest = std::min(lowest, samples.lowest);
+      highest = std::max(highest, samples.highest);
+      if (samples.contrast < 8.0f || samples.border_light * 10 > samples.border_samples) continue;
+      MarkerDetection marker;
+      marker.kind = config.kind;
+      if (config.kind == MarkerKind::Template) {
+        const auto match = matchTemplate(
+            sampleCodeArea(gray, quad, config.border, TemplatePattern::kSize), config.templates,
+            config.template_limits);
+        if (!match) continue;
+        marker.id = match->id;
+        marker.orientation = match->orientation;
+        marker.confidence = match->confidence;
+      } else {
+        const auto code = decodeCode(config.kind, samples, config.soft_decoding);
+        if (!code) continue;
+        marker.id = code->id;
+        marker.orientation = code->orientation;
+        marker.confidence = code->confidence;
+        marker.corrected_bits = code->corrected_bits;
+      }
+      // Printed corner k (TL, TR, BR, BL) is quad corner (k + 4 - orientation) mod 4.
+      for (int k = 0; k < 4; ++k) marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
+      if (markers.empty()) marker_median = samples.median;
+      markers.push_back(marker);
+    }
+    time.decode += microseconds(start, Clock::now());
+  }
+
+  // A square inside a larger decoded marker (e.g. a block of code cells) is not a marker.
+  static void dropNested(std::vector<MarkerDetection>& markers) {
+    std::vector<MarkerDetection> kept;
+    for (const MarkerDetection& m : markers) {
+      bool nested = false;
+      for (const MarkerDetection& other : markers) {
+        if (&other != &m && quadArea(other.corners) > quadArea(m.corners) &&
+            insideConvex(other.corners, centre(m.corners))) {
+          nested = true;
+          break;
+        }
+      }
+      if (!nested) kept.push_back(m);
+    }
+    markers.swap(kept);
+  }
+
+  DetectionResult detectSquares(StageTimes& time) {
+    DetectionResult result;
+    auto start = Clock::now();
+    // Smoothing suppresses sensor noise but softens small markers further: by default only a
+    // visibly noisy frame is smoothed.
+    const double noise_sigma = estimateNoiseSigma(gray);
+    const bool smooth = config.smoothing == Smoothing::Always ||
+                        (config.smoothing == Smoothing::Auto && noise_sigma >= kSmoothAboveNoise);
+    if (smooth) smoothBinomial3(gray, smoothed);
+    binarised = smooth ? &smoothed : &gray;
+    time.smooth = microseconds(start, Clock::now());
+
+    const ThresholdMode mode = config.threshold.mode;
+    const bool automatic = mode == ThresholdMode::AutoMedian || mode == ThresholdMode::AutoMidrange;
+    const int attempts = automatic ? 1 + config.threshold.retries_per_frame : 1;
+    for (int attempt = 0; attempt < attempts; ++attempt) {
+      const int global = mode == ThresholdMode::Constant ? config.threshold.value : threshold;
+      binarise(time, result, global, noise_sigma);
+      findQuads(time);
+      float lowest = 255.0f, highest = 0.0f, marker_median = -1.0f;
+      result.markers.clear();
+      decode(time, result.markers, lowest, highest, marker_median);
+      result.candidates = static_cast<int>(quads.size());
+      result.threshold_attempts = attempt + 1;
+      if (!automatic) break;
+      // ARToolKitPlus: midrange of all candidates' code samples; the original system: the median
+      // of the last seen marker's pixels. While nothing is found, a random threshold.
+      const bool found = mode == ThresholdMode::AutoMidrange ? !quads.empty() : !result.markers.empty();
+      if (found) {
+        threshold = mode == ThresholdMode::AutoMidrange
+                        ? static_cast<int>(std::lround((lowest + highest) * 0.5f))
+                        : static_cast<int>(std::lround(marker_median));
+        threshold = std::clamp(threshold, 0, 255);
+        break;
+      }
+      threshold = randomThreshold();
+      if (attempt + 1 < attempts) result.threshold_mode += ", retry";
+    }
+    dropNested(result.markers);
+    squares.clear();
+    for (const Quad& quad : quads) squares.push_back(quad.corners);
+    return result;
+  }
+
+  DetectionResult run() {
+    const auto start = Clock::now();
+    StageTimes time;
+    DetectionResult result;
+    squares.clear();
+    if (gray.empty() || gray.cols < 3 || gray.rows < 3) {
+      result.threshold = threshold;
+      result.threshold_mode = "empty image";
+    } else if (dictionary >= 0) {
+      const auto decode_start = Clock::now();
+      result.markers = detectDictionaryMarkers(gray, dictionary, config.kind);
+      time.decode = microseconds(decode_start, Clock::now());
+      result.threshold_mode = "opencv adaptive";
+    } else {
+      result = detectSquares(time);
+    }
+    time.total = microseconds(start, Clock::now());
+    result.timing = time;
+    return result;
+  }
+};
+
+MarkerDetector::MarkerDetector(DetectorConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
+MarkerDetector::~MarkerDetector() = default;
+MarkerDetector::MarkerDetector(MarkerDetector&&) noexcept = default;
+MarkerDetector& MarkerDetector::operator=(MarkerDetector&&) noexcept = default;
+
+DetectionResult MarkerDetector::detect(const cv::Mat& image) {
+  const auto start = Clock::now();
+  if (image.type() == CV_8UC1) {
+    impl_->gray = image;  // a view; never written
+  } else {
+    toLuminance(image, impl_->converted);
+    impl_->gray = impl_->converted;
+  }
+  const double convert = microseconds(start, Clock::now());
+  DetectionResult result = impl_->run();
+  result.timing.convert = convert;
+  result.timing.total += convert;
+  return result;
+}
+
+DetectionResult MarkerDetector::detect(const ImageView& image) {
+  const auto start = Clock::now();
+  toLuminance(image, impl_->converted);
+  impl_->gray = impl_->converted;
+  const double convert = microseconds(start, Clock::now());
+  DetectionResult result = impl_->run();
+  result.timing.convert = convert;
+  result.timing.total += convert;
+  return result;
+}
+
+const DetectorConfig& MarkerDetector::config() const { return impl_->config; }
+
+void MarkerDetector::setThreshold(const ThresholdSettings& settings) {
+  DetectorConfig changed = impl_->config;
+  changed.threshold = settings;
+  validate(changed);
+  impl_->config.threshold = settings;
+  impl_->resetThreshold();
+}
+
+int MarkerDetector::currentThreshold() const { return impl_->threshold; }
+
+const std::vector<SquareCorners>& MarkerDetector::lastSquares() const { return impl_->squares; }
+
+cv::Mat MarkerDetector::lastBinaryImage() const {
+  const cv::Mat& gray = impl_->gray;
+  cv::Mat binary(gray.rows, gray.cols, CV_8UC1, cv::Scalar(0));
+  if (impl_->dictionary >= 0 || gray.empty() || impl_->labels.maskStride() != gray.cols + 2) return binary;
+  for (int y = 0; y < gray.rows; ++y) {
+    std::uint8_t* row = binary.ptr<std::uint8_t>(y);
+    for (int x = 0; x < gray.cols; ++x) row[x] = impl_->labels.dark(x, y) ? 255 : 0;
+  }
+  return binary;
+}
+
+const cv::Mat& MarkerDetector::lastGrayImage() const { return impl_->gray; }
+
+}  // namespace arbci::vision

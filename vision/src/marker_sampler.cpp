@@ -1,0 +1,180 @@
+#include "marker_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "image_sampling.h"
+
+namespace arbci::vision {
+namespace {
+
+// Least-squares plane level(u, v) = p0 + p1 u + p2 v.
+struct Plane {
+  double p0 = 0, p1 = 0, p2 = 0;
+  double at(double u, double v) const { return p0 + p1 * u + p2 * v; }
+};
+
+Plane fitPlane(const cv::Point3d* samples, int count) {
+  double s[3][3] = {}, r[3] = {};
+  for (int n = 0; n < count; ++n) {
+    const cv::Point3d& p = samples[n];
+    const double basis[3] = {1.0, p.x, p.y};
+    for (int i = 0; i < 3; ++i) {
+      r[i] += basis[i] * p.z;
+      for (int j = 0; j < 3; ++j) s[i][j] += basis[i] * basis[j];
+    }
+  }
+  // Cramer's rule on the 3x3 normal equations.
+  auto det3 = [](const double m[3][3]) {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  };
+  const double det = det3(s);
+  if (std::abs(det) < 1e-12) {
+    double mean = 0;
+    for (int n = 0; n < count; ++n) mean += samples[n].z;
+    return {count == 0 ? 0.0 : mean / count, 0, 0};
+  }
+  double solution[3];
+  for (int k = 0; k < 3; ++k) {
+    double m[3][3];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) m[i][j] = j == k ? r[i] : s[i][j];
+    }
+    solution[k] = det3(m) / det;
+  }
+  return {solution[0], solution[1], solution[2]};
+}
+
+// Mean of five samples: (u, v) and the corners of a square +-`spread` (unit-square units) around.
+float sampleArea(const BilinearSampler& sample, const SquareToQuad& map, double u, double v,
+                 double spread) {
+  constexpr int kOffsets[5][2] = {{0, 0}, {-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
+  float sum = 0;
+  for (const auto& o : kOffsets) {
+    const cv::Point2f p = map(u + o[0] * spread, v + o[1] * spread);
+    sum += sample(p.x, p.y);
+  }
+  return sum / 5.0f;
+}
+
+// Where the square [low, high]^2 of marker coordinates lands in the image (a convex region when
+// the map's vanishing line stays outside it), plus a pixel for interpolation; an empty rectangle
+// (so every sample is clamped) when the map degenerates there.
+cv::Rect2f regionOf(const SquareToQuad& map, double low, double high) {
+  const std::array<cv::Point2f, 4> corners{map(low, low), map(high, low), map(high, high), map(low, high)};
+  if (!map.finiteOn(low, high)) return {-1.0f, -1.0f, 0.0f, 0.0f};
+  return boundsOf(corners, 1.0f);
+}
+
+}  // namespace
+
+SquareToQuad::SquareToQuad(const std::array<cv::Point2f, 4>& q) {
+  const double x0 = q[0].x, y0 = q[0].y, x1 = q[1].x, y1 = q[1].y;
+  const double x2 = q[2].x, y2 = q[2].y, x3 = q[3].x, y3 = q[3].y;
+  const double sx = x0 - x1 + x2 - x3, sy = y0 - y1 + y2 - y3;
+  if (std::abs(sx) < 1e-9 && std::abs(sy) < 1e-9) {
+    a_ = x1 - x0;
+    b_ = x3 - x0;
+    d_ = y1 - y0;
+    e_ = y3 - y0;
+    g_ = h_ = 0;
+  } else {
+    const double dx1 = x1 - x2, dx2 = x3 - x2, dy1 = y1 - y2, dy2 = y3 - y2;
+    const double den = dx1 * dy2 - dx2 * dy1;
+    g_ = (sx * dy2 - dx2 * sy) / den;
+    h_ = (dx1 * sy - sx * dy1) / den;
+    a_ = x1 - x0 + g_ * x1;
+    b_ = x3 - x0 + h_ * x3;
+    d_ = y1 - y0 + g_ * y1;
+    e_ = y3 - y0 + h_ * y3;
+  }
+  c_ = x0;
+  f_ = y0;
+}
+
+bool SquareToQuad::finiteOn(double low, double high) const {
+  for (double u : {low, high}) {
+    for (double v : {low, high}) {
+      if (g_ * u + h_ * v + 1.0 <= 1e-6) return false;
+    }
+  }
+  return true;
+}
+
+cv::Point2f SquareToQuad::operator()(double u, double v) const {
+  const double w = g_ * u + h_ * v + 1.0;
+  return {static_cast<float>((a_ * u + b_ * v + c_) / w), static_cast<float>((d_ * u + e_ * v + f_) / w)};
+}
+
+MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border) {
+  const SquareToQuad map(quad.corners);
+  const double cell = (1.0 - 2.0 * border) / 6.0;
+  const double spread = cell * 0.25;
+  // Samples reach half a cell outside the marker (the white surround).
+  const BilinearSampler sample(image, regionOf(map, -cell, 1.0 + cell));
+  MarkerSamples out;
+
+  // Black: the middle of the border band; white: half a cell outside the marker. Seven positions
+  // per side (one corner, and opposite each code cell).
+  constexpr int kRing = 28;
+  cv::Point3d black[kRing], white[kRing];
+  float all[kRing + 36];
+  int ring = 0;
+  const double band = border * 0.5, outside = -cell * 0.5;
+  for (int k = 0; k < 7; ++k) {
+    const double t = k == 0 ? band : border + cell * (k - 0.5);
+    const double along[4][2] = {{t, band}, {1.0 - band, t}, {1.0 - t, 1.0 - band}, {band, 1.0 - t}};
+    const double out[4][2] = {{t, outside}, {1.0 - outside, t}, {1.0 - t, 1.0 - outside},
+                              {outside, 1.0 - t}};
+    for (int s = 0; s < 4; ++s) {
+      const float b = sampleArea(sample, map, along[s][0], along[s][1], spread * 0.5);
+      black[ring] = {along[s][0], along[s][1], b};
+      all[ring] = b;
+      const cv::Point2f w = map(out[s][0], out[s][1]);
+      white[ring] = {out[s][0], out[s][1], sample(w.x, w.y)};
+      ++ring;
+    }
+  }
+  const Plane black_level = fitPlane(black, kRing), white_level = fitPlane(white, kRing);
+  out.contrast = static_cast<float>(white_level.at(0.5, 0.5) - black_level.at(0.5, 0.5));
+
+  out.lowest = 255.0f;
+  out.highest = 0.0f;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      const double u = border + cell * (c + 0.5), v = border + cell * (r + 0.5);
+      const float value = sampleArea(sample, map, u, v, spread);
+      out.cells[r * 6 + c] = value;
+      out.thresholds[r * 6 + c] = static_cast<float>(0.5 * (black_level.at(u, v) + white_level.at(u, v)));
+      out.lowest = std::min(out.lowest, value);
+      out.highest = std::max(out.highest, value);
+      all[kRing + r * 6 + c] = value;
+    }
+  }
+  for (const cv::Point3d& b : black) {
+    const double threshold = 0.5 * (black_level.at(b.x, b.y) + white_level.at(b.x, b.y));
+    out.border_light += b.z > threshold;
+  }
+  out.border_samples = kRing;
+  std::nth_element(all, all + (kRing + 36) / 2, all + kRing + 36);
+  out.median = all[(kRing + 36) / 2];
+  return out;
+}
+
+std::vector<float> sampleCodeArea(const cv::Mat& image, const Quad& quad, double border, int n) {
+  const SquareToQuad map(quad.corners);
+  const BilinearSampler sample(image, regionOf(map, 0.0, 1.0));
+  const double cell = (1.0 - 2.0 * border) / n;
+  std::vector<float> values(static_cast<size_t>(n) * n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) {
+      values[r * n + c] = sampleArea(sample, map, border + cell * (c + 0.5), border + cell * (r + 0.5),
+                                     cell * 0.25);
+    }
+  }
+  return values;
+}
+
+}  // namespace arbci::vision

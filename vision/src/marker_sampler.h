@@ -1,0 +1,45 @@
+// Private: pattern normalisation. The unit square (u right, v down; corner k of the quad at
+// (0,0), (1,0), (1,1), (0,1)) is mapped onto the image by the quad's homography, and the marker is
+// read in those coordinates: the 6x6 code cells, its black border and the white surround. Black
+// and white levels are planes fitted across the marker, so a cell's threshold follows a lighting
+// gradient.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "quad_fit.h"
+
+namespace arbci::vision {
+
+// Projective map of the unit square onto a quad (Heckbert's square-to-quad mapping).
+class SquareToQuad {
+ public:
+  explicit SquareToQuad(const std::array<cv::Point2f, 4>& corners);
+  cv::Point2f operator()(double u, double v) const;
+  // True when the square [low, high]^2 lies wholly on the finite side of the vanishing line.
+  bool finiteOn(double low, double high) const;
+
+ private:
+  double a_, b_, c_, d_, e_, f_, g_, h_;
+};
+
+struct MarkerSamples {
+  std::array<float, 36> cells{};       // mean intensity of each code cell, row-major
+  std::array<float, 36> thresholds{};  // the black/white midpoint at each cell
+  float contrast = 0;                  // white minus black level at the marker's centre
+  int border_samples = 0;
+  int border_light = 0;                // border samples lighter than their local threshold
+  float lowest = 0, highest = 0;       // extremes of the code cells
+  float median = 0;                    // median of the border and code samples
+};
+
+// `border` is the border width as a fraction of the side (0.125 thin, 0.25 standard).
+MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border);
+
+// An n x n grid of mean intensities over the code area [border, 1 - border]^2 (template patterns).
+std::vector<float> sampleCodeArea(const cv::Mat& image, const Quad& quad, double border, int n);
+
+}  // namespace arbci::vision

@@ -1,0 +1,302 @@
+#include "quad_fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "image_sampling.h"
+
+namespace arbci::vision {
+namespace {
+
+struct Line {
+  cv::Point2f point;      // a point on the line
+  cv::Point2f direction;  // unit length
+};
+
+float length(cv::Point2f v) { return std::sqrt(v.dot(v)); }
+
+// Index of the contour point in the forward arc (from, to) farthest from the chord from-to.
+int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, float& distance) {
+  const int n = static_cast<int>(contour.size());
+  const cv::Point a = contour[from];
+  const cv::Point2f chord = cv::Point2f(contour[to] - a);
+  const float chord_length = length(chord);
+  int best = -1;
+  float best_cross = 0.0f;
+  for (int i = (from + 1) % n; i != to; i = (i + 1) % n) {
+    const cv::Point2f p(contour[i] - a);
+    // |chord x p| is the distance times the chord's length (or the distance itself, when the
+    // chord is a single point).
+    const float cross = chord_length > 0.0f ? std::abs(chord.x * p.y - chord.y * p.x) : length(p);
+    if (cross > best_cross) {
+      best_cross = cross;
+      best = i;
+    }
+  }
+  distance = chord_length > 0.0f ? best_cross / chord_length : best_cross;
+  return best;
+}
+
+std::vector<int>& scratchIndices() {
+  thread_local std::vector<int> indices;
+  return indices;
+}
+
+// Of the candidate vertices (in contour order), the four spanning the largest area, in order.
+std::array<int, 4> largestQuadrilateral(const std::vector<cv::Point>& contour,
+                                        const std::vector<int>& candidates) {
+  const int m = static_cast<int>(candidates.size());
+  std::array<int, 4> best{candidates[0], candidates[1 % m], candidates[2 % m], candidates[3 % m]};
+  double best_area = -1.0;
+  auto twiceArea = [&](int a, int b, int c, int d) {
+    const cv::Point p[4] = {contour[a], contour[b], contour[c], contour[d]};
+    double area = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      area += static_cast<double>(p[k].x) * p[(k + 1) % 4].y - static_cast<double>(p[(k + 1) % 4].x) * p[k].y;
+    }
+    return std::abs(area);
+  };
+  for (int a = 0; a < m; ++a) {
+    for (int b = a + 1; b < m; ++b) {
+      for (int c = b + 1; c < m; ++c) {
+        for (int d = c + 1; d < m; ++d) {
+          const double area = twiceArea(candidates[a], candidates[b], candidates[c], candidates[d]);
+          if (area > best_area) {
+            best_area = area;
+            best = {candidates[a], candidates[b], candidates[c], candidates[d]};
+          }
+        }
+      }
+    }
+  }
+  // Keep corner 0 the one nearest the start of the candidate list (the ARToolKitPlus vertex).
+  const auto first = std::find(best.begin(), best.end(), candidates[0]);
+  if (first != best.end()) std::rotate(best.begin(), first, best.end());
+  return best;
+}
+
+std::vector<cv::Point2f>& scratchPoints() {
+  thread_local std::vector<cv::Point2f> points;
+  return points;
+}
+
+std::vector<float>& scratchWeights() {
+  thread_local std::vector<float> weights;
+  return weights;
+}
+
+// Appends, in contour order, the vertices of the forward arc (from, to) found by recursive
+// splitting; false once more than `limit` vertices are found (not a quadrilateral).
+bool splitArc(const std::vector<cv::Point>& contour, int from, int to, float tolerance, size_t limit,
+              std::vector<int>& vertices) {
+  float distance = 0.0f;
+  const int split = farthestFromChord(contour, from, to, distance);
+  if (split < 0 || distance <= tolerance) return true;
+  if (!splitArc(contour, from, split, tolerance, limit, vertices)) return false;
+  vertices.push_back(split);
+  if (vertices.size() > limit) return false;
+  return splitArc(contour, split, to, tolerance, limit, vertices);
+}
+
+// Weighted total-least-squares line through `count` points.
+std::optional<Line> fitLine(const cv::Point2f* points, const float* weights, int count) {
+  double sw = 0, sx = 0, sy = 0;
+  for (int i = 0; i < count; ++i) {
+    sw += weights[i];
+    sx += weights[i] * points[i].x;
+    sy += weights[i] * points[i].y;
+  }
+  if (count < 2 || sw <= 0) return std::nullopt;
+  const double mx = sx / sw, my = sy / sw;
+  double cxx = 0, cxy = 0, cyy = 0;
+  for (int i = 0; i < count; ++i) {
+    const double dx = points[i].x - mx, dy = points[i].y - my;
+    cxx += weights[i] * dx * dx;
+    cxy += weights[i] * dx * dy;
+    cyy += weights[i] * dy * dy;
+  }
+  // Principal axis of the 2x2 scatter matrix.
+  const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
+  return Line{cv::Point2f(static_cast<float>(mx), static_cast<float>(my)),
+              cv::Point2f(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)))};
+}
+
+std::optional<cv::Point2f> intersect(const Line& a, const Line& b) {
+  const float det = a.direction.x * b.direction.y - a.direction.y * b.direction.x;
+  if (std::abs(det) < 1e-6f) return std::nullopt;
+  const cv::Point2f d = b.point - a.point;
+  const float t = (d.x * b.direction.y - d.y * b.direction.x) / det;
+  return a.point + t * a.direction;
+}
+
+// Moves the side from `a` to `b` onto the image edge: at points along the side, the offset across
+// it (within +-radius px) where the intensity rises fastest (dark inside, light outside) is found
+// to sub-pixel precision by a parabola, and a line is fitted to those edge points weighted by the
+// rise.
+std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv::Point2f b,
+                               int radius) {
+  constexpr int kMaxSamples = 20, kMaxRadius = 4;
+  const cv::Point2f d = b - a;
+  const float length = std::sqrt(d.dot(d));
+  if (length < 4.0f) return std::nullopt;
+  radius = std::min(radius, kMaxRadius);
+  const cv::Point2f along = d / length;
+  const cv::Point2f outward(along.y, -along.x);  // clockwise on screen: the interior is right
+  const int samples = std::clamp(static_cast<int>(length / 2.5f), 5, kMaxSamples);
+  cv::Point2f points[kMaxSamples];
+  float weights[kMaxSamples];
+  int count = 0;
+  float profile[2 * kMaxRadius + 3], rise[2 * kMaxRadius + 1];
+  for (int s = 0; s < samples; ++s) {
+    // Stay clear of the corners, where the profile would cross the neighbouring side.
+    const float t = 0.2f + 0.6f * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
+    const cv::Point2f base = a + t * d;
+    for (int k = -radius - 1; k <= radius + 1; ++k) {
+      const cv::Point2f p = base + static_cast<float>(k) * outward;
+      profile[k + radius + 1] = sample(p.x, p.y);
+    }
+    int best = 0;
+    float best_rise = 0.0f;
+    for (int k = -radius; k <= radius; ++k) {
+      rise[k + radius] = profile[k + radius + 2] - profile[k + radius];
+      if (rise[k + radius] > best_rise) {
+        best_rise = rise[k + radius];
+        best = k;
+      }
+    }
+    if (best_rise <= 4.0f) continue;
+    float offset = static_cast<float>(best);
+    if (best > -radius && best < radius) {
+      const float left = rise[best + radius - 1], right = rise[best + radius + 1];
+      const float curvature = left - 2.0f * best_rise + right;
+      if (curvature < 0.0f) offset += 0.5f * (left - right) / curvature;
+    }
+    points[count] = base + offset * outward;
+    weights[count] = best_rise;
+    ++count;
+  }
+  if (count < 3) return std::nullopt;
+  return fitLine(points, weights, count);
+}
+
+}  // namespace
+
+std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel,
+                            const cv::Mat& image, const QuadFitParams& params) {
+  const int n = static_cast<int>(contour.size());
+  if (n < 8) return std::nullopt;
+  auto farthestFrom = [&](cv::Point2f from) {
+    int best = 0;
+    float best_distance = -1.0f;
+    for (int i = 0; i < n; ++i) {
+      const cv::Point2f d = cv::Point2f(contour[i]) - from;
+      const float distance = d.dot(d);
+      if (distance > best_distance) {
+        best_distance = distance;
+        best = i;
+      }
+    }
+    return best;
+  };
+  // Candidate vertices by recursive splitting at the point farthest from the chord (ARToolKit's
+  // method, with a fine tolerance so that rounded or chamfered corners still yield a vertex); the
+  // first is the point farthest from the first pixel, the next the point farthest from it. The
+  // corners are the four candidates spanning the largest quadrilateral, and every contour point
+  // must then lie close to its side.
+  float perimeter = 0.0f;
+  for (int i = 0; i < n; ++i) perimeter += length(cv::Point2f(contour[(i + 1) % n] - contour[i]));
+  const float side_estimate = perimeter / 4.0f;
+  std::vector<int>& candidates = scratchIndices();
+  const int first = farthestFrom(first_pixel);
+  const int second = farthestFrom(contour[first]);
+  constexpr size_t kMaxCandidates = 10;
+  float tolerance = std::max(1.0f, 0.03f * side_estimate);
+  for (int round = 0;; ++round) {
+    candidates.clear();
+    candidates.push_back(first);
+    bool few = splitArc(contour, first, second, tolerance, kMaxCandidates, candidates);
+    candidates.push_back(second);
+    few = few && splitArc(contour, second, first, tolerance, kMaxCandidates, candidates);
+    if (few && candidates.size() <= kMaxCandidates) break;
+    if (round == 2) return std::nullopt;  // too ragged to be a square
+    tolerance *= 2.0f;
+  }
+  if (candidates.size() < 4) return std::nullopt;
+  const std::array<int, 4> vertex = largestQuadrilateral(contour, candidates);
+  const float max_deviation = std::max(2.0f, params.max_side_deviation * side_estimate);
+  for (int k = 0; k < 4; ++k) {
+    float deviation = 0.0f;
+    farthestFromChord(contour, vertex[k], vertex[(k + 1) % 4], deviation);
+    if (deviation > max_deviation) return std::nullopt;
+  }
+
+  // Each side's contour must stay near its chord; fit a line to its inner part.
+  std::array<Line, 4> lines;
+  std::vector<cv::Point2f>& side_points = scratchPoints();
+  std::vector<float>& unit_weights = scratchWeights();
+  for (int k = 0; k < 4; ++k) {
+    const int from = vertex[k], to = vertex[(k + 1) % 4];
+    const cv::Point2f a = contour[from], b = contour[to];
+    if (length(b - a) < params.min_side) return std::nullopt;
+    const int count = (to - from + n) % n;
+    const int trim = std::max(1, count / 8);
+    side_points.clear();
+    for (int j = trim; j <= count - trim; ++j) side_points.push_back(contour[(from + j) % n]);
+    unit_weights.assign(side_points.size(), 1.0f);
+    const auto line = fitLine(side_points.data(), unit_weights.data(),
+                              static_cast<int>(side_points.size()));
+    if (!line || side_points.size() < 2) return std::nullopt;
+    lines[k] = *line;
+  }
+
+  Quad quad;
+  auto intersectAll = [&]() {
+    for (int k = 0; k < 4; ++k) {
+      const auto corner = intersect(lines[(k + 3) % 4], lines[k]);
+      if (!corner) return false;
+      quad.corners[k] = *corner;
+    }
+    return true;
+  };
+  if (!intersectAll()) return std::nullopt;
+  // Corners far from their contour vertices mean the sides were not straight lines.
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f d = quad.corners[k] - cv::Point2f(contour[vertex[k]]);
+    const float side = length(quad.corners[(k + 1) % 4] - quad.corners[k]);
+    if (length(d) > 2.0f + 0.25f * side) return std::nullopt;
+  }
+
+  if (params.refine_edges) {
+    // The search reaches at most a tenth of the smallest side across the edge (1..3 px).
+    float shortest = length(quad.corners[1] - quad.corners[0]);
+    for (int k = 1; k < 4; ++k) shortest = std::min(shortest, length(quad.corners[(k + 1) % 4] - quad.corners[k]));
+    const int reach = std::clamp(static_cast<int>(std::lround(0.1f * shortest)), 1, 3);
+    for (int radius : {reach, std::min(reach, 2)}) {
+      // Samples lie within radius + 1 px of the current sides.
+      const BilinearSampler sample(image, boundsOf(quad.corners, static_cast<float>(radius + 2)));
+      std::array<Line, 4> refined = lines;
+      for (int k = 0; k < 4; ++k) {
+        const auto line = refineSide(sample, quad.corners[k], quad.corners[(k + 1) % 4], radius);
+        if (line) refined[k] = *line;
+      }
+      lines = refined;
+      if (!intersectAll()) return std::nullopt;
+    }
+  }
+
+  // A marker is a convex quadrilateral with sides of a usable length.
+  float sign = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f e1 = quad.corners[(k + 1) % 4] - quad.corners[k];
+    const cv::Point2f e2 = quad.corners[(k + 2) % 4] - quad.corners[(k + 1) % 4];
+    if (length(e1) < params.min_side) return std::nullopt;
+    const float cross = e1.x * e2.y - e1.y * e2.x;
+    if (sign == 0.0f) sign = cross;
+    if (cross * sign <= 0.0f) return std::nullopt;
+  }
+  return quad;
+}
+
+}  // namespace arbci::vision

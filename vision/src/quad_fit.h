@@ -1,0 +1,32 @@
+// Private: from a traced contour to a quadrilateral with sub-pixel corners. Exactly four vertices
+// must come out of recursive splitting at the points farthest from the chords (the first is the
+// point farthest from the component's first pixel, as ARToolKitPlus); a line is fitted
+// to each side and then refined to the image's edge (the maximum of the intensity gradient across
+// it), and the corners are the refined lines' intersections.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+namespace arbci::vision {
+
+struct Quad {
+  // Clockwise on screen; corner 0 lies nearest the contour point farthest from the first pixel.
+  std::array<cv::Point2f, 4> corners;
+};
+
+struct QuadFitParams {
+  float min_side = 6.0f;          // px
+  // Contour points may stray this fraction of a side's length (at least 2 px) from the chord.
+  float max_side_deviation = 0.08f;
+  bool refine_edges = true;
+};
+
+std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel,
+                            const cv::Mat& image, const QuadFitParams& params);
+
+}  // namespace arbci::vision

@@ -1,0 +1,143 @@
+#include "run_labeling.h"
+
+#include <algorithm>
+#include <cstring>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
+namespace arbci::vision {
+void RunLabeler::label(const cv::Mat& image, const cv::Mat& limits) {
+  binarise(image, limits);
+  connect();
+  collect();
+}
+
+void RunLabeler::binarise(const cv::Mat& image, const cv::Mat& limits) {
+  CV_Assert(limits.type() == CV_8UC1 && limits.size() == image.size());
+  width_ = image.cols;
+  height_ = image.rows;
+  stride_ = width_ + 2;
+  mask_.assign(static_cast<size_t>(stride_) * (height_ + 2), 0);
+  runs_.clear();
+  row_begin_.assign(static_cast<size_t>(height_) + 1, 0);
+  const int words = (width_ + 63) / 64;
+  bits_.assign(static_cast<size_t>(words), 0);
+  for (int y = 0; y < height_; ++y) {
+    const std::uint8_t* pixels = image.ptr<std::uint8_t>(y);
+    std::uint8_t* mask = mask_.data() + static_cast<size_t>(y + 1) * stride_ + 1;
+    markDark(pixels, limits.ptr<std::uint8_t>(y), width_, mask, bits_.data());
+    row_begin_[y] = static_cast<int>(runs_.size());
+    appendRuns(bits_.data(), words, y);
+  }
+  row_begin_[height_] = static_cast<int>(runs_.size());
+}
+
+void RunLabeler::markDark(const std::uint8_t* pixels, const std::uint8_t* limit, int width,
+                          std::uint8_t* mask, std::uint64_t* bits) {
+  const int words = (width + 63) / 64;
+  std::fill_n(bits, words, 0);
+  int x = 0;
+#ifdef __SSE2__
+  const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi8(1);
+  for (; x + 16 <= width; x += 16) {
+    const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pixels + x));
+    const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(limit + x));
+    // limit - value saturates to 0 exactly when the pixel is not dark.
+    const __m128i light = _mm_cmpeq_epi8(_mm_subs_epu8(l, p), zero);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(mask + x), _mm_andnot_si128(light, one));
+    const std::uint64_t dark = ~static_cast<unsigned>(_mm_movemask_epi8(light)) & 0xFFFFu;
+    bits[x >> 6] |= dark << (x & 63);
+  }
+#endif
+  for (; x < width; ++x) {
+    const bool dark = pixels[x] < limit[x];
+    mask[x] = dark;
+    bits[x >> 6] |= static_cast<std::uint64_t>(dark) << (x & 63);
+  }
+}
+
+void RunLabeler::appendRuns(const std::uint64_t* bits, int words, int y) {
+  bool inside = false;
+  int start = 0;
+  for (int w = 0; w < words; ++w) {
+    const std::uint64_t word = bits[w];
+    if (word == (inside ? ~std::uint64_t{0} : std::uint64_t{0})) continue;
+    int position = 0;
+    while (position < 64) {
+      // Next change of state at or after `position`.
+      const std::uint64_t pending = (inside ? ~word : word) & (~std::uint64_t{0} << position);
+      if (pending == 0) break;
+      position = __builtin_ctzll(pending);
+      const int x = w * 64 + position;
+      if (inside) {
+        const int index = static_cast<int>(runs_.size());
+        runs_.push_back({start, x, y, index});
+      } else {
+        start = x;
+      }
+      inside = !inside;
+    }
+  }
+  if (inside) {
+    const int index = static_cast<int>(runs_.size());
+    runs_.push_back({start, width_, y, index});
+  }
+}
+
+int RunLabeler::find(int i) {
+  while (runs_[i].parent != i) {
+    runs_[i].parent = runs_[runs_[i].parent].parent;  // path halving
+    i = runs_[i].parent;
+  }
+  return i;
+}
+
+void RunLabeler::connect() {
+  for (int y = 1; y < height_; ++y) {
+    int i = row_begin_[y - 1];
+    const int i_end = row_begin_[y];
+    int j = row_begin_[y];
+    const int j_end = row_begin_[y + 1];
+    while (i < i_end && j < j_end) {
+      const PixelRun& above = runs_[i];
+      const PixelRun& here = runs_[j];
+      // 8-connected when the runs overlap or touch diagonally.
+      if (above.x0 <= here.x1 && here.x0 <= above.x1) {
+        const int a = find(i), b = find(j);
+        // The smaller index becomes the root, so a root is its component's first run.
+        if (a < b) {
+          runs_[b].parent = a;
+        } else if (b < a) {
+          runs_[a].parent = b;
+        }
+      }
+      if (above.x1 < here.x1) {
+        ++i;
+      } else {
+        ++j;
+      }
+    }
+  }
+}
+
+void RunLabeler::collect() {
+  components_.clear();
+  component_of_root_.assign(runs_.size(), -1);
+  for (int i = 0; i < static_cast<int>(runs_.size()); ++i) {
+    const int root = find(i);
+    const PixelRun& run = runs_[i];
+    if (root == i) {
+      component_of_root_[i] = static_cast<int>(components_.size());
+      components_.push_back({0, run.x0, run.x1 - 1, run.y, run.y, run.x0, run.y});
+    }
+    DarkComponent& component = components_[component_of_root_[root]];
+    component.area += run.x1 - run.x0;
+    component.min_x = std::min(component.min_x, run.x0);
+    component.max_x = std::max(component.max_x, run.x1 - 1);
+    component.max_y = run.y;  // rows arrive in order
+  }
+}
+
+}  // namespace arbci::vision

@@ -1,0 +1,11 @@
+// Private: a 3x3 binomial blur ([1 2 1] / 4 in each direction) of an 8-bit image, used before
+// binarisation and edge refinement to suppress sensor noise without moving edges.
+#pragma once
+
+#include <opencv2/core/mat.hpp>
+
+namespace arbci::vision {
+
+void smoothBinomial3(const cv::Mat& src, cv::Mat& dst);
+
+}  // namespace arbci::vision

@@ -1,0 +1,60 @@
+// Private: a threshold per 4x4-pixel tile. Global modes fill it with one value (plus the
+// vignetting offsets); the adaptive mode takes the midrange of the tile's 12 px neighbourhood
+// where it has contrast above the noise, and makes flat tiles wholly dark or light against the
+// nearest coarser neighbourhood (up to 192 px) that has contrast.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "arbci/vision/threshold.h"
+
+namespace arbci::vision {
+
+struct TileThresholds {
+  static constexpr int kTile = 4;
+  int cols = 0;
+  int rows = 0;
+  // A pixel is dark when its value is below the tile's limit (threshold + 1; 0 = never dark).
+  std::vector<std::uint8_t> limit;
+
+  std::uint8_t at(int tile_x, int tile_y) const { return limit[tile_y * cols + tile_x]; }
+  // The median threshold over tiles that have one (for reporting).
+  int median() const;
+};
+
+// The per-pixel limits (CV_8U, the image's size): tile values interpolated bilinearly between
+// tile centres, so that the threshold surface has no steps at tile borders.
+void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits);
+
+void fillGlobalThresholds(cv::Size image, int threshold, const std::optional<Vignetting>& vignetting,
+                          TileThresholds& out);
+
+// Computes adaptive tile thresholds; keeps its pyramids between frames to avoid allocation.
+class AdaptiveThresholder {
+ public:
+  // `min_contrast` in grey levels of `smoothed`.
+  void fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out);
+
+ private:
+  struct MinMaxGrid {
+    int cols = 0, rows = 0;
+    std::vector<std::uint8_t> lo, hi;
+    void resize(int c, int r);
+  };
+  static constexpr int kLevels = 5;  // tiles of 4, 8, 16, 32 and 64 px
+  std::array<MinMaxGrid, kLevels> raw_, dilated_;
+  MinMaxGrid scratch_;
+  std::vector<std::uint8_t> column_lo_, column_hi_;
+  std::array<std::vector<std::uint8_t>, kLevels> coarse_;  // per coarse cell: threshold + 1, or 0
+};
+
+// Standard deviation of the image noise (grey levels), from the median response of a Laplacian
+// mask on a subsample (robust to edges), for choosing the adaptive contrast floor.
+double estimateNoiseSigma(const cv::Mat& gray);
+
+}  // namespace arbci::vision
