@@ -83,6 +83,24 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled, const std::array<
   return CodeDecode{best.id, best.turns, best.disagreements, confidence};
 }
 
+// The cells as fractions between their local black (0) and white (1) levels, with an unsharp mask
+// over the 4-neighbours (the border around the code is black): a lone white cell that blur has
+// dimmed below half is lifted back above it, a lone black cell pushed down.
+std::array<float, 36> sharpenedLevels(const MarkerSamples& samples) {
+  std::array<float, 36> level{}, sharp{};
+  const float half_contrast = std::max(1.0f, samples.contrast * 0.5f);
+  for (int i = 0; i < 36; ++i) level[i] = 0.5f + (samples.cells[i] - samples.thresholds[i]) / (2.0f * half_contrast);
+  constexpr float kAmount = 1.0f;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      auto at = [&](int rr, int cc) { return rr < 0 || rr > 5 || cc < 0 || cc > 5 ? 0.0f : level[rr * 6 + cc]; };
+      const float around = 0.25f * (at(r - 1, c) + at(r + 1, c) + at(r, c - 1) + at(r, c + 1));
+      sharp[r * 6 + c] = level[r * 6 + c] + kAmount * (level[r * 6 + c] - around);
+    }
+  }
+  return sharp;
+}
+
 }  // namespace
 
 std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& samples,
@@ -98,7 +116,21 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   const std::optional<CodeDecode> hard = hardDecode(kind, sampled, ambiguous);
   if (hard && !ambiguous) return hard;
   if (ambiguous || kind != MarkerKind::Bch || !soft_decoding) return std::nullopt;
-  return chaseDecode(sampled, reliability);
+  // Blur: read the sharpened cells, then Chase-decode the plain and the sharpened reading.
+  const std::array<float, 36> sharp = sharpenedLevels(samples);
+  CodeGrid sharpened{};
+  std::array<float, 36> sharp_reliability{};
+  for (int i = 0; i < 36; ++i) {
+    sharpened[i] = sharp[i] > 0.5f;
+    sharp_reliability[i] = std::abs(sharp[i] - 0.5f) * 2.0f;
+  }
+  if (sharpened != sampled) {
+    const std::optional<CodeDecode> again = hardDecode(kind, sharpened, ambiguous);
+    if (again && !ambiguous) return CodeDecode{again->id, again->orientation, again->corrected_bits,
+                                               again->confidence * 0.9f};
+  }
+  if (auto chase = chaseDecode(sampled, reliability)) return chase;
+  return chaseDecode(sharpened, sharp_reliability);
 }
 
 }  // namespace arbci::vision

@@ -21,6 +21,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kSmoothAboveNoise = 2.5;  // grey levels of estimated noise
+constexpr size_t kMaxRetries = 12;          // near-miss components re-binarised per frame
+constexpr int kMaxRetrySide = 160;          // px; larger borders are not thinned by blur
+constexpr int kRetryMargin = 14;             // px around a near miss
+constexpr int kRetrySplit = 9;              // sixteenths: a darker split than the usual 7
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
@@ -86,6 +90,9 @@ struct MarkerDetector::Impl {
   RunLabeler labels;
   std::vector<cv::Point> contour;
   std::vector<Quad> quads;
+  std::vector<cv::Rect> near_misses;  // marker-sized components that did not fit a quad
+  RunLabeler roi_labels;
+  cv::Mat roi_limits;
   std::vector<SquareCorners> squares;
 
   explicit Impl(DetectorConfig c) : config(std::move(c)) {
@@ -141,17 +148,68 @@ struct MarkerDetector::Impl {
     const int min_area = std::max(12, static_cast<int>(0.2f * min_side * min_side));
     QuadFitParams params;
     params.min_side = min_side;
+    near_misses.clear();
+    const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
     for (const DarkComponent& c : labels.components()) {
       if (c.area < min_area || c.touchesBorder(width, height)) continue;
       const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
       if (std::max(w, h) < min_side || std::min(w, h) < 3) continue;
       const int max_length = 4 * (w + h) + 64;
       if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
-      if (auto quad = fitQuad(contour, {c.first_x, c.first_y}, *binarised, params)) {
-        quads.push_back(*quad);
+      const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *binarised, params);
+      if (fit.quad) {
+        quads.push_back(*fit.quad);
+      } else if (adaptive_mode && std::min(w, h) >= min_side * 0.5f && std::max(w, h) <= kMaxRetrySide) {
+        if (fit.hull_is_quadrilateral) near_misses.emplace_back(c.min_x, c.min_y, w, h);
       }
     }
+    if (near_misses.size() > kMaxRetries) near_misses.resize(kMaxRetries);
+    if (adaptive_mode) retryNearMisses(params);
     time.quads += microseconds(start, Clock::now());
+  }
+
+  // A small marker whose thin border blur has broken at the usual threshold often closes when
+  // its neighbourhood is binarised again with a darker split; a thin, steeply tilted one that
+  // smoothing has erased survives in the unsmoothed image.
+  void retryNearMisses(const QuadFitParams& params) {
+    const cv::Rect image(0, 0, gray.cols, gray.rows);
+    for (cv::Rect roi : near_misses) {
+      roi.x -= kRetryMargin;
+      roi.y -= kRetryMargin;
+      roi.width += 2 * kRetryMargin;
+      roi.height += 2 * kRetryMargin;
+      roi &= image;
+      if (retryRegion(roi, *binarised, kRetrySplit, params)) continue;
+      if (binarised != &gray) retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
+    }
+  }
+
+  // Binarises `roi` of `source` with edge tiles split at `split` sixteenths; adds the new quads.
+  bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split, const QuadFitParams& params) {
+    const cv::Mat patch = source(roi);
+    adaptive.roiLimits(roi, split, roi_limits);
+    roi_labels.label(patch, roi_limits);
+    bool added = false;
+    for (const DarkComponent& c : roi_labels.components()) {
+      const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
+      if (c.touchesBorder(roi.width, roi.height) || std::max(w, h) < params.min_side ||
+          std::min(w, h) < params.min_side * 0.5f) {
+        continue;
+      }
+      if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour)) continue;
+      auto quad = fitQuad(contour, {c.first_x, c.first_y}, patch, params).quad;
+      if (!quad) continue;
+      for (cv::Point2f& p : quad->corners) p += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      bool known = false;  // already found, from the frame or an earlier retry
+      for (size_t q = 0; q < quads.size() && !known; ++q) {
+        known = insideConvex(quads[q].corners, centre(quad->corners));
+      }
+      if (!known) {
+        quads.push_back(*quad);
+        added = true;
+      }
+    }
+    return added;
   }
 
   // Decodes every quad; returns the samples' extremes and the first marker's median for the

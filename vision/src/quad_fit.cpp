@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
@@ -21,21 +22,35 @@ float length(cv::Point2f v) { return std::sqrt(v.dot(v)); }
 int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, float& distance) {
   const int n = static_cast<int>(contour.size());
   const cv::Point a = contour[from];
-  const cv::Point2f chord = cv::Point2f(contour[to] - a);
-  const float chord_length = length(chord);
+  const cv::Point chord = contour[to] - a;
+  const bool point_chord = chord.x == 0 && chord.y == 0;
   int best = -1;
-  float best_cross = 0.0f;
-  for (int i = (from + 1) % n; i != to; i = (i + 1) % n) {
-    const cv::Point2f p(contour[i] - a);
-    // |chord x p| is the distance times the chord's length (or the distance itself, when the
-    // chord is a single point).
-    const float cross = chord_length > 0.0f ? std::abs(chord.x * p.y - chord.y * p.x) : length(p);
-    if (cross > best_cross) {
-      best_cross = cross;
+  std::int64_t best_measure = -1;
+  // |chord x p| is the distance times the chord's length (exact in integers); for a chord of one
+  // point, the squared distance.
+  auto visit = [&](int i) {
+    const cv::Point p = contour[i] - a;
+    const std::int64_t measure =
+        point_chord ? static_cast<std::int64_t>(p.x) * p.x + static_cast<std::int64_t>(p.y) * p.y
+                    : std::abs(static_cast<std::int64_t>(chord.x) * p.y - static_cast<std::int64_t>(chord.y) * p.x);
+    if (measure > best_measure) {
+      best_measure = measure;
       best = i;
     }
+  };
+  if (from < to) {
+    for (int i = from + 1; i < to; ++i) visit(i);
+  } else {
+    for (int i = from + 1; i < n; ++i) visit(i);
+    for (int i = 0; i < to; ++i) visit(i);
   }
-  distance = chord_length > 0.0f ? best_cross / chord_length : best_cross;
+  if (best < 0) {
+    distance = 0.0f;
+  } else if (point_chord) {
+    distance = std::sqrt(static_cast<float>(best_measure));
+  } else {
+    distance = static_cast<float>(best_measure) / length(cv::Point2f(chord));
+  }
   return best;
 }
 
@@ -75,6 +90,16 @@ std::array<int, 4> largestQuadrilateral(const std::vector<cv::Point>& contour,
   const auto first = std::find(best.begin(), best.end(), candidates[0]);
   if (first != best.end()) std::rotate(best.begin(), first, best.end());
   return best;
+}
+
+std::vector<int>& scratchHullIndices() {
+  thread_local std::vector<int> indices;
+  return indices;
+}
+
+std::vector<cv::Point>& scratchHull() {
+  thread_local std::vector<cv::Point> hull;
+  return hull;
 }
 
 std::vector<cv::Point2f>& scratchPoints() {
@@ -181,73 +206,157 @@ std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv:
   return fitLine(points, weights, count);
 }
 
-}  // namespace
-
-std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel,
-                            const cv::Mat& image, const QuadFitParams& params) {
-  const int n = static_cast<int>(contour.size());
-  if (n < 8) return std::nullopt;
-  auto farthestFrom = [&](cv::Point2f from) {
-    int best = 0;
-    float best_distance = -1.0f;
-    for (int i = 0; i < n; ++i) {
-      const cv::Point2f d = cv::Point2f(contour[i]) - from;
-      const float distance = d.dot(d);
-      if (distance > best_distance) {
-        best_distance = distance;
-        best = i;
-      }
+// Indices into `outline` (a closed polygon, clockwise) of the corners of the quadrilateral it
+// outlines. Candidate vertices come from recursive splitting at the point farthest from the chord
+// (ARToolKit's method, with a fine tolerance so that rounded or chamfered corners still yield a
+// vertex), starting from `first` and the point farthest from it; the corners are the four
+// candidates spanning the largest area, and every outline point must lie close to its side.
+std::optional<std::array<int, 4>> quadVertices(const std::vector<cv::Point>& outline, int first,
+                                               float side_estimate, float max_side_deviation) {
+  const int n = static_cast<int>(outline.size());
+  if (n < 4) return std::nullopt;
+  int second = first;
+  float farthest = -1.0f;
+  for (int i = 0; i < n; ++i) {
+    const cv::Point2f d(outline[i] - outline[first]);
+    if (d.dot(d) > farthest) {
+      farthest = d.dot(d);
+      second = i;
     }
-    return best;
-  };
-  // Candidate vertices by recursive splitting at the point farthest from the chord (ARToolKit's
-  // method, with a fine tolerance so that rounded or chamfered corners still yield a vertex); the
-  // first is the point farthest from the first pixel, the next the point farthest from it. The
-  // corners are the four candidates spanning the largest quadrilateral, and every contour point
-  // must then lie close to its side.
-  float perimeter = 0.0f;
-  for (int i = 0; i < n; ++i) perimeter += length(cv::Point2f(contour[(i + 1) % n] - contour[i]));
-  const float side_estimate = perimeter / 4.0f;
+  }
   std::vector<int>& candidates = scratchIndices();
-  const int first = farthestFrom(first_pixel);
-  const int second = farthestFrom(contour[first]);
   constexpr size_t kMaxCandidates = 10;
   float tolerance = std::max(1.0f, 0.03f * side_estimate);
   for (int round = 0;; ++round) {
     candidates.clear();
     candidates.push_back(first);
-    bool few = splitArc(contour, first, second, tolerance, kMaxCandidates, candidates);
+    bool few = splitArc(outline, first, second, tolerance, kMaxCandidates, candidates);
     candidates.push_back(second);
-    few = few && splitArc(contour, second, first, tolerance, kMaxCandidates, candidates);
+    few = few && splitArc(outline, second, first, tolerance, kMaxCandidates, candidates);
     if (few && candidates.size() <= kMaxCandidates) break;
     if (round == 2) return std::nullopt;  // too ragged to be a square
     tolerance *= 2.0f;
   }
   if (candidates.size() < 4) return std::nullopt;
-  const std::array<int, 4> vertex = largestQuadrilateral(contour, candidates);
+  const std::array<int, 4> vertex = largestQuadrilateral(outline, candidates);
+  const float max_deviation = std::max(2.0f, max_side_deviation * side_estimate);
+  for (int k = 0; k < 4; ++k) {
+    float deviation = 0.0f;
+    farthestFromChord(outline, vertex[k], vertex[(k + 1) % 4], deviation);
+    if (deviation > max_deviation) return std::nullopt;
+  }
+  return vertex;
+}
+
+// The convex hull of a contour as contour indices, clockwise on screen. Only the leftmost and
+// rightmost contour point of each row can be a hull vertex, and they come sorted by row, so
+// Andrew's monotone chain runs in time linear in the contour (no sort).
+void convexHullOfContour(const std::vector<cv::Point>& contour, std::vector<int>& hull) {
+  int y0 = contour[0].y, y1 = y0;
+  for (const cv::Point& p : contour) {
+    y0 = std::min(y0, p.y);
+    y1 = std::max(y1, p.y);
+  }
+  const int rows = y1 - y0 + 1;
+  thread_local std::vector<int> left, right, order;
+  left.assign(static_cast<size_t>(rows), -1);
+  right.assign(static_cast<size_t>(rows), -1);
+  for (int i = 0; i < static_cast<int>(contour.size()); ++i) {
+    const int r = contour[i].y - y0;
+    if (left[r] < 0 || contour[i].x < contour[left[r]].x) left[r] = i;
+    if (right[r] < 0 || contour[i].x > contour[right[r]].x) right[r] = i;
+  }
+  order.clear();  // sorted by (y, x)
+  for (int r = 0; r < rows; ++r) {
+    if (left[r] < 0) continue;
+    order.push_back(left[r]);
+    if (contour[right[r]].x != contour[left[r]].x) order.push_back(right[r]);
+  }
+  auto cross = [&](int o, int a, int b) {
+    const cv::Point oa = contour[a] - contour[o], ob = contour[b] - contour[o];
+    return static_cast<std::int64_t>(oa.x) * ob.y - static_cast<std::int64_t>(oa.y) * ob.x;
+  };
+  // Monotone chain over points sorted by y: the right side going down, then the left going up,
+  // keeping only turns to the right on screen (clockwise with y pointing down).
+  hull.clear();
+  for (int i : order) {
+    while (hull.size() >= 2 && cross(hull[hull.size() - 2], hull.back(), i) <= 0) hull.pop_back();
+    hull.push_back(i);
+  }
+  const size_t right_side = hull.size() + 1;
+  for (int k = static_cast<int>(order.size()) - 2; k >= 0; --k) {
+    const int i = order[k];
+    while (hull.size() >= right_side && cross(hull[hull.size() - 2], hull.back(), i) <= 0) hull.pop_back();
+    hull.push_back(i);
+  }
+  hull.pop_back();  // the first point again
+}
+
+float perimeterOf(const std::vector<cv::Point>& outline) {
+  const int n = static_cast<int>(outline.size());
+  float perimeter = 0.0f;
+  for (int i = 0; i < n; ++i) perimeter += length(cv::Point2f(outline[(i + 1) % n] - outline[i]));
+  return perimeter;
+}
+
+}  // namespace
+
+QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, const cv::Mat& image,
+                const QuadFitParams& params) {
+  QuadFit result;
+  const int n = static_cast<int>(contour.size());
+  if (n < 8) return result;
+  // Corners are looked for on the convex hull (a few dozen points, where a square's corners are
+  // plain); its vertices keep their contour indices.
+  std::vector<int>& hull_index = scratchHullIndices();
+  std::vector<cv::Point>& hull = scratchHull();
+  convexHullOfContour(contour, hull_index);
+  const int m = static_cast<int>(hull_index.size());
+  if (m < 4) return result;
+  hull.resize(static_cast<size_t>(m));
+  int first = 0;  // ARToolKitPlus's first vertex: farthest from the component's first pixel
+  float farthest = -1.0f;
+  for (int i = 0; i < m; ++i) {
+    hull[i] = contour[hull_index[i]];
+    const cv::Point2f d(hull[i] - first_pixel);
+    if (d.dot(d) > farthest) {
+      farthest = d.dot(d);
+      first = i;
+    }
+  }
+  const float side_estimate = perimeterOf(hull) / 4.0f;
+  const auto corners = quadVertices(hull, first, side_estimate, params.max_side_deviation);
+  if (!corners) return result;
+  result.hull_is_quadrilateral = true;
+  std::array<int, 4> vertex;
+  for (int k = 0; k < 4; ++k) vertex[k] = hull_index[(*corners)[k]];
+  // The contour must follow the hull's sides: the vertices in contour order, and no dent deeper
+  // than the tolerance (a broken border or a notch is not a square, though its hull is).
+  for (int k = 0; k < 4; ++k) {
+    const int step = (vertex[(k + 1) % 4] - vertex[k] + n) % n, next = (vertex[(k + 2) % 4] - vertex[k] + n) % n;
+    if (step == 0 || next <= step) return result;
+  }
   const float max_deviation = std::max(2.0f, params.max_side_deviation * side_estimate);
   for (int k = 0; k < 4; ++k) {
     float deviation = 0.0f;
     farthestFromChord(contour, vertex[k], vertex[(k + 1) % 4], deviation);
-    if (deviation > max_deviation) return std::nullopt;
+    if (deviation > max_deviation) return result;
   }
 
-  // Each side's contour must stay near its chord; fit a line to its inner part.
+  // A line through each side's contour arc, its ends trimmed.
   std::array<Line, 4> lines;
   std::vector<cv::Point2f>& side_points = scratchPoints();
   std::vector<float>& unit_weights = scratchWeights();
   for (int k = 0; k < 4; ++k) {
     const int from = vertex[k], to = vertex[(k + 1) % 4];
-    const cv::Point2f a = contour[from], b = contour[to];
-    if (length(b - a) < params.min_side) return std::nullopt;
+    if (length(cv::Point2f(contour[to] - contour[from])) < params.min_side) return result;
     const int count = (to - from + n) % n;
     const int trim = std::max(1, count / 8);
     side_points.clear();
     for (int j = trim; j <= count - trim; ++j) side_points.push_back(contour[(from + j) % n]);
     unit_weights.assign(side_points.size(), 1.0f);
-    const auto line = fitLine(side_points.data(), unit_weights.data(),
-                              static_cast<int>(side_points.size()));
-    if (!line || side_points.size() < 2) return std::nullopt;
+    const auto line = fitLine(side_points.data(), unit_weights.data(), static_cast<int>(side_points.size()));
+    if (!line || side_points.size() < 2) return result;
     lines[k] = *line;
   }
 
@@ -260,12 +369,12 @@ std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point fir
     }
     return true;
   };
-  if (!intersectAll()) return std::nullopt;
+  if (!intersectAll()) return result;
   // Corners far from their contour vertices mean the sides were not straight lines.
   for (int k = 0; k < 4; ++k) {
     const cv::Point2f d = quad.corners[k] - cv::Point2f(contour[vertex[k]]);
     const float side = length(quad.corners[(k + 1) % 4] - quad.corners[k]);
-    if (length(d) > 2.0f + 0.25f * side) return std::nullopt;
+    if (length(d) > 2.0f + 0.25f * side) return result;
   }
 
   if (params.refine_edges) {
@@ -282,7 +391,7 @@ std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point fir
         if (line) refined[k] = *line;
       }
       lines = refined;
-      if (!intersectAll()) return std::nullopt;
+      if (!intersectAll()) return result;
     }
   }
 
@@ -291,12 +400,13 @@ std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point fir
   for (int k = 0; k < 4; ++k) {
     const cv::Point2f e1 = quad.corners[(k + 1) % 4] - quad.corners[k];
     const cv::Point2f e2 = quad.corners[(k + 2) % 4] - quad.corners[(k + 1) % 4];
-    if (length(e1) < params.min_side) return std::nullopt;
+    if (length(e1) < params.min_side) return result;
     const float cross = e1.x * e2.y - e1.y * e2.x;
     if (sign == 0.0f) sign = cross;
-    if (cross * sign <= 0.0f) return std::nullopt;
+    if (cross * sign <= 0.0f) return result;
   }
-  return quad;
+  result.quad = quad;
+  return result;
 }
 
 }  // namespace arbci::vision

@@ -1,6 +1,7 @@
-// Private: from a traced contour to a quadrilateral with sub-pixel corners. Exactly four vertices
-// must come out of recursive splitting at the points farthest from the chords (the first is the
-// point farthest from the component's first pixel, as ARToolKitPlus); a line is fitted
+// Private: from a traced contour to a quadrilateral with sub-pixel corners. Four corners are
+// found on the contour's convex hull by recursive splitting at the points farthest from the
+// chords (the first is the one farthest from the component's first pixel, as ARToolKitPlus); the
+// contour must follow the hull between them; a line is fitted
 // to each side and then refined to the image's edge (the maximum of the intensity gradient across
 // it), and the corners are the refined lines' intersections.
 #pragma once
@@ -26,7 +27,14 @@ struct QuadFitParams {
   bool refine_edges = true;
 };
 
-std::optional<Quad> fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel,
-                            const cv::Mat& image, const QuadFitParams& params);
+struct QuadFit {
+  std::optional<Quad> quad;
+  // The contour's convex hull is a quadrilateral even if the contour is not: the outline of a
+  // square whose border is broken or dented (worth binarising again), rather than of clutter.
+  bool hull_is_quadrilateral = false;
+};
+
+QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, const cv::Mat& image,
+                const QuadFitParams& params);
 
 }  // namespace arbci::vision

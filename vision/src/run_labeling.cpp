@@ -19,7 +19,14 @@ void RunLabeler::binarise(const cv::Mat& image, const cv::Mat& limits) {
   width_ = image.cols;
   height_ = image.rows;
   stride_ = width_ + 2;
-  mask_.assign(static_cast<size_t>(stride_) * (height_ + 2), 0);
+  // Every interior byte is written below; only the one-pixel frame must be cleared.
+  mask_.resize(static_cast<size_t>(stride_) * (height_ + 2));
+  std::fill_n(mask_.begin(), stride_, 0);
+  std::fill_n(mask_.end() - stride_, stride_, 0);
+  for (int y = 1; y <= height_; ++y) {
+    mask_[static_cast<size_t>(y) * stride_] = 0;
+    mask_[static_cast<size_t>(y) * stride_ + stride_ - 1] = 0;
+  }
   runs_.clear();
   row_begin_.assign(static_cast<size_t>(height_) + 1, 0);
   const int words = (width_ + 63) / 64;

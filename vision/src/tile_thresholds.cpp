@@ -6,6 +6,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 namespace arbci::vision {
 namespace {
 
@@ -39,11 +43,60 @@ int TileThresholds::median() const {
   return 0;
 }
 
+namespace {
+
+// Pixel 4t + k lies between tile centres (4t + 1.5 is tile t's): k = 0, 1 towards tile t - 1,
+// k = 2, 3 towards tile t + 1, with these weights in eighths for the nearer and farther tile.
+constexpr int kNear[4] = {5, 7, 7, 5};
+constexpr int kFar[4] = {3, 1, 1, 3};
+
+// out = (w_near * near + w_far * far + 4) / 8, with w_near + w_far = 8.
+void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restrict far, int w_near,
+               int w_far, std::uint8_t* __restrict out, int n) {
+  int x = 0;
+#ifdef __SSE2__
+  const __m128i zero = _mm_setzero_si128(), four = _mm_set1_epi16(4);
+  const __m128i wn = _mm_set1_epi16(static_cast<short>(w_near)), wf = _mm_set1_epi16(static_cast<short>(w_far));
+  for (; x + 16 <= n; x += 16) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(near + x));
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(far + x));
+    const __m128i lo = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(a, zero), wn),
+                                                                 _mm_mullo_epi16(_mm_unpacklo_epi8(b, zero), wf)), four), 3);
+    const __m128i hi = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpackhi_epi8(a, zero), wn),
+                                                                 _mm_mullo_epi16(_mm_unpackhi_epi8(b, zero), wf)), four), 3);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x), _mm_packus_epi16(lo, hi));
+  }
+#endif
+  for (; x < n; ++x) out[x] = static_cast<std::uint8_t>((w_near * near[x] + w_far * far[x] + 4) >> 3);
+}
+
+}  // namespace
+
 void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits) {
-  const cv::Mat grid(tiles.rows, tiles.cols, CV_8UC1, const_cast<std::uint8_t*>(tiles.limit.data()));
-  // Tile t's centre is pixel 4t + 1.5, which is where INTER_LINEAR puts source sample t when
-  // scaling by 4; a partial last tile shifts this by under half a pixel.
-  cv::resize(grid, limits, image, 0, 0, cv::INTER_LINEAR);
+  const int tile = TileThresholds::kTile, cols = tiles.cols, rows = tiles.rows;
+  const int wide = cols * tile;
+  // Each tile row expanded along x first, then rows blended along y (own code rather than
+  // cv::resize, which would hand this small job to OpenCV's thread pool).
+  thread_local std::vector<std::uint8_t> expanded;
+  expanded.resize(static_cast<size_t>(rows) * wide);
+  for (int ty = 0; ty < rows; ++ty) {
+    const std::uint8_t* v = &tiles.limit[static_cast<size_t>(ty) * cols];
+    std::uint8_t* out = &expanded[static_cast<size_t>(ty) * wide];
+    for (int t = 0; t < cols; ++t) {
+      const int left = v[std::max(0, t - 1)], here = v[t], right = v[std::min(cols - 1, t + 1)];
+      out[4 * t + 0] = static_cast<std::uint8_t>((kNear[0] * here + kFar[0] * left + 4) >> 3);
+      out[4 * t + 1] = static_cast<std::uint8_t>((kNear[1] * here + kFar[1] * left + 4) >> 3);
+      out[4 * t + 2] = static_cast<std::uint8_t>((kNear[2] * here + kFar[2] * right + 4) >> 3);
+      out[4 * t + 3] = static_cast<std::uint8_t>((kNear[3] * here + kFar[3] * right + 4) >> 3);
+    }
+  }
+  limits.create(image, CV_8UC1);
+  for (int y = 0; y < image.height; ++y) {
+    const int t = y / tile, k = y % tile;
+    const int other = k < 2 ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
+    blendRows(&expanded[static_cast<size_t>(t) * wide], &expanded[static_cast<size_t>(other) * wide],
+              kNear[k], kFar[k], limits.ptr<std::uint8_t>(y), image.width);
+  }
 }
 
 void fillGlobalThresholds(cv::Size image, int threshold, const std::optional<Vignetting>& vignetting,
@@ -197,9 +250,11 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
       }
     }
   }
+  contrast_ = contrast;
   out.cols = base.cols;
   out.rows = base.rows;
   out.limit.assign(static_cast<size_t>(out.cols) * out.rows, 0);
+  // tileLimit() for every tile, row by row (kept inline: this loop runs over every tile).
   const int parent_cols = dilated_[1].cols;
   for (int ty = 0; ty < out.rows; ++ty) {
     const std::uint8_t* coarse = &coarse_[1][static_cast<size_t>(ty / 2) * parent_cols];
@@ -211,29 +266,61 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
     const std::uint8_t* own_hi = &base.hi[static_cast<size_t>(ty) * out.cols];
     std::uint8_t* limit = &out.limit[static_cast<size_t>(ty) * out.cols];
     for (int tx = 0; tx < out.cols; ++tx) {
-      const int lo = lo0[tx], hi = hi0[tx];
-      const int parent = coarse[tx / 2];
-      // A weak edge beside a strong one (grey table against a marker's white quiet zone) is not
-      // one to split at: such a tile is classified whole, like a flat one.
+      const int lo = lo0[tx], hi = hi0[tx], parent = coarse[tx / 2];
       const bool weak = 3 * (hi - lo) < hi1[tx / 2] - lo1[tx / 2];
       if (hi - lo >= contrast && !(weak && parent > 0)) {
-        limit[tx] = limitOf(lo + (hi - lo) * 7 / 16);
+        limit[tx] = limitOf(lo + (hi - lo) * kSplit / 16);
       } else if (parent > 0) {
-        const int own_level = (own_lo[tx] + own_hi[tx]) / 2;
-        limit[tx] = own_level < parent ? 255 : 0;  // all dark : all light
+        limit[tx] = (own_lo[tx] + own_hi[tx]) / 2 < parent ? 255 : 0;
       }
     }
   }
 }
 
+std::uint8_t AdaptiveThresholder::tileLimit(int tx, int ty, int split) const {
+  const MinMaxGrid& fine = dilated_[0];
+  const MinMaxGrid& middle = dilated_[1];
+  const size_t i = static_cast<size_t>(ty) * fine.cols + tx;
+  const size_t p = static_cast<size_t>(ty / 2) * middle.cols + tx / 2;
+  const int lo = fine.lo[i], hi = fine.hi[i];
+  const int parent = coarse_[1][p];
+  // A weak edge beside a strong one (grey table against a marker's white quiet zone) is not one
+  // to split at: such a tile is classified whole, like a flat one.
+  const bool weak = 3 * (hi - lo) < middle.hi[p] - middle.lo[p];
+  if (hi - lo >= contrast_ && !(weak && parent > 0)) return limitOf(lo + (hi - lo) * split / 16);
+  if (parent == 0) return 0;
+  const int own_level = (raw_[0].lo[i] + raw_[0].hi[i]) / 2;
+  return own_level < parent ? 255 : 0;  // all dark : all light
+}
+
+void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) const {
+  const int tile = TileThresholds::kTile, cols = dilated_[0].cols, rows = dilated_[0].rows;
+  // Tiles around the region (one more on each side for interpolation), resized exactly as the
+  // whole grid would be, then cropped.
+  const int tx0 = std::max(0, roi.x / tile - 1), ty0 = std::max(0, roi.y / tile - 1);
+  const int tx1 = std::min(cols - 1, (roi.x + roi.width - 1) / tile + 1);
+  const int ty1 = std::min(rows - 1, (roi.y + roi.height - 1) / tile + 1);
+  cv::Mat grid(ty1 - ty0 + 1, tx1 - tx0 + 1, CV_8UC1);
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    for (int tx = tx0; tx <= tx1; ++tx) grid.at<std::uint8_t>(ty - ty0, tx - tx0) = tileLimit(tx, ty, split);
+  }
+  TileThresholds part;
+  part.cols = grid.cols;
+  part.rows = grid.rows;
+  part.limit.assign(grid.datastart, grid.dataend);
+  cv::Mat expanded;
+  interpolateLimits(part, cv::Size(grid.cols * tile, grid.rows * tile), expanded);
+  expanded(cv::Rect(roi.x - tx0 * tile, roi.y - ty0 * tile, roi.width, roi.height)).copyTo(limits);
+}
+
 double estimateNoiseSigma(const cv::Mat& gray) {
   if (gray.cols < 3 || gray.rows < 3) return 0.0;
   // The mask [1 -2 1; -2 4 -2; 1 -2 1] cancels smooth image content and has norm 6 on white
-  // noise; the median of its absolute response over every 16th row and 2nd column is robust to
+  // noise; the median of its absolute response over every 24th row and 2nd column is robust to
   // the minority of pixels on edges.
   std::array<int, 1024> histogram{};
   int count = 0;
-  for (int y = 1; y + 1 < gray.rows; y += 16) {
+  for (int y = 1; y + 1 < gray.rows; y += 24) {
     const std::uint8_t* a = gray.ptr<std::uint8_t>(y - 1);
     const std::uint8_t* b = gray.ptr<std::uint8_t>(y);
     const std::uint8_t* c = gray.ptr<std::uint8_t>(y + 1);

@@ -39,6 +39,13 @@ class AdaptiveThresholder {
  public:
   // `min_contrast` in grey levels of `smoothed`.
   void fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out);
+  // After fill(): the per-pixel limits of `roi` with edge tiles split at `split` sixteenths of
+  // their range instead of the usual kSplit (a darker split closes borders thinned by blur).
+  void roiLimits(cv::Rect roi, int split, cv::Mat& limits) const;
+
+  // Where an edge tile's threshold sits between its minimum and maximum, in sixteenths: a little
+  // below the midrange, which keeps marker borders apart from their surroundings.
+  static constexpr int kSplit = 7;
 
  private:
   struct MinMaxGrid {
@@ -46,7 +53,10 @@ class AdaptiveThresholder {
     std::vector<std::uint8_t> lo, hi;
     void resize(int c, int r);
   };
+  std::uint8_t tileLimit(int tx, int ty, int split) const;
+
   static constexpr int kLevels = 5;  // tiles of 4, 8, 16, 32 and 64 px
+  int contrast_ = 8;
   std::array<MinMaxGrid, kLevels> raw_, dilated_;
   MinMaxGrid scratch_;
   std::vector<std::uint8_t> column_lo_, column_hi_;
