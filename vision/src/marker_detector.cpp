@@ -163,7 +163,12 @@ struct MarkerDetector::Impl {
         if (fit.hull_is_quadrilateral) near_misses.emplace_back(c.min_x, c.min_y, w, h);
       }
     }
-    if (near_misses.size() > kMaxRetries) near_misses.resize(kMaxRetries);
+    if (near_misses.size() > kMaxRetries) {
+      // The largest first: noise leaves many small near misses, markers are seldom the smallest.
+      std::partial_sort(near_misses.begin(), near_misses.begin() + kMaxRetries, near_misses.end(),
+                        [](const cv::Rect& a, const cv::Rect& b) { return a.area() > b.area(); });
+      near_misses.resize(kMaxRetries);
+    }
     if (adaptive_mode) retryNearMisses(params);
     time.quads += microseconds(start, Clock::now());
   }
