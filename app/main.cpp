@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   arbci::app::addGlInfoCommand(root, exit_code);
   arbci::app::addScreenshotCommand(root, exit_code);
+  arbci::app::addMarkerCommand(root, exit_code);
+  arbci::app::addDetectCommand(root, exit_code);
 
   try {
     root.parse(argc, argv);

@@ -8,6 +8,7 @@ find_package(OpenCV 4.6 REQUIRED COMPONENTS core imgproc imgcodecs calib3d video
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(OpenSSL REQUIRED)
+find_package(ZLIB REQUIRED)
 find_package(orocos_kdl REQUIRED)
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
 pkg_check_modules(BIOSIG REQUIRED IMPORTED_TARGET libbiosig)

@@ -8,5 +8,7 @@ namespace arbci::app {
 
 void addGlInfoCommand(CLI::App& root, int& exit_code);
 void addScreenshotCommand(CLI::App& root, int& exit_code);
+void addMarkerCommand(CLI::App& root, int& exit_code);
+void addDetectCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

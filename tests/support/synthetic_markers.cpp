@@ -200,17 +200,9 @@ std::string toString(Condition condition) {
 
 const std::vector<int>& usableIds(MarkerFamily family) {
   static const std::vector<int> bch = [] {
-    std::vector<vision::CodeWord> words(4096);
-    for (int id = 0; id < 4096; ++id) words[id] = vision::BchCode::encode(id);
     std::vector<int> ids;
-    for (int id = 0; id < 4096; ++id) {
-      int closest = 36;
-      for (int turns = 1; turns < 4; ++turns) {
-        const vision::CodeWord turned =
-            vision::gridToWord(vision::rotateClockwise(vision::wordToGrid(words[id]), turns));
-        for (vision::CodeWord other : words) closest = std::min(closest, __builtin_popcountll(turned ^ other));
-      }
-      if (closest >= 5) ids.push_back(id);
+    for (int id = 0; id <= vision::BchCode::kMaxId; ++id) {
+      if (vision::BchCode::rotationMargin(id) >= 5) ids.push_back(id);
     }
     return ids;
   }();

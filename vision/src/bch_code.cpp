@@ -73,4 +73,19 @@ std::optional<DecodedId> BchCode::decode(CodeWord word) {
   return DecodedId{id, corrected, 1.0f - 0.25f * static_cast<float>(corrected)};
 }
 
+int BchCode::rotationMargin(int id) {
+  static const std::vector<CodeWord> codewords = [] {
+    std::vector<CodeWord> words(kMaxId + 1);
+    for (int i = 0; i <= kMaxId; ++i) words[i] = encode(i);
+    return words;
+  }();
+  int margin = 36;
+  const CodeGrid grid = wordToGrid(encode(id));
+  for (int turns = 1; turns < 4; ++turns) {
+    const CodeWord turned = gridToWord(rotateClockwise(grid, turns));
+    for (CodeWord word : codewords) margin = std::min(margin, __builtin_popcountll(turned ^ word));
+  }
+  return margin;
+}
+
 }  // namespace arbci::vision

@@ -6,6 +6,8 @@
 #include <random>
 #include <stdexcept>
 
+#include <opencv2/imgproc.hpp>
+
 #include "code_decoder.h"
 #include "contour_trace.h"
 #include "dictionary_detector.h"
@@ -345,6 +347,10 @@ DetectionResult MarkerDetector::detect(const cv::Mat& image) {
   const auto start = Clock::now();
   if (image.type() == CV_8UC1) {
     impl_->gray = image;  // a view; never written
+  } else if (impl_->dictionary >= 0 && (image.type() == CV_8UC3 || image.type() == CV_8UC4)) {
+    // OpenCV's dictionaries are tuned on its own (BT.601) grey.
+    cv::cvtColor(image, impl_->converted, image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+    impl_->gray = impl_->converted;
   } else {
     toLuminance(image, impl_->converted);
     impl_->gray = impl_->converted;

@@ -170,13 +170,14 @@ std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv:
   const cv::Point2f along = d / length;
   const cv::Point2f outward(along.y, -along.x);  // clockwise on screen: the interior is right
   const int samples = std::clamp(static_cast<int>(length / 2.5f), 5, kMaxSamples);
+  const float end = std::min(0.3f, std::max(0.05f, (static_cast<float>(radius) + 1.0f) / length));
   cv::Point2f points[kMaxSamples];
   float weights[kMaxSamples];
   int count = 0;
   float profile[2 * kMaxRadius + 3], rise[2 * kMaxRadius + 1];
   for (int s = 0; s < samples; ++s) {
     // Stay clear of the corners, where the profile would cross the neighbouring side.
-    const float t = 0.2f + 0.6f * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
+    const float t = end + (1.0f - 2.0f * end) * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
     const cv::Point2f base = a + t * d;
     for (int k = -radius - 1; k <= radius + 1; ++k) {
       const cv::Point2f p = base + static_cast<float>(k) * outward;
@@ -192,11 +193,21 @@ std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv:
       }
     }
     if (best_rise <= 4.0f) continue;
+    // The edge: where the profile crosses the middle of its dark and light extremes, searched
+    // outward from the steepest rise (linear interpolation between samples).
+    float lo = profile[0], hi = profile[0];
+    for (int k = 0; k < 2 * radius + 3; ++k) {
+      lo = std::min(lo, profile[k]);
+      hi = std::max(hi, profile[k]);
+    }
+    const float middle = 0.5f * (lo + hi);
     float offset = static_cast<float>(best);
-    if (best > -radius && best < radius) {
-      const float left = rise[best + radius - 1], right = rise[best + radius + 1];
-      const float curvature = left - 2.0f * best_rise + right;
-      if (curvature < 0.0f) offset += 0.5f * (left - right) / curvature;
+    for (int k = -radius - 1; k <= radius; ++k) {
+      const float a = profile[k + radius + 1], b = profile[k + radius + 2];
+      if (a <= middle && b > middle && std::abs(static_cast<float>(k) + 0.5f - static_cast<float>(best)) <= 1.5f) {
+        offset = static_cast<float>(k) + (middle - a) / (b - a);
+        break;
+      }
     }
     points[count] = base + offset * outward;
     weights[count] = best_rise;

@@ -45,6 +45,10 @@ class BchCode {
   // Syndrome decoding; nullopt when more than two bits are wrong (the word is not within
   // distance 2 of a codeword).
   static std::optional<DecodedId> decode(CodeWord word);
+  // The fewest bits by which a quarter, half or three-quarter turn of `id`'s marker differs from
+  // any codeword. Below 5, a few misread cells can decode the turned marker as another id
+  // (ARToolKitPlus's notes list 1550/3080, 2098/2492, 2522/3192 among 60 such ids).
+  static int rotationMargin(int id);
 };
 
 }  // namespace arbci::vision

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,5 +74,13 @@ class MarkerDetector {
 
 // The OpenCV predefined dictionary names accepted for the ArUco and AprilTag kinds.
 std::vector<std::string> dictionaryNames();
+
+}  // namespace arbci::vision
+
+namespace arbci::vision {
+
+// A template pattern from an image of one marker seen face-on and upright: the largest dark
+// square's code area (inside `border`) sampled on a 16x16 grid; nullopt when no square is found.
+std::optional<TemplatePattern> trainTemplate(const cv::Mat& image, int id, double border);
 
 }  // namespace arbci::vision

@@ -1,0 +1,228 @@
+// `arbci detect`: markers in image files, a video file or a camera; one JSON object per frame on
+// one line (stdout); errors for unreadable inputs on stderr, the rest still processed.
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include <opencv2/imgproc.hpp>
+
+#include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_tracker.h"
+#include "commands/commands.h"
+#include "support/cli_error.h"
+#include "support/detection_json.h"
+#include "support/frame_source.h"
+#include "support/png.h"
+
+namespace arbci::app {
+namespace {
+
+struct DetectOptions {
+  std::vector<std::string> inputs;
+  std::string video;
+  int device = -1;
+  int frames = 0;
+  std::string raw;
+  std::string kind = "bch";
+  double border = 0.0;  // 0: the kind's usual border
+  std::string threshold = "adaptive";
+  std::string vignetting;
+  std::string dictionary;
+  std::vector<std::string> patterns;
+  bool track = false;
+  int repeat = 1;
+  std::string annotate;
+};
+
+vision::ThresholdSettings parseThreshold(const DetectOptions& options) {
+  vision::ThresholdSettings settings;
+  try {
+    size_t used = 0;
+    const int value = std::stoi(options.threshold, &used);
+    if (used != options.threshold.size() || value < 0 || value > 255) throw std::invalid_argument("");
+    settings.mode = vision::ThresholdMode::Constant;
+    settings.value = value;
+  } catch (const std::exception&) {
+    try {
+      settings.mode = vision::thresholdModeFromString(options.threshold);
+    } catch (const std::invalid_argument&) {
+      throw CliError("--threshold must be 0..255, adaptive, auto-median or auto-midrange, got '" +
+                     options.threshold + "'");
+    }
+  }
+  if (!options.vignetting.empty()) {
+    vision::Vignetting v;
+    char c1 = 0, c2 = 0;
+    std::istringstream in(options.vignetting);
+    if (!(in >> v.corners >> c1 >> v.left_right >> c2 >> v.top_bottom) || c1 != ',' || c2 != ',') {
+      throw CliError("--vignetting must be CORNERS,LEFTRIGHT,TOPBOTTOM offsets, got '" + options.vignetting + "'");
+    }
+    if (settings.mode == vision::ThresholdMode::Adaptive) {
+      throw CliError("--vignetting applies to constant and automatic thresholds, not adaptive");
+    }
+    settings.vignetting = v;
+  }
+  return settings;
+}
+
+vision::DetectorConfig makeConfig(const DetectOptions& options) {
+  vision::DetectorConfig config;
+  try {
+    config.kind = vision::markerKindFromString(options.kind);
+  } catch (const std::invalid_argument& error) {
+    throw CliError(error.what());
+  }
+  config.border = options.border > 0.0 ? options.border : config.kind == vision::MarkerKind::Bch ? 0.125 : 0.25;
+  config.threshold = parseThreshold(options);
+  config.dictionary = options.dictionary;
+  for (size_t i = 0; i < options.patterns.size(); ++i) {
+    // ID=FILE or FILE (ids count from 0 in the order given).
+    const std::string& spec = options.patterns[i];
+    const size_t equals = spec.find('=');
+    int id = static_cast<int>(i);
+    std::string file = spec;
+    if (equals != std::string::npos) {
+      try {
+        id = std::stoi(spec.substr(0, equals));
+      } catch (const std::exception&) {
+        throw CliError("--pattern must be FILE or ID=FILE, got '" + spec + "'");
+      }
+      file = spec.substr(equals + 1);
+    }
+    try {
+      config.templates.push_back(vision::TemplatePattern::load(file, id));
+    } catch (const std::runtime_error& error) {
+      throw CliError(error.what());
+    }
+  }
+  return config;
+}
+
+void annotate(const std::filesystem::path& folder, const Frame& frame, const std::vector<vision::MarkerDetection>& markers) {
+  cv::Mat canvas;
+  if (frame.image.channels() == 1) {
+    cv::cvtColor(frame.image, canvas, cv::COLOR_GRAY2BGR);
+  } else if (frame.image.channels() == 4) {
+    cv::cvtColor(frame.image, canvas, cv::COLOR_BGRA2BGR);
+  } else {
+    canvas = frame.image.clone();
+  }
+  const int thickness = std::max(1, canvas.cols / 640);
+  for (const vision::MarkerDetection& m : markers) {
+    std::vector<cv::Point> outline;
+    for (const cv::Point2f& p : m.corners) outline.emplace_back(cvRound(p.x), cvRound(p.y));
+    cv::polylines(canvas, outline, true, m.from_history ? cv::Scalar(0, 200, 255) : cv::Scalar(0, 220, 0),
+                  thickness, cv::LINE_AA);
+    cv::circle(canvas, outline[0], 3 * thickness, cv::Scalar(0, 0, 255), cv::FILLED);  // top-left
+    cv::putText(canvas, std::to_string(m.id), outline[0] + cv::Point(4, -4), cv::FONT_HERSHEY_SIMPLEX,
+                0.5 * thickness, cv::Scalar(255, 0, 0), thickness, cv::LINE_AA);
+  }
+  const std::string stem = std::filesystem::path(frame.name).stem().string();
+  writePng(folder / (stem.empty() ? frame.name : stem + ".png"), canvas);
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values.empty() ? 0.0 : values[values.size() / 2];
+}
+
+int runDetect(const DetectOptions& options) {
+  const int sources = (!options.inputs.empty()) + (!options.video.empty()) + (options.device >= 0);
+  if (sources != 1) throw CliError("give image files, or --video FILE, or --device N (exactly one)");
+  vision::MarkerDetector detector = [&] {
+    try {
+      return vision::MarkerDetector(makeConfig(options));
+    } catch (const std::invalid_argument& error) {
+      throw CliError(error.what());
+    }
+  }();
+  std::unique_ptr<FrameSource> source;
+  if (!options.inputs.empty()) {
+    std::optional<RawFormat> raw;
+    if (!options.raw.empty()) raw = parseRawFormat(options.raw);
+    source = imageFiles(options.inputs, raw);
+  } else if (!options.video.empty()) {
+    source = videoFile(options.video, options.frames);
+  } else {
+    source = camera(options.device, options.frames);
+  }
+  if (!options.annotate.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(options.annotate, error);
+    if (error) throw CliError("cannot create " + options.annotate + ": " + error.message());
+  }
+  vision::MarkerTracker tracker;
+  int failures = 0, index = 0;
+  while (auto frame = source->next()) {
+    if (!frame->error.empty()) {
+      std::cerr << "arbci: " << frame->error << "\n";
+      ++failures;
+      continue;
+    }
+    vision::DetectionResult result;
+    std::vector<vision::StageTimes> times;
+    for (int r = 0; r < options.repeat; ++r) {
+      result = detector.detect(frame->image);
+      times.push_back(result.timing);
+    }
+    if (options.repeat > 1) {
+      auto stage = [&](double vision::StageTimes::*field) {
+        std::vector<double> v;
+        for (const auto& t : times) v.push_back(t.*field);
+        return median(v);
+      };
+      using S = vision::StageTimes;
+      result.timing = {stage(&S::convert), stage(&S::smooth), stage(&S::threshold), stage(&S::label),
+                       stage(&S::quads),   stage(&S::decode), stage(&S::total)};
+    }
+    std::vector<vision::MarkerDetection> markers = result.markers;
+    if (options.track) markers = tracker.update(markers, detector.lastSquares(), index / 30.0);
+    nlohmann::json line{{"frame", frame->name},
+                        {"width", frame->image.cols},
+                        {"height", frame->image.rows},
+                        {"threshold", result.threshold},
+                        {"threshold_mode", result.threshold_mode},
+                        {"markers", nlohmann::json::array()}};
+    for (const auto& m : markers) line["markers"].push_back(markerJson(m));
+    line["timing_us"] = stageTimesJson(result.timing);
+    std::cout << line.dump() << "\n" << std::flush;
+    if (!options.annotate.empty()) annotate(options.annotate, *frame, markers);
+    ++index;
+  }
+  return failures > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+void addDetectCommand(CLI::App& root, int& exit_code) {
+  auto options = std::make_shared<DetectOptions>();
+  auto* command = root.add_subcommand(
+      "detect", "Find markers in images, a video or a camera; one JSON line per frame");
+  command->add_option("images", options->inputs, "Image files (PNG, JPEG, ...; or raw with --raw)");
+  command->add_option("--video", options->video, "A video file");
+  command->add_option("--device", options->device, "A camera (V4L2 device number)");
+  command->add_option("--frames", options->frames, "At most this many frames of a video or camera")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--raw", options->raw, "Inputs are headerless: WIDTHxHEIGHT[:gray|rgb|bgr|rgba|bgra|abgr|rgb565]");
+  command->add_option("--kind", options->kind, "bch, simple, template, aruco or apriltag")
+      ->check(CLI::IsMember({"bch", "simple", "template", "aruco", "apriltag"}))
+      ->capture_default_str();
+  command->add_option("--border", options->border,
+                      "Border as a fraction of the side (default 0.125 for bch, 0.25 otherwise)")
+      ->check(CLI::Range(0.01, 0.4));
+  command->add_option("--threshold", options->threshold,
+                      "adaptive, auto-median, auto-midrange, or a constant 0..255")
+      ->capture_default_str();
+  command->add_option("--vignetting", options->vignetting,
+                      "Threshold offsets CORNERS,LEFTRIGHT,TOPBOTTOM (constant and automatic modes)");
+  command->add_option("--dictionary", options->dictionary, "OpenCV dictionary for aruco/apriltag, e.g. DICT_6X6_250");
+  command->add_option("--pattern", options->patterns, "Template patterns for --kind template: FILE.patt or ID=FILE.patt");
+  command->add_flag("--track", options->track, "Keep identities over frames (video, camera, image sequences)");
+  command->add_option("--repeat", options->repeat, "Detect each frame N times, report median stage times")
+      ->check(CLI::Range(1, 100000));
+  command->add_option("--annotate", options->annotate, "Write each frame with its markers drawn into this folder");
+  command->callback([options, &exit_code] { exit_code = runDetect(*options); });
+}
+
+}  // namespace arbci::app

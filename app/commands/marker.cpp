@@ -1,0 +1,148 @@
+// `arbci marker make`: printable markers (PNG at print resolution and SVG), singly or on a
+// labelled sheet. `arbci marker train`: a template pattern (.patt) from an image of a marker.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "arbci/vision/id_codes.h"
+#include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_printer.h"
+#include "commands/commands.h"
+#include "support/cli_error.h"
+#include "support/id_list.h"
+#include "support/output_path.h"
+#include "support/png.h"
+
+namespace arbci::app {
+namespace {
+
+struct MakeOptions {
+  std::string kind = "bch";
+  std::string ids;
+  double border = 0.125;
+  double size_mm = 80.0;
+  int dpi = 300;
+  bool sheet = false;
+  std::string out;
+};
+
+void writeText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream file(path);
+  file << text;
+  file.close();
+  if (!file) throw CliError("cannot write " + path.string());
+}
+
+void makeMarkers(const MakeOptions& options) {
+  const vision::MarkerKind kind = vision::markerKindFromString(options.kind);
+  if (kind != vision::MarkerKind::Bch && kind != vision::MarkerKind::Simple) {
+    throw CliError("--kind must be bch or simple");
+  }
+  const int max_id = kind == vision::MarkerKind::Bch ? vision::BchCode::kMaxId : vision::SimpleIdCode::kMaxId;
+  const std::vector<int> ids = parseIdList(options.ids, max_id);
+  vision::PrintLayout layout;
+  layout.size_mm = options.size_mm;
+  layout.dpi = options.dpi;
+  std::filesystem::path base(options.out);
+  if (base.extension() == ".png" || base.extension() == ".svg") base.replace_extension();
+  if (kind == vision::MarkerKind::Bch) {
+    for (int id : ids) {
+      if (vision::BchCode::rotationMargin(id) < 5) {
+        std::cerr << "arbci: warning: BCH id " << id << " turned by 90/180/270 degrees lies within "
+                  << vision::BchCode::rotationMargin(id) << " bits of another id; prefer another id\n";
+      }
+    }
+  }
+  auto write = [&](const std::filesystem::path& stem, const cv::Mat& image, const std::string& svg) {
+    std::filesystem::path png = stem, vector = stem;
+    png += ".png";
+    vector += ".svg";
+    ensureWritable(png);
+    writePng(png, image, options.dpi);
+    writeText(vector, svg);
+    std::cout << png.string() << "\n" << vector.string() << "\n";
+  };
+  try {
+    if (options.sheet) {
+      write(base, vision::renderSheetImage(kind, ids, options.border, layout),
+            vision::renderSheetSvg(kind, ids, options.border, layout));
+    } else {
+      for (int id : ids) {
+        std::filesystem::path stem = base;
+        if (ids.size() > 1) stem += "-" + std::to_string(id);
+        write(stem, vision::renderMarkerImage(kind, id, options.border, layout),
+              vision::renderMarkerSvg(kind, id, options.border, layout));
+      }
+    }
+  } catch (const std::invalid_argument& error) {
+    throw CliError(error.what());
+  }
+}
+
+struct TrainOptions {
+  std::string image;
+  int id = 0;
+  double border = 0.25;
+  std::string out;
+};
+
+// The largest square in a face-on image of the marker, sampled as a template pattern.
+void trainPattern(const TrainOptions& options) {
+  const cv::Mat image = cv::imread(options.image, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) throw CliError("cannot read image " + options.image);
+  ensureWritable(options.out);
+  const auto pattern = vision::trainTemplate(image, options.id, options.border);
+  if (!pattern) throw CliError("no black-bordered square found in " + options.image);
+  pattern->save(options.out);
+  if (pattern->rotationalSymmetry() > 0.9f) {
+    std::cerr << "arbci: warning: the pattern looks alike when turned; its orientation will be ambiguous\n";
+  }
+  std::cout << options.out << "\n";
+}
+
+}  // namespace
+
+void addMarkerCommand(CLI::App& root, int& exit_code) {
+  auto* marker = root.add_subcommand("marker", "Printable markers and template patterns");
+  marker->require_subcommand(1);
+
+  auto make = std::make_shared<MakeOptions>();
+  auto* make_command = marker->add_subcommand(
+      "make", "Write printable markers as PNG (at print resolution) and SVG");
+  make_command->add_option("--kind", make->kind, "bch (0..4095) or simple (0..511)")
+      ->check(CLI::IsMember({"bch", "simple"}))
+      ->capture_default_str();
+  make_command->add_option("--id", make->ids, "Marker id, list or range: 7, 1,4,9 or 0-11")->required();
+  make_command->add_option("--border", make->border, "Border width as a fraction of the side")
+      ->check(CLI::IsMember({0.125, 0.25}))
+      ->capture_default_str();
+  make_command->add_option("--size-mm", make->size_mm, "Side of the black square in millimetres")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  make_command->add_option("--dpi", make->dpi, "PNG resolution")->check(CLI::Range(72, 2400))->capture_default_str();
+  make_command->add_flag("--sheet", make->sheet, "All ids on one labelled A4 sheet");
+  make_command->add_option("--out", make->out, "Output file name (.png and .svg are written)")->required();
+  make_command->callback([make, &exit_code] {
+    makeMarkers(*make);
+    exit_code = 0;
+  });
+
+  auto train = std::make_shared<TrainOptions>();
+  auto* train_command = marker->add_subcommand(
+      "train", "Train a template pattern (ARToolKit .patt) from a face-on image of a marker");
+  train_command->add_option("--image", train->image, "Image of the marker, seen face-on")->required();
+  train_command->add_option("--id", train->id, "Id to give the pattern")->capture_default_str();
+  train_command->add_option("--border", train->border, "Border width as a fraction of the side")
+      ->check(CLI::Range(0.05, 0.4))
+      ->capture_default_str();
+  train_command->add_option("--out", train->out, "Pattern file to write")->required();
+  train_command->callback([train, &exit_code] {
+    trainPattern(*train);
+    exit_code = 0;
+  });
+}
+
+}  // namespace arbci::app

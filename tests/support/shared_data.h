@@ -1,0 +1,12 @@
+// Paths into the shared reference data (../shared/data), which the tests read in place.
+#pragma once
+
+#include <string>
+
+namespace arbci::test {
+
+inline std::string sharedData(const std::string& relative) {
+  return std::string(ARBCI_SHARED_DATA_DIR) + "/" + relative;
+}
+
+}  // namespace arbci::test
