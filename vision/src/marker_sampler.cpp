@@ -116,28 +116,34 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
   const BilinearSampler sample(image, regionOf(map, -cell, 1.0 + cell));
   MarkerSamples out;
 
-  // Black: the middle of the border band; white: half a cell outside the marker. Seven positions
-  // per side (one corner, and opposite each code cell).
+  // Black: the border band at 30 % and 70 % of its width (so a light margin or a border too thin
+  // for the quad fails); white: half a cell outside the marker. Seven positions per side (one
+  // corner, and opposite each code cell).
   constexpr int kRing = 28;
-  cv::Point3d black[kRing], white[kRing];
-  float all[kRing + 36];
+  cv::Point3d black[2 * kRing], white[kRing];
+  float ring_samples[2 * kRing];  // the black border (middle depth) and the white surround
   int ring = 0;
   const double band = border * 0.5, outside = -cell * 0.5;
   for (int k = 0; k < 7; ++k) {
     const double t = k == 0 ? band : border + cell * (k - 0.5);
-    const double along[4][2] = {{t, band}, {1.0 - band, t}, {1.0 - t, 1.0 - band}, {band, 1.0 - t}};
-    const double out[4][2] = {{t, outside}, {1.0 - outside, t}, {1.0 - t, 1.0 - outside},
-                              {outside, 1.0 - t}};
+    for (int depth = 0; depth < 2; ++depth) {
+      const double d = border * (depth == 0 ? 0.3 : 0.7);
+      const double along[4][2] = {{t, d}, {1.0 - d, t}, {1.0 - t, 1.0 - d}, {d, 1.0 - t}};
+      for (int s = 0; s < 4; ++s) {
+        const float b = sampleArea(sample, map, along[s][0], along[s][1], spread * 0.5);
+        black[2 * (4 * k + s) + depth] = {along[s][0], along[s][1], b};
+      }
+    }
+    const double out[4][2] = {{t, outside}, {1.0 - outside, t}, {1.0 - t, 1.0 - outside}, {outside, 1.0 - t}};
     for (int s = 0; s < 4; ++s) {
-      const float b = sampleArea(sample, map, along[s][0], along[s][1], spread * 0.5);
-      black[ring] = {along[s][0], along[s][1], b};
-      all[ring] = b;
+      ring_samples[ring] = 0.5f * static_cast<float>(black[2 * ring].z + black[2 * ring + 1].z);
       const cv::Point2f w = map(out[s][0], out[s][1]);
       white[ring] = {out[s][0], out[s][1], sample(w.x, w.y)};
+      ring_samples[kRing + ring] = static_cast<float>(white[ring].z);
       ++ring;
     }
   }
-  const Plane black_level = fitPlane(black, kRing), white_level = fitPlane(white, kRing);
+  const Plane black_level = fitPlane(black, 2 * kRing), white_level = fitPlane(white, kRing);
   out.contrast = static_cast<float>(white_level.at(0.5, 0.5) - black_level.at(0.5, 0.5));
 
   out.lowest = 255.0f;
@@ -150,16 +156,19 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
       out.thresholds[r * 6 + c] = static_cast<float>(0.5 * (black_level.at(u, v) + white_level.at(u, v)));
       out.lowest = std::min(out.lowest, value);
       out.highest = std::max(out.highest, value);
-      all[kRing + r * 6 + c] = value;
     }
   }
   for (const cv::Point3d& b : black) {
     const double threshold = 0.5 * (black_level.at(b.x, b.y) + white_level.at(b.x, b.y));
     out.border_light += b.z > threshold;
   }
-  out.border_samples = kRing;
-  std::nth_element(all, all + (kRing + 36) / 2, all + kRing + 36);
-  out.median = all[(kRing + 36) / 2];
+  out.border_samples = 2 * kRing;
+  // With as many dark as light samples, the median (the mean of the middle two) falls between
+  // the lightest of the black and the darkest of the white.
+  std::nth_element(ring_samples, ring_samples + kRing, ring_samples + 2 * kRing);
+  const float upper = ring_samples[kRing];
+  const float lower = *std::max_element(ring_samples, ring_samples + kRing);
+  out.median = 0.5f * (lower + upper);
   return out;
 }
 

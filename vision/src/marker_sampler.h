@@ -33,7 +33,8 @@ struct MarkerSamples {
   int border_samples = 0;
   int border_light = 0;                // border samples lighter than their local threshold
   float lowest = 0, highest = 0;       // extremes of the code cells
-  float median = 0;                    // median of the border and code samples
+  // Median of the marker's pixels: of its black border and white surround samples, equally many.
+  float median = 0;
 };
 
 // `border` is the border width as a fraction of the side (0.125 thin, 0.25 standard).

@@ -11,7 +11,14 @@ std::optional<TemplatePattern> trainTemplate(const cv::Mat& image, int id, doubl
   config.border = border;
   MarkerDetector detector(config);
   detector.detect(image);
-  const std::vector<SquareCorners>& squares = detector.lastSquares();
+  // The largest square with a black border all round (not, say, the white card it is printed on).
+  std::vector<SquareCorners> squares;
+  for (const SquareCorners& corners : detector.lastSquares()) {
+    Quad quad;
+    quad.corners = corners;
+    const MarkerSamples samples = sampleMarker(detector.lastGrayImage(), quad, border);
+    if (samples.contrast >= 8.0f && samples.border_light * 10 <= samples.border_samples) squares.push_back(corners);
+  }
   if (squares.empty()) return std::nullopt;
   auto area = [](const SquareCorners& q) {
     float a = 0.0f;

@@ -20,7 +20,7 @@ struct TrackerOptions {
   int keep_frames = 3;        // how long an identity is kept for squares that fail to decode
   bool smooth_corners = false;
   double min_cutoff_hz = 1.0;  // One-Euro: cutoff at rest
-  double beta = 0.02;          // One-Euro: cutoff increase per px/s of corner speed
+  double beta = 0.2;           // One-Euro: cutoff increase per px/s of corner speed
   double derivative_cutoff_hz = 1.0;
 };
 
