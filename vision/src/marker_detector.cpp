@@ -56,6 +56,8 @@ float quadArea(const SquareCorners& q) {
 
 cv::Point2f centre(const SquareCorners& q) { return (q[0] + q[1] + q[2] + q[3]) * 0.25f; }
 
+cv::Point2f toFloat(cv::Point2d p) { return {static_cast<float>(p.x), static_cast<float>(p.y)}; }
+
 void validate(const DetectorConfig& config) {
   if (isSquareKind(config.kind) && !(config.border > 0.0 && config.border <= 0.4)) {
     throw std::invalid_argument("border must be in (0, 0.4] of the marker side, got " +
@@ -95,7 +97,7 @@ struct MarkerDetector::Impl {
   std::vector<cv::Rect> near_misses;  // marker-sized components that did not fit a quad
   RunLabeler roi_labels;
   cv::Mat roi_limits;
-  std::vector<SquareCorners> squares;
+  std::vector<SquareCorners> squares, ideal_squares;
 
   explicit Impl(DetectorConfig c) : config(std::move(c)) {
     validate(config);
@@ -150,6 +152,7 @@ struct MarkerDetector::Impl {
     const int min_area = std::max(12, static_cast<int>(0.2f * min_side * min_side));
     QuadFitParams params;
     params.min_side = min_side;
+    params.lens = config.lens.get();
     near_misses.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
     for (const DarkComponent& c : labels.components()) {
@@ -192,7 +195,9 @@ struct MarkerDetector::Impl {
   }
 
   // Binarises `roi` of `source` with edge tiles split at `split` sixteenths; adds the new quads.
-  bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split, const QuadFitParams& params) {
+  bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split, const QuadFitParams& frame_params) {
+    QuadFitParams params = frame_params;
+    params.lens = nullptr;  // region coordinates; ideal corners are computed below
     const cv::Mat patch = source(roi);
     adaptive.roiLimits(roi, split, roi_limits);
     roi_labels.label(patch, roi_limits);
@@ -206,7 +211,12 @@ struct MarkerDetector::Impl {
       if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour)) continue;
       auto quad = fitQuad(contour, {c.first_x, c.first_y}, patch, params).quad;
       if (!quad) continue;
-      for (cv::Point2f& p : quad->corners) p += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      for (cv::Point2f& p : quad->corners) p += offset;
+      // The region's ideal corners were computed as if it were the whole image: redo them.
+      for (int k = 0; k < 4; ++k) {
+        quad->ideal_corners[k] = config.lens ? toFloat(config.lens->undistort(quad->corners[k])) : quad->corners[k];
+      }
       bool known = false;  // already found, from the frame or an earlier retry
       for (size_t q = 0; q < quads.size() && !known; ++q) {
         known = insideConvex(quads[q].corners, centre(quad->corners));
@@ -248,7 +258,10 @@ struct MarkerDetector::Impl {
         marker.corrected_bits = code->corrected_bits;
       }
       // Printed corner k (TL, TR, BR, BL) is quad corner (k + 4 - orientation) mod 4.
-      for (int k = 0; k < 4; ++k) marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
+      for (int k = 0; k < 4; ++k) {
+        marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
+        marker.ideal_corners[k] = quad.ideal_corners[(k + 4 - marker.orientation) % 4];
+      }
       if (markers.empty()) marker_median = samples.median;
       markers.push_back(marker);
     }
@@ -312,7 +325,11 @@ struct MarkerDetector::Impl {
     }
     dropNested(result.markers);
     squares.clear();
-    for (const Quad& quad : quads) squares.push_back(quad.corners);
+    ideal_squares.clear();
+    for (const Quad& quad : quads) {
+      squares.push_back(quad.corners);
+      ideal_squares.push_back(quad.ideal_corners);
+    }
     return result;
   }
 
@@ -321,12 +338,25 @@ struct MarkerDetector::Impl {
     StageTimes time;
     DetectionResult result;
     squares.clear();
+    ideal_squares.clear();
+    if (!gray.empty() && config.lens && gray.size() != config.lens->camera().image_size) {
+      const cv::Size lens = config.lens->camera().image_size;
+      throw std::invalid_argument("frames are " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
+                                  " but the lens model (" + config.lens->camera().source + ") is for " +
+                                  std::to_string(lens.width) + "x" + std::to_string(lens.height) +
+                                  "; scale the camera model to the frame size");
+    }
     if (gray.empty() || gray.cols < 3 || gray.rows < 3) {
       result.threshold = threshold;
       result.threshold_mode = "empty image";
     } else if (dictionary >= 0) {
       const auto decode_start = Clock::now();
       result.markers = detectDictionaryMarkers(gray, dictionary, config.kind);
+      for (MarkerDetection& m : result.markers) {
+        for (int k = 0; k < 4; ++k) {
+          m.ideal_corners[k] = config.lens ? toFloat(config.lens->undistort(m.corners[k])) : m.corners[k];
+        }
+      }
       time.decode = microseconds(decode_start, Clock::now());
       result.threshold_mode = "opencv adaptive";
     } else {
@@ -386,6 +416,7 @@ void MarkerDetector::setThreshold(const ThresholdSettings& settings) {
 int MarkerDetector::currentThreshold() const { return impl_->threshold; }
 
 const std::vector<SquareCorners>& MarkerDetector::lastSquares() const { return impl_->squares; }
+const std::vector<SquareCorners>& MarkerDetector::lastIdealSquares() const { return impl_->ideal_squares; }
 
 cv::Mat MarkerDetector::lastBinaryImage() const {
   const cv::Mat& gray = impl_->gray;

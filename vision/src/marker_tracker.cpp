@@ -78,13 +78,16 @@ double MarkerTracker::OneEuro::filter(double x, double dt, const TrackerOptions&
 void MarkerTracker::smooth(Track& track, MarkerDetection& marker, double dt) {
   if (!options_.smooth_corners) return;
   for (int k = 0; k < 4; ++k) {
+    const cv::Point2f before = marker.corners[k];
     marker.corners[k].x = static_cast<float>(track.filters[2 * k].filter(marker.corners[k].x, dt, options_));
     marker.corners[k].y = static_cast<float>(track.filters[2 * k + 1].filter(marker.corners[k].y, dt, options_));
+    marker.ideal_corners[k] += marker.corners[k] - before;  // the same correction, locally
   }
 }
 
 std::vector<MarkerDetection> MarkerTracker::update(const std::vector<MarkerDetection>& detections,
-                                                   const std::vector<SquareCorners>& squares, double time_s) {
+                                                   const std::vector<SquareCorners>& squares, double time_s,
+                                                   const std::vector<SquareCorners>* ideal_squares) {
   ++frame_;
   const double dt = frame_ > 1 ? time_s - last_time_ : 0.0;
   last_time_ = time_s;
@@ -117,7 +120,14 @@ std::vector<MarkerDetection> MarkerTracker::update(const std::vector<MarkerDetec
       // A new identity where a confirmed one stood: hold it until it repeats.
       track.pending_id = marker.id;
       marker.id = track.marker.id;
-      marker.corners = alignCorners(marker.corners, track.marker.corners);
+      const auto turned = alignCorners(marker.corners, track.marker.corners);
+      for (int shift = 0; shift < 4; ++shift) {
+        if (marker.corners[shift] == turned[0]) {
+          const auto ideal = marker.ideal_corners;
+          for (int k = 0; k < 4; ++k) marker.ideal_corners[k] = ideal[(k + shift) % 4];
+        }
+      }
+      marker.corners = turned;
       marker.from_history = true;
       marker.confidence = track.marker.confidence * 0.5f;
     } else {
@@ -139,13 +149,23 @@ std::vector<MarkerDetection> MarkerTracker::update(const std::vector<MarkerDetec
     if (track_used[t]) continue;
     Track& track = tracks_[t];
     if (frame_ - track.last_frame > options_.keep_frames) continue;
-    for (const SquareCorners& square : squares) {
+    for (size_t s = 0; s < squares.size(); ++s) {
+      const SquareCorners& square = squares[s];
       if (!sameSquare(square, track.marker.corners)) continue;
       bool taken = false;
       for (const MarkerDetection& m : out) taken = taken || sameSquare(m.corners, square);
       if (taken) break;
       MarkerDetection marker = track.marker;
+      // The same turn of the square for its ideal corners.
       marker.corners = alignCorners(square, track.marker.corners);
+      marker.ideal_corners = marker.corners;
+      if (ideal_squares && s < ideal_squares->size()) {
+        for (int shift = 0; shift < 4; ++shift) {
+          if (square[shift] == marker.corners[0]) {
+            for (int k = 0; k < 4; ++k) marker.ideal_corners[k] = (*ideal_squares)[s][(k + shift) % 4];
+          }
+        }
+      }
       marker.from_history = true;
       marker.confidence = track.marker.confidence * 0.5f;
       smooth(track, marker, dt);

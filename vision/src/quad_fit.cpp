@@ -6,10 +6,26 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "arbci/vision/undistortion.h"
 #include "image_sampling.h"
 
 namespace arbci::vision {
 namespace {
+
+// Image <-> ideal coordinates through the lens; the identity without one.
+struct LensMap {
+  const Undistorter* lens = nullptr;
+  cv::Point2f toIdeal(cv::Point2f p) const {
+    if (!lens) return p;
+    const cv::Point2d q = lens->undistort(p);
+    return {static_cast<float>(q.x), static_cast<float>(q.y)};
+  }
+  cv::Point2f toImage(cv::Point2f p) const {
+    if (!lens) return p;
+    const cv::Point2d q = lens->distort(p);
+    return {static_cast<float>(q.x), static_cast<float>(q.y)};
+  }
+};
 
 struct Line {
   cv::Point2f point;      // a point on the line
@@ -160,7 +176,9 @@ std::optional<cv::Point2f> intersect(const Line& a, const Line& b) {
 // it (within +-radius px) where the intensity rises fastest (dark inside, light outside) is found
 // to sub-pixel precision by a parabola, and a line is fitted to those edge points weighted by the
 // rise.
-std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv::Point2f b,
+// `a` and `b` are ideal coordinates; profiles are sampled in the image across the side as the lens
+// bends it, and the edge points are fitted in ideal coordinates.
+std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& lens, cv::Point2f a, cv::Point2f b,
                                int radius) {
   constexpr int kMaxSamples = 20, kMaxRadius = 4;
   const cv::Point2f d = b - a;
@@ -168,7 +186,7 @@ std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv:
   if (length < 4.0f) return std::nullopt;
   radius = std::min(radius, kMaxRadius);
   const cv::Point2f along = d / length;
-  const cv::Point2f outward(along.y, -along.x);  // clockwise on screen: the interior is right
+  const cv::Point2f ideal_outward(along.y, -along.x);  // clockwise on screen: the interior is right
   const int samples = std::clamp(static_cast<int>(length / 2.5f), 5, kMaxSamples);
   const float end = std::min(0.3f, std::max(0.05f, (static_cast<float>(radius) + 1.0f) / length));
   cv::Point2f points[kMaxSamples];
@@ -178,7 +196,13 @@ std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv:
   for (int s = 0; s < samples; ++s) {
     // Stay clear of the corners, where the profile would cross the neighbouring side.
     const float t = end + (1.0f - 2.0f * end) * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
-    const cv::Point2f base = a + t * d;
+    const cv::Point2f ideal_base = a + t * d;
+    const cv::Point2f base = lens.toImage(ideal_base);
+    cv::Point2f outward = ideal_outward;
+    if (lens.lens) {
+      outward = lens.toImage(ideal_base + 0.5f * ideal_outward) - lens.toImage(ideal_base - 0.5f * ideal_outward);
+      outward /= std::max(1e-6f, std::sqrt(outward.dot(outward)));
+    }
     for (int k = -radius - 1; k <= radius + 1; ++k) {
       const cv::Point2f p = base + static_cast<float>(k) * outward;
       profile[k + radius + 1] = sample(p.x, p.y);
@@ -209,7 +233,7 @@ std::optional<Line> refineSide(const BilinearSampler& sample, cv::Point2f a, cv:
         break;
       }
     }
-    points[count] = base + offset * outward;
+    points[count] = lens.toIdeal(base + offset * outward);
     weights[count] = best_rise;
     ++count;
   }
@@ -355,6 +379,7 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   }
 
   // A line through each side's contour arc, its ends trimmed.
+  const LensMap lens{params.lens};
   std::array<Line, 4> lines;
   std::vector<cv::Point2f>& side_points = scratchPoints();
   std::vector<float>& unit_weights = scratchWeights();
@@ -364,13 +389,14 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     const int count = (to - from + n) % n;
     const int trim = std::max(1, count / 8);
     side_points.clear();
-    for (int j = trim; j <= count - trim; ++j) side_points.push_back(contour[(from + j) % n]);
+    for (int j = trim; j <= count - trim; ++j) side_points.push_back(lens.toIdeal(contour[(from + j) % n]));
     unit_weights.assign(side_points.size(), 1.0f);
     const auto line = fitLine(side_points.data(), unit_weights.data(), static_cast<int>(side_points.size()));
     if (!line || side_points.size() < 2) return result;
     lines[k] = *line;
   }
 
+  // From here on, corners are ideal coordinates.
   Quad quad;
   auto intersectAll = [&]() {
     for (int k = 0; k < 4; ++k) {
@@ -383,7 +409,7 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   if (!intersectAll()) return result;
   // Corners far from their contour vertices mean the sides were not straight lines.
   for (int k = 0; k < 4; ++k) {
-    const cv::Point2f d = quad.corners[k] - cv::Point2f(contour[vertex[k]]);
+    const cv::Point2f d = quad.corners[k] - lens.toIdeal(cv::Point2f(contour[vertex[k]]));
     const float side = length(quad.corners[(k + 1) % 4] - quad.corners[k]);
     if (length(d) > 2.0f + 0.25f * side) return result;
   }
@@ -394,11 +420,17 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     for (int k = 1; k < 4; ++k) shortest = std::min(shortest, length(quad.corners[(k + 1) % 4] - quad.corners[k]));
     const int reach = std::clamp(static_cast<int>(std::lround(0.1f * shortest)), 1, 3);
     for (int radius : {reach, std::min(reach, 2)}) {
-      // Samples lie within radius + 1 px of the current sides.
-      const BilinearSampler sample(image, boundsOf(quad.corners, static_cast<float>(radius + 2)));
+      // Samples lie within radius + 1 px of the current sides (as the lens bends them).
+      std::array<cv::Point2f, 20> outline;
+      for (int k = 0; k < 4; ++k) {
+        for (int j = 0; j < 5; ++j) {
+          outline[5 * k + j] = lens.toImage(quad.corners[k] + (quad.corners[(k + 1) % 4] - quad.corners[k]) * (j / 5.0f));
+        }
+      }
+      const BilinearSampler sample(image, boundsOf(outline, static_cast<float>(radius + 2)));
       std::array<Line, 4> refined = lines;
       for (int k = 0; k < 4; ++k) {
-        const auto line = refineSide(sample, quad.corners[k], quad.corners[(k + 1) % 4], radius);
+        const auto line = refineSide(sample, lens, quad.corners[k], quad.corners[(k + 1) % 4], radius);
         if (line) refined[k] = *line;
       }
       lines = refined;
@@ -416,6 +448,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     if (sign == 0.0f) sign = cross;
     if (cross * sign <= 0.0f) return result;
   }
+  quad.ideal_corners = quad.corners;
+  for (int k = 0; k < 4; ++k) quad.corners[k] = lens.toImage(quad.ideal_corners[k]);
   result.quad = quad;
   return result;
 }

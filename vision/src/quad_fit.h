@@ -15,9 +15,12 @@
 
 namespace arbci::vision {
 
+class Undistorter;
+
 struct Quad {
   // Clockwise on screen; corner 0 lies nearest the contour point farthest from the first pixel.
-  std::array<cv::Point2f, 4> corners;
+  std::array<cv::Point2f, 4> corners;        // image pixels
+  std::array<cv::Point2f, 4> ideal_corners;  // undistorted pixels (the same without a lens)
 };
 
 struct QuadFitParams {
@@ -25,6 +28,9 @@ struct QuadFitParams {
   // Contour points may stray this fraction of a side's length (at least 2 px) from the chord.
   float max_side_deviation = 0.08f;
   bool refine_edges = true;
+  // With a lens, sides are fitted as straight lines in undistorted coordinates (ARToolKitPlus
+  // undistorts contour points before fitting), so curved edges of a distorting lens fit exactly.
+  const Undistorter* lens = nullptr;
 };
 
 struct QuadFit {

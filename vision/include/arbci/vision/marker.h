@@ -21,6 +21,9 @@ struct MarkerDetection {
   // Corners of the printed marker: top-left, top-right, bottom-right, bottom-left, in image
   // pixels with OpenCV's convention (pixel centres at integer coordinates).
   std::array<cv::Point2f, 4> corners;
+  // The same corners undistorted (pixels of the ideal camera) when the detector has a camera
+  // model; equal to `corners` otherwise. Poses are computed from these.
+  std::array<cv::Point2f, 4> ideal_corners;
   // ARToolKitPlus's `dir`: clockwise quarter turns from the sampled grid to the printed one.
   int orientation = 0;
   // 1.0 for a clean decode; lower for corrected bits (ARToolKitPlus's scale) or weaker matches.

@@ -16,6 +16,7 @@
 #include "arbci/vision/pixel_format.h"
 #include "arbci/vision/template_pattern.h"
 #include "arbci/vision/threshold.h"
+#include "arbci/vision/undistortion.h"
 
 namespace arbci::vision {
 
@@ -36,6 +37,9 @@ struct DetectorConfig {
   bool soft_decoding = true;
   std::vector<TemplatePattern> templates;  // MarkerKind::Template
   TemplateMatchLimits template_limits;
+  // The camera's lens (its calibration and an undistortion mode): sides are fitted straight in
+  // undistorted coordinates and ideal corners are reported. Frames must match its image size.
+  std::shared_ptr<const Undistorter> lens;
   // MarkerKind::Aruco / AprilTag: an OpenCV predefined dictionary name; empty for the kind's
   // default (DICT_6X6_250, DICT_APRILTAG_36h11).
   std::string dictionary;
@@ -60,8 +64,10 @@ class MarkerDetector {
   void setThreshold(const ThresholdSettings& settings);
   // The global threshold the next frame starts from (automatic and constant modes).
   int currentThreshold() const;
-  // Every square outline of the last frame, decoded or not (clockwise on screen).
+  // Every square outline of the last frame, decoded or not (clockwise on screen), in image and
+  // in ideal coordinates (by index).
   const std::vector<SquareCorners>& lastSquares() const;
+  const std::vector<SquareCorners>& lastIdealSquares() const;
   // The last frame's binary image: 255 where a pixel counted as dark.
   cv::Mat lastBinaryImage() const;
   // The luminance image of the last frame (shares memory with the detector; copy to keep).

@@ -28,10 +28,12 @@ class MarkerTracker {
  public:
   explicit MarkerTracker(TrackerOptions options = {});
 
-  // The frame's stable markers from its detections and all its square outlines; `time_s` is the
-  // frame's capture time (smoothing uses the interval between frames).
+  // The frame's stable markers from its detections and all its square outlines (with their ideal
+  // corners by index when the detector has a lens); `time_s` is the frame's capture time
+  // (smoothing uses the interval between frames).
   std::vector<MarkerDetection> update(const std::vector<MarkerDetection>& detections,
-                                      const std::vector<SquareCorners>& squares, double time_s);
+                                      const std::vector<SquareCorners>& squares, double time_s,
+                                      const std::vector<SquareCorners>* ideal_squares = nullptr);
   void reset();
 
  private:
