@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   arbci::app::addScreenshotCommand(root, exit_code);
   arbci::app::addMarkerCommand(root, exit_code);
   arbci::app::addDetectCommand(root, exit_code);
+  arbci::app::addCalibrateCommand(root, exit_code);
 
   try {
     root.parse(argc, argv);

@@ -10,5 +10,6 @@ void addGlInfoCommand(CLI::App& root, int& exit_code);
 void addScreenshotCommand(CLI::App& root, int& exit_code);
 void addMarkerCommand(CLI::App& root, int& exit_code);
 void addDetectCommand(CLI::App& root, int& exit_code);
+void addCalibrateCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <optional>
 
 #include <opencv2/imgproc.hpp>
 
 #include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_set.h"
 #include "arbci/vision/marker_tracker.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
@@ -33,7 +36,31 @@ struct DetectOptions {
   bool track = false;
   int repeat = 1;
   std::string annotate;
+  std::string camera;
+  double marker_size_mm = 50.0;
+  std::string undistort = "lut";
+  std::string pose = "rpp";
+  std::string marker_set;
 };
+
+// What --camera adds: the lens for the frame size in use, and pose estimation.
+struct Geometry {
+  vision::CameraModel camera;  // at the frames' size
+  std::shared_ptr<const vision::Undistorter> lens;
+  vision::PoseOptions pose;
+  double marker_size_m = 0.05;
+  std::optional<vision::MarkerSet> set;
+  std::map<int, vision::Pose> previous;  // by marker id, so poses do not flip between frames
+};
+
+nlohmann::json poseJson(const vision::PoseEstimate& estimate) {
+  const cv::Vec3d t = estimate.pose.translation, r = estimate.pose.rotationVector();
+  auto round6 = [](double v) { return std::round(v * 1e6) / 1e6; };
+  nlohmann::json out{{"t_m", {round6(t[0]), round6(t[1]), round6(t[2])}},
+                     {"rvec", {round6(r[0]), round6(r[1]), round6(r[2])}},
+                     {"reprojection_rms_px", std::round(estimate.reprojection_rms_px * 1000.0) / 1000.0}};
+  return out;
+}
 
 vision::ThresholdSettings parseThreshold(const DetectOptions& options) {
   vision::ThresholdSettings settings;
@@ -127,6 +154,24 @@ double median(std::vector<double> values) {
   return values.empty() ? 0.0 : values[values.size() / 2];
 }
 
+Geometry makeGeometry(const DetectOptions& options, cv::Size frame_size) {
+  Geometry geometry;
+  try {
+    const vision::CameraModel camera = vision::CameraModel::load(options.camera);
+    camera.checkImageSize(frame_size);
+    geometry.camera = camera.scaledTo(frame_size);
+    geometry.lens = std::make_shared<vision::Undistorter>(geometry.camera, vision::undistortModeFromString(options.undistort));
+    geometry.pose.method = vision::poseMethodFromString(options.pose);
+    if (!options.marker_set.empty()) geometry.set = vision::MarkerSet::loadArToolKitConfig(options.marker_set);
+  } catch (const vision::CalibrationFileError& error) {
+    throw CliError(error.what());
+  } catch (const std::invalid_argument& error) {
+    throw CliError(error.what());
+  }
+  geometry.marker_size_m = options.marker_size_mm / 1000.0;
+  return geometry;
+}
+
 int runDetect(const DetectOptions& options) {
   const int sources = (!options.inputs.empty()) + (!options.video.empty()) + (options.device >= 0);
   if (sources != 1) throw CliError("give image files, or --video FILE, or --device N (exactly one)");
@@ -153,12 +198,20 @@ int runDetect(const DetectOptions& options) {
     if (error) throw CliError("cannot create " + options.annotate + ": " + error.message());
   }
   vision::MarkerTracker tracker;
+  std::optional<Geometry> geometry;
   int failures = 0, index = 0;
   while (auto frame = source->next()) {
     if (!frame->error.empty()) {
       std::cerr << "arbci: " << frame->error << "\n";
       ++failures;
       continue;
+    }
+    if (!options.camera.empty() && (!geometry || geometry->camera.image_size != frame->image.size())) {
+      // The lens and intrinsics for this frame size (built once per size).
+      geometry = makeGeometry(options, frame->image.size());
+      vision::DetectorConfig config = detector.config();
+      config.lens = geometry->lens;
+      detector = vision::MarkerDetector(config);
     }
     vision::DetectionResult result;
     std::vector<vision::StageTimes> times;
@@ -177,14 +230,40 @@ int runDetect(const DetectOptions& options) {
                        stage(&S::quads),   stage(&S::decode), stage(&S::total)};
     }
     std::vector<vision::MarkerDetection> markers = result.markers;
-    if (options.track) markers = tracker.update(markers, detector.lastSquares(), index / 30.0);
+    if (options.track) markers = tracker.update(markers, detector.lastSquares(), index / 30.0, &detector.lastIdealSquares());
     nlohmann::json line{{"frame", frame->name},
                         {"width", frame->image.cols},
                         {"height", frame->image.rows},
                         {"threshold", result.threshold},
                         {"threshold_mode", result.threshold_mode},
                         {"markers", nlohmann::json::array()}};
-    for (const auto& m : markers) line["markers"].push_back(markerJson(m));
+    for (const auto& m : markers) {
+      nlohmann::json marker = markerJson(m);
+      if (geometry) {
+        nlohmann::json ideal = nlohmann::json::array();
+        std::vector<cv::Point2d> corners;
+        for (const cv::Point2f& p : m.ideal_corners) {
+          ideal.push_back({std::round(p.x * 1000.0) / 1000.0, std::round(p.y * 1000.0) / 1000.0});
+          corners.emplace_back(p.x, p.y);
+        }
+        marker["ideal_corners"] = ideal;
+        vision::PoseOptions pose = geometry->pose;
+        if (const auto previous = geometry->previous.find(m.id); previous != geometry->previous.end()) {
+          pose.previous = previous->second;
+        }
+        const vision::PoseEstimate estimate =
+            vision::estimatePose(vision::markerCorners(geometry->marker_size_m), corners, geometry->camera.camera_matrix, pose);
+        geometry->previous[m.id] = estimate.pose;
+        marker["pose"] = poseJson(estimate);
+      }
+      line["markers"].push_back(marker);
+    }
+    if (geometry && geometry->set) {
+      if (const auto set_pose = vision::estimateSetPose(*geometry->set, markers, geometry->camera.camera_matrix, geometry->pose)) {
+        line["set_pose"] = poseJson(set_pose->estimate);
+        line["set_pose"]["markers"] = set_pose->used_ids;
+      }
+    }
     line["timing_us"] = stageTimesJson(result.timing);
     std::cout << line.dump() << "\n" << std::flush;
     if (!options.annotate.empty()) annotate(options.annotate, *frame, markers);
@@ -222,6 +301,18 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
   command->add_option("--repeat", options->repeat, "Detect each frame N times, report median stage times")
       ->check(CLI::Range(1, 100000));
   command->add_option("--annotate", options->annotate, "Write each frame with its markers drawn into this folder");
+  command->add_option("--camera", options->camera,
+                      "Camera calibration (OpenCV .yml/.xml or ARToolKitPlus .cal): adds undistorted corners and poses");
+  command->add_option("--marker-size-mm", options->marker_size_mm, "Side of the markers' black square, for poses")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--undistort", options->undistort, "none, algorithmic or lut")
+      ->check(CLI::IsMember({"none", "algorithmic", "lut"}))
+      ->capture_default_str();
+  command->add_option("--pose", options->pose, "rpp, ippe or iterative")
+      ->check(CLI::IsMember({"rpp", "ippe", "iterative"}))
+      ->capture_default_str();
+  command->add_option("--marker-set", options->marker_set, "ARToolKit multi-marker .cfg (mm): adds the set's pose");
   command->callback([options, &exit_code] { exit_code = runDetect(*options); });
 }
 

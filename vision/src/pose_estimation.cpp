@@ -4,6 +4,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "arbci/vision/pose.h"
+#include "pose_refinement.h"
 #include "rpp.h"
 
 namespace arbci::vision {
@@ -23,16 +24,6 @@ double reprojectionRms(const Pose& pose, const cv::Matx33d& k, std::span<const c
     sum += d.dot(d);
   }
   return std::sqrt(sum / static_cast<double>(object.size()));
-}
-
-Pose refined(const Pose& start, const cv::Matx33d& k, std::span<const cv::Point3d> object,
-             std::span<const cv::Point2d> image) {
-  const std::vector<cv::Point3d> o(object.begin(), object.end());
-  const std::vector<cv::Point2d> i(image.begin(), image.end());
-  cv::Vec3d rvec = start.rotationVector(), tvec = start.translation;
-  cv::solvePnPRefineLM(o, i, k, cv::noArray(), rvec, tvec,
-                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 1e-12));
-  return Pose::fromRotationVector(rvec, tvec);
 }
 
 bool planar(std::span<const cv::Point3d> object) {
@@ -96,7 +87,7 @@ PoseEstimate estimatePose(std::span<const cv::Point3d> object, std::span<const c
   std::vector<Candidate> candidates = solve(object, image, k, method);
   if (candidates.empty()) throw std::invalid_argument("pose: no solution in front of the camera");
   for (Candidate& c : candidates) {
-    if (options.refine) c.pose = refined(c.pose, k, object, image);
+    if (options.refine) c.pose = refineReprojection(c.pose, k, object, image);
     c.rms_px = reprojectionRms(c.pose, k, object, image);
   }
   std::sort(candidates.begin(), candidates.end(),

@@ -66,8 +66,9 @@ class ObjectSpace {
     Vector3d p_mean = Vector3d::Zero();
     for (const Vector3d& p : points_) p_mean += p;
     p_mean /= static_cast<double>(n);
+    std::vector<Vector3d>& q = scratch_;
+    q.resize(n);
     for (int iteration = 0; iteration < 200; ++iteration) {
-      std::vector<Vector3d> q(n);
       Vector3d q_mean = Vector3d::Zero();
       for (size_t i = 0; i < n; ++i) {
         q[i] = projections_[i] * (r * points_[i] + t);
@@ -82,7 +83,7 @@ class ObjectSpace {
       r = svd.matrixU() * d * svd.matrixV().transpose();
       t = optimalTranslation(r);
       const double e = error(r, t);
-      if (std::abs(previous - e) <= 1e-14 + 1e-10 * previous) {
+      if (std::abs(previous - e) <= 1e-16 + 1e-8 * previous) {
         previous = e;
         break;
       }
@@ -103,6 +104,7 @@ class ObjectSpace {
   std::vector<Vector3d> points_;
   std::vector<Matrix3d> projections_;
   Matrix3d translation_factor_;
+  mutable std::vector<Vector3d> scratch_;
 };
 
 Matrix3d rotationZ(double a) {
@@ -206,8 +208,18 @@ std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object, s
   // dE/dbeta = (c2 - c1) sin 2b + c3 cos 2b - c4 sin b + c5 cos b = 0, with u = tan(b / 2):
   const std::vector<double> polynomial{c3 + c5, 4.0 * (c2 - c1) - 2.0 * c4, -6.0 * c3,
                                        -4.0 * (c2 - c1) - 2.0 * c4, c3 - c5};
-  std::vector<double> betas{M_PI};  // u -> infinity
-  for (double u : realRoots(polynomial)) betas.push_back(2.0 * std::atan(u));
+  std::vector<double> stationary{M_PI};  // u -> infinity
+  for (double u : realRoots(polynomial)) stationary.push_back(2.0 * std::atan(u));
+  // The first solution sits at one minimum (beta0); refine only the other minima.
+  const double beta0 = std::atan2(std::hypot(aligned(0, 2), aligned(1, 2)), aligned(2, 2));
+  auto curvature = [&](double b) {
+    return 2.0 * (c2 - c1) * std::cos(2.0 * b) - 2.0 * c3 * std::sin(2.0 * b) - c4 * std::cos(b) - c5 * std::sin(b);
+  };
+  std::vector<double> betas;
+  for (double beta : stationary) {
+    const double from_first = std::abs(std::remainder(beta - beta0, 2.0 * M_PI));
+    if (curvature(beta) > 0.0 && from_first > 1e-3) betas.push_back(beta);
+  }
 
   std::vector<RppSolution> solutions{first};
   for (double beta : betas) {
