@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   arbci::app::addMarkerCommand(root, exit_code);
   arbci::app::addDetectCommand(root, exit_code);
   arbci::app::addCalibrateCommand(root, exit_code);
+  arbci::app::addEegCommand(root, exit_code);
 
   try {
     root.parse(argc, argv);

@@ -11,5 +11,6 @@ void addScreenshotCommand(CLI::App& root, int& exit_code);
 void addMarkerCommand(CLI::App& root, int& exit_code);
 void addDetectCommand(CLI::App& root, int& exit_code);
 void addCalibrateCommand(CLI::App& root, int& exit_code);
+void addEegCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

@@ -1,0 +1,154 @@
+// `arbci eeg info|convert|simulate`: look into EEG files, convert them to BDF+, and record the
+// simulated subject.
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "arbci/bci/recording.h"
+#include "arbci/bci/recording_writer.h"
+#include "commands/commands.h"
+#include "eeg/simulated_recording.h"
+#include "support/cli_error.h"
+#include "support/output_path.h"
+
+namespace arbci::app {
+namespace {
+
+bci::Recording read(const std::string& path, bool salvage) {
+  try {
+    bci::ReadOptions options;
+    options.salvage_truncated = salvage;
+    return bci::readRecording(path, options);
+  } catch (const bci::RecordingError& error) {
+    throw CliError(error.what());
+  }
+}
+
+void printInfo(const bci::Recording& r) {
+  std::cout << "file:      " << r.source << "\n"
+            << "format:    " << r.format << "\n"
+            << "channels:  " << r.info.channelCount() << " (";
+  for (int c = 0; c < r.info.channelCount(); ++c) std::cout << (c ? " " : "") << r.info.channels[c];
+  std::cout << ")\n"
+            << "rate:      " << r.info.rate_hz << " Hz\n"
+            << "samples:   " << r.samples << " (" << std::fixed << std::setprecision(2) << r.seconds() << " s)\n";
+  if (r.truncated) std::cout << "truncated: " << r.truncation_note << "; read up to the last complete record\n";
+  std::map<int, std::pair<int, int>> by_code;  // code -> (count, targets)
+  int targets = 0;
+  for (const bci::StimulusEvent& e : r.stimuli) {
+    ++by_code[e.code].first;
+    if (e.target) {
+      ++by_code[e.code].second;
+      ++targets;
+    }
+  }
+  std::cout << "stimuli:   " << r.stimuli.size() << " (" << targets << " targets)\n";
+  for (const auto& [code, counts] : by_code) {
+    std::cout << "  code " << std::setw(3) << code << ": " << std::setw(5) << counts.first << " (" << counts.second << " targets)\n";
+  }
+  std::cout << "other events: " << r.annotations.size() << "\n";
+  std::map<std::string, int> by_text;
+  for (const bci::Annotation& a : r.annotations) ++by_text[a.text.substr(0, a.text.find(' '))];
+  for (const auto& [word, count] : by_text) std::cout << "  " << word << ": " << count << "\n";
+  std::cout << "parameters: " << r.parameters.size() << "\n";
+}
+
+void convert(const std::string& in, const std::string& out, bool salvage) {
+  const std::filesystem::path target(out);
+  if (target.extension() != ".bdf") throw CliError(out + ": ARBCI writes BDF+ files; name the output *.bdf");
+  ensureWritable(target);
+  const bci::Recording r = read(in, salvage);
+  try {
+    std::map<std::string, std::string> parameters = r.parameters;
+    parameters["SourceFile"] = std::filesystem::path(in).filename().string();
+    bci::RecordingWriter writer(target, r.info, parameters);
+    const int step = static_cast<int>(std::max(1.0, r.info.rate_hz));
+    for (std::int64_t first = 0; first < r.samples; first += step) {
+      const int count = static_cast<int>(std::min<std::int64_t>(step, r.samples - first));
+      bci::Block block(first, r.info.channelCount(), count);
+      for (int c = 0; c < block.channels; ++c) {
+        for (int s = 0; s < count; ++s) block.at(c, s) = r.at(c, first + s);
+      }
+      writer.write(block);
+    }
+    for (const bci::StimulusEvent& e : r.stimuli) writer.addStimulus(e);
+    for (const bci::Annotation& a : r.annotations) writer.addAnnotation(a);
+    writer.close();
+    std::cout << "wrote " << out << ": " << r.info.channelCount() << " channels, " << r.samples << " samples, "
+              << r.stimuli.size() << " stimuli, " << r.annotations.size() << " other events";
+    if (writer.clippedSamples() > 0) std::cout << "; " << writer.clippedSamples() << " samples clipped to +-8000 uV";
+    if (writer.shortenedAnnotations() > 0) {
+      std::cout << "; " << writer.shortenedAnnotations() << " long parameters or events cut to fit a record";
+    }
+    std::cout << "\n";
+  } catch (const bci::RecordingError& error) {
+    throw CliError(error.what());
+  }
+}
+
+}  // namespace
+
+void addEegCommand(CLI::App& root, int& exit_code) {
+  CLI::App* eeg = root.add_subcommand("eeg", "EEG files: information, conversion to BDF+, simulated recordings");
+  eeg->require_subcommand(1);
+
+  struct Options {
+    std::string file, in, out;
+    bool salvage = false;
+    SimulationOptions simulation;
+  };
+  auto options = std::make_shared<Options>();
+
+  CLI::App* info = eeg->add_subcommand("info", "Channels, rate, duration and event counts by code of an EEG file\n"
+                                               "(BCI2000 .dat, GDF, EDF(+), BDF(+)).");
+  info->add_option("FILE", options->file, "the recording")->required();
+  info->add_flag("--salvage", options->salvage, "read a file cut short up to its last complete record");
+  info->callback([options, &exit_code] {
+    printInfo(read(options->file, options->salvage));
+    exit_code = 0;
+  });
+
+  CLI::App* conv = eeg->add_subcommand("convert", "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N\",\n"
+                                                  "other events, parameters as \"Param name=value\").");
+  conv->add_option("IN", options->in, "the recording to read")->required();
+  conv->add_option("OUT", options->out, "the BDF+ file to write (*.bdf)")->required();
+  conv->add_flag("--salvage", options->salvage, "convert a file cut short up to its last complete record");
+  conv->callback([options, &exit_code] {
+    convert(options->in, options->out, options->salvage);
+    exit_code = 0;
+  });
+
+  CLI::App* sim = eeg->add_subcommand("simulate", "Record the simulated subject in a copy task to BDF+: selections of\n"
+                                                  "--sequences sequences of --stimuli flashing stimuli, one attended\n"
+                                                  "target per selection (marked in the file).");
+  SimulationOptions& s = options->simulation;
+  sim->add_option("--seconds", s.seconds, "length of the recording")->required()->check(CLI::Range(1.0, 86400.0));
+  sim->add_option("--out", s.out, "BDF+ file to write")->required();
+  sim->add_option("--seed", s.seed, "random seed (same seed, same recording)")->capture_default_str();
+  sim->add_option("--rate", s.rate_hz, "sampling rate in Hz")->capture_default_str()->check(CLI::Range(64.0, 4096.0));
+  sim->add_option("--montage", s.montage, "comma-separated 10-20 channel names")->capture_default_str();
+  sim->add_option("--stimuli", s.stimuli, "stimuli flashed one at a time (objects)")->capture_default_str()->check(CLI::Range(2, 64));
+  sim->add_option("--rows", s.rows, "flash rows and columns of a ROWSxCOLUMNS matrix instead (with --columns)")->check(CLI::Range(0, 32));
+  sim->add_option("--columns", s.columns, "columns of the matrix")->check(CLI::Range(0, 32));
+  sim->add_option("--sequences", s.sequences, "sequences per selection")->capture_default_str()->check(CLI::Range(1, 100));
+  sim->add_option("--flash-ms", s.flash_ms, "flash duration")->capture_default_str()->check(CLI::Range(10.0, 1000.0));
+  sim->add_option("--isi-ms", s.isi_ms, "inter-stimulus interval")->capture_default_str()->check(CLI::Range(0.0, 2000.0));
+  sim->add_option("--line-hz", s.line_hz, "line noise frequency (50 or 60)")->capture_default_str();
+  sim->add_option("--alpha-hz", s.alpha_hz, "alpha peak frequency")->capture_default_str()->check(CLI::Range(6.0, 14.0));
+  sim->add_flag("--paced", s.paced, "run in real time (as a live session would) instead of as fast as possible");
+  sim->callback([options, &exit_code] {
+    ensureWritable(options->simulation.out);
+    if (std::filesystem::path(options->simulation.out).extension() != ".bdf") {
+      throw CliError(options->simulation.out + ": ARBCI records BDF+ files; name the output *.bdf");
+    }
+    if ((options->simulation.rows > 0) != (options->simulation.columns > 0)) throw CliError("give both --rows and --columns");
+    const SimulationSummary summary = recordSimulation(options->simulation, std::cerr);
+    std::cout << "wrote " << options->simulation.out << ": " << summary.samples << " samples, " << summary.stimuli
+              << " stimuli (" << summary.targets << " targets), " << summary.selections << " selections\n";
+    exit_code = 0;
+  });
+}
+
+}  // namespace arbci::app

@@ -1,0 +1,29 @@
+// Where EEG comes from. Sources are polled: poll() returns at once with the whole blocks their
+// clock allows (at most `max_blocks`), never waiting for data.
+#pragma once
+
+#include <set>
+#include <vector>
+
+#include "arbci/bci/signal.h"
+
+namespace arbci::bci {
+
+class EegSource {
+ public:
+  virtual ~EegSource() = default;
+  virtual const SignalInfo& info() const = 0;
+  virtual std::vector<Block> poll(int max_blocks = 64) = 0;
+  // True once a finite source (a file) has delivered its last block.
+  virtual bool finished() const { return false; }
+  // The stimuli presented, as they happen (the simulated subject responds to those it attends).
+  virtual void present(const StimulusEvent&) {}
+  // Which stimulus codes the subject attends from now on (empty: none). A row/column paradigm
+  // attends the target's row and its column.
+  virtual void attend(const std::set<int>&) {}
+  // Stimuli the source itself carries (a replayed file's events) up to the samples delivered so
+  // far; each is returned once.
+  virtual std::vector<StimulusEvent> takeRecordedStimuli() { return {}; }
+};
+
+}  // namespace arbci::bci

@@ -1,0 +1,80 @@
+// Causal filtering of blocks: common average reference, IIR band-pass and notch (biquad
+// cascades whose state carries across blocks, so filtering block by block gives exactly the
+// output of filtering the whole signal) and decimation by moving average.
+#pragma once
+
+#include <vector>
+
+#include "arbci/bci/signal.h"
+
+namespace arbci::bci {
+
+struct Biquad {
+  double b0 = 1.0, b1 = 0.0, b2 = 0.0, a1 = 0.0, a2 = 0.0;  // a0 = 1
+};
+
+// Butterworth sections by the bilinear transform (cut-offs pre-warped). Throw
+// std::invalid_argument unless 0 < cutoff < rate / 2 and 1 <= order <= 12.
+std::vector<Biquad> butterworthLowpass(int order, double cutoff_hz, double rate_hz);
+std::vector<Biquad> butterworthHighpass(int order, double cutoff_hz, double rate_hz);
+// A second-order notch of quality `q` (bandwidth = frequency / q).
+Biquad notchFilter(double frequency_hz, double q, double rate_hz);
+// Magnitude response of a cascade at `frequency_hz`.
+double magnitudeResponse(const std::vector<Biquad>& sections, double frequency_hz, double rate_hz);
+
+// A biquad cascade with one state per channel (transposed direct form II, in double).
+class IirFilter {
+ public:
+  IirFilter(std::vector<Biquad> sections, int channels);
+  void process(Block& block);  // in place
+  void reset();
+  const std::vector<Biquad>& sections() const { return sections_; }
+
+ private:
+  std::vector<Biquad> sections_;
+  int channels_;
+  std::vector<double> state_;  // [channel][section][2]
+};
+
+// Subtracts the mean over channels from every sample.
+void commonAverageReference(Block& block);
+
+struct FilterSettings {
+  bool common_average = true;
+  double highpass_hz = 0.5;  // 0: none
+  double lowpass_hz = 30.0;  // 0: none
+  int order = 4;             // of each Butterworth half
+  double notch_hz = 50.0;    // 0: none (60 in the Americas)
+  double notch_q = 25.0;
+};
+
+// The cleaning stage of the cycle: CAR, band-pass and notch, in that order.
+class FilterChain {
+ public:
+  // Throws std::invalid_argument naming the setting that does not fit `info`'s rate.
+  FilterChain(const FilterSettings& settings, const SignalInfo& info);
+  void process(Block& block);
+  double magnitude(double frequency_hz) const;  // of the IIR part
+
+ private:
+  FilterSettings settings_;
+  double rate_hz_;
+  IirFilter filter_;
+};
+
+// Keeps every `factor`-th sample of the moving average over the last `factor` samples; output
+// sample k covers input samples [k*factor, (k+1)*factor). State carries across blocks.
+class Decimator {
+ public:
+  Decimator(int factor, int channels);
+  Block process(const Block& block);  // the block of output samples completed by `block`
+  int factor() const { return factor_; }
+
+ private:
+  int factor_, channels_;
+  std::vector<double> sums_;
+  int count_ = 0;
+  std::int64_t next_input_ = -1;
+};
+
+}  // namespace arbci::bci

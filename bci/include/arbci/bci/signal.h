@@ -1,0 +1,51 @@
+// EEG in blocks: channels x samples of microvolts, stamped with the index of the first sample.
+// The sample index is the experiment's clock; stimulus events carry the index of the sample at
+// which they were presented.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace arbci::bci {
+
+struct SignalInfo {
+  double rate_hz = 256.0;
+  std::vector<std::string> channels;
+  int block_size = 15;  // samples per block (15 at 256 Hz: one 58.6 ms cycle)
+  int channelCount() const { return static_cast<int>(channels.size()); }
+  double blockSeconds() const { return block_size / rate_hz; }
+};
+
+// Channel-major: sample s of channel c is data[c * samples + s].
+struct Block {
+  std::int64_t first_sample = 0;
+  int channels = 0;
+  int samples = 0;
+  std::vector<float> data;
+
+  Block() = default;
+  Block(std::int64_t first, int channel_count, int sample_count)
+      : first_sample(first), channels(channel_count), samples(sample_count),
+        data(static_cast<size_t>(channel_count) * sample_count, 0.0f) {}
+  float& at(int channel, int sample) { return data[static_cast<size_t>(channel) * samples + sample]; }
+  float at(int channel, int sample) const { return data[static_cast<size_t>(channel) * samples + sample]; }
+  std::int64_t endSample() const { return first_sample + samples; }
+};
+
+// A stimulus presented to the subject (or any other event of the session).
+struct StimulusEvent {
+  std::int64_t sample = 0;  // the EEG sample at which it was presented
+  int code = 0;             // which stimulus: an object, a row or a column (1-based)
+  bool target = false;      // the stimulus the subject attends (known in calibration runs)
+  int duration_samples = 0;
+};
+
+// Other events a session records: phase changes, selections, robot commands.
+struct Annotation {
+  std::int64_t sample = 0;
+  std::string text;
+  int duration_samples = 0;
+};
+
+}  // namespace arbci::bci

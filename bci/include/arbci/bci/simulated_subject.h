@@ -1,0 +1,86 @@
+// The default EEG source: a simulated subject. Background EEG with a 1/f spectrum shared in part
+// between channels (volume conduction), alpha, line noise and eye blinks; every flash evokes a
+// small visual response, and flashes of the attended stimuli an N2/P3 complex with a parietal
+// maximum, its latency and amplitude varying from trial to trial. Deterministic for a seed and
+// the same sequence of calls.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "arbci/bci/eeg_source.h"
+#include "arbci/bci/sample_clock.h"
+
+namespace arbci::bci {
+
+// The ERP of one subject.
+struct SubjectProfile {
+  double p3_amplitude_uv = 5.0;
+  double p3_latency_s = 0.35;
+  double p3_width_s = 0.09;  // standard deviation of the Gaussian
+  double n2_amplitude_uv = -2.0;
+  double n2_latency_s = 0.24;
+  double n2_width_s = 0.035;
+  double latency_jitter_s = 0.04;      // trial-to-trial standard deviation
+  double amplitude_variability = 0.4;  // log-normal sigma of the trial's amplitude factor
+  double vep_amplitude_uv = 2.0;       // N1/P2 evoked by every flash, occipital
+
+  // A plausible subject drawn from `seed` (amplitude 3.5-7 uV, P3 latency 300-420 ms).
+  static SubjectProfile drawn(std::uint64_t seed);
+};
+
+struct SimulatedSubjectConfig {
+  std::vector<std::string> montage = {"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
+  double rate_hz = 256.0;
+  int block_size = 15;
+  std::uint64_t seed = 1;
+  double background_uv = 9.0;  // RMS of the 1/f background per channel
+  double shared_background = 0.5;  // fraction of the background's variance common to all channels
+  double alpha_hz = 10.0;
+  double alpha_uv = 4.0;  // RMS at occipital channels
+  double line_hz = 50.0;
+  double line_uv = 1.5;
+  double blinks_per_minute = 6.0;
+  double blink_uv = 100.0;  // at Fp1/Fp2; less further back
+  std::optional<SubjectProfile> profile;  // default: SubjectProfile::drawn(seed)
+};
+
+class SimulatedSubject final : public EegSource {
+ public:
+  // `clock` paces the source (WallClock: real time; ManualClock: the caller's; UnboundedClock: as
+  // fast as it is read). Throws std::invalid_argument for an empty montage or a bad rate.
+  SimulatedSubject(const SimulatedSubjectConfig& config, std::shared_ptr<const SampleClock> clock);
+  ~SimulatedSubject() override;
+
+  const SignalInfo& info() const override { return info_; }
+  std::vector<Block> poll(int max_blocks = 64) override;
+  void present(const StimulusEvent& event) override;
+  void attend(const std::set<int>& codes) override { attended_ = codes; }
+  const SubjectProfile& profile() const { return profile_; }
+  std::int64_t samplesGenerated() const { return generated_; }
+
+ private:
+  struct Generator;
+  struct ActiveResponse {
+    std::int64_t onset;
+    double p3_latency, p3_scale, n2_scale;
+    bool attended;
+  };
+  float evoked(int channel, std::int64_t sample) const;
+
+  SimulatedSubjectConfig config_;
+  SubjectProfile profile_;
+  SignalInfo info_;
+  std::shared_ptr<const SampleClock> clock_;
+  std::unique_ptr<Generator> generator_;
+  std::set<int> attended_;
+  std::vector<ActiveResponse> responses_;
+  std::mt19937_64 trial_random_;
+  std::int64_t generated_ = 0;
+};
+
+}  // namespace arbci::bci
