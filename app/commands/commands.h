@@ -12,5 +12,6 @@ void addMarkerCommand(CLI::App& root, int& exit_code);
 void addDetectCommand(CLI::App& root, int& exit_code);
 void addCalibrateCommand(CLI::App& root, int& exit_code);
 void addEegCommand(CLI::App& root, int& exit_code);
+void addP300Commands(CLI::App& root, int& exit_code);  // train, evaluate
 
 }  // namespace arbci::app

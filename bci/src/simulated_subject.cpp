@@ -74,7 +74,7 @@ SubjectProfile SubjectProfile::drawn(std::uint64_t seed) {
   std::mt19937_64 random(seed * 0x9E3779B97F4A7C15ULL + 17);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   SubjectProfile p;
-  p.p3_amplitude_uv = 3.5 + 3.5 * unit(random);
+  p.p3_amplitude_uv = 4.5 + 3.5 * unit(random);
   p.p3_latency_s = 0.30 + 0.12 * unit(random);
   p.p3_width_s = 0.07 + 0.04 * unit(random);
   p.n2_amplitude_uv = -(1.0 + 2.0 * unit(random));

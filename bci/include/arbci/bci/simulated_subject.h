@@ -38,7 +38,7 @@ struct SimulatedSubjectConfig {
   double rate_hz = 256.0;
   int block_size = 15;
   std::uint64_t seed = 1;
-  double background_uv = 9.0;  // RMS of the 1/f background per channel
+  double background_uv = 7.0;  // RMS of the 1/f background per channel
   double shared_background = 0.5;  // fraction of the background's variance common to all channels
   double alpha_hz = 10.0;
   double alpha_uv = 4.0;  // RMS at occipital channels

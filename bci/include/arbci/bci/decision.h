@@ -1,0 +1,58 @@
+// From flash scores to a selection. Scores accumulate per stimulus code over sequences; the
+// choice is the object (single stimulus) or the row and the column (row/column) with the most
+// evidence. The certainty is the posterior probability of the choice under a Gaussian model of
+// target and non-target scores (fitted on cross-validated training scores): it drives dynamic
+// stopping.
+#pragma once
+
+#include <map>
+#include <set>
+#include <vector>
+
+#include "arbci/bci/paradigm_layout.h"
+
+namespace arbci::bci {
+
+struct ScoreModel {
+  double target_mean = 1.0;
+  double other_mean = -1.0;
+  double sd = 1.0;  // pooled within-class standard deviation
+  // Fitted to scores and labels; throws std::invalid_argument without both classes.
+  static ScoreModel fit(const std::vector<double>& scores, const std::vector<bool>& target);
+};
+
+struct Decision {
+  std::set<int> codes;      // {object} or {row, rows + column}
+  int choice = -1;          // 0-based object or cell (row-major)
+  double certainty = 0.0;   // posterior probability of `codes`
+};
+
+struct StoppingRule {
+  int max_sequences = 15;
+  int min_sequences = 1;
+  double certainty = 0.0;  // stop once the decision is this sure; 0: always max_sequences
+};
+
+class SelectionAccumulator {
+ public:
+  SelectionAccumulator(const ParadigmLayout& layout, const ScoreModel& model);
+  void add(int code, double score);
+  // Sequences in which every code has flashed.
+  int completeSequences() const;
+  int flashes() const { return flashes_; }
+  Decision decide() const;
+  // After a complete sequence: stop with this rule?
+  bool shouldStop(const StoppingRule& rule) const;
+
+ private:
+  // Posterior over the candidates `codes` from the log-likelihood ratios.
+  std::map<int, double> posterior(int first_code, int count) const;
+
+  ParadigmLayout layout_;
+  ScoreModel model_;
+  std::map<int, double> evidence_;  // log-likelihood ratio target vs non-target, per code
+  std::map<int, int> counts_;
+  int flashes_ = 0;
+};
+
+}  // namespace arbci::bci

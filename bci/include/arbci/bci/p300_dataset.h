@@ -1,0 +1,53 @@
+// Labelled P300 epochs from recordings (BCI2000 .dat or ARBCI's BDF+), grouped into selections
+// and sequences, ready for training and evaluation.
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "arbci/bci/classifier.h"
+#include "arbci/bci/paradigm_layout.h"
+#include "arbci/bci/recording.h"
+
+namespace arbci::bci {
+
+struct SelectionEpochs {
+  std::vector<int> epochs;     // rows of the dataset, in presentation order
+  std::set<int> target_codes;  // what the subject attended (copy task); empty when unknown
+  int file = 0;
+};
+
+struct P300Dataset {
+  SignalInfo info;  // of the recordings
+  FeatureShape shape;
+  std::vector<std::string> feature_channels;
+  ParadigmLayout layout;
+  Eigen::MatrixXd features;  // one row per epoch
+  std::vector<bool> target;
+  std::vector<int> code;
+  std::vector<int> sequence;  // 0-based, within the selection
+  std::vector<int> selection;
+  std::vector<SelectionEpochs> selections;
+  std::vector<std::string> sources;
+  int dropped_epochs = 0;  // flashes too close to the end of a file for a whole window
+  // Averages of the filtered response windows at the full rate, all channels (rows), for plots.
+  Eigen::MatrixXd erp_target, erp_other;
+  double erp_start_s = 0.0;
+
+  int epochs() const { return static_cast<int>(features.rows()); }
+};
+
+// The layout a recording declares: BCI2000 NumMatrixRows/NumMatrixColumns (with the symbols of
+// TargetDefinitions), ARBCI's "Paradigm" parameter, or single stimuli numbered by the codes.
+ParadigmLayout layoutOf(const Recording& recording);
+
+// Filters each recording as the online cycle does, cuts the response windows and computes the
+// features. Throws std::invalid_argument naming the file for recordings without stimuli, with
+// other channels or rates than the first, or another paradigm.
+P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings,
+                         const Progress& progress = {});
+
+}  // namespace arbci::bci

@@ -1,0 +1,155 @@
+#include "arbci/bci/p300_dataset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace arbci::bci {
+namespace {
+
+// BCI2000 matrix parameters: "matrix R C v..." where R or C may be "{ labels }".
+std::vector<std::vector<std::string>> bci2000Matrix(const Recording& r, const std::string& name) {
+  const auto found = r.parameters.find(name);
+  if (found == r.parameters.end()) return {};
+  std::istringstream in(found->second);
+  std::string type;
+  in >> type;
+  auto dimension = [&]() {
+    std::string token;
+    in >> token;
+    if (token != "{") return std::atoi(token.c_str());
+    int count = 0;
+    while (in >> token && token != "}") ++count;
+    return count;
+  };
+  const int rows = dimension(), columns = dimension();
+  std::vector<std::vector<std::string>> matrix(static_cast<size_t>(std::max(rows, 0)));
+  for (auto& row : matrix) {
+    for (int c = 0; c < columns; ++c) {
+      std::string value;
+      if (!(in >> value)) return {};
+      row.push_back(value);
+    }
+  }
+  return matrix;
+}
+
+double medianGap(const std::vector<StimulusEvent>& stimuli, double rate) {
+  std::vector<double> gaps;
+  for (size_t i = 1; i < stimuli.size(); ++i) gaps.push_back((stimuli[i].sample - stimuli[i - 1].sample) / rate);
+  if (gaps.empty()) return 0.18;
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
+}  // namespace
+
+ParadigmLayout layoutOf(const Recording& r) {
+  const double soa = medianGap(r.stimuli, r.info.rate_hz);
+  if (r.parameters.count("NumMatrixRows") && r.parameters.count("NumMatrixColumns")) {
+    const int rows = static_cast<int>(bci2000Number(r, "NumMatrixRows"));
+    const int columns = static_cast<int>(bci2000Number(r, "NumMatrixColumns"));
+    ParadigmLayout layout = ParadigmLayout::matrix(rows, columns, soa);
+    for (const auto& row : bci2000Matrix(r, "TargetDefinitions")) {
+      if (!row.empty()) layout.symbols.push_back(row[0] == "%" ? "" : row[0]);
+    }
+    if (static_cast<int>(layout.symbols.size()) != rows * columns) layout.symbols.clear();
+    return layout;
+  }
+  const auto paradigm = r.parameters.find("Paradigm");
+  if (paradigm != r.parameters.end()) {
+    int rows = 0, columns = 0, stimuli = 0;
+    if (std::sscanf(paradigm->second.c_str(), "row/column %dx%d", &rows, &columns) == 2) return ParadigmLayout::matrix(rows, columns, soa);
+    if (std::sscanf(paradigm->second.c_str(), "single stimulus, %d", &stimuli) == 1) return ParadigmLayout::single(stimuli, soa);
+  }
+  int highest = 0;
+  for (const StimulusEvent& e : r.stimuli) highest = std::max(highest, e.code);
+  return ParadigmLayout::single(std::max(highest, 2), soa);
+}
+
+P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings, const Progress& progress) {
+  if (recordings.empty()) throw std::invalid_argument("no recordings given");
+  P300Dataset data;
+  data.info = recordings.front().info;
+  data.layout = layoutOf(recordings.front());
+  const FeatureExtractor extractor(settings, data.info);
+  data.shape = extractor.shape();
+  for (int c : extractor.channelIndices()) data.feature_channels.push_back(data.info.channels[static_cast<size_t>(c)]);
+  const Epocher window_shape(data.info.channelCount(), data.info.rate_hz, settings.window);
+  const int offset = window_shape.offsetSamples(), length = window_shape.samplesPerEpoch();
+
+  std::vector<Eigen::VectorXd> rows;
+  data.erp_target = Eigen::MatrixXd::Zero(data.info.channelCount(), length);
+  data.erp_other = Eigen::MatrixXd::Zero(data.info.channelCount(), length);
+  data.erp_start_s = settings.window.start_s;
+  int n_target = 0, n_other = 0;
+  for (size_t f = 0; f < recordings.size(); ++f) {
+    const Recording& r = recordings[f];
+    if (progress) progress(static_cast<double>(f) / recordings.size(), "filtering and epoching " + r.source);
+    if (r.stimuli.empty()) throw std::invalid_argument(r.source + ": no stimulus events (StimulusCode) to classify");
+    if (r.info.rate_hz != data.info.rate_hz) {
+      throw std::invalid_argument(r.source + ": sampled at " + std::to_string(r.info.rate_hz) + " Hz, the first file at " +
+                                  std::to_string(data.info.rate_hz) + " Hz");
+    }
+    if (r.info.channels != data.info.channels) throw std::invalid_argument(r.source + ": has other channels than the first file");
+    const ParadigmLayout layout = layoutOf(r);
+    if (layout.kind != data.layout.kind || layout.codes() != data.layout.codes()) {
+      throw std::invalid_argument(r.source + ": " + layout.describeShape() + ", the first file " + data.layout.describeShape());
+    }
+    data.sources.push_back(r.source);
+
+    // The whole signal through the online filter chain (block-wise and whole are identical).
+    Block signal(0, r.info.channelCount(), static_cast<int>(r.samples));
+    signal.data = r.data;
+    FilterChain(settings.filter, r.info).process(signal);
+
+    // Selections: runs of flashes separated by pauses longer than four stimulus intervals.
+    const double gap_limit = std::max(1.0, 4.0 * layout.soa_s) * r.info.rate_hz;
+    std::int64_t previous = -1;
+    int in_selection = 0;
+    for (const StimulusEvent& e : r.stimuli) {
+      if (previous < 0 || e.sample - previous > gap_limit) {
+        data.selections.push_back(SelectionEpochs{{}, {}, static_cast<int>(f)});
+        in_selection = 0;
+      }
+      previous = e.sample;
+      const std::int64_t first = e.sample + offset;
+      if (first < 0 || first + length > r.samples) {
+        ++data.dropped_epochs;
+        ++in_selection;
+        continue;
+      }
+      Epoch epoch;
+      epoch.event = e;
+      epoch.channels = signal.channels;
+      epoch.samples = length;
+      epoch.data.resize(static_cast<size_t>(signal.channels) * length);
+      for (int c = 0; c < signal.channels; ++c) {
+        std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + first), length,
+                    epoch.data.begin() + static_cast<std::ptrdiff_t>(c) * length);
+      }
+      rows.push_back(extractor.features(epoch));
+      Eigen::MatrixXd& erp = e.target ? data.erp_target : data.erp_other;
+      (e.target ? n_target : n_other)++;
+      for (int c = 0; c < signal.channels; ++c) {
+        for (int s = 0; s < length; ++s) erp(c, s) += epoch.at(c, s);
+      }
+      data.target.push_back(e.target);
+      data.code.push_back(e.code);
+      data.sequence.push_back(in_selection / layout.codes());
+      data.selection.push_back(static_cast<int>(data.selections.size()) - 1);
+      data.selections.back().epochs.push_back(static_cast<int>(rows.size()) - 1);
+      if (e.target) data.selections.back().target_codes.insert(e.code);
+      ++in_selection;
+    }
+  }
+  data.features.resize(static_cast<Eigen::Index>(rows.size()), data.shape.size());
+  for (size_t i = 0; i < rows.size(); ++i) data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  if (n_target > 0) data.erp_target /= n_target;
+  if (n_other > 0) data.erp_other /= n_other;
+  if (progress) progress(1.0, "epochs ready");
+  return data;
+}
+
+}  // namespace arbci::bci
