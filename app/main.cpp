@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   arbci::app::addCalibrateCommand(root, exit_code);
   arbci::app::addEegCommand(root, exit_code);
   arbci::app::addP300Commands(root, exit_code);
+  arbci::app::addRobotCommand(root, exit_code);
 
   try {
     root.parse(argc, argv);

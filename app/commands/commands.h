@@ -13,5 +13,6 @@ void addDetectCommand(CLI::App& root, int& exit_code);
 void addCalibrateCommand(CLI::App& root, int& exit_code);
 void addEegCommand(CLI::App& root, int& exit_code);
 void addP300Commands(CLI::App& root, int& exit_code);  // train, evaluate
+void addRobotCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

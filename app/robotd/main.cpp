@@ -1,0 +1,61 @@
+// arbci-robotd: the robot backend. Listens for authenticated commands on UDP and drives the
+// simulated arm (the default driver) in real time or faster.
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <iostream>
+
+#include "arbci/robot/backend.h"
+#include "arbci/robot/key_file.h"
+#include "arbci/robot/robot_config.h"
+#include "arbci/robot/simulated_arm.h"
+
+namespace {
+
+std::atomic<bool> stop_requested{false};
+
+void onSignal(int) { stop_requested = true; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"arbci-robotd: the ARBCI robot backend. Accepts GRASP, DROP, HOME, STOP and STATUS over UDP,\n"
+               "authenticated with the shared key (make one with `arbci robot keygen`), and drives a\n"
+               "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: docs/robot-protocol.md.",
+               "arbci-robotd"};
+  int port = 47800;
+  std::string host = "127.0.0.1", key_file, config_file;
+  double speed = 0.0;
+  app.add_option("--port", port, "UDP port to listen on")->capture_default_str()->check(CLI::Range(1, 65535));
+  app.add_option("--host", host, "address to listen on (127.0.0.1: this machine only)")->capture_default_str();
+  app.add_option("--key-file", key_file, "the shared key")->required();
+  app.add_option("--config", config_file, "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
+  app.add_option("--speed", speed, "simulated seconds per real second (overrides the config's speed_factor)")->check(CLI::Range(0.01, 1000.0));
+  app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);
+  app.failure_message([](const CLI::App*, const CLI::Error& error) { return std::string("arbci-robotd: ") + error.what() + "\n"; });
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    const arbci::robot::Key key = arbci::robot::loadKey(key_file);
+    arbci::robot::RobotConfig config;
+    if (!config_file.empty()) config = arbci::robot::RobotConfig::load(config_file);
+    arbci::robot::BackendOptions options;
+    options.port = port;
+    options.host = host;
+    options.speed_factor = speed > 0.0 ? speed : config.speed_factor;
+    options.log = &std::cerr;
+    arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config), options);
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port() << " (simulated arm, speed x" << options.speed_factor
+              << ", " << config.objects.size() << " objects)" << std::endl;
+    backend.run(stop_requested);
+    const arbci::robot::BackendStats s = backend.stats();
+    std::cerr << "arbci-robotd: stopped; " << s.datagrams << " datagrams, " << s.executed << " commands run, " << s.rejected
+              << " rejected, " << s.replayed << " replayed, " << s.ignored << " ignored" << std::endl;
+  } catch (const std::exception& error) {
+    std::cerr << "arbci-robotd: " << error.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,55 @@
+// The robot backend: authenticates every datagram, drops replays, runs each command exactly
+// once however many copies arrive, answers only the sender, and reports progress and the outcome
+// to the client that gave the command.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <ostream>
+
+#include "arbci/robot/protocol.h"
+#include "arbci/robot/robot_driver.h"
+#include "arbci/robot/udp_socket.h"
+
+namespace arbci::robot {
+
+struct BackendOptions {
+  int port = 0;  // 0: any free port (see RobotBackend::port)
+  std::string host = "127.0.0.1";
+  double speed_factor = 1.0;  // robot seconds per real second
+  double status_interval_s = 0.2;  // progress pushed to the commanding client
+  double max_clock_skew_s = 30.0;  // older or newer timestamps count as replays
+  std::ostream* log = nullptr;  // rejected and ignored datagrams (rate-limited)
+};
+
+struct BackendStats {
+  std::uint64_t datagrams = 0;
+  std::uint64_t ignored = 0;       // undecodable or unauthenticated: no answer
+  std::uint64_t replayed = 0;      // authenticated but replayed or stale
+  std::uint64_t duplicates = 0;    // retransmissions answered from the cache
+  std::uint64_t rejected = 0;      // commands refused (workspace, busy, state)
+  std::uint64_t executed = 0;      // motion commands started
+  std::map<DecodeError, std::uint64_t> by_error;
+};
+
+class RobotBackend {
+ public:
+  RobotBackend(const Key& key, std::unique_ptr<RobotDriver> driver, const BackendOptions& options);
+  ~RobotBackend();
+
+  int port() const;
+  std::uint64_t boot() const;
+  // Handles what has arrived and advances the robot; waits at most `wait_ms` for datagrams.
+  void poll(int wait_ms = 5);
+  // Polls until `stop` is set.
+  void run(const std::atomic<bool>& stop);
+  BackendStats stats() const;  // safe from any thread
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace arbci::robot

@@ -1,0 +1,333 @@
+// The backend and the client over real UDP on 127.0.0.1: a grasp-then-drop moves the object,
+// commands run exactly once through a lossy relay, floods of bad datagrams change nothing, the
+// workspace and STOP are obeyed, and a backend restarted mid-command is reported as a failure.
+// Every wait is bounded.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include "arbci/robot/backend.h"
+#include "arbci/robot/client.h"
+#include "arbci/robot/simulated_arm.h"
+
+namespace arbci::robot {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+Key testKey() {
+  Key key{};
+  for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<std::uint8_t>(i * 31 + 5);
+  return key;
+}
+
+RobotConfig twoObjects() {
+  RobotConfig c;
+  c.objects = {{1, {0.10, 0.60, 0.06}, 0.06, 0.03}, {2, {-0.15, 0.55, 0.06}, 0.06, 0.03}};
+  return c;
+}
+
+// A backend on its own thread.
+class RunningBackend {
+ public:
+  explicit RunningBackend(double speed, int port = 0, RobotConfig config = twoObjects()) {
+    BackendOptions options;
+    options.port = port;
+    options.speed_factor = speed;
+    options.status_interval_s = 0.05;
+    backend_ = std::make_unique<RobotBackend>(testKey(), std::make_unique<SimulatedArm>(config), options);
+    thread_ = std::thread([this] { backend_->run(stop_); });
+  }
+  ~RunningBackend() { halt(); }
+  void halt() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  int port() const { return backend_->port(); }
+  BackendStats stats() const { return backend_->stats(); }
+
+ private:
+  std::unique_ptr<RobotBackend> backend_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+ClientOptions fastClient() {
+  ClientOptions o;
+  o.first_retransmit_s = 0.01;
+  o.max_retransmit_s = 0.05;
+  o.status_interval_s = 0.02;
+  return o;
+}
+
+// Polls until an event for `sequence` ends it (finished, rejected, failed) or `timeout` passes.
+std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence, std::chrono::milliseconds timeout = 20s) {
+  std::vector<RobotEvent> seen;
+  const auto end = Clock::now() + timeout;
+  while (Clock::now() < end) {
+    client.poll();
+    for (RobotEvent& e : client.takeEvents()) {
+      const bool final = e.sequence == sequence && (e.kind == RobotEvent::Kind::Finished || e.kind == RobotEvent::Kind::Rejected ||
+                                                    e.kind == RobotEvent::Kind::Failed);
+      seen.push_back(std::move(e));
+      if (final) return seen;
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+  return seen;
+}
+
+const RobotEvent* finalEvent(const std::vector<RobotEvent>& events) { return events.empty() ? nullptr : &events.back(); }
+
+StatusPayload freshStatus(RobotClient& client) {
+  const auto end = Clock::now() + 3s;
+  client.takeEvents();
+  const auto before = client.status();
+  while (Clock::now() < end) {
+    client.poll();
+    if (client.status() && (!before || client.status()->tool.x != before->tool.x || Clock::now() > end - 2900ms)) break;
+    std::this_thread::sleep_for(1ms);
+  }
+  // Let two more status replies arrive so the one returned is current.
+  const auto settle = Clock::now() + 60ms;
+  while (Clock::now() < settle) {
+    client.poll();
+    std::this_thread::sleep_for(1ms);
+  }
+  return client.status().value_or(StatusPayload{});
+}
+
+TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {
+  RunningBackend backend(20.0);
+  RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
+  auto events = waitFor(client, client.send(MessageType::Grasp, {0.10, 0.60, 0.06}));
+  ASSERT_NE(finalEvent(events), nullptr);
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished) << finalEvent(events)->text;
+  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success) << finalEvent(events)->text;
+  const Vec3 drop{-0.20, 0.75, 0.0};
+  events = waitFor(client, client.send(MessageType::Drop, drop));
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success) << finalEvent(events)->text;
+  const StatusPayload status = freshStatus(client);
+  ASSERT_EQ(status.objects.size(), 2u);
+  const WorldObject& moved = status.objects[0];
+  EXPECT_EQ(moved.id, 1);
+  EXPECT_FALSE(moved.held);
+  const double base_z = moved.position.z - 0.06;  // the object's base on the table
+  EXPECT_LT(std::hypot(moved.position.x - drop.x, moved.position.y - drop.y, base_z - drop.z), 0.005);
+  EXPECT_EQ(status.holding, -1);
+  EXPECT_EQ(backend.stats().executed, 2u);
+}
+
+// Forwards datagrams between one client and the backend, dropping `loss` of them each way.
+class LossyRelay {
+ public:
+  LossyRelay(int backend_port, double loss) : backend_(Endpoint::resolve("127.0.0.1", backend_port)), loss_(loss) {
+    thread_ = std::thread([this] { run(); });
+  }
+  ~LossyRelay() {
+    stop_ = true;
+    thread_.join();
+  }
+  int port() const { return front_.port(); }
+  std::uint64_t dropped() const { return dropped_; }
+
+ private:
+  void run() {
+    std::mt19937 random(1234);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::optional<Endpoint> client;
+    while (!stop_) {
+      front_.wait(2);
+      while (auto d = front_.receive()) {
+        client = d->from;
+        if (unit(random) < loss_) ++dropped_;
+        else back_.sendTo(d->bytes, backend_);
+      }
+      while (auto d = back_.receive()) {
+        if (!client) continue;
+        if (unit(random) < loss_) ++dropped_;
+        else front_.sendTo(d->bytes, *client);
+      }
+    }
+  }
+  UdpSocket front_, back_;
+  Endpoint backend_;
+  double loss_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> dropped_{0};
+  std::thread thread_;
+};
+
+TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
+  RunningBackend backend(50.0);
+  LossyRelay relay(backend.port(), 0.30);
+  RobotClient client(Endpoint::resolve("127.0.0.1", relay.port()), testKey(), fastClient());
+  int finished = 0;
+  for (int i = 0; i < 100; ++i) {
+    const auto sequence = client.send(MessageType::Home);
+    const auto events = waitFor(client, sequence, 10s);
+    ASSERT_NE(finalEvent(events), nullptr) << "command " << i;
+    ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished) << "command " << i << ": " << finalEvent(events)->text;
+    ++finished;
+  }
+  EXPECT_EQ(finished, 100);
+  const BackendStats stats = backend.stats();
+  EXPECT_EQ(stats.executed, 100u);    // each exactly once
+  EXPECT_GT(stats.duplicates, 0u);    // although copies did arrive
+  EXPECT_GT(relay.dropped(), 50u);
+}
+
+TEST(RobotBackend, TenThousandBadDatagramsChangeNothing) {
+  RunningBackend backend(20.0);
+  const Endpoint target = Endpoint::resolve("127.0.0.1", backend.port());
+  RobotClient client(target, testKey(), fastClient());
+  const StatusPayload before = freshStatus(client);
+  ASSERT_EQ(before.objects.size(), 2u);
+
+  UdpSocket attacker;
+  std::mt19937 random(99);
+  std::uniform_int_distribution<int> byte(0, 255);
+  Key wrong = testKey();
+  wrong[0] ^= 0xff;
+  Message grasp;
+  grasp.type = MessageType::Grasp;
+  grasp.session = 777;
+  grasp.target = {0.10, 0.60, 0.06};
+  for (int i = 0; i < 10000; ++i) {
+    std::vector<std::uint8_t> bytes;
+    grasp.sequence = static_cast<std::uint64_t>(i + 1);
+    grasp.timestamp_ms = wallClockMs();
+    switch (i % 6) {
+      case 0:  // random bytes of random length
+        bytes.resize(static_cast<size_t>(random() % 300));
+        for (auto& b : bytes) b = static_cast<std::uint8_t>(byte(random));
+        break;
+      case 1:  // a valid command cut short
+        bytes = encode(grasp, testKey());
+        bytes.resize(static_cast<size_t>(random() % bytes.size()));
+        break;
+      case 2:  // another protocol version
+        bytes = encode(grasp, testKey());
+        bytes[4] = 9;
+        break;
+      case 3:  // oversized
+        bytes.assign(1500 + random() % 2000, 0x41);
+        break;
+      case 4:  // signed with another key
+        bytes = encode(grasp, wrong);
+        break;
+      case 5:  // an authenticated command from an hour ago: a replay
+        grasp.timestamp_ms = wallClockMs() - 3600 * 1000;
+        bytes = encode(grasp, testKey());
+        break;
+    }
+    attacker.sendTo(bytes, target);
+    if (i % 200 == 0) std::this_thread::sleep_for(1ms);  // do not overflow the socket buffer
+  }
+  std::this_thread::sleep_for(300ms);
+  const BackendStats stats = backend.stats();
+  EXPECT_EQ(stats.executed, 0u);
+  EXPECT_GE(stats.ignored, 8000u);
+  EXPECT_GE(stats.replayed, 1000u);
+  // Still answering, and nothing moved.
+  const StatusPayload after = freshStatus(client);
+  EXPECT_NEAR(after.tool.x, before.tool.x, 1e-9);
+  EXPECT_NEAR(after.tool.z, before.tool.z, 1e-9);
+  EXPECT_EQ(after.objects[0].position.x, before.objects[0].position.x);
+  EXPECT_EQ(after.holding, -1);
+  // A command replayed within its session is answered from the cache, never run again.
+  const auto events = waitFor(client, client.send(MessageType::Home));
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(backend.stats().executed, 1u);
+}
+
+TEST(RobotBackend, OutsideTheWorkspaceIsRejectedWithTheReason) {
+  RunningBackend backend(20.0);
+  RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
+  auto events = waitFor(client, client.send(MessageType::Grasp, {1.5, 0.6, 0.06}));
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Rejected);
+  EXPECT_EQ(finalEvent(events)->reason, RejectReason::OutsideWorkspace);
+  EXPECT_NE(finalEvent(events)->text.find("outside the workspace"), std::string::npos);
+  events = waitFor(client, client.send(MessageType::Grasp, {0.1, 0.6, -0.2}));
+  EXPECT_EQ(finalEvent(events)->reason, RejectReason::OutsideWorkspace);
+  events = waitFor(client, client.send(MessageType::Drop, {0.1, 0.6, 0.0}));
+  EXPECT_EQ(finalEvent(events)->reason, RejectReason::InvalidState);  // holding nothing
+  EXPECT_EQ(backend.stats().executed, 0u);
+}
+
+TEST(RobotBackend, StopHaltsAMotionAtOnce) {
+  RunningBackend backend(1.0);  // real time: the grasp takes seconds
+  RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
+  const auto grasp = client.send(MessageType::Grasp, {0.10, 0.60, 0.06});
+  const auto end = Clock::now() + 5s;
+  bool accepted = false;
+  while (Clock::now() < end && !accepted) {
+    client.poll();
+    for (const RobotEvent& e : client.takeEvents()) accepted |= e.kind == RobotEvent::Kind::Accepted && e.sequence == grasp;
+    std::this_thread::sleep_for(1ms);
+  }
+  ASSERT_TRUE(accepted);
+  std::this_thread::sleep_for(400ms);
+  const auto stop = client.send(MessageType::Stop);
+  auto events = waitFor(client, grasp, 3s);
+  ASSERT_NE(finalEvent(events), nullptr);
+  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Stopped);
+  (void)stop;
+  const StatusPayload halted = freshStatus(client);
+  std::this_thread::sleep_for(300ms);
+  const StatusPayload later = freshStatus(client);
+  EXPECT_EQ(halted.state, RobotState::Stopped);
+  EXPECT_EQ(later.tool.x, halted.tool.x);
+  EXPECT_EQ(later.tool.z, halted.tool.z);
+  // It moved before the stop, and will move again when told.
+  EXPECT_GT(std::abs(halted.tool.x) + std::abs(halted.tool.y - 0.45) + std::abs(halted.tool.z - 0.45), 0.01);
+  events = waitFor(client, client.send(MessageType::Home), 15s);
+  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+}
+
+TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {
+  auto first = std::make_unique<RunningBackend>(1.0);
+  const int port = first->port();
+  RobotClient client(Endpoint::resolve("127.0.0.1", port), testKey(), fastClient());
+  const auto grasp = client.send(MessageType::Grasp, {0.10, 0.60, 0.06});
+  const auto end = Clock::now() + 5s;
+  bool accepted = false;
+  while (Clock::now() < end && !accepted) {
+    client.poll();
+    for (const RobotEvent& e : client.takeEvents()) accepted |= e.kind == RobotEvent::Kind::Accepted;
+    std::this_thread::sleep_for(1ms);
+  }
+  ASSERT_TRUE(accepted);
+  first.reset();  // the backend dies mid-command
+  bool silent = false;
+  const auto quiet_end = Clock::now() + 1500ms;
+  const auto died = Clock::now();
+  double silent_after = 0.0;
+  while (Clock::now() < quiet_end && !silent) {
+    client.poll();
+    for (const RobotEvent& e : client.takeEvents()) {
+      if (e.kind == RobotEvent::Kind::Silent) {
+        silent = true;
+        silent_after = std::chrono::duration<double>(Clock::now() - died).count();
+      }
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+  EXPECT_TRUE(silent);
+  EXPECT_LE(silent_after, 1.1);  // reported within a second (plus one poll)
+  RunningBackend second(1.0, port);
+  const auto events = waitFor(client, grasp, 3s);
+  ASSERT_NE(finalEvent(events), nullptr);
+  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Failed);
+  EXPECT_NE(finalEvent(events)->text.find("restarted"), std::string::npos) << finalEvent(events)->text;
+}
+
+}  // namespace
+}  // namespace arbci::robot

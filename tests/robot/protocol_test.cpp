@@ -1,0 +1,127 @@
+// The wire format: every message survives a round trip; any change to the bytes, another key,
+// another version or a cut is caught; key files are private and checked.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "arbci/robot/key_file.h"
+#include "arbci/robot/protocol.h"
+
+namespace arbci::robot {
+namespace {
+
+Key testKey(std::uint8_t fill = 7) {
+  Key key{};
+  key.fill(fill);
+  return key;
+}
+
+Message statusMessage() {
+  Message m;
+  m.type = MessageType::StatusReply;
+  m.session = 0x1122334455667788ULL;
+  m.sequence = 42;
+  m.timestamp_ms = 1700000000123ULL;
+  m.boot = 99;
+  m.status.state = RobotState::Moving;
+  m.status.tool = {0.1, 0.5, 0.3};
+  m.status.gripper_opening = 0.25;
+  m.status.holding = 3;
+  m.status.current_command = MessageType::Grasp;
+  m.status.current_sequence = 41;
+  m.status.progress = 0.6;
+  m.status.last_finished_sequence = 40;
+  m.status.last_outcome = Outcome::Stopped;
+  m.status.last_outcome_text = "stopped by STOP";
+  m.status.objects = {{1, {0.1, 0.6, 0.06}, false}, {3, {0.1, 0.5, 0.25}, true}};
+  return m;
+}
+
+TEST(Protocol, EveryMessageSurvivesARoundTrip) {
+  const Key key = testKey();
+  Message grasp;
+  grasp.type = MessageType::Grasp;
+  grasp.session = 5;
+  grasp.sequence = 17;
+  grasp.timestamp_ms = 123;
+  grasp.target = {0.12, -0.5, 0.061};
+  auto bytes = encode(grasp, key);
+  Decoded d = decode(bytes.data(), bytes.size(), key);
+  ASSERT_TRUE(d.ok()) << toString(d.error);
+  EXPECT_EQ(d.message.type, MessageType::Grasp);
+  EXPECT_EQ(d.message.sequence, 17u);
+  EXPECT_EQ(d.message.target.y, -0.5);
+
+  const Message status = statusMessage();
+  bytes = encode(status, key);
+  d = decode(bytes.data(), bytes.size(), key);
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d.message.status.holding, 3);
+  EXPECT_EQ(d.message.status.last_outcome_text, "stopped by STOP");
+  ASSERT_EQ(d.message.status.objects.size(), 2u);
+  EXPECT_TRUE(d.message.status.objects[1].held);
+  EXPECT_EQ(d.message.boot, 99u);
+
+  Message rejected;
+  rejected.type = MessageType::Rejected;
+  rejected.reason = RejectReason::OutsideWorkspace;
+  rejected.text = "(2, 0, 0) lies outside the workspace";
+  bytes = encode(rejected, key);
+  d = decode(bytes.data(), bytes.size(), key);
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d.message.reason, RejectReason::OutsideWorkspace);
+  EXPECT_EQ(d.message.text, rejected.text);
+}
+
+TEST(Protocol, TamperingOtherKeysVersionsAndCutsAreCaught) {
+  const Key key = testKey();
+  const auto bytes = encode(statusMessage(), key);
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    auto changed = bytes;
+    changed[i] ^= 0x01;
+    EXPECT_FALSE(decode(changed.data(), changed.size(), key).ok()) << "byte " << i;
+  }
+  EXPECT_EQ(decode(bytes.data(), bytes.size(), testKey(8)).error, DecodeError::BadMac);
+  auto version = bytes;
+  version[4] = 2;
+  EXPECT_EQ(decode(version.data(), version.size(), key).error, DecodeError::BadVersion);
+  EXPECT_EQ(decode(bytes.data(), bytes.size() - 1, key).error, DecodeError::BadLength);
+  EXPECT_EQ(decode(bytes.data(), 20, key).error, DecodeError::TooShort);
+  std::vector<std::uint8_t> huge(5000, 0);
+  EXPECT_EQ(decode(huge.data(), huge.size(), key).error, DecodeError::TooLong);
+  // A NaN target is malformed even when authenticated.
+  Message nan;
+  nan.type = MessageType::Drop;
+  nan.target = {std::nan(""), 0.0, 0.0};
+  const auto bad = encode(nan, key);
+  EXPECT_EQ(decode(bad.data(), bad.size(), key).error, DecodeError::BadPayload);
+}
+
+TEST(KeyFile, WrittenPrivateAndCheckedOnLoad) {
+  const auto path = std::filesystem::temp_directory_path() / "arbci_test.key";
+  const Key key = generateKey();
+  saveKey(path, key);
+  struct stat info {};
+  ASSERT_EQ(stat(path.c_str(), &info), 0);
+  EXPECT_EQ(info.st_mode & 0777, 0600u);
+  EXPECT_EQ(loadKey(path), key);
+  EXPECT_NE(generateKey(), key);
+  chmod(path.c_str(), 0644);
+  EXPECT_THROW(loadKey(path), KeyError);
+  std::filesystem::remove(path);
+  std::ofstream(path) << "not hex";
+  chmod(path.c_str(), 0600);
+  try {
+    loadKey(path);
+    FAIL();
+  } catch (const KeyError& error) {
+    EXPECT_NE(std::string(error.what()).find("64 hex"), std::string::npos);
+  }
+  EXPECT_THROW(loadKey(path.string() + ".missing"), KeyError);
+}
+
+}  // namespace
+}  // namespace arbci::robot
