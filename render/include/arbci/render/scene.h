@@ -1,0 +1,45 @@
+// The simulated world as the simulated cameras see it, in the robot's frame (metres, z up, the
+// table top at table_z): the reference marker on the table, the objects with their markers on
+// top, the robot's gripper and what it holds.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "arbci/vision/marker.h"
+#include "arbci/vision/pose.h"
+
+namespace arbci::render {
+
+struct SceneMarker {
+  vision::MarkerKind kind = vision::MarkerKind::Bch;
+  int id = 0;
+  double side_m = 0.05;  // the black square
+  double border = 0.125;
+};
+
+struct SceneObject {
+  SceneMarker marker;
+  vision::Pose T_world_top;  // the centre of the top face; z out of the face
+  double width_m = 0.07;
+  double height_m = 0.06;
+  glm::vec3 color{0.85f, 0.35f, 0.25f};
+};
+
+struct SceneGripper {
+  cv::Vec3d tool;         // fingertips, robot frame
+  double opening = 1.0;   // 0 closed, 1 open
+};
+
+struct Scene {
+  double table_z = 0.0;
+  cv::Vec2d table_min{-0.7, 0.1}, table_max{0.7, 1.4};
+  SceneMarker reference{vision::MarkerKind::Bch, 0, 0.08, 0.125};
+  vision::Pose T_world_reference{cv::Matx33d::eye(), cv::Vec3d(0.0, 0.90, 0.0)};
+  std::vector<SceneObject> objects;
+  std::optional<SceneGripper> gripper;
+};
+
+}  // namespace arbci::render

@@ -1,0 +1,42 @@
+// Draws a Scene with depth: the table, boxes with their markers (textures made from the same
+// cells the marker printer draws), the reference marker with a white quiet zone, the gripper.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <tuple>
+
+#include <glm/glm.hpp>
+
+#include "arbci/render/scene.h"
+#include "arbci/render/shader_program.h"
+#include "arbci/render/texture.h"
+
+namespace arbci::render {
+
+class SceneRenderer {
+ public:
+  SceneRenderer();  // needs a current GL context
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  // Into the bound framebuffer's current viewport, depth-tested.
+  void draw(const Scene& scene, const glm::mat4& world_to_clip);
+
+ private:
+  struct Vertex {
+    glm::vec3 position;
+    glm::vec2 uv;
+    glm::vec4 color;
+  };
+  const Texture& markerTexture(const SceneMarker& marker);
+  void flush(const std::vector<Vertex>& vertices, const glm::mat4& transform, const Texture* texture);
+
+  ShaderProgram program_;
+  int transform_location_ = -1, textured_location_ = -1, sampler_location_ = -1;
+  unsigned int vertex_array_ = 0, vertex_buffer_ = 0;
+  std::map<std::tuple<int, int, int>, Texture> markers_;
+};
+
+}  // namespace arbci::render
