@@ -1,0 +1,163 @@
+// The experiment as the experimenter drives it: set-up, a calibration run (copy task: the target
+// is cued and data are recorded for training), then online trials. A trial selects an object
+// (every visible object flashes alone, in random order within each sequence), has the robot
+// grasp it, selects a place (rows and columns of the grid flash as in the P300 speller) and has
+// the robot put the object there. Pause, abort and emergency stop work in every state.
+//
+// It is driven by displayed frames: frame(i) says what frame i shows; timing is counted in frames
+// (60 ms flash, 120 ms interval at the display rate), decided ahead. The cycle feeds it the
+// classifier's decisions, the end of training and the robot's outcomes, and takes its events
+// (flash onsets, phase changes, selections, robot commands).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "arbci/bci/decision.h"
+#include "arbci/bci/paradigm_layout.h"
+#include "arbci/bci/stimulus_sequence.h"
+
+namespace arbci::bci {
+
+struct ParadigmSettings {
+  double display_hz = 60.0;
+  double flash_ms = 60.0;
+  double isi_ms = 120.0;
+  int sequences = 10;          // per selection (the maximum with dynamic stopping)
+  int min_sequences = 2;       // dynamic stopping never stops earlier
+  double certainty = 0.0;      // dynamic stopping threshold; 0: always `sequences`
+  double cue_s = 1.5;          // calibration: the target is shown before its flashes
+  double result_s = 1.0;       // a selection is shown this long
+  double pause_s = 1.0;        // between selections
+  int calibration_selections = 6;
+  int trials = 3;
+
+  int flashFrames() const;     // frames a flash lasts (60 ms at 60 Hz: 4)
+  int onsetFrames() const;     // frames from one flash onset to the next (180 ms: 11)
+};
+
+enum class Phase {
+  Setup,
+  CalibrationCue,
+  CalibrationFlashing,
+  Training,
+  ObjectFlashing,
+  ObjectSelected,
+  Grasping,
+  CellFlashing,
+  CellSelected,
+  Dropping,
+  Finished,
+  Aborted,
+  Paused,
+  EmergencyStop,
+  RobotFault,
+};
+const char* toString(Phase phase);
+
+// What one displayed frame shows.
+struct FrameStimulus {
+  Phase phase = Phase::Setup;
+  bool grid_visible = false;
+  std::set<int> lit;                  // codes lit on this frame (objects, or grid rows/columns)
+  std::optional<int> cued_object;     // 1-based object slot
+  std::optional<int> selected_object;
+  std::optional<std::pair<int, int>> cued_cell, selected_cell;  // (row, column)
+};
+
+struct ParadigmEvent {
+  enum class Kind {
+    PhaseChanged,      // text: the phase
+    SelectionStarted,  // layout, target codes (calibration) in `codes`
+    Flash,             // code, onset frame
+    SelectionMade,     // codes chosen, certainty
+    TrainModel,        // the calibration run is complete: train now and call modelTrained()
+    RobotGrasp,        // object slot in `object`
+    RobotDrop,         // cell in `cell`
+    RobotStop,
+    TrialDone,
+  };
+  explicit ParadigmEvent(Kind k) : kind(k) {}
+  Kind kind;
+  std::int64_t frame = 0;
+  Phase phase = Phase::Setup;
+  int code = 0;
+  int object = 0;
+  std::pair<int, int> cell{0, 0};
+  std::set<int> codes;
+  bool objects_layout = true;  // the selection's stimuli are objects (else grid rows/columns)
+  double certainty = 0.0;
+  int trial = 0;
+  std::string text;
+};
+
+class Paradigm {
+ public:
+  // `objects`: how many objects can be selected; `grid`: the grid's rows and columns.
+  Paradigm(const ParadigmSettings& settings, int objects, int rows, int columns, std::uint64_t seed);
+
+  // Experimenter controls (any state).
+  void start(bool calibrate);  // from Setup: with a calibration run, or straight to the trials
+  void pause();
+  void resume();  // also acknowledges a robot fault or an emergency stop: the trial continues
+  void abort();
+  void emergencyStop();
+
+  // What frame `index` shows; call once per displayed frame in order.
+  FrameStimulus frame(std::int64_t index);
+
+  // From the cycle: the classifier may end flashing early (dynamic stopping).
+  void requestStopFlashing();
+  // All epochs of the selection are scored: its decision.
+  void decide(const Decision& decision);
+  void modelTrained(bool ok, const std::string& text);
+  void robotFinished(bool success, const std::string& text);
+  // The number of objects that can be selected from the next trial on (those tracked).
+  void setObjectCount(int objects);
+
+  std::vector<ParadigmEvent> takeEvents();
+  Phase phase() const { return phase_; }
+  int trial() const { return trial_; }
+  int sequence() const { return sequence_; }  // the current sequence of a flashing phase (1-based)
+  bool awaitingDecision() const { return awaiting_decision_; }
+  const ParadigmLayout& objectLayout() const { return object_layout_; }
+  const ParadigmLayout& gridLayout() const { return grid_layout_; }
+  // The calibration target (1-based object) while cueing or flashing in the calibration run.
+  std::optional<int> calibrationTarget() const { return calibration_target_; }
+  const ParadigmSettings& settings() const { return settings_; }
+
+ private:
+  void enter(Phase phase, std::int64_t frame, const std::string& text = "");
+  void startFlashing(std::int64_t frame, bool objects);
+  void scheduleSequence(std::int64_t first_frame);
+  void event(ParadigmEvent e);
+
+  ParadigmSettings settings_;
+  ParadigmLayout object_layout_, grid_layout_;
+  std::mt19937_64 random_;
+  std::optional<StimulusSequencer> sequencer_;
+  Phase phase_ = Phase::Setup;
+  Phase paused_from_ = Phase::Setup;
+  std::int64_t now_ = 0;            // the last frame shown
+  std::int64_t phase_until_ = 0;    // timed phases end at this frame
+  // Flashing: onset frame and code of the current sequence's flashes.
+  std::vector<std::pair<std::int64_t, int>> schedule_;
+  size_t next_flash_ = 0;
+  int sequence_ = 0;
+  bool stop_requested_ = false;
+  bool awaiting_decision_ = false;
+  bool flashing_objects_ = true;
+  bool calibrating_ = false;
+  int calibration_done_ = 0;
+  std::optional<int> calibration_target_;
+  int trial_ = 0;
+  std::optional<int> selected_object_;
+  std::optional<std::pair<int, int>> selected_cell_;
+  std::vector<ParadigmEvent> events_;
+};
+
+}  // namespace arbci::bci

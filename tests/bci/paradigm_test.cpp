@@ -1,0 +1,173 @@
+// The paradigm, frame by frame: flash timing in frames, every stimulus once per sequence and never
+// twice in a row, the calibration run, a whole trial with the robot, dynamic stopping, and pause,
+// abort, emergency stop and robot faults.
+#include <gtest/gtest.h>
+
+#include "arbci/bci/paradigm.h"
+
+namespace arbci::bci {
+namespace {
+
+using Kind = ParadigmEvent::Kind;
+
+ParadigmSettings fast() {
+  ParadigmSettings s;
+  s.sequences = 3;
+  s.calibration_selections = 2;
+  s.trials = 2;
+  return s;
+}
+
+// Runs frames until `until` holds or `limit` frames pass; collects the events.
+template <typename Condition>
+std::vector<ParadigmEvent> runUntil(Paradigm& p, std::int64_t& frame, Condition until, int limit = 5000) {
+  std::vector<ParadigmEvent> events;
+  for (int i = 0; i < limit && !until(); ++i) {
+    p.frame(frame++);
+    for (auto& e : p.takeEvents()) events.push_back(e);
+  }
+  for (auto& e : p.takeEvents()) events.push_back(e);
+  return events;
+}
+
+Decision choose(int choice, const std::set<int>& codes) {
+  Decision d;
+  d.choice = choice;
+  d.codes = codes;
+  d.certainty = 0.99;
+  return d;
+}
+
+TEST(Paradigm, FlashesLastFourFramesEveryElevenFramesEachCodeOncePerSequence) {
+  Paradigm p(fast(), 4, 3, 3, 1);
+  std::int64_t frame = 0;
+  p.start(false);
+  std::vector<std::set<int>> lit;
+  std::vector<ParadigmEvent> flashes;
+  for (int i = 0; i < 200 && !p.awaitingDecision(); ++i) {
+    lit.push_back(p.frame(frame++).lit);
+    for (auto& e : p.takeEvents()) {
+      if (e.kind == Kind::Flash) flashes.push_back(e);
+    }
+  }
+  ASSERT_EQ(flashes.size(), 12u);  // 3 sequences of 4 objects
+  for (size_t i = 0; i < flashes.size(); ++i) {
+    if (i > 0) {
+      EXPECT_EQ(flashes[i].frame - flashes[i - 1].frame, 11);  // 183 ms at 60 Hz
+      EXPECT_NE(flashes[i].code, flashes[i - 1].code);         // never twice in a row
+    }
+    const auto onset = static_cast<size_t>(flashes[i].frame);
+    for (size_t f = onset; f < onset + 11; ++f) EXPECT_EQ(lit[f].count(flashes[i].code) > 0, f < onset + 4) << "frame " << f;
+  }
+  for (int s = 0; s < 3; ++s) {
+    std::set<int> codes;
+    for (int i = 0; i < 4; ++i) codes.insert(flashes[static_cast<size_t>(s * 4 + i)].code);
+    EXPECT_EQ(codes, (std::set<int>{1, 2, 3, 4}));
+  }
+}
+
+TEST(Paradigm, CalibrationRunCuesTargetsThenAsksForTraining) {
+  Paradigm p(fast(), 4, 3, 3, 2);
+  std::int64_t frame = 0;
+  p.start(true);
+  auto events = p.takeEvents();
+  ASSERT_TRUE(p.calibrationTarget().has_value());
+  EXPECT_EQ(p.phase(), Phase::CalibrationCue);
+  EXPECT_EQ(p.frame(frame++).cued_object, p.calibrationTarget());
+  for (int selection = 0; selection < 2; ++selection) {
+    events = runUntil(p, frame, [&] { return p.awaitingDecision(); });
+    EXPECT_EQ(p.phase(), Phase::CalibrationFlashing);
+    int flashes = 0;
+    for (const auto& e : events) flashes += e.kind == Kind::Flash;
+    EXPECT_EQ(flashes, 12);
+    p.decide(Decision{});
+  }
+  events = p.takeEvents();
+  EXPECT_EQ(p.phase(), Phase::Training);
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::TrainModel; }));
+  p.modelTrained(true, "");
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
+  EXPECT_EQ(p.trial(), 1);
+}
+
+TEST(Paradigm, ATrialSelectsAnObjectGraspsItSelectsACellAndPutsItDown) {
+  Paradigm p(fast(), 4, 3, 3, 3);
+  std::int64_t frame = 0;
+  p.start(false);
+  for (int trial = 1; trial <= 2; ++trial) {
+    runUntil(p, frame, [&] { return p.awaitingDecision(); });
+    p.decide(choose(2, {3}));
+    EXPECT_EQ(p.phase(), Phase::ObjectSelected);
+    EXPECT_EQ(p.frame(frame++).selected_object, 3);
+    auto events = runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
+    const auto grasp = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; });
+    ASSERT_NE(grasp, events.end());
+    EXPECT_EQ(grasp->object, 3);
+    p.robotFinished(true, "holding");
+    EXPECT_EQ(p.phase(), Phase::CellFlashing);
+    std::vector<ParadigmEvent> flashes;
+    for (int i = 0; i < 1000 && !p.awaitingDecision(); ++i) {
+      EXPECT_TRUE(p.frame(frame++).grid_visible);
+      for (auto& e : p.takeEvents()) {
+        if (e.kind == Kind::Flash) flashes.push_back(e);
+      }
+    }
+    EXPECT_EQ(flashes.size(), 18u);  // 3 sequences of 3 rows and 3 columns
+    EXPECT_FALSE(flashes.front().objects_layout);
+    p.decide(choose(5, {2, 6}));  // row 2, column 3
+    EXPECT_EQ(p.phase(), Phase::CellSelected);
+    events = runUntil(p, frame, [&] { return p.phase() == Phase::Dropping; });
+    const auto drop = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::RobotDrop; });
+    ASSERT_NE(drop, events.end());
+    EXPECT_EQ(drop->cell, std::make_pair(2, 3));
+    p.robotFinished(true, "released");
+    events = p.takeEvents();
+    EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::TrialDone; }));
+  }
+  EXPECT_EQ(p.phase(), Phase::Finished);
+}
+
+TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {
+  ParadigmSettings s = fast();
+  s.sequences = 10;
+  s.min_sequences = 2;
+  Paradigm p(s, 4, 3, 3, 4);
+  std::int64_t frame = 0;
+  p.start(false);
+  p.requestStopFlashing();
+  const auto events = runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  EXPECT_EQ(std::count_if(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::Flash; }), 8);
+}
+
+TEST(Paradigm, PauseAbortEmergencyStopAndRobotFaults) {
+  Paradigm p(fast(), 4, 3, 3, 5);
+  std::int64_t frame = 0;
+  p.start(false);
+  runUntil(p, frame, [&] { return frame >= 20; });
+  p.pause();
+  EXPECT_EQ(p.phase(), Phase::Paused);
+  for (int i = 0; i < 50; ++i) EXPECT_TRUE(p.frame(frame++).lit.empty());
+  p.resume();
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(0, {1}));
+  runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
+  // The grasp fails: the paradigm waits for the experimenter, then goes on with the next trial.
+  p.robotFinished(false, "nothing to grasp");
+  EXPECT_EQ(p.phase(), Phase::RobotFault);
+  runUntil(p, frame, [&] { return frame >= 400; });
+  EXPECT_EQ(p.phase(), Phase::RobotFault);
+  p.resume();
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
+  EXPECT_EQ(p.trial(), 2);
+  p.emergencyStop();
+  auto events = p.takeEvents();
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::RobotStop; }));
+  EXPECT_EQ(p.phase(), Phase::EmergencyStop);
+  EXPECT_TRUE(p.frame(frame++).lit.empty());
+  p.abort();
+  EXPECT_EQ(p.phase(), Phase::Aborted);
+}
+
+}  // namespace
+}  // namespace arbci::bci
