@@ -14,5 +14,6 @@ void addCalibrateCommand(CLI::App& root, int& exit_code);
 void addEegCommand(CLI::App& root, int& exit_code);
 void addP300Commands(CLI::App& root, int& exit_code);  // train, evaluate
 void addRobotCommand(CLI::App& root, int& exit_code);
+void addRunCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

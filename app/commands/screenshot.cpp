@@ -1,6 +1,10 @@
-// `arbci screenshot`: renders the experimenter window headless (EGL) and writes it as a PNG.
+// `arbci screenshot`: renders the experimenter window headless (EGL) and writes it as a PNG: the
+// shell, or one panel (or the HMD view) on the live data of a simulated session.
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
+#include <unistd.h>
 
 #include <opencv2/core/version.hpp>
 
@@ -8,8 +12,11 @@
 #include "arbci/render/gl_context.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
+#include "arbci/ui/panels.h"
 #include "arbci/ui/system_panel.h"
 #include "commands/commands.h"
+#include "session/session.h"
+#include "session/session_model.h"
 #include "support/cli_error.h"
 #include "support/output_path.h"
 #include "support/png.h"
@@ -21,6 +28,8 @@ struct ScreenshotOptions {
   bool headless = false;
   std::string out;
   std::string size = "1600x900";
+  std::string panel;
+  std::string session;
 };
 
 render::Size parseSize(const std::string& text) {
@@ -33,9 +42,25 @@ render::Size parseSize(const std::string& text) {
   return {width, height};
 }
 
-void renderShell(const ScreenshotOptions& options) {
-  const render::Size size = parseSize(options.size);
-  ensureWritable(options.out);
+// Draws the shell with `panels` for a few frames (ImGui settles its layout) and writes the PNG.
+void renderPanels(render::GlContext& context, render::Size size, const std::vector<ui::Panel*>& panels, const std::string& status,
+                  const std::string& out, const std::function<void()>& before_frame = {}) {
+  ui::ImGuiLayer imgui(context, "");
+  ui::ExperimenterShell shell;
+  for (ui::Panel* panel : panels) shell.addPanel(*panel);
+  for (int frame = 0; frame < 3; ++frame) {
+    if (before_frame) before_frame();
+    context.makeCurrent();
+    imgui.beginFrame(1.0f / 60.0f);
+    shell.draw(size, {16.7f, status, "screenshot"});
+    render::clearFramebuffer(context.drawFramebuffer(), size, {0.08f, 0.09f, 0.11f, 1.0f});
+    imgui.endFrame();
+    context.present();
+  }
+  writePng(out, render::readPixels(context.drawFramebuffer(), size));
+}
+
+void renderShell(const ScreenshotOptions& options, render::Size size) {
   auto context = render::createHeadlessContext(size);
   const render::GlInfo gl = context->info();
   ui::SystemPanel system({{"version", std::string("arbci ") + ARBCI_VERSION},
@@ -44,18 +69,76 @@ void renderShell(const ScreenshotOptions& options) {
                           {"GL renderer", gl.renderer},
                           {"GL version", gl.version},
                           {"OpenCV", CV_VERSION}});
-  ui::ImGuiLayer imgui(*context, "");
-  ui::ExperimenterShell shell;
-  shell.addPanel(system);
-  // ImGui lays windows out over the first frames; the third frame is settled.
-  for (int frame = 0; frame < 3; ++frame) {
-    imgui.beginFrame(1.0f / 60.0f);
-    shell.draw(size, {16.7f, "no session", "screenshot"});
-    render::clearFramebuffer(context->drawFramebuffer(), size, {0.08f, 0.09f, 0.11f, 1.0f});
-    imgui.endFrame();
-    context->present();
+  renderPanels(*context, size, {&system}, "no session", options.out);
+}
+
+// Runs a simulated session (a still head, so it goes fast) until `ready`, then shows a panel.
+void renderPanel(const ScreenshotOptions& options, render::Size size) {
+  SessionConfig config;
+  try {
+    config = SessionConfig::load(options.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.session));
+  } catch (const SessionConfigError& error) {
+    throw CliError(error.what());
   }
-  writePng(options.out, render::readPixels(context->drawFramebuffer(), size));
+  if (options.session.empty()) {
+    config.cameras.head_motion_m = 0.0;
+    config.cameras.head_motion_deg = 0.0;
+    config.robot_speed_factor = 20.0;
+  }
+  auto context = render::createHeadlessContext(size);
+  SessionOptions session_options;
+  session_options.folder = std::filesystem::temp_directory_path() / ("arbci-screenshot-" + std::to_string(::getpid()));
+  session_options.trials = 1;
+  Session session(config, session_options, *context);
+  SessionModel model(session);
+  auto runUntil = [&](const std::function<bool()>& ready) {
+    for (int i = 0; i < 60 * 600 && !ready() && session.step(); ++i) {
+    }
+  };
+  auto phase = [&] { return session.paradigm().phase(); };
+  const std::string& panel = options.panel;
+  if (panel == "threshold") {
+    runUntil([&] { return session.frame() > 30; });
+    ui::ThresholdPanel p(model);
+    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+  } else if (panel == "calibration") {
+    ui::CalibrationPanel p(model);
+    p.holdBoard(true);
+    for (int view = 0; view < 6; ++view) {
+      const std::int64_t until = session.frame() + 4;
+      runUntil([&] { return session.frame() >= until; });
+      p.captureView();
+    }
+    p.calibrate();
+    runUntil([&] { return session.frame() % 4 == 0; });
+    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+  } else if (panel == "training") {
+    runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
+    ui::TrainingPanel p(model);
+    p.setRecordings((session.folder() / "recording.bdf").string());
+    p.train(true);
+    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+  } else if (panel == "robot") {
+    runUntil([&] { return phase() == bci::Phase::Grasping && session.robotStatus() && session.robotStatus()->progress > 0.3; });
+    ui::RobotPanel p(model);
+    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+  } else if (panel == "session") {
+    runUntil([&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    ui::SessionPanel p(model);
+    renderPanels(*context, size, {&p}, session.statusLine(), options.out, [&] { session.step(); });
+  } else if (panel == "hmd") {
+    runUntil([&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    // The HMD framebuffer itself, as the subject sees it.
+    runUntil([&] { return session.frame() % 11 == 1; });
+    ensureWritable(options.out);
+    session.screenshot(options.out);
+  } else {
+    throw CliError("--panel must be threshold, calibration, training, robot, session or hmd");
+  }
+  session.abort();
+  session.step();
+  std::error_code ignored;
+  std::filesystem::remove_all(session_options.folder, ignored);
 }
 
 }  // namespace
@@ -63,14 +146,24 @@ void renderShell(const ScreenshotOptions& options) {
 void addScreenshotCommand(CLI::App& root, int& exit_code) {
   auto options = std::make_shared<ScreenshotOptions>();
   auto* command = root.add_subcommand(
-      "screenshot", "Render the experimenter window to a PNG file (headless through EGL)");
+      "screenshot", "Render the experimenter window, or one panel on a simulated session's live data, to a PNG\n"
+                    "(headless through EGL)");
   command->add_flag("--headless", options->headless,
                     "Render without a display through EGL (the only mode screenshots use)");
   command->add_option("--out", options->out, "PNG file to write")->required();
   command->add_option("--size", options->size, "Image size WIDTHxHEIGHT")
       ->capture_default_str();
+  command->add_option("--panel", options->panel, "threshold, calibration, training, robot, session or hmd (the HMD view)")
+      ->check(CLI::IsMember({"threshold", "calibration", "training", "robot", "session", "hmd"}));
+  command->add_option("--session", options->session, "session file for --panel (default: the embedded simulated session)");
   command->callback([options, &exit_code] {
-    renderShell(*options);
+    ensureWritable(options->out);
+    const render::Size size = parseSize(options->size);
+    if (options->panel.empty()) {
+      renderShell(*options, size);
+    } else {
+      renderPanel(*options, size);
+    }
     exit_code = 0;
   });
 }

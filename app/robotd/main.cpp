@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
+#include <fstream>
 #include <iostream>
 
 #include "arbci/robot/backend.h"
@@ -24,9 +25,10 @@ int main(int argc, char** argv) {
                "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: docs/robot-protocol.md.",
                "arbci-robotd"};
   int port = 47800;
-  std::string host = "127.0.0.1", key_file, config_file;
+  std::string host = "127.0.0.1", key_file, config_file, port_file;
   double speed = 0.0;
-  app.add_option("--port", port, "UDP port to listen on")->capture_default_str()->check(CLI::Range(1, 65535));
+  app.add_option("--port", port, "UDP port to listen on (0: any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
+  app.add_option("--port-file", port_file, "write the port listened on to this file once listening");
   app.add_option("--host", host, "address to listen on (127.0.0.1: this machine only)")->capture_default_str();
   app.add_option("--key-file", key_file, "the shared key")->required();
   app.add_option("--config", config_file, "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
@@ -45,6 +47,11 @@ int main(int argc, char** argv) {
     options.speed_factor = speed > 0.0 ? speed : config.speed_factor;
     options.log = &std::cerr;
     arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config), options);
+    if (!port_file.empty()) {
+      std::ofstream out(port_file);
+      out << backend.port() << "\n";
+      if (!out) throw std::runtime_error("cannot write " + port_file);
+    }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port() << " (simulated arm, speed x" << options.speed_factor

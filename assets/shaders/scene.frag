@@ -1,11 +1,7 @@
 #version 330 core
+// Textured parts of the scene: the markers.
 in vec2 texture_coord;
 in vec4 vertex_color;
 uniform sampler2D marker;
-uniform bool textured;
 out vec4 fragment_color;
-void main() {
-  vec4 c = vertex_color;
-  if (textured) c.rgb *= texture(marker, texture_coord).rrr;
-  fragment_color = c;
-}
+void main() { fragment_color = vec4(vertex_color.rgb * texture(marker, texture_coord).rrr, vertex_color.a); }

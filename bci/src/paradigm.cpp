@@ -117,8 +117,9 @@ FrameStimulus Paradigm::frame(std::int64_t index) {
     }
     // The sequence's last interval is over: another sequence, or the end of flashing.
     if (!schedule_.empty() && index >= schedule_.back().first + settings_.onsetFrames() - 1) {
-      const bool dynamic_stop = stop_requested_ && sequence_ >= settings_.min_sequences;
-      if (sequence_ < settings_.sequences && !dynamic_stop) {
+      const bool dynamic_stop = !calibrating_ && stop_requested_ && sequence_ >= settings_.min_sequences;
+      const int most = calibrating_ ? settings_.calibration_sequences : settings_.sequences;
+      if (sequence_ < most && !dynamic_stop) {
         scheduleSequence(index + 1);
       } else {
         awaiting_decision_ = true;

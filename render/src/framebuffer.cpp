@@ -1,5 +1,7 @@
 #include "arbci/render/framebuffer.h"
 
+#include <algorithm>
+
 #include <cstring>
 #include <string>
 
@@ -72,6 +74,23 @@ RgbaImage readPixels(unsigned int framebuffer, Size size) {
     std::memcpy(bottom, row.data(), stride);
   }
   return image;
+}
+
+void blitTexture(unsigned int texture, Size source, Size target) {
+  GLuint read = 0;
+  glGenFramebuffers(1, &read);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, read);
+  glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glViewport(0, 0, target.width, target.height);
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  const double scale = std::min(static_cast<double>(target.width) / source.width, static_cast<double>(target.height) / source.height);
+  const int w = static_cast<int>(source.width * scale), h = static_cast<int>(source.height * scale);
+  const int x = (target.width - w) / 2, y = (target.height - h) / 2;
+  glBlitFramebuffer(0, 0, source.width, source.height, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &read);
 }
 
 }  // namespace arbci::render

@@ -39,10 +39,10 @@ void box(std::vector<V>& out, const vision::Pose& pose, double width, double dep
 
 }  // namespace
 
-SceneRenderer::SceneRenderer() : program_(ShaderProgram::fromAssets("scene")) {
-  transform_location_ = program_.uniform("transform");
-  textured_location_ = program_.uniform("textured");
-  sampler_location_ = program_.uniform("marker");
+SceneRenderer::SceneRenderer() : textured_(ShaderProgram::fromAssets("scene")), flat_(ShaderProgram::fromAssets("scene_flat")) {
+  textured_transform_ = textured_.uniform("transform");
+  flat_transform_ = flat_.uniform("transform");
+  sampler_location_ = textured_.uniform("marker");
   glGenVertexArrays(1, &vertex_array_);
   glGenBuffers(1, &vertex_buffer_);
   glBindVertexArray(vertex_array_);
@@ -73,23 +73,52 @@ const Texture& SceneRenderer::markerTexture(const SceneMarker& marker) {
   return markers_.emplace(key, std::move(texture)).first->second;
 }
 
-void SceneRenderer::flush(const std::vector<Vertex>& vertices, const glm::mat4& transform, const Texture* texture) {
+const Texture& SceneRenderer::boardTexture(const SceneBoard& board) {
+  const auto key = std::make_pair(board.inner_corners.width, board.inner_corners.height);
+  auto found = boards_.find(key);
+  if (found != boards_.end()) return found->second;
+  // Squares of 32 px, a white margin of one square around them.
+  const int squares_x = board.inner_corners.width + 1, squares_y = board.inner_corners.height + 1, s = 32;
+  cv::Mat image((squares_y + 2) * s, (squares_x + 2) * s, CV_8UC1, cv::Scalar(255));
+  for (int y = 0; y < squares_y; ++y) {
+    for (int x = 0; x < squares_x; ++x) {
+      if ((x + y) % 2 == 0) image(cv::Rect((x + 1) * s, (y + 1) * s, s, s)).setTo(0);
+    }
+  }
+  Texture texture;
+  texture.upload(image, true);
+  return boards_.emplace(key, std::move(texture)).first->second;
+}
+
+void SceneRenderer::drawBatches(const std::vector<Vertex>& vertices, const std::vector<Batch>& batches, const glm::mat4& transform) {
   if (vertices.empty()) return;
-  program_.use();
-  glUniformMatrix4fv(transform_location_, 1, GL_FALSE, &transform[0][0]);
-  glUniform1i(textured_location_, texture ? 1 : 0);
+  textured_.use();
+  glUniformMatrix4fv(textured_transform_, 1, GL_FALSE, &transform[0][0]);
   glUniform1i(sampler_location_, 0);
+  flat_.use();
+  glUniformMatrix4fv(flat_transform_, 1, GL_FALSE, &transform[0][0]);
   glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, texture ? texture->id() : 0);
   glBindVertexArray(vertex_array_);
   glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer_);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), GL_STREAM_DRAW);
-  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(vertices.size()));
+  for (const Batch& b : batches) {
+    if (b.depth_test) {
+      glEnable(GL_DEPTH_TEST);
+    } else {
+      glDisable(GL_DEPTH_TEST);
+    }
+    if (b.texture) {
+      textured_.use();
+      glBindTexture(GL_TEXTURE_2D, b.texture->id());
+    } else {
+      flat_.use();
+    }
+    glDrawArrays(GL_TRIANGLES, static_cast<GLint>(b.first), static_cast<GLsizei>(b.count));
+  }
   glBindVertexArray(0);
 }
 
 void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
-  glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
   glDisable(GL_CULL_FACE);
   std::vector<Vertex> solid;
@@ -108,6 +137,9 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
   lifted.translation += scene.T_world_reference.rotation * cv::Vec3d(0, 0, 0.0005);
   const double quiet = scene.reference.side_m * 1.4;
   box(solid, lifted, quiet, quiet, 0.0005, glm::vec3(0.95f), glm::vec3(0.95f));
+  // The table and the quiet zone lie behind everything else: drawn first, without the depth
+  // test (which costs llvmpipe more than the drawing).
+  const size_t flat = solid.size();
   // Objects: coloured sides, a white top carrying the marker.
   for (const SceneObject& o : scene.objects) box(solid, o.T_world_top, o.width_m, o.width_m, o.height_m, o.color, glm::vec3(0.95f));
   if (scene.gripper) {
@@ -120,18 +152,24 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
     box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(gap / 2 + 0.006, 0, 0.06)}, 0.012, 0.03, 0.06, dark, dark);
     box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(0, 0, 0.30)}, 0.05, 0.05, 0.20, metal, metal);
   }
-  flush(solid, world_to_clip, nullptr);
-
+  std::vector<Batch> batches{{0, flat, nullptr, false}, {flat, solid.size() - flat, nullptr, true}};
   // Markers, each a textured square a hair above its face.
-  auto drawMarker = [&](const SceneMarker& marker, const vision::Pose& face, double lift) {
+  auto addMarker = [&](const SceneMarker& marker, const vision::Pose& face, double lift) {
     const double h = marker.side_m / 2;
     auto p = [&](double x, double y) { return toGlm(face.apply(cv::Vec3d(x, y, lift))); };
-    std::vector<Vertex> square;
-    quad(square, p(-h, h), p(h, h), p(h, -h), p(-h, -h), glm::vec4(1.0f));
-    flush(square, world_to_clip, &markerTexture(marker));
+    batches.push_back({solid.size(), 6, &markerTexture(marker), true});
+    quad(solid, p(-h, h), p(h, h), p(h, -h), p(-h, -h), glm::vec4(1.0f));
   };
-  drawMarker(scene.reference, scene.T_world_reference, 0.0012);
-  for (const SceneObject& o : scene.objects) drawMarker(o.marker, o.T_world_top, 0.0007);
+  addMarker(scene.reference, scene.T_world_reference, 0.0012);
+  if (scene.board) {
+    const SceneBoard& b = *scene.board;
+    const double w = (b.inner_corners.width + 3) * b.square_m / 2, h = (b.inner_corners.height + 3) * b.square_m / 2;
+    auto p = [&](double x, double y) { return toGlm(b.T_world_board.apply(cv::Vec3d(x, y, 0.0))); };
+    batches.push_back({solid.size(), 6, &boardTexture(b), true});
+    quad(solid, p(-w, h), p(w, h), p(w, -h), p(-w, -h), glm::vec4(1.0f));
+  }
+  for (const SceneObject& o : scene.objects) addMarker(o.marker, o.T_world_top, 0.0007);
+  drawBatches(solid, batches, world_to_clip);
 }
 
 }  // namespace arbci::render

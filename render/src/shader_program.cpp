@@ -3,12 +3,9 @@
 #include <string_view>
 #include <vector>
 
+#include "arbci/assets.h"
 #include "arbci/render/gl_context.h"
 #include "gl.h"
-
-namespace arbci::assets {
-std::string_view embedded(std::string_view name);
-}
 
 namespace arbci::render {
 namespace {

@@ -10,7 +10,7 @@
 
 namespace arbci::render {
 
-SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_t seed) : camera_(camera), random_(seed) {
+SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_t seed) : camera_(camera), random_(seed ? seed : 1) {
   const cv::Size size = camera.image_size;
   GLint max_samples = 0;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
@@ -36,8 +36,7 @@ SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (!camera.distortion.empty()) {
     // Where each pixel of the distorted image comes from in the ideal rendering.
-    cv::initUndistortRectifyMap(camera.camera_matrix, cv::noArray(), cv::noArray(), camera.camera_matrix, size, CV_32FC1, distort_x_,
-                                distort_y_);
+    cv::Mat distort_x(size, CV_32FC1), distort_y(size, CV_32FC1);
     cv::Mat points(size.area(), 1, CV_64FC2);
     for (int y = 0, i = 0; y < size.height; ++y) {
       for (int x = 0; x < size.width; ++x, ++i) points.at<cv::Vec2d>(i) = cv::Vec2d(x, y);
@@ -47,10 +46,11 @@ SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_
     for (int y = 0, i = 0; y < size.height; ++y) {
       for (int x = 0; x < size.width; ++x, ++i) {
         const cv::Vec2d p = ideal.at<cv::Vec2d>(i);
-        distort_x_.at<float>(y, x) = static_cast<float>(p[0]);
-        distort_y_.at<float>(y, x) = static_cast<float>(p[1]);
+        distort_x.at<float>(y, x) = static_cast<float>(p[0]);
+        distort_y.at<float>(y, x) = static_cast<float>(p[1]);
       }
     }
+    cv::convertMaps(distort_x, distort_y, distort_map1_, distort_map2_, CV_16SC2);
   }
 }
 
@@ -81,26 +81,45 @@ cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_wo
   cv::cvtColor(rgba, frame, cv::COLOR_BGRA2BGR);
   cv::flip(frame, frame, 0);  // GL rows start at the bottom
 
-  if (effects.distort && !distort_x_.empty()) {
+  if (effects.distort && !distort_map1_.empty()) {
     cv::Mat distorted;
-    cv::remap(frame, distorted, distort_x_, distort_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(77, 82, 90));
+    cv::remap(frame, distorted, distort_map1_, distort_map2_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(77, 82, 90));
     frame = distorted;
   }
   if (effects.blur_sigma > 0.0) cv::GaussianBlur(frame, frame, cv::Size(), effects.blur_sigma);
   if (effects.vignetting > 0.0 || effects.gradient > 0.0 || effects.noise_sigma > 0.0) {
-    cv::Mat f;
-    frame.convertTo(f, CV_32FC3);
-    const double cx = size.width / 2.0, cy = size.height / 2.0, r2 = cx * cx + cy * cy;
-    std::normal_distribution<float> noise(0.0f, static_cast<float>(effects.noise_sigma));
-    for (int y = 0; y < size.height; ++y) {
-      auto* row = f.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < size.width; ++x) {
-        const double d2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / r2;
-        const float gain = static_cast<float>((1.0 - effects.vignetting * d2) * (1.0 - effects.gradient * x / size.width));
-        for (int c = 0; c < 3; ++c) row[x][c] = row[x][c] * gain + (effects.noise_sigma > 0.0 ? noise(random_) : 0.0f);
+    // Integer arithmetic on 16-bit pixels: a frame's effects cost about a millisecond.
+    cv::Mat pixels;
+    frame.convertTo(pixels, CV_16SC3);
+    if (effects.vignetting > 0.0 || effects.gradient > 0.0) {
+      if (effects.vignetting != gain_vignetting_ || effects.gradient != gain_gradient_) {
+        cv::Mat gain(size, CV_16SC1);
+        const double cx = size.width / 2.0, cy = size.height / 2.0, r2 = cx * cx + cy * cy;
+        for (int y = 0; y < size.height; ++y) {
+          auto* row = gain.ptr<std::int16_t>(y);
+          for (int x = 0; x < size.width; ++x) {
+            const double d2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / r2;
+            row[x] = static_cast<std::int16_t>(std::lround(256.0 * (1.0 - effects.vignetting * d2) * (1.0 - effects.gradient * x / size.width)));
+          }
+        }
+        cv::merge(std::vector<cv::Mat>{gain, gain, gain}, gain_);
+        gain_vignetting_ = effects.vignetting;
+        gain_gradient_ = effects.gradient;
       }
+      cv::multiply(pixels, gain_, pixels, 1.0 / 256.0);
     }
-    f.convertTo(frame, CV_8UC3);
+    if (effects.noise_sigma > 0.0) {
+      // Gaussian noise drawn once for a field 64 pixels larger than the frame; each frame takes
+      // a window at a random offset, so the noise changes from frame to frame.
+      if (effects.noise_sigma != noise_sigma_) {
+        noise_.create(size.height + 64, size.width + 64, CV_16SC3);
+        random_.fill(noise_, cv::RNG::NORMAL, cv::Scalar::all(0.0), cv::Scalar::all(effects.noise_sigma));
+        noise_sigma_ = effects.noise_sigma;
+      }
+      const cv::Rect window(random_.uniform(0, 64), random_.uniform(0, 64), size.width, size.height);
+      cv::add(pixels, noise_(window), pixels);
+    }
+    pixels.convertTo(frame, CV_8UC3);
   }
   return frame;
 }

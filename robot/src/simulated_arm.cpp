@@ -15,7 +15,7 @@ namespace arbci::robot {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kStep = 0.002;   // seconds of robot time per integration step
+constexpr double kStep = 0.005;   // seconds of robot time per integration step
 constexpr double kGripperLength = 0.15;  // flange to fingertips
 
 // UR10 (standard DH) with the gripper's length added to the last link.
@@ -52,7 +52,7 @@ struct SimulatedArm::Impl {
   KDL::JntArray q{6};
   std::vector<SimulatedObject> objects;
   int holding = -1;
-  double grasp_offset = 0.0;  // object top below the fingertips while held
+  Vec3 grasp_offset;  // the held object's top centre relative to the fingertips (it does not centre itself)
   double gripper = 1.0;
   RobotState state = RobotState::Idle;
   DriverCommand command;
@@ -104,7 +104,7 @@ struct SimulatedArm::Impl {
   void carry() {
     if (SimulatedObject* o = held()) {
       const Vec3 t = tool();
-      o->position = {t.x, t.y, t.z - grasp_offset};
+      o->position = {t.x + grasp_offset.x, t.y + grasp_offset.y, t.z + grasp_offset.z};
     }
   }
 
@@ -171,7 +171,7 @@ struct SimulatedArm::Impl {
         // Contact: fingertips on the surface, or the held object's base on it.
         const Vec3 t = tool();
         const SimulatedObject* o = held();
-        const double base = o ? t.z - grasp_offset - o->height : t.z;
+        const double base = o ? t.z + grasp_offset.z - o->height : t.z;
         const double contact = surfaceBelow(t.x, t.y);
         if (base <= contact + 1e-6) return true;
         const double drop = std::min(config.descend_speed * dt, base - contact);
@@ -191,7 +191,7 @@ struct SimulatedArm::Impl {
           for (const SimulatedObject& o : objects) {
             if (std::hypot(o.position.x - t.x, o.position.y - t.y) <= o.radius && std::abs(o.position.z - t.z) < 0.005) {
               holding = o.id;
-              grasp_offset = t.z - o.position.z;
+              grasp_offset = {o.position.x - t.x, o.position.y - t.y, o.position.z - t.z};
             }
           }
           if (holding < 0) {

@@ -13,6 +13,7 @@ using Kind = ParadigmEvent::Kind;
 ParadigmSettings fast() {
   ParadigmSettings s;
   s.sequences = 3;
+  s.calibration_sequences = 3;
   s.calibration_selections = 2;
   s.trials = 2;
   return s;

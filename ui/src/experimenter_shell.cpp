@@ -46,6 +46,13 @@ void ExperimenterShell::drawMenuBar() {
     if (ImGui::MenuItem("About")) show_about_ = true;
     ImGui::EndMenu();
   }
+  if (on_stop_) {
+    ImGui::SameLine(ImGui::GetWindowWidth() - 170.0f);
+    ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
+    ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));
+    if (ImGui::SmallButton("EMERGENCY STOP")) on_stop_();
+    ImGui::PopStyleColor(2);
+  }
   ImGui::EndMainMenuBar();
 }
 

@@ -27,7 +27,8 @@ struct ParadigmSettings {
   double display_hz = 60.0;
   double flash_ms = 60.0;
   double isi_ms = 120.0;
-  int sequences = 10;          // per selection (the maximum with dynamic stopping)
+  int sequences = 10;          // per online selection (the maximum with dynamic stopping)
+  int calibration_sequences = 10;  // per calibration selection (always all)
   int min_sequences = 2;       // dynamic stopping never stops earlier
   double certainty = 0.0;      // dynamic stopping threshold; 0: always `sequences`
   double cue_s = 1.5;          // calibration: the target is shown before its flashes

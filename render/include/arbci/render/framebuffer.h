@@ -32,6 +32,10 @@ class Framebuffer {
 // colour and depth.
 void clearFramebuffer(unsigned int framebuffer, Size size, const float (&rgba)[4]);
 
+// Copies a colour texture of `source` size (e.g. another context's framebuffer, shared) into the
+// current context's default framebuffer of `target` size, scaled to fit with its aspect ratio.
+void blitTexture(unsigned int texture, Size source, Size target);
+
 // Reads the colour attachment of `framebuffer` (0 = default) into a top-down RGBA image.
 RgbaImage readPixels(unsigned int framebuffer, Size size);
 

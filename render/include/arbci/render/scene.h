@@ -33,6 +33,13 @@ struct SceneGripper {
   double opening = 1.0;   // 0 closed, 1 open
 };
 
+// A printed chessboard held up for camera calibration (white margin of one square).
+struct SceneBoard {
+  vision::Pose T_world_board;  // origin at the board's centre, z out of the print
+  cv::Size inner_corners{9, 6};
+  double square_m = 0.025;
+};
+
 struct Scene {
   double table_z = 0.0;
   cv::Vec2d table_min{-0.7, 0.1}, table_max{0.7, 1.4};
@@ -40,6 +47,7 @@ struct Scene {
   vision::Pose T_world_reference{cv::Matx33d::eye(), cv::Vec3d(0.0, 0.90, 0.0)};
   std::vector<SceneObject> objects;
   std::optional<SceneGripper> gripper;
+  std::optional<SceneBoard> board;
 };
 
 }  // namespace arbci::render

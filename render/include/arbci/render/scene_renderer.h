@@ -30,13 +30,23 @@ class SceneRenderer {
     glm::vec2 uv;
     glm::vec4 color;
   };
+  // Runs of vertices sharing a texture (none for plain colour). All of a frame's vertices go to
+  // the GPU in one upload: re-filling the buffer between draws makes Mesa's llvmpipe finish
+  // each draw first, which costs more than the drawing.
+  struct Batch {
+    size_t first = 0, count = 0;
+    const Texture* texture = nullptr;
+    bool depth_test = true;
+  };
   const Texture& markerTexture(const SceneMarker& marker);
-  void flush(const std::vector<Vertex>& vertices, const glm::mat4& transform, const Texture* texture);
+  const Texture& boardTexture(const SceneBoard& board);
+  void drawBatches(const std::vector<Vertex>& vertices, const std::vector<Batch>& batches, const glm::mat4& transform);
 
-  ShaderProgram program_;
-  int transform_location_ = -1, textured_location_ = -1, sampler_location_ = -1;
+  ShaderProgram textured_, flat_;
+  int textured_transform_ = -1, flat_transform_ = -1, sampler_location_ = -1;
   unsigned int vertex_array_ = 0, vertex_buffer_ = 0;
   std::map<std::tuple<int, int, int>, Texture> markers_;
+  std::map<std::pair<int, int>, Texture> boards_;
 };
 
 }  // namespace arbci::render

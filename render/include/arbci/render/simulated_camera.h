@@ -5,9 +5,8 @@
 
 #include <cstdint>
 #include <memory>
-#include <random>
 
-#include <opencv2/core/mat.hpp>
+#include <opencv2/core.hpp>
 
 #include "arbci/render/scene.h"
 #include "arbci/render/scene_renderer.h"
@@ -39,8 +38,12 @@ class SimulatedCamera {
   vision::CameraModel camera_;
   SceneRenderer renderer_;
   unsigned int multisample_fbo_ = 0, color_rb_ = 0, depth_rb_ = 0, resolve_fbo_ = 0, resolve_rb_ = 0;
-  cv::Mat distort_x_, distort_y_;
-  std::mt19937_64 random_;
+  cv::Mat distort_map1_, distort_map2_;  // fixed-point remap tables of the lens
+  cv::Mat gain_;                         // uneven light (CV_16SC3, 256 = 1), for the last effects used
+  double gain_vignetting_ = -1.0, gain_gradient_ = -1.0;
+  cv::Mat noise_;                        // a noise field larger than the frame (CV_16SC3)
+  double noise_sigma_ = -1.0;
+  cv::RNG random_;
 };
 
 }  // namespace arbci::render

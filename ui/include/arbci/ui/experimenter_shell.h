@@ -22,6 +22,8 @@ class ExperimenterShell {
   // Panels are shown in order; the shell does not own them.
   void addPanel(Panel& panel, bool open = true);
   void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
+  // An emergency stop button in the menu bar, shown whatever panels are open.
+  void setEmergencyStop(std::function<void()> on_stop) { on_stop_ = std::move(on_stop); }
   // Draws the whole shell for one frame; call between ImGuiLayer::beginFrame and endFrame.
   void draw(render::Size display, const ShellStatus& status);
 
@@ -34,7 +36,7 @@ class ExperimenterShell {
   void drawPanels(render::Size display, float top, float bottom);
   void drawStatusBar(render::Size display, float height, const ShellStatus& status);
   std::vector<Entry> panels_;
-  std::function<void()> on_quit_;
+  std::function<void()> on_quit_, on_stop_;
   bool show_about_ = false;
 };
 

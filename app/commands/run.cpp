@@ -1,0 +1,99 @@
+// `arbci run`: the workstation. Windowed with the experimenter panels and the HMD mirror, or
+// headless (chosen automatically without a display) for batch work and tests.
+#include <ctime>
+#include <iomanip>
+#include <iostream>
+
+#include "arbci/render/window_context.h"
+#include "commands/commands.h"
+#include "session/session.h"
+#include "session/workstation.h"
+#include "support/cli_error.h"
+
+namespace arbci::app {
+namespace {
+
+struct RunOptions {
+  std::string session, out;
+  bool headless = false, realtime = false;
+  int trials = 0;
+  long long seed = -1;
+  double fault_wait_s = 5.0;
+};
+
+std::string defaultFolder() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char name[64];
+  std::strftime(name, sizeof name, "arbci-session-%Y%m%d-%H%M%S", &local);
+  return name;
+}
+
+void printSummary(const Session& session) {
+  std::cout << "session folder: " << session.folder().string() << "\n";
+  for (const TrialRecord& t : session.trials()) {
+    std::cout << "trial " << t.trial << ": object " << t.selected_object << (t.selected_object == t.intended_object ? " (intended)" : " (intended " + std::to_string(t.intended_object) + ")")
+              << ", cell " << t.selected_cell.first << "," << t.selected_cell.second
+              << (t.selected_cell == t.intended_cell ? " (intended)"
+                                                     : " (intended " + std::to_string(t.intended_cell.first) + "," + std::to_string(t.intended_cell.second) + ")");
+    if (t.placement_error_m >= 0.0) std::cout << ", placed " << std::fixed << std::setprecision(1) << t.placement_error_m * 1000.0 << " mm from the cell centre";
+    std::cout << " [" << t.outcome << "]\n";
+  }
+  const Percentiles p = session.timing().totalPercentiles();
+  std::cout << std::fixed << std::setprecision(2) << "cycle compute time: p50 " << p.p50 << " ms, p99 " << p.p99 << " ms, max " << p.max
+            << " ms; overruns (> " << session.timing().budgetMs() << " ms): " << session.timing().overruns() << "\n";
+  std::cout << "ended: " << session.endReason() << "\n";
+}
+
+int runSession(const RunOptions& o) {
+  SessionConfig config;
+  try {
+    config = SessionConfig::load(o.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.session));
+  } catch (const SessionConfigError& error) {
+    throw CliError(error.what());
+  }
+  SessionOptions options;
+  options.folder = o.out.empty() ? defaultFolder() : o.out;
+  if (o.trials > 0) options.trials = o.trials;
+  if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
+  options.fault_wait_s = o.fault_wait_s;
+  options.progress = &std::cerr;
+  const bool headless = o.headless || !render::displayAvailable();
+  try {
+    if (!headless) return runWorkstation(config, options);
+    options.simulated_clock = !o.realtime;
+    auto context = render::createHeadlessContext({64, 64});
+    Session session(config, options, *context);
+    session.run();
+    printSummary(session);
+    return session.endReason() == "finished" ? 0 : 3;
+  } catch (const SessionConfigError& error) {
+    throw CliError(error.what());
+  } catch (const render::GlError& error) {
+    throw CliError(error.what());
+  } catch (const std::runtime_error& error) {
+    throw CliError(error.what());
+  }
+}
+
+}  // namespace
+
+void addRunCommand(CLI::App& root, int& exit_code) {
+  auto o = std::make_shared<RunOptions>();
+  CLI::App* run = root.add_subcommand("run", "Run a session: calibration run and training when there is no model, then online\n"
+                                             "trials (select an object, the robot grasps it, select a cell, the robot puts it\n"
+                                             "down). Without --session the embedded simulated world runs: simulated cameras,\n"
+                                             "subject and arm. Writes a session folder (recording.bdf, log.jsonl, HMD\n"
+                                             "screenshots, summary.json). Exit status: 0 finished, 3 ended by a fault or abort.");
+  run->add_option("--session", o->session, "session file (JSON; see assets/sessions/simulated.json)");
+  run->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
+  run->add_option("--trials", o->trials, "online trials (overrides the session file)")->check(CLI::Range(1, 1000));
+  run->add_option("--seed", o->seed, "random seed of the simulated subject and world")->check(CLI::Range(0LL, 1LL << 30));
+  run->add_option("--out", o->out, "session folder (default: arbci-session-<date>-<time>)");
+  run->add_flag("--realtime", o->realtime, "headless: pace to the wall clock instead of running as fast as possible");
+  run->add_option("--fault-wait", o->fault_wait_s, "headless: seconds to wait for an experimenter after a robot fault")->capture_default_str();
+  run->callback([o, &exit_code] { exit_code = runSession(*o); });
+}
+
+}  // namespace arbci::app

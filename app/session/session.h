@@ -1,0 +1,130 @@
+// A session: the render-loop-synchronised cycle that ties every part together. Each displayed
+// frame it polls the EEG source, filters, epochs and classifies; grabs the camera frames and
+// tracks the markers; updates the world model, the robot and the paradigm; renders the HMD view.
+// Every flash is stamped with the EEG sample index at its presentation. Each stage is timed; a
+// cycle whose compute time exceeds the block budget is an overrun, counted and logged.
+//
+// Headless runs advance a simulated clock (display frames and EEG samples together) as fast as
+// the machine allows, unless real time is asked for; windowed runs follow the wall clock.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "arbci/bci/paradigm.h"
+#include "arbci/render/gl_context.h"
+#include "arbci/render/hmd_view.h"
+#include "arbci/robot/client.h"
+#include "session/cycle_timing.h"
+#include "session/eeg_stage.h"
+#include "session/session_config.h"
+#include "session/vision_stage.h"
+
+namespace arbci::app {
+
+struct SessionOptions {
+  bool simulated_clock = true;  // false: the wall clock (windowed, or --realtime)
+  std::filesystem::path folder;
+  std::optional<int> trials;
+  std::optional<std::uint64_t> seed;
+  // Without an experimenter (headless), how long a robot fault or an emergency stop waits before
+  // the run ends (seconds of session time).
+  double fault_wait_s = 5.0;
+  double max_session_s = 3600.0;  // a safety bound on a headless run
+  bool start_immediately = true;  // headless: no experimenter presses Start
+  std::ostream* progress = nullptr;
+};
+
+struct TrialRecord {
+  int trial = 0;
+  int intended_object = -1, selected_object = -1;
+  std::pair<int, int> intended_cell{0, 0}, selected_cell{0, 0};
+  double object_certainty = 0.0, cell_certainty = 0.0;
+  int object_flashes = 0, cell_flashes = 0;
+  double placement_error_m = -1.0;
+  std::string outcome = "incomplete";
+};
+
+class Session {
+ public:
+  // Creates the session folder, starts the robot backend (simulated) and the recording. Throws
+  // std::runtime_error (or SessionConfigError) with the reason.
+  Session(SessionConfig config, const SessionOptions& options, render::GlContext& context);
+  ~Session();
+
+  // One displayed frame. Returns false once the session has ended.
+  bool step();
+  // Steps until the end (headless). Returns the summary.
+  nlohmann::json run();
+
+  // Experimenter controls.
+  void start();
+  void pause();
+  void resume();
+  void abort();
+  void emergencyStop();
+
+  // For the panels and the windowed app.
+  const SessionConfig& config() const { return config_; }
+  const bci::Paradigm& paradigm() const { return *paradigm_; }
+  VisionStage& vision() { return *vision_; }
+  EegStage& eeg() { return *eeg_; }
+  const CycleTiming& timing() const { return timing_; }
+  const std::optional<robot::StatusPayload>& robotStatus() const { return client_->status(); }
+  bool robotSilent() const { return client_->silent(); }
+  const std::vector<std::string>& robotLog() const { return robot_log_; }
+  const std::vector<TrialRecord>& trials() const { return trials_; }
+  std::optional<bci::EvaluationReport> calibrationReport() const { return calibration_report_; }
+  unsigned int hmdTexture() const;  // the last HMD frame, for the UI
+  render::Size hmdSize() const { return {config_.hmd_width, config_.hmd_height}; }
+  const std::filesystem::path& folder() const { return folder_; }
+  double time() const { return time_; }
+  std::int64_t frame() const { return frame_; }
+  std::string statusLine() const;
+  bool ended() const { return ended_; }
+  std::string endReason() const { return end_reason_; }
+  // Experimenter settings from the panels.
+  void setThreshold(const vision::ThresholdSettings& settings);
+  void setReference(int id, const cv::Vec3d& position);
+  bool canHoldBoard() const;
+  void holdBoard(bool show);
+  void useModel(const bci::P300Model& model);
+  std::vector<std::string> selectionLines() const;
+  // Writes the HMD view as it is now.
+  void screenshot(const std::filesystem::path& path);
+  nlohmann::json summary() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  SessionConfig config_;
+  SessionOptions options_;
+  std::filesystem::path folder_;
+  std::unique_ptr<bci::Paradigm> paradigm_;
+  std::unique_ptr<VisionStage> vision_;
+  std::unique_ptr<EegStage> eeg_;
+  std::unique_ptr<robot::RobotClient> client_;
+  CycleTiming timing_;
+  std::vector<std::string> robot_log_;
+  std::vector<TrialRecord> trials_;
+  std::optional<bci::EvaluationReport> calibration_report_;
+  double time_ = 0.0;
+  std::int64_t frame_ = 0;
+  bool ended_ = false;
+  std::string end_reason_;
+
+  void handleParadigmEvents();
+  void measurePlacement();
+  render::GridLayout gridLayout() const;
+  void handleRobotEvents();
+  void decideIfReady();
+  void renderHmd(const bci::FrameStimulus& stimulus);
+  void endRun(const std::string& reason);
+  TrialRecord& currentTrial();
+};
+
+}  // namespace arbci::app

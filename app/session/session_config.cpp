@@ -1,0 +1,316 @@
+#include "session/session_config.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "arbci/assets.h"
+#include "arbci/vision/camera_model.h"
+
+namespace arbci::app {
+namespace {
+
+using Json = nlohmann::json;
+
+// One object of the file with its dotted path, for messages.
+class Section {
+ public:
+  Section(const Json& json, std::string path, std::string file) : json_(json), path_(std::move(path)), file_(std::move(file)) {
+    if (!json_.is_object()) fail("", "must be an object");
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw SessionConfigError(file_ + ": " + name(key) + " " + what);
+  }
+  std::string name(const std::string& key) const { return path_.empty() ? key : key.empty() ? path_ : path_ + "." + key; }
+  bool has(const std::string& key) const { return json_.contains(key); }
+  const Json& at(const std::string& key) const { return json_.at(key); }
+  Section section(const std::string& key) const {
+    static const Json empty = Json::object();
+    return Section(has(key) ? json_.at(key) : empty, name(key), file_);
+  }
+  void known(std::initializer_list<const char*> keys) const {
+    std::set<std::string> allowed(keys.begin(), keys.end());
+    for (const auto& [key, value] : json_.items()) {
+      if (!allowed.count(key)) {
+        std::string list;
+        for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
+        fail(key, "is not a known key (known here: " + list + ")");
+      }
+    }
+  }
+  double number(const std::string& key, double fallback, double low, double high) const {
+    if (!has(key)) return fallback;
+    if (!at(key).is_number()) fail(key, "= " + at(key).dump() + " must be a number");
+    const double v = at(key).get<double>();
+    if (!(v >= low && v <= high)) fail(key, "= " + at(key).dump() + " must lie in [" + fmt(low) + ", " + fmt(high) + "]");
+    return v;
+  }
+  int integer(const std::string& key, int fallback, int low, int high) const {
+    if (!has(key)) return fallback;
+    if (!at(key).is_number_integer()) fail(key, "= " + at(key).dump() + " must be an integer");
+    const int v = at(key).get<int>();
+    if (v < low || v > high) fail(key, "= " + std::to_string(v) + " must lie in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
+    return v;
+  }
+  bool boolean(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    if (!at(key).is_boolean()) fail(key, "= " + at(key).dump() + " must be true or false");
+    return at(key).get<bool>();
+  }
+  std::string text(const std::string& key, const std::string& fallback, std::initializer_list<const char*> allowed = {}) const {
+    if (!has(key)) return fallback;
+    if (!at(key).is_string()) fail(key, "= " + at(key).dump() + " must be a string");
+    const std::string v = at(key).get<std::string>();
+    if (allowed.size() > 0) {
+      std::string list;
+      bool ok = false;
+      for (const char* a : allowed) {
+        ok |= v == a;
+        list += (list.empty() ? "" : ", ") + std::string(a);
+      }
+      if (!ok) fail(key, "= \"" + v + "\" must be one of " + list);
+    }
+    return v;
+  }
+  std::vector<double> numbers(const std::string& key, const std::vector<double>& fallback, size_t min_size, size_t max_size) const {
+    if (!has(key)) return fallback;
+    const Json& j = at(key);
+    if (!j.is_array() || j.size() < min_size || j.size() > max_size) {
+      std::string count = std::to_string(min_size);
+      if (max_size != min_size) count.append(1, '-').append(std::to_string(max_size));
+      fail(key, "= " + j.dump() + " must be a list of " + count + " numbers");
+    }
+    std::vector<double> out;
+    for (const Json& v : j) {
+      if (!v.is_number()) fail(key, "= " + j.dump() + " must contain numbers only");
+      out.push_back(v.get<double>());
+    }
+    return out;
+  }
+  cv::Vec3d vec3(const std::string& key, const cv::Vec3d& fallback) const {
+    const auto v = numbers(key, {fallback[0], fallback[1], fallback[2]}, 3, 3);
+    return {v[0], v[1], v[2]};
+  }
+
+ private:
+  static std::string fmt(double v) {
+    std::string s = std::to_string(v);
+    while (s.find('.') != std::string::npos && (s.back() == '0' || s.back() == '.')) {
+      const bool dot = s.back() == '.';
+      s.pop_back();
+      if (dot) break;
+    }
+    return s;
+  }
+  const Json& json_;
+  std::string path_, file_;
+};
+
+void parseCameras(const Section& s, CameraSettings& c) {
+  s.known({"source", "rate_hz", "width", "height", "focal_px", "distortion", "baseline_m", "head_position", "look_at", "head_motion_m",
+           "head_motion_deg", "noise", "blur_px", "left", "right", "stereo_calibration"});
+  c.source = s.text("source", c.source, {"simulated", "devices"});
+  c.rate_hz = s.number("rate_hz", c.rate_hz, 1.0, 240.0);
+  c.width = s.integer("width", c.width, 64, 4096);
+  c.height = s.integer("height", c.height, 48, 4096);
+  c.focal_px = s.number("focal_px", c.focal_px, 10.0, 1e5);
+  c.distortion = s.numbers("distortion", c.distortion, 0, 8);
+  c.baseline_m = s.number("baseline_m", c.baseline_m, 0.0, 0.5);
+  c.head_position = s.vec3("head_position", c.head_position);
+  c.look_at = s.vec3("look_at", c.look_at);
+  c.head_motion_m = s.number("head_motion_m", c.head_motion_m, 0.0, 0.2);
+  c.head_motion_deg = s.number("head_motion_deg", c.head_motion_deg, 0.0, 20.0);
+  c.noise = s.number("noise", c.noise, 0.0, 50.0);
+  c.blur_px = s.number("blur_px", c.blur_px, 0.0, 10.0);
+  c.stereo_calibration = s.text("stereo_calibration", c.stereo_calibration);
+  for (const char* side : {"left", "right"}) {
+    if (!s.has(side)) continue;
+    const Section cam = s.section(side);
+    cam.known({"device", "video", "calibration"});
+    CameraSource& source = std::string(side) == "left" ? c.left : c.right;
+    source.device = cam.integer("device", -1, -1, 63);
+    source.video = cam.text("video", "");
+    source.calibration = cam.text("calibration", "");
+    if (source.device < 0 && source.video.empty()) cam.fail("", "needs a device number or a video file");
+    if (source.calibration.empty()) cam.fail("calibration", "is required: the camera's calibration file (arbci calibrate)");
+  }
+  if (c.source == "devices" && c.left.device < 0 && c.left.video.empty()) s.fail("left", "is required when source is \"devices\"");
+}
+
+void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
+  s.known({"table_z", "reference", "objects", "grid"});
+  w.table_z = s.number("table_z", w.table_z, -2.0, 2.0);
+  const Section ref = s.section("reference");
+  ref.known({"id", "size_m", "position"});
+  w.reference_id = ref.integer("id", w.reference_id, 0, 4095);
+  w.reference_size_m = ref.number("size_m", w.reference_size_m, 0.005, 1.0);
+  w.reference_position = ref.vec3("position", w.reference_position);
+  if (s.has("objects")) {
+    if (!s.at("objects").is_array() || s.at("objects").empty()) s.fail("objects", "must be a non-empty list");
+    w.objects.clear();
+    for (size_t i = 0; i < s.at("objects").size(); ++i) {
+      const Section o(s.at("objects")[i], s.name("objects") + "[" + std::to_string(i) + "]", file);
+      o.known({"id", "position", "marker_m", "width_m", "height_m", "color"});
+      WorldObjectSettings object;
+      object.id = o.integer("id", -1, 0, 4095);
+      if (object.id < 0) o.fail("id", "is required (the object's marker id)");
+      if (object.id == w.reference_id) o.fail("id", "= " + std::to_string(object.id) + " is the reference marker's id");
+      if (!o.has("position")) o.fail("position", "is required: [x, y, z] of the top centre in metres");
+      object.position = o.vec3("position", {});
+      object.marker_m = o.number("marker_m", object.marker_m, 0.005, 0.5);
+      object.width_m = o.number("width_m", object.width_m, object.marker_m, 0.6);
+      object.height_m = o.number("height_m", object.height_m, 0.005, 0.6);
+      object.color = o.vec3("color", object.color);
+      for (const auto& other : w.objects) {
+        if (other.id == object.id) o.fail("id", "= " + std::to_string(object.id) + " is used twice");
+      }
+      w.objects.push_back(object);
+    }
+  }
+  const Section g = s.section("grid");
+  g.known({"rows", "columns", "cell_m", "centre"});
+  w.grid.rows = g.integer("rows", w.grid.rows, 1, 12);
+  w.grid.columns = g.integer("columns", w.grid.columns, 1, 12);
+  if (w.grid.rows * w.grid.columns < 2) g.fail("", "needs at least 2 cells");
+  w.grid.cell_m = g.number("cell_m", w.grid.cell_m, 0.01, 1.0);
+  w.grid.centre = g.vec3("centre", w.grid.centre);
+}
+
+void parse(const Json& json, const std::string& file, SessionConfig& c) {
+  const Section root(json, "", file);
+  root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "paradigm", "classifier", "robot"});
+  c.display_hz = root.number("display_hz", c.display_hz, 10.0, 500.0);
+  const Section hmd = root.section("hmd");
+  hmd.known({"width", "height", "undistort", "mirror_monitor"});
+  c.hmd_width = hmd.integer("width", c.hmd_width, 64, 8192);
+  c.hmd_height = hmd.integer("height", c.hmd_height, 48, 8192);
+  c.undistort = hmd.boolean("undistort", c.undistort);
+  c.mirror_monitor = hmd.integer("mirror_monitor", c.mirror_monitor, -1, 15);
+  parseCameras(root.section("cameras"), c.cameras);
+  const Section tracker = root.section("tracker");
+  tracker.known({"kind", "border"});
+  c.tracker_kind = tracker.text("kind", c.tracker_kind, {"bch", "simple"});
+  c.tracker_border = tracker.number("border", c.tracker_border, 0.05, 0.4);
+  const Section world_section = root.section("world");
+  parseWorld(world_section, file, c.world);
+  if (c.world.objects.size() < 2) world_section.fail("objects", "must name at least 2 objects");
+
+  const Section eeg = root.section("eeg");
+  eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale", "file"});
+  c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file"});
+  c.eeg.seed = static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
+  if (eeg.has("montage")) {
+    if (!eeg.at("montage").is_array() || eeg.at("montage").empty()) eeg.fail("montage", "must be a list of channel names");
+    c.eeg.montage = eeg.at("montage").get<std::vector<std::string>>();
+  }
+  c.eeg.rate_hz = eeg.number("rate_hz", c.eeg.rate_hz, 64.0, 4096.0);
+  c.eeg.block_size = eeg.integer("block_size", c.eeg.block_size, 1, 4096);
+  c.eeg.line_hz = eeg.number("line_hz", c.eeg.line_hz, 0.0, 70.0);
+  c.eeg.erp_scale = eeg.number("erp_scale", c.eeg.erp_scale, 0.0, 10.0);
+  c.eeg.file = eeg.text("file", c.eeg.file);
+  if (c.eeg.source == "file" && c.eeg.file.empty()) eeg.fail("file", "is required when source is \"file\"");
+
+  const Section p = root.section("paradigm");
+  p.known({"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "calibration_selections", "calibration_sequences", "trials",
+           "intended", "cue_s", "result_s", "pause_s"});
+  bci::ParadigmSettings& ps = c.paradigm;
+  ps.display_hz = c.display_hz;
+  ps.flash_ms = p.number("flash_ms", 60.0, 5.0, 2000.0);
+  ps.isi_ms = p.number("isi_ms", 120.0, 0.0, 5000.0);
+  ps.sequences = p.integer("sequences", 8, 1, 100);
+  ps.min_sequences = p.integer("min_sequences", 3, 1, ps.sequences);
+  ps.certainty = p.number("certainty", 0.999, 0.0, 1.0);
+  ps.calibration_selections = p.integer("calibration_selections", 8, 2, 200);
+  ps.calibration_sequences = p.integer("calibration_sequences", 8, 1, 100);
+  ps.trials = p.integer("trials", 3, 1, 1000);
+  ps.cue_s = p.number("cue_s", 1.5, 0.0, 60.0);
+  ps.result_s = p.number("result_s", 1.0, 0.0, 60.0);
+  ps.pause_s = p.number("pause_s", 1.0, 0.0, 60.0);
+  if (p.has("intended")) {
+    if (!p.at("intended").is_array()) p.fail("intended", "must be a list of {\"object\": id, \"cell\": [row, column]}");
+    c.intended.clear();
+    for (size_t i = 0; i < p.at("intended").size(); ++i) {
+      const Section t(p.at("intended")[i], p.name("intended") + "[" + std::to_string(i) + "]", file);
+      t.known({"object", "cell"});
+      TrialIntent intent;
+      intent.object = t.integer("object", -1, 0, 4095);
+      bool known_object = false;
+      for (const auto& o : c.world.objects) known_object |= o.id == intent.object;
+      if (!known_object) t.fail("object", "= " + std::to_string(intent.object) + " is not one of world.objects");
+      const auto cell = t.numbers("cell", {1, 1}, 2, 2);
+      intent.row = static_cast<int>(cell[0]);
+      intent.column = static_cast<int>(cell[1]);
+      if (intent.row < 1 || intent.row > c.world.grid.rows || intent.column < 1 || intent.column > c.world.grid.columns) {
+        t.fail("cell", "lies outside the " + std::to_string(c.world.grid.rows) + "x" + std::to_string(c.world.grid.columns) + " grid");
+      }
+      c.intended.push_back(intent);
+    }
+  }
+  const Section cl = root.section("classifier");
+  cl.known({"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz", "notch_hz", "model"});
+  c.classifier_method = cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn"});
+  const auto window = cl.numbers("window_ms", {0, 800}, 2, 2);
+  if (!(window[1] > window[0])) cl.fail("window_ms", "must end after it starts");
+  c.pipeline.window = {window[0] / 1000.0, window[1] / 1000.0};
+  c.pipeline.decimate_hz = cl.number("decimate_hz", 20.0, 1.0, 500.0);
+  c.pipeline.filter.highpass_hz = cl.number("highpass_hz", 0.5, 0.0, 100.0);
+  c.pipeline.filter.lowpass_hz = cl.number("lowpass_hz", 20.0, 0.0, 500.0);
+  c.pipeline.filter.notch_hz = cl.number("notch_hz", 0.0, 0.0, 500.0);
+  c.model_file = cl.text("model", "");
+
+  const Section r = root.section("robot");
+  r.known({"backend", "speed_factor", "host", "port", "key_file"});
+  c.robot_backend = r.text("backend", c.robot_backend, {"simulated", "remote"});
+  c.robot_speed_factor = r.number("speed_factor", c.robot_speed_factor, 0.1, 100.0);
+  c.robot_host = r.text("host", c.robot_host);
+  c.robot_port = r.integer("port", c.robot_port, 1, 65535);
+  c.robot_key_file = r.text("key_file", c.robot_key_file);
+  if (c.robot_backend == "remote" && c.robot_key_file.empty()) r.fail("key_file", "is required for a remote robot");
+}
+
+}  // namespace
+
+SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& path) {
+  SessionConfig config;
+  const Json defaults = Json::parse(assets::embedded("sessions/simulated.json"));
+  parse(defaults, "embedded default session", config);
+  if (!path) return config;
+  std::ifstream in(*path);
+  if (!in) throw SessionConfigError(path->string() + ": cannot open the session file");
+  Json json;
+  try {
+    in >> json;
+  } catch (const Json::exception& error) {
+    throw SessionConfigError(path->string() + ": not JSON (" + std::string(error.what()) + ")");
+  }
+  config.source = path->string();
+  parse(json, path->string(), config);
+  return config;
+}
+
+void SessionConfig::checkResources() const {
+  auto exists = [&](const std::string& key, const std::string& file) {
+    if (!file.empty() && !std::filesystem::exists(file)) throw SessionConfigError(source + ": " + key + " = \"" + file + "\": no such file");
+  };
+  exists("eeg.file", eeg.file);
+  exists("classifier.model", model_file);
+  exists("robot.key_file", robot_key_file);
+  exists("cameras.stereo_calibration", cameras.stereo_calibration);
+  for (const auto& [side, cam] : {std::pair{"cameras.left", &cameras.left}, std::pair{"cameras.right", &cameras.right}}) {
+    exists(std::string(side) + ".video", cam->video);
+    exists(std::string(side) + ".calibration", cam->calibration);
+    if (!cam->calibration.empty()) {
+      try {
+        vision::CameraModel::load(cam->calibration);
+      } catch (const std::exception& error) {
+        throw SessionConfigError(source + ": " + side + ".calibration: " + error.what());
+      }
+    }
+    if (cam->device >= 0 && !std::filesystem::exists("/dev/video" + std::to_string(cam->device))) {
+      throw SessionConfigError(source + ": " + side + ".device = " + std::to_string(cam->device) + ": /dev/video" +
+                               std::to_string(cam->device) + " does not exist");
+    }
+  }
+}
+
+}  // namespace arbci::app

@@ -1,0 +1,114 @@
+// A session file (JSON): the display, the cameras, the tracker, the world (reference marker,
+// objects, grid), the EEG source, the paradigm, the classifier and the robot. Every key has a
+// default (the embedded simulated session, assets/sessions/simulated.json); a file names only what
+// differs. Loading validates everything once and names the key, the value and what is allowed.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/matx.hpp>
+
+#include "arbci/bci/features.h"
+#include "arbci/bci/paradigm.h"
+
+namespace arbci::app {
+
+class SessionConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct CameraSource {
+  int device = -1;         // V4L2 index, or
+  std::string video;       // a video file
+  std::string calibration; // its calibration file (OpenCV YAML/XML)
+};
+
+struct CameraSettings {
+  std::string source = "simulated";  // "simulated" or "devices"
+  double rate_hz = 30.0;
+  // Simulated cameras.
+  int width = 640, height = 480;
+  double focal_px = 800.0;
+  std::vector<double> distortion;
+  double baseline_m = 0.064;
+  cv::Vec3d head_position{0.0, 1.20, 0.75};
+  cv::Vec3d look_at{0.0, 0.70, 0.0};
+  double head_motion_m = 0.008, head_motion_deg = 0.6;
+  double noise = 2.0, blur_px = 0.5;
+  // Real cameras.
+  CameraSource left, right;  // right.device < 0 and right.video empty: mono (feeds both eyes)
+  std::string stereo_calibration;  // optional: the right camera's pose in the left's frame
+};
+
+struct WorldObjectSettings {
+  int id = 0;  // its marker's BCH id
+  cv::Vec3d position;  // top centre, robot frame
+  double marker_m = 0.05, width_m = 0.07, height_m = 0.06;
+  cv::Vec3d color{0.8, 0.4, 0.3};
+};
+
+struct GridSettings {
+  int rows = 3, columns = 3;
+  double cell_m = 0.09;
+  cv::Vec3d centre{0.0, 0.66, 0.0};  // robot frame, on the table
+};
+
+struct WorldSettings {
+  double table_z = 0.0;
+  int reference_id = 0;
+  double reference_size_m = 0.08;
+  cv::Vec3d reference_position{0.0, 0.90, 0.0};
+  std::vector<WorldObjectSettings> objects;
+  GridSettings grid;
+};
+
+struct EegSettings {
+  std::string source = "simulated";  // "simulated" or "file"
+  std::uint64_t seed = 1;
+  std::vector<std::string> montage{"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
+  double rate_hz = 256.0;
+  int block_size = 15;
+  double line_hz = 50.0;
+  double erp_scale = 1.0;  // the simulated subject's ERP amplitude factor (weak subjects < 1)
+  std::string file;        // source "file": a recording replayed in real time
+};
+
+struct TrialIntent {
+  int object = 0;  // marker id
+  int row = 1, column = 1;
+};
+
+struct SessionConfig {
+  std::string source = "embedded default";
+  double display_hz = 60.0;
+  int hmd_width = 1280, hmd_height = 480;
+  bool undistort = true;
+  int mirror_monitor = -1;
+  CameraSettings cameras;
+  std::string tracker_kind = "bch";
+  double tracker_border = 0.125;
+  WorldSettings world;
+  EegSettings eeg;
+  bci::ParadigmSettings paradigm;
+  std::vector<TrialIntent> intended;
+  std::string classifier_method = "slda";
+  bci::PipelineSettings pipeline;
+  std::string model_file;  // a trained model: no calibration run
+  std::string robot_backend = "simulated";  // "simulated" (arbci-robotd here) or "remote"
+  double robot_speed_factor = 8.0;
+  std::string robot_host = "127.0.0.1";
+  int robot_port = 47800;
+  std::string robot_key_file;
+
+  // The embedded default, or `path` over the defaults. Throws SessionConfigError.
+  static SessionConfig load(const std::optional<std::filesystem::path>& path);
+  // Checks that what the file names can be opened (files, devices); throws naming the key.
+  void checkResources() const;
+};
+
+}  // namespace arbci::app

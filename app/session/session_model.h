@@ -1,0 +1,56 @@
+// The running session as the experimenter panels see it (ui::WorkstationModel over Session).
+#pragma once
+
+#include "arbci/ui/workstation_model.h"
+#include "session/session.h"
+
+namespace arbci::app {
+
+class SessionModel final : public ui::WorkstationModel {
+ public:
+  explicit SessionModel(Session& session) : session_(session) {}
+
+  cv::Mat cameraImage() override { return session_.vision().leftImage(); }
+  cv::Mat binaryImage() override { return session_.vision().detector().lastBinaryImage(); }
+  vision::DetectionResult detection() override { return session_.vision().lastDetection(); }
+  vision::ThresholdSettings threshold() override { return threshold_; }
+  void setThreshold(const vision::ThresholdSettings& settings) override;
+  std::vector<ui::TrackedObject> trackedObjects() override;
+  std::string worldStatus() override { return session_.vision().world().status(session_.time()); }
+
+  vision::CameraModel camera() override { return session_.vision().leftCamera(); }
+  bool canHoldBoard() override { return session_.canHoldBoard(); }
+  void holdBoard(bool show) override { session_.holdBoard(show); }
+  int referenceId() override { return session_.vision().world().reference().id; }
+  cv::Vec3d referencePosition() override { return session_.vision().world().reference().T_robot_ref.translation; }
+  void setReference(int id, const cv::Vec3d& position) override { session_.setReference(id, position); }
+
+  std::optional<bci::P300Model> model() override { return session_.eeg().model(); }
+  void useModel(const bci::P300Model& model) override { session_.useModel(model); }
+
+  std::optional<robot::StatusPayload> robotStatus() override { return session_.robotStatus(); }
+  bool robotSilent() override { return session_.robotSilent(); }
+  std::vector<std::string> robotLog() override { return session_.robotLog(); }
+  void emergencyStop() override { session_.emergencyStop(); }
+
+  std::string phase() override;
+  int trial() override { return session_.paradigm().trial(); }
+  int trials() override { return session_.config().paradigm.trials; }
+  int sequence() override { return session_.paradigm().sequence(); }
+  bool started() override { return session_.paradigm().phase() != bci::Phase::Setup; }
+  void start() override { session_.start(); }
+  void pause() override { session_.pause(); }
+  void resume() override { session_.resume(); }
+  void abort() override { session_.abort(); }
+  double sessionTime() override { return session_.time(); }
+  double budgetMs() override { return session_.timing().budgetMs(); }
+  int overruns() override { return session_.timing().overruns(); }
+  std::vector<ui::StageTiming> timing() override;
+  std::vector<std::string> selections() override { return session_.selectionLines(); }
+
+ private:
+  Session& session_;
+  vision::ThresholdSettings threshold_;
+};
+
+}  // namespace arbci::app

@@ -1,0 +1,53 @@
+// The camera half of the cycle: tracks the markers of the left camera's frames (lens-aware), turns
+// them into robot-frame poses through the reference marker, and gives each eye's camera pose in
+// the robot frame for the HMD overlays (the right one through the rig's extrinsics).
+#pragma once
+
+#include <map>
+#include <optional>
+
+#include "arbci/vision/marker_detector.h"
+#include "arbci/vision/world_model.h"
+#include "session/session_config.h"
+
+namespace arbci::app {
+
+class VisionStage {
+ public:
+  VisionStage(const SessionConfig& config, const vision::CameraModel& left, const vision::CameraModel& right,
+              const vision::Pose& T_right_left);
+
+  // A new pair of frames at time `t` (seconds); the right one may be empty (mono).
+  void process(double t, const cv::Mat& left, const cv::Mat& right);
+  // The same frames as last time, at time `t`: the last poses are seen again without tracking.
+  void repeat(double t);
+
+  const cv::Mat& leftImage() const { return left_image_; }
+  const cv::Mat& rightImage() const { return right_image_.empty() ? left_image_ : right_image_; }
+  const vision::CameraModel& leftCamera() const { return left_camera_; }
+  const vision::CameraModel& rightCamera() const { return right_image_.empty() ? left_camera_ : right_camera_; }
+  std::optional<vision::Pose> T_cam_world_left() const;
+  std::optional<vision::Pose> T_cam_world_right() const;
+  const vision::WorldModel& world() const { return world_; }
+  const vision::DetectionResult& lastDetection() const { return last_; }
+  vision::MarkerDetector& detector() { return detector_; }
+  // A new reference marker (id, position in the robot frame): object poses start afresh.
+  void setReference(int id, double size_m, const cv::Vec3d& position);
+  // Marker side by id: the reference's or the object's.
+  double markerSize(int id) const;
+
+ private:
+  const SessionConfig& config_;
+  int reference_id_;
+  double reference_size_m_;
+  vision::CameraModel left_camera_, right_camera_;
+  vision::Pose T_right_left_;
+  vision::MarkerDetector detector_;
+  vision::WorldModel world_;
+  std::map<int, vision::Pose> previous_;  // for the pose's anti-flip rule
+  std::map<int, vision::PoseEstimate> last_poses_;
+  vision::DetectionResult last_;
+  cv::Mat left_image_, right_image_;
+};
+
+}  // namespace arbci::app

@@ -1,0 +1,88 @@
+#include "session/workstation.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "arbci/render/framebuffer.h"
+#include "arbci/render/window_context.h"
+#include "arbci/ui/experimenter_shell.h"
+#include "arbci/ui/imgui_layer.h"
+#include "arbci/ui/panels.h"
+#include "session/session_model.h"
+
+namespace arbci::app {
+namespace {
+
+// Where the panel layout is kept between runs.
+std::string layoutFile() {
+  const char* config = std::getenv("XDG_CONFIG_HOME");
+  const char* home = std::getenv("HOME");
+  std::filesystem::path dir = config ? std::filesystem::path(config) : home ? std::filesystem::path(home) / ".config" : ".";
+  dir /= "arbci";
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  return (dir / "layout.ini").string();
+}
+
+}  // namespace
+
+int runWorkstation(const SessionConfig& config, SessionOptions options) {
+  options.simulated_clock = false;
+  options.start_immediately = false;  // the experimenter presses Start
+  render::WindowOptions window;
+  window.title = "ARBCI workstation";
+  render::WindowContext main_window(window);
+  std::unique_ptr<render::WindowContext> mirror;
+  if (config.mirror_monitor >= 0 && config.mirror_monitor < render::WindowContext::monitorCount()) {
+    render::WindowOptions m;
+    m.title = "ARBCI HMD";
+    m.fullscreen_monitor = config.mirror_monitor;
+    m.share_with = main_window.window();
+    mirror = std::make_unique<render::WindowContext>(m);
+    main_window.makeCurrent();
+  }
+  Session session(config, options, main_window);
+  SessionModel model(session);
+  ui::ImGuiLayer imgui(main_window, layoutFile());
+  ui::ExperimenterShell shell;
+  ui::SessionPanel session_panel(model);
+  ui::HmdPanel hmd_panel(session.hmdTexture(), static_cast<float>(config.hmd_width) / config.hmd_height);
+  ui::ThresholdPanel threshold_panel(model);
+  ui::RobotPanel robot_panel(model);
+  ui::CalibrationPanel calibration_panel(model);
+  ui::TrainingPanel training_panel(model);
+  shell.addPanel(session_panel);
+  shell.addPanel(hmd_panel);
+  shell.addPanel(robot_panel);
+  shell.addPanel(threshold_panel);
+  shell.addPanel(calibration_panel, false);
+  shell.addPanel(training_panel, false);
+  shell.setEmergencyStop([&] { model.emergencyStop(); });
+  shell.setQuitHandler([&] { main_window.requestClose(); });
+  auto last = std::chrono::steady_clock::now();
+  while (!main_window.shouldClose()) {
+    render::WindowContext::pollEvents();
+    session.step();
+    main_window.makeCurrent();
+    const auto now = std::chrono::steady_clock::now();
+    const float frame_ms = std::chrono::duration<float, std::milli>(now - last).count();
+    last = now;
+    const render::Size size = main_window.framebufferSize();
+    imgui.beginFrame(frame_ms / 1000.0f);
+    shell.draw(size, {frame_ms, model.phase(), session.statusLine()});
+    render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
+    imgui.endFrame();
+    main_window.present();
+    if (mirror) {
+      mirror->makeCurrent();
+      render::blitTexture(session.hmdTexture(), session.hmdSize(), mirror->framebufferSize());
+      mirror->present();
+      main_window.makeCurrent();
+    }
+  }
+  return session.ended() && session.endReason() != "finished" ? 3 : 0;
+}
+
+}  // namespace arbci::app

@@ -1,0 +1,132 @@
+// The experimenter panels, each on the running workstation's live data.
+#pragma once
+
+#include <atomic>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arbci/bci/evaluation.h"
+#include "arbci/bci/p300_dataset.h"
+#include "arbci/ui/image_view.h"
+#include "arbci/ui/panel.h"
+#include "arbci/ui/workstation_model.h"
+#include "arbci/vision/calibration.h"
+
+namespace arbci::ui {
+
+// Threshold mode and value, the live binarised image beside the camera image, and the markers
+// found with ID, confidence and pose.
+class ThresholdPanel final : public Panel {
+ public:
+  explicit ThresholdPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "Threshold"; }
+  void draw() override;
+
+ private:
+  WorkstationModel& model_;
+  ImageView camera_, binary_;
+};
+
+// Chessboard views with a live detection overlay, the coverage map, per-view and overall
+// reprojection error, calibrate and save, an undistortion preview, and the reference marker.
+class CalibrationPanel final : public Panel {
+ public:
+  explicit CalibrationPanel(WorkstationModel& model);
+  const char* title() const override { return "Calibration"; }
+  void draw() override;
+  // What the buttons do, also for scripted use.
+  void captureView();
+  void calibrate();
+  void holdBoard(bool show);
+
+ private:
+  WorkstationModel& model_;
+  vision::IncrementalCalibrator calibrator_;
+  std::optional<vision::CalibrationResult> result_;
+  std::string last_view_, message_;
+  std::vector<cv::Point2f> last_corners_;
+  char save_path_[256] = "camera.yml";
+  bool preview_undistorted_ = false, board_ = false;
+  int reference_id_ = 0;
+  float reference_position_[3] = {0.0f, 0.9f, 0.0f};
+  ImageView view_, coverage_;
+};
+
+// Recordings, method and parameters; training with progress on a worker thread; the ERP averages
+// and accuracy by sequences; saving the model and using it in the session.
+class TrainingPanel final : public Panel {
+ public:
+  explicit TrainingPanel(WorkstationModel& model) : model_(model) {}
+  ~TrainingPanel() override;
+  const char* title() const override { return "Classifier training"; }
+  void draw() override;
+  void setRecordings(const std::string& files);
+  // Trains as the button does; `wait` blocks until the result is in.
+  void train(bool wait);
+
+ private:
+  struct Outcome {
+    std::optional<bci::TrainingResult> result;
+    std::optional<bci::P300Dataset> data;
+    std::string error;
+  };
+  void startTraining();
+  void collect();
+  WorkstationModel& model_;
+  char files_[1024] = "";
+  char save_path_[256] = "model.json";
+  int method_ = 1;  // swlda, slda, xdawn
+  float window_end_ms_ = 800.0f, decimate_hz_ = 20.0f;
+  std::atomic<double> progress_{0.0};
+  std::mutex stage_mutex_;
+  std::string stage_;
+  std::future<Outcome> training_;
+  std::optional<Outcome> outcome_;
+  std::string message_;
+};
+
+// Connection, state, current command and progress, tool position, what the gripper holds,
+// errors, and the emergency stop.
+class RobotPanel final : public Panel {
+ public:
+  explicit RobotPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "Robot"; }
+  void draw() override;
+
+ private:
+  WorkstationModel& model_;
+};
+
+// The paradigm's state and phase, start/pause/resume/abort, the current sequence, the selections
+// made, and the cycle's timing per stage with its overruns against the block budget.
+class SessionPanel final : public Panel {
+ public:
+  explicit SessionPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "Session"; }
+  void draw() override;
+
+ private:
+  WorkstationModel& model_;
+  std::vector<float> history_;
+};
+
+// The HMD view as the subject sees it (both eyes), mirrored for the experimenter.
+class HmdPanel final : public Panel {
+ public:
+  HmdPanel(unsigned int texture, float aspect) : texture_(texture), aspect_(aspect) {}
+  const char* title() const override { return "HMD view"; }
+  void draw() override;
+
+ private:
+  unsigned int texture_;
+  float aspect_;
+};
+
+// The emergency stop: a button that shows whatever panels are open (drawn by the shell).
+void emergencyStopButton(WorkstationModel& model);
+
+}  // namespace arbci::ui

@@ -1,0 +1,55 @@
+#include <imgui.h>
+
+#include "arbci/ui/panels.h"
+#include "widgets.h"
+
+namespace arbci::ui {
+
+void emergencyStopButton(WorkstationModel& model) {
+  ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
+  ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));
+  if (ImGui::Button("EMERGENCY STOP")) model.emergencyStop();
+  ImGui::PopStyleColor(2);
+}
+
+void RobotPanel::draw() {
+  emergencyStopButton(model_);
+  const auto status = model_.robotStatus();
+  if (model_.robotSilent()) {
+    ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "backend silent: no answer for over a second");
+  } else if (!status) {
+    ImGui::TextDisabled("waiting for the backend's first status");
+  } else {
+    ImGui::TextColored(ImVec4(0.4f, 1, 0.4f, 1), "connected");
+  }
+  if (status) {
+    ImGui::Text("state: %s", robot::toString(status->state));
+    if (status->current_command != robot::MessageType::Status) {
+      ImGui::Text("command: %s #%llu", robot::toString(status->current_command), static_cast<unsigned long long>(status->current_sequence));
+      ImGui::ProgressBar(static_cast<float>(status->progress));
+    } else {
+      ImGui::TextDisabled("no command running");
+    }
+    ImGui::Text("tool: (%.3f, %.3f, %.3f) m", status->tool.x, status->tool.y, status->tool.z);
+    ImGui::Text("gripper: %s (%.0f%% open)", status->gripper_opening > 0.5 ? "open" : "closed", status->gripper_opening * 100.0);
+    ImGui::Text("holding: %s", status->holding >= 0 ? ("object " + std::to_string(status->holding)).c_str() : "nothing");
+    if (status->last_finished_sequence > 0) {
+      ImGui::Text("last finished: #%llu %s %s", static_cast<unsigned long long>(status->last_finished_sequence), robot::toString(status->last_outcome),
+                  status->last_outcome_text.c_str());
+    }
+  }
+  heading("messages");
+  const auto log = model_.robotLog();
+  ImGui::BeginChild("robot log", ImVec2(0, 0), true);
+  for (auto it = log.rbegin(); it != log.rend(); ++it) {
+    const bool bad = it->find("rejected") == 0 || it->find("failed") == 0 || it->find("silent") == 0;
+    if (bad) {
+      ImGui::TextColored(ImVec4(1, 0.5f, 0.3f, 1), "%s", it->c_str());
+    } else {
+      ImGui::TextUnformatted(it->c_str());
+    }
+  }
+  ImGui::EndChild();
+}
+
+}  // namespace arbci::ui

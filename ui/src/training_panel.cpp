@@ -1,0 +1,141 @@
+#include <imgui.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+
+#include "arbci/bci/p300_model.h"
+#include "arbci/ui/panels.h"
+#include "widgets.h"
+
+namespace arbci::ui {
+
+TrainingPanel::~TrainingPanel() {
+  if (training_.valid()) training_.wait();
+}
+
+void TrainingPanel::startTraining() {
+  std::vector<std::string> files;
+  std::istringstream in(files_);
+  std::string file;
+  while (in >> file) files.push_back(file);
+  if (files.empty()) {
+    message_ = "name at least one recording (BCI2000 .dat or ARBCI .bdf)";
+    return;
+  }
+  const char* methods[] = {"swlda", "slda", "xdawn"};
+  bci::TrainingSettings settings;
+  settings.method = methods[method_];
+  bci::PipelineSettings pipeline;
+  pipeline.window.end_s = window_end_ms_ / 1000.0;
+  pipeline.decimate_hz = decimate_hz_;
+  progress_ = 0.0;
+  message_.clear();
+  outcome_.reset();
+  training_ = std::async(std::launch::async, [this, files, settings, pipeline] {
+    Outcome outcome;
+    try {
+      std::vector<bci::Recording> recordings;
+      for (const std::string& f : files) recordings.push_back(bci::readRecording(f));
+      const bci::Progress progress = [this](double fraction, const std::string& stage) {
+        progress_ = fraction;
+        std::lock_guard lock(stage_mutex_);
+        stage_ = stage;
+      };
+      outcome.data = bci::buildDataset(recordings, pipeline, progress);
+      outcome.result = bci::trainModel(*outcome.data, pipeline, settings, progress);
+    } catch (const std::exception& error) {
+      outcome.error = error.what();
+    }
+    return outcome;
+  });
+}
+
+void TrainingPanel::setRecordings(const std::string& files) { std::snprintf(files_, sizeof files_, "%s", files.c_str()); }
+
+void TrainingPanel::train(bool wait) {
+  startTraining();
+  if (wait && training_.valid()) {
+    training_.wait();
+    collect();
+  }
+}
+
+void TrainingPanel::collect() {
+  if (training_.valid() && training_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    outcome_ = training_.get();
+    if (!outcome_->error.empty()) message_ = outcome_->error;
+  }
+}
+
+void TrainingPanel::draw() {
+  ImGui::InputTextMultiline("recordings", files_, sizeof files_, ImVec2(-1, ImGui::GetTextLineHeight() * 3));
+  const char* methods[] = {"SWLDA (as BCI2000)", "shrinkage LDA", "xDAWN + LDA"};
+  ImGui::Combo("method", &method_, methods, 3);
+  ImGui::SliderFloat("window end (ms)", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
+  ImGui::SliderFloat("decimate to (Hz)", &decimate_hz_, 10.0f, 64.0f, "%.0f");
+  collect();
+  const bool running = training_.valid();
+  ImGui::BeginDisabled(running);
+  if (ImGui::Button("Train")) startTraining();
+  ImGui::EndDisabled();
+  if (running) {
+    std::lock_guard lock(stage_mutex_);
+    ImGui::SameLine();
+    ImGui::ProgressBar(static_cast<float>(progress_.load()), ImVec2(-1, 0), stage_.c_str());
+  }
+  if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+
+  // The session's own model when nothing was trained here.
+  if (!outcome_ || !outcome_->result) {
+    const auto current = model_.model();
+    if (current) {
+      ImGui::Text("session model: %s, trained on %s", current->method.c_str(),
+                  current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
+    } else {
+      ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
+    }
+    return;
+  }
+  const bci::TrainingResult& r = *outcome_->result;
+  const bci::EvaluationReport& cv = r.cross_validation.report;
+  ImGui::Text("cross-validated (%d folds by selection): AUC %.3f; %d selections", r.cross_validation.folds, cv.auc,
+              cv.selections_with_truth);
+  std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()), bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
+  ImGui::PlotLines("accuracy by sequences", accuracy.data(), static_cast<int>(accuracy.size()), 0, nullptr, 0.0f, 1.0f, ImVec2(0, 70));
+  ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0, nullptr, 0.0f, FLT_MAX, ImVec2(0, 70));
+  const bci::P300Dataset& d = *outcome_->data;
+  heading("ERP averages: target (upper) and non-target (lower) per channel");
+  // One scale for all channels and both classes, so the averages compare.
+  const float limit = static_cast<float>(std::max({1.0, d.erp_target.cwiseAbs().maxCoeff(), d.erp_other.cwiseAbs().maxCoeff()}));
+  for (int c = 0; c < static_cast<int>(d.erp_target.rows()); ++c) {
+    std::vector<float> t(d.erp_target.row(c).data(), d.erp_target.row(c).data() + d.erp_target.cols());
+    std::vector<float> o(d.erp_other.row(c).data(), d.erp_other.row(c).data() + d.erp_other.cols());
+    ImGui::PushID(c);
+    ImGui::PlotLines(d.info.channels[static_cast<size_t>(c)].c_str(), t.data(), static_cast<int>(t.size()), 0, "target", -limit, limit,
+                     ImVec2(0, 40));
+    ImGui::PlotLines("##other", o.data(), static_cast<int>(o.size()), 0, "non-target", -limit, limit, ImVec2(0, 40));
+    ImGui::PopID();
+  }
+  ImGui::InputText("##model", save_path_, sizeof save_path_);
+  ImGui::SameLine();
+  if (ImGui::Button("Save model")) {
+    try {
+      r.model.save(save_path_);
+      message_ = std::string("saved ") + save_path_;
+    } catch (const std::exception& error) {
+      message_ = error.what();
+    }
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Use in the session")) {
+    try {
+      model_.useModel(r.model);
+      message_ = "the session now uses this model";
+    } catch (const std::exception& error) {
+      message_ = error.what();
+    }
+  }
+}
+
+}  // namespace arbci::ui
