@@ -15,7 +15,7 @@ namespace {
 
 struct RunOptions {
   std::string session, out;
-  bool headless = false, realtime = false;
+  bool headless = false, realtime = false, wait_for_start = false;
   int trials = 0;
   long long seed = -1;
   double fault_wait_s = 5.0;
@@ -58,6 +58,7 @@ int runSession(const RunOptions& o) {
   if (o.trials > 0) options.trials = o.trials;
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
   options.fault_wait_s = o.fault_wait_s;
+  options.start_immediately = !o.wait_for_start;
   options.progress = &std::cerr;
   const bool headless = o.headless || !render::displayAvailable();
   try {
@@ -92,6 +93,7 @@ void addRunCommand(CLI::App& root, int& exit_code) {
   run->add_option("--seed", o->seed, "random seed of the simulated subject and world")->check(CLI::Range(0LL, 1LL << 30));
   run->add_option("--out", o->out, "session folder (default: arbci-session-<date>-<time>)");
   run->add_flag("--realtime", o->realtime, "headless: pace to the wall clock instead of running as fast as possible");
+  run->add_flag("--wait-for-start", o->wait_for_start, "windowed: wait for the experimenter to press Start");
   run->add_option("--fault-wait", o->fault_wait_s, "headless: seconds to wait for an experimenter after a robot fault")->capture_default_str();
   run->callback([o, &exit_code] { exit_code = runSession(*o); });
 }

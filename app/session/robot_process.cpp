@@ -2,10 +2,12 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -15,9 +17,15 @@
 namespace arbci::app {
 
 std::filesystem::path robotdNextToMe() {
+  if (const char* explicit_path = std::getenv("ARBCI_ROBOTD")) return explicit_path;
   std::error_code error;
   const auto me = std::filesystem::read_symlink("/proc/self/exe", error);
-  return (error ? std::filesystem::path(".") : me.parent_path()) / "arbci-robotd";
+  const std::filesystem::path dir = error ? std::filesystem::path(".") : me.parent_path();
+  // Next to arbci, or one level up (the benchmarks' and tests' folders of a build tree).
+  for (const auto& candidate : {dir / "arbci-robotd", dir.parent_path() / "arbci-robotd"}) {
+    if (std::filesystem::exists(candidate)) return candidate;
+  }
+  return dir / "arbci-robotd";
 }
 
 RobotProcess::RobotProcess(const std::filesystem::path& executable, const std::filesystem::path& key_file,
@@ -30,6 +38,7 @@ RobotProcess::RobotProcess(const std::filesystem::path& executable, const std::f
   pid_ = fork();
   if (pid_ < 0) throw std::runtime_error("cannot start arbci-robotd: fork failed");
   if (pid_ == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);  // the backend stops with the session, however it ends
     const int log = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (log >= 0) {
       dup2(log, STDERR_FILENO);

@@ -27,7 +27,8 @@ class RobotProcess {
   int port_ = 0;
 };
 
-// The arbci-robotd next to the running executable.
+// The arbci-robotd to start: $ARBCI_ROBOTD, else the one next to the running executable (or one
+// folder up, as in a build tree).
 std::filesystem::path robotdNextToMe();
 
 }  // namespace arbci::app

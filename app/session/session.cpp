@@ -282,6 +282,7 @@ bool Session::step() {
   renderHmd(stimulus);
   timing_.mark("render");
   if (m.context.isHeadless()) m.context.present();  // a window is presented by its owner, with the panels
+  timing_.mark("present");
   const double total = timing_.endCycle();
   if (total > timing_.budgetMs()) {
     m.log->write("overrun", time_, {{"frame", frame_}, {"compute_ms", total}, {"stages", timing_.lastCycle()}});

@@ -1,6 +1,8 @@
 #include "session/workstation.h"
 
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +16,9 @@
 
 namespace arbci::app {
 namespace {
+
+std::atomic<bool> close_requested{false};
+void onSignal(int) { close_requested = true; }
 
 // Where the panel layout is kept between runs.
 std::string layoutFile() {
@@ -30,7 +35,8 @@ std::string layoutFile() {
 
 int runWorkstation(const SessionConfig& config, SessionOptions options) {
   options.simulated_clock = false;
-  options.start_immediately = false;  // the experimenter presses Start
+  const bool wait = !options.start_immediately;  // --wait-for-start: the experimenter presses Start
+  options.start_immediately = false;
   render::WindowOptions window;
   window.title = "ARBCI workstation";
   render::WindowContext main_window(window);
@@ -44,6 +50,7 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
     main_window.makeCurrent();
   }
   Session session(config, options, main_window);
+  if (!wait) session.start();
   SessionModel model(session);
   ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;
@@ -61,8 +68,12 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
   shell.addPanel(training_panel, false);
   shell.setEmergencyStop([&] { model.emergencyStop(); });
   shell.setQuitHandler([&] { main_window.requestClose(); });
+  // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
   auto last = std::chrono::steady_clock::now();
   while (!main_window.shouldClose()) {
+    if (close_requested) main_window.requestClose();
     render::WindowContext::pollEvents();
     session.step();
     main_window.makeCurrent();

@@ -1,0 +1,184 @@
+// The simulated session end to end, headless, through the real executables: a calibration run,
+// training, then online trials with given intentions; a subject without ERP (selections fail,
+// the session says so and carries on); and the robot backend killed during a grasp.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "arbci/bci/recording.h"
+#include "support/run_process.h"
+
+namespace arbci::test {
+namespace {
+
+const std::string kArbci = ARBCI_EXECUTABLE;
+const std::string kSessions = ARBCI_TEST_SESSIONS;
+
+std::filesystem::path fresh(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("arbci_session_test_" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+nlohmann::json readJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+std::vector<nlohmann::json> readLog(const std::filesystem::path& path) {
+  std::vector<nlohmann::json> lines;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
+
+TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimetre) {
+  const auto folder = fresh("e2e");
+  const auto start = std::chrono::steady_clock::now();
+  const ProcessResult r = runProcess(kArbci, {"run", "--headless", "--session", kSessions + "/steady_head.json", "--seed", "3", "--out",
+                                              folder.string()},
+                                     300.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 120.0);
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "finished");
+  ASSERT_EQ(summary["trials"].size(), 3u);
+  for (const auto& t : summary["trials"]) {
+    EXPECT_EQ(t["selected_object"], t["intended_object"]) << t.dump();
+    EXPECT_EQ(t["selected_cell"], t["intended_cell"]) << t.dump();
+    ASSERT_TRUE(t["placement_error_m"].is_number()) << t.dump();
+    EXPECT_LT(t["placement_error_m"].get<double>(), 0.01) << t.dump();
+    EXPECT_EQ(t["outcome"], "placed");
+  }
+  EXPECT_EQ(summary["overruns"], 0) << summary["cycle"].dump();
+  EXPECT_DOUBLE_EQ(summary["objects"]["accuracy"].get<double>(), 1.0);
+  EXPECT_GT(summary["objects"]["bits_per_minute"].get<double>(), 0.0);
+  EXPECT_TRUE(summary["cycle"]["stages"].contains("eeg"));
+  EXPECT_TRUE(summary["cycle"]["stages"].contains("tracking"));
+  EXPECT_GT(summary["calibration"]["auc"].get<double>(), 0.7);
+
+  // The folder is complete.
+  for (const char* file : {"recording.bdf", "log.jsonl", "summary.json", "model.json", "session.json", "hmd_calibration.png",
+                           "hmd_trial1_1_objects_flashing.png", "hmd_trial2_3_grasping.png", "hmd_trial3_4_grid_flashing.png",
+                           "hmd_trial3_6_putting_down.png", "hmd_finished.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(folder / file)) << file;
+  }
+  // The recording is readable, with every flash and the selections.
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  EXPECT_EQ(recording.format, "BDF+");
+  EXPECT_EQ(recording.info.channelCount(), 8);
+  EXPECT_NEAR(recording.seconds(), summary["duration_s"].get<double>(), 0.1);
+  int calibration_targets = 0, grid_flashes = 0;
+  for (const auto& s : recording.stimuli) {
+    calibration_targets += s.target;
+    grid_flashes += s.code > 100;
+  }
+  EXPECT_EQ(calibration_targets, 6 * 8);  // 6 cued selections of 8 sequences
+  EXPECT_GT(grid_flashes, 0);
+  int selections = 0;
+  for (const auto& a : recording.annotations) selections += a.text.rfind("Selected", 0) == 0;
+  EXPECT_EQ(selections, 6);
+  // The log has the robot's commands and replies and per-cycle timings.
+  int commands = 0, finished = 0, cycles = 0;
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    commands += line["event"] == "robot_command";
+    finished += line["event"] == "robot" && line["kind"] == "finished";
+    cycles += line["event"] == "cycle";
+  }
+  EXPECT_EQ(commands, 6);
+  EXPECT_EQ(finished, 6);
+  EXPECT_GT(cycles, 100);
+}
+
+TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
+  const auto folder = fresh("weak");
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"eeg": {"erp_scale": 0.0}, "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 4, "sequences": 4, "min_sequences": 2, "trials": 3}, "robot": {"speed_factor": 20}})";
+  const ProcessResult r = runProcess(kArbci, {"run", "--headless", "--session", session, "--seed", "5", "--out", folder.string()}, 300.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;  // finished, not hung
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  ASSERT_EQ(summary["trials"].size(), 3u);
+  int wrong = 0;
+  for (const auto& t : summary["trials"]) {
+    wrong += t["selected_object"] != t["intended_object"];
+    wrong += t["selected_cell"] != t["intended_cell"];
+    EXPECT_GE(t["selected_object"].get<int>(), 0);  // every trial made its selections
+  }
+  EXPECT_GT(wrong, 0);
+  EXPECT_NE(r.err.find("differs from the intended one; carrying on"), std::string::npos) << r.err;
+  int logged_wrong = 0;
+  for (const auto& line : readLog(folder / "log.jsonl")) logged_wrong += line["event"] == "selection" && line["correct"] == false;
+  EXPECT_EQ(logged_wrong, wrong);
+}
+
+TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIntact) {
+  const auto folder = fresh("robot_fault");
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 4, "trials": 2}, "robot": {"speed_factor": 2}})";
+  int out_pipe[2];
+  ASSERT_EQ(pipe(out_pipe), 0);
+  const pid_t child = fork();
+  if (child == 0) {
+    dup2(out_pipe[1], STDOUT_FILENO);
+    dup2(out_pipe[1], STDERR_FILENO);
+    close(out_pipe[0]);
+    execl(kArbci.c_str(), kArbci.c_str(), "run", "--headless", "--session", session.c_str(), "--seed", "2", "--out", folder.c_str(),
+          "--fault-wait", "5", nullptr);
+    _exit(127);
+  }
+  close(out_pipe[1]);
+  // Wait for the first GRASP, then kill the backend.
+  bool killed = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(180);
+  while (!killed && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::ifstream log(folder / "log.jsonl");
+    std::stringstream text;
+    text << log.rdbuf();
+    if (text.str().find("\"command\":\"GRASP\"") == std::string::npos) continue;
+    std::ifstream pid_file(folder / "robotd.pid");
+    pid_t robotd = 0;
+    ASSERT_TRUE(pid_file >> robotd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // mid-motion
+    ASSERT_EQ(kill(robotd, SIGKILL), 0);
+    killed = true;
+  }
+  ASSERT_TRUE(killed) << "no grasp was commanded";
+  std::string output;
+  char buffer[4096];
+  ssize_t n = 0;
+  while ((n = read(out_pipe[0], buffer, sizeof buffer)) > 0) output.append(buffer, static_cast<size_t>(n));
+  close(out_pipe[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << output;  // ended by the fault, after waiting for an experimenter
+  bool fault_phase = false;
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    fault_phase |= line["event"] == "phase" && line["phase"].get<std::string>().find("robot fault") != std::string::npos;
+  }
+  EXPECT_TRUE(fault_phase);
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_NE(summary["ended"].get<std::string>().find("robot fault"), std::string::npos) << summary["ended"];
+  EXPECT_NE(summary["trials"][0]["outcome"].get<std::string>().find("silent"), std::string::npos) << summary["trials"][0].dump();
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  EXPECT_NEAR(recording.seconds(), summary["duration_s"].get<double>(), 0.1);
+  bool ended_note = false;
+  for (const auto& a : recording.annotations) ended_note |= a.text.find("Session ended") != std::string::npos;
+  EXPECT_TRUE(ended_note);
+}
+
+}  // namespace
+}  // namespace arbci::test
