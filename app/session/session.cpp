@@ -174,10 +174,7 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   // Warm-up: Mesa compiles its shader variants and the tracker builds its tables on first use;
   // that happens here, before the cycle's time is measured.
   if (m.world) {
-    for (int i = 0; i < 3; ++i) {
-      const SimulatedWorld::Frames frames = m.world->capture(-1.0 - i);
-      vision_->process(0.0, frames.left, frames.right);
-    }
+    for (int i = 0; i < 3; ++i) vision_->process(0.0, m.world->captureLeft(-1.0 - i).image, m.world->captureRight(-1.0 - i).image);
     // Every kind of overlay once: highlights in each state, the grid with rows, columns and cells.
     bci::FrameStimulus all;
     all.grid_visible = true;
@@ -245,17 +242,25 @@ bool Session::step() {
   timing_.mark("eeg");
 
   // Cameras and tracking.
-  if (m.world && frame_ % m.camera_every == 0) {
+  const bool left_due = frame_ % m.camera_every == 0;
+  // The right camera half a camera period later, so no cycle renders both (at 60 Hz, both).
+  const bool right_due = m.camera_every == 1 || frame_ % m.camera_every == 1;
+  if (m.world && left_due) {
     if (client_->status()) m.world->update(*client_->status());
-    const SimulatedWorld::Frames frames = m.world->capture(time_);
+    const SimulatedWorld::Frame left = m.world->captureLeft(time_);
     timing_.mark("cameras");
-    if (frames.changed) {
-      vision_->process(time_, frames.left, frames.right);
+    if (left.changed) {
+      vision_->process(time_, left.image, cv::Mat());
     } else {
       vision_->repeat(time_);
     }
     timing_.mark("tracking");
-  } else if (m.left_capture) {
+  }
+  if (m.world && right_due) {
+    vision_->setRightImage(m.world->captureRight(time_).image);
+    timing_.mark("cameras");
+  }
+  if (m.left_capture) {
     const auto [left, count] = m.left_capture->latest();
     if (count != m.left_seen && !left.empty()) {
       m.left_seen = count;

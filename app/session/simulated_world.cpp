@@ -63,14 +63,14 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
       const cv::Vec3d p(reported.position.x, reported.position.y, reported.position.z);
       if (o.marker.id == reported.id && p != o.T_world_top.translation) {
         o.T_world_top.translation = p;
-        scene_changed_ = true;
+        ++scene_revision_;
       }
     }
   }
   const cv::Vec3d tool(status.tool.x, status.tool.y, status.tool.z);
   if (!scene_.gripper || scene_.gripper->tool != tool || scene_.gripper->opening != status.gripper_opening) {
     scene_.gripper = render::SceneGripper{tool, status.gripper_opening};
-    scene_changed_ = true;
+    ++scene_revision_;
   }
 }
 
@@ -92,27 +92,26 @@ vision::Pose SimulatedWorld::T_right_left() const { return vision::Pose{cv::Matx
 
 vision::Pose SimulatedWorld::rightCamera(double t) const { return T_right_left() * leftCamera(t); }
 
-SimulatedWorld::Frames SimulatedWorld::capture(double t) {
-  const vision::Pose left = leftCamera(t);
-  const bool moved = !last_left_ || left.translation != last_left_->translation || left.rotation != last_left_->rotation;
-  if (!moved && !scene_changed_ && !last_.left.empty()) {
-    Frames same = last_;
-    same.changed = false;
-    return same;
-  }
-  last_left_ = left;
-  scene_changed_ = false;
+SimulatedWorld::Frame SimulatedWorld::capture(render::SimulatedCamera& camera, Cache& cache, const vision::Pose& pose) {
+  const bool moved = !cache.pose || pose.translation != cache.pose->translation || pose.rotation != cache.pose->rotation;
+  if (!moved && cache.scene_revision == scene_revision_ && !cache.image.empty()) return {cache.image, false};
   render::CameraEffects effects;
   effects.distort = !camera_.distortion.empty();
   effects.noise_sigma = config_.cameras.noise;
   effects.blur_sigma = config_.cameras.blur_px;
   effects.vignetting = 0.15;
-  last_ = {left_->render(scene_, left, effects), right_->render(scene_, T_right_left() * left, effects), true};
-  return last_;
+  cache.image = camera.render(scene_, pose, effects);
+  cache.pose = pose;
+  cache.scene_revision = scene_revision_;
+  return {cache.image, true};
 }
 
+SimulatedWorld::Frame SimulatedWorld::captureLeft(double t) { return capture(*left_, left_cache_, leftCamera(t)); }
+
+SimulatedWorld::Frame SimulatedWorld::captureRight(double t) { return capture(*right_, right_cache_, rightCamera(t)); }
+
 void SimulatedWorld::holdBoard(bool show, double t) {
-  scene_changed_ = true;
+  ++scene_revision_;
   if (!show) {
     scene_.board.reset();
     return;

@@ -30,13 +30,14 @@ class SimulatedWorld {
   // The right camera's pose in the left's frame (the rig's extrinsics).
   vision::Pose T_right_left() const;
   const vision::CameraModel& camera() const { return camera_; }
-  struct Frames {
-    cv::Mat left, right;
-    bool changed = true;  // false: nothing in view moved since the last capture (same frames)
+  struct Frame {
+    cv::Mat image;
+    bool changed = true;  // false: nothing in view moved since this camera's last frame (the same)
   };
-  // Both cameras' frames at time `t`. Frames are rendered again only when the head, an object or
-  // the gripper moved.
-  Frames capture(double t);
+  // One camera's frame at time `t` (the cycle renders the two on alternate frames, so no cycle
+  // pays for both). A frame is rendered again only when the head, an object or the gripper moved.
+  Frame captureLeft(double t);
+  Frame captureRight(double t);
   const render::Scene& scene() const { return scene_; }
   // Holds a 9x6 chessboard (25 mm squares) up in front of the left camera, each call at the next
   // of a dozen poses (tilted, near and far, off centre), or puts it away.
@@ -49,10 +50,15 @@ class SimulatedWorld {
   vision::CameraModel camera_;
   render::Scene scene_;
   std::unique_ptr<render::SimulatedCamera> left_, right_;
-  bool scene_changed_ = true;
+  struct Cache {
+    std::uint64_t scene_revision = 0;
+    std::optional<vision::Pose> pose;
+    cv::Mat image;
+  };
+  Frame capture(render::SimulatedCamera& camera, Cache& cache, const vision::Pose& pose);
+  std::uint64_t scene_revision_ = 1;
   int board_pose_ = 0;
-  std::optional<vision::Pose> last_left_;
-  Frames last_;
+  Cache left_cache_, right_cache_;
 };
 
 // A camera at `eye` looking at `target` (robot frame, z up), image x to the robot's right.

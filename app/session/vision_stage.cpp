@@ -53,7 +53,7 @@ double VisionStage::markerSize(int id) const {
 
 void VisionStage::process(double t, const cv::Mat& left, const cv::Mat& right) {
   left_image_ = left;
-  right_image_ = right;
+  if (!right.empty()) right_image_ = right;
   last_ = detector_.detect(left);
   std::map<int, vision::PoseEstimate> poses;
   for (const vision::MarkerDetection& m : last_.markers) {

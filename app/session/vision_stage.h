@@ -19,11 +19,14 @@ class VisionStage {
 
   // A new pair of frames at time `t` (seconds); the right one may be empty (mono).
   void process(double t, const cv::Mat& left, const cv::Mat& right);
+  // A new right frame (shown in the HMD; the left camera is the one tracked).
+  void setRightImage(const cv::Mat& right) { right_image_ = right; }
   // The same frames as last time, at time `t`: the last poses are seen again without tracking.
   void repeat(double t);
 
   const cv::Mat& leftImage() const { return left_image_; }
   const cv::Mat& rightImage() const { return right_image_.empty() ? left_image_ : right_image_; }
+  bool stereo() const { return !right_image_.empty(); }
   const vision::CameraModel& leftCamera() const { return left_camera_; }
   const vision::CameraModel& rightCamera() const { return right_image_.empty() ? left_camera_ : right_camera_; }
   std::optional<vision::Pose> T_cam_world_left() const;
