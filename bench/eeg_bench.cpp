@@ -37,7 +37,8 @@ void filterAndEpoch(benchmark::State& state) {
     sample += 15;
     benchmark::DoNotOptimize(block.data.data());
   }
-  state.counters["epochs/block"] = benchmark::Counter(static_cast<double>(epochs) / static_cast<double>(state.iterations()));
+  state.counters["epochs/block"] =
+      benchmark::Counter(static_cast<double>(epochs) / static_cast<double>(state.iterations()));
   state.SetLabel(std::to_string(channels) + " channels");
 }
 

@@ -2,10 +2,10 @@
 // iterative solver on the same corner sets (5 cm markers at 0.3-1.0 m, 0.05 px corner noise, a
 // 1280x720 camera of 900 px focal length), and the cost of the three undistortion modes.
 //   geometry_bench [--poses N]
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -28,20 +28,28 @@ struct Case {
 cv::Matx33d markerRotation(double tilt_deg, double azimuth_deg, double spin_deg) {
   const double deg = std::numbers::pi / 180.0;
   cv::Matx33d tilt, spin;
-  cv::Rodrigues(cv::Vec3d(std::cos(azimuth_deg * deg), std::sin(azimuth_deg * deg), 0.0) * (tilt_deg * deg), tilt);
+  cv::Rodrigues(
+      cv::Vec3d(std::cos(azimuth_deg * deg), std::sin(azimuth_deg * deg), 0.0) * (tilt_deg * deg),
+      tilt);
   cv::Rodrigues(cv::Vec3d(0.0, 0.0, spin_deg * deg), spin);
   return tilt * spin * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1);
 }
 
-double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+double seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App cli{
+      "Pose time and accuracy of RPP, IPPE and OpenCV's iterative solver; undistortion time of the "
+      "three modes"};
   int poses = 2000;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--poses") && i + 1 < argc) poses = std::max(10, std::atoi(argv[++i]));
-  }
+  cli.add_option("--poses", poses, "random marker poses")
+      ->check(CLI::Range(10, 1000000))
+      ->capture_default_str();
+  CLI11_PARSE(cli, argc, argv);
   const cv::Matx33d k(900, 0, 639.5, 0, 900, 359.5, 0, 0, 1);
   std::mt19937 random(42);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -55,12 +63,15 @@ int main(int argc, char** argv) {
     c.truth.rotation = markerRotation(tilt, 360.0 * unit(random), 360.0 * unit(random));
     const cv::Vec3d direction((unit(random) - 0.5) * 0.9, (unit(random) - 0.5) * 0.5, 1.0);
     c.truth.translation = direction / cv::norm(direction) * distance;
-    for (const cv::Point3d& p : object) c.image.push_back(project(c.truth, k, p) + cv::Point2d(noise(random), noise(random)));
+    for (const cv::Point3d& p : object)
+      c.image.push_back(project(c.truth, k, p) + cv::Point2d(noise(random), noise(random)));
     cases.push_back(c);
   }
-  std::printf("Pose of a 5 cm marker from its 4 corners, %d poses, 0.05 px corner noise, tilt 0-60 deg.\n", poses);
-  std::printf("%-10s %-7s %9s %11s %11s %13s %13s\n", "method", "refine", "us/pose", "pos err %", "rot err deg",
-              "rot <30deg", "rot >=30deg");
+  std::printf(
+      "Pose of a 5 cm marker from its 4 corners, %d poses, 0.05 px corner noise, tilt 0-60 deg.\n",
+      poses);
+  std::printf("%-10s %-7s %9s %11s %11s %13s %13s\n", "method", "refine", "us/pose", "pos err %",
+              "rot err deg", "rot <30deg", "rot >=30deg");
   for (PoseMethod method : {PoseMethod::Rpp, PoseMethod::Ippe, PoseMethod::Iterative}) {
     for (bool refine : {false, true}) {
       PoseOptions options;
@@ -82,9 +93,9 @@ int main(int argc, char** argv) {
         (cases[i].tilt_deg < 30.0 ? low : high) += 1;
       }
       const double n = static_cast<double>(cases.size());
-      std::printf("%-10s %-7s %9.1f %11.3f %11.3f %13.3f %13.3f\n", toString(method).c_str(), refine ? "yes" : "no",
-                  1e6 * elapsed / n, 100.0 * position / n, rotation / n, rotation_low / std::max(1, low),
-                  rotation_high / std::max(1, high));
+      std::printf("%-10s %-7s %9.1f %11.3f %11.3f %13.3f %13.3f\n", toString(method).c_str(),
+                  refine ? "yes" : "no", 1e6 * elapsed / n, 100.0 * position / n, rotation / n,
+                  rotation_low / std::max(1, low), rotation_high / std::max(1, high));
     }
   }
 
@@ -105,23 +116,27 @@ int main(int argc, char** argv) {
     }
     cv::Mat image(size, CV_8UC1);
     cv::randu(image, 0, 256);
-    for (UndistortMode mode : {UndistortMode::None, UndistortMode::Algorithmic, UndistortMode::LookupTable}) {
+    for (UndistortMode mode :
+         {UndistortMode::None, UndistortMode::Algorithmic, UndistortMode::LookupTable}) {
       const auto setup_start = Clock::now();
       const Undistorter lens(scaled, mode);
       const double setup = seconds(setup_start, Clock::now());
       std::vector<cv::Point2d> points;
-      for (int i = 0; i < 20000; ++i) points.emplace_back(unit(random) * (size.width - 1), unit(random) * (size.height - 1));
+      for (int i = 0; i < 20000; ++i)
+        points.emplace_back(unit(random) * (size.width - 1), unit(random) * (size.height - 1));
       double sink = 0.0;
       const auto point_start = Clock::now();
       for (const cv::Point2d& p : points) sink += lens.undistort(p).x;
-      const double per_point = seconds(point_start, Clock::now()) / static_cast<double>(points.size());
+      const double per_point =
+          seconds(point_start, Clock::now()) / static_cast<double>(points.size());
       cv::Mat out;
       const int repeats = 20;
       const auto image_start = Clock::now();
       for (int r = 0; r < repeats; ++r) lens.undistortImage(image, out);
       const double per_image = seconds(image_start, Clock::now()) / repeats;
-      std::printf("%4dx%-7d %-10s %12.3f %14.3f %12.1f%s\n", size.width, size.height, toString(mode).c_str(),
-                  1e6 * per_point, 1e3 * per_image, 1e3 * setup, sink == 12345.678 ? "!" : "");
+      std::printf("%4dx%-7d %-10s %12.3f %14.3f %12.1f%s\n", size.width, size.height,
+                  toString(mode).c_str(), 1e6 * per_point, 1e3 * per_image, 1e3 * setup,
+                  sink == 12345.678 ? "!" : "");
     }
   }
   return 0;

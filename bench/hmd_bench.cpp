@@ -57,13 +57,14 @@ void stereoView(benchmark::State& state) {
   for (auto _ : state) {
     view.draw(frame, context->drawFramebuffer(), {2 * width, height});
     if (read_back) {
-      benchmark::DoNotOptimize(readPixels(context->drawFramebuffer(), {2 * width, height}).pixels.data());
+      benchmark::DoNotOptimize(
+          readPixels(context->drawFramebuffer(), {2 * width, height}).pixels.data());
     } else {
       context->present();  // waits for the GPU
     }
   }
-  state.SetLabel(std::string("2x") + std::to_string(width) + "x" + std::to_string(height) + (undistort ? " undistorted" : " raw") +
-                 (read_back ? " +read-back" : ""));
+  state.SetLabel(std::string("2x") + std::to_string(width) + "x" + std::to_string(height) +
+                 (undistort ? " undistorted" : " raw") + (read_back ? " +read-back" : ""));
 }
 
 }  // namespace

@@ -18,7 +18,8 @@ class ArbciTracker final : public MarkerDetectorUnderTest {
   bool orderedCorners() const override { return true; }
   std::vector<test::FoundMarker> detect(const cv::Mat& gray) override {
     std::vector<test::FoundMarker> found;
-    for (const vision::MarkerDetection& m : detector_.detect(gray).markers) found.push_back({m.id, m.corners});
+    for (const vision::MarkerDetection& m : detector_.detect(gray).markers)
+      found.push_back({m.id, m.corners});
     return found;
   }
 
@@ -61,7 +62,8 @@ class AprilTag final : public MarkerDetectorUnderTest {
       m.id = d->id;
       // libapriltag's pixel centres are at +0.5 of OpenCV's.
       for (int k = 0; k < 4; ++k) {
-        m.corners[k] = cv::Point2f(static_cast<float>(d->p[k][0] - 0.5), static_cast<float>(d->p[k][1] - 0.5));
+        m.corners[k] =
+            cv::Point2f(static_cast<float>(d->p[k][0] - 0.5), static_cast<float>(d->p[k][1] - 0.5));
       }
       found.push_back(m);
     }
@@ -104,10 +106,14 @@ class Aruco final : public MarkerDetectorUnderTest {
 
 }  // namespace
 
-std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker() { return std::make_unique<ArbciTracker>(); }
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker() {
+  return std::make_unique<ArbciTracker>();
+}
 std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate) {
   return std::make_unique<AprilTag>(decimate);
 }
-std::unique_ptr<MarkerDetectorUnderTest> makeAruco() { return std::make_unique<Aruco>(); }
+std::unique_ptr<MarkerDetectorUnderTest> makeAruco() {
+  return std::make_unique<Aruco>();
+}
 
 }  // namespace arbci::bench
