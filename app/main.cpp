@@ -7,9 +7,10 @@
 #include "support/cli_error.h"
 
 int main(int argc, char** argv) {
-  CLI::App root{"ARBCI: augmented-reality BCI experimenter workstation.\n"
-                "Markers, EEG, P300 classification and a robot arm, in one cycle.",
-                "arbci"};
+  CLI::App root{
+      "ARBCI: augmented-reality BCI experimenter workstation.\n"
+      "Markers, EEG, P300 classification and a robot arm, in one cycle.",
+      "arbci"};
   root.set_version_flag("--version", std::string("arbci ") + ARBCI_VERSION);
   root.require_subcommand(0, 1);
   root.failure_message([](const CLI::App*, const CLI::Error& error) {

@@ -56,9 +56,10 @@ struct Geometry {
 nlohmann::json poseJson(const vision::PoseEstimate& estimate) {
   const cv::Vec3d t = estimate.pose.translation, r = estimate.pose.rotationVector();
   auto round6 = [](double v) { return std::round(v * 1e6) / 1e6; };
-  nlohmann::json out{{"t_m", {round6(t[0]), round6(t[1]), round6(t[2])}},
-                     {"rvec", {round6(r[0]), round6(r[1]), round6(r[2])}},
-                     {"reprojection_rms_px", std::round(estimate.reprojection_rms_px * 1000.0) / 1000.0}};
+  nlohmann::json out{
+      {"t_m", {round6(t[0]), round6(t[1]), round6(t[2])}},
+      {"rvec", {round6(r[0]), round6(r[1]), round6(r[2])}},
+      {"reprojection_rms_px", std::round(estimate.reprojection_rms_px * 1000.0) / 1000.0}};
   return out;
 }
 
@@ -67,7 +68,8 @@ vision::ThresholdSettings parseThreshold(const DetectOptions& options) {
   try {
     size_t used = 0;
     const int value = std::stoi(options.threshold, &used);
-    if (used != options.threshold.size() || value < 0 || value > 255) throw std::invalid_argument("");
+    if (used != options.threshold.size() || value < 0 || value > 255)
+      throw std::invalid_argument("");
     settings.mode = vision::ThresholdMode::Constant;
     settings.value = value;
   } catch (const std::exception&) {
@@ -83,7 +85,8 @@ vision::ThresholdSettings parseThreshold(const DetectOptions& options) {
     char c1 = 0, c2 = 0;
     std::istringstream in(options.vignetting);
     if (!(in >> v.corners >> c1 >> v.left_right >> c2 >> v.top_bottom) || c1 != ',' || c2 != ',') {
-      throw CliError("--vignetting must be CORNERS,LEFTRIGHT,TOPBOTTOM offsets, got '" + options.vignetting + "'");
+      throw CliError("--vignetting must be CORNERS,LEFTRIGHT,TOPBOTTOM offsets, got '" +
+                     options.vignetting + "'");
     }
     if (settings.mode == vision::ThresholdMode::Adaptive) {
       throw CliError("--vignetting applies to constant and automatic thresholds, not adaptive");
@@ -100,7 +103,9 @@ vision::DetectorConfig makeConfig(const DetectOptions& options) {
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
   }
-  config.border = options.border > 0.0 ? options.border : config.kind == vision::MarkerKind::Bch ? 0.125 : 0.25;
+  config.border = options.border > 0.0                     ? options.border
+                  : config.kind == vision::MarkerKind::Bch ? 0.125
+                                                           : 0.25;
   config.threshold = parseThreshold(options);
   config.dictionary = options.dictionary;
   for (size_t i = 0; i < options.patterns.size(); ++i) {
@@ -126,7 +131,8 @@ vision::DetectorConfig makeConfig(const DetectOptions& options) {
   return config;
 }
 
-void annotate(const std::filesystem::path& folder, const Frame& frame, const std::vector<vision::MarkerDetection>& markers) {
+void annotate(const std::filesystem::path& folder, const Frame& frame,
+              const std::vector<vision::MarkerDetection>& markers) {
   cv::Mat canvas;
   if (frame.image.channels() == 1) {
     cv::cvtColor(frame.image, canvas, cv::COLOR_GRAY2BGR);
@@ -139,11 +145,13 @@ void annotate(const std::filesystem::path& folder, const Frame& frame, const std
   for (const vision::MarkerDetection& m : markers) {
     std::vector<cv::Point> outline;
     for (const cv::Point2f& p : m.corners) outline.emplace_back(cvRound(p.x), cvRound(p.y));
-    cv::polylines(canvas, outline, true, m.from_history ? cv::Scalar(0, 200, 255) : cv::Scalar(0, 220, 0),
-                  thickness, cv::LINE_AA);
+    cv::polylines(canvas, outline, true,
+                  m.from_history ? cv::Scalar(0, 200, 255) : cv::Scalar(0, 220, 0), thickness,
+                  cv::LINE_AA);
     cv::circle(canvas, outline[0], 3 * thickness, cv::Scalar(0, 0, 255), cv::FILLED);  // top-left
-    cv::putText(canvas, std::to_string(m.id), outline[0] + cv::Point(4, -4), cv::FONT_HERSHEY_SIMPLEX,
-                0.5 * thickness, cv::Scalar(255, 0, 0), thickness, cv::LINE_AA);
+    cv::putText(canvas, std::to_string(m.id), outline[0] + cv::Point(4, -4),
+                cv::FONT_HERSHEY_SIMPLEX, 0.5 * thickness, cv::Scalar(255, 0, 0), thickness,
+                cv::LINE_AA);
   }
   const std::string stem = std::filesystem::path(frame.name).stem().string();
   writePng(folder / (stem.empty() ? frame.name : stem + ".png"), canvas);
@@ -160,9 +168,11 @@ Geometry makeGeometry(const DetectOptions& options, cv::Size frame_size) {
     const vision::CameraModel camera = vision::CameraModel::load(options.camera);
     camera.checkImageSize(frame_size);
     geometry.camera = camera.scaledTo(frame_size);
-    geometry.lens = std::make_shared<vision::Undistorter>(geometry.camera, vision::undistortModeFromString(options.undistort));
+    geometry.lens = std::make_shared<vision::Undistorter>(
+        geometry.camera, vision::undistortModeFromString(options.undistort));
     geometry.pose.method = vision::poseMethodFromString(options.pose);
-    if (!options.marker_set.empty()) geometry.set = vision::MarkerSet::loadArToolKitConfig(options.marker_set);
+    if (!options.marker_set.empty())
+      geometry.set = vision::MarkerSet::loadArToolKitConfig(options.marker_set);
   } catch (const vision::CalibrationFileError& error) {
     throw CliError(error.what());
   } catch (const std::invalid_argument& error) {
@@ -174,7 +184,8 @@ Geometry makeGeometry(const DetectOptions& options, cv::Size frame_size) {
 
 int runDetect(const DetectOptions& options) {
   const int sources = (!options.inputs.empty()) + (!options.video.empty()) + (options.device >= 0);
-  if (sources != 1) throw CliError("give image files, or --video FILE, or --device N (exactly one)");
+  if (sources != 1)
+    throw CliError("give image files, or --video FILE, or --device N (exactly one)");
   vision::MarkerDetector detector = [&] {
     try {
       return vision::MarkerDetector(makeConfig(options));
@@ -206,7 +217,8 @@ int runDetect(const DetectOptions& options) {
       ++failures;
       continue;
     }
-    if (!options.camera.empty() && (!geometry || geometry->camera.image_size != frame->image.size())) {
+    if (!options.camera.empty() &&
+        (!geometry || geometry->camera.image_size != frame->image.size())) {
       // The lens and intrinsics for this frame size (built once per size).
       geometry = makeGeometry(options, frame->image.size());
       vision::DetectorConfig config = detector.config();
@@ -226,11 +238,14 @@ int runDetect(const DetectOptions& options) {
         return median(v);
       };
       using S = vision::StageTimes;
-      result.timing = {stage(&S::convert), stage(&S::smooth), stage(&S::threshold), stage(&S::label),
-                       stage(&S::quads),   stage(&S::decode), stage(&S::total)};
+      result.timing = {stage(&S::convert), stage(&S::smooth), stage(&S::threshold),
+                       stage(&S::label),   stage(&S::quads),  stage(&S::decode),
+                       stage(&S::total)};
     }
     std::vector<vision::MarkerDetection> markers = result.markers;
-    if (options.track) markers = tracker.update(markers, detector.lastSquares(), index / 30.0, &detector.lastIdealSquares());
+    if (options.track)
+      markers = tracker.update(markers, detector.lastSquares(), index / 30.0,
+                               &detector.lastIdealSquares());
     nlohmann::json line{{"frame", frame->name},
                         {"width", frame->image.cols},
                         {"height", frame->image.rows},
@@ -248,18 +263,21 @@ int runDetect(const DetectOptions& options) {
         }
         marker["ideal_corners"] = ideal;
         vision::PoseOptions pose = geometry->pose;
-        if (const auto previous = geometry->previous.find(m.id); previous != geometry->previous.end()) {
+        if (const auto previous = geometry->previous.find(m.id);
+            previous != geometry->previous.end()) {
           pose.previous = previous->second;
         }
         const vision::PoseEstimate estimate =
-            vision::estimatePose(vision::markerCorners(geometry->marker_size_m), corners, geometry->camera.camera_matrix, pose);
+            vision::estimatePose(vision::markerCorners(geometry->marker_size_m), corners,
+                                 geometry->camera.camera_matrix, pose);
         geometry->previous[m.id] = estimate.pose;
         marker["pose"] = poseJson(estimate);
       }
       line["markers"].push_back(marker);
     }
     if (geometry && geometry->set) {
-      if (const auto set_pose = vision::estimateSetPose(*geometry->set, markers, geometry->camera.camera_matrix, geometry->pose)) {
+      if (const auto set_pose = vision::estimateSetPose(
+              *geometry->set, markers, geometry->camera.camera_matrix, geometry->pose)) {
         line["set_pose"] = poseJson(set_pose->estimate);
         line["set_pose"]["markers"] = set_pose->used_ids;
       }
@@ -283,27 +301,40 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
   command->add_option("--device", options->device, "A camera (V4L2 device number)");
   command->add_option("--frames", options->frames, "At most this many frames of a video or camera")
       ->check(CLI::NonNegativeNumber);
-  command->add_option("--raw", options->raw, "Inputs are headerless: WIDTHxHEIGHT[:gray|rgb|bgr|rgba|bgra|abgr|rgb565]");
+  command->add_option("--raw", options->raw,
+                      "Inputs are headerless: WIDTHxHEIGHT[:gray|rgb|bgr|rgba|bgra|abgr|rgb565]");
   command->add_option("--kind", options->kind, "bch, simple, template, aruco or apriltag")
       ->check(CLI::IsMember({"bch", "simple", "template", "aruco", "apriltag"}))
       ->capture_default_str();
-  command->add_option("--border", options->border,
-                      "Border as a fraction of the side (default 0.125 for bch, 0.25 otherwise)")
+  command
+      ->add_option("--border", options->border,
+                   "Border as a fraction of the side (default 0.125 for bch, 0.25 otherwise)")
       ->check(CLI::Range(0.01, 0.4));
-  command->add_option("--threshold", options->threshold,
-                      "adaptive, auto-median, auto-midrange, or a constant 0..255")
+  command
+      ->add_option("--threshold", options->threshold,
+                   "adaptive, auto-median, auto-midrange, or a constant 0..255")
       ->capture_default_str();
-  command->add_option("--vignetting", options->vignetting,
-                      "Threshold offsets CORNERS,LEFTRIGHT,TOPBOTTOM (constant and automatic modes)");
-  command->add_option("--dictionary", options->dictionary, "OpenCV dictionary for aruco/apriltag, e.g. DICT_6X6_250");
-  command->add_option("--pattern", options->patterns, "Template patterns for --kind template: FILE.patt or ID=FILE.patt");
-  command->add_flag("--track", options->track, "Keep identities over frames (video, camera, image sequences)");
-  command->add_option("--repeat", options->repeat, "Detect each frame N times, report median stage times")
+  command->add_option(
+      "--vignetting", options->vignetting,
+      "Threshold offsets CORNERS,LEFTRIGHT,TOPBOTTOM (constant and automatic modes)");
+  command->add_option("--dictionary", options->dictionary,
+                      "OpenCV dictionary for aruco/apriltag, e.g. DICT_6X6_250");
+  command->add_option("--pattern", options->patterns,
+                      "Template patterns for --kind template: FILE.patt or ID=FILE.patt");
+  command->add_flag("--track", options->track,
+                    "Keep identities over frames (video, camera, image sequences)");
+  command
+      ->add_option("--repeat", options->repeat,
+                   "Detect each frame N times, report median stage times")
       ->check(CLI::Range(1, 100000));
-  command->add_option("--annotate", options->annotate, "Write each frame with its markers drawn into this folder");
+  command->add_option("--annotate", options->annotate,
+                      "Write each frame with its markers drawn into this folder");
   command->add_option("--camera", options->camera,
-                      "Camera calibration (OpenCV .yml/.xml or ARToolKitPlus .cal): adds undistorted corners and poses");
-  command->add_option("--marker-size-mm", options->marker_size_mm, "Side of the markers' black square, for poses")
+                      "Camera calibration (OpenCV .yml/.xml or ARToolKitPlus .cal): adds "
+                      "undistorted corners and poses");
+  command
+      ->add_option("--marker-size-mm", options->marker_size_mm,
+                   "Side of the markers' black square, for poses")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   command->add_option("--undistort", options->undistort, "none, algorithmic or lut")
@@ -312,7 +343,8 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
   command->add_option("--pose", options->pose, "rpp, ippe or iterative")
       ->check(CLI::IsMember({"rpp", "ippe", "iterative"}))
       ->capture_default_str();
-  command->add_option("--marker-set", options->marker_set, "ARToolKit multi-marker .cfg (mm): adds the set's pose");
+  command->add_option("--marker-set", options->marker_set,
+                      "ARToolKit multi-marker .cfg (mm): adds the set's pose");
   command->callback([options, &exit_code] { exit_code = runDetect(*options); });
 }
 

@@ -33,8 +33,10 @@ void printInfo(const bci::Recording& r) {
   for (int c = 0; c < r.info.channelCount(); ++c) std::cout << (c ? " " : "") << r.info.channels[c];
   std::cout << ")\n"
             << "rate:      " << r.info.rate_hz << " Hz\n"
-            << "samples:   " << r.samples << " (" << std::fixed << std::setprecision(2) << r.seconds() << " s)\n";
-  if (r.truncated) std::cout << "truncated: " << r.truncation_note << "; read up to the last complete record\n";
+            << "samples:   " << r.samples << " (" << std::fixed << std::setprecision(2)
+            << r.seconds() << " s)\n";
+  if (r.truncated)
+    std::cout << "truncated: " << r.truncation_note << "; read up to the last complete record\n";
   std::map<int, std::pair<int, int>> by_code;  // code -> (count, targets)
   int targets = 0;
   for (const bci::StimulusEvent& e : r.stimuli) {
@@ -46,7 +48,8 @@ void printInfo(const bci::Recording& r) {
   }
   std::cout << "stimuli:   " << r.stimuli.size() << " (" << targets << " targets)\n";
   for (const auto& [code, counts] : by_code) {
-    std::cout << "  code " << std::setw(3) << code << ": " << std::setw(5) << counts.first << " (" << counts.second << " targets)\n";
+    std::cout << "  code " << std::setw(3) << code << ": " << std::setw(5) << counts.first << " ("
+              << counts.second << " targets)\n";
   }
   std::cout << "other events: " << r.annotations.size() << "\n";
   std::map<std::string, int> by_text;
@@ -57,7 +60,8 @@ void printInfo(const bci::Recording& r) {
 
 void convert(const std::string& in, const std::string& out, bool salvage) {
   const std::filesystem::path target(out);
-  if (target.extension() != ".bdf") throw CliError(out + ": ARBCI writes BDF+ files; name the output *.bdf");
+  if (target.extension() != ".bdf")
+    throw CliError(out + ": ARBCI writes BDF+ files; name the output *.bdf");
   ensureWritable(target);
   const bci::Recording r = read(in, salvage);
   try {
@@ -76,11 +80,14 @@ void convert(const std::string& in, const std::string& out, bool salvage) {
     for (const bci::StimulusEvent& e : r.stimuli) writer.addStimulus(e);
     for (const bci::Annotation& a : r.annotations) writer.addAnnotation(a);
     writer.close();
-    std::cout << "wrote " << out << ": " << r.info.channelCount() << " channels, " << r.samples << " samples, "
-              << r.stimuli.size() << " stimuli, " << r.annotations.size() << " other events";
-    if (writer.clippedSamples() > 0) std::cout << "; " << writer.clippedSamples() << " samples clipped to +-8000 uV";
+    std::cout << "wrote " << out << ": " << r.info.channelCount() << " channels, " << r.samples
+              << " samples, " << r.stimuli.size() << " stimuli, " << r.annotations.size()
+              << " other events";
+    if (writer.clippedSamples() > 0)
+      std::cout << "; " << writer.clippedSamples() << " samples clipped to +-8000 uV";
     if (writer.shortenedAnnotations() > 0) {
-      std::cout << "; " << writer.shortenedAnnotations() << " long parameters or events cut to fit a record";
+      std::cout << "; " << writer.shortenedAnnotations()
+                << " long parameters or events cut to fit a record";
     }
     std::cout << "\n";
   } catch (const bci::RecordingError& error) {
@@ -91,7 +98,8 @@ void convert(const std::string& in, const std::string& out, bool salvage) {
 }  // namespace
 
 void addEegCommand(CLI::App& root, int& exit_code) {
-  CLI::App* eeg = root.add_subcommand("eeg", "EEG files: information, conversion to BDF+, simulated recordings");
+  CLI::App* eeg = root.add_subcommand(
+      "eeg", "EEG files: information, conversion to BDF+, simulated recordings");
   eeg->require_subcommand(1);
 
   struct Options {
@@ -101,52 +109,81 @@ void addEegCommand(CLI::App& root, int& exit_code) {
   };
   auto options = std::make_shared<Options>();
 
-  CLI::App* info = eeg->add_subcommand("info", "Channels, rate, duration and event counts by code of an EEG file\n"
-                                               "(BCI2000 .dat, GDF, EDF(+), BDF(+)).");
+  CLI::App* info =
+      eeg->add_subcommand("info",
+                          "Channels, rate, duration and event counts by code of an EEG file\n"
+                          "(BCI2000 .dat, GDF, EDF(+), BDF(+)).");
   info->add_option("FILE", options->file, "the recording")->required();
-  info->add_flag("--salvage", options->salvage, "read a file cut short up to its last complete record");
+  info->add_flag("--salvage", options->salvage,
+                 "read a file cut short up to its last complete record");
   info->callback([options, &exit_code] {
     printInfo(read(options->file, options->salvage));
     exit_code = 0;
   });
 
-  CLI::App* conv = eeg->add_subcommand("convert", "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N\",\n"
-                                                  "other events, parameters as \"Param name=value\").");
+  CLI::App* conv =
+      eeg->add_subcommand("convert",
+                          "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N\",\n"
+                          "other events, parameters as \"Param name=value\").");
   conv->add_option("IN", options->in, "the recording to read")->required();
   conv->add_option("OUT", options->out, "the BDF+ file to write (*.bdf)")->required();
-  conv->add_flag("--salvage", options->salvage, "convert a file cut short up to its last complete record");
+  conv->add_flag("--salvage", options->salvage,
+                 "convert a file cut short up to its last complete record");
   conv->callback([options, &exit_code] {
     convert(options->in, options->out, options->salvage);
     exit_code = 0;
   });
 
-  CLI::App* sim = eeg->add_subcommand("simulate", "Record the simulated subject in a copy task to BDF+: selections of\n"
-                                                  "--sequences sequences of --stimuli flashing stimuli, one attended\n"
-                                                  "target per selection (marked in the file).");
+  CLI::App* sim =
+      eeg->add_subcommand("simulate",
+                          "Record the simulated subject in a copy task to BDF+: selections of\n"
+                          "--sequences sequences of --stimuli flashing stimuli, one attended\n"
+                          "target per selection (marked in the file).");
   SimulationOptions& s = options->simulation;
-  sim->add_option("--seconds", s.seconds, "length of the recording")->required()->check(CLI::Range(1.0, 86400.0));
+  sim->add_option("--seconds", s.seconds, "length of the recording")
+      ->required()
+      ->check(CLI::Range(1.0, 86400.0));
   sim->add_option("--out", s.out, "BDF+ file to write")->required();
-  sim->add_option("--seed", s.seed, "random seed (same seed, same recording)")->capture_default_str();
-  sim->add_option("--rate", s.rate_hz, "sampling rate in Hz")->capture_default_str()->check(CLI::Range(64.0, 4096.0));
-  sim->add_option("--montage", s.montage, "comma-separated 10-20 channel names")->capture_default_str();
-  sim->add_option("--stimuli", s.stimuli, "stimuli flashed one at a time (objects)")->capture_default_str()->check(CLI::Range(2, 64));
-  sim->add_option("--rows", s.rows, "flash rows and columns of a ROWSxCOLUMNS matrix instead (with --columns)")->check(CLI::Range(0, 32));
+  sim->add_option("--seed", s.seed, "random seed (same seed, same recording)")
+      ->capture_default_str();
+  sim->add_option("--rate", s.rate_hz, "sampling rate in Hz")
+      ->capture_default_str()
+      ->check(CLI::Range(64.0, 4096.0));
+  sim->add_option("--montage", s.montage, "comma-separated 10-20 channel names")
+      ->capture_default_str();
+  sim->add_option("--stimuli", s.stimuli, "stimuli flashed one at a time (objects)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 64));
+  sim->add_option("--rows", s.rows,
+                  "flash rows and columns of a ROWSxCOLUMNS matrix instead (with --columns)")
+      ->check(CLI::Range(0, 32));
   sim->add_option("--columns", s.columns, "columns of the matrix")->check(CLI::Range(0, 32));
-  sim->add_option("--sequences", s.sequences, "sequences per selection")->capture_default_str()->check(CLI::Range(1, 100));
-  sim->add_option("--flash-ms", s.flash_ms, "flash duration")->capture_default_str()->check(CLI::Range(10.0, 1000.0));
-  sim->add_option("--isi-ms", s.isi_ms, "inter-stimulus interval")->capture_default_str()->check(CLI::Range(0.0, 2000.0));
+  sim->add_option("--sequences", s.sequences, "sequences per selection")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  sim->add_option("--flash-ms", s.flash_ms, "flash duration")
+      ->capture_default_str()
+      ->check(CLI::Range(10.0, 1000.0));
+  sim->add_option("--isi-ms", s.isi_ms, "inter-stimulus interval")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 2000.0));
   sim->add_option("--line-hz", s.line_hz, "line noise frequency (50 or 60)")->capture_default_str();
-  sim->add_option("--alpha-hz", s.alpha_hz, "alpha peak frequency")->capture_default_str()->check(CLI::Range(6.0, 14.0));
-  sim->add_flag("--paced", s.paced, "run in real time (as a live session would) instead of as fast as possible");
+  sim->add_option("--alpha-hz", s.alpha_hz, "alpha peak frequency")
+      ->capture_default_str()
+      ->check(CLI::Range(6.0, 14.0));
+  sim->add_flag("--paced", s.paced,
+                "run in real time (as a live session would) instead of as fast as possible");
   sim->callback([options, &exit_code] {
     ensureWritable(options->simulation.out);
     if (std::filesystem::path(options->simulation.out).extension() != ".bdf") {
       throw CliError(options->simulation.out + ": ARBCI records BDF+ files; name the output *.bdf");
     }
-    if ((options->simulation.rows > 0) != (options->simulation.columns > 0)) throw CliError("give both --rows and --columns");
+    if ((options->simulation.rows > 0) != (options->simulation.columns > 0))
+      throw CliError("give both --rows and --columns");
     const SimulationSummary summary = recordSimulation(options->simulation, std::cerr);
-    std::cout << "wrote " << options->simulation.out << ": " << summary.samples << " samples, " << summary.stimuli
-              << " stimuli (" << summary.targets << " targets), " << summary.selections << " selections\n";
+    std::cout << "wrote " << options->simulation.out << ": " << summary.samples << " samples, "
+              << summary.stimuli << " stimuli (" << summary.targets << " targets), "
+              << summary.selections << " selections\n";
     exit_code = 0;
   });
 }

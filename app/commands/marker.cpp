@@ -41,7 +41,8 @@ void makeMarkers(const MakeOptions& options) {
   if (kind != vision::MarkerKind::Bch && kind != vision::MarkerKind::Simple) {
     throw CliError("--kind must be bch or simple");
   }
-  const int max_id = kind == vision::MarkerKind::Bch ? vision::BchCode::kMaxId : vision::SimpleIdCode::kMaxId;
+  const int max_id =
+      kind == vision::MarkerKind::Bch ? vision::BchCode::kMaxId : vision::SimpleIdCode::kMaxId;
   const std::vector<int> ids = parseIdList(options.ids, max_id);
   vision::PrintLayout layout;
   layout.size_mm = options.size_mm;
@@ -52,11 +53,13 @@ void makeMarkers(const MakeOptions& options) {
     for (int id : ids) {
       if (vision::BchCode::rotationMargin(id) < 5) {
         std::cerr << "arbci: warning: BCH id " << id << " turned by 90/180/270 degrees lies within "
-                  << vision::BchCode::rotationMargin(id) << " bits of another id; prefer another id\n";
+                  << vision::BchCode::rotationMargin(id)
+                  << " bits of another id; prefer another id\n";
       }
     }
   }
-  auto write = [&](const std::filesystem::path& stem, const cv::Mat& image, const std::string& svg) {
+  auto write = [&](const std::filesystem::path& stem, const cv::Mat& image,
+                   const std::string& svg) {
     std::filesystem::path png = stem, vector = stem;
     png += ".png";
     vector += ".svg";
@@ -98,7 +101,8 @@ void trainPattern(const TrainOptions& options) {
   if (!pattern) throw CliError("no black-bordered square found in " + options.image);
   pattern->save(options.out);
   if (pattern->rotationalSymmetry() > 0.9f) {
-    std::cerr << "arbci: warning: the pattern looks alike when turned; its orientation will be ambiguous\n";
+    std::cerr << "arbci: warning: the pattern looks alike when turned; its orientation will be "
+                 "ambiguous\n";
   }
   std::cout << options.out << "\n";
 }
@@ -115,16 +119,20 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
   make_command->add_option("--kind", make->kind, "bch (0..4095) or simple (0..511)")
       ->check(CLI::IsMember({"bch", "simple"}))
       ->capture_default_str();
-  make_command->add_option("--id", make->ids, "Marker id, list or range: 7, 1,4,9 or 0-11")->required();
+  make_command->add_option("--id", make->ids, "Marker id, list or range: 7, 1,4,9 or 0-11")
+      ->required();
   make_command->add_option("--border", make->border, "Border width as a fraction of the side")
       ->check(CLI::IsMember({0.125, 0.25}))
       ->capture_default_str();
   make_command->add_option("--size-mm", make->size_mm, "Side of the black square in millimetres")
       ->check(CLI::Range(1.0, 1000.0))
       ->capture_default_str();
-  make_command->add_option("--dpi", make->dpi, "PNG resolution")->check(CLI::Range(72, 2400))->capture_default_str();
+  make_command->add_option("--dpi", make->dpi, "PNG resolution")
+      ->check(CLI::Range(72, 2400))
+      ->capture_default_str();
   make_command->add_flag("--sheet", make->sheet, "All ids on one labelled A4 sheet");
-  make_command->add_option("--out", make->out, "Output file name (.png and .svg are written)")->required();
+  make_command->add_option("--out", make->out, "Output file name (.png and .svg are written)")
+      ->required();
   make_command->callback([make, &exit_code] {
     makeMarkers(*make);
     exit_code = 0;
@@ -133,7 +141,8 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
   auto train = std::make_shared<TrainOptions>();
   auto* train_command = marker->add_subcommand(
       "train", "Train a template pattern (ARToolKit .patt) from a face-on image of a marker");
-  train_command->add_option("--image", train->image, "Image of the marker, seen face-on")->required();
+  train_command->add_option("--image", train->image, "Image of the marker, seen face-on")
+      ->required();
   train_command->add_option("--id", train->id, "Id to give the pattern")->capture_default_str();
   train_command->add_option("--border", train->border, "Border width as a fraction of the side")
       ->check(CLI::Range(0.05, 0.4))

@@ -33,23 +33,32 @@ std::string defaultFolder() {
 void printSummary(const Session& session) {
   std::cout << "session folder: " << session.folder().string() << "\n";
   for (const TrialRecord& t : session.trials()) {
-    std::cout << "trial " << t.trial << ": object " << t.selected_object << (t.selected_object == t.intended_object ? " (intended)" : " (intended " + std::to_string(t.intended_object) + ")")
+    std::cout << "trial " << t.trial << ": object " << t.selected_object
+              << (t.selected_object == t.intended_object
+                      ? " (intended)"
+                      : " (intended " + std::to_string(t.intended_object) + ")")
               << ", cell " << t.selected_cell.first << "," << t.selected_cell.second
-              << (t.selected_cell == t.intended_cell ? " (intended)"
-                                                     : " (intended " + std::to_string(t.intended_cell.first) + "," + std::to_string(t.intended_cell.second) + ")");
-    if (t.placement_error_m >= 0.0) std::cout << ", placed " << std::fixed << std::setprecision(1) << t.placement_error_m * 1000.0 << " mm from the cell centre";
+              << (t.selected_cell == t.intended_cell
+                      ? " (intended)"
+                      : " (intended " + std::to_string(t.intended_cell.first) + "," +
+                            std::to_string(t.intended_cell.second) + ")");
+    if (t.placement_error_m >= 0.0)
+      std::cout << ", placed " << std::fixed << std::setprecision(1) << t.placement_error_m * 1000.0
+                << " mm from the cell centre";
     std::cout << " [" << t.outcome << "]\n";
   }
   const Percentiles p = session.timing().totalPercentiles();
-  std::cout << std::fixed << std::setprecision(2) << "cycle compute time: p50 " << p.p50 << " ms, p99 " << p.p99 << " ms, max " << p.max
-            << " ms; overruns (> " << session.timing().budgetMs() << " ms): " << session.timing().overruns() << "\n";
+  std::cout << std::fixed << std::setprecision(2) << "cycle compute time: p50 " << p.p50
+            << " ms, p99 " << p.p99 << " ms, max " << p.max << " ms; overruns (> "
+            << session.timing().budgetMs() << " ms): " << session.timing().overruns() << "\n";
   std::cout << "ended: " << session.endReason() << "\n";
 }
 
 int runSession(const RunOptions& o) {
   SessionConfig config;
   try {
-    config = SessionConfig::load(o.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.session));
+    config = SessionConfig::load(
+        o.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.session));
   } catch (const SessionConfigError& error) {
     throw CliError(error.what());
   }
@@ -82,19 +91,28 @@ int runSession(const RunOptions& o) {
 
 void addRunCommand(CLI::App& root, int& exit_code) {
   auto o = std::make_shared<RunOptions>();
-  CLI::App* run = root.add_subcommand("run", "Run a session: calibration run and training when there is no model, then online\n"
-                                             "trials (select an object, the robot grasps it, select a cell, the robot puts it\n"
-                                             "down). Without --session the embedded simulated world runs: simulated cameras,\n"
-                                             "subject and arm. Writes a session folder (recording.bdf, log.jsonl, HMD\n"
-                                             "screenshots, summary.json). Exit status: 0 finished, 3 ended by a fault or abort.");
-  run->add_option("--session", o->session, "session file (JSON; see assets/sessions/simulated.json)");
+  CLI::App* run = root.add_subcommand(
+      "run",
+      "Run a session: calibration run and training when there is no model, then online\n"
+      "trials (select an object, the robot grasps it, select a cell, the robot puts it\n"
+      "down). Without --session the embedded simulated world runs: simulated cameras,\n"
+      "subject and arm. Writes a session folder (recording.bdf, log.jsonl, HMD\n"
+      "screenshots, summary.json). Exit status: 0 finished, 3 ended by a fault or abort.");
+  run->add_option("--session", o->session,
+                  "session file (JSON; see assets/sessions/simulated.json)");
   run->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
-  run->add_option("--trials", o->trials, "online trials (overrides the session file)")->check(CLI::Range(1, 1000));
-  run->add_option("--seed", o->seed, "random seed of the simulated subject and world")->check(CLI::Range(0LL, 1LL << 30));
+  run->add_option("--trials", o->trials, "online trials (overrides the session file)")
+      ->check(CLI::Range(1, 1000));
+  run->add_option("--seed", o->seed, "random seed of the simulated subject and world")
+      ->check(CLI::Range(0LL, 1LL << 30));
   run->add_option("--out", o->out, "session folder (default: arbci-session-<date>-<time>)");
-  run->add_flag("--realtime", o->realtime, "headless: pace to the wall clock instead of running as fast as possible");
-  run->add_flag("--wait-for-start", o->wait_for_start, "windowed: wait for the experimenter to press Start");
-  run->add_option("--fault-wait", o->fault_wait_s, "headless: seconds to wait for an experimenter after a robot fault")->capture_default_str();
+  run->add_flag("--realtime", o->realtime,
+                "headless: pace to the wall clock instead of running as fast as possible");
+  run->add_flag("--wait-for-start", o->wait_for_start,
+                "windowed: wait for the experimenter to press Start");
+  run->add_option("--fault-wait", o->fault_wait_s,
+                  "headless: seconds to wait for an experimenter after a robot fault")
+      ->capture_default_str();
   run->callback([o, &exit_code] { exit_code = runSession(*o); });
 }
 

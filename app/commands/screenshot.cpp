@@ -1,10 +1,10 @@
 // `arbci screenshot`: renders the experimenter window headless (EGL) and writes it as a PNG: the
 // shell, or one panel (or the HMD view) on the live data of a simulated session.
+#include <unistd.h>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
-#include <unistd.h>
 
 #include <opencv2/core/version.hpp>
 
@@ -43,7 +43,8 @@ render::Size parseSize(const std::string& text) {
 }
 
 // Draws the shell with `panels` for a few frames (ImGui settles its layout) and writes the PNG.
-void renderPanels(render::GlContext& context, render::Size size, const std::vector<ui::Panel*>& panels, const std::string& status,
+void renderPanels(render::GlContext& context, render::Size size,
+                  const std::vector<ui::Panel*>& panels, const std::string& status,
                   const std::string& out, const std::function<void()>& before_frame = {}) {
   ui::ImGuiLayer imgui(context, "");
   ui::ExperimenterShell shell;
@@ -76,7 +77,9 @@ void renderShell(const ScreenshotOptions& options, render::Size size) {
 void renderPanel(const ScreenshotOptions& options, render::Size size) {
   SessionConfig config;
   try {
-    config = SessionConfig::load(options.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.session));
+    config = SessionConfig::load(options.session.empty()
+                                     ? std::nullopt
+                                     : std::optional<std::filesystem::path>(options.session));
   } catch (const SessionConfigError& error) {
     throw CliError(error.what());
   }
@@ -87,7 +90,8 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
   }
   auto context = render::createHeadlessContext(size);
   SessionOptions session_options;
-  session_options.folder = std::filesystem::temp_directory_path() / ("arbci-screenshot-" + std::to_string(::getpid()));
+  session_options.folder =
+      std::filesystem::temp_directory_path() / ("arbci-screenshot-" + std::to_string(::getpid()));
   session_options.trials = 1;
   Session session(config, session_options, *context);
   SessionModel model(session);
@@ -119,15 +123,20 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     p.train(true);
     renderPanels(*context, size, {&p}, session.statusLine(), options.out);
   } else if (panel == "robot") {
-    runUntil([&] { return phase() == bci::Phase::Grasping && session.robotStatus() && session.robotStatus()->progress > 0.3; });
+    runUntil([&] {
+      return phase() == bci::Phase::Grasping && session.robotStatus() &&
+             session.robotStatus()->progress > 0.3;
+    });
     ui::RobotPanel p(model);
     renderPanels(*context, size, {&p}, session.statusLine(), options.out);
   } else if (panel == "session") {
-    runUntil([&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    runUntil(
+        [&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
     ui::SessionPanel p(model);
     renderPanels(*context, size, {&p}, session.statusLine(), options.out, [&] { session.step(); });
   } else if (panel == "hmd") {
-    runUntil([&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    runUntil(
+        [&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
     // The HMD framebuffer itself, as the subject sees it.
     runUntil([&] { return session.frame() % 11 == 1; });
     ensureWritable(options.out);
@@ -146,16 +155,19 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
 void addScreenshotCommand(CLI::App& root, int& exit_code) {
   auto options = std::make_shared<ScreenshotOptions>();
   auto* command = root.add_subcommand(
-      "screenshot", "Render the experimenter window, or one panel on a simulated session's live data, to a PNG\n"
-                    "(headless through EGL)");
+      "screenshot",
+      "Render the experimenter window, or one panel on a simulated session's live data, to a PNG\n"
+      "(headless through EGL)");
   command->add_flag("--headless", options->headless,
                     "Render without a display through EGL (the only mode screenshots use)");
   command->add_option("--out", options->out, "PNG file to write")->required();
-  command->add_option("--size", options->size, "Image size WIDTHxHEIGHT")
-      ->capture_default_str();
-  command->add_option("--panel", options->panel, "threshold, calibration, training, robot, session or hmd (the HMD view)")
+  command->add_option("--size", options->size, "Image size WIDTHxHEIGHT")->capture_default_str();
+  command
+      ->add_option("--panel", options->panel,
+                   "threshold, calibration, training, robot, session or hmd (the HMD view)")
       ->check(CLI::IsMember({"threshold", "calibration", "training", "robot", "session", "hmd"}));
-  command->add_option("--session", options->session, "session file for --panel (default: the embedded simulated session)");
+  command->add_option("--session", options->session,
+                      "session file for --panel (default: the embedded simulated session)");
   command->callback([options, &exit_code] {
     ensureWritable(options->out);
     const render::Size size = parseSize(options->size);

@@ -13,7 +13,9 @@ namespace arbci::app {
 
 // Writes erp.png and accuracy.png into `folder` (created if missing); returns their paths.
 // Throws CliError when the folder cannot be written.
-std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder, const bci::P300Dataset& data,
-                                                  const bci::EvaluationReport& report, const std::string& title);
+std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,
+                                                  const bci::P300Dataset& data,
+                                                  const bci::EvaluationReport& report,
+                                                  const std::string& title);
 
 }  // namespace arbci::app

@@ -43,12 +43,13 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
       const int row = std::uniform_int_distribution<int>(1, o.rows)(random);
       const int column = std::uniform_int_distribution<int>(1, o.columns)(random);
       selection.attended = {row, o.rows + column};
-      selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) + " target row " + std::to_string(row) +
-                        " column " + std::to_string(column);
+      selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) +
+                        " target row " + std::to_string(row) + " column " + std::to_string(column);
     } else {
       const int target = std::uniform_int_distribution<int>(1, o.stimuli)(random);
       selection.attended = {target};
-      selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) + " target " + std::to_string(target);
+      selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) + " target " +
+                        std::to_string(target);
     }
     double onset = t + 1.0;
     for (int sequence = 0; sequence < o.sequences; ++sequence) {
@@ -102,8 +103,9 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
   std::map<std::string, std::string> parameters = {
       {"Source", "ARBCI simulated subject"},
       {"Seed", std::to_string(o.seed)},
-      {"Paradigm", o.rows > 0 ? "row/column " + std::to_string(o.rows) + "x" + std::to_string(o.columns)
-                              : "single stimulus, " + std::to_string(o.stimuli) + " stimuli"},
+      {"Paradigm", o.rows > 0
+                       ? "row/column " + std::to_string(o.rows) + "x" + std::to_string(o.columns)
+                       : "single stimulus, " + std::to_string(o.stimuli) + " stimuli"},
       {"NumberOfSequences", std::to_string(o.sequences)},
       {"StimulusDuration", std::to_string(o.flash_ms) + "ms"},
       {"ISIDuration", std::to_string(o.isi_ms) + "ms"},
@@ -118,13 +120,15 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
     while (subject.samplesGenerated() < total) {
       const std::int64_t block_end = subject.samplesGenerated() + subject.info().block_size;
       // Cue and present what falls into the next block before it is generated.
-      while (next_selection < schedule.selections.size() && schedule.selections[next_selection].start < block_end) {
+      while (next_selection < schedule.selections.size() &&
+             schedule.selections[next_selection].start < block_end) {
         const Selection& s = schedule.selections[next_selection++];
         subject.attend(s.attended);
         writer.addAnnotation({s.start, s.label, 0});
         ++summary.selections;
       }
-      while (next_stimulus < schedule.stimuli.size() && schedule.stimuli[next_stimulus].sample < block_end) {
+      while (next_stimulus < schedule.stimuli.size() &&
+             schedule.stimuli[next_stimulus].sample < block_end) {
         const bci::StimulusEvent& e = schedule.stimuli[next_stimulus++];
         subject.present(e);
         writer.addStimulus(e);
@@ -137,7 +141,8 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
         manual->advanceTo(static_cast<double>(block_end) / o.rate_hz);
       }
       for (const bci::Block& block : subject.poll(1)) writer.write(block);
-      const int percent = static_cast<int>(100 * subject.samplesGenerated() / std::max<std::int64_t>(total, 1));
+      const int percent =
+          static_cast<int>(100 * subject.samplesGenerated() / std::max<std::int64_t>(total, 1));
       if (percent / 10 != last_percent / 10) {
         progress << "\rsimulating: " << percent << "%" << std::flush;
         last_percent = percent;

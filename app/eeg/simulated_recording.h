@@ -14,7 +14,7 @@ struct SimulationOptions {
   std::uint64_t seed = 1;
   double rate_hz = 256.0;
   std::string montage = "Fz,Cz,P3,Pz,P4,PO7,Oz,PO8";
-  int stimuli = 4;  // single-stimulus paradigm (objects)
+  int stimuli = 4;            // single-stimulus paradigm (objects)
   int rows = 0, columns = 0;  // row/column paradigm when both are set
   int sequences = 10;
   double flash_ms = 60.0;

@@ -15,26 +15,40 @@ namespace {
 
 std::atomic<bool> stop_requested{false};
 
-void onSignal(int) { stop_requested = true; }
+void onSignal(int) {
+  stop_requested = true;
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"arbci-robotd: the ARBCI robot backend. Accepts GRASP, DROP, HOME, STOP and STATUS over UDP,\n"
-               "authenticated with the shared key (make one with `arbci robot keygen`), and drives a\n"
-               "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: docs/robot-protocol.md.",
-               "arbci-robotd"};
+  CLI::App app{
+      "arbci-robotd: the ARBCI robot backend. Accepts GRASP, DROP, HOME, STOP and STATUS over "
+      "UDP,\n"
+      "authenticated with the shared key (make one with `arbci robot keygen`), and drives a\n"
+      "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: "
+      "docs/robot-protocol.md.",
+      "arbci-robotd"};
   int port = 47800;
   std::string host = "127.0.0.1", key_file, config_file, port_file;
   double speed = 0.0;
-  app.add_option("--port", port, "UDP port to listen on (0: any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
-  app.add_option("--port-file", port_file, "write the port listened on to this file once listening");
-  app.add_option("--host", host, "address to listen on (127.0.0.1: this machine only)")->capture_default_str();
+  app.add_option("--port", port, "UDP port to listen on (0: any free port)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--port-file", port_file,
+                 "write the port listened on to this file once listening");
+  app.add_option("--host", host, "address to listen on (127.0.0.1: this machine only)")
+      ->capture_default_str();
   app.add_option("--key-file", key_file, "the shared key")->required();
-  app.add_option("--config", config_file, "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
-  app.add_option("--speed", speed, "simulated seconds per real second (overrides the config's speed_factor)")->check(CLI::Range(0.01, 1000.0));
+  app.add_option("--config", config_file,
+                 "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
+  app.add_option("--speed", speed,
+                 "simulated seconds per real second (overrides the config's speed_factor)")
+      ->check(CLI::Range(0.01, 1000.0));
   app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);
-  app.failure_message([](const CLI::App*, const CLI::Error& error) { return std::string("arbci-robotd: ") + error.what() + "\n"; });
+  app.failure_message([](const CLI::App*, const CLI::Error& error) {
+    return std::string("arbci-robotd: ") + error.what() + "\n";
+  });
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -46,7 +60,8 @@ int main(int argc, char** argv) {
     options.host = host;
     options.speed_factor = speed > 0.0 ? speed : config.speed_factor;
     options.log = &std::cerr;
-    arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config), options);
+    arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config),
+                                       options);
     if (!port_file.empty()) {
       std::ofstream out(port_file);
       out << backend.port() << "\n";
@@ -54,12 +69,14 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port() << " (simulated arm, speed x" << options.speed_factor
-              << ", " << config.objects.size() << " objects)" << std::endl;
+    std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port()
+              << " (simulated arm, speed x" << options.speed_factor << ", " << config.objects.size()
+              << " objects)" << std::endl;
     backend.run(stop_requested);
     const arbci::robot::BackendStats s = backend.stats();
-    std::cerr << "arbci-robotd: stopped; " << s.datagrams << " datagrams, " << s.executed << " commands run, " << s.rejected
-              << " rejected, " << s.replayed << " replayed, " << s.ignored << " ignored" << std::endl;
+    std::cerr << "arbci-robotd: stopped; " << s.datagrams << " datagrams, " << s.executed
+              << " commands run, " << s.rejected << " rejected, " << s.replayed << " replayed, "
+              << s.ignored << " ignored" << std::endl;
   } catch (const std::exception& error) {
     std::cerr << "arbci-robotd: " << error.what() << "\n";
     return 1;

@@ -5,9 +5,12 @@
 
 namespace arbci::app {
 
-CameraCapture::CameraCapture(int device, const std::string& video, const std::string& what) : file_(device < 0) {
+CameraCapture::CameraCapture(int device, const std::string& video, const std::string& what)
+    : file_(device < 0) {
   const bool opened = device >= 0 ? capture_.open(device, cv::CAP_V4L2) : capture_.open(video);
-  if (!opened) throw std::runtime_error(what + ": cannot open " + (device >= 0 ? "/dev/video" + std::to_string(device) : video));
+  if (!opened)
+    throw std::runtime_error(what + ": cannot open " +
+                             (device >= 0 ? "/dev/video" + std::to_string(device) : video));
   const double fps = capture_.get(cv::CAP_PROP_FPS);
   const auto interval = std::chrono::duration<double>(file_ && fps > 0 ? 1.0 / fps : 0.0);
   thread_ = std::thread([this, interval] {

@@ -9,7 +9,10 @@ Percentiles percentiles(std::vector<double> v) {
   Percentiles p;
   if (v.empty()) return p;
   std::sort(v.begin(), v.end());
-  auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5))]; };
+  auto at = [&](double q) {
+    return v[std::min(v.size() - 1,
+                      static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+  };
   p.p50 = at(0.5);
   p.p90 = at(0.9);
   p.p99 = at(0.99);
@@ -30,7 +33,8 @@ void CycleTiming::mark(const std::string& stage) {
 }
 
 double CycleTiming::endCycle() {
-  const double total = std::chrono::duration<double, std::milli>(Clock::now() - cycle_start_).count();
+  const double total =
+      std::chrono::duration<double, std::milli>(Clock::now() - cycle_start_).count();
   for (const auto& [stage, ms] : current_) stages_[stage].push_back(ms);
   total_.push_back(total);
   if (total > budget_ms_) ++overruns_;
@@ -45,8 +49,17 @@ std::map<std::string, Percentiles> CycleTiming::stagePercentiles() const {
 }
 
 nlohmann::json CycleTiming::toJson() const {
-  auto json = [](const Percentiles& p) { return nlohmann::json{{"p50_ms", p.p50}, {"p90_ms", p.p90}, {"p99_ms", p.p99}, {"max_ms", p.max}, {"mean_ms", p.mean}}; };
-  nlohmann::json out = {{"cycles", total_.size()}, {"budget_ms", budget_ms_}, {"overruns", overruns_}, {"total", json(totalPercentiles())}};
+  auto json = [](const Percentiles& p) {
+    return nlohmann::json{{"p50_ms", p.p50},
+                          {"p90_ms", p.p90},
+                          {"p99_ms", p.p99},
+                          {"max_ms", p.max},
+                          {"mean_ms", p.mean}};
+  };
+  nlohmann::json out = {{"cycles", total_.size()},
+                        {"budget_ms", budget_ms_},
+                        {"overruns", overruns_},
+                        {"total", json(totalPercentiles())}};
   for (const auto& [stage, p] : stagePercentiles()) out["stages"][stage] = json(p);
   return out;
 }

@@ -8,7 +8,8 @@
 
 namespace arbci::app {
 
-EegStage::EegStage(const SessionConfig& config, const std::filesystem::path& recording_path, std::shared_ptr<bci::SampleClock> clock,
+EegStage::EegStage(const SessionConfig& config, const std::filesystem::path& recording_path,
+                   std::shared_ptr<bci::SampleClock> clock,
                    const std::map<std::string, std::string>& parameters)
     : config_(config), clock_(std::move(clock)) {
   if (config.eeg.source == "file") {
@@ -30,11 +31,13 @@ EegStage::EegStage(const SessionConfig& config, const std::filesystem::path& rec
   }
   writer_ = std::make_unique<bci::RecordingWriter>(recording_path, source_->info(), parameters);
   filters_ = std::make_unique<bci::FilterChain>(config.pipeline.filter, source_->info());
-  epocher_ = std::make_unique<bci::Epocher>(source_->info().channelCount(), source_->info().rate_hz, config.pipeline.window, 10.0);
+  epocher_ = std::make_unique<bci::Epocher>(source_->info().channelCount(), source_->info().rate_hz,
+                                            config.pipeline.window, 10.0);
   calibration_.source = "calibration run";
   calibration_.format = "memory";
   calibration_.info = source_->info();
-  calibration_.parameters["Paradigm"] = "single stimulus, " + std::to_string(config.world.objects.size()) + " stimuli";
+  calibration_.parameters["Paradigm"] =
+      "single stimulus, " + std::to_string(config.world.objects.size()) + " stimuli";
   recent_.assign(static_cast<size_t>(source_->info().channelCount()), {});
 }
 
@@ -46,7 +49,9 @@ EegStage::~EegStage() {
   }
 }
 
-std::int64_t EegStage::sampleAt(double seconds) const { return static_cast<std::int64_t>(seconds * info().rate_hz); }
+std::int64_t EegStage::sampleAt(double seconds) const {
+  return static_cast<std::int64_t>(seconds * info().rate_hz);
+}
 
 void EegStage::setModel(bci::P300Model model) {
   model.checkCompatible(info(), "the EEG source");
@@ -84,12 +89,14 @@ void EegStage::poll() {
       flashes_.erase(found);
       if (record.selection != selection_) continue;
       ++scored_;
-      if (accumulator_ && extractor_) accumulator_->add(record.code, model_->classifier->score(extractor_->features(epoch)));
+      if (accumulator_ && extractor_)
+        accumulator_->add(record.code, model_->classifier->score(extractor_->features(epoch)));
     }
   }
 }
 
-void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout, const std::set<int>& attended, std::optional<int> target) {
+void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,
+                              const std::set<int>& attended, std::optional<int> target) {
   ++selection_;
   selection_objects_ = objects;
   target_ = target;
@@ -111,7 +118,9 @@ void EegStage::flash(int code, std::int64_t sample, int duration_samples) {
   ++presented_;
 }
 
-void EegStage::annotate(std::int64_t sample, const std::string& text) { writer_->addAnnotation({sample, text, 0}); }
+void EegStage::annotate(std::int64_t sample, const std::string& text) {
+  writer_->addAnnotation({sample, text, 0});
+}
 
 bci::EvaluationReport EegStage::train(const std::string& method, const bci::Progress& progress) {
   // Channel-major, as a recording holds its samples.
@@ -120,7 +129,8 @@ bci::EvaluationReport EegStage::train(const std::string& method, const bci::Prog
   recording.data.assign(calibration_.data.size(), 0.0f);
   for (std::int64_t s = 0; s < calibration_.samples; ++s) {
     for (int c = 0; c < channels; ++c) {
-      recording.data[static_cast<size_t>(c * calibration_.samples + s)] = calibration_.data[static_cast<size_t>(s * channels + c)];
+      recording.data[static_cast<size_t>(c * calibration_.samples + s)] =
+          calibration_.data[static_cast<size_t>(s * channels + c)];
     }
   }
   bci::TrainingSettings settings;
@@ -133,15 +143,25 @@ bci::EvaluationReport EegStage::train(const std::string& method, const bci::Prog
   return result.cross_validation.report;
 }
 
-bool EegStage::selectionScored() const { return presented_ > 0 && scored_ >= presented_; }
+bool EegStage::selectionScored() const {
+  return presented_ > 0 && scored_ >= presented_;
+}
 
-int EegStage::scoredSequences() const { return accumulator_ ? accumulator_->completeSequences() : 0; }
+int EegStage::scoredSequences() const {
+  return accumulator_ ? accumulator_->completeSequences() : 0;
+}
 
-bci::Decision EegStage::decide() const { return accumulator_ ? accumulator_->decide() : bci::Decision{}; }
+bci::Decision EegStage::decide() const {
+  return accumulator_ ? accumulator_->decide() : bci::Decision{};
+}
 
-std::int64_t EegStage::missedEpochs() const { return epocher_->missed(); }
+std::int64_t EegStage::missedEpochs() const {
+  return epocher_->missed();
+}
 
-std::int64_t EegStage::samplesRecorded() const { return writer_ ? writer_->samplesWritten() : 0; }
+std::int64_t EegStage::samplesRecorded() const {
+  return writer_ ? writer_->samplesWritten() : 0;
+}
 
 void EegStage::close() {
   if (writer_) writer_->close();
@@ -149,7 +169,10 @@ void EegStage::close() {
 
 std::vector<std::vector<float>> EegStage::recentSignal(int samples) const {
   std::vector<std::vector<float>> out;
-  for (const auto& r : recent_) out.emplace_back(r.end() - std::min<std::ptrdiff_t>(samples, static_cast<std::ptrdiff_t>(r.size())), r.end());
+  for (const auto& r : recent_)
+    out.emplace_back(
+        r.end() - std::min<std::ptrdiff_t>(samples, static_cast<std::ptrdiff_t>(r.size())),
+        r.end());
   return out;
 }
 

@@ -24,7 +24,8 @@ namespace arbci::app {
 class EegStage {
  public:
   // Opens the source named by the session and starts the recording. Throws std::runtime_error.
-  EegStage(const SessionConfig& config, const std::filesystem::path& recording_path, std::shared_ptr<bci::SampleClock> clock,
+  EegStage(const SessionConfig& config, const std::filesystem::path& recording_path,
+           std::shared_ptr<bci::SampleClock> clock,
            const std::map<std::string, std::string>& parameters);
   ~EegStage();
 
@@ -35,7 +36,8 @@ class EegStage {
 
   // A new selection: its stimuli (objects, or grid rows and columns), what the subject attends
   // (the simulated subject looks there), and for the calibration run the cued target.
-  void startSelection(bool objects, const bci::ParadigmLayout& layout, const std::set<int>& attended, std::optional<int> target);
+  void startSelection(bool objects, const bci::ParadigmLayout& layout,
+                      const std::set<int>& attended, std::optional<int> target);
   // A flash presented at `sample`; grid codes are recorded as 100 + code.
   void flash(int code, std::int64_t sample, int duration_samples);
   void annotate(std::int64_t sample, const std::string& text);

@@ -28,9 +28,13 @@ std::filesystem::path robotdNextToMe() {
   return dir / "arbci-robotd";
 }
 
-RobotProcess::RobotProcess(const std::filesystem::path& executable, const std::filesystem::path& key_file,
-                           const std::filesystem::path& config_file, double speed_factor, const std::filesystem::path& folder) {
-  if (!std::filesystem::exists(executable)) throw std::runtime_error(executable.string() + ": the robot backend is not there (build arbci-robotd)");
+RobotProcess::RobotProcess(const std::filesystem::path& executable,
+                           const std::filesystem::path& key_file,
+                           const std::filesystem::path& config_file, double speed_factor,
+                           const std::filesystem::path& folder) {
+  if (!std::filesystem::exists(executable))
+    throw std::runtime_error(executable.string() +
+                             ": the robot backend is not there (build arbci-robotd)");
   const auto port_file = folder / "robotd.port";
   const auto log_file = folder / "robotd.log";
   std::filesystem::remove(port_file);
@@ -44,8 +48,9 @@ RobotProcess::RobotProcess(const std::filesystem::path& executable, const std::f
       dup2(log, STDERR_FILENO);
       dup2(log, STDOUT_FILENO);
     }
-    execl(executable.c_str(), executable.c_str(), "--port", "0", "--port-file", port_file.c_str(), "--key-file", key_file.c_str(),
-          "--config", config_file.c_str(), "--speed", speed.c_str(), nullptr);
+    execl(executable.c_str(), executable.c_str(), "--port", "0", "--port-file", port_file.c_str(),
+          "--key-file", key_file.c_str(), "--config", config_file.c_str(), "--speed", speed.c_str(),
+          nullptr);
     _exit(127);
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);

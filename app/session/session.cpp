@@ -62,23 +62,36 @@ namespace {
 
 std::string phaseSlug(bci::Phase phase) {
   switch (phase) {
-    case bci::Phase::CalibrationFlashing: return "calibration";
-    case bci::Phase::ObjectFlashing: return "1_objects_flashing";
-    case bci::Phase::ObjectSelected: return "2_object_selected";
-    case bci::Phase::Grasping: return "3_grasping";
-    case bci::Phase::CellFlashing: return "4_grid_flashing";
-    case bci::Phase::CellSelected: return "5_cell_selected";
-    case bci::Phase::Dropping: return "6_putting_down";
-    case bci::Phase::RobotFault: return "robot_fault";
-    case bci::Phase::Finished: return "finished";
-    default: return "";
+    case bci::Phase::CalibrationFlashing:
+      return "calibration";
+    case bci::Phase::ObjectFlashing:
+      return "1_objects_flashing";
+    case bci::Phase::ObjectSelected:
+      return "2_object_selected";
+    case bci::Phase::Grasping:
+      return "3_grasping";
+    case bci::Phase::CellFlashing:
+      return "4_grid_flashing";
+    case bci::Phase::CellSelected:
+      return "5_cell_selected";
+    case bci::Phase::Dropping:
+      return "6_putting_down";
+    case bci::Phase::RobotFault:
+      return "robot_fault";
+    case bci::Phase::Finished:
+      return "finished";
+    default:
+      return "";
   }
 }
 
 }  // namespace
 
 Session::Session(SessionConfig config, const SessionOptions& options, render::GlContext& context)
-    : impl_(std::make_unique<Impl>(context)), config_(std::move(config)), options_(options), timing_(0.0) {
+    : impl_(std::make_unique<Impl>(context)),
+      config_(std::move(config)),
+      options_(options),
+      timing_(0.0) {
   Impl& m = *impl_;
   if (options.seed) config_.eeg.seed = *options.seed;
   if (options.trials) config_.paradigm.trials = *options.trials;
@@ -87,9 +100,12 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   folder_ = options.folder;
   std::error_code error;
   std::filesystem::create_directories(folder_, error);
-  if (error) throw std::runtime_error(folder_.string() + ": cannot create the session folder (" + error.message() + ")");
+  if (error)
+    throw std::runtime_error(folder_.string() + ": cannot create the session folder (" +
+                             error.message() + ")");
   m.log = std::make_unique<SessionLog>(folder_ / "log.jsonl");
-  m.camera_every = std::max(1, static_cast<int>(std::lround(config_.display_hz / config_.cameras.rate_hz)));
+  m.camera_every =
+      std::max(1, static_cast<int>(std::lround(config_.display_hz / config_.cameras.rate_hz)));
 
   // What the subject intends in each trial: the file's list, then random choices for the seed.
   std::mt19937_64 random(config_.eeg.seed * 31 + 7);
@@ -120,13 +136,16 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     T_right_left = m.world->T_right_left();
   } else {
     left_camera = vision::CameraModel::load(config_.cameras.left.calibration);
-    m.left_capture = std::make_unique<CameraCapture>(config_.cameras.left.device, config_.cameras.left.video, "cameras.left");
+    m.left_capture = std::make_unique<CameraCapture>(config_.cameras.left.device,
+                                                     config_.cameras.left.video, "cameras.left");
     right_camera = left_camera;
     if (!config_.cameras.right.calibration.empty()) {
       right_camera = vision::CameraModel::load(config_.cameras.right.calibration);
-      m.right_capture = std::make_unique<CameraCapture>(config_.cameras.right.device, config_.cameras.right.video, "cameras.right");
+      m.right_capture = std::make_unique<CameraCapture>(
+          config_.cameras.right.device, config_.cameras.right.video, "cameras.right");
       if (!config_.cameras.stereo_calibration.empty()) {
-        const vision::StereoCameras stereo = vision::StereoCameras::load(config_.cameras.stereo_calibration);
+        const vision::StereoCameras stereo =
+            vision::StereoCameras::load(config_.cameras.stereo_calibration);
         T_right_left = {stereo.rotation, stereo.translation};
       }
     }
@@ -142,7 +161,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     robot::saveKey(key_file, key);
     robot::RobotConfig robot_config = m.world ? m.world->robotConfig() : robot::RobotConfig{};
     std::ofstream(folder_ / "robot.json") << robot_config.toJson();
-    m.robotd = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder_ / "robot.json", config_.robot_speed_factor, folder_);
+    m.robotd = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder_ / "robot.json",
+                                              config_.robot_speed_factor, folder_);
     std::ofstream(folder_ / "robotd.pid") << m.robotd->pid() << "\n";
     endpoint = robot::Endpoint::resolve("127.0.0.1", m.robotd->port());
   } else {
@@ -156,7 +176,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
       {"Session", config_.source},
       {"Seed", std::to_string(config_.eeg.seed)},
       {"Paradigm", "single stimulus, " + std::to_string(config_.world.objects.size()) + " stimuli"},
-      {"GridCodes", "100 + row (1-" + std::to_string(config_.world.grid.rows) + "), 100 + rows + column"},
+      {"GridCodes",
+       "100 + row (1-" + std::to_string(config_.world.grid.rows) + "), 100 + rows + column"},
       {"FlashMs", std::to_string(config_.paradigm.flash_ms)},
       {"IsiMs", std::to_string(config_.paradigm.isi_ms)},
       {"DisplayHz", std::to_string(config_.display_hz)},
@@ -165,16 +186,23 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   eeg_ = std::make_unique<EegStage>(config_, folder_ / "recording.bdf", m.clock, parameters);
   if (!config_.model_file.empty()) eeg_->setModel(bci::P300Model::load(config_.model_file));
 
-  paradigm_ = std::make_unique<bci::Paradigm>(config_.paradigm, static_cast<int>(config_.world.objects.size()), config_.world.grid.rows,
-                                              config_.world.grid.columns, config_.eeg.seed + 11);
+  paradigm_ = std::make_unique<bci::Paradigm>(
+      config_.paradigm, static_cast<int>(config_.world.objects.size()), config_.world.grid.rows,
+      config_.world.grid.columns, config_.eeg.seed + 11);
   m.hmd = std::make_unique<render::HmdView>();
   m.hmd->setUndistort(config_.undistort);
-  m.hmd_fbo = std::make_unique<render::Framebuffer>(render::Size{config_.hmd_width, config_.hmd_height});
-  std::ofstream(folder_ / "session.json") << nlohmann::json{{"source", config_.source}, {"seed", config_.eeg.seed}, {"trials", config_.paradigm.trials}}.dump(2);
+  m.hmd_fbo =
+      std::make_unique<render::Framebuffer>(render::Size{config_.hmd_width, config_.hmd_height});
+  std::ofstream(folder_ / "session.json") << nlohmann::json{
+      {"source", config_.source},
+      {"seed", config_.eeg.seed},
+      {"trials", config_.paradigm.trials}}.dump(2);
   // Warm-up: Mesa compiles its shader variants and the tracker builds its tables on first use;
   // that happens here, before the cycle's time is measured.
   if (m.world) {
-    for (int i = 0; i < 3; ++i) vision_->process(0.0, m.world->captureLeft(-1.0 - i).image, m.world->captureRight(-1.0 - i).image);
+    for (int i = 0; i < 3; ++i)
+      vision_->process(0.0, m.world->captureLeft(-1.0 - i).image,
+                       m.world->captureRight(-1.0 - i).image);
     // Every kind of overlay once: highlights in each state, the grid with rows, columns and cells.
     bci::FrameStimulus all;
     all.grid_visible = true;
@@ -188,7 +216,9 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     renderHmd(all);
     renderHmd(bci::FrameStimulus{});
   }
-  m.log->write("session_started", 0.0, {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
+  m.log->write(
+      "session_started", 0.0,
+      {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
   if (options.start_immediately) start();
 }
 
@@ -204,12 +234,16 @@ void Session::start() {
   if (paradigm_->phase() != bci::Phase::Setup) return;
   paradigm_->start(!eeg_->hasModel());
 }
-void Session::pause() { paradigm_->pause(); }
+void Session::pause() {
+  paradigm_->pause();
+}
 void Session::resume() {
   impl_->fault_since = -1.0;
   paradigm_->resume();
 }
-void Session::abort() { paradigm_->abort(); }
+void Session::abort() {
+  paradigm_->abort();
+}
 void Session::emergencyStop() {
   client_->send(robot::MessageType::Stop);
   paradigm_->emergencyStop();
@@ -232,8 +266,10 @@ bool Session::step() {
   if (ended_) return false;
   Impl& m = *impl_;
   m.context.makeCurrent();
-  time_ = options_.simulated_clock ? static_cast<double>(frame_) / config_.display_hz
-                                   : std::chrono::duration<double>(std::chrono::steady_clock::now() - m.wall_start).count();
+  time_ =
+      options_.simulated_clock
+          ? static_cast<double>(frame_) / config_.display_hz
+          : std::chrono::duration<double>(std::chrono::steady_clock::now() - m.wall_start).count();
   timing_.beginCycle();
 
   // EEG: everything up to now.
@@ -286,13 +322,17 @@ bool Session::step() {
 
   renderHmd(stimulus);
   timing_.mark("render");
-  if (m.context.isHeadless()) m.context.present();  // a window is presented by its owner, with the panels
+  if (m.context.isHeadless())
+    m.context.present();  // a window is presented by its owner, with the panels
   timing_.mark("present");
   const double total = timing_.endCycle();
   if (total > timing_.budgetMs()) {
-    m.log->write("overrun", time_, {{"frame", frame_}, {"compute_ms", total}, {"stages", timing_.lastCycle()}});
+    m.log->write("overrun", time_,
+                 {{"frame", frame_}, {"compute_ms", total}, {"stages", timing_.lastCycle()}});
   }
-  if (frame_ % 6 == 0) m.log->write("cycle", time_, {{"frame", frame_}, {"compute_ms", total}, {"stages", timing_.lastCycle()}});
+  if (frame_ % 6 == 0)
+    m.log->write("cycle", time_,
+                 {{"frame", frame_}, {"compute_ms", total}, {"stages", timing_.lastCycle()}});
 
   // Without an experimenter, a fault or a stop ends the run after a while.
   const bci::Phase phase = paradigm_->phase();
@@ -305,22 +345,29 @@ bool Session::step() {
     m.fault_since = -1.0;
   }
   // The last placement is measured before the run ends (a status after the drop, or 3 s).
-  if (phase == bci::Phase::Finished && (!m.placement || std::chrono::steady_clock::now() - m.placement_since > std::chrono::seconds(3))) {
+  if (phase == bci::Phase::Finished &&
+      (!m.placement ||
+       std::chrono::steady_clock::now() - m.placement_since > std::chrono::seconds(3))) {
     endRun("finished");
   }
   if (phase == bci::Phase::Aborted) endRun("aborted");
-  if (options_.start_immediately && time_ > options_.max_session_s) endRun("the session ran past its time limit");
-  if (options_.progress && frame_ % 600 == 0) *options_.progress << "\r" << statusLine() << "      " << std::flush;
+  if (options_.start_immediately && time_ > options_.max_session_s)
+    endRun("the session ran past its time limit");
+  if (options_.progress && frame_ % 600 == 0)
+    *options_.progress << "\r" << statusLine() << "      " << std::flush;
   ++frame_;
   if (options_.simulated_clock && m.robot_command && m.robotd) {
     const double robot_seconds = (time_ - m.robot_started_at) / config_.robot_speed_factor;
-    std::this_thread::sleep_until(m.robot_started_wall + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                             std::chrono::duration<double>(robot_seconds)));
+    std::this_thread::sleep_until(m.robot_started_wall +
+                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(robot_seconds)));
   }
   if (!options_.simulated_clock && m.context.isHeadless()) {
     // --realtime without a display: pace the frames to the wall clock.
-    const auto due = m.wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                        std::chrono::duration<double>(static_cast<double>(frame_) / config_.display_hz));
+    const auto due =
+        m.wall_start +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(static_cast<double>(frame_) / config_.display_hz));
     std::this_thread::sleep_until(due);
   }
   return !ended_;
@@ -329,11 +376,15 @@ bool Session::step() {
 void Session::handleRobotEvents() {
   Impl& m = *impl_;
   for (const robot::RobotEvent& e : client_->takeEvents()) {
-    nlohmann::json fields = {{"kind", robot::toString(e.kind)}, {"sequence", e.sequence}, {"command", robot::toString(e.command)}, {"text", e.text}};
+    nlohmann::json fields = {{"kind", robot::toString(e.kind)},
+                             {"sequence", e.sequence},
+                             {"command", robot::toString(e.command)},
+                             {"text", e.text}};
     if (e.kind == robot::RobotEvent::Kind::Rejected) fields["reason"] = robot::toString(e.reason);
     if (e.kind == robot::RobotEvent::Kind::Finished) fields["outcome"] = robot::toString(e.outcome);
     m.log->write("robot", time_, fields);
-    robot_log_.push_back(std::string(robot::toString(e.kind)) + " " + robot::toString(e.command) + (e.text.empty() ? "" : ": " + e.text));
+    robot_log_.push_back(std::string(robot::toString(e.kind)) + " " + robot::toString(e.command) +
+                         (e.text.empty() ? "" : ": " + e.text));
     if (robot_log_.size() > 200) robot_log_.erase(robot_log_.begin());
     if (!m.robot_command) continue;
     const bool ours = e.sequence == *m.robot_command;
@@ -346,11 +397,15 @@ void Session::handleRobotEvents() {
         m.placement = std::make_pair(currentTrial().trial, e.sequence);
         m.placement_since = std::chrono::steady_clock::now();
       }
-      if (!success) currentTrial().outcome = std::string("robot ") + robot::toString(e.outcome) + ": " + e.text;
+      if (!success)
+        currentTrial().outcome = std::string("robot ") + robot::toString(e.outcome) + ": " + e.text;
       paradigm_->robotFinished(success, e.text);
     } else if (ours && (e.kind == Kind::Rejected || e.kind == Kind::Failed)) {
       m.robot_command.reset();
-      const std::string why = e.kind == Kind::Rejected ? std::string("rejected (") + robot::toString(e.reason) + "): " + e.text : e.text;
+      const std::string why =
+          e.kind == Kind::Rejected
+              ? std::string("rejected (") + robot::toString(e.reason) + "): " + e.text
+              : e.text;
       currentTrial().outcome = "robot " + why;
       paradigm_->robotFinished(false, why);
     } else if (e.kind == Kind::Silent) {
@@ -373,10 +428,15 @@ void Session::measurePlacement() {
     for (const auto& s : config_.world.objects) {
       if (s.id == o.id) height = s.height_m;
     }
-    const cv::Vec3d centre = gridLayout().cellCentre(trial.selected_cell.first, trial.selected_cell.second);
-    trial.placement_error_m = cv::norm(cv::Vec3d(o.position.x, o.position.y, o.position.z - height) - centre);
-    impl_->log->write("placement", time_, {{"trial", trial.trial}, {"object", o.id}, {"error_m", trial.placement_error_m},
-                                           {"position", {o.position.x, o.position.y, o.position.z - height}}});
+    const cv::Vec3d centre =
+        gridLayout().cellCentre(trial.selected_cell.first, trial.selected_cell.second);
+    trial.placement_error_m =
+        cv::norm(cv::Vec3d(o.position.x, o.position.y, o.position.z - height) - centre);
+    impl_->log->write("placement", time_,
+                      {{"trial", trial.trial},
+                       {"object", o.id},
+                       {"error_m", trial.placement_error_m},
+                       {"position", {o.position.x, o.position.y, o.position.z - height}}});
   }
   m.placement.reset();
 }
@@ -397,14 +457,19 @@ void Session::handleParadigmEvents() {
     const std::int64_t sample = eeg_->sampleAt(time_);
     switch (e.kind) {
       case Kind::PhaseChanged: {
-        m.log->write("phase", time_, {{"phase", bci::toString(e.phase)}, {"text", e.text}, {"trial", e.trial}});
+        m.log->write("phase", time_,
+                     {{"phase", bci::toString(e.phase)}, {"text", e.text}, {"trial", e.trial}});
         eeg_->annotate(sample, "Phase " + e.text);
         const std::string slug = phaseSlug(e.phase);
-        if (!slug.empty() && !(e.phase == bci::Phase::CalibrationFlashing && std::filesystem::exists(folder_ / "hmd_calibration.png"))) {
-          m.screenshot_name = e.phase == bci::Phase::CalibrationFlashing || e.phase == bci::Phase::Finished || e.phase == bci::Phase::RobotFault
+        if (!slug.empty() && !(e.phase == bci::Phase::CalibrationFlashing &&
+                               std::filesystem::exists(folder_ / "hmd_calibration.png"))) {
+          m.screenshot_name = e.phase == bci::Phase::CalibrationFlashing ||
+                                      e.phase == bci::Phase::Finished ||
+                                      e.phase == bci::Phase::RobotFault
                                   ? "hmd_" + slug + ".png"
                                   : "hmd_trial" + std::to_string(e.trial) + "_" + slug + ".png";
-          m.screenshot_needs_flash = e.phase == bci::Phase::CalibrationFlashing || e.phase == bci::Phase::ObjectFlashing ||
+          m.screenshot_needs_flash = e.phase == bci::Phase::CalibrationFlashing ||
+                                     e.phase == bci::Phase::ObjectFlashing ||
                                      e.phase == bci::Phase::CellFlashing;
         }
         if (options_.progress) *options_.progress << "\r" << statusLine() << "      " << std::flush;
@@ -415,25 +480,32 @@ void Session::handleParadigmEvents() {
         m.selection_objects = e.objects_layout;
         std::set<int> attended;
         std::optional<int> target;
-        if (paradigm_->phase() == bci::Phase::CalibrationCue || paradigm_->phase() == bci::Phase::CalibrationFlashing) {
+        if (paradigm_->phase() == bci::Phase::CalibrationCue ||
+            paradigm_->phase() == bci::Phase::CalibrationFlashing) {
           attended = e.codes;
           target = *e.codes.begin();
-          m.log->write("calibration_target", time_, {{"object", config_.world.objects[static_cast<size_t>(*target - 1)].id}});
+          m.log->write("calibration_target", time_,
+                       {{"object", config_.world.objects[static_cast<size_t>(*target - 1)].id}});
         } else {
           const TrialRecord& trial = currentTrial();
           if (e.objects_layout) {
             for (size_t i = 0; i < config_.world.objects.size(); ++i) {
-              if (config_.world.objects[i].id == trial.intended_object) attended = {static_cast<int>(i) + 1};
+              if (config_.world.objects[i].id == trial.intended_object)
+                attended = {static_cast<int>(i) + 1};
             }
           } else {
-            attended = {trial.intended_cell.first, config_.world.grid.rows + trial.intended_cell.second};
+            attended = {trial.intended_cell.first,
+                        config_.world.grid.rows + trial.intended_cell.second};
           }
         }
-        eeg_->startSelection(e.objects_layout, e.objects_layout ? paradigm_->objectLayout() : paradigm_->gridLayout(), attended, target);
+        eeg_->startSelection(e.objects_layout,
+                             e.objects_layout ? paradigm_->objectLayout() : paradigm_->gridLayout(),
+                             attended, target);
         break;
       }
       case Kind::Flash: {
-        const int duration = static_cast<int>(std::lround(config_.paradigm.flashFrames() / config_.display_hz * eeg_->info().rate_hz));
+        const int duration = static_cast<int>(std::lround(
+            config_.paradigm.flashFrames() / config_.display_hz * eeg_->info().rate_hz));
         eeg_->flash(e.code, sample, duration);
         ++m.selection_flashes;
         break;
@@ -449,9 +521,13 @@ void Session::handleParadigmEvents() {
           trial.cell_certainty = e.certainty;
           trial.cell_flashes = m.selection_flashes;
         }
-        const bool correct = e.objects_layout ? trial.selected_object == trial.intended_object : trial.selected_cell == trial.intended_cell;
-        nlohmann::json fields = {{"trial", trial.trial}, {"kind", e.objects_layout ? "object" : "cell"}, {"certainty", e.certainty},
-                                 {"flashes", m.selection_flashes}, {"correct", correct}};
+        const bool correct = e.objects_layout ? trial.selected_object == trial.intended_object
+                                              : trial.selected_cell == trial.intended_cell;
+        nlohmann::json fields = {{"trial", trial.trial},
+                                 {"kind", e.objects_layout ? "object" : "cell"},
+                                 {"certainty", e.certainty},
+                                 {"flashes", m.selection_flashes},
+                                 {"correct", correct}};
         if (e.objects_layout) {
           fields["selected"] = trial.selected_object;
           fields["intended"] = trial.intended_object;
@@ -460,12 +536,16 @@ void Session::handleParadigmEvents() {
           fields["intended"] = {trial.intended_cell.first, trial.intended_cell.second};
         }
         m.log->write("selection", time_, fields);
-        eeg_->annotate(sample, std::string("Selected ") + (e.objects_layout ? "object " + std::to_string(trial.selected_object)
-                                                                              : "cell " + std::to_string(e.cell.first) + "," + std::to_string(e.cell.second)) +
-                                   (correct ? " (intended)" : " (not the intended)"));
+        eeg_->annotate(sample,
+                       std::string("Selected ") +
+                           (e.objects_layout ? "object " + std::to_string(trial.selected_object)
+                                             : "cell " + std::to_string(e.cell.first) + "," +
+                                                   std::to_string(e.cell.second)) +
+                           (correct ? " (intended)" : " (not the intended)"));
         if (!correct && options_.progress) {
-          *options_.progress << "\nselection " << (e.objects_layout ? "of the object" : "of the cell") << " in trial " << trial.trial
-                             << " differs from the intended one; carrying on\n";
+          *options_.progress << "\nselection "
+                             << (e.objects_layout ? "of the object" : "of the cell") << " in trial "
+                             << trial.trial << " differs from the intended one; carrying on\n";
         }
         break;
       }
@@ -473,8 +553,10 @@ void Session::handleParadigmEvents() {
         try {
           calibration_report_ = eeg_->train(config_.classifier_method);
           eeg_->model()->save(folder_ / "model.json");
-          m.log->write("trained", time_, {{"method", config_.classifier_method}, {"auc", calibration_report_->auc},
-                                          {"accuracy_by_sequences", calibration_report_->accuracy}});
+          m.log->write("trained", time_,
+                       {{"method", config_.classifier_method},
+                        {"auc", calibration_report_->auc},
+                        {"accuracy_by_sequences", calibration_report_->accuracy}});
           paradigm_->modelTrained(true, "");
         } catch (const std::exception& error) {
           m.log->write("training_failed", time_, {{"reason", error.what()}});
@@ -487,7 +569,8 @@ void Session::handleParadigmEvents() {
         const int id = config_.world.objects[static_cast<size_t>(e.object - 1)].id;
         const auto state = vision_->world().object(id);
         if (!state) {
-          currentTrial().outcome = "object " + std::to_string(id) + " was never seen by the cameras";
+          currentTrial().outcome =
+              "object " + std::to_string(id) + " was never seen by the cameras";
           paradigm_->robotFinished(false, currentTrial().outcome);
           break;
         }
@@ -497,17 +580,25 @@ void Session::handleParadigmEvents() {
         m.robot_started_at = time_;
         m.robot_started_wall = std::chrono::steady_clock::now();
         m.robot_command_type = robot::MessageType::Grasp;
-        m.log->write("robot_command", time_, {{"command", "GRASP"}, {"object", id}, {"target", {p[0], p[1], p[2]}}, {"sequence", *m.robot_command}});
+        m.log->write("robot_command", time_,
+                     {{"command", "GRASP"},
+                      {"object", id},
+                      {"target", {p[0], p[1], p[2]}},
+                      {"sequence", *m.robot_command}});
         break;
       }
       case Kind::RobotDrop: {
         const cv::Vec3d p = gridLayout().cellCentre(e.cell.first, e.cell.second);
-        m.robot_command = client_->send(robot::MessageType::Drop, {p[0], p[1], config_.world.table_z});
+        m.robot_command =
+            client_->send(robot::MessageType::Drop, {p[0], p[1], config_.world.table_z});
         m.robot_started_at = time_;
         m.robot_started_wall = std::chrono::steady_clock::now();
         m.robot_command_type = robot::MessageType::Drop;
-        m.log->write("robot_command", time_, {{"command", "DROP"}, {"cell", {e.cell.first, e.cell.second}}, {"target", {p[0], p[1], config_.world.table_z}},
-                                              {"sequence", *m.robot_command}});
+        m.log->write("robot_command", time_,
+                     {{"command", "DROP"},
+                      {"cell", {e.cell.first, e.cell.second}},
+                      {"target", {p[0], p[1], config_.world.table_z}},
+                      {"sequence", *m.robot_command}});
         break;
       }
       case Kind::RobotStop:
@@ -526,7 +617,8 @@ void Session::decideIfReady() {
   const bci::Phase phase = paradigm_->phase();
   const bool online = phase == bci::Phase::ObjectFlashing || phase == bci::Phase::CellFlashing;
   // Dynamic stopping: certain enough after the minimum number of scored sequences.
-  if (online && eeg_->hasModel() && config_.paradigm.certainty > 0.0 && eeg_->scoredSequences() >= config_.paradigm.min_sequences &&
+  if (online && eeg_->hasModel() && config_.paradigm.certainty > 0.0 &&
+      eeg_->scoredSequences() >= config_.paradigm.min_sequences &&
       eeg_->decide().certainty >= config_.paradigm.certainty) {
     paradigm_->requestStopFlashing();
   }
@@ -538,7 +630,8 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
   render::HmdFrame frame;
   frame.left = {vision_->leftImage(), vision_->leftCamera(), vision_->T_cam_world_left()};
   frame.right = {vision_->rightImage(), vision_->rightCamera(), vision_->T_cam_world_right()};
-  const bool objects_phase = stimulus.phase == bci::Phase::ObjectFlashing || stimulus.phase == bci::Phase::CalibrationFlashing;
+  const bool objects_phase = stimulus.phase == bci::Phase::ObjectFlashing ||
+                             stimulus.phase == bci::Phase::CalibrationFlashing;
   const int holding = client_->status() ? client_->status()->holding : -1;
   for (size_t i = 0; i < config_.world.objects.size(); ++i) {
     const WorldObjectSettings& o = config_.world.objects[i];
@@ -550,7 +643,9 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
     h.side_m = o.marker_m;
     const int slot = static_cast<int>(i) + 1;
     if (objects_phase && stimulus.lit.count(slot)) h.state = render::HighlightState::Flashing;
-    if (stimulus.cued_object == slot) h.state = stimulus.lit.count(slot) ? render::HighlightState::Flashing : render::HighlightState::Cued;
+    if (stimulus.cued_object == slot)
+      h.state = stimulus.lit.count(slot) ? render::HighlightState::Flashing
+                                         : render::HighlightState::Cued;
     if (stimulus.selected_object == slot) h.state = render::HighlightState::Selected;
     if (holding == o.id) h.state = render::HighlightState::Held;
     frame.objects.push_back(h);
@@ -560,26 +655,33 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
     frame.grid = grid;
     if (stimulus.phase == bci::Phase::CellFlashing) {
       for (int code : stimulus.lit) {
-        if (code <= grid.rows) frame.grid_highlight.rows.insert(code);
-        else frame.grid_highlight.columns.insert(code - grid.rows);
+        if (code <= grid.rows)
+          frame.grid_highlight.rows.insert(code);
+        else
+          frame.grid_highlight.columns.insert(code - grid.rows);
       }
     }
     frame.grid_highlight.selected = stimulus.selected_cell;
   }
   // What this frame shows; unchanged, the framebuffer already holds it.
   std::ostringstream signature;
-  signature << static_cast<const void*>(frame.left.image.data) << static_cast<const void*>(frame.right.image.data);
+  signature << static_cast<const void*>(frame.left.image.data)
+            << static_cast<const void*>(frame.right.image.data);
   for (const auto* eye : {&frame.left, &frame.right}) {
-    if (eye->T_cam_world) signature << cv::Mat(eye->T_cam_world->rotation) << cv::Mat(eye->T_cam_world->translation);
+    if (eye->T_cam_world)
+      signature << cv::Mat(eye->T_cam_world->rotation) << cv::Mat(eye->T_cam_world->translation);
   }
   for (const render::ObjectHighlight& h : frame.objects) {
-    signature << h.id << static_cast<int>(h.state) << cv::Mat(h.T_world_top.rotation) << cv::Mat(h.T_world_top.translation);
+    signature << h.id << static_cast<int>(h.state) << cv::Mat(h.T_world_top.rotation)
+              << cv::Mat(h.T_world_top.translation);
   }
   if (frame.grid) {
     signature << "grid";
     for (int r : frame.grid_highlight.rows) signature << 'r' << r;
     for (int c : frame.grid_highlight.columns) signature << 'c' << c;
-    if (frame.grid_highlight.selected) signature << 's' << frame.grid_highlight.selected->first << frame.grid_highlight.selected->second;
+    if (frame.grid_highlight.selected)
+      signature << 's' << frame.grid_highlight.selected->first
+                << frame.grid_highlight.selected->second;
   }
   if (signature.str() != m.last_hmd_signature) {
     m.hmd->draw(frame, m.hmd_fbo->id(), m.hmd_fbo->size());
@@ -591,16 +693,23 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
   }
 }
 
-unsigned int Session::hmdTexture() const { return impl_->hmd_fbo->colorTexture(); }
+unsigned int Session::hmdTexture() const {
+  return impl_->hmd_fbo->colorTexture();
+}
 
-void Session::setThreshold(const vision::ThresholdSettings& settings) { vision_->detector().setThreshold(settings); }
+void Session::setThreshold(const vision::ThresholdSettings& settings) {
+  vision_->detector().setThreshold(settings);
+}
 
 void Session::setReference(int id, const cv::Vec3d& position) {
   vision_->setReference(id, config_.world.reference_size_m, position);
-  impl_->log->write("reference", time_, {{"id", id}, {"position", {position[0], position[1], position[2]}}});
+  impl_->log->write("reference", time_,
+                    {{"id", id}, {"position", {position[0], position[1], position[2]}}});
 }
 
-bool Session::canHoldBoard() const { return impl_->world != nullptr; }
+bool Session::canHoldBoard() const {
+  return impl_->world != nullptr;
+}
 
 void Session::holdBoard(bool show) {
   if (impl_->world) impl_->world->holdBoard(show, time_);
@@ -615,12 +724,19 @@ std::vector<std::string> Session::selectionLines() const {
   std::vector<std::string> lines;
   for (const TrialRecord& t : trials_) {
     std::string line = "trial " + std::to_string(t.trial) + ": object ";
-    line += t.selected_object >= 0 ? std::to_string(t.selected_object) + (t.selected_object == t.intended_object ? " (intended)" : " (not intended)") : "-";
+    line += t.selected_object >= 0
+                ? std::to_string(t.selected_object) +
+                      (t.selected_object == t.intended_object ? " (intended)" : " (not intended)")
+                : "-";
     line += ", cell ";
-    line += t.selected_cell.first > 0 ? std::to_string(t.selected_cell.first) + "," + std::to_string(t.selected_cell.second) +
-                                            (t.selected_cell == t.intended_cell ? " (intended)" : " (not intended)")
-                                      : "-";
-    if (t.placement_error_m >= 0.0) line += ", placed " + std::to_string(static_cast<int>(t.placement_error_m * 1000.0 + 0.5)) + " mm off";
+    line += t.selected_cell.first > 0
+                ? std::to_string(t.selected_cell.first) + "," +
+                      std::to_string(t.selected_cell.second) +
+                      (t.selected_cell == t.intended_cell ? " (intended)" : " (not intended)")
+                : "-";
+    if (t.placement_error_m >= 0.0)
+      line += ", placed " + std::to_string(static_cast<int>(t.placement_error_m * 1000.0 + 0.5)) +
+              " mm off";
     lines.push_back(line + " [" + t.outcome + "]");
   }
   return lines;
@@ -636,8 +752,10 @@ void Session::screenshot(const std::filesystem::path& path) {
 
 std::string Session::statusLine() const {
   char text[256];
-  std::snprintf(text, sizeof text, "t=%.1f s  trial %d/%d  %s  cycle p50 %.1f ms  overruns %d", time_, std::max(paradigm_->trial(), 0),
-                config_.paradigm.trials, bci::toString(paradigm_->phase()), timing_.totalPercentiles().p50, timing_.overruns());
+  std::snprintf(text, sizeof text, "t=%.1f s  trial %d/%d  %s  cycle p50 %.1f ms  overruns %d",
+                time_, std::max(paradigm_->trial(), 0), config_.paradigm.trials,
+                bci::toString(paradigm_->phase()), timing_.totalPercentiles().p50,
+                timing_.overruns());
   return text;
 }
 
@@ -651,7 +769,8 @@ void Session::endRun(const std::string& reason) {
   m.images.flush();
   m.log->write("session_ended", time_, {{"reason", reason}});
   std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
-  if (options_.progress) *options_.progress << "\r" << statusLine() << "\nsession ended: " << reason << "\n";
+  if (options_.progress)
+    *options_.progress << "\r" << statusLine() << "\nsession ended: " << reason << "\n";
 }
 
 nlohmann::json Session::summary() const {
@@ -659,17 +778,20 @@ nlohmann::json Session::summary() const {
   int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0;
   double object_flashes = 0, cell_flashes = 0;
   for (const TrialRecord& t : trials_) {
-    nlohmann::json j = {{"trial", t.trial},
-                        {"intended_object", t.intended_object},
-                        {"selected_object", t.selected_object},
-                        {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
-                        {"selected_cell", {t.selected_cell.first, t.selected_cell.second}},
-                        {"object_flashes", t.object_flashes},
-                        {"cell_flashes", t.cell_flashes},
-                        {"object_selection_s", t.object_flashes * config_.paradigm.onsetFrames() / config_.display_hz},
-                        {"cell_selection_s", t.cell_flashes * config_.paradigm.onsetFrames() / config_.display_hz},
-                        {"outcome", t.outcome}};
-    j["placement_error_m"] = t.placement_error_m >= 0.0 ? nlohmann::json(t.placement_error_m) : nlohmann::json(nullptr);
+    nlohmann::json j = {
+        {"trial", t.trial},
+        {"intended_object", t.intended_object},
+        {"selected_object", t.selected_object},
+        {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
+        {"selected_cell", {t.selected_cell.first, t.selected_cell.second}},
+        {"object_flashes", t.object_flashes},
+        {"cell_flashes", t.cell_flashes},
+        {"object_selection_s",
+         t.object_flashes * config_.paradigm.onsetFrames() / config_.display_hz},
+        {"cell_selection_s", t.cell_flashes * config_.paradigm.onsetFrames() / config_.display_hz},
+        {"outcome", t.outcome}};
+    j["placement_error_m"] =
+        t.placement_error_m >= 0.0 ? nlohmann::json(t.placement_error_m) : nlohmann::json(nullptr);
     trials.push_back(j);
     if (t.selected_object >= 0) {
       ++objects_made;
@@ -686,9 +808,11 @@ nlohmann::json Session::summary() const {
   auto rate = [&](int choices, int right, int made, double flashes) {
     if (made == 0) return nlohmann::json(nullptr);
     const double seconds = flashes / made * soa;
-    return nlohmann::json{{"accuracy", static_cast<double>(right) / made},
-                          {"seconds_per_selection", seconds},
-                          {"bits_per_minute", bci::wolpawBits(choices, static_cast<double>(right) / made) * 60.0 / seconds}};
+    return nlohmann::json{
+        {"accuracy", static_cast<double>(right) / made},
+        {"seconds_per_selection", seconds},
+        {"bits_per_minute",
+         bci::wolpawBits(choices, static_cast<double>(right) / made) * 60.0 / seconds}};
   };
   nlohmann::json out = {
       {"session", config_.source},
@@ -697,14 +821,21 @@ nlohmann::json Session::summary() const {
       {"duration_s", time_},
       {"frames", frame_},
       {"trials", trials},
-      {"objects", rate(static_cast<int>(config_.world.objects.size()), objects_right, objects_made, object_flashes)},
-      {"cells", rate(config_.world.grid.rows * config_.world.grid.columns, cells_right, cells_made, cell_flashes)},
+      {"objects", rate(static_cast<int>(config_.world.objects.size()), objects_right, objects_made,
+                       object_flashes)},
+      {"cells", rate(config_.world.grid.rows * config_.world.grid.columns, cells_right, cells_made,
+                     cell_flashes)},
       {"cycle", timing_.toJson()},
       {"overruns", timing_.overruns()},
-      {"eeg", {{"recording", "recording.bdf"}, {"samples", eeg_->samplesRecorded()}, {"lost_samples", eeg_->lostSamples()}, {"missed_epochs", eeg_->missedEpochs()}}},
+      {"eeg",
+       {{"recording", "recording.bdf"},
+        {"samples", eeg_->samplesRecorded()},
+        {"lost_samples", eeg_->lostSamples()},
+        {"missed_epochs", eeg_->missedEpochs()}}},
   };
   if (calibration_report_) {
-    out["calibration"] = {{"selections", calibration_report_->selections.size()}, {"auc", calibration_report_->auc},
+    out["calibration"] = {{"selections", calibration_report_->selections.size()},
+                          {"auc", calibration_report_->auc},
                           {"accuracy_by_sequences", calibration_report_->accuracy}};
   }
   return out;

@@ -15,13 +15,16 @@ using Json = nlohmann::json;
 // One object of the file with its dotted path, for messages.
 class Section {
  public:
-  Section(const Json& json, std::string path, std::string file) : json_(json), path_(std::move(path)), file_(std::move(file)) {
+  Section(const Json& json, std::string path, std::string file)
+      : json_(json), path_(std::move(path)), file_(std::move(file)) {
     if (!json_.is_object()) fail("", "must be an object");
   }
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw SessionConfigError(file_ + ": " + name(key) + " " + what);
   }
-  std::string name(const std::string& key) const { return path_.empty() ? key : key.empty() ? path_ : path_ + "." + key; }
+  std::string name(const std::string& key) const {
+    return path_.empty() ? key : key.empty() ? path_ : path_ + "." + key;
+  }
   bool has(const std::string& key) const { return json_.contains(key); }
   const Json& at(const std::string& key) const { return json_.at(key); }
   Section section(const std::string& key) const {
@@ -42,14 +45,17 @@ class Section {
     if (!has(key)) return fallback;
     if (!at(key).is_number()) fail(key, "= " + at(key).dump() + " must be a number");
     const double v = at(key).get<double>();
-    if (!(v >= low && v <= high)) fail(key, "= " + at(key).dump() + " must lie in [" + fmt(low) + ", " + fmt(high) + "]");
+    if (!(v >= low && v <= high))
+      fail(key, "= " + at(key).dump() + " must lie in [" + fmt(low) + ", " + fmt(high) + "]");
     return v;
   }
   int integer(const std::string& key, int fallback, int low, int high) const {
     if (!has(key)) return fallback;
     if (!at(key).is_number_integer()) fail(key, "= " + at(key).dump() + " must be an integer");
     const int v = at(key).get<int>();
-    if (v < low || v > high) fail(key, "= " + std::to_string(v) + " must lie in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
+    if (v < low || v > high)
+      fail(key, "= " + std::to_string(v) + " must lie in [" + std::to_string(low) + ", " +
+                    std::to_string(high) + "]");
     return v;
   }
   bool boolean(const std::string& key, bool fallback) const {
@@ -57,7 +63,8 @@ class Section {
     if (!at(key).is_boolean()) fail(key, "= " + at(key).dump() + " must be true or false");
     return at(key).get<bool>();
   }
-  std::string text(const std::string& key, const std::string& fallback, std::initializer_list<const char*> allowed = {}) const {
+  std::string text(const std::string& key, const std::string& fallback,
+                   std::initializer_list<const char*> allowed = {}) const {
     if (!has(key)) return fallback;
     if (!at(key).is_string()) fail(key, "= " + at(key).dump() + " must be a string");
     const std::string v = at(key).get<std::string>();
@@ -72,7 +79,8 @@ class Section {
     }
     return v;
   }
-  std::vector<double> numbers(const std::string& key, const std::vector<double>& fallback, size_t min_size, size_t max_size) const {
+  std::vector<double> numbers(const std::string& key, const std::vector<double>& fallback,
+                              size_t min_size, size_t max_size) const {
     if (!has(key)) return fallback;
     const Json& j = at(key);
     if (!j.is_array() || j.size() < min_size || j.size() > max_size) {
@@ -107,8 +115,9 @@ class Section {
 };
 
 void parseCameras(const Section& s, CameraSettings& c) {
-  s.known({"source", "rate_hz", "width", "height", "focal_px", "distortion", "baseline_m", "head_position", "look_at", "head_motion_m",
-           "head_motion_deg", "noise", "blur_px", "left", "right", "stereo_calibration"});
+  s.known({"source", "rate_hz", "width", "height", "focal_px", "distortion", "baseline_m",
+           "head_position", "look_at", "head_motion_m", "head_motion_deg", "noise", "blur_px",
+           "left", "right", "stereo_calibration"});
   c.source = s.text("source", c.source, {"simulated", "devices"});
   c.rate_hz = s.number("rate_hz", c.rate_hz, 1.0, 240.0);
   c.width = s.integer("width", c.width, 64, 4096);
@@ -131,10 +140,13 @@ void parseCameras(const Section& s, CameraSettings& c) {
     source.device = cam.integer("device", -1, -1, 63);
     source.video = cam.text("video", "");
     source.calibration = cam.text("calibration", "");
-    if (source.device < 0 && source.video.empty()) cam.fail("", "needs a device number or a video file");
-    if (source.calibration.empty()) cam.fail("calibration", "is required: the camera's calibration file (arbci calibrate)");
+    if (source.device < 0 && source.video.empty())
+      cam.fail("", "needs a device number or a video file");
+    if (source.calibration.empty())
+      cam.fail("calibration", "is required: the camera's calibration file (arbci calibrate)");
   }
-  if (c.source == "devices" && c.left.device < 0 && c.left.video.empty()) s.fail("left", "is required when source is \"devices\"");
+  if (c.source == "devices" && c.left.device < 0 && c.left.video.empty())
+    s.fail("left", "is required when source is \"devices\"");
 }
 
 void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
@@ -146,7 +158,8 @@ void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
   w.reference_size_m = ref.number("size_m", w.reference_size_m, 0.005, 1.0);
   w.reference_position = ref.vec3("position", w.reference_position);
   if (s.has("objects")) {
-    if (!s.at("objects").is_array() || s.at("objects").empty()) s.fail("objects", "must be a non-empty list");
+    if (!s.at("objects").is_array() || s.at("objects").empty())
+      s.fail("objects", "must be a non-empty list");
     w.objects.clear();
     for (size_t i = 0; i < s.at("objects").size(); ++i) {
       const Section o(s.at("objects")[i], s.name("objects") + "[" + std::to_string(i) + "]", file);
@@ -154,15 +167,18 @@ void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
       WorldObjectSettings object;
       object.id = o.integer("id", -1, 0, 4095);
       if (object.id < 0) o.fail("id", "is required (the object's marker id)");
-      if (object.id == w.reference_id) o.fail("id", "= " + std::to_string(object.id) + " is the reference marker's id");
-      if (!o.has("position")) o.fail("position", "is required: [x, y, z] of the top centre in metres");
+      if (object.id == w.reference_id)
+        o.fail("id", "= " + std::to_string(object.id) + " is the reference marker's id");
+      if (!o.has("position"))
+        o.fail("position", "is required: [x, y, z] of the top centre in metres");
       object.position = o.vec3("position", {});
       object.marker_m = o.number("marker_m", object.marker_m, 0.005, 0.5);
       object.width_m = o.number("width_m", object.width_m, object.marker_m, 0.6);
       object.height_m = o.number("height_m", object.height_m, 0.005, 0.6);
       object.color = o.vec3("color", object.color);
       for (const auto& other : w.objects) {
-        if (other.id == object.id) o.fail("id", "= " + std::to_string(object.id) + " is used twice");
+        if (other.id == object.id)
+          o.fail("id", "= " + std::to_string(object.id) + " is used twice");
       }
       w.objects.push_back(object);
     }
@@ -178,7 +194,8 @@ void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
 
 void parse(const Json& json, const std::string& file, SessionConfig& c) {
   const Section root(json, "", file);
-  root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "paradigm", "classifier", "robot"});
+  root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "paradigm",
+              "classifier", "robot"});
   c.display_hz = root.number("display_hz", c.display_hz, 10.0, 500.0);
   const Section hmd = root.section("hmd");
   hmd.known({"width", "height", "undistort", "mirror_monitor"});
@@ -198,9 +215,11 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   const Section eeg = root.section("eeg");
   eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale", "file"});
   c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file"});
-  c.eeg.seed = static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
+  c.eeg.seed =
+      static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
   if (eeg.has("montage")) {
-    if (!eeg.at("montage").is_array() || eeg.at("montage").empty()) eeg.fail("montage", "must be a list of channel names");
+    if (!eeg.at("montage").is_array() || eeg.at("montage").empty())
+      eeg.fail("montage", "must be a list of channel names");
     c.eeg.montage = eeg.at("montage").get<std::vector<std::string>>();
   }
   c.eeg.rate_hz = eeg.number("rate_hz", c.eeg.rate_hz, 64.0, 4096.0);
@@ -208,11 +227,13 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   c.eeg.line_hz = eeg.number("line_hz", c.eeg.line_hz, 0.0, 70.0);
   c.eeg.erp_scale = eeg.number("erp_scale", c.eeg.erp_scale, 0.0, 10.0);
   c.eeg.file = eeg.text("file", c.eeg.file);
-  if (c.eeg.source == "file" && c.eeg.file.empty()) eeg.fail("file", "is required when source is \"file\"");
+  if (c.eeg.source == "file" && c.eeg.file.empty())
+    eeg.fail("file", "is required when source is \"file\"");
 
   const Section p = root.section("paradigm");
-  p.known({"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "calibration_selections", "calibration_sequences", "trials",
-           "intended", "cue_s", "result_s", "pause_s"});
+  p.known({"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty",
+           "calibration_selections", "calibration_sequences", "trials", "intended", "cue_s",
+           "result_s", "pause_s"});
   bci::ParadigmSettings& ps = c.paradigm;
   ps.display_hz = c.display_hz;
   ps.flash_ms = p.number("flash_ms", 60.0, 5.0, 2000.0);
@@ -227,27 +248,33 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   ps.result_s = p.number("result_s", 1.0, 0.0, 60.0);
   ps.pause_s = p.number("pause_s", 1.0, 0.0, 60.0);
   if (p.has("intended")) {
-    if (!p.at("intended").is_array()) p.fail("intended", "must be a list of {\"object\": id, \"cell\": [row, column]}");
+    if (!p.at("intended").is_array())
+      p.fail("intended", "must be a list of {\"object\": id, \"cell\": [row, column]}");
     c.intended.clear();
     for (size_t i = 0; i < p.at("intended").size(); ++i) {
-      const Section t(p.at("intended")[i], p.name("intended") + "[" + std::to_string(i) + "]", file);
+      const Section t(p.at("intended")[i], p.name("intended") + "[" + std::to_string(i) + "]",
+                      file);
       t.known({"object", "cell"});
       TrialIntent intent;
       intent.object = t.integer("object", -1, 0, 4095);
       bool known_object = false;
       for (const auto& o : c.world.objects) known_object |= o.id == intent.object;
-      if (!known_object) t.fail("object", "= " + std::to_string(intent.object) + " is not one of world.objects");
+      if (!known_object)
+        t.fail("object", "= " + std::to_string(intent.object) + " is not one of world.objects");
       const auto cell = t.numbers("cell", {1, 1}, 2, 2);
       intent.row = static_cast<int>(cell[0]);
       intent.column = static_cast<int>(cell[1]);
-      if (intent.row < 1 || intent.row > c.world.grid.rows || intent.column < 1 || intent.column > c.world.grid.columns) {
-        t.fail("cell", "lies outside the " + std::to_string(c.world.grid.rows) + "x" + std::to_string(c.world.grid.columns) + " grid");
+      if (intent.row < 1 || intent.row > c.world.grid.rows || intent.column < 1 ||
+          intent.column > c.world.grid.columns) {
+        t.fail("cell", "lies outside the " + std::to_string(c.world.grid.rows) + "x" +
+                           std::to_string(c.world.grid.columns) + " grid");
       }
       c.intended.push_back(intent);
     }
   }
   const Section cl = root.section("classifier");
-  cl.known({"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz", "notch_hz", "model"});
+  cl.known(
+      {"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz", "notch_hz", "model"});
   c.classifier_method = cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn"});
   const auto window = cl.numbers("window_ms", {0, 800}, 2, 2);
   if (!(window[1] > window[0])) cl.fail("window_ms", "must end after it starts");
@@ -265,7 +292,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   c.robot_host = r.text("host", c.robot_host);
   c.robot_port = r.integer("port", c.robot_port, 1, 65535);
   c.robot_key_file = r.text("key_file", c.robot_key_file);
-  if (c.robot_backend == "remote" && c.robot_key_file.empty()) r.fail("key_file", "is required for a remote robot");
+  if (c.robot_backend == "remote" && c.robot_key_file.empty())
+    r.fail("key_file", "is required for a remote robot");
 }
 
 }  // namespace
@@ -290,13 +318,15 @@ SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& pa
 
 void SessionConfig::checkResources() const {
   auto exists = [&](const std::string& key, const std::string& file) {
-    if (!file.empty() && !std::filesystem::exists(file)) throw SessionConfigError(source + ": " + key + " = \"" + file + "\": no such file");
+    if (!file.empty() && !std::filesystem::exists(file))
+      throw SessionConfigError(source + ": " + key + " = \"" + file + "\": no such file");
   };
   exists("eeg.file", eeg.file);
   exists("classifier.model", model_file);
   exists("robot.key_file", robot_key_file);
   exists("cameras.stereo_calibration", cameras.stereo_calibration);
-  for (const auto& [side, cam] : {std::pair{"cameras.left", &cameras.left}, std::pair{"cameras.right", &cameras.right}}) {
+  for (const auto& [side, cam] :
+       {std::pair{"cameras.left", &cameras.left}, std::pair{"cameras.right", &cameras.right}}) {
     exists(std::string(side) + ".video", cam->video);
     exists(std::string(side) + ".calibration", cam->calibration);
     if (!cam->calibration.empty()) {
@@ -307,8 +337,8 @@ void SessionConfig::checkResources() const {
       }
     }
     if (cam->device >= 0 && !std::filesystem::exists("/dev/video" + std::to_string(cam->device))) {
-      throw SessionConfigError(source + ": " + side + ".device = " + std::to_string(cam->device) + ": /dev/video" +
-                               std::to_string(cam->device) + " does not exist");
+      throw SessionConfigError(source + ": " + side + ".device = " + std::to_string(cam->device) +
+                               ": /dev/video" + std::to_string(cam->device) + " does not exist");
     }
   }
 }

@@ -23,9 +23,9 @@ class SessionConfigError : public std::runtime_error {
 };
 
 struct CameraSource {
-  int device = -1;         // V4L2 index, or
-  std::string video;       // a video file
-  std::string calibration; // its calibration file (OpenCV YAML/XML)
+  int device = -1;          // V4L2 index, or
+  std::string video;        // a video file
+  std::string calibration;  // its calibration file (OpenCV YAML/XML)
 };
 
 struct CameraSettings {
@@ -41,12 +41,12 @@ struct CameraSettings {
   double head_motion_m = 0.008, head_motion_deg = 0.6;
   double noise = 2.0, blur_px = 0.5;
   // Real cameras.
-  CameraSource left, right;  // right.device < 0 and right.video empty: mono (feeds both eyes)
+  CameraSource left, right;        // right.device < 0 and right.video empty: mono (feeds both eyes)
   std::string stereo_calibration;  // optional: the right camera's pose in the left's frame
 };
 
 struct WorldObjectSettings {
-  int id = 0;  // its marker's BCH id
+  int id = 0;          // its marker's BCH id
   cv::Vec3d position;  // top centre, robot frame
   double marker_m = 0.05, width_m = 0.07, height_m = 0.06;
   cv::Vec3d color{0.8, 0.4, 0.3};
@@ -98,7 +98,7 @@ struct SessionConfig {
   std::vector<TrialIntent> intended;
   std::string classifier_method = "slda";
   bci::PipelineSettings pipeline;
-  std::string model_file;  // a trained model: no calibration run
+  std::string model_file;                   // a trained model: no calibration run
   std::string robot_backend = "simulated";  // "simulated" (arbci-robotd here) or "remote"
   double robot_speed_factor = 8.0;
   std::string robot_host = "127.0.0.1";

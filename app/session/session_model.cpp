@@ -10,7 +10,8 @@ void SessionModel::setThreshold(const vision::ThresholdSettings& settings) {
 std::vector<ui::TrackedObject> SessionModel::trackedObjects() {
   std::vector<ui::TrackedObject> out;
   for (const vision::ObjectState& o : session_.vision().world().objects()) {
-    out.push_back({o.id, o.T_robot_object.translation, o.age(session_.time()), o.reprojection_rms_px});
+    out.push_back(
+        {o.id, o.T_robot_object.translation, o.age(session_.time()), o.reprojection_rms_px});
   }
   return out;
 }
@@ -29,7 +30,8 @@ std::vector<ui::StageTiming> SessionModel::timing() {
     out.push_back({stage, p.p50, p.p90, p.p99, p.max, found == last.end() ? 0.0 : found->second});
   }
   const Percentiles total = session_.timing().totalPercentiles();
-  out.push_back({"total", total.p50, total.p90, total.p99, total.max, session_.timing().lastTotalMs()});
+  out.push_back(
+      {"total", total.p50, total.p90, total.p99, total.max, session_.timing().lastTotalMs()});
   return out;
 }
 

@@ -22,8 +22,12 @@ class SessionModel final : public ui::WorkstationModel {
   bool canHoldBoard() override { return session_.canHoldBoard(); }
   void holdBoard(bool show) override { session_.holdBoard(show); }
   int referenceId() override { return session_.vision().world().reference().id; }
-  cv::Vec3d referencePosition() override { return session_.vision().world().reference().T_robot_ref.translation; }
-  void setReference(int id, const cv::Vec3d& position) override { session_.setReference(id, position); }
+  cv::Vec3d referencePosition() override {
+    return session_.vision().world().reference().T_robot_ref.translation;
+  }
+  void setReference(int id, const cv::Vec3d& position) override {
+    session_.setReference(id, position);
+  }
 
   std::optional<bci::P300Model> model() override { return session_.eeg().model(); }
   void useModel(const bci::P300Model& model) override { session_.useModel(model); }

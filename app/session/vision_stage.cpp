@@ -12,7 +12,8 @@ vision::DetectorConfig detectorFor(const SessionConfig& config, const vision::Ca
   vision::DetectorConfig d;
   d.kind = vision::markerKindFromString(config.tracker_kind);
   d.border = config.tracker_border;
-  if (!camera.distortion.empty()) d.lens = std::make_shared<vision::Undistorter>(camera, vision::UndistortMode::LookupTable);
+  if (!camera.distortion.empty())
+    d.lens = std::make_shared<vision::Undistorter>(camera, vision::UndistortMode::LookupTable);
   return d;
 }
 
@@ -26,9 +27,15 @@ vision::ReferenceMarker referenceOf(const SessionConfig& config) {
 
 }  // namespace
 
-VisionStage::VisionStage(const SessionConfig& config, const vision::CameraModel& left, const vision::CameraModel& right,
-                         const vision::Pose& T_right_left)
-    : config_(config), reference_id_(config.world.reference_id), reference_size_m_(config.world.reference_size_m), left_camera_(left), right_camera_(right), T_right_left_(T_right_left), detector_(detectorFor(config, left)),
+VisionStage::VisionStage(const SessionConfig& config, const vision::CameraModel& left,
+                         const vision::CameraModel& right, const vision::Pose& T_right_left)
+    : config_(config),
+      reference_id_(config.world.reference_id),
+      reference_size_m_(config.world.reference_size_m),
+      left_camera_(left),
+      right_camera_(right),
+      T_right_left_(T_right_left),
+      detector_(detectorFor(config, left)),
       world_(referenceOf(config)) {}
 
 void VisionStage::setReference(int id, double size_m, const cv::Vec3d& position) {
@@ -66,7 +73,8 @@ void VisionStage::process(double t, const cv::Mat& left, const cv::Mat& right) {
     const auto previous = previous_.find(m.id);
     if (previous != previous_.end()) options.previous = previous->second;
     try {
-      const vision::PoseEstimate estimate = vision::estimatePose(object, image, left_camera_.camera_matrix, options);
+      const vision::PoseEstimate estimate =
+          vision::estimatePose(object, image, left_camera_.camera_matrix, options);
       poses[m.id] = estimate;
       previous_[m.id] = estimate.pose;
     } catch (const std::exception&) {
@@ -77,7 +85,9 @@ void VisionStage::process(double t, const cv::Mat& left, const cv::Mat& right) {
   last_poses_ = std::move(poses);
 }
 
-void VisionStage::repeat(double t) { world_.update(t, last_poses_); }
+void VisionStage::repeat(double t) {
+  world_.update(t, last_poses_);
+}
 
 std::optional<vision::Pose> VisionStage::T_cam_world_left() const {
   const auto T_robot_cam = world_.T_robot_cam();

@@ -14,8 +14,8 @@ namespace arbci::app {
 
 class VisionStage {
  public:
-  VisionStage(const SessionConfig& config, const vision::CameraModel& left, const vision::CameraModel& right,
-              const vision::Pose& T_right_left);
+  VisionStage(const SessionConfig& config, const vision::CameraModel& left,
+              const vision::CameraModel& right, const vision::Pose& T_right_left);
 
   // A new pair of frames at time `t` (seconds); the right one may be empty (mono).
   void process(double t, const cv::Mat& left, const cv::Mat& right);
@@ -28,7 +28,9 @@ class VisionStage {
   const cv::Mat& rightImage() const { return right_image_.empty() ? left_image_ : right_image_; }
   bool stereo() const { return !right_image_.empty(); }
   const vision::CameraModel& leftCamera() const { return left_camera_; }
-  const vision::CameraModel& rightCamera() const { return right_image_.empty() ? left_camera_ : right_camera_; }
+  const vision::CameraModel& rightCamera() const {
+    return right_image_.empty() ? left_camera_ : right_camera_;
+  }
   std::optional<vision::Pose> T_cam_world_left() const;
   std::optional<vision::Pose> T_cam_world_right() const;
   const vision::WorldModel& world() const { return world_; }

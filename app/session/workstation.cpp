@@ -18,13 +18,17 @@ namespace arbci::app {
 namespace {
 
 std::atomic<bool> close_requested{false};
-void onSignal(int) { close_requested = true; }
+void onSignal(int) {
+  close_requested = true;
+}
 
 // Where the panel layout is kept between runs.
 std::string layoutFile() {
   const char* config = std::getenv("XDG_CONFIG_HOME");
   const char* home = std::getenv("HOME");
-  std::filesystem::path dir = config ? std::filesystem::path(config) : home ? std::filesystem::path(home) / ".config" : ".";
+  std::filesystem::path dir = config ? std::filesystem::path(config)
+                              : home ? std::filesystem::path(home) / ".config"
+                                     : ".";
   dir /= "arbci";
   std::error_code error;
   std::filesystem::create_directories(dir, error);
@@ -55,7 +59,8 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
   ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;
   ui::SessionPanel session_panel(model);
-  ui::HmdPanel hmd_panel(session.hmdTexture(), static_cast<float>(config.hmd_width) / config.hmd_height);
+  ui::HmdPanel hmd_panel(session.hmdTexture(),
+                         static_cast<float>(config.hmd_width) / config.hmd_height);
   ui::ThresholdPanel threshold_panel(model);
   ui::RobotPanel robot_panel(model);
   ui::CalibrationPanel calibration_panel(model);

@@ -5,12 +5,15 @@
 namespace arbci::app {
 namespace {
 // Rounded to 1 / scale (scale 1000: three decimals) so that JSON prints short numbers.
-double rounded(double value, double scale) { return std::round(value * scale) / scale; }
+double rounded(double value, double scale) {
+  return std::round(value * scale) / scale;
+}
 }  // namespace
 
 nlohmann::json markerJson(const vision::MarkerDetection& marker) {
   nlohmann::json corners = nlohmann::json::array();
-  for (const cv::Point2f& p : marker.corners) corners.push_back({rounded(p.x, 1000), rounded(p.y, 1000)});
+  for (const cv::Point2f& p : marker.corners)
+    corners.push_back({rounded(p.x, 1000), rounded(p.y, 1000)});
   nlohmann::json out{{"id", marker.id},
                      {"kind", vision::toString(marker.kind)},
                      {"corners", corners},
@@ -23,8 +26,8 @@ nlohmann::json markerJson(const vision::MarkerDetection& marker) {
 
 nlohmann::json stageTimesJson(const vision::StageTimes& t) {
   auto us = [](double value) { return rounded(value, 10); };
-  return {{"total", us(t.total)},   {"convert", us(t.convert)}, {"smooth", us(t.smooth)},
-          {"threshold", us(t.threshold)}, {"label", us(t.label)}, {"quads", us(t.quads)},
+  return {{"total", us(t.total)},         {"convert", us(t.convert)}, {"smooth", us(t.smooth)},
+          {"threshold", us(t.threshold)}, {"label", us(t.label)},     {"quads", us(t.quads)},
           {"decode", us(t.decode)}};
 }
 

@@ -19,11 +19,12 @@ Frame readRaw(const std::string& path, const RawFormat& raw) {
     frame.error = "cannot read " + path + ": " + error.message();
     return frame;
   }
-  const auto expected = static_cast<std::uintmax_t>(raw.width) * raw.height * vision::bytesPerPixel(raw.format);
+  const auto expected =
+      static_cast<std::uintmax_t>(raw.width) * raw.height * vision::bytesPerPixel(raw.format);
   if (size != expected) {
-    frame.error = path + ": a " + std::to_string(raw.width) + "x" + std::to_string(raw.height) + " " +
-                  vision::toString(raw.format) + " raw image has " + std::to_string(expected) +
-                  " bytes, the file has " + std::to_string(size);
+    frame.error = path + ": a " + std::to_string(raw.width) + "x" + std::to_string(raw.height) +
+                  " " + vision::toString(raw.format) + " raw image has " +
+                  std::to_string(expected) + " bytes, the file has " + std::to_string(size);
     return frame;
   }
   std::vector<std::uint8_t> bytes(static_cast<size_t>(size));
@@ -34,14 +35,16 @@ Frame readRaw(const std::string& path, const RawFormat& raw) {
     return frame;
   }
   const vision::ImageView view{bytes.data(), raw.width, raw.height,
-                               static_cast<size_t>(raw.width) * vision::bytesPerPixel(raw.format), raw.format};
+                               static_cast<size_t>(raw.width) * vision::bytesPerPixel(raw.format),
+                               raw.format};
   vision::toLuminance(view, frame.image);
   return frame;
 }
 
 class ImageFiles final : public FrameSource {
  public:
-  ImageFiles(std::vector<std::string> paths, std::optional<RawFormat> raw) : paths_(std::move(paths)), raw_(raw) {}
+  ImageFiles(std::vector<std::string> paths, std::optional<RawFormat> raw)
+      : paths_(std::move(paths)), raw_(raw) {}
   std::optional<Frame> next() override {
     if (index_ >= paths_.size()) return std::nullopt;
     const std::string& path = paths_[index_++];
@@ -63,7 +66,8 @@ class ImageFiles final : public FrameSource {
       frame.image.convertTo(frame.image, CV_8U, frame.image.depth() == CV_16U ? 1.0 / 257.0 : 1.0);
     }
     if (frame.image.channels() == 2) frame.image = cv::Mat();  // grey + alpha is rare: reject
-    if (frame.error.empty() && frame.image.empty()) frame.error = path + ": unsupported channel layout";
+    if (frame.error.empty() && frame.image.empty())
+      frame.error = path + ": unsupported channel layout";
     return frame;
   }
 
@@ -75,7 +79,8 @@ class ImageFiles final : public FrameSource {
 
 class Capture final : public FrameSource {
  public:
-  Capture(cv::VideoCapture capture, int max_frames) : capture_(std::move(capture)), max_frames_(max_frames) {}
+  Capture(cv::VideoCapture capture, int max_frames)
+      : capture_(std::move(capture)), max_frames_(max_frames) {}
   std::optional<Frame> next() override {
     if (max_frames_ > 0 && index_ >= max_frames_) return std::nullopt;
     Frame frame{std::to_string(index_), {}, {}};
@@ -96,8 +101,8 @@ RawFormat parseRawFormat(const std::string& text) {
   RawFormat raw;
   char separator = 0;
   std::istringstream in(text);
-  if (!(in >> raw.width >> separator >> raw.height) || separator != 'x' || raw.width <= 0 || raw.height <= 0 ||
-      raw.width > 32768 || raw.height > 32768) {
+  if (!(in >> raw.width >> separator >> raw.height) || separator != 'x' || raw.width <= 0 ||
+      raw.height <= 0 || raw.width > 32768 || raw.height > 32768) {
     throw CliError("--raw must be WIDTHxHEIGHT[:FORMAT], got '" + text + "'");
   }
   std::string rest;
@@ -113,14 +118,17 @@ RawFormat parseRawFormat(const std::string& text) {
   return raw;
 }
 
-std::unique_ptr<FrameSource> imageFiles(std::vector<std::string> paths, std::optional<RawFormat> raw) {
+std::unique_ptr<FrameSource> imageFiles(std::vector<std::string> paths,
+                                        std::optional<RawFormat> raw) {
   return std::make_unique<ImageFiles>(std::move(paths), raw);
 }
 
 std::unique_ptr<FrameSource> videoFile(const std::string& path, int max_frames) {
-  if (!std::filesystem::is_regular_file(path)) throw CliError("cannot open video " + path + ": no such file");
+  if (!std::filesystem::is_regular_file(path))
+    throw CliError("cannot open video " + path + ": no such file");
   cv::VideoCapture capture(path);
-  if (!capture.isOpened()) throw CliError("cannot open video " + path + " (unknown format or codec)");
+  if (!capture.isOpened())
+    throw CliError("cannot open video " + path + " (unknown format or codec)");
   return std::make_unique<Capture>(std::move(capture), max_frames);
 }
 

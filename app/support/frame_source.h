@@ -34,7 +34,8 @@ class FrameSource {
   virtual std::optional<Frame> next() = 0;
 };
 
-std::unique_ptr<FrameSource> imageFiles(std::vector<std::string> paths, std::optional<RawFormat> raw);
+std::unique_ptr<FrameSource> imageFiles(std::vector<std::string> paths,
+                                        std::optional<RawFormat> raw);
 std::unique_ptr<FrameSource> videoFile(const std::string& path, int max_frames);
 std::unique_ptr<FrameSource> camera(int device, int max_frames);
 

@@ -34,7 +34,8 @@ std::vector<int> parseIdList(const std::string& text, int max_id) {
       ids.push_back(parseId(part, max_id));
       continue;
     }
-    const int first = parseId(part.substr(0, dash), max_id), last = parseId(part.substr(dash + 1), max_id);
+    const int first = parseId(part.substr(0, dash), max_id),
+              last = parseId(part.substr(dash + 1), max_id);
     if (last < first) throw CliError("id range " + part + " runs backwards");
     for (int id = first; id <= last; ++id) ids.push_back(id);
   }

@@ -15,7 +15,8 @@ namespace arbci::app {
 namespace {
 
 void putBigEndian(std::vector<std::uint8_t>& out, std::uint32_t value) {
-  for (int shift = 24; shift >= 0; shift -= 8) out.push_back(static_cast<std::uint8_t>(value >> shift));
+  for (int shift = 24; shift >= 0; shift -= 8)
+    out.push_back(static_cast<std::uint8_t>(value >> shift));
 }
 
 // A pHYs chunk (pixels per metre, both axes) inserted right after the IHDR chunk.
@@ -48,13 +49,15 @@ void writePng(const std::filesystem::path& path, const render::RgbaImage& image)
 void writePng(const std::filesystem::path& path, const cv::Mat& image, int dpi) {
   std::vector<std::uint8_t> encoded;
   try {
-    if (!cv::imencode(".png", image, encoded)) throw CliError("cannot encode " + path.string() + " as PNG");
+    if (!cv::imencode(".png", image, encoded))
+      throw CliError("cannot encode " + path.string() + " as PNG");
   } catch (const cv::Exception& error) {
     throw CliError("cannot encode " + path.string() + " as PNG: " + error.err);
   }
   if (dpi > 0) encoded = withResolution(encoded, dpi);
   std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(encoded.data()), static_cast<std::streamsize>(encoded.size()));
+  out.write(reinterpret_cast<const char*>(encoded.data()),
+            static_cast<std::streamsize>(encoded.size()));
   out.close();
   if (!out) throw CliError("cannot write " + path.string() + ": " + std::strerror(errno));
 }

@@ -26,7 +26,8 @@ struct StateField {
 std::string urlDecode(const std::string& text) {
   std::string out;
   for (size_t i = 0; i < text.size(); ++i) {
-    if (text[i] == '%' && i + 2 < text.size() && std::isxdigit(static_cast<unsigned char>(text[i + 1])) &&
+    if (text[i] == '%' && i + 2 < text.size() &&
+        std::isxdigit(static_cast<unsigned char>(text[i + 1])) &&
         std::isxdigit(static_cast<unsigned char>(text[i + 2]))) {
       out.push_back(static_cast<char>(std::stoi(text.substr(i + 1, 2), nullptr, 16)));
       i += 2;
@@ -76,23 +77,28 @@ int positiveInt(const std::filesystem::path& path, const std::map<std::string, s
 double bci2000Number(const Recording& recording, const std::string& name, int index) {
   const std::vector<std::string> values = bci2000Values(recording, name);
   if (index >= static_cast<int>(values.size())) {
-    throw RecordingError(recording.source + ": parameter " + name + " has no value " + std::to_string(index + 1));
+    throw RecordingError(recording.source + ": parameter " + name + " has no value " +
+                         std::to_string(index + 1));
   }
   const std::string& text = values[index];
   char* end = nullptr;
   const double number = std::strtod(text.c_str(), &end);
-  if (end == text.c_str()) throw RecordingError(recording.source + ": parameter " + name + " = '" + text + "' is not a number");
+  if (end == text.c_str())
+    throw RecordingError(recording.source + ": parameter " + name + " = '" + text +
+                         "' is not a number");
   const std::string unit(end);
   if (unit == "ms") return number / 1000.0;
   if (unit == "s" || unit == "Hz" || unit == "muV" || unit == "uV" || unit.empty()) return number;
   if (unit == "kHz") return number * 1000.0;
   if (unit == "mV") return number * 1000.0;
-  throw RecordingError(recording.source + ": parameter " + name + " = '" + text + "' has an unknown unit");
+  throw RecordingError(recording.source + ": parameter " + name + " = '" + text +
+                       "' has an unknown unit");
 }
 
 std::vector<std::string> bci2000Values(const Recording& recording, const std::string& name) {
   const auto found = recording.parameters.find(name);
-  if (found == recording.parameters.end()) throw RecordingError(recording.source + ": parameter " + name + " is missing");
+  if (found == recording.parameters.end())
+    throw RecordingError(recording.source + ": parameter " + name + " is missing");
   // "type value..." where list types start with a count.
   std::vector<std::string> t = tokens(found->second);
   if (t.empty()) throw RecordingError(recording.source + ": parameter " + name + " is empty");
@@ -117,13 +123,15 @@ Recording readBci2000(const std::filesystem::path& path, const ReadOptions& opti
   std::string first;
   std::getline(in, first);
   const auto fields = firstLineFields(first);
-  if (!fields.count("HeaderLen")) fail(path, "not a BCI2000 file (no HeaderLen= on the first line)");
+  if (!fields.count("HeaderLen"))
+    fail(path, "not a BCI2000 file (no HeaderLen= on the first line)");
   const int header_length = positiveInt(path, fields, "HeaderLen", 100 * 1024 * 1024);
   const int channels = positiveInt(path, fields, "SourceCh", 4096);
   const int state_bytes = positiveInt(path, fields, "StatevectorLen", 1024);
   if (channels == 0) fail(path, "SourceCh= 0: no channels");
   if (header_length > file_size) {
-    fail(path, "HeaderLen= " + std::to_string(header_length) + " but the file has only " + std::to_string(file_size) + " bytes");
+    fail(path, "HeaderLen= " + std::to_string(header_length) + " but the file has only " +
+                   std::to_string(file_size) + " bytes");
   }
   std::string format = "int16";
   if (fields.count("DataFormat")) format = fields.at("DataFormat");
@@ -154,10 +162,14 @@ Recording readBci2000(const std::filesystem::path& path, const ReadOptions& opti
     }
     if (section.find("State Vector") != std::string::npos) {
       const std::vector<std::string> t = tokens(line);
-      if (t.size() < 5) fail(path, "state definition '" + line + "' needs name length value byte bit");
-      StateField state{t[0], std::atoi(t[1].c_str()), std::atoi(t[3].c_str()) * 8 + std::atoi(t[4].c_str())};
-      if (state.length <= 0 || state.length > 32 || state.location + state.length > state_bytes * 8) {
-        fail(path, "state " + state.name + " lies outside the " + std::to_string(state_bytes) + "-byte state vector");
+      if (t.size() < 5)
+        fail(path, "state definition '" + line + "' needs name length value byte bit");
+      StateField state{t[0], std::atoi(t[1].c_str()),
+                       std::atoi(t[3].c_str()) * 8 + std::atoi(t[4].c_str())};
+      if (state.length <= 0 || state.length > 32 ||
+          state.location + state.length > state_bytes * 8) {
+        fail(path, "state " + state.name + " lies outside the " + std::to_string(state_bytes) +
+                       "-byte state vector");
       }
       states.push_back(state);
     } else if (section.find("Parameter") != std::string::npos) {
@@ -173,40 +185,47 @@ Recording readBci2000(const std::filesystem::path& path, const ReadOptions& opti
 
   // Signal properties.
   recording.info.rate_hz = bci2000Number(recording, "SamplingRate");
-  if (!(recording.info.rate_hz > 0.0 && recording.info.rate_hz < 1e6)) fail(path, "SamplingRate is not a valid rate");
+  if (!(recording.info.rate_hz > 0.0 && recording.info.rate_hz < 1e6))
+    fail(path, "SamplingRate is not a valid rate");
   recording.info.block_size = recording.parameters.count("SampleBlockSize")
                                   ? static_cast<int>(bci2000Number(recording, "SampleBlockSize"))
                                   : 15;
   std::vector<std::string> names;
   if (recording.parameters.count("ChannelNames")) names = bci2000Values(recording, "ChannelNames");
   for (int c = 0; c < channels; ++c) {
-    recording.info.channels.push_back(c < static_cast<int>(names.size()) && !names[c].empty() ? names[c]
-                                                                                            : "Ch" + std::to_string(c + 1));
+    recording.info.channels.push_back(c < static_cast<int>(names.size()) && !names[c].empty()
+                                          ? names[c]
+                                          : "Ch" + std::to_string(c + 1));
   }
   std::vector<double> offset(channels, 0.0), gain(channels, 1.0);
   for (int c = 0; c < channels; ++c) {
-    if (recording.parameters.count("SourceChOffset")) offset[c] = bci2000Number(recording, "SourceChOffset", c);
-    if (recording.parameters.count("SourceChGain")) gain[c] = bci2000Number(recording, "SourceChGain", c);
+    if (recording.parameters.count("SourceChOffset"))
+      offset[c] = bci2000Number(recording, "SourceChOffset", c);
+    if (recording.parameters.count("SourceChGain"))
+      gain[c] = bci2000Number(recording, "SourceChGain", c);
   }
 
   // Records.
-  const std::int64_t record_bytes = static_cast<std::int64_t>(channels) * sample_bytes + state_bytes;
+  const std::int64_t record_bytes =
+      static_cast<std::int64_t>(channels) * sample_bytes + state_bytes;
   const std::int64_t body = file_size - header_length;
   std::int64_t records = body / record_bytes;
   if (body % record_bytes != 0) {
-    const std::string note = "the file ends " + std::to_string(body % record_bytes) + " bytes into record " +
-                             std::to_string(records + 1) + " (cut short?)";
+    const std::string note = "the file ends " + std::to_string(body % record_bytes) +
+                             " bytes into record " + std::to_string(records + 1) + " (cut short?)";
     if (!options.salvage_truncated) fail(path, note);
     recording.truncated = true;
     recording.truncation_note = note;
   }
   recording.samples = records;
   recording.data.assign(static_cast<size_t>(channels) * records, 0.0f);
-  for (const StateField& s : states) recording.states[s.name].assign(static_cast<size_t>(records), 0);
+  for (const StateField& s : states)
+    recording.states[s.name].assign(static_cast<size_t>(records), 0);
   std::vector<std::uint8_t> record(static_cast<size_t>(record_bytes));
   in.seekg(header_length);
   for (std::int64_t n = 0; n < records; ++n) {
-    if (!in.read(reinterpret_cast<char*>(record.data()), record_bytes)) fail(path, "read failed at record " + std::to_string(n + 1));
+    if (!in.read(reinterpret_cast<char*>(record.data()), record_bytes))
+      fail(path, "read failed at record " + std::to_string(n + 1));
     for (int c = 0; c < channels; ++c) {
       const std::uint8_t* p = record.data() + static_cast<size_t>(c) * sample_bytes;
       double raw = 0.0;
@@ -223,7 +242,8 @@ Recording readBci2000(const std::filesystem::path& path, const ReadOptions& opti
         std::memcpy(&v, p, 4);
         raw = v;
       }
-      recording.data[static_cast<size_t>(c) * records + n] = static_cast<float>((raw - offset[c]) * gain[c]);
+      recording.data[static_cast<size_t>(c) * records + n] =
+          static_cast<float>((raw - offset[c]) * gain[c]);
     }
     const std::uint8_t* bits = record.data() + static_cast<size_t>(channels) * sample_bytes;
     for (const StateField& s : states) {
@@ -239,7 +259,8 @@ Recording readBci2000(const std::filesystem::path& path, const ReadOptions& opti
   // Stimuli: runs of non-zero StimulusCode.
   if (recording.states.count("StimulusCode")) {
     const auto& code = recording.states["StimulusCode"];
-    const std::vector<std::int32_t>* type = recording.states.count("StimulusType") ? &recording.states["StimulusType"] : nullptr;
+    const std::vector<std::int32_t>* type =
+        recording.states.count("StimulusType") ? &recording.states["StimulusType"] : nullptr;
     for (std::int64_t n = 0; n < records; ++n) {
       if (code[n] == 0 || (n > 0 && code[n - 1] == code[n])) continue;
       StimulusEvent event;

@@ -35,7 +35,9 @@ struct HeaderFields {
   int annotation_samples = kAnnotationBytes / 3;
 };
 
-inline int headerBytes(int signals_with_annotations) { return 256 * (signals_with_annotations + 1); }
+inline int headerBytes(int signals_with_annotations) {
+  return 256 * (signals_with_annotations + 1);
+}
 
 // A space-padded ASCII field of exactly `width` characters.
 inline std::string field(std::string text, size_t width) {
@@ -80,7 +82,9 @@ inline std::string number(double value, size_t width) {
 
 // The digital value of a physical one (unclamped, may be NaN).
 inline double digital(double physical, double physical_min, double physical_max) {
-  return std::round((physical - physical_min) / (physical_max - physical_min) * (kDigitalMax - kDigitalMin) + kDigitalMin);
+  return std::round((physical - physical_min) / (physical_max - physical_min) *
+                        (kDigitalMax - kDigitalMin) +
+                    kDigitalMin);
 }
 
 inline void appendInt24(std::string& out, std::int32_t value) {
@@ -94,11 +98,15 @@ inline std::string header(const HeaderFields& h) {
   const int ns = static_cast<int>(h.signals.size()) + 1;
   std::tm start{};
   gmtime_r(&h.start, &start);
-  static const char* kMonths[] = {"JAN", "FEB", "MAR", "APR", "MAY", "JUN", "JUL", "AUG", "SEP", "OCT", "NOV", "DEC"};
+  static const char* kMonths[] = {"JAN", "FEB", "MAR", "APR", "MAY", "JUN",
+                                  "JUL", "AUG", "SEP", "OCT", "NOV", "DEC"};
   char date[32], time_of_day[32], edf_date[32];
-  std::snprintf(date, sizeof date, "%02d.%02d.%02d", start.tm_mday, start.tm_mon + 1, start.tm_year % 100);
-  std::snprintf(time_of_day, sizeof time_of_day, "%02d.%02d.%02d", start.tm_hour, start.tm_min, start.tm_sec);
-  std::snprintf(edf_date, sizeof edf_date, "%02d-%s-%04d", start.tm_mday, kMonths[start.tm_mon], start.tm_year + 1900);
+  std::snprintf(date, sizeof date, "%02d.%02d.%02d", start.tm_mday, start.tm_mon + 1,
+                start.tm_year % 100);
+  std::snprintf(time_of_day, sizeof time_of_day, "%02d.%02d.%02d", start.tm_hour, start.tm_min,
+                start.tm_sec);
+  std::snprintf(edf_date, sizeof edf_date, "%02d-%s-%04d", start.tm_mday, kMonths[start.tm_mon],
+                start.tm_year + 1900);
 
   std::string out;
   out += std::string("\xff") + "BIOSEMI";
@@ -114,7 +122,8 @@ inline std::string header(const HeaderFields& h) {
   std::vector<Signal> all = h.signals;
   all.push_back({"BDF Annotations", "", -1.0, 1.0, h.annotation_samples});
   for (const Signal& s : all) out += field(s.label, 16);
-  for (size_t i = 0; i < all.size(); ++i) out += field(i + 1 < all.size() ? "AgAgCl electrode" : "", 80);
+  for (size_t i = 0; i < all.size(); ++i)
+    out += field(i + 1 < all.size() ? "AgAgCl electrode" : "", 80);
   for (const Signal& s : all) out += field(s.unit, 8);
   for (const Signal& s : all) out += number(s.physical_min, 8);
   for (const Signal& s : all) out += number(s.physical_max, 8);

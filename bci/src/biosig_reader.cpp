@@ -45,7 +45,8 @@ bool parseStimulus(const std::string& text, StimulusEvent& event) {
   std::istringstream in(text);
   std::string word, kind;
   int code = 0;
-  if (!(in >> word >> code >> kind) || word != "Stim" || code <= 0 || (kind != "T" && kind != "N")) return false;
+  if (!(in >> word >> code >> kind) || word != "Stim" || code <= 0 || (kind != "T" && kind != "N"))
+    return false;
   std::string rest;
   if (in >> rest) return false;
   event.code = code;
@@ -72,7 +73,8 @@ EdfSize edfSize(const std::filesystem::path& path) {
     if (signals <= 0 || signals > 4096 || size.header != 256LL * (signals + 1)) return size;
     std::string fields(static_cast<size_t>(signals) * 256, '\0');
     if (!in.read(fields.data(), static_cast<std::streamsize>(fields.size()))) return size;
-    for (int s = 0; s < signals; ++s) size.record += std::stoll(fields.substr(static_cast<size_t>(signals) * 216 + s * 8, 8));
+    for (int s = 0; s < signals; ++s)
+      size.record += std::stoll(fields.substr(static_cast<size_t>(signals) * 216 + s * 8, 8));
     size.record *= bdf ? 3 : 2;
     size.known = size.record > 0;
   } catch (const std::exception&) {
@@ -99,14 +101,16 @@ class TemporaryFile {
 };
 
 // A copy of an EDF/BDF file cut short, holding its complete records and a header that says so.
-void writeSalvagedCopy(const std::filesystem::path& from, const std::filesystem::path& to, const EdfSize& size,
-                       std::int64_t complete) {
+void writeSalvagedCopy(const std::filesystem::path& from, const std::filesystem::path& to,
+                       const EdfSize& size, std::int64_t complete) {
   std::ifstream in(from, std::ios::binary);
   std::ofstream out(to, std::ios::binary | std::ios::trunc);
   std::string bytes(static_cast<size_t>(size.header + complete * size.record), '\0');
-  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) fail(from, "cannot read it to salvage");
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size())))
+    fail(from, "cannot read it to salvage");
   bytes.replace(bdf::kRecordCountOffset, 8, bdf::field(std::to_string(complete), 8));
-  if (!out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()))) fail(to, "cannot write the salvaged copy");
+  if (!out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())))
+    fail(to, "cannot write the salvaged copy");
 }
 
 // BioSig reports problems by printing to stderr; ARBCI reports them as one-line errors instead,
@@ -151,10 +155,11 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   std::unique_ptr<TemporaryFile> salvaged;
   std::string truncation_note;
   if (expected.known && expected.records >= 0) {
-    const std::int64_t complete = std::max<std::int64_t>(0, (file_size - expected.header) / expected.record);
+    const std::int64_t complete =
+        std::max<std::int64_t>(0, (file_size - expected.header) / expected.record);
     if (complete < expected.records) {
-      truncation_note = "the header promises " + std::to_string(expected.records) + " records but the file holds " +
-                        std::to_string(complete) + " (cut short?)";
+      truncation_note = "the header promises " + std::to_string(expected.records) +
+                        " records but the file holds " + std::to_string(complete) + " (cut short?)";
       if (!options.salvage_truncated) fail(path, truncation_note);
       if (complete == 0) fail(path, truncation_note + "; nothing to salvage");
       salvaged = std::make_unique<TemporaryFile>(path);
@@ -186,10 +191,18 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   recording.truncated = salvaged != nullptr;
   recording.truncation_note = truncation_note;
   switch (biosig_get_filetype(hdr.get())) {
-    case GDF: recording.format = "GDF"; break;
-    case EDF: recording.format = "EDF"; break;
-    case BDF: recording.format = "BDF"; break;
-    default: recording.format = "BioSig"; break;
+    case GDF:
+      recording.format = "GDF";
+      break;
+    case EDF:
+      recording.format = "EDF";
+      break;
+    case BDF:
+      recording.format = "BDF";
+      break;
+    default:
+      recording.format = "BioSig";
+      break;
   }
   const long channels = biosig_get_number_of_channels(hdr.get());
   const double rate = biosig_get_samplerate(hdr.get());
@@ -200,9 +213,11 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   for (long c = 0; c < channels; ++c) {
     CHANNEL_TYPE* channel = biosig_get_channel(hdr.get(), static_cast<int>(c));
     const char* label = channel ? biosig_channel_get_label(channel) : nullptr;
-    recording.info.channels.push_back(label && *label ? trimmed(label) : "Ch" + std::to_string(c + 1));
+    recording.info.channels.push_back(label && *label ? trimmed(label)
+                                                      : "Ch" + std::to_string(c + 1));
     if (channel && biosig_get_channel_samplerate(hdr.get(), static_cast<int>(c)) != rate) {
-      fail(path, "channel " + recording.info.channels.back() + " has another sampling rate; mixed rates are not supported");
+      fail(path, "channel " + recording.info.channels.back() +
+                     " has another sampling rate; mixed rates are not supported");
     }
   }
 
@@ -212,13 +227,16 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   recording.data.resize(static_cast<size_t>(channels) * samples);
   for (long c = 0; c < channels; ++c) {
     CHANNEL_TYPE* channel = biosig_get_channel(hdr.get(), static_cast<int>(c));
-    const std::string unit = channel && biosig_channel_get_physdim(channel) ? trimmed(biosig_channel_get_physdim(channel)) : "";
+    const std::string unit = channel && biosig_channel_get_physdim(channel)
+                                 ? trimmed(biosig_channel_get_physdim(channel))
+                                 : "";
     double scale = 1.0;
     if (unit == "mV") scale = 1e3;
     if (unit == "V") scale = 1e6;
     if (unit == "nV") scale = 1e-3;
     for (std::int64_t s = 0; s < samples; ++s) {
-      recording.data[static_cast<size_t>(c) * samples + s] = static_cast<float>(data[static_cast<size_t>(c) * samples + s] * scale);
+      recording.data[static_cast<size_t>(c) * samples + s] =
+          static_cast<float>(data[static_cast<size_t>(c) * samples + s] * scale);
     }
   }
 
@@ -231,10 +249,13 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
     uint16_t type = 0, channel = 0;
     uint32_t position = 0, duration = 0;
     const char* description = nullptr;
-    if (biosig_get_nth_event(hdr.get(), n, &type, &position, &channel, &duration, nullptr, &description) != 0) continue;
+    if (biosig_get_nth_event(hdr.get(), n, &type, &position, &channel, &duration, nullptr,
+                             &description) != 0)
+      continue;
     const auto sample = static_cast<std::int64_t>(std::llround(position * to_samples));
     const auto length = static_cast<int>(std::lround(duration * to_samples));
-    const std::string text = description ? trimmed(description) : "event type " + std::to_string(type);
+    const std::string text =
+        description ? trimmed(description) : "event type " + std::to_string(type);
     StimulusEvent stimulus;
     if (parseStimulus(text, stimulus)) {
       stimulus.sample = sample;
@@ -279,7 +300,8 @@ Recording readRecording(const std::filesystem::path& path, const ReadOptions& op
   in.read(head.data(), 16);
   head.resize(static_cast<size_t>(in.gcount()));
   if (head.empty()) fail(path, "is empty");
-  if (head.rfind("HeaderLen=", 0) == 0 || head.rfind("BCI2000V=", 0) == 0) return readBci2000(path, options);
+  if (head.rfind("HeaderLen=", 0) == 0 || head.rfind("BCI2000V=", 0) == 0)
+    return readBci2000(path, options);
   const bool edf = head.size() >= 8 && head.substr(0, 8) == "0       ";
   const bool bdf = head.size() >= 8 && head.substr(0, 8) == std::string("\xff") + "BIOSEMI";
   const bool gdf = head.rfind("GDF", 0) == 0;

@@ -6,7 +6,8 @@ namespace arbci::bci {
 
 double LinearClassifierBase::score(const Eigen::Ref<const Eigen::VectorXd>& features) const {
   if (features.size() != weights_.size()) {
-    throw std::invalid_argument("classifier: " + std::to_string(features.size()) + " features given, the model has " +
+    throw std::invalid_argument("classifier: " + std::to_string(features.size()) +
+                                " features given, the model has " +
                                 std::to_string(weights_.size()));
   }
   return weights_.dot(features) + bias_;
@@ -27,34 +28,45 @@ void LinearClassifierBase::restore(const nlohmann::json& json, const FeatureShap
   }
   const std::vector<double> w = json["weights"].get<std::vector<double>>();
   if (static_cast<int>(w.size()) != shape.size()) {
-    throw std::invalid_argument("classifier: " + std::to_string(w.size()) + " weights for " + std::to_string(shape.size()) +
-                                " features (" + std::to_string(shape.channels) + " channels x " + std::to_string(shape.bins) + " bins)");
+    throw std::invalid_argument("classifier: " + std::to_string(w.size()) + " weights for " +
+                                std::to_string(shape.size()) + " features (" +
+                                std::to_string(shape.channels) + " channels x " +
+                                std::to_string(shape.bins) + " bins)");
   }
   weights_ = Eigen::Map<const Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
   bias_ = json["bias"].get<double>();
   details_ = json.value("details", nlohmann::json::object());
 }
 
-void checkTrainingData(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape) {
-  if (features.rows() != static_cast<Eigen::Index>(target.size())) throw std::invalid_argument("one label per epoch is needed");
-  if (features.cols() != shape.size()) throw std::invalid_argument("feature vectors do not match the feature shape");
+void checkTrainingData(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                       const FeatureShape& shape) {
+  if (features.rows() != static_cast<Eigen::Index>(target.size()))
+    throw std::invalid_argument("one label per epoch is needed");
+  if (features.cols() != shape.size())
+    throw std::invalid_argument("feature vectors do not match the feature shape");
   const auto targets = static_cast<int>(std::count(target.begin(), target.end(), true));
   const int others = static_cast<int>(target.size()) - targets;
   if (targets < kMinimumTargets || others < kMinimumTargets) {
-    throw std::invalid_argument("too few examples to train: " + std::to_string(targets) + " target and " + std::to_string(others) +
-                                " non-target epochs (at least " + std::to_string(kMinimumTargets) + " of each)");
+    throw std::invalid_argument("too few examples to train: " + std::to_string(targets) +
+                                " target and " + std::to_string(others) +
+                                " non-target epochs (at least " + std::to_string(kMinimumTargets) +
+                                " of each)");
   }
-  if (!features.allFinite()) throw std::invalid_argument("the features contain NaN or infinite values");
+  if (!features.allFinite())
+    throw std::invalid_argument("the features contain NaN or infinite values");
 }
 
-std::unique_ptr<Classifier> makeClassifier(const std::string& method, const SwldaSettings& swlda, const XdawnSettings& xdawn) {
+std::unique_ptr<Classifier> makeClassifier(const std::string& method, const SwldaSettings& swlda,
+                                           const XdawnSettings& xdawn) {
   if (method == "swlda") return std::make_unique<SwldaClassifier>(swlda);
   if (method == "slda") return std::make_unique<ShrinkageLdaClassifier>();
   if (method == "xdawn") return std::make_unique<XdawnClassifier>(xdawn);
-  throw std::invalid_argument("unknown classification method '" + method + "' (swlda, slda or xdawn)");
+  throw std::invalid_argument("unknown classification method '" + method +
+                              "' (swlda, slda or xdawn)");
 }
 
-std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json, const FeatureShape& shape) {
+std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
+                                               const FeatureShape& shape) {
   if (!json.is_object() || !json.contains("method") || !json["method"].is_string()) {
     throw std::invalid_argument("classifier: no method");
   }

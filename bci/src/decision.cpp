@@ -16,16 +16,19 @@ ScoreModel ScoreModel::fit(const std::vector<double>& scores, const std::vector<
     sum2[k] += scores[i] * scores[i];
     ++n[k];
   }
-  if (n[0] < 2 || n[1] < 2) throw std::invalid_argument("score model: needs target and non-target scores");
+  if (n[0] < 2 || n[1] < 2)
+    throw std::invalid_argument("score model: needs target and non-target scores");
   ScoreModel model;
   model.target_mean = sum[1] / n[1];
   model.other_mean = sum[0] / n[0];
-  const double within = (sum2[1] - n[1] * model.target_mean * model.target_mean) + (sum2[0] - n[0] * model.other_mean * model.other_mean);
+  const double within = (sum2[1] - n[1] * model.target_mean * model.target_mean) +
+                        (sum2[0] - n[0] * model.other_mean * model.other_mean);
   model.sd = std::sqrt(std::max(within / (n[0] + n[1] - 2), 1e-12));
   return model;
 }
 
-SelectionAccumulator::SelectionAccumulator(const ParadigmLayout& layout, const ScoreModel& model) : layout_(layout), model_(model) {
+SelectionAccumulator::SelectionAccumulator(const ParadigmLayout& layout, const ScoreModel& model)
+    : layout_(layout), model_(model) {
   for (int code = 1; code <= layout.codes(); ++code) {
     evidence_[code] = 0.0;
     counts_[code] = 0;
@@ -52,7 +55,8 @@ std::map<int, double> SelectionAccumulator::posterior(int first_code, int count)
   for (int c = first_code; c < first_code + count; ++c) top = std::max(top, evidence_.at(c));
   std::map<int, double> p;
   double total = 0.0;
-  for (int c = first_code; c < first_code + count; ++c) total += p[c] = std::exp(evidence_.at(c) - top);
+  for (int c = first_code; c < first_code + count; ++c)
+    total += p[c] = std::exp(evidence_.at(c) - top);
   for (auto& [code, value] : p) value /= total;
   return p;
 }
@@ -60,7 +64,8 @@ std::map<int, double> SelectionAccumulator::posterior(int first_code, int count)
 Decision SelectionAccumulator::decide() const {
   Decision decision;
   auto best = [](const std::map<int, double>& p) {
-    return *std::max_element(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    return *std::max_element(p.begin(), p.end(),
+                             [](const auto& a, const auto& b) { return a.second < b.second; });
   };
   if (layout_.kind == ParadigmLayout::Kind::RowColumn) {
     const auto row = best(posterior(1, layout_.rows));

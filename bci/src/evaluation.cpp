@@ -47,7 +47,8 @@ std::string EvaluationReport::selected(int sequences) const {
   std::string out;
   const bool speller = !layout.symbols.empty();
   for (const SelectionResult& s : selections) {
-    const Decision& d = s.by_sequences[static_cast<size_t>(std::clamp(sequences, 1, max_sequences) - 1)];
+    const Decision& d =
+        s.by_sequences[static_cast<size_t>(std::clamp(sequences, 1, max_sequences) - 1)];
     if (!speller && !out.empty()) out += ", ";
     out += layout.describe(d.codes);
   }
@@ -63,8 +64,8 @@ std::string EvaluationReport::selectedDynamic() const {
   return out;
 }
 
-EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<double>& scores, const ScoreModel& model,
-                                const StoppingRule& dynamic) {
+EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<double>& scores,
+                                const ScoreModel& model, const StoppingRule& dynamic) {
   EvaluationReport report;
   report.layout = data.layout;
   report.dynamic_rule = dynamic;
@@ -83,10 +84,12 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
   for (const SelectionEpochs& s : data.selections) {
     int complete = 0;
     if (!s.epochs.empty()) complete = data.sequence[static_cast<size_t>(s.epochs.back())] + 1;
-    if (static_cast<int>(s.epochs.size()) < complete * data.layout.codes()) --complete;  // last one cut short
+    if (static_cast<int>(s.epochs.size()) < complete * data.layout.codes())
+      --complete;  // last one cut short
     report.max_sequences = std::min(report.max_sequences, complete);
   }
-  if (data.selections.empty() || report.max_sequences < 1) throw std::invalid_argument("no selection has a whole sequence");
+  if (data.selections.empty() || report.max_sequences < 1)
+    throw std::invalid_argument("no selection has a whole sequence");
   const int n_max = report.max_sequences;
   report.accuracy.assign(static_cast<size_t>(n_max), 0.0);
 
@@ -115,7 +118,9 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     dynamic_flashes += result.dynamic_flashes;
     if (!result.truth.empty()) {
       ++report.selections_with_truth;
-      for (int n = 0; n < n_max; ++n) report.accuracy[static_cast<size_t>(n)] += result.by_sequences[static_cast<size_t>(n)].codes == result.truth;
+      for (int n = 0; n < n_max; ++n)
+        report.accuracy[static_cast<size_t>(n)] +=
+            result.by_sequences[static_cast<size_t>(n)].codes == result.truth;
       dynamic_correct += result.dynamic.codes == result.truth;
     }
     report.selections.push_back(std::move(result));
@@ -125,29 +130,35 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     report.accuracy[static_cast<size_t>(n)] /= known;
     const double seconds = (n + 1) * data.layout.codes() * data.layout.soa_s;
     report.seconds_per_selection.push_back(seconds);
-    report.bits_per_minute.push_back(wolpawBits(data.layout.choices(), report.accuracy[static_cast<size_t>(n)]) * 60.0 / seconds);
+    report.bits_per_minute.push_back(
+        wolpawBits(data.layout.choices(), report.accuracy[static_cast<size_t>(n)]) * 60.0 /
+        seconds);
   }
   report.dynamic_accuracy = dynamic_correct / known;
   report.dynamic_mean_flashes = dynamic_flashes / static_cast<double>(data.selections.size());
   report.dynamic_seconds = report.dynamic_mean_flashes * data.layout.soa_s;
-  report.dynamic_bits_per_minute = wolpawBits(data.layout.choices(), report.dynamic_accuracy) * 60.0 / report.dynamic_seconds;
+  report.dynamic_bits_per_minute =
+      wolpawBits(data.layout.choices(), report.dynamic_accuracy) * 60.0 / report.dynamic_seconds;
   return report;
 }
 
-CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& settings, const Progress& progress) {
+CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& settings,
+                              const Progress& progress) {
   std::vector<int> labelled;
   for (size_t s = 0; s < data.selections.size(); ++s) {
     if (!data.selections[s].target_codes.empty()) labelled.push_back(static_cast<int>(s));
   }
   if (labelled.size() < 2) {
-    throw std::invalid_argument("cross-validation needs at least 2 selections with known targets, the data have " +
-                                std::to_string(labelled.size()));
+    throw std::invalid_argument(
+        "cross-validation needs at least 2 selections with known targets, the data have " +
+        std::to_string(labelled.size()));
   }
   CrossValidation cv;
   cv.folds = std::clamp(settings.folds, 2, static_cast<int>(labelled.size()));
   cv.scores.assign(static_cast<size_t>(data.epochs()), 0.0);
   std::vector<int> fold_of(data.selections.size(), -1);
-  for (size_t k = 0; k < labelled.size(); ++k) fold_of[static_cast<size_t>(labelled[k])] = static_cast<int>(k * cv.folds / labelled.size());
+  for (size_t k = 0; k < labelled.size(); ++k)
+    fold_of[static_cast<size_t>(labelled[k])] = static_cast<int>(k * cv.folds / labelled.size());
   for (int fold = 0; fold < cv.folds; ++fold) {
     std::vector<int> train_rows, test_rows;
     for (int row = 0; row < data.epochs(); ++row) {
@@ -163,11 +174,13 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
     }
     auto classifier = makeClassifier(settings.method, settings.swlda, settings.xdawn);
     const Progress inner = progress ? Progress([&](double f, const std::string& stage) {
-      progress((fold + f) / (cv.folds + 1.0), "fold " + std::to_string(fold + 1) + "/" + std::to_string(cv.folds) + ": " + stage);
+      progress((fold + f) / (cv.folds + 1.0),
+               "fold " + std::to_string(fold + 1) + "/" + std::to_string(cv.folds) + ": " + stage);
     })
                                     : Progress();
     classifier->train(x, y, data.shape, inner);
-    for (int row : test_rows) cv.scores[static_cast<size_t>(row)] = classifier->score(data.features.row(row).transpose());
+    for (int row : test_rows)
+      cv.scores[static_cast<size_t>(row)] = classifier->score(data.features.row(row).transpose());
   }
   // Only labelled selections take part in the report.
   P300Dataset tested = data;

@@ -18,14 +18,17 @@ FeatureExtractor::FeatureExtractor(const PipelineSettings& settings, const Signa
   } else {
     for (const std::string& name : settings.channels) {
       const auto found = std::find(info.channels.begin(), info.channels.end(), name);
-      if (found == info.channels.end()) throw std::invalid_argument("the signal has no channel " + name);
+      if (found == info.channels.end())
+        throw std::invalid_argument("the signal has no channel " + name);
       channel_indices_.push_back(static_cast<int>(found - info.channels.begin()));
     }
   }
-  const int samples = static_cast<int>(std::lround((settings.window.end_s - settings.window.start_s) * info.rate_hz));
+  const int samples = static_cast<int>(
+      std::lround((settings.window.end_s - settings.window.start_s) * info.rate_hz));
   shape_.channels = static_cast<int>(channel_indices_.size());
   shape_.bins = samples / factor_;
-  if (shape_.bins < 1) throw std::invalid_argument("the response window is shorter than one decimation bin");
+  if (shape_.bins < 1)
+    throw std::invalid_argument("the response window is shorter than one decimation bin");
 }
 
 Eigen::VectorXd FeatureExtractor::features(const Epoch& epoch) const {

@@ -10,10 +10,12 @@ namespace arbci::bci {
 namespace {
 
 void checkDesign(int order, double cutoff_hz, double rate_hz, const char* what) {
-  if (order < 1 || order > 12) throw std::invalid_argument(std::string(what) + ": order must be 1-12");
+  if (order < 1 || order > 12)
+    throw std::invalid_argument(std::string(what) + ": order must be 1-12");
   if (!(cutoff_hz > 0.0 && cutoff_hz < rate_hz / 2.0)) {
     throw std::invalid_argument(std::string(what) + ": cut-off " + std::to_string(cutoff_hz) +
-                                " Hz must lie between 0 and half the sampling rate (" + std::to_string(rate_hz / 2.0) + " Hz)");
+                                " Hz must lie between 0 and half the sampling rate (" +
+                                std::to_string(rate_hz / 2.0) + " Hz)");
   }
 }
 
@@ -78,19 +80,24 @@ double magnitudeResponse(const std::vector<Biquad>& sections, double frequency_h
   const std::complex<double> z1 = std::polar(1.0, -2.0 * std::numbers::pi * frequency_hz / rate_hz);
   const std::complex<double> z2 = z1 * z1;
   std::complex<double> h = 1.0;
-  for (const Biquad& s : sections) h *= (s.b0 + s.b1 * z1 + s.b2 * z2) / (1.0 + s.a1 * z1 + s.a2 * z2);
+  for (const Biquad& s : sections)
+    h *= (s.b0 + s.b1 * z1 + s.b2 * z2) / (1.0 + s.a1 * z1 + s.a2 * z2);
   return std::abs(h);
 }
 
 IirFilter::IirFilter(std::vector<Biquad> sections, int channels)
-    : sections_(std::move(sections)), channels_(channels), state_(static_cast<size_t>(channels) * sections_.size() * 2, 0.0) {}
+    : sections_(std::move(sections)),
+      channels_(channels),
+      state_(static_cast<size_t>(channels) * sections_.size() * 2, 0.0) {}
 
-void IirFilter::reset() { std::fill(state_.begin(), state_.end(), 0.0); }
+void IirFilter::reset() {
+  std::fill(state_.begin(), state_.end(), 0.0);
+}
 
 void IirFilter::process(Block& block) {
   if (block.channels != channels_) {
-    throw std::invalid_argument("filter: block has " + std::to_string(block.channels) + " channels, the filter " +
-                                std::to_string(channels_));
+    throw std::invalid_argument("filter: block has " + std::to_string(block.channels) +
+                                " channels, the filter " + std::to_string(channels_));
   }
   const size_t n_sections = sections_.size();
   for (int c = 0; c < channels_; ++c) {
@@ -116,7 +123,8 @@ void commonAverageReference(Block& block) {
     double mean = 0.0;
     for (int c = 0; c < block.channels; ++c) mean += block.at(c, s);
     mean /= block.channels;
-    for (int c = 0; c < block.channels; ++c) block.at(c, s) = static_cast<float>(block.at(c, s) - mean);
+    for (int c = 0; c < block.channels; ++c)
+      block.at(c, s) = static_cast<float>(block.at(c, s) - mean);
   }
 }
 
@@ -133,8 +141,9 @@ std::vector<Biquad> chainSections(const FilterSettings& f, double rate) {
     sections.insert(sections.end(), lp.begin(), lp.end());
   }
   if (f.highpass_hz > 0.0 && f.lowpass_hz > 0.0 && f.highpass_hz >= f.lowpass_hz) {
-    throw std::invalid_argument("band-pass: high-pass " + std::to_string(f.highpass_hz) + " Hz must be below low-pass " +
-                                std::to_string(f.lowpass_hz) + " Hz");
+    throw std::invalid_argument("band-pass: high-pass " + std::to_string(f.highpass_hz) +
+                                " Hz must be below low-pass " + std::to_string(f.lowpass_hz) +
+                                " Hz");
   }
   if (f.notch_hz > 0.0) sections.push_back(notchFilter(f.notch_hz, f.notch_q, rate));
   return sections;
@@ -143,23 +152,30 @@ std::vector<Biquad> chainSections(const FilterSettings& f, double rate) {
 }  // namespace
 
 FilterChain::FilterChain(const FilterSettings& settings, const SignalInfo& info)
-    : settings_(settings), rate_hz_(info.rate_hz), filter_(chainSections(settings, info.rate_hz), info.channelCount()) {}
+    : settings_(settings),
+      rate_hz_(info.rate_hz),
+      filter_(chainSections(settings, info.rate_hz), info.channelCount()) {}
 
 void FilterChain::process(Block& block) {
   if (settings_.common_average) commonAverageReference(block);
   filter_.process(block);
 }
 
-double FilterChain::magnitude(double frequency_hz) const { return magnitudeResponse(filter_.sections(), frequency_hz, rate_hz_); }
+double FilterChain::magnitude(double frequency_hz) const {
+  return magnitudeResponse(filter_.sections(), frequency_hz, rate_hz_);
+}
 
-Decimator::Decimator(int factor, int channels) : factor_(factor), channels_(channels), sums_(static_cast<size_t>(channels), 0.0) {
+Decimator::Decimator(int factor, int channels)
+    : factor_(factor), channels_(channels), sums_(static_cast<size_t>(channels), 0.0) {
   if (factor < 1) throw std::invalid_argument("decimation factor must be at least 1");
 }
 
 Block Decimator::process(const Block& block) {
-  if (block.channels != channels_) throw std::invalid_argument("decimator: block has another channel count");
+  if (block.channels != channels_)
+    throw std::invalid_argument("decimator: block has another channel count");
   if (next_input_ >= 0 && block.first_sample != next_input_) {
-    throw std::invalid_argument("decimator: block starts at sample " + std::to_string(block.first_sample) + ", expected " +
+    throw std::invalid_argument("decimator: block starts at sample " +
+                                std::to_string(block.first_sample) + ", expected " +
                                 std::to_string(next_input_));
   }
   // Groups start at multiples of the factor; samples before the first whole group are skipped.

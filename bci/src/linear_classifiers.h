@@ -17,19 +17,21 @@ class LinearClassifierBase : public Classifier {
  protected:
   Eigen::VectorXd weights_;
   double bias_ = 0.0;
-  nlohmann::json details_ = nlohmann::json::object();  // what each method adds (selected features, filters)
+  nlohmann::json details_ =
+      nlohmann::json::object();  // what each method adds (selected features, filters)
 };
 
 // Shrinkage LDA on rows of X: weights and bias with the decision threshold midway between the
 // class means. Returns the shrinkage intensity used.
-double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target, Eigen::VectorXd& weights, double& bias);
+double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target,
+                         Eigen::VectorXd& weights, double& bias);
 
 class SwldaClassifier final : public LinearClassifierBase {
  public:
   explicit SwldaClassifier(const SwldaSettings& settings) : settings_(settings) {}
   std::string method() const override { return "swlda"; }
-  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-             const Progress& progress) override;
+  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+             const FeatureShape& shape, const Progress& progress) override;
 
  private:
   SwldaSettings settings_;
@@ -38,16 +40,16 @@ class SwldaClassifier final : public LinearClassifierBase {
 class ShrinkageLdaClassifier final : public LinearClassifierBase {
  public:
   std::string method() const override { return "slda"; }
-  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-             const Progress& progress) override;
+  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+             const FeatureShape& shape, const Progress& progress) override;
 };
 
 class XdawnClassifier final : public LinearClassifierBase {
  public:
   explicit XdawnClassifier(const XdawnSettings& settings) : settings_(settings) {}
   std::string method() const override { return "xdawn"; }
-  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-             const Progress& progress) override;
+  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+             const FeatureShape& shape, const Progress& progress) override;
 
  private:
   XdawnSettings settings_;

@@ -37,9 +37,11 @@ std::vector<std::vector<std::string>> bci2000Matrix(const Recording& r, const st
 
 double medianGap(const std::vector<StimulusEvent>& stimuli, double rate) {
   std::vector<double> gaps;
-  for (size_t i = 1; i < stimuli.size(); ++i) gaps.push_back((stimuli[i].sample - stimuli[i - 1].sample) / rate);
+  for (size_t i = 1; i < stimuli.size(); ++i)
+    gaps.push_back((stimuli[i].sample - stimuli[i - 1].sample) / rate);
   if (gaps.empty()) return 0.18;
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2),
+                   gaps.end());
   return gaps[gaps.size() / 2];
 }
 
@@ -60,22 +62,26 @@ ParadigmLayout layoutOf(const Recording& r) {
   const auto paradigm = r.parameters.find("Paradigm");
   if (paradigm != r.parameters.end()) {
     int rows = 0, columns = 0, stimuli = 0;
-    if (std::sscanf(paradigm->second.c_str(), "row/column %dx%d", &rows, &columns) == 2) return ParadigmLayout::matrix(rows, columns, soa);
-    if (std::sscanf(paradigm->second.c_str(), "single stimulus, %d", &stimuli) == 1) return ParadigmLayout::single(stimuli, soa);
+    if (std::sscanf(paradigm->second.c_str(), "row/column %dx%d", &rows, &columns) == 2)
+      return ParadigmLayout::matrix(rows, columns, soa);
+    if (std::sscanf(paradigm->second.c_str(), "single stimulus, %d", &stimuli) == 1)
+      return ParadigmLayout::single(stimuli, soa);
   }
   int highest = 0;
   for (const StimulusEvent& e : r.stimuli) highest = std::max(highest, e.code);
   return ParadigmLayout::single(std::max(highest, 2), soa);
 }
 
-P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings, const Progress& progress) {
+P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings,
+                         const Progress& progress) {
   if (recordings.empty()) throw std::invalid_argument("no recordings given");
   P300Dataset data;
   data.info = recordings.front().info;
   data.layout = layoutOf(recordings.front());
   const FeatureExtractor extractor(settings, data.info);
   data.shape = extractor.shape();
-  for (int c : extractor.channelIndices()) data.feature_channels.push_back(data.info.channels[static_cast<size_t>(c)]);
+  for (int c : extractor.channelIndices())
+    data.feature_channels.push_back(data.info.channels[static_cast<size_t>(c)]);
   const Epocher window_shape(data.info.channelCount(), data.info.rate_hz, settings.window);
   const int offset = window_shape.offsetSamples(), length = window_shape.samplesPerEpoch();
 
@@ -86,16 +92,21 @@ P300Dataset buildDataset(const std::vector<Recording>& recordings, const Pipelin
   int n_target = 0, n_other = 0;
   for (size_t f = 0; f < recordings.size(); ++f) {
     const Recording& r = recordings[f];
-    if (progress) progress(static_cast<double>(f) / recordings.size(), "filtering and epoching " + r.source);
-    if (r.stimuli.empty()) throw std::invalid_argument(r.source + ": no stimulus events (StimulusCode) to classify");
+    if (progress)
+      progress(static_cast<double>(f) / recordings.size(), "filtering and epoching " + r.source);
+    if (r.stimuli.empty())
+      throw std::invalid_argument(r.source + ": no stimulus events (StimulusCode) to classify");
     if (r.info.rate_hz != data.info.rate_hz) {
-      throw std::invalid_argument(r.source + ": sampled at " + std::to_string(r.info.rate_hz) + " Hz, the first file at " +
-                                  std::to_string(data.info.rate_hz) + " Hz");
+      throw std::invalid_argument(r.source + ": sampled at " + std::to_string(r.info.rate_hz) +
+                                  " Hz, the first file at " + std::to_string(data.info.rate_hz) +
+                                  " Hz");
     }
-    if (r.info.channels != data.info.channels) throw std::invalid_argument(r.source + ": has other channels than the first file");
+    if (r.info.channels != data.info.channels)
+      throw std::invalid_argument(r.source + ": has other channels than the first file");
     const ParadigmLayout layout = layoutOf(r);
     if (layout.kind != data.layout.kind || layout.codes() != data.layout.codes()) {
-      throw std::invalid_argument(r.source + ": " + layout.describeShape() + ", the first file " + data.layout.describeShape());
+      throw std::invalid_argument(r.source + ": " + layout.describeShape() + ", the first file " +
+                                  data.layout.describeShape());
     }
     data.sources.push_back(r.source);
 
@@ -126,8 +137,8 @@ P300Dataset buildDataset(const std::vector<Recording>& recordings, const Pipelin
       epoch.samples = length;
       epoch.data.resize(static_cast<size_t>(signal.channels) * length);
       for (int c = 0; c < signal.channels; ++c) {
-        std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + first), length,
-                    epoch.data.begin() + static_cast<std::ptrdiff_t>(c) * length);
+        std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + first),
+                    length, epoch.data.begin() + static_cast<std::ptrdiff_t>(c) * length);
       }
       rows.push_back(extractor.features(epoch));
       Eigen::MatrixXd& erp = e.target ? data.erp_target : data.erp_other;
@@ -145,7 +156,8 @@ P300Dataset buildDataset(const std::vector<Recording>& recordings, const Pipelin
     }
   }
   data.features.resize(static_cast<Eigen::Index>(rows.size()), data.shape.size());
-  for (size_t i = 0; i < rows.size(); ++i) data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  for (size_t i = 0; i < rows.size(); ++i)
+    data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
   if (n_target > 0) data.erp_target /= n_target;
   if (n_other > 0) data.erp_other /= n_other;
   if (progress) progress(1.0, "epochs ready");

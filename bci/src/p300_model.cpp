@@ -8,8 +8,8 @@ namespace arbci::bci {
 
 void P300Model::checkCompatible(const SignalInfo& info, const std::string& what) const {
   if (std::abs(info.rate_hz - rate_hz) > 1e-6) {
-    throw ModelError(what + " is sampled at " + std::to_string(info.rate_hz) + " Hz; the model was trained at " +
-                     std::to_string(rate_hz) + " Hz");
+    throw ModelError(what + " is sampled at " + std::to_string(info.rate_hz) +
+                     " Hz; the model was trained at " + std::to_string(rate_hz) + " Hz");
   }
   for (const std::string& channel : pipeline.channels) {
     if (std::find(info.channels.begin(), info.channels.end(), channel) == info.channels.end()) {
@@ -26,54 +26,70 @@ nlohmann::json P300Model::toJson() const {
   json["signal"] = {{"rate_hz", rate_hz}};
   const FilterSettings& f = pipeline.filter;
   json["pipeline"] = {{"filter",
-                       {{"common_average", f.common_average}, {"highpass_hz", f.highpass_hz}, {"lowpass_hz", f.lowpass_hz},
-                        {"order", f.order}, {"notch_hz", f.notch_hz}, {"notch_q", f.notch_q}}},
+                       {{"common_average", f.common_average},
+                        {"highpass_hz", f.highpass_hz},
+                        {"lowpass_hz", f.lowpass_hz},
+                        {"order", f.order},
+                        {"notch_hz", f.notch_hz},
+                        {"notch_q", f.notch_q}}},
                       {"window_s", {pipeline.window.start_s, pipeline.window.end_s}},
                       {"decimate_hz", pipeline.decimate_hz},
                       {"decimation_factor", pipeline.decimationFactor(rate_hz)},
                       {"channels", pipeline.channels}};
   json["shape"] = {{"channels", shape.channels}, {"bins", shape.bins}};
   json["classifier"] = classifier->toJson();
-  json["score_model"] = {{"target_mean", score_model.target_mean}, {"other_mean", score_model.other_mean}, {"sd", score_model.sd}};
-  json["paradigm"] = {{"kind", layout.kind == ParadigmLayout::Kind::RowColumn ? "row/column" : "single stimulus"},
-                      {"stimuli", layout.stimuli},
-                      {"rows", layout.rows},
-                      {"columns", layout.columns},
-                      {"soa_s", layout.soa_s},
-                      {"symbols", layout.symbols}};
+  json["score_model"] = {{"target_mean", score_model.target_mean},
+                         {"other_mean", score_model.other_mean},
+                         {"sd", score_model.sd}};
+  json["paradigm"] = {
+      {"kind", layout.kind == ParadigmLayout::Kind::RowColumn ? "row/column" : "single stimulus"},
+      {"stimuli", layout.stimuli},
+      {"rows", layout.rows},
+      {"columns", layout.columns},
+      {"soa_s", layout.soa_s},
+      {"symbols", layout.symbols}};
   json["provenance"] = provenance;
   return json;
 }
 
 P300Model P300Model::fromJson(const nlohmann::json& json, const std::string& source) {
   try {
-    if (json.value("format", "") != "arbci-p300-model") throw ModelError(source + ": not an ARBCI P300 model (format)");
-    if (json.value("version", 0) != 1) throw ModelError(source + ": model version " + json.value("version", nlohmann::json()).dump() + " is not 1");
+    if (json.value("format", "") != "arbci-p300-model")
+      throw ModelError(source + ": not an ARBCI P300 model (format)");
+    if (json.value("version", 0) != 1)
+      throw ModelError(source + ": model version " +
+                       json.value("version", nlohmann::json()).dump() + " is not 1");
     P300Model model;
     model.method = json.at("method").get<std::string>();
     model.rate_hz = json.at("signal").at("rate_hz").get<double>();
     if (!(model.rate_hz > 0.0)) throw ModelError(source + ": signal.rate_hz must be positive");
     const auto& p = json.at("pipeline");
     const auto& f = p.at("filter");
-    model.pipeline.filter = {f.at("common_average").get<bool>(), f.at("highpass_hz").get<double>(), f.at("lowpass_hz").get<double>(),
-                             f.at("order").get<int>(), f.at("notch_hz").get<double>(), f.at("notch_q").get<double>()};
+    model.pipeline.filter = {f.at("common_average").get<bool>(), f.at("highpass_hz").get<double>(),
+                             f.at("lowpass_hz").get<double>(),   f.at("order").get<int>(),
+                             f.at("notch_hz").get<double>(),     f.at("notch_q").get<double>()};
     const auto window = p.at("window_s").get<std::vector<double>>();
-    if (window.size() != 2 || !(window[1] > window[0])) throw ModelError(source + ": pipeline.window_s must be [start, end]");
+    if (window.size() != 2 || !(window[1] > window[0]))
+      throw ModelError(source + ": pipeline.window_s must be [start, end]");
     model.pipeline.window = {window[0], window[1]};
     model.pipeline.decimate_hz = p.at("decimate_hz").get<double>();
     model.pipeline.channels = p.at("channels").get<std::vector<std::string>>();
-    model.shape = {json.at("shape").at("channels").get<int>(), json.at("shape").at("bins").get<int>()};
+    model.shape = {json.at("shape").at("channels").get<int>(),
+                   json.at("shape").at("bins").get<int>()};
     if (model.shape.channels != static_cast<int>(model.pipeline.channels.size())) {
       throw ModelError(source + ": shape.channels does not match pipeline.channels");
     }
     model.classifier = classifierFromJson(json.at("classifier"), model.shape);
     const auto& s = json.at("score_model");
-    model.score_model = {s.at("target_mean").get<double>(), s.at("other_mean").get<double>(), s.at("sd").get<double>()};
+    model.score_model = {s.at("target_mean").get<double>(), s.at("other_mean").get<double>(),
+                         s.at("sd").get<double>()};
     const auto& l = json.at("paradigm");
     if (l.at("kind").get<std::string>() == "row/column") {
-      model.layout = ParadigmLayout::matrix(l.at("rows").get<int>(), l.at("columns").get<int>(), l.at("soa_s").get<double>());
+      model.layout = ParadigmLayout::matrix(l.at("rows").get<int>(), l.at("columns").get<int>(),
+                                            l.at("soa_s").get<double>());
     } else {
-      model.layout = ParadigmLayout::single(l.at("stimuli").get<int>(), l.at("soa_s").get<double>());
+      model.layout =
+          ParadigmLayout::single(l.at("stimuli").get<int>(), l.at("soa_s").get<double>());
     }
     model.layout.symbols = l.value("symbols", std::vector<std::string>{});
     model.provenance = json.value("provenance", nlohmann::json::object());
@@ -107,8 +123,9 @@ P300Model P300Model::load(const std::filesystem::path& path) {
 
 std::string P300Model::bci2000Fragment() const {
   if (std::abs(pipeline.window.start_s) > 1e-9) {
-    throw ModelError("BCI2000's P3TemporalFilter epochs start at the stimulus; this model's window starts at " +
-                     std::to_string(pipeline.window.start_s) + " s");
+    throw ModelError(
+        "BCI2000's P3TemporalFilter epochs start at the stimulus; this model's window starts at " +
+        std::to_string(pipeline.window.start_s) + " s");
   }
   const int factor = pipeline.decimationFactor(rate_hz);
   const Eigen::VectorXd w = classifier->weights();
@@ -129,24 +146,31 @@ std::string P300Model::bci2000Fragment() const {
   out << "Filtering:LinearClassifier matrix Classifier= " << count
       << " { input%20channel input%20element%20(bin) output%20channel weight }" << entries.str()
       << " // ARBCI " << method << " model\n";
-  out << "Filtering:P3TemporalFilter int EpochLength= " << std::lround(pipeline.window.end_s * 1000.0)
+  out << "Filtering:P3TemporalFilter int EpochLength= "
+      << std::lround(pipeline.window.end_s * 1000.0)
       << "ms 500ms 0 % // Length of data epoch from stimulus onset\n";
   out << "Filtering:P3TemporalFilter int EpochsToAverage= 1 1 0 % // Number of epochs to average\n";
-  out << "Source:Online%20Processing:TransmissionFilter list TransmitChList= " << pipeline.channels.size();
+  out << "Source:Online%20Processing:TransmissionFilter list TransmitChList= "
+      << pipeline.channels.size();
   for (const std::string& c : pipeline.channels) out << " " << c;
   out << " // channels the classifier reads, in its input-channel order\n";
-  out << "Filtering:SpatialFilter int SpatialFilterType= " << (pipeline.filter.common_average ? 3 : 0)
-      << " 2 0 3 // " << (pipeline.filter.common_average ? "common average reference" : "none") << " (enumeration)\n";
+  out << "Filtering:SpatialFilter int SpatialFilterType= "
+      << (pipeline.filter.common_average ? 3 : 0) << " 2 0 3 // "
+      << (pipeline.filter.common_average ? "common average reference" : "none")
+      << " (enumeration)\n";
   const FilterSettings& f = pipeline.filter;
-  out << "Filtering:IIRBandpass float HighPassCorner= " << f.highpass_hz << "Hz 0.1Hz % % // ARBCI's Butterworth high-pass\n";
-  out << "Filtering:IIRBandpass float LowPassCorner= " << f.lowpass_hz << "Hz 0Hz % % // ARBCI's Butterworth low-pass\n";
-  out << "Filtering:IIRBandpass int FilterOrder= " << f.order << " 4 1 % // of each Butterworth half\n";
+  out << "Filtering:IIRBandpass float HighPassCorner= " << f.highpass_hz
+      << "Hz 0.1Hz % % // ARBCI's Butterworth high-pass\n";
+  out << "Filtering:IIRBandpass float LowPassCorner= " << f.lowpass_hz
+      << "Hz 0Hz % % // ARBCI's Butterworth low-pass\n";
+  out << "Filtering:IIRBandpass int FilterOrder= " << f.order
+      << " 4 1 % // of each Butterworth half\n";
   out << "Filtering:IIRBandpass float NotchCenter= " << f.notch_hz << "Hz 0Hz % % // 0: none\n";
   return out.str();
 }
 
-TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipeline, const TrainingSettings& settings,
-                          const Progress& progress) {
+TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipeline,
+                          const TrainingSettings& settings, const Progress& progress) {
   TrainingResult result;
   result.cross_validation = crossValidate(data, settings, progress);
   // The final model learns from every labelled epoch.
@@ -161,11 +185,12 @@ TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipel
     y.push_back(data.target[static_cast<size_t>(rows[i])]);
   }
   auto classifier = makeClassifier(settings.method, settings.swlda, settings.xdawn);
-  classifier->train(x, y, data.shape, progress ? Progress([&](double f, const std::string& stage) {
-    const double folds = result.cross_validation.folds;
-    progress((folds + f) / (folds + 1.0), "final model: " + stage);
-  })
-                                               : Progress());
+  classifier->train(x, y, data.shape,
+                    progress ? Progress([&](double f, const std::string& stage) {
+                      const double folds = result.cross_validation.folds;
+                      progress((folds + f) / (folds + 1.0), "final model: " + stage);
+                    })
+                             : Progress());
   P300Model& model = result.model;
   model.method = settings.method;
   model.rate_hz = data.info.rate_hz;
@@ -186,7 +211,8 @@ TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipel
                         {"accuracy_by_sequences", report.accuracy},
                         {"bits_per_minute", report.bits_per_minute}}}};
   if (settings.method == "swlda") {
-    model.provenance["parameters"] = {{"p_enter", settings.swlda.p_enter}, {"p_remove", settings.swlda.p_remove},
+    model.provenance["parameters"] = {{"p_enter", settings.swlda.p_enter},
+                                      {"p_remove", settings.swlda.p_remove},
                                       {"max_features", settings.swlda.max_features}};
   } else if (settings.method == "xdawn") {
     model.provenance["parameters"] = {{"filters", settings.xdawn.filters}};

@@ -6,37 +6,58 @@
 
 namespace arbci::bci {
 
-int ParadigmSettings::flashFrames() const { return std::max(1, static_cast<int>(std::lround(flash_ms * display_hz / 1000.0))); }
+int ParadigmSettings::flashFrames() const {
+  return std::max(1, static_cast<int>(std::lround(flash_ms * display_hz / 1000.0)));
+}
 
 int ParadigmSettings::onsetFrames() const {
-  return std::max(flashFrames() + 1, static_cast<int>(std::lround((flash_ms + isi_ms) * display_hz / 1000.0)));
+  return std::max(flashFrames() + 1,
+                  static_cast<int>(std::lround((flash_ms + isi_ms) * display_hz / 1000.0)));
 }
 
 const char* toString(Phase phase) {
   switch (phase) {
-    case Phase::Setup: return "set-up";
-    case Phase::CalibrationCue: return "calibration: target cued";
-    case Phase::CalibrationFlashing: return "calibration: flashing";
-    case Phase::Training: return "training the classifier";
-    case Phase::ObjectFlashing: return "phase 1: objects flashing";
-    case Phase::ObjectSelected: return "phase 1: object selected";
-    case Phase::Grasping: return "robot grasping";
-    case Phase::CellFlashing: return "phase 2: grid flashing";
-    case Phase::CellSelected: return "phase 2: cell selected";
-    case Phase::Dropping: return "robot putting down";
-    case Phase::Finished: return "finished";
-    case Phase::Aborted: return "aborted";
-    case Phase::Paused: return "paused";
-    case Phase::EmergencyStop: return "EMERGENCY STOP";
-    case Phase::RobotFault: return "robot fault: waiting for the experimenter";
+    case Phase::Setup:
+      return "set-up";
+    case Phase::CalibrationCue:
+      return "calibration: target cued";
+    case Phase::CalibrationFlashing:
+      return "calibration: flashing";
+    case Phase::Training:
+      return "training the classifier";
+    case Phase::ObjectFlashing:
+      return "phase 1: objects flashing";
+    case Phase::ObjectSelected:
+      return "phase 1: object selected";
+    case Phase::Grasping:
+      return "robot grasping";
+    case Phase::CellFlashing:
+      return "phase 2: grid flashing";
+    case Phase::CellSelected:
+      return "phase 2: cell selected";
+    case Phase::Dropping:
+      return "robot putting down";
+    case Phase::Finished:
+      return "finished";
+    case Phase::Aborted:
+      return "aborted";
+    case Phase::Paused:
+      return "paused";
+    case Phase::EmergencyStop:
+      return "EMERGENCY STOP";
+    case Phase::RobotFault:
+      return "robot fault: waiting for the experimenter";
   }
   return "unknown";
 }
 
-Paradigm::Paradigm(const ParadigmSettings& settings, int objects, int rows, int columns, std::uint64_t seed)
+Paradigm::Paradigm(const ParadigmSettings& settings, int objects, int rows, int columns,
+                   std::uint64_t seed)
     : settings_(settings),
-      object_layout_(ParadigmLayout::single(std::max(objects, 2), settings.onsetFrames() / settings.display_hz)),
-      grid_layout_(ParadigmLayout::matrix(rows, columns, settings.onsetFrames() / settings.display_hz)),
+      object_layout_(ParadigmLayout::single(std::max(objects, 2),
+                                            settings.onsetFrames() / settings.display_hz)),
+      grid_layout_(
+          ParadigmLayout::matrix(rows, columns, settings.onsetFrames() / settings.display_hz)),
       random_(seed) {}
 
 void Paradigm::event(ParadigmEvent e) {
@@ -59,7 +80,8 @@ void Paradigm::start(bool calibrate) {
   calibrating_ = calibrate;
   if (calibrate && settings_.calibration_selections > 0) {
     calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
-    phase_until_ = now_ + static_cast<std::int64_t>(std::lround(settings_.cue_s * settings_.display_hz));
+    phase_until_ =
+        now_ + static_cast<std::int64_t>(std::lround(settings_.cue_s * settings_.display_hz));
     enter(Phase::CalibrationCue, now_, "object " + std::to_string(*calibration_target_));
     ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
     e.codes = {*calibration_target_};
@@ -79,7 +101,9 @@ void Paradigm::startFlashing(std::int64_t frame, bool objects) {
   stop_requested_ = false;
   awaiting_decision_ = false;
   if (objects) selected_cell_.reset();
-  enter(calibrating_ ? Phase::CalibrationFlashing : (objects ? Phase::ObjectFlashing : Phase::CellFlashing), frame);
+  enter(calibrating_ ? Phase::CalibrationFlashing
+                     : (objects ? Phase::ObjectFlashing : Phase::CellFlashing),
+        frame);
   if (!calibrating_) {
     ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
     e.objects_layout = objects;
@@ -102,7 +126,8 @@ void Paradigm::scheduleSequence(std::int64_t first_frame) {
 FrameStimulus Paradigm::frame(std::int64_t index) {
   now_ = index;
   FrameStimulus out;
-  const bool flashing = phase_ == Phase::CalibrationFlashing || phase_ == Phase::ObjectFlashing || phase_ == Phase::CellFlashing;
+  const bool flashing = phase_ == Phase::CalibrationFlashing || phase_ == Phase::ObjectFlashing ||
+                        phase_ == Phase::CellFlashing;
   if (flashing && !awaiting_decision_) {
     for (size_t i = 0; i < schedule_.size(); ++i) {
       const auto [onset, code] = schedule_[i];
@@ -117,7 +142,8 @@ FrameStimulus Paradigm::frame(std::int64_t index) {
     }
     // The sequence's last interval is over: another sequence, or the end of flashing.
     if (!schedule_.empty() && index >= schedule_.back().first + settings_.onsetFrames() - 1) {
-      const bool dynamic_stop = !calibrating_ && stop_requested_ && sequence_ >= settings_.min_sequences;
+      const bool dynamic_stop =
+          !calibrating_ && stop_requested_ && sequence_ >= settings_.min_sequences;
       const int most = calibrating_ ? settings_.calibration_sequences : settings_.sequences;
       if (sequence_ < most && !dynamic_stop) {
         scheduleSequence(index + 1);
@@ -140,7 +166,9 @@ FrameStimulus Paradigm::frame(std::int64_t index) {
       break;
     case Phase::CellSelected:
       if (index >= phase_until_) {
-        enter(Phase::Dropping, index, "row " + std::to_string(selected_cell_->first) + " column " + std::to_string(selected_cell_->second));
+        enter(Phase::Dropping, index,
+              "row " + std::to_string(selected_cell_->first) + " column " +
+                  std::to_string(selected_cell_->second));
         ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
         e.cell = *selected_cell_;
         event(e);
@@ -150,18 +178,22 @@ FrameStimulus Paradigm::frame(std::int64_t index) {
       break;
   }
   out.phase = phase_;
-  out.grid_visible = phase_ == Phase::CellFlashing || phase_ == Phase::CellSelected || phase_ == Phase::Dropping ||
-                     phase_ == Phase::Grasping;
-  if (calibrating_ && (phase_ == Phase::CalibrationCue || phase_ == Phase::CalibrationFlashing)) out.cued_object = calibration_target_;
-  if (phase_ == Phase::ObjectSelected || phase_ == Phase::Grasping || phase_ == Phase::CellFlashing || phase_ == Phase::CellSelected ||
-      phase_ == Phase::Dropping) {
+  out.grid_visible = phase_ == Phase::CellFlashing || phase_ == Phase::CellSelected ||
+                     phase_ == Phase::Dropping || phase_ == Phase::Grasping;
+  if (calibrating_ && (phase_ == Phase::CalibrationCue || phase_ == Phase::CalibrationFlashing))
+    out.cued_object = calibration_target_;
+  if (phase_ == Phase::ObjectSelected || phase_ == Phase::Grasping ||
+      phase_ == Phase::CellFlashing || phase_ == Phase::CellSelected || phase_ == Phase::Dropping) {
     out.selected_object = selected_object_;
   }
-  if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping) out.selected_cell = selected_cell_;
+  if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping)
+    out.selected_cell = selected_cell_;
   return out;
 }
 
-void Paradigm::requestStopFlashing() { stop_requested_ = true; }
+void Paradigm::requestStopFlashing() {
+  stop_requested_ = true;
+}
 
 void Paradigm::decide(const Decision& decision) {
   if (!awaiting_decision_) return;
@@ -171,7 +203,8 @@ void Paradigm::decide(const Decision& decision) {
     ++calibration_done_;
     if (calibration_done_ < settings_.calibration_selections) {
       calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
-      phase_until_ = now_ + static_cast<std::int64_t>(std::lround((settings_.pause_s + settings_.cue_s) * settings_.display_hz));
+      phase_until_ = now_ + static_cast<std::int64_t>(std::lround(
+                                (settings_.pause_s + settings_.cue_s) * settings_.display_hz));
       enter(Phase::CalibrationCue, now_, "object " + std::to_string(*calibration_target_));
       ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
       e.codes = {*calibration_target_};
@@ -188,7 +221,8 @@ void Paradigm::decide(const Decision& decision) {
   made.codes = decision.codes;
   made.certainty = decision.certainty;
   made.objects_layout = phase_ == Phase::ObjectFlashing;
-  const std::int64_t show = static_cast<std::int64_t>(std::lround(settings_.result_s * settings_.display_hz));
+  const std::int64_t show =
+      static_cast<std::int64_t>(std::lround(settings_.result_s * settings_.display_hz));
   if (phase_ == Phase::ObjectFlashing) {
     selected_object_ = decision.choice + 1;
     made.object = *selected_object_;
@@ -196,11 +230,14 @@ void Paradigm::decide(const Decision& decision) {
     phase_until_ = now_ + show;
     enter(Phase::ObjectSelected, now_, "object " + std::to_string(*selected_object_));
   } else if (phase_ == Phase::CellFlashing) {
-    selected_cell_ = {decision.choice / grid_layout_.columns + 1, decision.choice % grid_layout_.columns + 1};
+    selected_cell_ = {decision.choice / grid_layout_.columns + 1,
+                      decision.choice % grid_layout_.columns + 1};
     made.cell = *selected_cell_;
     event(made);
     phase_until_ = now_ + show;
-    enter(Phase::CellSelected, now_, "row " + std::to_string(selected_cell_->first) + " column " + std::to_string(selected_cell_->second));
+    enter(Phase::CellSelected, now_,
+          "row " + std::to_string(selected_cell_->first) + " column " +
+              std::to_string(selected_cell_->second));
   }
 }
 
@@ -233,7 +270,9 @@ void Paradigm::robotFinished(bool success, const std::string& text) {
     enter(Phase::Finished, now_);
   } else {
     ++trial_;
-    startFlashing(now_ + static_cast<std::int64_t>(std::lround(settings_.pause_s * settings_.display_hz)), true);
+    startFlashing(
+        now_ + static_cast<std::int64_t>(std::lround(settings_.pause_s * settings_.display_hz)),
+        true);
   }
 }
 
@@ -242,8 +281,8 @@ void Paradigm::setObjectCount(int objects) {
 }
 
 void Paradigm::pause() {
-  if (phase_ == Phase::Setup || phase_ == Phase::Finished || phase_ == Phase::Aborted || phase_ == Phase::Paused ||
-      phase_ == Phase::EmergencyStop || phase_ == Phase::RobotFault) {
+  if (phase_ == Phase::Setup || phase_ == Phase::Finished || phase_ == Phase::Aborted ||
+      phase_ == Phase::Paused || phase_ == Phase::EmergencyStop || phase_ == Phase::RobotFault) {
     return;
   }
   paused_from_ = phase_;
@@ -256,7 +295,9 @@ void Paradigm::resume() {
     const Phase back = paused_from_;
     phase_until_ += now_;
     enter(back, now_, "resumed");
-    if ((back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing || back == Phase::CellFlashing) && !awaiting_decision_) {
+    if ((back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing ||
+         back == Phase::CellFlashing) &&
+        !awaiting_decision_) {
       // The interrupted sequence is shown again from its start.
       --sequence_;
       scheduleSequence(now_ + 1);
@@ -268,7 +309,8 @@ void Paradigm::resume() {
     const bool robot_phase = was == Phase::Grasping || was == Phase::Dropping;
     if (!robot_phase && phase_ == Phase::EmergencyStop) {
       enter(was, now_, "resumed after the stop");
-      if (was == Phase::CalibrationFlashing || was == Phase::ObjectFlashing || was == Phase::CellFlashing) {
+      if (was == Phase::CalibrationFlashing || was == Phase::ObjectFlashing ||
+          was == Phase::CellFlashing) {
         --sequence_;
         scheduleSequence(now_ + 1);
       }
@@ -288,7 +330,8 @@ void Paradigm::resume() {
 
 void Paradigm::abort() {
   if (phase_ == Phase::Finished || phase_ == Phase::Aborted) return;
-  if (phase_ == Phase::Grasping || phase_ == Phase::Dropping) event(ParadigmEvent{ParadigmEvent::Kind::RobotStop});
+  if (phase_ == Phase::Grasping || phase_ == Phase::Dropping)
+    event(ParadigmEvent{ParadigmEvent::Kind::RobotStop});
   schedule_.clear();
   enter(Phase::Aborted, now_, "by the experimenter");
 }
@@ -296,11 +339,14 @@ void Paradigm::abort() {
 void Paradigm::emergencyStop() {
   if (phase_ == Phase::Finished || phase_ == Phase::Aborted) return;
   event(ParadigmEvent{ParadigmEvent::Kind::RobotStop});
-  if (phase_ != Phase::EmergencyStop && phase_ != Phase::RobotFault && phase_ != Phase::Paused) paused_from_ = phase_;
+  if (phase_ != Phase::EmergencyStop && phase_ != Phase::RobotFault && phase_ != Phase::Paused)
+    paused_from_ = phase_;
   schedule_.clear();
   enter(Phase::EmergencyStop, now_);
 }
 
-std::vector<ParadigmEvent> Paradigm::takeEvents() { return std::exchange(events_, {}); }
+std::vector<ParadigmEvent> Paradigm::takeEvents() {
+  return std::exchange(events_, {});
+}
 
 }  // namespace arbci::bci

@@ -5,7 +5,8 @@
 namespace arbci::bci {
 
 ParadigmLayout ParadigmLayout::single(int stimuli, double soa_s) {
-  if (stimuli < 2) throw std::invalid_argument("a single-stimulus paradigm needs at least 2 stimuli");
+  if (stimuli < 2)
+    throw std::invalid_argument("a single-stimulus paradigm needs at least 2 stimuli");
   ParadigmLayout layout;
   layout.stimuli = stimuli;
   layout.soa_s = soa_s;
@@ -13,7 +14,8 @@ ParadigmLayout ParadigmLayout::single(int stimuli, double soa_s) {
 }
 
 ParadigmLayout ParadigmLayout::matrix(int rows, int columns, double soa_s) {
-  if (rows < 1 || columns < 1 || rows * columns < 2) throw std::invalid_argument("a matrix needs at least 2 cells");
+  if (rows < 1 || columns < 1 || rows * columns < 2)
+    throw std::invalid_argument("a matrix needs at least 2 cells");
   ParadigmLayout layout;
   layout.kind = Kind::RowColumn;
   layout.rows = rows;
@@ -28,11 +30,14 @@ std::set<int> ParadigmLayout::codesOf(int choice) const {
 }
 
 std::string ParadigmLayout::describe(const std::set<int>& codes) const {
-  if (kind == Kind::SingleStimulus) return codes.size() == 1 ? "object " + std::to_string(*codes.begin()) : "?";
+  if (kind == Kind::SingleStimulus)
+    return codes.size() == 1 ? "object " + std::to_string(*codes.begin()) : "?";
   int row = 0, column = 0;
   for (int code : codes) {
-    if (isRow(code)) row = code;
-    else column = code - rows;
+    if (isRow(code))
+      row = code;
+    else
+      column = code - rows;
   }
   if (row < 1 || column < 1 || column > columns) return "?";
   const size_t cell = static_cast<size_t>((row - 1) * columns + column - 1);
@@ -41,7 +46,8 @@ std::string ParadigmLayout::describe(const std::set<int>& codes) const {
 }
 
 std::string ParadigmLayout::describeShape() const {
-  if (kind == Kind::RowColumn) return "row/column " + std::to_string(rows) + "x" + std::to_string(columns);
+  if (kind == Kind::RowColumn)
+    return "row/column " + std::to_string(rows) + "x" + std::to_string(columns);
   return "single stimulus, " + std::to_string(stimuli) + " stimuli";
 }
 

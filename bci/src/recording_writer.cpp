@@ -25,7 +25,8 @@ namespace {
 std::pair<double, int> recordLayout(double rate) {
   for (double seconds : {0.25, 0.5, 1.0, 2.0, 5.0, 10.0}) {
     const double samples = rate * seconds;
-    if (std::abs(samples - std::round(samples)) < 1e-9 && samples >= 1.0) return {seconds, static_cast<int>(std::round(samples))};
+    if (std::abs(samples - std::round(samples)) < 1e-9 && samples >= 1.0)
+      return {seconds, static_cast<int>(std::round(samples))};
   }
   return {1.0, static_cast<int>(std::round(rate))};
 }
@@ -79,12 +80,15 @@ struct RecordingWriter::State {
 
   State(const std::filesystem::path& p, int fd) : path(p), file(fd) {}
 
-  [[noreturn]] void fail(const std::string& what) const { throw RecordingError(path.string() + ": " + what); }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw RecordingError(path.string() + ": " + what);
+  }
 
   void writeAt(const std::string& bytes, off_t offset) {
     size_t done = 0;
     while (done < bytes.size()) {
-      const ssize_t n = ::pwrite(file.get(), bytes.data() + done, bytes.size() - done, offset + static_cast<off_t>(done));
+      const ssize_t n = ::pwrite(file.get(), bytes.data() + done, bytes.size() - done,
+                                 offset + static_cast<off_t>(done));
       if (n < 0) fail(std::string("write failed: ") + std::strerror(errno));
       done += static_cast<size_t>(n);
     }
@@ -107,11 +111,12 @@ struct RecordingWriter::State {
 
   void writeRecord() {
     std::string record;
-    record.reserve(static_cast<size_t>(info.channelCount() * record_samples * 3 + annotation_bytes));
+    record.reserve(
+        static_cast<size_t>(info.channelCount() * record_samples * 3 + annotation_bytes));
     for (int c = 0; c < info.channelCount(); ++c) {
       for (int s = 0; s < record_samples; ++s) {
-        const double value = bdf::digital(pending[static_cast<size_t>(c) * record_samples + s], -options.range_microvolts,
-                                          options.range_microvolts);
+        const double value = bdf::digital(pending[static_cast<size_t>(c) * record_samples + s],
+                                          -options.range_microvolts, options.range_microvolts);
         const double limited = std::clamp(value, bdf::kDigitalMin, bdf::kDigitalMax);
         if (limited != value || std::isnan(value)) ++clipped;
         bdf::appendInt24(record, std::isnan(value) ? 0 : static_cast<std::int32_t>(limited));
@@ -119,8 +124,11 @@ struct RecordingWriter::State {
     }
     // The record's time-keeping TAL, then as many waiting annotations as fit.
     std::string annotation_area(1, '+');
-    annotation_area.append(bdf::seconds(records * record_seconds)).append("\x14\x14").append(1, '\0');
-    while (!annotations.empty() && annotation_area.size() + annotations.front().size() <= static_cast<size_t>(annotation_bytes)) {
+    annotation_area.append(bdf::seconds(records * record_seconds))
+        .append("\x14\x14")
+        .append(1, '\0');
+    while (!annotations.empty() && annotation_area.size() + annotations.front().size() <=
+                                       static_cast<size_t>(annotation_bytes)) {
       annotation_area += annotations.front();
       annotations.pop_front();
     }
@@ -147,8 +155,10 @@ struct RecordingWriter::State {
 RecordingWriter::RecordingWriter(const std::filesystem::path& path, const SignalInfo& info,
                                  const std::map<std::string, std::string>& parameters,
                                  const RecordingWriterOptions& options) {
-  if (info.channelCount() == 0) throw RecordingError(path.string() + ": a recording needs at least one channel");
-  if (!(info.rate_hz > 0.0)) throw RecordingError(path.string() + ": the sampling rate must be positive");
+  if (info.channelCount() == 0)
+    throw RecordingError(path.string() + ": a recording needs at least one channel");
+  if (!(info.rate_hz > 0.0))
+    throw RecordingError(path.string() + ": the sampling rate must be positive");
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw RecordingError(path.string() + ": cannot create: " + std::strerror(errno));
   state_ = std::make_unique<State>(path, fd);
@@ -164,12 +174,14 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Signal
   header.start = std::time(nullptr);
   header.record_seconds = s.record_seconds;
   for (int c = 0; c < info.channelCount(); ++c) {
-    header.signals.push_back({info.channels[c], "uV", -options.range_microvolts, options.range_microvolts, s.record_samples});
+    header.signals.push_back({info.channels[c], "uV", -options.range_microvolts,
+                              options.range_microvolts, s.record_samples});
   }
   header.annotation_samples = s.annotation_bytes / 3;
   s.writeAt(bdf::header(header), 0);
 
-  for (const auto& [name, value] : parameters) s.annotations.push_back(s.tal(0.0, 0.0, "Param " + name + "=" + value));
+  for (const auto& [name, value] : parameters)
+    s.annotations.push_back(s.tal(0.0, 0.0, "Param " + name + "=" + value));
   s.syncer = std::thread([&s] { s.syncLoop(); });
 }
 
@@ -185,10 +197,12 @@ void RecordingWriter::write(const Block& block) {
   State& s = *state_;
   if (s.closed) s.fail("write after close");
   if (block.channels != s.info.channelCount()) {
-    s.fail("block has " + std::to_string(block.channels) + " channels, the recording " + std::to_string(s.info.channelCount()));
+    s.fail("block has " + std::to_string(block.channels) + " channels, the recording " +
+           std::to_string(s.info.channelCount()));
   }
   if (block.first_sample != s.samples) {
-    s.fail("block starts at sample " + std::to_string(block.first_sample) + ", expected " + std::to_string(s.samples));
+    s.fail("block starts at sample " + std::to_string(block.first_sample) + ", expected " +
+           std::to_string(s.samples));
   }
   for (int i = 0; i < block.samples; ++i) {
     for (int c = 0; c < block.channels; ++c) {
@@ -202,13 +216,15 @@ void RecordingWriter::write(const Block& block) {
 
 void RecordingWriter::addStimulus(const StimulusEvent& event) {
   State& s = *state_;
-  s.annotations.push_back(s.tal(event.sample / s.info.rate_hz, event.duration_samples / s.info.rate_hz,
-                                "Stim " + std::to_string(event.code) + (event.target ? " T" : " N")));
+  s.annotations.push_back(
+      s.tal(event.sample / s.info.rate_hz, event.duration_samples / s.info.rate_hz,
+            "Stim " + std::to_string(event.code) + (event.target ? " T" : " N")));
 }
 
 void RecordingWriter::addAnnotation(const Annotation& annotation) {
   State& s = *state_;
-  s.annotations.push_back(s.tal(annotation.sample / s.info.rate_hz, annotation.duration_samples / s.info.rate_hz, annotation.text));
+  s.annotations.push_back(s.tal(annotation.sample / s.info.rate_hz,
+                                annotation.duration_samples / s.info.rate_hz, annotation.text));
 }
 
 void RecordingWriter::close() {
@@ -220,7 +236,8 @@ void RecordingWriter::close() {
     // Padding completes the last record; the marker tells ARBCI's reader where the signal ends.
     const double end = true_samples / s.info.rate_hz;
     const double padded_end = (s.records + 1) * s.record_seconds;
-    s.annotations.push_back(s.tal(end, padded_end - end, std::string(bdf::kEndMarker) + std::to_string(true_samples)));
+    s.annotations.push_back(
+        s.tal(end, padded_end - end, std::string(bdf::kEndMarker) + std::to_string(true_samples)));
     do {
       s.writeRecord();
     } while (!s.annotations.empty());
@@ -234,9 +251,17 @@ void RecordingWriter::close() {
   ::fdatasync(s.file.get());
 }
 
-std::int64_t RecordingWriter::samplesWritten() const { return state_->samples; }
-std::int64_t RecordingWriter::clippedSamples() const { return state_->clipped; }
-std::int64_t RecordingWriter::shortenedAnnotations() const { return state_->shortened; }
-const std::filesystem::path& RecordingWriter::path() const { return state_->path; }
+std::int64_t RecordingWriter::samplesWritten() const {
+  return state_->samples;
+}
+std::int64_t RecordingWriter::clippedSamples() const {
+  return state_->clipped;
+}
+std::int64_t RecordingWriter::shortenedAnnotations() const {
+  return state_->shortened;
+}
+const std::filesystem::path& RecordingWriter::path() const {
+  return state_->path;
+}
 
 }  // namespace arbci::bci

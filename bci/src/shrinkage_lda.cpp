@@ -7,7 +7,8 @@
 
 namespace arbci::bci {
 
-double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target, Eigen::VectorXd& weights, double& bias) {
+double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target,
+                         Eigen::VectorXd& weights, double& bias) {
   const Eigen::Index n = x.rows(), p = x.cols();
   Eigen::VectorXd mean_target = Eigen::VectorXd::Zero(p), mean_other = Eigen::VectorXd::Zero(p);
   int n_target = 0, n_other = 0;
@@ -25,7 +26,8 @@ double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& targ
   // Pooled within-class deviations.
   Eigen::MatrixXd centred(n, p);
   for (Eigen::Index i = 0; i < n; ++i) {
-    centred.row(i) = x.row(i) - (target[static_cast<size_t>(i)] ? mean_target : mean_other).transpose();
+    centred.row(i) =
+        x.row(i) - (target[static_cast<size_t>(i)] ? mean_target : mean_other).transpose();
   }
   const Eigen::MatrixXd sample = centred.transpose() * centred / static_cast<double>(n);
   const double mu = sample.trace() / static_cast<double>(p);
@@ -37,7 +39,8 @@ double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& targ
     const double r2 = centred.row(i).squaredNorm();
     sum_x4 += r2 * r2;
   }
-  const double b2_bar = (sum_x4 - static_cast<double>(n) * s_norm2) / (static_cast<double>(n) * static_cast<double>(n));
+  const double b2_bar = (sum_x4 - static_cast<double>(n) * s_norm2) /
+                        (static_cast<double>(n) * static_cast<double>(n));
   const double shrinkage = d2 > 0.0 ? std::clamp(b2_bar / d2, 0.0, 1.0) : 1.0;
   Eigen::MatrixXd covariance = (1.0 - shrinkage) * sample;
   covariance.diagonal().array() += shrinkage * mu;
@@ -46,8 +49,8 @@ double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& targ
   return shrinkage;
 }
 
-void ShrinkageLdaClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-                                   const Progress& progress) {
+void ShrinkageLdaClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                                   const FeatureShape& shape, const Progress& progress) {
   checkTrainingData(features, target, shape);
   if (progress) progress(0.0, "shrinkage LDA");
   const double shrinkage = trainShrinkageLda(features, target, weights_, bias_);

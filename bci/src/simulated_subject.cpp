@@ -86,8 +86,8 @@ SubjectProfile SubjectProfile::drawn(std::uint64_t seed) {
 struct SimulatedSubject::Generator {
   std::mt19937_64 random;
   std::normal_distribution<double> normal{0.0, 1.0};
-  std::vector<PinkNoise> own;     // per channel
-  PinkNoise shared;               // common to all channels
+  std::vector<PinkNoise> own;      // per channel
+  PinkNoise shared;                // common to all channels
   std::vector<double> shared_mix;  // per channel, random sign and size
   Resonator alpha;
   std::vector<double> line_amplitude, line_phase;
@@ -96,7 +96,8 @@ struct SimulatedSubject::Generator {
   std::int64_t blink_start = -1, blink_length = 0;
   double blink_size = 1.0;
 
-  Generator(const SimulatedSubjectConfig& c) : random(c.seed), shared(c.rate_hz), alpha(c.alpha_hz, c.rate_hz) {
+  Generator(const SimulatedSubjectConfig& c)
+      : random(c.seed), shared(c.rate_hz), alpha(c.alpha_hz, c.rate_hz) {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     for (const std::string& name : c.montage) {
       own.emplace_back(c.rate_hz);
@@ -110,14 +111,19 @@ struct SimulatedSubject::Generator {
   }
 };
 
-SimulatedSubject::SimulatedSubject(const SimulatedSubjectConfig& config, std::shared_ptr<const SampleClock> clock)
-    : config_(config), profile_(config.profile ? *config.profile : SubjectProfile::drawn(config.seed)),
-      clock_(std::move(clock)), trial_random_(config.seed ^ 0xA5A5A5A5ULL) {
-  if (config.montage.empty()) throw std::invalid_argument("simulated subject: the montage has no channels");
+SimulatedSubject::SimulatedSubject(const SimulatedSubjectConfig& config,
+                                   std::shared_ptr<const SampleClock> clock)
+    : config_(config),
+      profile_(config.profile ? *config.profile : SubjectProfile::drawn(config.seed)),
+      clock_(std::move(clock)),
+      trial_random_(config.seed ^ 0xA5A5A5A5ULL) {
+  if (config.montage.empty())
+    throw std::invalid_argument("simulated subject: the montage has no channels");
   if (!(config.rate_hz >= 32.0 && config.rate_hz <= 20000.0)) {
     throw std::invalid_argument("simulated subject: sampling rate must be 32-20000 Hz");
   }
-  if (config.block_size <= 0) throw std::invalid_argument("simulated subject: block size must be positive");
+  if (config.block_size <= 0)
+    throw std::invalid_argument("simulated subject: block size must be positive");
   if (!clock_) throw std::invalid_argument("simulated subject: no clock");
   info_.rate_hz = config.rate_hz;
   info_.block_size = config.block_size;
@@ -133,8 +139,9 @@ void SimulatedSubject::present(const StimulusEvent& event) {
   response.onset = event.sample;
   response.attended = attended_.count(event.code) > 0;
   response.p3_latency = profile_.p3_latency_s + profile_.latency_jitter_s * normal(trial_random_);
-  response.p3_scale = std::exp(profile_.amplitude_variability * normal(trial_random_) -
-                               0.5 * profile_.amplitude_variability * profile_.amplitude_variability);
+  response.p3_scale =
+      std::exp(profile_.amplitude_variability * normal(trial_random_) -
+               0.5 * profile_.amplitude_variability * profile_.amplitude_variability);
   response.n2_scale = std::exp(0.3 * normal(trial_random_));
   responses_.push_back(response);
 }
@@ -146,11 +153,14 @@ float SimulatedSubject::evoked(int channel, std::int64_t sample) const {
     const double t = (sample - r.onset) / config_.rate_hz;
     if (t < 0.0 || t > 1.0) continue;
     // N1/P2 to every flash.
-    value += w.vep * profile_.vep_amplitude_uv * (-gaussian(t, 0.15, 0.02) + 0.8 * gaussian(t, 0.21, 0.03));
+    value += w.vep * profile_.vep_amplitude_uv *
+             (-gaussian(t, 0.15, 0.02) + 0.8 * gaussian(t, 0.21, 0.03));
     if (!r.attended) continue;
     const double latency_shift = r.p3_latency - profile_.p3_latency_s;
-    value += w.n2 * profile_.n2_amplitude_uv * r.n2_scale * gaussian(t, profile_.n2_latency_s + 0.5 * latency_shift, profile_.n2_width_s);
-    value += w.p3 * profile_.p3_amplitude_uv * r.p3_scale * gaussian(t, r.p3_latency, profile_.p3_width_s);
+    value += w.n2 * profile_.n2_amplitude_uv * r.n2_scale *
+             gaussian(t, profile_.n2_latency_s + 0.5 * latency_shift, profile_.n2_width_s);
+    value += w.p3 * profile_.p3_amplitude_uv * r.p3_scale *
+             gaussian(t, r.p3_latency, profile_.p3_width_s);
   }
   return static_cast<float>(value);
 }
@@ -160,21 +170,28 @@ std::vector<Block> SimulatedSubject::poll(int max_blocks) {
   const std::int64_t available = clock_->available(config_.rate_hz);
   Generator& g = *generator_;
   const int channels = info_.channelCount();
-  const double blink_mean_gap = config_.blinks_per_minute > 0.0 ? 60.0 / config_.blinks_per_minute * config_.rate_hz : 0.0;
+  const double blink_mean_gap =
+      config_.blinks_per_minute > 0.0 ? 60.0 / config_.blinks_per_minute * config_.rate_hz : 0.0;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  while (static_cast<int>(blocks.size()) < max_blocks && generated_ + config_.block_size <= available) {
+  while (static_cast<int>(blocks.size()) < max_blocks &&
+         generated_ + config_.block_size <= available) {
     Block block(generated_, channels, config_.block_size);
     for (int s = 0; s < config_.block_size; ++s) {
       const std::int64_t n = generated_ + s;
       const double time = n / config_.rate_hz;
       // Blinks arrive as a Poisson process; each lasts 300-450 ms.
       if (blink_mean_gap > 0.0) {
-        if (g.next_blink < 0) g.next_blink = n + static_cast<std::int64_t>(-std::log(1.0 - unit(g.random)) * blink_mean_gap);
+        if (g.next_blink < 0)
+          g.next_blink =
+              n + static_cast<std::int64_t>(-std::log(1.0 - unit(g.random)) * blink_mean_gap);
         if (n == g.next_blink) {
           g.blink_start = n;
-          g.blink_length = static_cast<std::int64_t>((0.30 + 0.15 * unit(g.random)) * config_.rate_hz);
+          g.blink_length =
+              static_cast<std::int64_t>((0.30 + 0.15 * unit(g.random)) * config_.rate_hz);
           g.blink_size = 0.6 + 0.8 * unit(g.random);
-          g.next_blink = n + g.blink_length + static_cast<std::int64_t>(-std::log(1.0 - unit(g.random)) * blink_mean_gap);
+          g.next_blink =
+              n + g.blink_length +
+              static_cast<std::int64_t>(-std::log(1.0 - unit(g.random)) * blink_mean_gap);
         }
       }
       double blink = 0.0;
@@ -188,10 +205,12 @@ std::vector<Block> SimulatedSubject::poll(int max_blocks) {
       const double shared_weight = std::sqrt(config_.shared_background);
       for (int c = 0; c < channels; ++c) {
         const ScalpWeights& w = g.weights[static_cast<size_t>(c)];
-        double v = config_.background_uv * (own_weight * g.own[static_cast<size_t>(c)].next(g.random, g.normal) +
-                                            shared_weight * g.shared_mix[static_cast<size_t>(c)] * shared);
+        double v = config_.background_uv *
+                   (own_weight * g.own[static_cast<size_t>(c)].next(g.random, g.normal) +
+                    shared_weight * g.shared_mix[static_cast<size_t>(c)] * shared);
         v += config_.alpha_uv * w.alpha * alpha;
-        v += g.line_amplitude[static_cast<size_t>(c)] * std::sin(kTwoPi * config_.line_hz * time + g.line_phase[static_cast<size_t>(c)]);
+        v += g.line_amplitude[static_cast<size_t>(c)] *
+             std::sin(kTwoPi * config_.line_hz * time + g.line_phase[static_cast<size_t>(c)]);
         v += w.blink * blink;
         v += evoked(c, n);
         block.at(c, s) = static_cast<float>(v);
@@ -200,7 +219,9 @@ std::vector<Block> SimulatedSubject::poll(int max_blocks) {
     generated_ += config_.block_size;
     blocks.push_back(std::move(block));
     // Responses more than a second old are over.
-    std::erase_if(responses_, [&](const ActiveResponse& r) { return r.onset + static_cast<std::int64_t>(config_.rate_hz) < generated_; });
+    std::erase_if(responses_, [&](const ActiveResponse& r) {
+      return r.onset + static_cast<std::int64_t>(config_.rate_hz) < generated_;
+    });
   }
   return blocks;
 }

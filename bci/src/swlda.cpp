@@ -33,12 +33,15 @@ Fit fitModel(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const std::vect
   fit.coefficients = qr.solve(y);
   const double df = static_cast<double>(n - k - 1);
   const double sigma2 = (y - design * fit.coefficients).squaredNorm() / df;
-  const Eigen::MatrixXd r = qr.matrixQR().topLeftCorner(k + 1, k + 1).triangularView<Eigen::Upper>();
-  const Eigen::MatrixXd r_inverse = r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(k + 1, k + 1));
+  const Eigen::MatrixXd r =
+      qr.matrixQR().topLeftCorner(k + 1, k + 1).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd r_inverse =
+      r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(k + 1, k + 1));
   fit.p_values.resize(k);
   for (Eigen::Index j = 0; j < k; ++j) {
     const double variance = sigma2 * r_inverse.row(j + 1).squaredNorm();
-    fit.p_values[j] = variance > 0.0 ? studentTwoSidedP(fit.coefficients[j + 1] / std::sqrt(variance), df) : 1.0;
+    fit.p_values[j] =
+        variance > 0.0 ? studentTwoSidedP(fit.coefficients[j + 1] / std::sqrt(variance), df) : 1.0;
   }
   return fit;
 }
@@ -72,7 +75,8 @@ class Residuals {
   double enterP(int j) const {
     const auto col = residual_x_.col(j);
     const double ss = col.squaredNorm();
-    if (ss < 1e-10 * std::max(1.0, x_.col(j).squaredNorm())) return 1.0;  // collinear with the model
+    if (ss < 1e-10 * std::max(1.0, x_.col(j).squaredNorm()))
+      return 1.0;  // collinear with the model
     const double cross = col.dot(residual_y_);
     const double rss_old = residual_y_.squaredNorm();
     const double rss_new = rss_old - cross * cross / ss;
@@ -91,10 +95,11 @@ class Residuals {
 
 }  // namespace
 
-void SwldaClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-                            const Progress& progress) {
+void SwldaClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                            const FeatureShape& shape, const Progress& progress) {
   checkTrainingData(features, target, shape);
-  if (!(settings_.p_enter > 0.0 && settings_.p_enter < settings_.p_remove && settings_.p_remove < 1.0)) {
+  if (!(settings_.p_enter > 0.0 && settings_.p_enter < settings_.p_remove &&
+        settings_.p_remove < 1.0)) {
     throw std::invalid_argument("SWLDA needs 0 < p-enter < p-remove < 1");
   }
   const Eigen::Index n = features.rows(), p = features.cols();
@@ -105,13 +110,16 @@ void SwldaClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
   Residuals residuals(features, y);
   const int max_steps = 4 * settings_.max_features + 20;  // stepwise fits can cycle; bound them
   for (int step = 0; step < max_steps; ++step) {
-    if (progress) progress(std::min(1.0, static_cast<double>(selected.size()) / settings_.max_features), "SWLDA step " + std::to_string(step + 1));
+    if (progress)
+      progress(std::min(1.0, static_cast<double>(selected.size()) / settings_.max_features),
+               "SWLDA step " + std::to_string(step + 1));
     // Try to add the most significant feature.
     int best = -1;
     double best_p = settings_.p_enter;
     if (static_cast<int>(selected.size()) < settings_.max_features) {
       for (Eigen::Index j = 0; j < p; ++j) {
-        if (std::find(selected.begin(), selected.end(), static_cast<int>(j)) != selected.end()) continue;
+        if (std::find(selected.begin(), selected.end(), static_cast<int>(j)) != selected.end())
+          continue;
         const double pj = residuals.enterP(static_cast<int>(j));
         if (pj < best_p) {
           best_p = pj;
@@ -134,7 +142,8 @@ void SwldaClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
     residuals.rebuild(selected);
   }
   if (selected.empty()) {
-    throw std::invalid_argument("SWLDA: no feature separates targets from non-targets at p < " + std::to_string(settings_.p_enter));
+    throw std::invalid_argument("SWLDA: no feature separates targets from non-targets at p < " +
+                                std::to_string(settings_.p_enter));
   }
   const Fit fit = fitModel(features, y, selected);
   weights_ = Eigen::VectorXd::Zero(p);
@@ -142,11 +151,15 @@ void SwldaClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
   for (size_t j = 0; j < selected.size(); ++j) {
     const int feature = selected[j];
     weights_[feature] = fit.coefficients[static_cast<Eigen::Index>(j) + 1];
-    kept.push_back({{"channel", feature / shape.bins}, {"bin", feature % shape.bins}, {"weight", weights_[feature]},
+    kept.push_back({{"channel", feature / shape.bins},
+                    {"bin", feature % shape.bins},
+                    {"weight", weights_[feature]},
                     {"p", fit.p_values[static_cast<Eigen::Index>(j)]}});
   }
   bias_ = fit.coefficients[0];
-  details_ = {{"p_enter", settings_.p_enter}, {"p_remove", settings_.p_remove}, {"max_features", settings_.max_features},
+  details_ = {{"p_enter", settings_.p_enter},
+              {"p_remove", settings_.p_remove},
+              {"max_features", settings_.max_features},
               {"features", kept}};
   if (progress) progress(1.0, "SWLDA: " + std::to_string(selected.size()) + " features");
 }

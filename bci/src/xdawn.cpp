@@ -9,8 +9,8 @@
 
 namespace arbci::bci {
 
-void XdawnClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-                            const Progress& progress) {
+void XdawnClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                            const FeatureShape& shape, const Progress& progress) {
   checkTrainingData(features, target, shape);
   const int channels = shape.channels, bins = shape.bins;
   const Eigen::Index n = features.rows();
@@ -33,10 +33,13 @@ void XdawnClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
   signal_covariance /= static_cast<double>(n * bins);
   signal_covariance.diagonal().array() += 1e-9 * signal_covariance.trace() / channels;
   const Eigen::MatrixXd evoked_covariance = target_mean * target_mean.transpose() / bins;
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(evoked_covariance, signal_covariance);
-  if (solver.info() != Eigen::Success) throw std::invalid_argument("xDAWN: the signal covariance is singular");
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(evoked_covariance,
+                                                                         signal_covariance);
+  if (solver.info() != Eigen::Success)
+    throw std::invalid_argument("xDAWN: the signal covariance is singular");
   const int kept = std::clamp(settings_.filters, 1, channels);
-  const Eigen::MatrixXd filters = solver.eigenvectors().rightCols(kept);  // largest eigenvalues last
+  const Eigen::MatrixXd filters =
+      solver.eigenvectors().rightCols(kept);  // largest eigenvalues last
 
   // Filtered epochs: kept x bins each, flattened filter-major.
   Eigen::MatrixXd projected(n, kept * bins);

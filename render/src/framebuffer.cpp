@@ -9,9 +9,13 @@
 
 namespace arbci::render {
 
-Framebuffer::Framebuffer(Size size) : size_(size) { create(); }
+Framebuffer::Framebuffer(Size size) : size_(size) {
+  create();
+}
 
-Framebuffer::~Framebuffer() { destroy(); }
+Framebuffer::~Framebuffer() {
+  destroy();
+}
 
 void Framebuffer::resize(Size size) {
   if (size == size_) return;
@@ -85,10 +89,12 @@ void blitTexture(unsigned int texture, Size source, Size target) {
   glViewport(0, 0, target.width, target.height);
   glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
-  const double scale = std::min(static_cast<double>(target.width) / source.width, static_cast<double>(target.height) / source.height);
+  const double scale = std::min(static_cast<double>(target.width) / source.width,
+                                static_cast<double>(target.height) / source.height);
   const int w = static_cast<int>(source.width * scale), h = static_cast<int>(source.height * scale);
   const int x = (target.width - w) / 2, y = (target.height - h) / 2;
-  glBlitFramebuffer(0, 0, source.width, source.height, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBlitFramebuffer(0, 0, source.width, source.height, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT,
+                    GL_LINEAR);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
   glDeleteFramebuffers(1, &read);
 }

@@ -1,8 +1,8 @@
 #include "arbci/render/hmd_view.h"
 
 #include <map>
-#include <sstream>
 #include <opencv2/calib3d.hpp>
+#include <sstream>
 
 #include "arbci/render/primitive_renderer.h"
 #include "arbci/render/shader_program.h"
@@ -17,7 +17,9 @@ cv::Vec3d GridLayout::cellCorner(double row_edge, double column_edge) const {
   return T_world_grid.apply(cv::Vec3d(x, y, 0.0));
 }
 
-cv::Vec3d GridLayout::cellCentre(int row, int column) const { return cellCorner(row - 0.5, column - 0.5); }
+cv::Vec3d GridLayout::cellCentre(int row, int column) const {
+  return cellCorner(row - 0.5, column - 0.5);
+}
 
 namespace {
 
@@ -31,14 +33,17 @@ struct Rectification {
 Rectification rectify(const vision::CameraModel& camera) {
   Rectification r;
   const cv::Size size = camera.image_size;
-  r.camera_matrix = cv::getOptimalNewCameraMatrix(camera.camera_matrix, camera.distortion, size, 0.0, size);
+  r.camera_matrix =
+      cv::getOptimalNewCameraMatrix(camera.camera_matrix, camera.distortion, size, 0.0, size);
   cv::Mat map;
-  cv::initUndistortRectifyMap(camera.camera_matrix, camera.distortion, cv::noArray(), r.camera_matrix, size, CV_32FC2, map, cv::noArray());
+  cv::initUndistortRectifyMap(camera.camera_matrix, camera.distortion, cv::noArray(),
+                              r.camera_matrix, size, CV_32FC2, map, cv::noArray());
   r.map.create(size, CV_32FC2);
   for (int y = 0; y < size.height; ++y) {
     for (int x = 0; x < size.width; ++x) {
       const cv::Vec2f s = map.at<cv::Vec2f>(y, x);
-      r.map.at<cv::Vec2f>(y, x) = cv::Vec2f((s[0] + 0.5f) / size.width, (s[1] + 0.5f) / size.height);
+      r.map.at<cv::Vec2f>(y, x) =
+          cv::Vec2f((s[0] + 0.5f) / size.width, (s[1] + 0.5f) / size.height);
     }
   }
   return r;
@@ -115,7 +120,8 @@ struct HmdView::Impl {
 HmdView::HmdView() : impl_(std::make_unique<Impl>()) {}
 HmdView::~HmdView() = default;
 
-std::optional<cv::Point2d> HmdView::project(const EyeImage& eye, const cv::Vec3d& world, Size viewport) const {
+std::optional<cv::Point2d> HmdView::project(const EyeImage& eye, const cv::Vec3d& world,
+                                            Size viewport) const {
   if (!eye.T_cam_world) return std::nullopt;
   const cv::Vec3d p = eye.T_cam_world->apply(world);
   if (p[2] < 0.01) return std::nullopt;
@@ -124,11 +130,15 @@ std::optional<cv::Point2d> HmdView::project(const EyeImage& eye, const cv::Vec3d
   if (distorting && !undistort_) {
     std::vector<cv::Point3d> object{cv::Point3d(p[0], p[1], p[2])};
     std::vector<cv::Point2d> image;
-    cv::projectPoints(object, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), eye.camera.camera_matrix, eye.camera.distortion, image);
+    cv::projectPoints(object, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), eye.camera.camera_matrix,
+                      eye.camera.distortion, image);
     pixel = image[0];
   } else {
-    const cv::Matx33d k = distorting ? impl_->rectificationOf(eye.camera).rectification.camera_matrix : eye.camera.camera_matrix;
-    pixel = {k(0, 0) * p[0] / p[2] + k(0, 1) * p[1] / p[2] + k(0, 2), k(1, 1) * p[1] / p[2] + k(1, 2)};
+    const cv::Matx33d k = distorting
+                              ? impl_->rectificationOf(eye.camera).rectification.camera_matrix
+                              : eye.camera.camera_matrix;
+    pixel = {k(0, 0) * p[0] / p[2] + k(0, 1) * p[1] / p[2] + k(0, 2),
+             k(1, 1) * p[1] / p[2] + k(1, 2)};
   }
   const double sx = static_cast<double>(viewport.width) / eye.camera.image_size.width;
   const double sy = static_cast<double>(viewport.height) / eye.camera.image_size.height;
@@ -174,7 +184,8 @@ void HmdView::draw(const HmdFrame& frame, unsigned int framebuffer, Size size) {
     if (frame.grid) {
       const GridLayout& g = *frame.grid;
       auto cell = [&](int row, int column) {
-        return std::vector<cv::Vec3d>{g.cellCorner(row - 1, column - 1), g.cellCorner(row - 1, column), g.cellCorner(row, column),
+        return std::vector<cv::Vec3d>{g.cellCorner(row - 1, column - 1),
+                                      g.cellCorner(row - 1, column), g.cellCorner(row, column),
                                       g.cellCorner(row, column - 1)};
       };
       const GridHighlight& h = frame.grid_highlight;
@@ -182,8 +193,10 @@ void HmdView::draw(const HmdFrame& frame, unsigned int framebuffer, Size size) {
         for (int c = 1; c <= g.columns; ++c) {
           glm::vec4 fill(0.0f);
           if (h.rows.count(r) || h.columns.count(c)) fill = colors_.flash;
-          if (h.cued && *h.cued == std::make_pair(r, c)) fill = colors_.cued * glm::vec4(1, 1, 1, 0.6f);
-          if (h.selected && *h.selected == std::make_pair(r, c)) fill = colors_.selected * glm::vec4(1, 1, 1, 0.6f);
+          if (h.cued && *h.cued == std::make_pair(r, c))
+            fill = colors_.cued * glm::vec4(1, 1, 1, 0.6f);
+          if (h.selected && *h.selected == std::make_pair(r, c))
+            fill = colors_.selected * glm::vec4(1, 1, 1, 0.6f);
           if (fill.a > 0.0f) {
             const auto polygon = outline(cell(r, c), true);
             if (!polygon.empty()) m.primitives.fillPolygon(polygon, fill, viewport);
@@ -202,7 +215,8 @@ void HmdView::draw(const HmdFrame& frame, unsigned int framebuffer, Size size) {
     for (const ObjectHighlight& o : frame.objects) {
       const double h = o.side_m * o.margin / 2.0;
       std::vector<cv::Vec3d> corners;
-      for (const auto& [x, y] : {std::pair{-h, h}, {h, h}, {h, -h}, {-h, -h}}) corners.push_back(o.T_world_top.apply(cv::Vec3d(x, y, 0.0)));
+      for (const auto& [x, y] : {std::pair{-h, h}, {h, h}, {h, -h}, {-h, -h}})
+        corners.push_back(o.T_world_top.apply(cv::Vec3d(x, y, 0.0)));
       const auto polygon = outline(corners, true);
       if (polygon.empty()) continue;
       switch (o.state) {

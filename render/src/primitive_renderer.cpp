@@ -8,12 +8,18 @@ namespace arbci::render {
 namespace {
 GLenum glPrimitive(Primitive primitive) {
   switch (primitive) {
-    case Primitive::Points: return GL_POINTS;
-    case Primitive::Lines: return GL_LINES;
-    case Primitive::LineStrip: return GL_LINE_STRIP;
-    case Primitive::Triangles: return GL_TRIANGLES;
-    case Primitive::TriangleStrip: return GL_TRIANGLE_STRIP;
-    case Primitive::TriangleFan: return GL_TRIANGLE_FAN;
+    case Primitive::Points:
+      return GL_POINTS;
+    case Primitive::Lines:
+      return GL_LINES;
+    case Primitive::LineStrip:
+      return GL_LINE_STRIP;
+    case Primitive::Triangles:
+      return GL_TRIANGLES;
+    case Primitive::TriangleStrip:
+      return GL_TRIANGLE_STRIP;
+    case Primitive::TriangleFan:
+      return GL_TRIANGLE_FAN;
   }
   return GL_POINTS;
 }

@@ -8,11 +8,14 @@
 namespace arbci::render {
 namespace {
 
-glm::vec3 toGlm(const cv::Vec3d& v) { return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])}; }
+glm::vec3 toGlm(const cv::Vec3d& v) {
+  return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+}
 
 // Appends two triangles for the quad a b c d (counter-clockwise seen from outside).
 template <typename V>
-void quad(std::vector<V>& out, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d, const glm::vec4& color,
+void quad(std::vector<V>& out, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+          const glm::vec3& d, const glm::vec4& color,
           const glm::vec2 (&uv)[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}) {
   out.push_back({a, uv[0], color});
   out.push_back({b, uv[1], color});
@@ -25,8 +28,8 @@ void quad(std::vector<V>& out, const glm::vec3& a, const glm::vec3& b, const glm
 // A box in the frame `pose` (its top face centred at the origin, extending down by `height`),
 // shaded as lit from above.
 template <typename V>
-void box(std::vector<V>& out, const vision::Pose& pose, double width, double depth, double height, const glm::vec3& color,
-         const glm::vec3& top_color) {
+void box(std::vector<V>& out, const vision::Pose& pose, double width, double depth, double height,
+         const glm::vec3& color, const glm::vec3& top_color) {
   const double w = width / 2, d = depth / 2;
   auto p = [&](double x, double y, double z) { return toGlm(pose.apply(cv::Vec3d(x, y, z))); };
   const glm::vec4 top(top_color, 1.0f), side_a(color * 0.75f, 1.0f), side_b(color * 0.6f, 1.0f);
@@ -39,7 +42,9 @@ void box(std::vector<V>& out, const vision::Pose& pose, double width, double dep
 
 }  // namespace
 
-SceneRenderer::SceneRenderer() : textured_(ShaderProgram::fromAssets("scene")), flat_(ShaderProgram::fromAssets("scene_flat")) {
+SceneRenderer::SceneRenderer()
+    : textured_(ShaderProgram::fromAssets("scene")),
+      flat_(ShaderProgram::fromAssets("scene_flat")) {
   textured_transform_ = textured_.uniform("transform");
   flat_transform_ = flat_.uniform("transform");
   sampler_location_ = textured_.uniform("marker");
@@ -48,11 +53,14 @@ SceneRenderer::SceneRenderer() : textured_(ShaderProgram::fromAssets("scene")), 
   glBindVertexArray(vertex_array_);
   glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer_);
   glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, position)));
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                        reinterpret_cast<void*>(offsetof(Vertex, position)));
   glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
+  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                        reinterpret_cast<void*>(offsetof(Vertex, uv)));
   glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, color)));
+  glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                        reinterpret_cast<void*>(offsetof(Vertex, color)));
   glBindVertexArray(0);
 }
 
@@ -62,7 +70,8 @@ SceneRenderer::~SceneRenderer() {
 }
 
 const Texture& SceneRenderer::markerTexture(const SceneMarker& marker) {
-  const auto key = std::make_tuple(static_cast<int>(marker.kind), marker.id, static_cast<int>(marker.border * 1000));
+  const auto key = std::make_tuple(static_cast<int>(marker.kind), marker.id,
+                                   static_cast<int>(marker.border * 1000));
   auto found = markers_.find(key);
   if (found != markers_.end()) return found->second;
   const cv::Mat cells = vision::markerCells(marker.kind, marker.id, marker.border);
@@ -78,7 +87,8 @@ const Texture& SceneRenderer::boardTexture(const SceneBoard& board) {
   auto found = boards_.find(key);
   if (found != boards_.end()) return found->second;
   // Squares of 32 px, a white margin of one square around them.
-  const int squares_x = board.inner_corners.width + 1, squares_y = board.inner_corners.height + 1, s = 32;
+  const int squares_x = board.inner_corners.width + 1, squares_y = board.inner_corners.height + 1,
+            s = 32;
   cv::Mat image((squares_y + 2) * s, (squares_x + 2) * s, CV_8UC1, cv::Scalar(255));
   for (int y = 0; y < squares_y; ++y) {
     for (int x = 0; x < squares_x; ++x) {
@@ -90,7 +100,8 @@ const Texture& SceneRenderer::boardTexture(const SceneBoard& board) {
   return boards_.emplace(key, std::move(texture)).first->second;
 }
 
-void SceneRenderer::drawBatches(const std::vector<Vertex>& vertices, const std::vector<Batch>& batches, const glm::mat4& transform) {
+void SceneRenderer::drawBatches(const std::vector<Vertex>& vertices,
+                                const std::vector<Batch>& batches, const glm::mat4& transform) {
   if (vertices.empty()) return;
   textured_.use();
   glUniformMatrix4fv(textured_transform_, 1, GL_FALSE, &transform[0][0]);
@@ -100,7 +111,8 @@ void SceneRenderer::drawBatches(const std::vector<Vertex>& vertices, const std::
   glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(vertex_array_);
   glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer_);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), GL_STREAM_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
+               vertices.data(), GL_STREAM_DRAW);
   for (const Batch& b : batches) {
     if (b.depth_test) {
       glEnable(GL_DEPTH_TEST);
@@ -124,8 +136,9 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
   std::vector<Vertex> solid;
   // The table: a light grey top, slightly darker far away (soft light from the subject's side).
   const float z = static_cast<float>(scene.table_z);
-  const glm::vec3 a(scene.table_min[0], scene.table_min[1], z), b(scene.table_max[0], scene.table_min[1], z),
-      c(scene.table_max[0], scene.table_max[1], z), d(scene.table_min[0], scene.table_max[1], z);
+  const glm::vec3 a(scene.table_min[0], scene.table_min[1], z),
+      b(scene.table_max[0], scene.table_min[1], z), c(scene.table_max[0], scene.table_max[1], z),
+      d(scene.table_min[0], scene.table_max[1], z);
   solid.push_back({a, {0, 0}, {0.62f, 0.60f, 0.56f, 1}});
   solid.push_back({b, {0, 0}, {0.62f, 0.60f, 0.56f, 1}});
   solid.push_back({c, {0, 0}, {0.52f, 0.50f, 0.47f, 1}});
@@ -141,16 +154,21 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
   // test (which costs llvmpipe more than the drawing).
   const size_t flat = solid.size();
   // Objects: coloured sides, a white top carrying the marker.
-  for (const SceneObject& o : scene.objects) box(solid, o.T_world_top, o.width_m, o.width_m, o.height_m, o.color, glm::vec3(0.95f));
+  for (const SceneObject& o : scene.objects)
+    box(solid, o.T_world_top, o.width_m, o.width_m, o.height_m, o.color, glm::vec3(0.95f));
   if (scene.gripper) {
     const cv::Vec3d t = scene.gripper->tool;
     const double gap = 0.02 + 0.05 * scene.gripper->opening;
     vision::Pose palm{cv::Matx33d::eye(), t + cv::Vec3d(0, 0, 0.06)};
     const glm::vec3 dark(0.25f), metal(0.45f, 0.47f, 0.5f);
-    box(solid, vision::Pose{cv::Matx33d::eye(), palm.translation + cv::Vec3d(0, 0, 0.03)}, 0.10, 0.04, 0.03, dark, dark);
-    box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(-gap / 2 - 0.006, 0, 0.06)}, 0.012, 0.03, 0.06, dark, dark);
-    box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(gap / 2 + 0.006, 0, 0.06)}, 0.012, 0.03, 0.06, dark, dark);
-    box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(0, 0, 0.30)}, 0.05, 0.05, 0.20, metal, metal);
+    box(solid, vision::Pose{cv::Matx33d::eye(), palm.translation + cv::Vec3d(0, 0, 0.03)}, 0.10,
+        0.04, 0.03, dark, dark);
+    box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(-gap / 2 - 0.006, 0, 0.06)}, 0.012,
+        0.03, 0.06, dark, dark);
+    box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(gap / 2 + 0.006, 0, 0.06)}, 0.012,
+        0.03, 0.06, dark, dark);
+    box(solid, vision::Pose{cv::Matx33d::eye(), t + cv::Vec3d(0, 0, 0.30)}, 0.05, 0.05, 0.20, metal,
+        metal);
   }
   std::vector<Batch> batches{{0, flat, nullptr, false}, {flat, solid.size() - flat, nullptr, true}};
   // Markers, each a textured square a hair above its face.
@@ -163,7 +181,8 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
   addMarker(scene.reference, scene.T_world_reference, 0.0012);
   if (scene.board) {
     const SceneBoard& b = *scene.board;
-    const double w = (b.inner_corners.width + 3) * b.square_m / 2, h = (b.inner_corners.height + 3) * b.square_m / 2;
+    const double w = (b.inner_corners.width + 3) * b.square_m / 2,
+                 h = (b.inner_corners.height + 3) * b.square_m / 2;
     auto p = [&](double x, double y) { return toGlm(b.T_world_board.apply(cv::Vec3d(x, y, 0.0))); };
     batches.push_back({solid.size(), 6, &boardTexture(b), true});
     quad(solid, p(-w, h), p(w, h), p(w, -h), p(-w, -h), glm::vec4(1.0f));

@@ -71,8 +71,12 @@ ShaderProgram::ShaderProgram(ShaderProgram&& other) noexcept : program_(other.pr
   other.program_ = 0;
 }
 
-void ShaderProgram::use() const { glUseProgram(program_); }
+void ShaderProgram::use() const {
+  glUseProgram(program_);
+}
 
-int ShaderProgram::uniform(const char* name) const { return glGetUniformLocation(program_, name); }
+int ShaderProgram::uniform(const char* name) const {
+  return glGetUniformLocation(program_, name);
+}
 
 }  // namespace arbci::render

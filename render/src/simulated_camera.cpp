@@ -10,7 +10,8 @@
 
 namespace arbci::render {
 
-SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_t seed) : camera_(camera), random_(seed ? seed : 1) {
+SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_t seed)
+    : camera_(camera), random_(seed ? seed : 1) {
   const cv::Size size = camera.image_size;
   GLint max_samples = 0;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
@@ -21,18 +22,22 @@ SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_
   glBindRenderbuffer(GL_RENDERBUFFER, color_rb_);
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, size.width, size.height);
   glBindRenderbuffer(GL_RENDERBUFFER, depth_rb_);
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH24_STENCIL8, size.width, size.height);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH24_STENCIL8, size.width,
+                                   size.height);
   glBindFramebuffer(GL_FRAMEBUFFER, multisample_fbo_);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb_);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) throw GlError("simulated camera: multisample framebuffer incomplete");
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
+                            depth_rb_);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw GlError("simulated camera: multisample framebuffer incomplete");
   glGenFramebuffers(1, &resolve_fbo_);
   glGenRenderbuffers(1, &resolve_rb_);
   glBindRenderbuffer(GL_RENDERBUFFER, resolve_rb_);
   glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, size.width, size.height);
   glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_rb_);
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) throw GlError("simulated camera: resolve framebuffer incomplete");
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw GlError("simulated camera: resolve framebuffer incomplete");
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (!camera.distortion.empty()) {
     // Where each pixel of the distorted image comes from in the ideal rendering.
@@ -42,7 +47,8 @@ SimulatedCamera::SimulatedCamera(const vision::CameraModel& camera, std::uint64_
       for (int x = 0; x < size.width; ++x, ++i) points.at<cv::Vec2d>(i) = cv::Vec2d(x, y);
     }
     cv::Mat ideal;
-    cv::undistortPoints(points, ideal, camera.camera_matrix, camera.distortion, cv::noArray(), camera.camera_matrix);
+    cv::undistortPoints(points, ideal, camera.camera_matrix, camera.distortion, cv::noArray(),
+                        camera.camera_matrix);
     for (int y = 0, i = 0; y < size.height; ++y) {
       for (int x = 0; x < size.width; ++x, ++i) {
         const cv::Vec2d p = ideal.at<cv::Vec2d>(i);
@@ -62,7 +68,8 @@ SimulatedCamera::~SimulatedCamera() {
   glDeleteRenderbuffers(1, &resolve_rb_);
 }
 
-cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_world, const CameraEffects& effects) {
+cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_world,
+                                const CameraEffects& effects) {
   const cv::Size size = camera_.image_size;
   glBindFramebuffer(GL_FRAMEBUFFER, multisample_fbo_);
   glViewport(0, 0, size.width, size.height);
@@ -71,7 +78,8 @@ cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_wo
   renderer_.draw(scene, worldToClip(camera_.camera_matrix, size, T_cam_world));
   glBindFramebuffer(GL_READ_FRAMEBUFFER, multisample_fbo_);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_);
-  glBlitFramebuffer(0, 0, size.width, size.height, 0, 0, size.width, size.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitFramebuffer(0, 0, size.width, size.height, 0, 0, size.width, size.height,
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
   cv::Mat rgba(size, CV_8UC4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -83,7 +91,8 @@ cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_wo
 
   if (effects.distort && !distort_map1_.empty()) {
     cv::Mat distorted;
-    cv::remap(frame, distorted, distort_map1_, distort_map2_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(77, 82, 90));
+    cv::remap(frame, distorted, distort_map1_, distort_map2_, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+              cv::Scalar(77, 82, 90));
     frame = distorted;
   }
   if (effects.blur_sigma > 0.0) cv::GaussianBlur(frame, frame, cv::Size(), effects.blur_sigma);
@@ -99,7 +108,9 @@ cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_wo
           auto* row = gain.ptr<std::int16_t>(y);
           for (int x = 0; x < size.width; ++x) {
             const double d2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / r2;
-            row[x] = static_cast<std::int16_t>(std::lround(256.0 * (1.0 - effects.vignetting * d2) * (1.0 - effects.gradient * x / size.width)));
+            row[x] =
+                static_cast<std::int16_t>(std::lround(256.0 * (1.0 - effects.vignetting * d2) *
+                                                      (1.0 - effects.gradient * x / size.width)));
           }
         }
         cv::merge(std::vector<cv::Mat>{gain, gain, gain}, gain_);
@@ -113,10 +124,12 @@ cv::Mat SimulatedCamera::render(const Scene& scene, const vision::Pose& T_cam_wo
       // a window at a random offset, so the noise changes from frame to frame.
       if (effects.noise_sigma != noise_sigma_) {
         noise_.create(size.height + 64, size.width + 64, CV_16SC3);
-        random_.fill(noise_, cv::RNG::NORMAL, cv::Scalar::all(0.0), cv::Scalar::all(effects.noise_sigma));
+        random_.fill(noise_, cv::RNG::NORMAL, cv::Scalar::all(0.0),
+                     cv::Scalar::all(effects.noise_sigma));
         noise_sigma_ = effects.noise_sigma;
       }
-      const cv::Rect window(random_.uniform(0, 64), random_.uniform(0, 64), size.width, size.height);
+      const cv::Rect window(random_.uniform(0, 64), random_.uniform(0, 64), size.width,
+                            size.height);
       cv::add(pixels, noise_(window), pixels);
     }
     pixels.convertTo(frame, CV_8UC3);

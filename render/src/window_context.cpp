@@ -55,8 +55,8 @@ WindowContext::WindowContext(const WindowOptions& options) {
       size = {mode->width, mode->height};
     }
   }
-  window_ = glfwCreateWindow(size.width, size.height, options.title.c_str(), monitor,
-                             options.share_with);
+  window_ =
+      glfwCreateWindow(size.width, size.height, options.title.c_str(), monitor, options.share_with);
   if (!window_) {
     const std::string reason = lastGlfwError();
     releaseGlfw();
@@ -71,7 +71,9 @@ WindowContext::~WindowContext() {
   releaseGlfw();
 }
 
-void WindowContext::makeCurrent() { glfwMakeContextCurrent(window_); }
+void WindowContext::makeCurrent() {
+  glfwMakeContextCurrent(window_);
+}
 
 Size WindowContext::framebufferSize() const {
   Size size;
@@ -79,13 +81,21 @@ Size WindowContext::framebufferSize() const {
   return size;
 }
 
-void WindowContext::present() { glfwSwapBuffers(window_); }
+void WindowContext::present() {
+  glfwSwapBuffers(window_);
+}
 
-bool WindowContext::shouldClose() const { return glfwWindowShouldClose(window_); }
+bool WindowContext::shouldClose() const {
+  return glfwWindowShouldClose(window_);
+}
 
-void WindowContext::requestClose() { glfwSetWindowShouldClose(window_, GLFW_TRUE); }
+void WindowContext::requestClose() {
+  glfwSetWindowShouldClose(window_, GLFW_TRUE);
+}
 
-void WindowContext::pollEvents() { glfwPollEvents(); }
+void WindowContext::pollEvents() {
+  glfwPollEvents();
+}
 
 int WindowContext::monitorCount() {
   if (g_windows == 0) return 0;

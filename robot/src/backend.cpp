@@ -136,7 +136,8 @@ struct RobotBackend::Impl {
       std::lock_guard lock(stats_mutex);
       ++stats.ignored;
       ++stats.by_error[decoded.error];
-      log(toString(decoded.error), "ignored a datagram from " + d.from.toString() + ": " + toString(decoded.error));
+      log(toString(decoded.error),
+          "ignored a datagram from " + d.from.toString() + ": " + toString(decoded.error));
       return;
     }
     const Message& m = decoded.message;
@@ -145,16 +146,20 @@ struct RobotBackend::Impl {
       ++stats.ignored;
       return;  // a reply sent to the backend: nothing to do
     }
-    const double skew = std::abs(static_cast<double>(wallClockMs()) - static_cast<double>(m.timestamp_ms)) / 1000.0;
+    const double skew =
+        std::abs(static_cast<double>(wallClockMs()) - static_cast<double>(m.timestamp_ms)) / 1000.0;
     if (skew > options.max_clock_skew_s) {
-      reject(m, d.from, RejectReason::Replayed, "timestamp " + std::to_string(static_cast<long>(skew)) + " s away from the backend's clock");
+      reject(m, d.from, RejectReason::Replayed,
+             "timestamp " + std::to_string(static_cast<long>(skew)) +
+                 " s away from the backend's clock");
       return;
     }
     Session& s = sessions[m.session];
     s.peer = d.from;  // answers go to the sender, and so do this session's progress and outcomes
     s.active = SteadyClock::now();
     if (s.highest > kReplayWindow && m.sequence <= s.highest - kReplayWindow) {
-      reject(m, d.from, RejectReason::Replayed, "sequence " + std::to_string(m.sequence) + " is older than the replay window");
+      reject(m, d.from, RejectReason::Replayed,
+             "sequence " + std::to_string(m.sequence) + " is older than the replay window");
       return;
     }
     if (s.seen.count(m.sequence)) {
@@ -166,13 +171,15 @@ struct RobotBackend::Impl {
       } else if (m.type == MessageType::Status) {
         send(statusFor(m.session, m.sequence), d.from);
       } else {
-        reject(m, d.from, RejectReason::Replayed, "sequence " + std::to_string(m.sequence) + " was already used");
+        reject(m, d.from, RejectReason::Replayed,
+               "sequence " + std::to_string(m.sequence) + " was already used");
       }
       return;
     }
     s.seen.insert(m.sequence);
     s.highest = std::max(s.highest, m.sequence);
-    while (!s.seen.empty() && *s.seen.begin() + kReplayWindow < s.highest) s.seen.erase(s.seen.begin());
+    while (!s.seen.empty() && *s.seen.begin() + kReplayWindow < s.highest)
+      s.seen.erase(s.seen.begin());
     process(m, s, d.from);
     while (s.replies.size() > kCachedReplies) s.replies.erase(s.replies.begin());
   }
@@ -183,12 +190,16 @@ struct RobotBackend::Impl {
     r.text = text;
     {
       std::lock_guard lock(stats_mutex);
-      if (reason == RejectReason::Replayed) ++stats.replayed;
-      else ++stats.rejected;
+      if (reason == RejectReason::Replayed)
+        ++stats.replayed;
+      else
+        ++stats.rejected;
     }
-    log(toString(reason), std::string("rejected ") + toString(m.type) + " from " + to.toString() + ": " + text);
+    log(toString(reason),
+        std::string("rejected ") + toString(m.type) + " from " + to.toString() + ": " + text);
     const auto found = sessions.find(m.session);
-    if (found != sessions.end() && reason != RejectReason::Replayed) found->second.replies[m.sequence] = r;
+    if (found != sessions.end() && reason != RejectReason::Replayed)
+      found->second.replies[m.sequence] = r;
     send(r, to);
   }
 
@@ -207,7 +218,9 @@ struct RobotBackend::Impl {
       }
       default: {
         if (running) {
-          reject(m, from, RejectReason::Busy, std::string("busy with ") + toString(running->type) + " " + std::to_string(running->sequence));
+          reject(m, from, RejectReason::Busy,
+                 std::string("busy with ") + toString(running->type) + " " +
+                     std::to_string(running->sequence));
           return;
         }
         const DriverCommand command{m.type, m.target};
@@ -234,26 +247,34 @@ struct RobotBackend::Impl {
     const double elapsed = std::chrono::duration<double>(now - last_step).count();
     last_step = now;
     if (running) {
-      if (const auto result = driver->step(std::min(elapsed, 0.1) * options.speed_factor)) finish(result->outcome, result->text);
+      if (const auto result = driver->step(std::min(elapsed, 0.1) * options.speed_factor))
+        finish(result->outcome, result->text);
     }
-    if (running && std::chrono::duration<double>(now - last_push).count() >= options.status_interval_s) {
+    if (running &&
+        std::chrono::duration<double>(now - last_push).count() >= options.status_interval_s) {
       last_push = now;
       const auto found = sessions.find(running->session);
       if (found != sessions.end()) send(statusFor(running->session, 0), found->second.peer);
     }
     std::erase_if(sessions, [&](const auto& entry) {
-      return now - entry.second.active > kSessionLifetime && !(running && running->session == entry.first);
+      return now - entry.second.active > kSessionLifetime &&
+             !(running && running->session == entry.first);
     });
   }
 };
 
-RobotBackend::RobotBackend(const Key& key, std::unique_ptr<RobotDriver> driver, const BackendOptions& options)
+RobotBackend::RobotBackend(const Key& key, std::unique_ptr<RobotDriver> driver,
+                           const BackendOptions& options)
     : impl_(std::make_unique<Impl>(key, std::move(driver), options)) {}
 
 RobotBackend::~RobotBackend() = default;
 
-int RobotBackend::port() const { return impl_->socket.port(); }
-std::uint64_t RobotBackend::boot() const { return impl_->boot; }
+int RobotBackend::port() const {
+  return impl_->socket.port();
+}
+std::uint64_t RobotBackend::boot() const {
+  return impl_->boot;
+}
 
 void RobotBackend::poll(int wait_ms) {
   Impl& m = *impl_;

@@ -11,19 +11,28 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
 
 }  // namespace
 
 const char* toString(RobotEvent::Kind kind) {
   switch (kind) {
-    case RobotEvent::Kind::Accepted: return "accepted";
-    case RobotEvent::Kind::Rejected: return "rejected";
-    case RobotEvent::Kind::Finished: return "finished";
-    case RobotEvent::Kind::Failed: return "failed";
-    case RobotEvent::Kind::Silent: return "silent";
-    case RobotEvent::Kind::Reachable: return "reachable";
-    case RobotEvent::Kind::Restarted: return "restarted";
+    case RobotEvent::Kind::Accepted:
+      return "accepted";
+    case RobotEvent::Kind::Rejected:
+      return "rejected";
+    case RobotEvent::Kind::Finished:
+      return "finished";
+    case RobotEvent::Kind::Failed:
+      return "failed";
+    case RobotEvent::Kind::Silent:
+      return "silent";
+    case RobotEvent::Kind::Reachable:
+      return "reachable";
+    case RobotEvent::Kind::Restarted:
+      return "restarted";
   }
   return "unknown";
 }
@@ -74,24 +83,32 @@ void RobotClient::complete(std::uint64_t sequence, RobotEvent event) {
 
 void RobotClient::handle(const Message& m) {
   if (m.session != session_ || isCommand(m.type)) return;
-  const double skew = std::abs(static_cast<double>(wallClockMs()) - static_cast<double>(m.timestamp_ms)) / 1000.0;
+  const double skew =
+      std::abs(static_cast<double>(wallClockMs()) - static_cast<double>(m.timestamp_ms)) / 1000.0;
   if (skew > 30.0) return;  // a stale reply: ignore it
   last_heard_ = Clock::now();
   heard_ = true;
   if (silent_) {
     silent_ = false;
-    events_.push_back({RobotEvent::Kind::Reachable, 0, MessageType::Status, {}, {}, "the backend answers again"});
+    events_.push_back(
+        {RobotEvent::Kind::Reachable, 0, MessageType::Status, {}, {}, "the backend answers again"});
   }
   if (boot_ != 0 && m.boot != boot_) {
-    events_.push_back({RobotEvent::Kind::Restarted, 0, MessageType::Status, {}, {}, "the backend restarted"});
+    events_.push_back(
+        {RobotEvent::Kind::Restarted, 0, MessageType::Status, {}, {}, "the backend restarted"});
     // Accepted commands died with the old backend: they must not be taken for done.
     std::vector<Pending> lost;
     for (const Pending& p : pending_) {
       if (p.accepted && p.accepted_boot != m.boot) lost.push_back(p);
     }
     for (const Pending& p : lost) {
-      complete(p.sequence, {RobotEvent::Kind::Failed, p.sequence, p.type, {}, Outcome::Failed,
-                            std::string(toString(p.type)) + " lost: the backend restarted during the command"});
+      complete(p.sequence,
+               {RobotEvent::Kind::Failed,
+                p.sequence,
+                p.type,
+                {},
+                Outcome::Failed,
+                std::string(toString(p.type)) + " lost: the backend restarted during the command"});
     }
   }
   boot_ = m.boot;
@@ -102,15 +119,21 @@ void RobotClient::handle(const Message& m) {
         p->accepted = true;
         p->accepted_boot = m.boot;
         events_.push_back({RobotEvent::Kind::Accepted, p->sequence, p->type, {}, {}, ""});
-        if (p->type == MessageType::Stop) complete(p->sequence, {RobotEvent::Kind::Finished, p->sequence, p->type, {}, Outcome::Success, "stopped"});
+        if (p->type == MessageType::Stop)
+          complete(
+              p->sequence,
+              {RobotEvent::Kind::Finished, p->sequence, p->type, {}, Outcome::Success, "stopped"});
       }
       break;
     case MessageType::Rejected:
-      if (p) complete(p->sequence, {RobotEvent::Kind::Rejected, p->sequence, p->type, m.reason, {}, m.text});
+      if (p)
+        complete(p->sequence,
+                 {RobotEvent::Kind::Rejected, p->sequence, p->type, m.reason, {}, m.text});
       break;
     case MessageType::Finished:
       if (p && (!p->accepted || p->accepted_boot == m.boot)) {
-        complete(p->sequence, {RobotEvent::Kind::Finished, p->sequence, p->type, {}, m.outcome, m.text});
+        complete(p->sequence,
+                 {RobotEvent::Kind::Finished, p->sequence, p->type, {}, m.outcome, m.text});
       }
       break;
     case MessageType::StatusReply: {
@@ -118,7 +141,12 @@ void RobotClient::handle(const Message& m) {
       // A lost FINISHED shows in the status as this session's last finished command.
       Pending* done = find(m.status.last_finished_sequence);
       if (done && done->accepted && done->accepted_boot == m.boot) {
-        complete(done->sequence, {RobotEvent::Kind::Finished, done->sequence, done->type, {}, m.status.last_outcome, m.status.last_outcome_text});
+        complete(done->sequence, {RobotEvent::Kind::Finished,
+                                  done->sequence,
+                                  done->type,
+                                  {},
+                                  m.status.last_outcome,
+                                  m.status.last_outcome_text});
       }
       break;
     }
@@ -146,8 +174,13 @@ void RobotClient::poll() {
     }
   }
   for (const Pending& p : expired) {
-    complete(p.sequence, {RobotEvent::Kind::Failed, p.sequence, p.type, {}, Outcome::Failed,
-                          std::string(toString(p.type)) + " was never accepted: no answer from the backend"});
+    complete(p.sequence,
+             {RobotEvent::Kind::Failed,
+              p.sequence,
+              p.type,
+              {},
+              Outcome::Failed,
+              std::string(toString(p.type)) + " was never accepted: no answer from the backend"});
   }
   if (now >= next_status_) {
     next_status_ = now + seconds(options_.status_interval_s);
@@ -161,10 +194,17 @@ void RobotClient::poll() {
   const auto quiet_since = heard_ ? last_heard_ : created_;
   if (!silent_ && now - quiet_since > seconds(options_.silence_s)) {
     silent_ = true;
-    events_.push_back({RobotEvent::Kind::Silent, 0, MessageType::Status, {}, {}, "no answer from the backend for a second"});
+    events_.push_back({RobotEvent::Kind::Silent,
+                       0,
+                       MessageType::Status,
+                       {},
+                       {},
+                       "no answer from the backend for a second"});
   }
 }
 
-std::vector<RobotEvent> RobotClient::takeEvents() { return std::exchange(events_, {}); }
+std::vector<RobotEvent> RobotClient::takeEvents() {
+  return std::exchange(events_, {});
+}
 
 }  // namespace arbci::robot

@@ -16,7 +16,8 @@ class Writer {
   explicit Writer(std::vector<std::uint8_t>& out) : out_(out) {}
   template <typename T>
   void integer(T value) {
-    for (size_t i = 0; i < sizeof(T); ++i) out_.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(value) >> (8 * i)));
+    for (size_t i = 0; i < sizeof(T); ++i)
+      out_.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(value) >> (8 * i)));
   }
   void real(double value) {
     std::uint64_t bits;
@@ -49,7 +50,8 @@ class Reader {
       return T{};
     }
     std::uint64_t value = 0;
-    for (size_t i = 0; i < sizeof(T); ++i) value |= static_cast<std::uint64_t>(data_[at_ + i]) << (8 * i);
+    for (size_t i = 0; i < sizeof(T); ++i)
+      value |= static_cast<std::uint64_t>(data_[at_ + i]) << (8 * i);
     at_ += sizeof(T);
     return static_cast<T>(value);
   }
@@ -92,8 +94,12 @@ std::array<std::uint8_t, kMacBytes> mac(const std::uint8_t* data, size_t size, c
   return out;
 }
 
-bool validType(std::uint8_t t) { return (t >= 1 && t <= 5) || (t >= 0x81 && t <= 0x84); }
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool validType(std::uint8_t t) {
+  return (t >= 1 && t <= 5) || (t >= 0x81 && t <= 0x84);
+}
+bool finite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 void writePayload(Writer& w, const Message& m) {
   switch (m.type) {
@@ -222,7 +228,8 @@ Decoded decode(const std::uint8_t* data, size_t size, const Key& key) {
   const size_t payload = static_cast<size_t>(data[40]) | (static_cast<size_t>(data[41]) << 8);
   if (kHeaderBytes + payload + kMacBytes != size) return {DecodeError::BadLength, {}};
   const auto expected = mac(data, kHeaderBytes + payload, key);
-  if (CRYPTO_memcmp(expected.data(), data + kHeaderBytes + payload, kMacBytes) != 0) return {DecodeError::BadMac, {}};
+  if (CRYPTO_memcmp(expected.data(), data + kHeaderBytes + payload, kMacBytes) != 0)
+    return {DecodeError::BadMac, {}};
   if (!validType(data[5])) return {DecodeError::BadType, {}};
   Reader r(data, kHeaderBytes + payload);
   r.integer<std::uint32_t>();  // magic
@@ -239,73 +246,108 @@ Decoded decode(const std::uint8_t* data, size_t size, const Key& key) {
   return result;
 }
 
-bool isCommand(MessageType type) { return static_cast<std::uint8_t>(type) < 0x80; }
+bool isCommand(MessageType type) {
+  return static_cast<std::uint8_t>(type) < 0x80;
+}
 
 const char* toString(MessageType type) {
   switch (type) {
-    case MessageType::Grasp: return "GRASP";
-    case MessageType::Drop: return "DROP";
-    case MessageType::Home: return "HOME";
-    case MessageType::Stop: return "STOP";
-    case MessageType::Status: return "STATUS";
-    case MessageType::Accepted: return "ACCEPTED";
-    case MessageType::Finished: return "FINISHED";
-    case MessageType::Rejected: return "REJECTED";
-    case MessageType::StatusReply: return "STATUS reply";
+    case MessageType::Grasp:
+      return "GRASP";
+    case MessageType::Drop:
+      return "DROP";
+    case MessageType::Home:
+      return "HOME";
+    case MessageType::Stop:
+      return "STOP";
+    case MessageType::Status:
+      return "STATUS";
+    case MessageType::Accepted:
+      return "ACCEPTED";
+    case MessageType::Finished:
+      return "FINISHED";
+    case MessageType::Rejected:
+      return "REJECTED";
+    case MessageType::StatusReply:
+      return "STATUS reply";
   }
   return "unknown";
 }
 
 const char* toString(RejectReason reason) {
   switch (reason) {
-    case RejectReason::OutsideWorkspace: return "outside the workspace";
-    case RejectReason::Busy: return "busy";
-    case RejectReason::Malformed: return "malformed";
-    case RejectReason::NotAuthenticated: return "not authenticated";
-    case RejectReason::Replayed: return "replayed";
-    case RejectReason::Unreachable: return "unreachable";
-    case RejectReason::InvalidState: return "invalid in this state";
+    case RejectReason::OutsideWorkspace:
+      return "outside the workspace";
+    case RejectReason::Busy:
+      return "busy";
+    case RejectReason::Malformed:
+      return "malformed";
+    case RejectReason::NotAuthenticated:
+      return "not authenticated";
+    case RejectReason::Replayed:
+      return "replayed";
+    case RejectReason::Unreachable:
+      return "unreachable";
+    case RejectReason::InvalidState:
+      return "invalid in this state";
   }
   return "unknown";
 }
 
 const char* toString(Outcome outcome) {
   switch (outcome) {
-    case Outcome::Success: return "success";
-    case Outcome::Failed: return "failed";
-    case Outcome::Stopped: return "stopped";
+    case Outcome::Success:
+      return "success";
+    case Outcome::Failed:
+      return "failed";
+    case Outcome::Stopped:
+      return "stopped";
   }
   return "unknown";
 }
 
 const char* toString(RobotState state) {
   switch (state) {
-    case RobotState::Idle: return "idle";
-    case RobotState::Moving: return "moving";
-    case RobotState::Stopped: return "stopped";
-    case RobotState::Fault: return "fault";
+    case RobotState::Idle:
+      return "idle";
+    case RobotState::Moving:
+      return "moving";
+    case RobotState::Stopped:
+      return "stopped";
+    case RobotState::Fault:
+      return "fault";
   }
   return "unknown";
 }
 
 const char* toString(DecodeError error) {
   switch (error) {
-    case DecodeError::None: return "none";
-    case DecodeError::TooShort: return "too short";
-    case DecodeError::TooLong: return "too long";
-    case DecodeError::BadMagic: return "not an ARBCI robot message";
-    case DecodeError::BadVersion: return "unsupported protocol version";
-    case DecodeError::BadLength: return "length field does not match";
-    case DecodeError::BadMac: return "not authenticated (bad MAC)";
-    case DecodeError::BadType: return "unknown message type";
-    case DecodeError::BadPayload: return "malformed payload";
+    case DecodeError::None:
+      return "none";
+    case DecodeError::TooShort:
+      return "too short";
+    case DecodeError::TooLong:
+      return "too long";
+    case DecodeError::BadMagic:
+      return "not an ARBCI robot message";
+    case DecodeError::BadVersion:
+      return "unsupported protocol version";
+    case DecodeError::BadLength:
+      return "length field does not match";
+    case DecodeError::BadMac:
+      return "not authenticated (bad MAC)";
+    case DecodeError::BadType:
+      return "unknown message type";
+    case DecodeError::BadPayload:
+      return "malformed payload";
   }
   return "unknown";
 }
 
 std::uint64_t wallClockMs() {
-  return static_cast<std::uint64_t>(
-      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
 }
 
 }  // namespace arbci::robot

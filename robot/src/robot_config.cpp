@@ -7,15 +7,18 @@ namespace arbci::robot {
 namespace {
 
 Vec3 vec(const nlohmann::json& j, const std::string& field, const std::string& file) {
-  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number()) {
+  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() ||
+      !j[2].is_number()) {
     throw ConfigError(file + ": " + field + " must be [x, y, z] in metres");
   }
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
 }
 
-double positive(const nlohmann::json& j, const std::string& field, double fallback, const std::string& file) {
+double positive(const nlohmann::json& j, const std::string& field, double fallback,
+                const std::string& file) {
   if (!j.contains(field)) return fallback;
-  if (!j[field].is_number() || !(j[field].get<double>() > 0.0)) throw ConfigError(file + ": " + field + " must be a positive number");
+  if (!j[field].is_number() || !(j[field].get<double>() > 0.0))
+    throw ConfigError(file + ": " + field + " must be a positive number");
   return j[field].get<double>();
 }
 
@@ -41,7 +44,8 @@ RobotConfig RobotConfig::load(const std::filesystem::path& path) {
   if (j.contains("workspace")) {
     c.workspace_min = vec(j["workspace"].value("min", nlohmann::json()), "workspace.min", file);
     c.workspace_max = vec(j["workspace"].value("max", nlohmann::json()), "workspace.max", file);
-    if (!(c.workspace_min.x < c.workspace_max.x && c.workspace_min.y < c.workspace_max.y && c.workspace_min.z < c.workspace_max.z)) {
+    if (!(c.workspace_min.x < c.workspace_max.x && c.workspace_min.y < c.workspace_max.y &&
+          c.workspace_min.z < c.workspace_max.z)) {
       throw ConfigError(file + ": workspace.min must lie below workspace.max on every axis");
     }
   }
@@ -57,7 +61,8 @@ RobotConfig RobotConfig::load(const std::filesystem::path& path) {
     for (size_t i = 0; i < j["objects"].size(); ++i) {
       const auto& o = j["objects"][i];
       const std::string at = "objects[" + std::to_string(i) + "]";
-      if (!o.is_object() || !o.contains("id") || !o["id"].is_number_integer()) throw ConfigError(file + ": " + at + ".id must be an integer");
+      if (!o.is_object() || !o.contains("id") || !o["id"].is_number_integer())
+        throw ConfigError(file + ": " + at + ".id must be an integer");
       SimulatedObject object;
       object.id = o["id"].get<int>();
       object.position = vec(o.value("position", nlohmann::json()), at + ".position", file);
@@ -83,7 +88,8 @@ std::string RobotConfig::toJson() const {
                       {"home", v(home)},
                       {"objects", nlohmann::json::array()}};
   for (const SimulatedObject& o : objects) {
-    j["objects"].push_back({{"id", o.id}, {"position", v(o.position)}, {"height", o.height}, {"radius", o.radius}});
+    j["objects"].push_back(
+        {{"id", o.id}, {"position", v(o.position)}, {"height", o.height}, {"radius", o.radius}});
   }
   return j.dump(2);
 }

@@ -6,16 +6,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <numbers>
-#include <cstdio>
 #include <stdexcept>
 
 namespace arbci::robot {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kStep = 0.005;   // seconds of robot time per integration step
+constexpr double kStep = 0.005;          // seconds of robot time per integration step
 constexpr double kGripperLength = 0.15;  // flange to fingertips
 
 // UR10 (standard DH) with the gripper's length added to the last link.
@@ -24,7 +24,9 @@ KDL::Chain ur10() {
   const double a[6] = {0.0, -0.612, -0.5723, 0.0, 0.0, 0.0};
   const double alpha[6] = {kPi / 2, 0.0, 0.0, kPi / 2, -kPi / 2, 0.0};
   const double d[6] = {0.1273, 0.0, 0.0, 0.163941, 0.1157, 0.0922 + kGripperLength};
-  for (int i = 0; i < 6; ++i) chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::DH(a[i], alpha[i], d[i], 0.0)));
+  for (int i = 0; i < 6; ++i)
+    chain.addSegment(
+        KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::DH(a[i], alpha[i], d[i], 0.0)));
   return chain;
 }
 
@@ -32,9 +34,13 @@ const double kLowerLimit[6] = {-2 * kPi, -2 * kPi, -kPi, -2 * kPi, -2 * kPi, -2 
 const double kUpperLimit[6] = {2 * kPi, 2 * kPi, kPi, 2 * kPi, 2 * kPi, 2 * kPi};
 
 // The tool pointing straight down, its x axis along the robot's x.
-KDL::Frame toolDown(const Vec3& p) { return KDL::Frame(KDL::Rotation::RotX(kPi), KDL::Vector(p.x, p.y, p.z)); }
+KDL::Frame toolDown(const Vec3& p) {
+  return KDL::Frame(KDL::Rotation::RotX(kPi), KDL::Vector(p.x, p.y, p.z));
+}
 
-double distance(const Vec3& a, const Vec3& b) { return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z); }
+double distance(const Vec3& a, const Vec3& b) {
+  return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
+}
 
 // One part of a command: a straight move, a descent until contact, or the gripper.
 struct Segment {
@@ -52,7 +58,8 @@ struct SimulatedArm::Impl {
   KDL::JntArray q{6};
   std::vector<SimulatedObject> objects;
   int holding = -1;
-  Vec3 grasp_offset;  // the held object's top centre relative to the fingertips (it does not centre itself)
+  Vec3 grasp_offset;  // the held object's top centre relative to the fingertips (it does not centre
+                      // itself)
   double gripper = 1.0;
   RobotState state = RobotState::Idle;
   DriverCommand command;
@@ -89,7 +96,8 @@ struct SimulatedArm::Impl {
     double top = config.table_z;
     for (const SimulatedObject& o : objects) {
       if (o.id == holding) continue;
-      if (std::hypot(o.position.x - x, o.position.y - y) <= o.radius) top = std::max(top, o.position.z);
+      if (std::hypot(o.position.x - x, o.position.y - y) <= o.radius)
+        top = std::max(top, o.position.z);
     }
     return top;
   }
@@ -116,12 +124,15 @@ struct SimulatedArm::Impl {
     if (remaining < 1e-6) return true;
     double fraction = std::min(1.0, speed * dt / remaining);
     for (int attempt = 0; attempt < 6; ++attempt, fraction *= 0.5) {
-      const Vec3 next{here.x + (goal.x - here.x) * fraction, here.y + (goal.y - here.y) * fraction, here.z + (goal.z - here.z) * fraction};
+      const Vec3 next{here.x + (goal.x - here.x) * fraction, here.y + (goal.y - here.y) * fraction,
+                      here.z + (goal.z - here.z) * fraction};
       KDL::JntArray solution(6);
       if (!solve(next, q, solution)) continue;
       double fastest = 0.0;
-      for (unsigned i = 0; i < 6; ++i) fastest = std::max(fastest, std::abs(solution(i) - q(i)) / dt);
-      if (fastest > config.max_joint_speed * 1.0001) continue;  // too fast for a joint: smaller step
+      for (unsigned i = 0; i < 6; ++i)
+        fastest = std::max(fastest, std::abs(solution(i) - q(i)) / dt);
+      if (fastest > config.max_joint_speed * 1.0001)
+        continue;  // too fast for a joint: smaller step
       q = solution;
       carry();
       return fraction >= 1.0;
@@ -143,7 +154,8 @@ struct SimulatedArm::Impl {
         plan.push_back({Segment::Kind::Move, above});
         plan.push_back({Segment::Kind::Descend, {c.target.x, c.target.y, config.table_z}});
         plan.push_back({Segment::Kind::Close, {}});
-        plan.push_back({Segment::Kind::Move, {c.target.x, c.target.y, config.table_z + config.lift_height}});
+        plan.push_back(
+            {Segment::Kind::Move, {c.target.x, c.target.y, config.table_z + config.lift_height}});
         break;
       }
       case MessageType::Drop: {
@@ -189,14 +201,16 @@ struct SimulatedArm::Impl {
         if (s.kind == Segment::Kind::Close) {
           // Grasp what lies under the fingertips: its top within 5 mm, its axis within its radius.
           for (const SimulatedObject& o : objects) {
-            if (std::hypot(o.position.x - t.x, o.position.y - t.y) <= o.radius && std::abs(o.position.z - t.z) < 0.005) {
+            if (std::hypot(o.position.x - t.x, o.position.y - t.y) <= o.radius &&
+                std::abs(o.position.z - t.z) < 0.005) {
               holding = o.id;
               grasp_offset = {o.position.x - t.x, o.position.y - t.y, o.position.z - t.z};
             }
           }
           if (holding < 0) {
             char where[96];
-            std::snprintf(where, sizeof where, "nothing to grasp at (%.3f, %.3f, %.3f)", t.x, t.y, t.z);
+            std::snprintf(where, sizeof where, "nothing to grasp at (%.3f, %.3f, %.3f)", t.x, t.y,
+                          t.z);
             failure = where;
             // Lift back out empty-handed: only the last segment (the lift) remains.
             while (plan.size() > 2) plan.erase(plan.begin() + 1);
@@ -220,7 +234,8 @@ SimulatedArm::SimulatedArm(const RobotConfig& config) : impl_(std::make_unique<I
   KDL::JntArray seed(6);
   const double posture[6] = {kPi / 2, -kPi / 2, kPi / 2, -kPi / 2, -kPi / 2, 0.0};
   for (unsigned i = 0; i < 6; ++i) seed(i) = posture[i];
-  if (!m.solve(config.home, seed, m.q)) throw ConfigError("the home position is not reachable by the simulated arm");
+  if (!m.solve(config.home, seed, m.q))
+    throw ConfigError("the home position is not reachable by the simulated arm");
 }
 
 SimulatedArm::~SimulatedArm() = default;
@@ -230,25 +245,36 @@ bool SimulatedArm::reachable(const Vec3& position) const {
   return impl_->solve(position, impl_->q, solution);
 }
 
-std::vector<double> SimulatedArm::joints() const { return {impl_->q.data.data(), impl_->q.data.data() + 6}; }
+std::vector<double> SimulatedArm::joints() const {
+  return {impl_->q.data.data(), impl_->q.data.data() + 6};
+}
 
 std::optional<Rejection> SimulatedArm::check(const DriverCommand& c) const {
   const Impl& m = *impl_;
   const RobotConfig& cfg = m.config;
   if (c.type == MessageType::Grasp || c.type == MessageType::Drop) {
     const Vec3& p = c.target;
-    const bool inside = p.x >= cfg.workspace_min.x && p.x <= cfg.workspace_max.x && p.y >= cfg.workspace_min.y &&
-                        p.y <= cfg.workspace_max.y && p.z >= cfg.workspace_min.z && p.z <= cfg.workspace_max.z;
+    const bool inside = p.x >= cfg.workspace_min.x && p.x <= cfg.workspace_max.x &&
+                        p.y >= cfg.workspace_min.y && p.y <= cfg.workspace_max.y &&
+                        p.z >= cfg.workspace_min.z && p.z <= cfg.workspace_max.z;
     char where[96];
     std::snprintf(where, sizeof where, "(%.3f, %.3f, %.3f)", p.x, p.y, p.z);
-    if (!inside) return Rejection{RejectReason::OutsideWorkspace, std::string(where) + " lies outside the workspace"};
-    if (p.z < cfg.table_z - 0.001) return Rejection{RejectReason::OutsideWorkspace, std::string(where) + " lies below the table"};
+    if (!inside)
+      return Rejection{RejectReason::OutsideWorkspace,
+                       std::string(where) + " lies outside the workspace"};
+    if (p.z < cfg.table_z - 0.001)
+      return Rejection{RejectReason::OutsideWorkspace,
+                       std::string(where) + " lies below the table"};
     const Vec3 above{p.x, p.y, std::max(p.z + cfg.approach_height, cfg.table_z + cfg.lift_height)};
-    if (!reachable(p) || !reachable(above)) return Rejection{RejectReason::Unreachable, std::string(where) + " is out of the arm's reach"};
+    if (!reachable(p) || !reachable(above))
+      return Rejection{RejectReason::Unreachable,
+                       std::string(where) + " is out of the arm's reach"};
     if (c.type == MessageType::Grasp && m.holding >= 0) {
-      return Rejection{RejectReason::InvalidState, "already holding object " + std::to_string(m.holding)};
+      return Rejection{RejectReason::InvalidState,
+                       "already holding object " + std::to_string(m.holding)};
     }
-    if (c.type == MessageType::Drop && m.holding < 0) return Rejection{RejectReason::InvalidState, "holding nothing to drop"};
+    if (c.type == MessageType::Drop && m.holding < 0)
+      return Rejection{RejectReason::InvalidState, "holding nothing to drop"};
   }
   return std::nullopt;
 }
@@ -279,7 +305,8 @@ std::optional<DriverResult> SimulatedArm::step(double seconds) {
     if (blocked) {
       m.plan.clear();
       m.state = RobotState::Fault;
-      return DriverResult{Outcome::Failed, "no joint motion reaches the next point (joint limit or singularity)"};
+      return DriverResult{Outcome::Failed,
+                          "no joint motion reaches the next point (joint limit or singularity)"};
     }
   }
   if (!m.plan.empty()) return std::nullopt;
@@ -289,9 +316,12 @@ std::optional<DriverResult> SimulatedArm::step(double seconds) {
   std::snprintf(where, sizeof where, "(%.3f, %.3f, %.3f)", t.x, t.y, t.z);
   if (!m.failure.empty()) return DriverResult{Outcome::Failed, m.failure};
   switch (m.command.type) {
-    case MessageType::Grasp: return DriverResult{Outcome::Success, "holding object " + std::to_string(m.holding)};
-    case MessageType::Drop: return DriverResult{Outcome::Success, std::string("released at ") + where};
-    default: return DriverResult{Outcome::Success, std::string("at home ") + where};
+    case MessageType::Grasp:
+      return DriverResult{Outcome::Success, "holding object " + std::to_string(m.holding)};
+    case MessageType::Drop:
+      return DriverResult{Outcome::Success, std::string("released at ") + where};
+    default:
+      return DriverResult{Outcome::Success, std::string("at home ") + where};
   }
 }
 
@@ -302,13 +332,16 @@ DriverStatus SimulatedArm::status() const {
   s.tool = m.tool();
   s.gripper_opening = m.gripper;
   s.holding = m.holding;
-  s.progress = m.state == RobotState::Moving && m.plan_size > 0 ? 1.0 - static_cast<double>(m.plan.size()) / m.plan_size : 0.0;
+  s.progress = m.state == RobotState::Moving && m.plan_size > 0
+                   ? 1.0 - static_cast<double>(m.plan.size()) / m.plan_size
+                   : 0.0;
   return s;
 }
 
 std::vector<WorldObject> SimulatedArm::world() const {
   std::vector<WorldObject> out;
-  for (const SimulatedObject& o : impl_->objects) out.push_back({o.id, o.position, o.id == impl_->holding});
+  for (const SimulatedObject& o : impl_->objects)
+    out.push_back({o.id, o.position, o.id == impl_->holding});
   return out;
 }
 

@@ -21,17 +21,20 @@ std::string Endpoint::toString() const {
 }
 
 bool Endpoint::operator==(const Endpoint& other) const {
-  return address.sin_addr.s_addr == other.address.sin_addr.s_addr && address.sin_port == other.address.sin_port;
+  return address.sin_addr.s_addr == other.address.sin_addr.s_addr &&
+         address.sin_port == other.address.sin_port;
 }
 
 Endpoint Endpoint::resolve(const std::string& host, int port) {
-  if (port <= 0 || port > 65535) throw SocketError("port " + std::to_string(port) + " is not 1-65535");
+  if (port <= 0 || port > 65535)
+    throw SocketError("port " + std::to_string(port) + " is not 1-65535");
   addrinfo hints{};
   hints.ai_family = AF_INET;
   hints.ai_socktype = SOCK_DGRAM;
   addrinfo* found = nullptr;
   const int status = getaddrinfo(host.c_str(), nullptr, &hints, &found);
-  if (status != 0 || !found) throw SocketError("cannot resolve host '" + host + "': " + gai_strerror(status));
+  if (status != 0 || !found)
+    throw SocketError("cannot resolve host '" + host + "': " + gai_strerror(status));
   Endpoint endpoint;
   std::memcpy(&endpoint.address, found->ai_addr, sizeof(sockaddr_in));
   endpoint.address.sin_port = htons(static_cast<std::uint16_t>(port));
@@ -41,7 +44,8 @@ Endpoint Endpoint::resolve(const std::string& host, int port) {
 
 UdpSocket::UdpSocket(int port, const std::string& host) {
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (fd_ < 0) throw SocketError(std::string("cannot create a UDP socket: ") + std::strerror(errno));
+  if (fd_ < 0)
+    throw SocketError(std::string("cannot create a UDP socket: ") + std::strerror(errno));
   Endpoint local = Endpoint::resolve(host, port == 0 ? 1 : port);
   local.address.sin_port = htons(static_cast<std::uint16_t>(port));
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&local.address), sizeof local.address) != 0) {
@@ -64,14 +68,16 @@ int UdpSocket::port() const {
 
 void UdpSocket::sendTo(const std::vector<std::uint8_t>& bytes, const Endpoint& to) {
   // UDP may drop; a full send buffer is the same as a lost datagram, which the protocol handles.
-  ::sendto(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&to.address), sizeof to.address);
+  ::sendto(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT,
+           reinterpret_cast<const sockaddr*>(&to.address), sizeof to.address);
 }
 
 std::optional<Datagram> UdpSocket::receive() {
   std::uint8_t buffer[65536];
   Datagram d;
   socklen_t length = sizeof d.from.address;
-  const ssize_t n = ::recvfrom(fd_, buffer, sizeof buffer, MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&d.from.address), &length);
+  const ssize_t n = ::recvfrom(fd_, buffer, sizeof buffer, MSG_DONTWAIT,
+                               reinterpret_cast<sockaddr*>(&d.from.address), &length);
   if (n < 0) return std::nullopt;
   d.bytes.assign(buffer, buffer + n);
   return d;

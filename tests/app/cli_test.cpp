@@ -38,8 +38,10 @@ TEST(Cli, VersionPrintsTheProjectVersion) {
 
 TEST(Cli, UnknownOptionGivesOneLineErrorAndNonZeroExit) {
   for (const auto& arguments : std::vector<std::vector<std::string>>{
-           {"--no-such-option"}, {"screenshot", "--headless", "--out", "x.png", "--bogus"},
-           {"no-such-command"}, {"screenshot", "--headless"}}) {
+           {"--no-such-option"},
+           {"screenshot", "--headless", "--out", "x.png", "--bogus"},
+           {"no-such-command"},
+           {"screenshot", "--headless"}}) {
     const ProcessResult result = runProcess(kArbci, arguments);
     EXPECT_NE(result.exit_code, 0) << arguments[0];
     EXPECT_EQ(lineCount(result.err), 1) << result.err;
@@ -66,8 +68,8 @@ TEST(Cli, GlInfoHeadlessPrintsVendorRendererAndVersion) {
 TEST(Cli, HeadlessScreenshotWritesAPngOfTheRequestedSizeThatIsNotOneColour) {
   const auto path = tempPath("shell.png");
   std::filesystem::remove(path);
-  const ProcessResult result =
-      runProcess(kArbci, {"screenshot", "--headless", "--size", "1024x640", "--out", path.string()});
+  const ProcessResult result = runProcess(
+      kArbci, {"screenshot", "--headless", "--size", "1024x640", "--out", path.string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
   ASSERT_FALSE(image.empty());

@@ -1,8 +1,8 @@
 // `arbci eeg`: info on the BCI2000 sample data, simulate and convert, an independent reader
 // (BioSig's save2gdf) agreeing, a recording killed mid-session still readable, and one-line
 // errors for bad files.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -28,7 +28,8 @@ std::filesystem::path scratch(const std::string& name) {
 }
 
 TEST(EegCommand, InfoGivesChannelsRateDurationAndEventsByCode) {
-  const ProcessResult r = runProcess(kArbci, {"eeg", "info", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat")});
+  const ProcessResult r =
+      runProcess(kArbci, {"eeg", "info", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat")});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("channels:  8 (Fz Cz P3 Pz P4 PO7 Oz PO8)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("rate:      256 Hz"), std::string::npos);
@@ -40,8 +41,9 @@ TEST(EegCommand, InfoGivesChannelsRateDurationAndEventsByCode) {
 
 TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
   const auto bdf = scratch("sim.bdf");
-  ProcessResult r = runProcess(kArbci, {"eeg", "simulate", "--seconds", "30", "--rows", "3", "--columns", "3", "--sequences", "5",
-                                        "--out", bdf.string()});
+  ProcessResult r =
+      runProcess(kArbci, {"eeg", "simulate", "--seconds", "30", "--rows", "3", "--columns", "3",
+                          "--sequences", "5", "--out", bdf.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("100%"), std::string::npos);  // progress
   const bci::Recording ours = bci::readRecording(bdf);
@@ -67,9 +69,11 @@ TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
 
   // BCI2000 to BDF+: the same stimuli and samples.
   const auto converted = scratch("eeg3_1.bdf");
-  r = runProcess(kArbci, {"eeg", "convert", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"), converted.string()});
+  r = runProcess(kArbci, {"eeg", "convert", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"),
+                          converted.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const bci::Recording original = bci::readRecording(sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"));
+  const bci::Recording original =
+      bci::readRecording(sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"));
   const bci::Recording copy = bci::readRecording(converted);
   ASSERT_EQ(copy.samples, original.samples);
   ASSERT_EQ(copy.stimuli.size(), 720u);
@@ -90,20 +94,30 @@ TEST(EegCommand, RecordingKilledMidSessionIsReadableUpToItsLastSecond) {
     const int null = ::open("/dev/null", O_WRONLY);
     dup2(null, STDERR_FILENO);
     dup2(null, STDOUT_FILENO);
-    execl(kArbci.c_str(), kArbci.c_str(), "eeg", "simulate", "--paced", "--seconds", "60", "--out", bdf.c_str(), nullptr);
+    execl(kArbci.c_str(), kArbci.c_str(), "eeg", "simulate", "--paced", "--seconds", "60", "--out",
+          bdf.c_str(), nullptr);
     _exit(127);
   }
-  const auto started = std::chrono::steady_clock::now();
+  using Clock = std::chrono::steady_clock;
+  const auto launched = Clock::now();
+  // The recording's clock starts just before its file is created: time it from there.
+  while (!std::filesystem::exists(bdf) && Clock::now() - launched < std::chrono::seconds(20)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const auto created = Clock::now();
   std::this_thread::sleep_for(std::chrono::milliseconds(3000));
   ASSERT_EQ(kill(child, SIGKILL), 0);
+  const auto killed = Clock::now();
   int status = 0;
   waitpid(child, &status, 0);
-  const double ran = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   ASSERT_TRUE(WIFSIGNALED(status));
 
   const bci::Recording r = bci::readRecording(bdf);  // no salvage needed: the header is always true
-  EXPECT_GE(r.seconds(), ran - 1.0 - 0.3);  // at most a second lost (0.3 s for the start-up)
-  EXPECT_LE(r.seconds(), ran);
+  const auto seconds = [](auto from, auto to) {
+    return std::chrono::duration<double>(to - from).count();
+  };
+  EXPECT_GE(r.seconds(), seconds(created, killed) - 1.0 - 0.1);  // at most a second lost
+  EXPECT_LE(r.seconds(), seconds(launched, killed));
   EXPECT_FALSE(r.stimuli.empty());
   EXPECT_EQ(r.parameters.at("Source"), "ARBCI simulated subject");
   for (const auto& e : r.stimuli) EXPECT_LT(e.sample, r.samples + 256);
@@ -115,12 +129,15 @@ TEST(EegCommand, BadFilesGiveOneLineNamingTheFileAndWhatIsWrong) {
     std::ifstream in(sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"), std::ios::binary);
     std::string bytes(2000000, '\0');
     in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    std::ofstream(truncated, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(truncated, std::ios::binary)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
   const auto unknown = scratch("unknown.edf");
   std::ofstream(unknown) << "this is not EEG";
   for (const auto& [file, reason] : std::vector<std::pair<std::string, std::string>>{
-           {truncated.string(), "cut short"}, {unknown.string(), "unknown format"}, {scratch("none.gdf").string(), "no such file"}}) {
+           {truncated.string(), "cut short"},
+           {unknown.string(), "unknown format"},
+           {scratch("none.gdf").string(), "no such file"}}) {
     const ProcessResult r = runProcess(kArbci, {"eeg", "info", file});
     EXPECT_EQ(r.exit_code, 1) << file;
     EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
@@ -128,10 +145,12 @@ TEST(EegCommand, BadFilesGiveOneLineNamingTheFileAndWhatIsWrong) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
   // The truncated file can be salvaged.
-  const ProcessResult salvaged = runProcess(kArbci, {"eeg", "info", "--salvage", truncated.string()});
+  const ProcessResult salvaged =
+      runProcess(kArbci, {"eeg", "info", "--salvage", truncated.string()});
   EXPECT_EQ(salvaged.exit_code, 0) << salvaged.err;
   EXPECT_NE(salvaged.out.find("truncated:"), std::string::npos) << salvaged.out;
-  const ProcessResult wrong_out = runProcess(kArbci, {"eeg", "convert", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"), "x.edf"});
+  const ProcessResult wrong_out = runProcess(
+      kArbci, {"eeg", "convert", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"), "x.edf"});
   EXPECT_EQ(wrong_out.exit_code, 1);
   EXPECT_NE(wrong_out.err.find("*.bdf"), std::string::npos);
 }

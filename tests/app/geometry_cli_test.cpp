@@ -39,10 +39,12 @@ TEST(CalibrateCommand, WritesAnOpenCvCalibrationWithProgressPerView) {
 TEST(CalibrateCommand, TooFewViewsAndBadBoardsGiveAReason) {
   const auto out = std::filesystem::temp_directory_path() / "arbci_cli_bad.yml";
   const ProcessResult few =
-      runProcess(kArbci, {"calibrate", sharedData("vision/opencv_samples_chessboard/left01.jpg"), "--out", out.string()});
+      runProcess(kArbci, {"calibrate", sharedData("vision/opencv_samples_chessboard/left01.jpg"),
+                          "--out", out.string()});
   EXPECT_NE(few.exit_code, 0);
   EXPECT_NE(few.err.find("at least 3"), std::string::npos) << few.err;
-  const ProcessResult board = runProcess(kArbci, {"calibrate", "--board", "9by6", "x.png", "--out", out.string()});
+  const ProcessResult board =
+      runProcess(kArbci, {"calibrate", "--board", "9by6", "x.png", "--out", out.string()});
   EXPECT_NE(board.exit_code, 0);
   EXPECT_NE(board.err.find("--board"), std::string::npos) << board.err;
 }
@@ -50,9 +52,9 @@ TEST(CalibrateCommand, TooFewViewsAndBadBoardsGiveAReason) {
 TEST(DetectCommand, WithACameraAddsUndistortedCornersAndPoses) {
   const std::string samples = sharedData("vision/artoolkitplus_samples/");
   const ProcessResult result = runProcess(
-      kArbci, {"detect", "--kind", "simple", "--border", "0.125", "--threshold", "160", "--camera", samples + "PGR_M12x0.5_2.5mm.cal",
-               "--marker-size-mm", "40", "--marker-set", samples + "markerboard_480-499.cfg",
-               samples + "markerboard_480-499_from_raw.png"});
+      kArbci, {"detect", "--kind", "simple", "--border", "0.125", "--threshold", "160", "--camera",
+               samples + "PGR_M12x0.5_2.5mm.cal", "--marker-size-mm", "40", "--marker-set",
+               samples + "markerboard_480-499.cfg", samples + "markerboard_480-499_from_raw.png"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json frame = nlohmann::json::parse(result.out);
   ASSERT_GE(frame["markers"].size(), 10u);
@@ -66,7 +68,8 @@ TEST(DetectCommand, WithACameraAddsUndistortedCornersAndPoses) {
   const auto& t = frame["set_pose"]["t_m"];
   // ARToolKitPlus: (4.49, -14.77, 177.61) mm.
   EXPECT_NEAR(t[2].get<double>(), 0.1776, 0.01);
-  const ProcessResult wrong = runProcess(kArbci, {"detect", "--camera", samples + "no_such.cal", samples + "markerboard_480-499_from_raw.png"});
+  const ProcessResult wrong = runProcess(kArbci, {"detect", "--camera", samples + "no_such.cal",
+                                                  samples + "markerboard_480-499_from_raw.png"});
   EXPECT_NE(wrong.exit_code, 0);
   EXPECT_NE(wrong.err.find("no_such.cal"), std::string::npos) << wrong.err;
 }

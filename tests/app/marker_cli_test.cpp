@@ -33,8 +33,8 @@ std::vector<nlohmann::json> jsonLines(const std::string& text) {
 TEST(DetectCommand, PrintsOneJsonObjectPerFrameWithMarkersAndStageTimes) {
   const std::string samples = sharedData("vision/artoolkitplus_samples/");
   const ProcessResult result = runProcess(
-      kArbci, {"detect", "--kind", "simple", "--border", "0.25", "--threshold", "150", "--raw", "320x240",
-               "--repeat", "3", samples + "image_320_240_8_marker_id_simple_nr031.raw",
+      kArbci, {"detect", "--kind", "simple", "--border", "0.25", "--threshold", "150", "--raw",
+               "320x240", "--repeat", "3", samples + "image_320_240_8_marker_id_simple_nr031.raw",
                samples + "image_320_240_8_marker_id_simple_nr321.raw"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto lines = jsonLines(result.out);
@@ -94,8 +94,8 @@ TEST(DetectCommand, DictionaryKindsAndAnnotation) {
 
 TEST(MarkerCommand, WritesPrintScaleMarkersThatDetectAsTheirIds) {
   const auto base = scratch("bch_0042");
-  const ProcessResult make = runProcess(
-      kArbci, {"marker", "make", "--kind", "bch", "--id", "42", "--size-mm", "50", "--out", base.string()});
+  const ProcessResult make = runProcess(kArbci, {"marker", "make", "--kind", "bch", "--id", "42",
+                                                 "--size-mm", "50", "--out", base.string()});
   ASSERT_EQ(make.exit_code, 0) << make.err;
   const cv::Mat png = cv::imread(base.string() + ".png", cv::IMREAD_GRAYSCALE);
   // 50 mm + two 6.25 mm quiet zones at 300 dpi.
@@ -112,22 +112,25 @@ TEST(MarkerCommand, WritesPrintScaleMarkersThatDetectAsTheirIds) {
 
 TEST(MarkerCommand, ASheetHoldsEveryIdAndHazardousIdsAreWarnedAbout) {
   const auto base = scratch("sheet");
-  const ProcessResult make = runProcess(kArbci, {"marker", "make", "--kind", "simple", "--border", "0.25", "--id",
-                                                 "3,7,10-12", "--size-mm", "40", "--sheet", "--out", base.string()});
+  const ProcessResult make =
+      runProcess(kArbci, {"marker", "make", "--kind", "simple", "--border", "0.25", "--id",
+                          "3,7,10-12", "--size-mm", "40", "--sheet", "--out", base.string()});
   ASSERT_EQ(make.exit_code, 0) << make.err;
-  const ProcessResult detect = runProcess(kArbci, {"detect", "--kind", "simple", base.string() + ".png"});
+  const ProcessResult detect =
+      runProcess(kArbci, {"detect", "--kind", "simple", base.string() + ".png"});
   const auto lines = jsonLines(detect.out);
   ASSERT_EQ(lines.size(), 1u) << detect.err;
   std::vector<int> ids;
   for (const auto& m : lines[0]["markers"]) ids.push_back(m["id"]);
   std::sort(ids.begin(), ids.end());
   EXPECT_EQ(ids, (std::vector<int>{3, 7, 10, 11, 12}));
-  const ProcessResult hazard =
-      runProcess(kArbci, {"marker", "make", "--kind", "bch", "--id", "1550", "--out", scratch("h").string()});
+  const ProcessResult hazard = runProcess(
+      kArbci, {"marker", "make", "--kind", "bch", "--id", "1550", "--out", scratch("h").string()});
   EXPECT_EQ(hazard.exit_code, 0);
   EXPECT_NE(hazard.err.find("1550"), std::string::npos);
-  const ProcessResult out_of_range =
-      runProcess(kArbci, {"marker", "make", "--kind", "simple", "--id", "512", "--out", scratch("x").string()});
+  const ProcessResult out_of_range = runProcess(
+      kArbci,
+      {"marker", "make", "--kind", "simple", "--id", "512", "--out", scratch("x").string()});
   EXPECT_NE(out_of_range.exit_code, 0);
   EXPECT_NE(out_of_range.err.find("512"), std::string::npos);
 }

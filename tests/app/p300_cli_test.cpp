@@ -21,13 +21,16 @@ std::filesystem::path scratch(const std::string& name) {
   return dir / name;
 }
 
-std::string eeg(const std::string& name) { return sharedData("eeg/bci2000_samplefiles/" + name); }
+std::string eeg(const std::string& name) {
+  return sharedData("eeg/bci2000_samplefiles/" + name);
+}
 
 TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
   const auto model = scratch("swlda.json"), prm = scratch("swlda.prm"), plots = scratch("plots");
   std::filesystem::remove_all(plots);
-  ProcessResult r = runProcess(kArbci, {"train", "--method", "swlda", eeg("eeg3_1.dat"), "--out", model.string(), "--bci2000",
-                                        prm.string(), "--plots", plots.string()});
+  ProcessResult r =
+      runProcess(kArbci, {"train", "--method", "swlda", eeg("eeg3_1.dat"), "--out", model.string(),
+                          "--bci2000", prm.string(), "--plots", plots.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("100%"), std::string::npos);
   EXPECT_NE(r.out.find("cross-validation, 4 folds split by selection"), std::string::npos) << r.out;
@@ -35,7 +38,8 @@ TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
   std::ifstream in(model);
   const nlohmann::json json = nlohmann::json::parse(in);
   EXPECT_EQ(json["method"], "swlda");
-  EXPECT_NE(json["provenance"]["training_files"][0].get<std::string>().find("eeg3_1.dat"), std::string::npos);
+  EXPECT_NE(json["provenance"]["training_files"][0].get<std::string>().find("eeg3_1.dat"),
+            std::string::npos);
   EXPECT_EQ(json["provenance"]["cross_validation"]["accuracy_by_sequences"].size(), 15u);
   for (const char* plot : {"erp.png", "accuracy.png"}) {
     const cv::Mat image = cv::imread((plots / plot).string());
@@ -59,26 +63,35 @@ TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
 
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
-  ASSERT_EQ(runProcess(kArbci, {"train", "--method", "slda", eeg("eeg3_1.dat"), "--out", model.string()}).exit_code, 0);
+  ASSERT_EQ(
+      runProcess(kArbci, {"train", "--method", "slda", eeg("eeg3_1.dat"), "--out", model.string()})
+          .exit_code,
+      0);
   // A model for other channels.
-  ProcessResult r = runProcess(kArbci, {"evaluate", "--model", model.string(), eeg("P3SpellerS001R01_synthetic.dat")});
+  ProcessResult r = runProcess(
+      kArbci, {"evaluate", "--model", model.string(), eeg("P3SpellerS001R01_synthetic.dat")});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("has no channel Fz"), std::string::npos) << r.err;
   // A file without stimuli.
   const auto quiet = scratch("quiet.bdf");
-  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "3", "--out", quiet.string()}).exit_code, 0);
+  ASSERT_EQ(
+      runProcess(kArbci, {"eeg", "simulate", "--seconds", "3", "--out", quiet.string()}).exit_code,
+      0);
   r = runProcess(kArbci, {"train", quiet.string(), "--out", scratch("none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no stimulus events"), std::string::npos) << r.err;
   // Too little to train on: a single selection.
   const auto short_file = scratch("short.bdf");
-  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "10", "--out", short_file.string()}).exit_code, 0);
+  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "10", "--out", short_file.string()})
+                .exit_code,
+            0);
   r = runProcess(kArbci, {"train", short_file.string(), "--out", scratch("none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("at least 2 selections"), std::string::npos) << r.err;
   // A broken model file.
   std::ofstream(scratch("broken.json")) << "{\"format\": \"arbci-p300-model\"";
-  r = runProcess(kArbci, {"evaluate", "--model", scratch("broken.json").string(), eeg("eeg3_2.dat")});
+  r = runProcess(kArbci,
+                 {"evaluate", "--model", scratch("broken.json").string(), eeg("eeg3_2.dat")});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
 }

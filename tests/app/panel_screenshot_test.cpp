@@ -18,7 +18,10 @@ class PanelScreenshot : public ::testing::TestWithParam<std::string> {};
 TEST_P(PanelScreenshot, RendersThePanelOnLiveData) {
   const auto out = std::filesystem::temp_directory_path() / ("arbci_panel_" + GetParam() + ".png");
   std::filesystem::remove(out);
-  const ProcessResult r = runProcess(kArbci, {"screenshot", "--headless", "--panel", GetParam(), "--size", "1000x700", "--out", out.string()}, 120.0);
+  const ProcessResult r = runProcess(kArbci,
+                                     {"screenshot", "--headless", "--panel", GetParam(), "--size",
+                                      "1000x700", "--out", out.string()},
+                                     120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const cv::Mat image = cv::imread(out.string());
   ASSERT_FALSE(image.empty());
@@ -32,10 +35,13 @@ TEST_P(PanelScreenshot, RendersThePanelOnLiveData) {
   EXPECT_GT(deviation[0] + deviation[1] + deviation[2], 30.0);  // not one flat colour
 }
 
-INSTANTIATE_TEST_SUITE_P(Panels, PanelScreenshot, ::testing::Values("threshold", "calibration", "training", "robot", "session", "hmd"));
+INSTANTIATE_TEST_SUITE_P(Panels, PanelScreenshot,
+                         ::testing::Values("threshold", "calibration", "training", "robot",
+                                           "session", "hmd"));
 
 TEST(PanelScreenshotErrors, AnUnknownPanelIsRefused) {
-  const ProcessResult r = runProcess(kArbci, {"screenshot", "--headless", "--panel", "mixer", "--out", "/tmp/x.png"});
+  const ProcessResult r =
+      runProcess(kArbci, {"screenshot", "--headless", "--panel", "mixer", "--out", "/tmp/x.png"});
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--panel"), std::string::npos) << r.err;
 }

@@ -65,7 +65,8 @@ TEST(RobotCommand, KeygenWritesAPrivateKey) {
 TEST(RobotCommand, GraspDropAndRejectionsThroughTheBackend) {
   const auto key = scratch("session.key"), config = scratch("robot.json");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
-  std::ofstream(config) << R"({"speed_factor": 20, "objects": [{"id": 4, "position": [0.1, 0.6, 0.06]}]})";
+  std::ofstream(config)
+      << R"({"speed_factor": 20, "objects": [{"id": 4, "position": [0.1, 0.6, 0.06]}]})";
   const std::string port = "47913";
   Robotd robotd({"--port", port, "--key-file", key.string(), "--config", config.string()});
   const std::vector<std::string> base{"robot", "--port", port, "--key-file", key.string()};
@@ -94,11 +95,13 @@ TEST(RobotCommand, NoBackendOrWrongKeyGivesAReason) {
   const auto key = scratch("lonely.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
   const auto start = std::chrono::steady_clock::now();
-  const ProcessResult r = runProcess(kArbci, {"robot", "--port", "47999", "--key-file", key.string(), "home"}, 30.0);
+  const ProcessResult r =
+      runProcess(kArbci, {"robot", "--port", "47999", "--key-file", key.string(), "home"}, 30.0);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no answer from the backend"), std::string::npos) << r.err;
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
-  const ProcessResult missing = runProcess(kArbci, {"robot", "--key-file", scratch("none.key").string(), "status"});
+  const ProcessResult missing =
+      runProcess(kArbci, {"robot", "--key-file", scratch("none.key").string(), "status"});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("no key file"), std::string::npos) << missing.err;
 }

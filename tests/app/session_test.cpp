@@ -44,11 +44,14 @@ std::vector<nlohmann::json> readLog(const std::filesystem::path& path) {
 TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimetre) {
   const auto folder = fresh("e2e");
   const auto start = std::chrono::steady_clock::now();
-  const ProcessResult r = runProcess(kArbci, {"run", "--headless", "--session", kSessions + "/steady_head.json", "--seed", "3", "--out",
-                                              folder.string()},
-                                     300.0);
+  const ProcessResult r =
+      runProcess(kArbci,
+                 {"run", "--headless", "--session", kSessions + "/steady_head.json", "--seed", "3",
+                  "--out", folder.string()},
+                 300.0);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 120.0);
   const nlohmann::json summary = readJson(folder / "summary.json");
   EXPECT_EQ(summary["ended"], "finished");
@@ -68,9 +71,10 @@ TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimet
   EXPECT_GT(summary["calibration"]["auc"].get<double>(), 0.7);
 
   // The folder is complete.
-  for (const char* file : {"recording.bdf", "log.jsonl", "summary.json", "model.json", "session.json", "hmd_calibration.png",
-                           "hmd_trial1_1_objects_flashing.png", "hmd_trial2_3_grasping.png", "hmd_trial3_4_grid_flashing.png",
-                           "hmd_trial3_6_putting_down.png", "hmd_finished.png"}) {
+  for (const char* file :
+       {"recording.bdf", "log.jsonl", "summary.json", "model.json", "session.json",
+        "hmd_calibration.png", "hmd_trial1_1_objects_flashing.png", "hmd_trial2_3_grasping.png",
+        "hmd_trial3_4_grid_flashing.png", "hmd_trial3_6_putting_down.png", "hmd_finished.png"}) {
     EXPECT_TRUE(std::filesystem::exists(folder / file)) << file;
   }
   // The recording is readable, with every flash and the selections.
@@ -103,9 +107,12 @@ TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimet
 TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
   const auto folder = fresh("weak");
   const auto session = folder.string() + ".json";
-  std::ofstream(session) << R"({"eeg": {"erp_scale": 0.0}, "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+  std::ofstream(session)
+      << R"({"eeg": {"erp_scale": 0.0}, "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
     "paradigm": {"calibration_selections": 4, "sequences": 4, "min_sequences": 2, "trials": 3}, "robot": {"speed_factor": 20}})";
-  const ProcessResult r = runProcess(kArbci, {"run", "--headless", "--session", session, "--seed", "5", "--out", folder.string()}, 300.0);
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session, "--seed", "5", "--out", folder.string()},
+      300.0);
   ASSERT_EQ(r.exit_code, 0) << r.err;  // finished, not hung
   const nlohmann::json summary = readJson(folder / "summary.json");
   ASSERT_EQ(summary["trials"].size(), 3u);
@@ -118,7 +125,8 @@ TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
   EXPECT_GT(wrong, 0);
   EXPECT_NE(r.err.find("differs from the intended one; carrying on"), std::string::npos) << r.err;
   int logged_wrong = 0;
-  for (const auto& line : readLog(folder / "log.jsonl")) logged_wrong += line["event"] == "selection" && line["correct"] == false;
+  for (const auto& line : readLog(folder / "log.jsonl"))
+    logged_wrong += line["event"] == "selection" && line["correct"] == false;
   EXPECT_EQ(logged_wrong, wrong);
 }
 
@@ -134,8 +142,8 @@ TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIn
     dup2(out_pipe[1], STDOUT_FILENO);
     dup2(out_pipe[1], STDERR_FILENO);
     close(out_pipe[0]);
-    execl(kArbci.c_str(), kArbci.c_str(), "run", "--headless", "--session", session.c_str(), "--seed", "2", "--out", folder.c_str(),
-          "--fault-wait", "5", nullptr);
+    execl(kArbci.c_str(), kArbci.c_str(), "run", "--headless", "--session", session.c_str(),
+          "--seed", "2", "--out", folder.c_str(), "--fault-wait", "5", nullptr);
     _exit(127);
   }
   close(out_pipe[1]);
@@ -159,24 +167,30 @@ TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIn
   std::string output;
   char buffer[4096];
   ssize_t n = 0;
-  while ((n = read(out_pipe[0], buffer, sizeof buffer)) > 0) output.append(buffer, static_cast<size_t>(n));
+  while ((n = read(out_pipe[0], buffer, sizeof buffer)) > 0)
+    output.append(buffer, static_cast<size_t>(n));
   close(out_pipe[0]);
   int status = 0;
   waitpid(child, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 3) << output;  // ended by the fault, after waiting for an experimenter
+  EXPECT_EQ(WEXITSTATUS(status), 3)
+      << output;  // ended by the fault, after waiting for an experimenter
   bool fault_phase = false;
   for (const auto& line : readLog(folder / "log.jsonl")) {
-    fault_phase |= line["event"] == "phase" && line["phase"].get<std::string>().find("robot fault") != std::string::npos;
+    fault_phase |= line["event"] == "phase" &&
+                   line["phase"].get<std::string>().find("robot fault") != std::string::npos;
   }
   EXPECT_TRUE(fault_phase);
   const nlohmann::json summary = readJson(folder / "summary.json");
-  EXPECT_NE(summary["ended"].get<std::string>().find("robot fault"), std::string::npos) << summary["ended"];
-  EXPECT_NE(summary["trials"][0]["outcome"].get<std::string>().find("silent"), std::string::npos) << summary["trials"][0].dump();
+  EXPECT_NE(summary["ended"].get<std::string>().find("robot fault"), std::string::npos)
+      << summary["ended"];
+  EXPECT_NE(summary["trials"][0]["outcome"].get<std::string>().find("silent"), std::string::npos)
+      << summary["trials"][0].dump();
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
   EXPECT_NEAR(recording.seconds(), summary["duration_s"].get<double>(), 0.1);
   bool ended_note = false;
-  for (const auto& a : recording.annotations) ended_note |= a.text.find("Session ended") != std::string::npos;
+  for (const auto& a : recording.annotations)
+    ended_note |= a.text.find("Session ended") != std::string::npos;
   EXPECT_TRUE(ended_note);
 }
 

@@ -15,7 +15,9 @@
 namespace arbci::bci {
 namespace {
 
-std::string sampleFile(const std::string& name) { return test::sharedData("eeg/bci2000_samplefiles/" + name); }
+std::string sampleFile(const std::string& name) {
+  return test::sharedData("eeg/bci2000_samplefiles/" + name);
+}
 
 // The raw int16 of (sample, channel), read straight from the file's bytes.
 int rawSample(const std::string& path, int sample, int channel) {
@@ -51,7 +53,8 @@ std::vector<std::pair<int, int>> targetsPerCharacter(const Recording& r) {
 TEST(Bci2000Files, Eeg3_1HasTheShapeStimuliAndTargetsOfT3OF) {
   const Recording r = readRecording(sampleFile("eeg3_1.dat"));
   EXPECT_EQ(r.format, "BCI2000");
-  EXPECT_EQ(r.info.channels, (std::vector<std::string>{"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"}));
+  EXPECT_EQ(r.info.channels,
+            (std::vector<std::string>{"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"}));
   EXPECT_EQ(r.info.rate_hz, 256.0);
   EXPECT_EQ(r.samples, 56840);
   ASSERT_EQ(r.stimuli.size(), 720u);
@@ -85,7 +88,8 @@ TEST(Bci2000Files, MicrovoltsAreRawMinusOffsetTimesGain) {
       const double gain = bci2000Number(r, "SourceChGain", channel);
       for (int sample : {0, 1, 1000, static_cast<int>(r.samples) - 1}) {
         const double expected = (rawSample(path, sample, channel) - offset) * gain;
-        EXPECT_NEAR(r.at(channel, sample), expected, 1e-4 * std::max(1.0, std::abs(expected))) << name << " ch " << channel;
+        EXPECT_NEAR(r.at(channel, sample), expected, 1e-4 * std::max(1.0, std::abs(expected)))
+            << name << " ch " << channel;
       }
     }
   }
@@ -118,7 +122,8 @@ TEST(Bci2000Files, BioSigReadsTheSameSamplesOfEeg3) {
   ASSERT_EQ(theirs.samples, ours.samples);
   double worst = 0.0;
   for (int c = 0; c < 8; ++c) {
-    for (std::int64_t s = 0; s < ours.samples; s += 7) worst = std::max(worst, std::abs(double(ours.at(c, s)) - theirs.at(c, s)));
+    for (std::int64_t s = 0; s < ours.samples; s += 7)
+      worst = std::max(worst, std::abs(double(ours.at(c, s)) - theirs.at(c, s)));
   }
   EXPECT_LT(worst, 1e-3);
   EXPECT_TRUE(theirs.stimuli.empty());  // BioSig drops the states: why they are parsed here

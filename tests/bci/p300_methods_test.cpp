@@ -7,10 +7,10 @@
 #include <fstream>
 #include <random>
 
+#include "../../bci/src/statistics.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
-#include "../../bci/src/statistics.h"
 
 namespace arbci::bci {
 namespace {
@@ -144,7 +144,8 @@ TEST(CrossValidation, SplitsBySelectionSoNothingLeaks) {
     data.selections.push_back(selection);
   }
   data.features.resize(static_cast<Eigen::Index>(rows.size()), 10);
-  for (size_t i = 0; i < rows.size(); ++i) data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  for (size_t i = 0; i < rows.size(); ++i)
+    data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
   TrainingSettings settings;
   settings.method = "slda";
   settings.folds = 4;
@@ -180,7 +181,9 @@ Recording simulatedCopyTask(std::uint64_t seed, int selections) {
     next += 512;
     size_t presented = 0;
     while (subject.samplesGenerated() < next) {
-      while (presented < flashes.size() && flashes[presented].sample < subject.samplesGenerated() + 15) subject.present(flashes[presented++]);
+      while (presented < flashes.size() &&
+             flashes[presented].sample < subject.samplesGenerated() + 15)
+        subject.present(flashes[presented++]);
       for (const Block& b : subject.poll(1)) {
         for (int c = 0; c < 8; ++c) {
           for (int i = 0; i < b.samples; ++i) channels[c].push_back(b.at(c, i));
@@ -217,8 +220,8 @@ TEST(P300Model, JsonRoundTripScoresTheSameAndKeepsItsProvenance) {
   EXPECT_EQ(loaded.method, "xdawn");
   EXPECT_EQ(loaded.pipeline.channels, data.feature_channels);
   for (int i = 0; i < data.epochs(); i += 13) {
-    EXPECT_NEAR(loaded.classifier->score(data.features.row(i).transpose()), trained.model.classifier->score(data.features.row(i).transpose()),
-                1e-9);
+    EXPECT_NEAR(loaded.classifier->score(data.features.row(i).transpose()),
+                trained.model.classifier->score(data.features.row(i).transpose()), 1e-9);
   }
   EXPECT_EQ(loaded.provenance.at("training_files").at(0), "simulated");
   EXPECT_EQ(loaded.provenance.at("cross_validation").at("split"), "by selection");

@@ -11,7 +11,9 @@
 namespace arbci::bci {
 namespace {
 
-Recording sample(const std::string& name) { return readRecording(test::sharedData("eeg/bci2000_samplefiles/" + name)); }
+Recording sample(const std::string& name) {
+  return readRecording(test::sharedData("eeg/bci2000_samplefiles/" + name));
+}
 
 struct Evaluated {
   TrainingResult trained;
@@ -30,7 +32,8 @@ const Evaluated& trainedOnEeg3_1(const std::string& method) {
   e.trained = trainModel(buildDataset({sample("eeg3_1.dat")}, pipeline), pipeline, settings);
   const P300Dataset test = buildDataset({sample("eeg3_2.dat")}, e.trained.model.pipeline);
   std::vector<double> scores;
-  for (int i = 0; i < test.epochs(); ++i) scores.push_back(e.trained.model.classifier->score(test.features.row(i).transpose()));
+  for (int i = 0; i < test.epochs(); ++i)
+    scores.push_back(e.trained.model.classifier->score(test.features.row(i).transpose()));
   e.test = evaluateScores(test, scores, e.trained.model.score_model, StoppingRule{15, 2, 0.99});
   return cache.emplace(method, std::move(e)).first->second;
 }
@@ -81,7 +84,8 @@ TEST(P300RealEeg, SwldaKeepsAtMost60FeaturesAndExportsToBci2000) {
     ++entries;
   }
   EXPECT_EQ(entries, kept * 13);
-  EXPECT_NEAR(bci2000_score + model.classifier->bias(), model.classifier->score(data.features.row(10).transpose()), 1e-3);
+  EXPECT_NEAR(bci2000_score + model.classifier->bias(),
+              model.classifier->score(data.features.row(10).transpose()), 1e-3);
   EXPECT_NE(fragment.find("EpochLength= 800ms"), std::string::npos);
 }
 

@@ -21,7 +21,8 @@ ParadigmSettings fast() {
 
 // Runs frames until `until` holds or `limit` frames pass; collects the events.
 template <typename Condition>
-std::vector<ParadigmEvent> runUntil(Paradigm& p, std::int64_t& frame, Condition until, int limit = 5000) {
+std::vector<ParadigmEvent> runUntil(Paradigm& p, std::int64_t& frame, Condition until,
+                                    int limit = 5000) {
   std::vector<ParadigmEvent> events;
   for (int i = 0; i < limit && !until(); ++i) {
     p.frame(frame++);
@@ -58,7 +59,8 @@ TEST(Paradigm, FlashesLastFourFramesEveryElevenFramesEachCodeOncePerSequence) {
       EXPECT_NE(flashes[i].code, flashes[i - 1].code);         // never twice in a row
     }
     const auto onset = static_cast<size_t>(flashes[i].frame);
-    for (size_t f = onset; f < onset + 11; ++f) EXPECT_EQ(lit[f].count(flashes[i].code) > 0, f < onset + 4) << "frame " << f;
+    for (size_t f = onset; f < onset + 11; ++f)
+      EXPECT_EQ(lit[f].count(flashes[i].code) > 0, f < onset + 4) << "frame " << f;
   }
   for (int s = 0; s < 3; ++s) {
     std::set<int> codes;
@@ -85,7 +87,8 @@ TEST(Paradigm, CalibrationRunCuesTargetsThenAsksForTraining) {
   }
   events = p.takeEvents();
   EXPECT_EQ(p.phase(), Phase::Training);
-  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::TrainModel; }));
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(),
+                          [](const ParadigmEvent& e) { return e.kind == Kind::TrainModel; }));
   p.modelTrained(true, "");
   EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
   EXPECT_EQ(p.trial(), 1);
@@ -101,7 +104,9 @@ TEST(Paradigm, ATrialSelectsAnObjectGraspsItSelectsACellAndPutsItDown) {
     EXPECT_EQ(p.phase(), Phase::ObjectSelected);
     EXPECT_EQ(p.frame(frame++).selected_object, 3);
     auto events = runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
-    const auto grasp = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; });
+    const auto grasp = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) {
+      return e.kind == Kind::RobotGrasp;
+    });
     ASSERT_NE(grasp, events.end());
     EXPECT_EQ(grasp->object, 3);
     p.robotFinished(true, "holding");
@@ -118,12 +123,15 @@ TEST(Paradigm, ATrialSelectsAnObjectGraspsItSelectsACellAndPutsItDown) {
     p.decide(choose(5, {2, 6}));  // row 2, column 3
     EXPECT_EQ(p.phase(), Phase::CellSelected);
     events = runUntil(p, frame, [&] { return p.phase() == Phase::Dropping; });
-    const auto drop = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::RobotDrop; });
+    const auto drop = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) {
+      return e.kind == Kind::RobotDrop;
+    });
     ASSERT_NE(drop, events.end());
     EXPECT_EQ(drop->cell, std::make_pair(2, 3));
     p.robotFinished(true, "released");
     events = p.takeEvents();
-    EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::TrialDone; }));
+    EXPECT_TRUE(std::any_of(events.begin(), events.end(),
+                            [](const ParadigmEvent& e) { return e.kind == Kind::TrialDone; }));
   }
   EXPECT_EQ(p.phase(), Phase::Finished);
 }
@@ -137,7 +145,9 @@ TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {
   p.start(false);
   p.requestStopFlashing();
   const auto events = runUntil(p, frame, [&] { return p.awaitingDecision(); });
-  EXPECT_EQ(std::count_if(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::Flash; }), 8);
+  EXPECT_EQ(std::count_if(events.begin(), events.end(),
+                          [](const ParadigmEvent& e) { return e.kind == Kind::Flash; }),
+            8);
 }
 
 TEST(Paradigm, PauseAbortEmergencyStopAndRobotFaults) {
@@ -163,7 +173,8 @@ TEST(Paradigm, PauseAbortEmergencyStopAndRobotFaults) {
   EXPECT_EQ(p.trial(), 2);
   p.emergencyStop();
   auto events = p.takeEvents();
-  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) { return e.kind == Kind::RobotStop; }));
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(),
+                          [](const ParadigmEvent& e) { return e.kind == Kind::RobotStop; }));
   EXPECT_EQ(p.phase(), Phase::EmergencyStop);
   EXPECT_TRUE(p.frame(frame++).lit.empty());
   p.abort();

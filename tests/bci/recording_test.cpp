@@ -59,7 +59,9 @@ Session recordSession(const std::filesystem::path& path, bool close = true) {
   return session;
 }
 
-std::filesystem::path temporary(const std::string& name) { return std::filesystem::temp_directory_path() / name; }
+std::filesystem::path temporary(const std::string& name) {
+  return std::filesystem::temp_directory_path() / name;
+}
 
 TEST(Recording, RoundTripLosesNoSampleAndNoEvent) {
   const auto path = temporary("arbci_roundtrip.bdf");
@@ -72,7 +74,8 @@ TEST(Recording, RoundTripLosesNoSampleAndNoEvent) {
   double worst = 0.0;
   for (const Block& b : session.blocks) {
     for (int c = 0; c < b.channels; ++c) {
-      for (int s = 0; s < b.samples; ++s) worst = std::max(worst, std::abs(double(b.at(c, s)) - r.at(c, b.first_sample + s)));
+      for (int s = 0; s < b.samples; ++s)
+        worst = std::max(worst, std::abs(double(b.at(c, s)) - r.at(c, b.first_sample + s)));
     }
   }
   EXPECT_LT(worst, 0.0006);  // half a step of 16000 uV / 2^24
@@ -94,18 +97,23 @@ TEST(Recording, EdflibReadsTheSameChannelsRateAndEvents) {
   const auto path = temporary("arbci_edflib.bdf");
   const Session session = recordSession(path);
   edf_hdr_struct header{};
-  ASSERT_EQ(edfopen_file_readonly(path.c_str(), &header, EDFLIB_READ_ALL_ANNOTATIONS), 0) << "EDFlib error " << header.filetype;
+  ASSERT_EQ(edfopen_file_readonly(path.c_str(), &header, EDFLIB_READ_ALL_ANNOTATIONS), 0)
+      << "EDFlib error " << header.filetype;
   EXPECT_EQ(header.filetype, EDFLIB_FILETYPE_BDFPLUS);
   EXPECT_EQ(header.edfsignals, 8);
   EXPECT_STREQ(header.signalparam[3].label, "Pz              ");
-  EXPECT_EQ(header.signalparam[0].smp_in_datarecord * EDFLIB_TIME_DIMENSION / header.datarecord_duration, 256);
+  EXPECT_EQ(
+      header.signalparam[0].smp_in_datarecord * EDFLIB_TIME_DIMENSION / header.datarecord_duration,
+      256);
   // Every stimulus and selection, the two parameters and the end-of-signal mark.
-  EXPECT_EQ(header.annotations_in_file, static_cast<long long>(session.stimuli.size() + session.annotations.size() + 3));
+  EXPECT_EQ(header.annotations_in_file,
+            static_cast<long long>(session.stimuli.size() + session.annotations.size() + 3));
   edf_annotation_struct annotation{};
   ASSERT_EQ(edf_get_annotation(header.handle, 2, &annotation), 0);
   int stim_code = 0;
   char kind = 0;
-  ASSERT_EQ(std::sscanf(annotation.annotation, "Stim %d %c", &stim_code, &kind), 2) << annotation.annotation;
+  ASSERT_EQ(std::sscanf(annotation.annotation, "Stim %d %c", &stim_code, &kind), 2)
+      << annotation.annotation;
   EXPECT_EQ(stim_code, session.stimuli[0].code);
   EXPECT_EQ(annotation.onset, session.stimuli[0].sample * EDFLIB_TIME_DIMENSION / 256);
   // Samples agree with what was written.
@@ -156,8 +164,10 @@ TEST(Recording, BadFilesGiveOneLineNamingTheFileNeverACrash) {
     return dir / name;
   };
   std::string edf_garbage = "0       " + std::string(248, 'x');
-  std::string bci_lying = "HeaderLen= 999999 SourceCh= 8 StatevectorLen= 4\r\n[ State Vector Definition ]\r\n";
-  std::string bci_no_rate = "HeaderLen= 90 SourceCh= 2 StatevectorLen= 1\r\n[ Parameter Definition ]\r\n";
+  std::string bci_lying =
+      "HeaderLen= 999999 SourceCh= 8 StatevectorLen= 4\r\n[ State Vector Definition ]\r\n";
+  std::string bci_no_rate =
+      "HeaderLen= 90 SourceCh= 2 StatevectorLen= 1\r\n[ Parameter Definition ]\r\n";
   bci_no_rate.resize(90, ' ');
   bci_no_rate += std::string(10, '\0');
   const std::vector<std::pair<std::filesystem::path, std::string>> cases{

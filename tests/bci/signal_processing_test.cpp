@@ -60,8 +60,8 @@ TEST(Filters, PassBandKeptStopBandAndLineRemoved) {
   const FilterChain chain(FilterSettings{}, eightChannels());
   EXPECT_NEAR(chain.magnitude(5.0), 1.0, 0.02);
   EXPECT_NEAR(chain.magnitude(10.0), 1.0, 0.02);
-  EXPECT_LT(chain.magnitude(50.0), 0.001);   // notch and low-pass: below -60 dB
-  EXPECT_LT(chain.magnitude(0.05), 0.01);    // drifts
+  EXPECT_LT(chain.magnitude(50.0), 0.001);                   // notch and low-pass: below -60 dB
+  EXPECT_LT(chain.magnitude(0.05), 0.01);                    // drifts
   EXPECT_NEAR(chain.magnitude(30.0), std::sqrt(0.5), 0.02);  // -3 dB at the cut-off
   EXPECT_NEAR(magnitudeResponse({notchFilter(60.0, 25.0, 256.0)}, 60.0, 256.0), 0.0, 1e-9);
 
@@ -70,7 +70,8 @@ TEST(Filters, PassBandKeptStopBandAndLineRemoved) {
   for (int c = 0; c < 8; ++c) {
     for (int s = 0; s < b.samples; ++s) {
       const double t = s / 256.0;
-      b.at(c, s) = static_cast<float>((c + 1) * std::sin(2 * std::numbers::pi * 6 * t) + 10 * std::sin(2 * std::numbers::pi * 50 * t));
+      b.at(c, s) = static_cast<float>((c + 1) * std::sin(2 * std::numbers::pi * 6 * t) +
+                                      10 * std::sin(2 * std::numbers::pi * 50 * t));
     }
   }
   FilterSettings settings;
@@ -78,7 +79,8 @@ TEST(Filters, PassBandKeptStopBandAndLineRemoved) {
   FilterChain(settings, eightChannels()).process(b);
   auto amplitude = [&](double frequency) {  // over the last 5 s, after the filter has settled
     std::complex<double> sum = 0.0;
-    for (int s = 1280; s < b.samples; ++s) sum += double(b.at(2, s)) * std::polar(1.0, -2 * std::numbers::pi * frequency * s / 256.0);
+    for (int s = 1280; s < b.samples; ++s)
+      sum += double(b.at(2, s)) * std::polar(1.0, -2 * std::numbers::pi * frequency * s / 256.0);
     return 2.0 * std::abs(sum) / 1280.0;
   };
   EXPECT_NEAR(amplitude(6.0), 3.0, 0.05);
@@ -111,7 +113,8 @@ TEST(Decimator, AveragesGroupsAcrossBlockBoundaries) {
   for (int s = 0; s < 100; ++s) ramp.at(0, s) = static_cast<float>(s);
   Decimator decimator(12, 1);
   std::vector<Block> outputs;
-  for (int first = 0; first < 100; first += 15) outputs.push_back(decimator.process(slice(ramp, first, std::min(15, 100 - first))));
+  for (int first = 0; first < 100; first += 15)
+    outputs.push_back(decimator.process(slice(ramp, first, std::min(15, 100 - first))));
   std::vector<float> values;
   std::int64_t expected_index = 0;
   for (const Block& o : outputs) {

@@ -81,7 +81,8 @@ TEST(SimulatedSubject, TargetMinusNonTargetAtPzPeaksBetween250And500Ms) {
   SignalInfo info;
   info.channels = config.montage;
   Block all(0, static_cast<int>(config.montage.size()), static_cast<int>(run.channels[0].size()));
-  for (int c = 0; c < all.channels; ++c) std::copy(run.channels[c].begin(), run.channels[c].end(), all.data.begin() + c * all.samples);
+  for (int c = 0; c < all.channels; ++c)
+    std::copy(run.channels[c].begin(), run.channels[c].end(), all.data.begin() + c * all.samples);
   FilterSettings settings;
   settings.lowpass_hz = 12.0;
   FilterChain(settings, info).process(all);
@@ -97,7 +98,8 @@ TEST(SimulatedSubject, TargetMinusNonTargetAtPzPeaksBetween250And500Ms) {
   ASSERT_GT(n_target, 100);
   int peak = 0;
   for (int s = 0; s < length; ++s) {
-    if (target[s] / n_target - other[s] / n_other > target[peak] / n_target - other[peak] / n_other) peak = s;
+    if (target[s] / n_target - other[s] / n_other > target[peak] / n_target - other[peak] / n_other)
+      peak = s;
   }
   const double peak_ms = peak * 1000.0 / 256.0;
   EXPECT_GE(peak_ms, 250.0);

@@ -37,9 +37,12 @@ TEST(HeadlessContext, RendersQuadrantsAndAThickLineThatReadBackExactly) {
   clearFramebuffer(context->drawFramebuffer(), size, {0.0f, 0.0f, 0.0f, 1.0f});
   const glm::vec2 viewport(size.width, size.height);
   const float w = 48.0f, h = 32.0f;
-  renderer.fillPolygon(std::vector<glm::vec2>{{0, 0}, {w, 0}, {w, h}, {0, h}}, {1, 0, 0, 1}, viewport);
-  renderer.fillPolygon(std::vector<glm::vec2>{{w, 0}, {96, 0}, {96, h}, {w, h}}, {0, 1, 0, 1}, viewport);
-  renderer.fillPolygon(std::vector<glm::vec2>{{0, h}, {w, h}, {w, 64}, {0, 64}}, {0, 0, 1, 1}, viewport);
+  renderer.fillPolygon(std::vector<glm::vec2>{{0, 0}, {w, 0}, {w, h}, {0, h}}, {1, 0, 0, 1},
+                       viewport);
+  renderer.fillPolygon(std::vector<glm::vec2>{{w, 0}, {96, 0}, {96, h}, {w, h}}, {0, 1, 0, 1},
+                       viewport);
+  renderer.fillPolygon(std::vector<glm::vec2>{{0, h}, {w, h}, {w, 64}, {0, 64}}, {0, 0, 1, 1},
+                       viewport);
   // A 4 px wide horizontal white line centred on y = 50, from x = 60 to 90, in the bottom right.
   renderer.drawPolyline(std::vector<glm::vec2>{{60, 50}, {90, 50}}, false, 4.0f, {1, 1, 1, 1},
                         viewport);
@@ -47,13 +50,13 @@ TEST(HeadlessContext, RendersQuadrantsAndAThickLineThatReadBackExactly) {
   const RgbaImage image = readPixels(context->drawFramebuffer(), size);
   ASSERT_EQ(image.width, 96);
   ASSERT_EQ(image.height, 64);
-  expectPixel(image, 0, 0, 255, 0, 0);     // top-left quadrant red (rows are top-down)
+  expectPixel(image, 0, 0, 255, 0, 0);  // top-left quadrant red (rows are top-down)
   expectPixel(image, 47, 31, 255, 0, 0);
-  expectPixel(image, 48, 0, 0, 255, 0);    // top-right green
+  expectPixel(image, 48, 0, 0, 255, 0);  // top-right green
   expectPixel(image, 95, 31, 0, 255, 0);
-  expectPixel(image, 0, 32, 0, 0, 255);    // bottom-left blue
+  expectPixel(image, 0, 32, 0, 0, 255);  // bottom-left blue
   expectPixel(image, 47, 63, 0, 0, 255);
-  expectPixel(image, 70, 60, 0, 0, 0);     // bottom-right stays clear
+  expectPixel(image, 70, 60, 0, 0, 0);  // bottom-right stays clear
   for (int y = 48; y < 52; ++y) expectPixel(image, 75, y, 255, 255, 255);  // the line, 4 rows
   expectPixel(image, 75, 47, 0, 0, 0);
   expectPixel(image, 75, 52, 0, 0, 0);

@@ -44,7 +44,8 @@ cv::Mat toMat(const RgbaImage& image) {
 
 // The centre line of a stroke of colour channel `channel` crossing segment a-b, as a fitted line.
 // Scans `reach` pixels to either side (less than the distance to any other stroke).
-cv::Vec4f strokeLine(const cv::Mat& image, int channel, cv::Point2d a, cv::Point2d b, double reach) {
+cv::Vec4f strokeLine(const cv::Mat& image, int channel, cv::Point2d a, cv::Point2d b,
+                     double reach) {
   const cv::Point2d d = (b - a) / cv::norm(b - a), n(-d.y, d.x);
   std::vector<cv::Point2f> centres;
   for (double t = 0.15; t <= 0.85; t += 0.01) {
@@ -88,7 +89,9 @@ TEST(HmdView, HighlightCornersLieWithinAPixelOfTheProjectedMarkerCorners) {
   frame.right = {cv::Mat::zeros(480, 640, CV_8UC3), rig.camera, rig.right};
   const double a = 0.4;
   ObjectHighlight object;
-  object.T_world_top = {cv::Matx33d(std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1), cv::Vec3d(0.12, 0.55, 0.06)};
+  object.T_world_top = {
+      cv::Matx33d(std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1),
+      cv::Vec3d(0.12, 0.55, 0.06)};
   object.side_m = 0.12;  // large on screen, so the strokes of opposite sides lie far apart
   object.margin = 1.0;
   object.state = HighlightState::Selected;
@@ -105,10 +108,12 @@ TEST(HmdView, HighlightCornersLieWithinAPixelOfTheProjectedMarkerCorners) {
       expected.emplace_back(700 * cam[0] / cam[2] + 319.5, 700 * cam[1] / cam[2] + 239.5);
     }
     std::vector<cv::Vec4f> lines;
-    for (int i = 0; i < 4; ++i) lines.push_back(strokeLine(half, 2, expected[i], expected[(i + 1) % 4], 6.0));
+    for (int i = 0; i < 4; ++i)
+      lines.push_back(strokeLine(half, 2, expected[i], expected[(i + 1) % 4], 6.0));
     for (int i = 0; i < 4; ++i) {
       const cv::Point2d corner = intersect(lines[(i + 3) % 4], lines[i]);
-      EXPECT_LT(cv::norm(corner - expected[i]), 1.0) << "eye " << eye << " corner " << i << ": " << corner << " vs " << expected[i];
+      EXPECT_LT(cv::norm(corner - expected[i]), 1.0)
+          << "eye " << eye << " corner " << i << ": " << corner << " vs " << expected[i];
     }
   }
 }
@@ -124,7 +129,9 @@ TEST(HmdView, GridLinesLieWhereTheReferencePoseProjectsThem) {
   // The grid 25 cm in front of a reference marker at (0, 0.9, 0), turned by 10 degrees.
   const vision::Pose T_world_ref{cv::Matx33d::eye(), cv::Vec3d(0, 0.9, 0)};
   const double a = 10.0 * M_PI / 180.0;
-  const vision::Pose T_ref_grid{cv::Matx33d(std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1), cv::Vec3d(0.05, -0.30, 0)};
+  const vision::Pose T_ref_grid{
+      cv::Matx33d(std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1),
+      cv::Vec3d(0.05, -0.30, 0)};
   GridLayout grid;
   grid.T_world_grid = T_world_ref * T_ref_grid;
   grid.rows = 3;
@@ -132,9 +139,11 @@ TEST(HmdView, GridLinesLieWhereTheReferencePoseProjectsThem) {
   grid.cell_m = 0.07;
   frame.grid = grid;
   view.draw(frame, context->drawFramebuffer(), {1280, 480});
-  const cv::Mat image = toMat(readPixels(context->drawFramebuffer(), {1280, 480}))(cv::Rect(0, 0, 640, 480));
+  const cv::Mat image =
+      toMat(readPixels(context->drawFramebuffer(), {1280, 480}))(cv::Rect(0, 0, 640, 480));
   auto check = [&](const cv::Vec3d& from, const cv::Vec3d& to) {
-    const cv::Point2d a2 = *view.project(frame.left, from, {640, 480}), b2 = *view.project(frame.left, to, {640, 480});
+    const cv::Point2d a2 = *view.project(frame.left, from, {640, 480}),
+                      b2 = *view.project(frame.left, to, {640, 480});
     const cv::Vec4f line = strokeLine(image, 1, a2, b2, 3.0);
     for (double t : {0.3, 0.5, 0.7}) {
       const cv::Point2d p = a2 + (b2 - a2) * t;
@@ -157,7 +166,8 @@ TEST(HmdView, AScheduledFlashAppearsOnItsFramesAndNoOther) {
   frame.right.T_cam_world = rig.right;
   ObjectHighlight object;
   object.T_world_top = {cv::Matx33d::eye(), cv::Vec3d(0.0, 0.6, 0.06)};
-  const std::set<int> scheduled{3, 4, 5, 6, 14, 15, 16, 17};  // 60 ms flashes at 60 Hz, 120 ms apart
+  const std::set<int> scheduled{3,  4,  5,  6,
+                                14, 15, 16, 17};  // 60 ms flashes at 60 Hz, 120 ms apart
   const cv::Point2d centre = *view.project(frame.left, object.T_world_top.translation, {640, 480});
   for (int f = 0; f < 24; ++f) {
     object.state = scheduled.count(f) ? HighlightState::Flashing : HighlightState::Idle;
@@ -188,7 +198,8 @@ TEST(HmdView, UndistortedBackgroundMatchesItsRectifiedVirtualCamera) {
   frame.left = {distorted, lens, rig.left};
   frame.right = frame.left;
   view.draw(frame, context->drawFramebuffer(), {1280, 480});
-  const cv::Mat shown = toMat(readPixels(context->drawFramebuffer(), {1280, 480}))(cv::Rect(0, 0, 640, 480)).clone();
+  const cv::Mat shown =
+      toMat(readPixels(context->drawFramebuffer(), {1280, 480}))(cv::Rect(0, 0, 640, 480)).clone();
   // The shown image is an ideal pinhole view: the detector needs no lens model, and the marker's
   // corners sit where the view projects them.
   vision::MarkerDetector detector(vision::DetectorConfig{});
@@ -200,12 +211,14 @@ TEST(HmdView, UndistortedBackgroundMatchesItsRectifiedVirtualCamera) {
   ASSERT_NE(found, nullptr);
   const auto corners = vision::markerCorners(0.05);
   for (int i = 0; i < 4; ++i) {
-    const cv::Vec3d world = object.T_world_top.apply(cv::Vec3d(corners[i].x, corners[i].y, corners[i].z));
+    const cv::Vec3d world =
+        object.T_world_top.apply(cv::Vec3d(corners[i].x, corners[i].y, corners[i].z));
     const cv::Point2d expected = *view.project(frame.left, world, {640, 480});
     EXPECT_LT(cv::norm(cv::Point2d(found->corners[i].x, found->corners[i].y) - expected), 1.0) << i;
   }
   // No empty border: the corners of the view show the scene, not black.
-  for (const cv::Point corner : {cv::Point(1, 1), cv::Point(638, 1), cv::Point(1, 478), cv::Point(638, 478)}) {
+  for (const cv::Point corner :
+       {cv::Point(1, 1), cv::Point(638, 1), cv::Point(1, 478), cv::Point(638, 478)}) {
     EXPECT_GT(cv::norm(shown.at<cv::Vec3b>(corner)), 30.0) << corner;
   }
 }

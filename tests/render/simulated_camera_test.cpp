@@ -44,9 +44,11 @@ Scene oneObject(int id, const vision::Pose& top) {
   return scene;
 }
 
-void expectDetectedAt(const cv::Mat& frame, const vision::CameraModel& camera, bool distorted, int id, const vision::Pose& truth) {
+void expectDetectedAt(const cv::Mat& frame, const vision::CameraModel& camera, bool distorted,
+                      int id, const vision::Pose& truth) {
   vision::DetectorConfig config;
-  if (distorted) config.lens = std::make_shared<vision::Undistorter>(camera, vision::UndistortMode::LookupTable);
+  if (distorted)
+    config.lens = std::make_shared<vision::Undistorter>(camera, vision::UndistortMode::LookupTable);
   vision::MarkerDetector detector(config);
   const auto markers = detector.detect(frame).markers;
   const vision::MarkerDetection* found = nullptr;
@@ -67,9 +69,12 @@ TEST(SimulatedCamera, AMarkerAtAKnownPoseIsTrackedWithinACentimetreAndADegree) {
   const vision::CameraModel camera = camera640();
   SimulatedCamera simulated(camera);
   const vision::Pose T_cam_world = lookAt({0.05, 1.45, 0.45}, {0.0, 0.65, 0.0});
-  for (const auto& [x, y, spin] : std::vector<std::tuple<double, double, double>>{{0.0, 0.6, 0.0}, {0.15, 0.5, 30.0}, {-0.2, 0.75, -60.0}}) {
+  for (const auto& [x, y, spin] : std::vector<std::tuple<double, double, double>>{
+           {0.0, 0.6, 0.0}, {0.15, 0.5, 30.0}, {-0.2, 0.75, -60.0}}) {
     const double a = spin * M_PI / 180.0;
-    const vision::Pose top{cv::Matx33d(std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1), cv::Vec3d(x, y, 0.06)};
+    const vision::Pose top{
+        cv::Matx33d(std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1),
+        cv::Vec3d(x, y, 0.06)};
     const cv::Mat frame = simulated.render(oneObject(12, top), T_cam_world);
     ASSERT_EQ(frame.size(), cv::Size(640, 480));
     expectDetectedAt(frame, camera, false, 12, T_cam_world * top);

@@ -40,7 +40,8 @@ class RunningBackend {
     options.port = port;
     options.speed_factor = speed;
     options.status_interval_s = 0.05;
-    backend_ = std::make_unique<RobotBackend>(testKey(), std::make_unique<SimulatedArm>(config), options);
+    backend_ =
+        std::make_unique<RobotBackend>(testKey(), std::make_unique<SimulatedArm>(config), options);
     thread_ = std::thread([this] { backend_->run(stop_); });
   }
   ~RunningBackend() { halt(); }
@@ -57,6 +58,16 @@ class RunningBackend {
   std::thread thread_;
 };
 
+// Waits (up to 5 s) until the backend has taken `count` datagrams off its socket.
+bool backendReceived(const RunningBackend& backend, std::uint64_t count) {
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  while (backend.stats().datagrams < count) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
 ClientOptions fastClient() {
   ClientOptions o;
   o.first_retransmit_s = 0.01;
@@ -66,13 +77,15 @@ ClientOptions fastClient() {
 }
 
 // Polls until an event for `sequence` ends it (finished, rejected, failed) or `timeout` passes.
-std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence, std::chrono::milliseconds timeout = 20s) {
+std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence,
+                                std::chrono::milliseconds timeout = 20s) {
   std::vector<RobotEvent> seen;
   const auto end = Clock::now() + timeout;
   while (Clock::now() < end) {
     client.poll();
     for (RobotEvent& e : client.takeEvents()) {
-      const bool final = e.sequence == sequence && (e.kind == RobotEvent::Kind::Finished || e.kind == RobotEvent::Kind::Rejected ||
+      const bool final = e.sequence == sequence && (e.kind == RobotEvent::Kind::Finished ||
+                                                    e.kind == RobotEvent::Kind::Rejected ||
                                                     e.kind == RobotEvent::Kind::Failed);
       seen.push_back(std::move(e));
       if (final) return seen;
@@ -82,7 +95,9 @@ std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence, std
   return seen;
 }
 
-const RobotEvent* finalEvent(const std::vector<RobotEvent>& events) { return events.empty() ? nullptr : &events.back(); }
+const RobotEvent* finalEvent(const std::vector<RobotEvent>& events) {
+  return events.empty() ? nullptr : &events.back();
+}
 
 StatusPayload freshStatus(RobotClient& client) {
   const auto end = Clock::now() + 3s;
@@ -90,7 +105,9 @@ StatusPayload freshStatus(RobotClient& client) {
   const auto before = client.status();
   while (Clock::now() < end) {
     client.poll();
-    if (client.status() && (!before || client.status()->tool.x != before->tool.x || Clock::now() > end - 2900ms)) break;
+    if (client.status() &&
+        (!before || client.status()->tool.x != before->tool.x || Clock::now() > end - 2900ms))
+      break;
     std::this_thread::sleep_for(1ms);
   }
   // Let two more status replies arrive so the one returned is current.
@@ -119,7 +136,8 @@ TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {
   EXPECT_EQ(moved.id, 1);
   EXPECT_FALSE(moved.held);
   const double base_z = moved.position.z - 0.06;  // the object's base on the table
-  EXPECT_LT(std::hypot(moved.position.x - drop.x, moved.position.y - drop.y, base_z - drop.z), 0.005);
+  EXPECT_LT(std::hypot(moved.position.x - drop.x, moved.position.y - drop.y, base_z - drop.z),
+            0.005);
   EXPECT_EQ(status.holding, -1);
   EXPECT_EQ(backend.stats().executed, 2u);
 }
@@ -127,7 +145,8 @@ TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {
 // Forwards datagrams between one client and the backend, dropping `loss` of them each way.
 class LossyRelay {
  public:
-  LossyRelay(int backend_port, double loss) : backend_(Endpoint::resolve("127.0.0.1", backend_port)), loss_(loss) {
+  LossyRelay(int backend_port, double loss)
+      : backend_(Endpoint::resolve("127.0.0.1", backend_port)), loss_(loss) {
     thread_ = std::thread([this] { run(); });
   }
   ~LossyRelay() {
@@ -146,13 +165,17 @@ class LossyRelay {
       front_.wait(2);
       while (auto d = front_.receive()) {
         client = d->from;
-        if (unit(random) < loss_) ++dropped_;
-        else back_.sendTo(d->bytes, backend_);
+        if (unit(random) < loss_)
+          ++dropped_;
+        else
+          back_.sendTo(d->bytes, backend_);
       }
       while (auto d = back_.receive()) {
         if (!client) continue;
-        if (unit(random) < loss_) ++dropped_;
-        else front_.sendTo(d->bytes, *client);
+        if (unit(random) < loss_)
+          ++dropped_;
+        else
+          front_.sendTo(d->bytes, *client);
       }
     }
   }
@@ -173,13 +196,14 @@ TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
     const auto sequence = client.send(MessageType::Home);
     const auto events = waitFor(client, sequence, 10s);
     ASSERT_NE(finalEvent(events), nullptr) << "command " << i;
-    ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished) << "command " << i << ": " << finalEvent(events)->text;
+    ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished)
+        << "command " << i << ": " << finalEvent(events)->text;
     ++finished;
   }
   EXPECT_EQ(finished, 100);
   const BackendStats stats = backend.stats();
-  EXPECT_EQ(stats.executed, 100u);    // each exactly once
-  EXPECT_GT(stats.duplicates, 0u);    // although copies did arrive
+  EXPECT_EQ(stats.executed, 100u);  // each exactly once
+  EXPECT_GT(stats.duplicates, 0u);  // although copies did arrive
   EXPECT_GT(relay.dropped(), 50u);
 }
 
@@ -199,6 +223,7 @@ TEST(RobotBackend, TenThousandBadDatagramsChangeNothing) {
   grasp.type = MessageType::Grasp;
   grasp.session = 777;
   grasp.target = {0.10, 0.60, 0.06};
+  const std::uint64_t before_flood = backend.stats().datagrams;
   for (int i = 0; i < 10000; ++i) {
     std::vector<std::uint8_t> bytes;
     grasp.sequence = static_cast<std::uint64_t>(i + 1);
@@ -228,13 +253,15 @@ TEST(RobotBackend, TenThousandBadDatagramsChangeNothing) {
         break;
     }
     attacker.sendTo(bytes, target);
-    if (i % 200 == 0) std::this_thread::sleep_for(1ms);  // do not overflow the socket buffer
+    // Let the backend drain each batch, so the kernel drops none however loaded the machine.
+    if ((i + 1) % 50 == 0) {
+      ASSERT_TRUE(backendReceived(backend, before_flood + i + 1)) << i;
+    }
   }
-  std::this_thread::sleep_for(300ms);
   const BackendStats stats = backend.stats();
   EXPECT_EQ(stats.executed, 0u);
-  EXPECT_GE(stats.ignored, 8000u);
-  EXPECT_GE(stats.replayed, 1000u);
+  EXPECT_EQ(stats.replayed, 1666u);  // every sixth datagram: authenticated, an hour old
+  EXPECT_EQ(stats.ignored, 10000u - 1666u);
   // Still answering, and nothing moved.
   const StatusPayload after = freshStatus(client);
   EXPECT_NEAR(after.tool.x, before.tool.x, 1e-9);
@@ -269,7 +296,8 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
   bool accepted = false;
   while (Clock::now() < end && !accepted) {
     client.poll();
-    for (const RobotEvent& e : client.takeEvents()) accepted |= e.kind == RobotEvent::Kind::Accepted && e.sequence == grasp;
+    for (const RobotEvent& e : client.takeEvents())
+      accepted |= e.kind == RobotEvent::Kind::Accepted && e.sequence == grasp;
     std::this_thread::sleep_for(1ms);
   }
   ASSERT_TRUE(accepted);
@@ -287,7 +315,9 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
   EXPECT_EQ(later.tool.x, halted.tool.x);
   EXPECT_EQ(later.tool.z, halted.tool.z);
   // It moved before the stop, and will move again when told.
-  EXPECT_GT(std::abs(halted.tool.x) + std::abs(halted.tool.y - 0.45) + std::abs(halted.tool.z - 0.45), 0.01);
+  EXPECT_GT(
+      std::abs(halted.tool.x) + std::abs(halted.tool.y - 0.45) + std::abs(halted.tool.z - 0.45),
+      0.01);
   events = waitFor(client, client.send(MessageType::Home), 15s);
   EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
 }
@@ -301,7 +331,8 @@ TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {
   bool accepted = false;
   while (Clock::now() < end && !accepted) {
     client.poll();
-    for (const RobotEvent& e : client.takeEvents()) accepted |= e.kind == RobotEvent::Kind::Accepted;
+    for (const RobotEvent& e : client.takeEvents())
+      accepted |= e.kind == RobotEvent::Kind::Accepted;
     std::this_thread::sleep_for(1ms);
   }
   ASSERT_TRUE(accepted);
@@ -326,7 +357,8 @@ TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {
   const auto events = waitFor(client, grasp, 3s);
   ASSERT_NE(finalEvent(events), nullptr);
   EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Failed);
-  EXPECT_NE(finalEvent(events)->text.find("restarted"), std::string::npos) << finalEvent(events)->text;
+  EXPECT_NE(finalEvent(events)->text.find("restarted"), std::string::npos)
+      << finalEvent(events)->text;
 }
 
 }  // namespace

@@ -51,7 +51,8 @@ Score scoreFrame(const std::vector<int>& ids, const std::vector<Corners>& truth,
   std::vector<bool> matched(truth.size(), false);
   for (const FoundMarker& detection : detections) {
     const cv::Point2f centre = (detection.corners[0] + detection.corners[1] + detection.corners[2] +
-                                detection.corners[3]) * 0.25f;
+                                detection.corners[3]) *
+                               0.25f;
     int on = -1;
     for (size_t i = 0; i < truth.size(); ++i) {
       if (inside(truth[i], centre)) on = static_cast<int>(i);

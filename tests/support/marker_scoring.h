@@ -13,10 +13,10 @@ struct FoundMarker {
 };
 
 struct Score {
-  int truth = 0;           // markers in the frames
-  int found = 0;           // markers detected with their right id
-  int wrong_id = 0;        // detections on a marker with another id
-  int false_positive = 0;  // detections on no marker (decoys, background) or duplicates
+  int truth = 0;                  // markers in the frames
+  int found = 0;                  // markers detected with their right id
+  int wrong_id = 0;               // detections on a marker with another id
+  int false_positive = 0;         // detections on no marker (decoys, background) or duplicates
   double corner_error_sum = 0.0;  // over the corners of found markers, px
   int corners = 0;
 

@@ -9,12 +9,14 @@
 
 namespace arbci::test {
 
-Corners drawPosedMarker(cv::Mat& frame, const cv::Matx33d& k, const vision::Pose& T_cam_marker, double side_m,
-                        MarkerFamily family, int id) {
+Corners drawPosedMarker(cv::Mat& frame, const cv::Matx33d& k, const vision::Pose& T_cam_marker,
+                        double side_m, MarkerFamily family, int id) {
   // The printed image is 10 cells: the black square (8 cells) inside a 1-cell quiet zone.
   const double half = side_m / 2.0, outer = side_m * 10.0 / 8.0 / 2.0;
-  const cv::Point3d black[4] = {{-half, half, 0}, {half, half, 0}, {half, -half, 0}, {-half, -half, 0}};
-  const cv::Point3d quiet[4] = {{-outer, outer, 0}, {outer, outer, 0}, {outer, -outer, 0}, {-outer, -outer, 0}};
+  const cv::Point3d black[4] = {
+      {-half, half, 0}, {half, half, 0}, {half, -half, 0}, {-half, -half, 0}};
+  const cv::Point3d quiet[4] = {
+      {-outer, outer, 0}, {outer, outer, 0}, {outer, -outer, 0}, {-outer, -outer, 0}};
   Corners truth, outline;
   for (int c = 0; c < 4; ++c) {
     const cv::Point2d b = vision::project(T_cam_marker, k, black[c]);
@@ -49,7 +51,9 @@ cv::Mat DistortingCamera::operator()(const cv::Mat& ideal) const {
 cv::Matx33d markerRotation(double tilt_deg, double azimuth_deg, double spin_deg) {
   const double deg = std::numbers::pi / 180.0;
   cv::Matx33d tilt, spin;
-  cv::Rodrigues(cv::Vec3d(std::cos(azimuth_deg * deg), std::sin(azimuth_deg * deg), 0.0) * (tilt_deg * deg), tilt);
+  cv::Rodrigues(
+      cv::Vec3d(std::cos(azimuth_deg * deg), std::sin(azimuth_deg * deg), 0.0) * (tilt_deg * deg),
+      tilt);
   cv::Rodrigues(cv::Vec3d(0.0, 0.0, spin_deg * deg), spin);
   // Facing the camera: the marker's z towards the camera (-z), its y up in the image (-y).
   return tilt * spin * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1);

@@ -13,8 +13,9 @@ namespace arbci::test {
 // Draws `family`'s marker `id` with its black square of side `side_m` at `T_cam_marker`
 // (ARToolKitPlus marker frame: x right, y up, z out of the print) into `frame` (ideal pinhole
 // camera `camera_matrix`). Returns the true ideal corners TL TR BR BL.
-Corners drawPosedMarker(cv::Mat& frame, const cv::Matx33d& camera_matrix, const vision::Pose& T_cam_marker,
-                        double side_m, MarkerFamily family, int id);
+Corners drawPosedMarker(cv::Mat& frame, const cv::Matx33d& camera_matrix,
+                        const vision::Pose& T_cam_marker, double side_m, MarkerFamily family,
+                        int id);
 
 // What the real (distorting) camera sees of an ideal image (same camera matrix): maps computed
 // once per camera, applied to any number of frames.

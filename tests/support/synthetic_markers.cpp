@@ -19,7 +19,9 @@ constexpr float kBlackCells = 8.0f;
 
 struct Camera {
   float f, cx, cy;
-  cv::Point2f project(const cv::Point3f& p) const { return {f * p.x / p.z + cx, f * p.y / p.z + cy}; }
+  cv::Point2f project(const cv::Point3f& p) const {
+    return {f * p.x / p.z + cx, f * p.y / p.z + cy};
+  }
 };
 
 cv::Matx33f rotation(cv::Vec3f axis, float angle) {
@@ -29,8 +31,10 @@ cv::Matx33f rotation(cv::Vec3f axis, float angle) {
 }
 
 // The corners of a square of half-side `half` in the marker plane, posed and projected.
-Corners projectSquare(const Camera& camera, const cv::Matx33f& r, const cv::Point3f& centre, float half) {
-  const cv::Vec3f local[4] = {{-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
+Corners projectSquare(const Camera& camera, const cv::Matx33f& r, const cv::Point3f& centre,
+                      float half) {
+  const cv::Vec3f local[4] = {
+      {-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
   Corners corners;
   for (int k = 0; k < 4; ++k) {
     const cv::Vec3f p = r * local[k];
@@ -39,7 +43,9 @@ Corners projectSquare(const Camera& camera, const cv::Matx33f& r, const cv::Poin
   return corners;
 }
 
-cv::Point2f centroid(const Corners& q) { return (q[0] + q[1] + q[2] + q[3]) * 0.25f; }
+cv::Point2f centroid(const Corners& q) {
+  return (q[0] + q[1] + q[2] + q[3]) * 0.25f;
+}
 
 float radius(const Corners& q) {
   const cv::Point2f c = centroid(q);
@@ -51,7 +57,8 @@ float radius(const Corners& q) {
 // The quiet-zone square around a marker's black square (same plane, 10/8 the size).
 Corners outerSquare(const Corners& black) {
   const std::vector<cv::Point2f> from{{1, 1}, {9, 1}, {9, 9}, {1, 9}};
-  const cv::Matx33d h = cv::getPerspectiveTransform(from, std::vector<cv::Point2f>(black.begin(), black.end()));
+  const cv::Matx33d h =
+      cv::getPerspectiveTransform(from, std::vector<cv::Point2f>(black.begin(), black.end()));
   const cv::Point2f unit[4] = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
   Corners out;
   for (int k = 0; k < 4; ++k) {
@@ -77,8 +84,8 @@ cv::Mat decoyImage(int style, int cell_px) {
       const bool border = r == 1 || r == 8 || c == 1 || c == 8;
       bool black = border;
       if (style == 0) black = border || ((r >= 4 && r <= 5) && (c >= 4 && c <= 5));  // frame, dot
-      if (style == 1) black = border || (((r - 2) / 2 + (c - 2) / 2) % 2 == 0);       // checker
-      if (style == 2) black = true;                                                     // solid
+      if (style == 1) black = border || (((r - 2) / 2 + (c - 2) / 2) % 2 == 0);      // checker
+      if (style == 2) black = true;                                                  // solid
       cells[r * 10 + c] = black ? 0 : 255;
     }
   }
@@ -105,15 +112,28 @@ void drawBackground(cv::Mat& frame, std::mt19937& random) {
   // Clutter: shapes, lines and text of any grey.
   for (int i = 0; i < 30; ++i) {
     const cv::Point a(static_cast<int>(unit(random) * w), static_cast<int>(unit(random) * h));
-    const cv::Point size(5 + static_cast<int>(unit(random) * w / 6), 5 + static_cast<int>(unit(random) * h / 6));
+    const cv::Point size(5 + static_cast<int>(unit(random) * w / 6),
+                         5 + static_cast<int>(unit(random) * h / 6));
     const cv::Scalar colour(grey(random));
     const int thickness = unit(random) < 0.5f ? cv::FILLED : 1 + static_cast<int>(unit(random) * 4);
     switch (i % 5) {
-      case 0: cv::rectangle(frame, a, a + size, colour, thickness, cv::LINE_AA); break;
-      case 1: cv::ellipse(frame, a, cv::Size(size.x / 2, size.y / 2), unit(random) * 180, 0, 360, colour, thickness, cv::LINE_AA); break;
-      case 2: cv::line(frame, a, a + size, colour, 1 + static_cast<int>(unit(random) * 5), cv::LINE_AA); break;
-      case 3: cv::putText(frame, "ARBCI 42", a, cv::FONT_HERSHEY_SIMPLEX, 0.4 + unit(random), colour, 1, cv::LINE_AA); break;
-      case 4: cv::circle(frame, a, size.x / 3, colour, thickness, cv::LINE_AA); break;
+      case 0:
+        cv::rectangle(frame, a, a + size, colour, thickness, cv::LINE_AA);
+        break;
+      case 1:
+        cv::ellipse(frame, a, cv::Size(size.x / 2, size.y / 2), unit(random) * 180, 0, 360, colour,
+                    thickness, cv::LINE_AA);
+        break;
+      case 2:
+        cv::line(frame, a, a + size, colour, 1 + static_cast<int>(unit(random) * 5), cv::LINE_AA);
+        break;
+      case 3:
+        cv::putText(frame, "ARBCI 42", a, cv::FONT_HERSHEY_SIMPLEX, 0.4 + unit(random), colour, 1,
+                    cv::LINE_AA);
+        break;
+      case 4:
+        cv::circle(frame, a, size.x / 3, colour, thickness, cv::LINE_AA);
+        break;
     }
   }
 }
@@ -136,7 +156,8 @@ cv::Mat gainField(cv::Size size, std::mt19937& random) {
       const float gradient = 1.0f - 0.6f * along;
       const float r = static_cast<float>(cv::norm(d)) / corner;
       const float vignette = 1.0f - 0.55f * r * r;
-      const float across = std::abs(d.x * std::cos(band_angle) + d.y * std::sin(band_angle) - band_offset);
+      const float across =
+          std::abs(d.x * std::cos(band_angle) + d.y * std::sin(band_angle) - band_offset);
       const float edge = std::clamp((across - band_width * 0.5f) / 20.0f + 0.5f, 0.0f, 1.0f);
       const float shadow = 0.35f + 0.65f * edge * edge * (3.0f - 2.0f * edge);
       const float g = gradient * vignette * shadow;
@@ -180,20 +201,28 @@ void drawDecoys(cv::Mat& frame, const SceneLayout& layout) {
 
 std::string toString(MarkerFamily family) {
   switch (family) {
-    case MarkerFamily::ArbciBch: return "arbci-bch";
-    case MarkerFamily::Aruco6x6: return "aruco-6x6";
-    case MarkerFamily::AprilTag36h11: return "apriltag-36h11";
+    case MarkerFamily::ArbciBch:
+      return "arbci-bch";
+    case MarkerFamily::Aruco6x6:
+      return "aruco-6x6";
+    case MarkerFamily::AprilTag36h11:
+      return "apriltag-36h11";
   }
   return "?";
 }
 
 std::string toString(Condition condition) {
   switch (condition) {
-    case Condition::Clean: return "clean";
-    case Condition::Blur: return "blur";
-    case Condition::Noise: return "noise";
-    case Condition::UnevenLight: return "uneven light";
-    case Condition::Combined: return "combined";
+    case Condition::Clean:
+      return "clean";
+    case Condition::Blur:
+      return "blur";
+    case Condition::Noise:
+      return "noise";
+    case Condition::UnevenLight:
+      return "uneven light";
+    case Condition::Combined:
+      return "combined";
   }
   return "?";
 }
@@ -217,9 +246,12 @@ const std::vector<int>& usableIds(MarkerFamily family) {
     return ids;
   }();
   switch (family) {
-    case MarkerFamily::ArbciBch: return bch;
-    case MarkerFamily::Aruco6x6: return aruco;
-    default: return apriltag;
+    case MarkerFamily::ArbciBch:
+      return bch;
+    case MarkerFamily::Aruco6x6:
+      return aruco;
+    default:
+      return apriltag;
   }
 }
 
@@ -235,7 +267,8 @@ cv::Mat markerImage(MarkerFamily family, int id, int cell_px) {
     }
   } else if (family == MarkerFamily::Aruco6x6) {
     cv::Mat drawn;
-    cv::aruco::drawMarker(cv::aruco::getPredefinedDictionary(cv::aruco::DICT_6X6_250), id, 8, drawn, 1);
+    cv::aruco::drawMarker(cv::aruco::getPredefinedDictionary(cv::aruco::DICT_6X6_250), id, 8, drawn,
+                          1);
     for (int r = 0; r < 8; ++r) {
       for (int c = 0; c < 8; ++c) cells[(r + 1) * 10 + c + 1] = drawn.at<std::uint8_t>(r, c);
     }
@@ -268,7 +301,8 @@ void drawWarped(cv::Mat& frame, const cv::Mat& patch, const Corners& quad) {
   const cv::Size region(x1 - x0 + 1, y1 - y0 + 1);
   // Patch corners in OpenCV coordinates, and where they land on the supersampled canvas.
   const float w = static_cast<float>(patch.cols), h = static_cast<float>(patch.rows);
-  const std::vector<cv::Point2f> from{{-0.5f, -0.5f}, {w - 0.5f, -0.5f}, {w - 0.5f, h - 0.5f}, {-0.5f, h - 0.5f}};
+  const std::vector<cv::Point2f> from{
+      {-0.5f, -0.5f}, {w - 0.5f, -0.5f}, {w - 0.5f, h - 0.5f}, {-0.5f, h - 0.5f}};
   std::vector<cv::Point2f> to;
   for (const cv::Point2f& p : quad) {
     to.emplace_back((p.x - static_cast<float>(x0) + 0.5f) * kScale - 0.5f,
@@ -276,7 +310,8 @@ void drawWarped(cv::Mat& frame, const cv::Mat& patch, const Corners& quad) {
   }
   const cv::Mat h_matrix = cv::getPerspectiveTransform(from, to);
   cv::Mat canvas, coverage;
-  cv::warpPerspective(patch, canvas, h_matrix, region * kScale, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+  cv::warpPerspective(patch, canvas, h_matrix, region * kScale, cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT, 0);
   cv::warpPerspective(cv::Mat(patch.size(), CV_8UC1, cv::Scalar(255)), coverage, h_matrix,
                       region * kScale, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   cv::Mat small, alpha;
@@ -297,7 +332,8 @@ void drawWarped(cv::Mat& frame, const cv::Mat& patch, const Corners& quad) {
 SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed) {
   std::mt19937 random(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  const Camera camera{0.9f * options.size.width, options.size.width * 0.5f, options.size.height * 0.5f};
+  const Camera camera{0.9f * options.size.width, options.size.width * 0.5f,
+                      options.size.height * 0.5f};
   SceneLayout layout;
   layout.size = options.size;
   layout.seed = seed;
@@ -305,8 +341,8 @@ SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed) {
   const int total = options.markers + options.decoys;
   for (int object = 0; object < total; ++object) {
     for (int attempt = 0; attempt < 500; ++attempt) {
-      const float side = options.min_side_px *
-                         std::pow(options.max_side_px / options.min_side_px, unit(random));
+      const float side =
+          options.min_side_px * std::pow(options.max_side_px / options.min_side_px, unit(random));
       const float depth = 1.0f;
       const float half = 0.5f * side * depth / camera.f;
       const float tilt = options.max_tilt_deg * unit(random) * static_cast<float>(CV_PI) / 180.0f;
@@ -315,15 +351,18 @@ SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed) {
       const cv::Matx33f r = rotation({std::cos(axis_angle), std::sin(axis_angle), 0.0f}, tilt) *
                             rotation({0, 0, 1}, spin);
       const cv::Point2f at(unit(random) * options.size.width, unit(random) * options.size.height);
-      const cv::Point3f centre((at.x - camera.cx) * depth / camera.f, (at.y - camera.cy) * depth / camera.f, depth);
+      const cv::Point3f centre((at.x - camera.cx) * depth / camera.f,
+                               (at.y - camera.cy) * depth / camera.f, depth);
       const Corners black = projectSquare(camera, r, centre, half);
       const Corners outer = projectSquare(camera, r, centre, half * kCellsPerSide / kBlackCells);
       bool fits = true;
       for (const cv::Point2f& p : outer) {
-        fits = fits && p.x > 3 && p.y > 3 && p.x < options.size.width - 4 && p.y < options.size.height - 4;
+        fits = fits && p.x > 3 && p.y > 3 && p.x < options.size.width - 4 &&
+               p.y < options.size.height - 4;
       }
       for (const Corners& other : placed) {
-        fits = fits && cv::norm(centroid(other) - centroid(outer)) > radius(other) + radius(outer) + 4.0f;
+        fits = fits &&
+               cv::norm(centroid(other) - centroid(outer)) > radius(other) + radius(outer) + 4.0f;
       }
       if (!fits) continue;
       placed.push_back(outer);

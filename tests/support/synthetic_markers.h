@@ -26,7 +26,7 @@ struct LayoutOptions {
   cv::Size size{640, 480};
   int markers = 3;
   int decoys = 2;
-  float min_side_px = 20.0f;   // face-on size of the smallest marker
+  float min_side_px = 20.0f;  // face-on size of the smallest marker
   float max_side_px = 110.0f;
   float max_tilt_deg = 60.0f;
 };

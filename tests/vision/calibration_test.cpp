@@ -33,7 +33,8 @@ CalibrationBoard sampleBoard() {
 
 TEST(Calibration, OpenCvLeftChessboardsGiveTheReferenceIntrinsics) {
   IncrementalCalibrator calibrator(sampleBoard());
-  for (int i : kViews) EXPECT_EQ(calibrator.addView(chessboard("left", i)).outcome, ViewOutcome::Accepted) << i;
+  for (int i : kViews)
+    EXPECT_EQ(calibrator.addView(chessboard("left", i)).outcome, ViewOutcome::Accepted) << i;
   const CalibrationResult result = calibrator.calibrate();
   // Reference (SOURCES.md): RMS 0.4088, fx 536.074, fy 536.017, cx 342.370, cy 235.538.
   EXPECT_NEAR(result.rms_px, 0.4088, 0.05);
@@ -66,8 +67,10 @@ TEST(Calibration, RejectsBoardlessBlurredDuplicateAndMisfitViewsWithAReason) {
   const ViewResult blur = calibrator.addView(blurred);
   EXPECT_EQ(blur.outcome, ViewOutcome::Blurred) << blur.reason;
   EXPECT_NE(blur.reason.find("px"), std::string::npos);
-  EXPECT_EQ(calibrator.addView(cv::Mat(480, 640, CV_8UC1, cv::Scalar(128))).outcome, ViewOutcome::NoBoard);
-  EXPECT_EQ(calibrator.addView(cv::Mat(240, 320, CV_8UC1, cv::Scalar(128))).outcome, ViewOutcome::WrongSize);
+  EXPECT_EQ(calibrator.addView(cv::Mat(480, 640, CV_8UC1, cv::Scalar(128))).outcome,
+            ViewOutcome::NoBoard);
+  EXPECT_EQ(calibrator.addView(cv::Mat(240, 320, CV_8UC1, cv::Scalar(128))).outcome,
+            ViewOutcome::WrongSize);
   EXPECT_THROW(calibrator.calibrate(), std::runtime_error);
   for (int i : {5, 9, 12}) calibrator.addView(chessboard("left", i));
   EXPECT_GT(calibrator.coverageFraction(), coverage_one);
@@ -77,8 +80,9 @@ TEST(Calibration, RejectsBoardlessBlurredDuplicateAndMisfitViewsWithAReason) {
 TEST(Calibration, CharucoViewsCalibrateASyntheticCamera) {
   // The tutorial's ChArUco board (5x7 squares, DICT_6X6_250) seen by a camera with f = 800 px
   // from eight sides.
-  const cv::Mat board = cv::imread(test::sharedData("vision/opencv_contrib_aruco_tutorial/charucoboard.png"),
-                                   cv::IMREAD_GRAYSCALE);
+  const cv::Mat board =
+      cv::imread(test::sharedData("vision/opencv_contrib_aruco_tutorial/charucoboard.png"),
+                 cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(board.empty());
   CalibrationBoard spec;
   spec.kind = CalibrationBoard::Kind::Charuco;
@@ -93,9 +97,11 @@ TEST(Calibration, CharucoViewsCalibrateASyntheticCamera) {
     const double angle = view * CV_PI / 4;
     cv::Matx33d r;
     cv::Rodrigues(cv::Vec3d(std::cos(angle), std::sin(angle), 0) * 0.45, r);
-    const Pose pose{r * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1), cv::Vec3d(0.01 * (view % 3), -0.01, 0.55)};
+    const Pose pose{r * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1),
+                    cv::Vec3d(0.01 * (view % 3), -0.01, 0.55)};
     test::Corners outline;
-    const cv::Point3d corners[4] = {{-w / 2, h / 2, 0}, {w / 2, h / 2, 0}, {w / 2, -h / 2, 0}, {-w / 2, -h / 2, 0}};
+    const cv::Point3d corners[4] = {
+        {-w / 2, h / 2, 0}, {w / 2, h / 2, 0}, {w / 2, -h / 2, 0}, {-w / 2, -h / 2, 0}};
     for (int c = 0; c < 4; ++c) {
       const cv::Point2d p = project(pose, k, corners[c]);
       outline[c] = cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y));
@@ -124,16 +130,20 @@ TEST(Calibration, StereoPairsGiveTheBaselineAndRectify) {
   // After rectification, the same corner lies on the same row in both images.
   cv::Mat r1, r2, p1, p2, q;
   cv::stereoRectify(cv::Mat(stereo.cameras.left.camera_matrix), stereo.cameras.left.distortion,
-                    cv::Mat(stereo.cameras.right.camera_matrix), stereo.cameras.right.distortion, cv::Size(640, 480),
-                    cv::Mat(stereo.cameras.rotation), cv::Mat(stereo.cameras.translation), r1, r2, p1, p2, q);
+                    cv::Mat(stereo.cameras.right.camera_matrix), stereo.cameras.right.distortion,
+                    cv::Size(640, 480), cv::Mat(stereo.cameras.rotation),
+                    cv::Mat(stereo.cameras.translation), r1, r2, p1, p2, q);
   std::vector<cv::Point2f> lc, rc;
   ASSERT_TRUE(cv::findChessboardCorners(left[0], {9, 6}, lc));
   ASSERT_TRUE(cv::findChessboardCorners(right[0], {9, 6}, rc));
   std::vector<cv::Point2f> lr, rr;
-  cv::undistortPoints(lc, lr, cv::Mat(stereo.cameras.left.camera_matrix), stereo.cameras.left.distortion, r1, p1);
-  cv::undistortPoints(rc, rr, cv::Mat(stereo.cameras.right.camera_matrix), stereo.cameras.right.distortion, r2, p2);
+  cv::undistortPoints(lc, lr, cv::Mat(stereo.cameras.left.camera_matrix),
+                      stereo.cameras.left.distortion, r1, p1);
+  cv::undistortPoints(rc, rr, cv::Mat(stereo.cameras.right.camera_matrix),
+                      stereo.cameras.right.distortion, r2, p2);
   double worst = 0.0;
-  for (size_t i = 0; i < lr.size(); ++i) worst = std::max(worst, static_cast<double>(std::abs(lr[i].y - rr[i].y)));
+  for (size_t i = 0; i < lr.size(); ++i)
+    worst = std::max(worst, static_cast<double>(std::abs(lr[i].y - rr[i].y)));
   EXPECT_LT(worst, 1.5);
   const auto path = std::filesystem::temp_directory_path() / "arbci_stereo.yml";
   stereo.cameras.save(path);
@@ -151,21 +161,25 @@ TEST(CalibrationFiles, OpenCvFilesLoadUnchangedAndRoundTrip) {
   EXPECT_NEAR(reference.distortion[4], 0.23839, 1e-5);
   EXPECT_NEAR(reference.rms_px, 0.3926, 1e-4);
   for (const char* extension : {".yml", ".xml"}) {
-    const auto path = std::filesystem::temp_directory_path() / (std::string("arbci_camera") + extension);
+    const auto path =
+        std::filesystem::temp_directory_path() / (std::string("arbci_camera") + extension);
     reference.save(path);
     const CameraModel loaded = CameraModel::load(path);
     EXPECT_EQ(loaded.image_size, reference.image_size);
-    EXPECT_NEAR(cv::norm(cv::Mat(loaded.camera_matrix), cv::Mat(reference.camera_matrix)), 0.0, 1e-9);
+    EXPECT_NEAR(cv::norm(cv::Mat(loaded.camera_matrix), cv::Mat(reference.camera_matrix)), 0.0,
+                1e-9);
     EXPECT_EQ(loaded.distortion, reference.distortion);
   }
-  const CameraModel artk = CameraModel::load(test::sharedData("vision/artoolkitplus_samples/PGR_M12x0.5_2.5mm.cal"));
+  const CameraModel artk =
+      CameraModel::load(test::sharedData("vision/artoolkitplus_samples/PGR_M12x0.5_2.5mm.cal"));
   EXPECT_NEAR(artk.fx(), 492.370, 0.001);
   EXPECT_NEAR(artk.distortion[0], -0.41862, 1e-5);
   const CameraModel half = artk.scaledTo({320, 240});
   EXPECT_NEAR(half.fx(), 246.185, 0.001);
 }
 
-void expectError(const std::filesystem::path& path, const std::string& text, const std::string& mentions) {
+void expectError(const std::filesystem::path& path, const std::string& text,
+                 const std::string& mentions) {
   std::ofstream(path) << text;
   try {
     CameraModel::load(path);
@@ -178,16 +192,20 @@ void expectError(const std::filesystem::path& path, const std::string& text, con
 
 TEST(CalibrationFiles, BadFilesNameTheFileAndTheField) {
   const auto dir = std::filesystem::temp_directory_path();
-  expectError(dir / "missing_k.yml", "%YAML:1.0\nimage_width: 640\nimage_height: 480\n", "camera_matrix");
+  expectError(dir / "missing_k.yml", "%YAML:1.0\nimage_width: 640\nimage_height: 480\n",
+              "camera_matrix");
   expectError(dir / "no_size.yml",
-              "%YAML:1.0\ncamera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
+              "%YAML:1.0\ncamera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: "
+              "[500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
               "image_width");
   expectError(dir / "negative_f.yml",
-              "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [-500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
+              "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  "
+              "rows: 3\n  cols: 3\n  dt: d\n  data: [-500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
               "focal");
   expectError(dir / "garbage.yml", "this is not yaml: [", "YAML");
   EXPECT_THROW(CameraModel::load(dir / "does_not_exist.yml"), CalibrationFileError);
-  const CameraModel camera = CameraModel::load(test::sharedData("vision/opencv_samples_chessboard/left_intrinsics.yml"));
+  const CameraModel camera =
+      CameraModel::load(test::sharedData("vision/opencv_samples_chessboard/left_intrinsics.yml"));
   try {
     camera.checkImageSize({1280, 800});
     FAIL();

@@ -31,7 +31,8 @@ std::vector<MarkerImage> shippedMarkerImages() {
     for (const auto& entry : std::filesystem::directory_iterator(
              test::sharedData(std::string("vision/artoolkitplus_markers/") + folder))) {
       const std::string stem = entry.path().stem().string();
-      images.push_back({entry.path(), kind.first, kind.second, std::stoi(stem.substr(stem.find('_') + 1))});
+      images.push_back(
+          {entry.path(), kind.first, kind.second, std::stoi(stem.substr(stem.find('_') + 1))});
     }
   }
   return images;
@@ -41,7 +42,8 @@ CodeGrid cellsOf(const cv::Mat& image) {
   const int offset = (image.cols - 6) / 2;
   CodeGrid grid{};
   for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) grid[r * 6 + c] = image.at<std::uint8_t>(r + offset, c + offset) > 127;
+    for (int c = 0; c < 6; ++c)
+      grid[r * 6 + c] = image.at<std::uint8_t>(r + offset, c + offset) > 127;
   }
   return grid;
 }
@@ -53,7 +55,8 @@ TEST(IdCodes, EveryShippedMarkerImageDecodesToTheIdInItsName) {
     const cv::Mat image = cv::imread(m.path.string(), cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty()) << m.path;
     const CodeWord word = gridToWord(cellsOf(image));
-    const auto decoded = m.kind == MarkerKind::Bch ? BchCode::decode(word) : SimpleIdCode::decode(word);
+    const auto decoded =
+        m.kind == MarkerKind::Bch ? BchCode::decode(word) : SimpleIdCode::decode(word);
     ASSERT_TRUE(decoded.has_value()) << m.path;
     EXPECT_EQ(decoded->id, m.id) << m.path;
     EXPECT_EQ(decoded->corrected_bits, 0) << m.path;

@@ -25,7 +25,8 @@ TEST(OddInput, EmptyTinyAndDegenerateImagesGiveNoMarkers) {
   EXPECT_TRUE(detector.detect(stripes).markers.empty());
   cv::Mat checker(480, 640, CV_8UC1);
   for (int y = 0; y < checker.rows; ++y) {
-    for (int x = 0; x < checker.cols; ++x) checker.at<std::uint8_t>(y, x) = ((x / 20 + y / 20) % 2) * 255;
+    for (int x = 0; x < checker.cols; ++x)
+      checker.at<std::uint8_t>(y, x) = ((x / 20 + y / 20) % 2) * 255;
   }
   EXPECT_TRUE(detector.detect(checker).markers.empty());
   EXPECT_TRUE(detector.detect(cv::Mat(480, 640, CV_8UC1, cv::Scalar(128))).markers.empty());

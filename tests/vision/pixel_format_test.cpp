@@ -11,7 +11,8 @@ namespace arbci::vision {
 namespace {
 
 // Packs a BGR image into `format` with `padding` extra bytes at the end of each row.
-std::vector<std::uint8_t> pack(const cv::Mat& bgr, PixelFormat format, int padding, size_t& stride) {
+std::vector<std::uint8_t> pack(const cv::Mat& bgr, PixelFormat format, int padding,
+                               size_t& stride) {
   const int bpp = bytesPerPixel(format);
   stride = static_cast<size_t>(bgr.cols) * bpp + padding;
   std::vector<std::uint8_t> buffer(stride * bgr.rows, 0xAB);
@@ -21,12 +22,37 @@ std::vector<std::uint8_t> pack(const cv::Mat& bgr, PixelFormat format, int paddi
       const std::uint8_t b = p[0], g = p[1], r = p[2];
       std::uint8_t* out = &buffer[y * stride + static_cast<size_t>(x) * bpp];
       switch (format) {
-        case PixelFormat::Gray: out[0] = static_cast<std::uint8_t>((r + 2 * g + b) / 4); break;
-        case PixelFormat::Rgb: out[0] = r; out[1] = g; out[2] = b; break;
-        case PixelFormat::Bgr: out[0] = b; out[1] = g; out[2] = r; break;
-        case PixelFormat::Rgba: out[0] = r; out[1] = g; out[2] = b; out[3] = 255; break;
-        case PixelFormat::Bgra: out[0] = b; out[1] = g; out[2] = r; out[3] = 255; break;
-        case PixelFormat::Abgr: out[0] = 255; out[1] = b; out[2] = g; out[3] = r; break;
+        case PixelFormat::Gray:
+          out[0] = static_cast<std::uint8_t>((r + 2 * g + b) / 4);
+          break;
+        case PixelFormat::Rgb:
+          out[0] = r;
+          out[1] = g;
+          out[2] = b;
+          break;
+        case PixelFormat::Bgr:
+          out[0] = b;
+          out[1] = g;
+          out[2] = r;
+          break;
+        case PixelFormat::Rgba:
+          out[0] = r;
+          out[1] = g;
+          out[2] = b;
+          out[3] = 255;
+          break;
+        case PixelFormat::Bgra:
+          out[0] = b;
+          out[1] = g;
+          out[2] = r;
+          out[3] = 255;
+          break;
+        case PixelFormat::Abgr:
+          out[0] = 255;
+          out[1] = b;
+          out[2] = g;
+          out[3] = r;
+          break;
         case PixelFormat::Rgb565: {
           const unsigned v = ((r >> 3) << 11) | ((g >> 2) << 5) | (b >> 3);
           out[0] = static_cast<std::uint8_t>(v & 0xFF);
@@ -41,15 +67,19 @@ std::vector<std::uint8_t> pack(const cv::Mat& bgr, PixelFormat format, int paddi
 
 TEST(PixelFormats, AllFormatsGiveTheSameLuminanceAndMarkers) {
   const test::SceneLayout layout = test::makeLayout({}, 77);
-  const cv::Mat gray = test::renderScene(layout, test::MarkerFamily::ArbciBch, test::Condition::Clean).image;
+  const cv::Mat gray =
+      test::renderScene(layout, test::MarkerFamily::ArbciBch, test::Condition::Clean).image;
   cv::Mat bgr;
   cv::cvtColor(gray, bgr, cv::COLOR_GRAY2BGR);
-  bgr.forEach<cv::Vec3b>([](cv::Vec3b& p, const int* pos) { p[0] = cv::saturate_cast<std::uint8_t>(p[0] + (pos[1] % 7)); });
+  bgr.forEach<cv::Vec3b>([](cv::Vec3b& p, const int* pos) {
+    p[0] = cv::saturate_cast<std::uint8_t>(p[0] + (pos[1] % 7));
+  });
   MarkerDetector reference_detector(DetectorConfig{});
   const auto reference = reference_detector.detect(bgr).markers;
   ASSERT_FALSE(reference.empty());
-  for (PixelFormat format : {PixelFormat::Gray, PixelFormat::Rgb, PixelFormat::Bgr, PixelFormat::Rgba,
-                             PixelFormat::Bgra, PixelFormat::Abgr, PixelFormat::Rgb565}) {
+  for (PixelFormat format :
+       {PixelFormat::Gray, PixelFormat::Rgb, PixelFormat::Bgr, PixelFormat::Rgba, PixelFormat::Bgra,
+        PixelFormat::Abgr, PixelFormat::Rgb565}) {
     size_t stride = 0;
     const auto buffer = pack(bgr, format, 13, stride);
     const ImageView view{buffer.data(), bgr.cols, bgr.rows, stride, format};
@@ -81,9 +111,12 @@ TEST(PixelFormats, LuminanceIsArToolKitPlusWeighting) {
 TEST(PixelFormats, BadBuffersAreRejectedWithAReason) {
   std::vector<std::uint8_t> data(100);
   cv::Mat out;
-  EXPECT_THROW(toLuminance(ImageView{data.data(), 10, 10, 20, PixelFormat::Rgb}, out), std::invalid_argument);
-  EXPECT_THROW(toLuminance(ImageView{nullptr, 10, 10, 10, PixelFormat::Gray}, out), std::invalid_argument);
-  EXPECT_THROW(toLuminance(ImageView{data.data(), -1, 10, 10, PixelFormat::Gray}, out), std::invalid_argument);
+  EXPECT_THROW(toLuminance(ImageView{data.data(), 10, 10, 20, PixelFormat::Rgb}, out),
+               std::invalid_argument);
+  EXPECT_THROW(toLuminance(ImageView{nullptr, 10, 10, 10, PixelFormat::Gray}, out),
+               std::invalid_argument);
+  EXPECT_THROW(toLuminance(ImageView{data.data(), -1, 10, 10, PixelFormat::Gray}, out),
+               std::invalid_argument);
   toLuminance(ImageView{nullptr, 0, 0, 0, PixelFormat::Gray}, out);
   EXPECT_TRUE(out.empty());
   EXPECT_THROW(pixelFormatFromString("yuyv"), std::invalid_argument);

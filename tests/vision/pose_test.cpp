@@ -54,7 +54,8 @@ struct Lens {
 std::optional<Errors> measure(const CameraModel& camera, const Pose& truth, PoseMethod method,
                               const std::optional<Lens>& lens = std::nullopt) {
   cv::Mat frame(camera.image_size, CV_8UC1, cv::Scalar(190));
-  test::drawPosedMarker(frame, camera.camera_matrix, truth, 0.05, test::MarkerFamily::ArbciBch, 321);
+  test::drawPosedMarker(frame, camera.camera_matrix, truth, 0.05, test::MarkerFamily::ArbciBch,
+                        321);
   DetectorConfig config;
   if (lens) {
     frame = (*lens->camera)(frame);
@@ -65,7 +66,8 @@ std::optional<Errors> measure(const CameraModel& camera, const Pose& truth, Pose
   if (markers.size() != 1 || markers[0].id != 321) return std::nullopt;
   PoseOptions options;
   options.method = method;
-  const PoseEstimate estimate = estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix, options);
+  const PoseEstimate estimate =
+      estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix, options);
   const double distance = cv::norm(truth.translation);
   return Errors{cv::norm(estimate.pose.translation - truth.translation) / distance,
                 rotationAngleDeg(estimate.pose.rotation, truth.rotation)};
@@ -74,8 +76,8 @@ std::optional<Errors> measure(const CameraModel& camera, const Pose& truth, Pose
 Pose randomPose(std::mt19937& random, double min_tilt, double max_tilt) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const double distance = 0.3 + 0.7 * unit(random);
-  const cv::Matx33d r = test::markerRotation(min_tilt + (max_tilt - min_tilt) * unit(random), 360 * unit(random),
-                                             360 * unit(random));
+  const cv::Matx33d r = test::markerRotation(min_tilt + (max_tilt - min_tilt) * unit(random),
+                                             360 * unit(random), 360 * unit(random));
   // Anywhere in the central two thirds of the view.
   const cv::Vec3d direction((unit(random) - 0.5) * 0.9, (unit(random) - 0.5) * 0.5, 1.0);
   return {r, direction / cv::norm(direction) * distance};
@@ -85,8 +87,8 @@ class PoseAccuracy : public testing::TestWithParam<bool> {};
 
 TEST_P(PoseAccuracy, RppWithinHalfAPercentAndHalfADegreeAt30To60DegreesTilt) {
   const bool distorting = GetParam();
-  const CameraModel camera =
-      hmdCamera(distorting ? std::vector<double>{-0.12, 0.04, 0.0005, -0.0004, 0.0} : std::vector<double>{});
+  const CameraModel camera = hmdCamera(
+      distorting ? std::vector<double>{-0.12, 0.04, 0.0005, -0.0004, 0.0} : std::vector<double>{});
   std::optional<Lens> lens;
   if (distorting) {
     lens = Lens{std::make_shared<Undistorter>(camera, UndistortMode::LookupTable),
@@ -105,8 +107,9 @@ TEST_P(PoseAccuracy, RppWithinHalfAPercentAndHalfADegreeAt30To60DegreesTilt) {
   EXPECT_EQ(measured, 25);
 }
 
-INSTANTIATE_TEST_SUITE_P(Lens, PoseAccuracy, testing::Values(false, true),
-                         [](const auto& info) { return info.param ? std::string("distorting") : std::string("pinhole"); });
+INSTANTIATE_TEST_SUITE_P(Lens, PoseAccuracy, testing::Values(false, true), [](const auto& info) {
+  return info.param ? std::string("distorting") : std::string("pinhole");
+});
 
 TEST(PoseAccuracy, PositionWithinHalfAPercentAtAnyTiltForEveryMethod) {
   const CameraModel camera = hmdCamera();
@@ -129,19 +132,22 @@ TEST(PoseAmbiguity, NoFlipWhileAMarkerSweepsThroughFaceOn) {
     const double tilt = -25.0 + step;  // degrees, through 0
     const Pose truth{test::markerRotation(tilt, 20.0, 35.0), cv::Vec3d(0.02, -0.01, 0.55)};
     cv::Mat frame(camera.image_size, CV_8UC1, cv::Scalar(190));
-    test::drawPosedMarker(frame, camera.camera_matrix, truth, 0.05, test::MarkerFamily::ArbciBch, 77);
+    test::drawPosedMarker(frame, camera.camera_matrix, truth, 0.05, test::MarkerFamily::ArbciBch,
+                          77);
     const auto markers = detector.detect(frame).markers;
     ASSERT_EQ(markers.size(), 1u) << "tilt " << tilt;
     PoseOptions options;
     options.previous = previous;
-    const PoseEstimate estimate = estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix, options);
+    const PoseEstimate estimate =
+        estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix, options);
     // A flip mirrors the tilt: an error of about twice the tilt.
     const double error = rotationAngleDeg(estimate.pose.rotation, truth.rotation);
     if (previous) {
       EXPECT_LT(error, 3.0) << "tilt " << tilt;
     }
     previous = estimate.pose;
-    const PoseEstimate memoryless = estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix, {});
+    const PoseEstimate memoryless =
+        estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix, {});
     flips_without_memory += rotationAngleDeg(memoryless.pose.rotation, truth.rotation) > 3.0;
   }
   RecordProperty("flips_without_previous_pose", flips_without_memory);
@@ -153,7 +159,10 @@ TEST(MarkerSets, ABoardOfFourIsMoreAccurateThanAnyOfItsMarkers) {
   std::vector<MarkerPlacement> placements;
   const int ids[4] = {10, 11, 12, 13};
   for (int i = 0; i < 4; ++i) {
-    placements.push_back({ids[i], 0.05, {cv::Matx33d::eye(), cv::Vec3d(i % 2 ? 0.035 : -0.035, i < 2 ? 0.035 : -0.035, 0)}});
+    placements.push_back(
+        {ids[i],
+         0.05,
+         {cv::Matx33d::eye(), cv::Vec3d(i % 2 ? 0.035 : -0.035, i < 2 ? 0.035 : -0.035, 0)}});
   }
   const MarkerSet board(placements);
   ASSERT_TRUE(board.planar());
@@ -164,7 +173,8 @@ TEST(MarkerSets, ABoardOfFourIsMoreAccurateThanAnyOfItsMarkers) {
     const Pose T_cam_set{truth.rotation, truth.translation * (0.8 / cv::norm(truth.translation))};
     cv::Mat frame(camera.image_size, CV_8UC1, cv::Scalar(190));
     for (const MarkerPlacement& p : placements) {
-      test::drawPosedMarker(frame, camera.camera_matrix, T_cam_set * p.T_set_marker, 0.05, test::MarkerFamily::ArbciBch, p.id);
+      test::drawPosedMarker(frame, camera.camera_matrix, T_cam_set * p.T_set_marker, 0.05,
+                            test::MarkerFamily::ArbciBch, p.id);
     }
     MarkerDetector detector(DetectorConfig{});
     const auto markers = detector.detect(frame).markers;
@@ -180,12 +190,13 @@ TEST(MarkerSets, ABoardOfFourIsMoreAccurateThanAnyOfItsMarkers) {
       single_error[index] += rotationAngleDeg(T_cam_set_single.rotation, T_cam_set.rotation);
     }
   }
-  for (double e : single_error) EXPECT_LT(set_error, e) << "the set is not better than a single marker";
+  for (double e : single_error)
+    EXPECT_LT(set_error, e) << "the set is not better than a single marker";
 }
 
 TEST(MarkerSets, ArToolKitBoardConfigurationReadsAndPosesTheRealBoard) {
-  const MarkerSet board =
-      MarkerSet::loadArToolKitConfig(test::sharedData("vision/artoolkitplus_samples/markerboard_480-499.cfg"));
+  const MarkerSet board = MarkerSet::loadArToolKitConfig(
+      test::sharedData("vision/artoolkitplus_samples/markerboard_480-499.cfg"));
   ASSERT_EQ(board.markers().size(), 20u);
   EXPECT_NEAR(board.markers()[0].size_m, 0.040, 1e-12);
   // Marker 480 sits at (-100, 75) mm: its top-left corner at (-120, 95).
@@ -193,15 +204,17 @@ TEST(MarkerSets, ArToolKitBoardConfigurationReadsAndPosesTheRealBoard) {
   EXPECT_NEAR(board.cornersOf(480)->at(0).y, 0.095, 1e-12);
   // ARToolKitPlus poses the bent board photo at t = (4.49, -14.77, 177.61) mm from 10 markers.
   const CameraModel camera =
-      CameraModel::load(test::sharedData("vision/artoolkitplus_samples/PGR_M12x0.5_2.5mm.cal")).scaledTo({320, 240});
+      CameraModel::load(test::sharedData("vision/artoolkitplus_samples/PGR_M12x0.5_2.5mm.cal"))
+          .scaledTo({320, 240});
   DetectorConfig config;
   config.kind = MarkerKind::Simple;
   config.threshold.mode = ThresholdMode::Constant;
   config.threshold.value = 160;
   config.lens = std::make_shared<Undistorter>(camera, UndistortMode::LookupTable);
   MarkerDetector detector(config);
-  const cv::Mat image = cv::imread(test::sharedData("vision/artoolkitplus_samples/markerboard_480-499_from_raw.png"),
-                                   cv::IMREAD_GRAYSCALE);
+  const cv::Mat image =
+      cv::imread(test::sharedData("vision/artoolkitplus_samples/markerboard_480-499_from_raw.png"),
+                 cv::IMREAD_GRAYSCALE);
   const auto pose = estimateSetPose(board, detector.detect(image).markers, camera.camera_matrix);
   ASSERT_TRUE(pose.has_value());
   EXPECT_GE(pose->used_ids.size(), 10u);
@@ -210,9 +223,10 @@ TEST(MarkerSets, ArToolKitBoardConfigurationReadsAndPosesTheRealBoard) {
 }
 
 TEST(Undistortion, TheThreeModesAgreeOnPointsAndImages) {
-  const CameraModel camera = CameraModel::load(test::sharedData("vision/artoolkitplus_samples/PGR_M12x0.5_2.5mm.cal"));
-  const Undistorter none(camera, UndistortMode::None), algorithmic(camera, UndistortMode::Algorithmic),
-      table(camera, UndistortMode::LookupTable);
+  const CameraModel camera =
+      CameraModel::load(test::sharedData("vision/artoolkitplus_samples/PGR_M12x0.5_2.5mm.cal"));
+  const Undistorter none(camera, UndistortMode::None),
+      algorithmic(camera, UndistortMode::Algorithmic), table(camera, UndistortMode::LookupTable);
   double worst_table = 0.0, worst_round_trip = 0.0;
   for (double y = 5.3; y < 475; y += 23.7) {
     for (double x = 3.1; x < 637; x += 21.9) {

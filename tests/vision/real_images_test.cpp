@@ -28,11 +28,20 @@ struct Sample {
 };
 
 const Sample kSamples[] = {
-    {"image_320_240_8_marker_id_simple_nr031.raw", MarkerKind::Simple, 0.25, 31,
+    {"image_320_240_8_marker_id_simple_nr031.raw",
+     MarkerKind::Simple,
+     0.25,
+     31,
      {{{215.88f, 148.37f}, {270.19f, 191.04f}, {186.36f, 221.63f}, {140.47f, 170.88f}}}},
-    {"image_320_240_8_marker_id_simple_nr321.raw", MarkerKind::Simple, 0.25, 321,
+    {"image_320_240_8_marker_id_simple_nr321.raw",
+     MarkerKind::Simple,
+     0.25,
+     321,
      {{{256.90f, 139.29f}, {119.15f, 180.10f}, {74.37f, 106.46f}, {185.64f, 83.17f}}}},
-    {"image_320_240_8_marker_id_bch_nr0100.raw", MarkerKind::Bch, 0.125, 100,
+    {"image_320_240_8_marker_id_bch_nr0100.raw",
+     MarkerKind::Bch,
+     0.125,
+     100,
      {{{199.11f, 69.71f}, {246.15f, 135.11f}, {117.34f, 164.14f}, {92.95f, 89.48f}}}},
 };
 
@@ -53,7 +62,8 @@ TEST_P(ArToolKitPlusSamples, GiveTheirIdsWithCornersWithinAPixelOfArToolKitPlus)
     EXPECT_EQ(m.confidence, 1.0f) << sample.file;
     for (int k = 0; k < 4; ++k) {
       EXPECT_LT(cv::norm(m.corners[k] - sample.raw_corners[k]), 1.0)
-          << sample.file << " corner " << k << " at " << m.corners[k] << ", ARToolKitPlus " << sample.raw_corners[k];
+          << sample.file << " corner " << k << " at " << m.corners[k] << ", ARToolKitPlus "
+          << sample.raw_corners[k];
     }
   }
 }
@@ -96,12 +106,18 @@ TEST(OpenCvDictionaries, ArucoTutorialPhotosGiveTheirIds) {
   config.kind = MarkerKind::Aruco;
   MarkerDetector detector(config);
   std::set<int> ids;
-  for (const auto& m : detector.detect(cv::imread(test::sharedData("vision/opencv_contrib_aruco_tutorial/singlemarkersoriginal.jpg"))).markers) {
+  for (const auto& m : detector
+                           .detect(cv::imread(test::sharedData(
+                               "vision/opencv_contrib_aruco_tutorial/singlemarkersoriginal.jpg")))
+                           .markers) {
     ids.insert(m.id);
   }
   EXPECT_EQ(ids, (std::set<int>{23, 40, 62, 98, 124, 203}));
   ids.clear();
-  for (const auto& m : detector.detect(cv::imread(test::sharedData("vision/opencv_contrib_aruco_tutorial/choriginal.jpg"))).markers) {
+  for (const auto& m : detector
+                           .detect(cv::imread(test::sharedData(
+                               "vision/opencv_contrib_aruco_tutorial/choriginal.jpg")))
+                           .markers) {
     ids.insert(m.id);
   }
   std::set<int> board;
@@ -115,10 +131,12 @@ TEST(OpenCvDictionaries, AprilTagPhotosGiveTagZeroAsOftenAsOpenCvFindsIt) {
   MarkerDetector detector(config);
   // OpenCV 4.6's count per photo (SOURCES.md); every detection must be id 0.
   const std::pair<const char*, size_t> photos[] = {{"33369213973_9d9bb4cc96_c.jpg", 11},
-                                                    {"34085369442_304b6bafd9_c.jpg", 4},
-                                                    {"34139872896_defdb2f8d9_c.jpg", 7}};
+                                                   {"34085369442_304b6bafd9_c.jpg", 4},
+                                                   {"34139872896_defdb2f8d9_c.jpg", 7}};
   for (const auto& [file, count] : photos) {
-    const auto markers = detector.detect(cv::imread(test::sharedData(std::string("vision/apriltag_test/") + file))).markers;
+    const auto markers =
+        detector.detect(cv::imread(test::sharedData(std::string("vision/apriltag_test/") + file)))
+            .markers;
     EXPECT_GE(markers.size(), count) << file;
     for (const auto& m : markers) EXPECT_EQ(m.id, 0) << file;
   }

@@ -29,15 +29,19 @@ TEST(RobotFrame, ObjectsOnTheTableComeOutWithin5MillimetresThroughTheReferenceMa
   const cv::Matx33d k(900, 0, 639.5, 0, 900, 359.5, 0, 0, 1);
   const ReferenceMarker reference;  // id 0, 8 cm, at (0, 0.90, 0)
   WorldModel world(reference);
-  const std::map<int, cv::Vec3d> objects{{5, {0.12, 0.72, 0.0}}, {6, {-0.10, 0.66, 0.0}}, {7, {0.02, 0.80, 0.0}}};
+  const std::map<int, cv::Vec3d> objects{
+      {5, {0.12, 0.72, 0.0}}, {6, {-0.10, 0.66, 0.0}}, {7, {0.02, 0.80, 0.0}}};
   // Slight head motion over a few frames.
   for (int frame_index = 0; frame_index < 4; ++frame_index) {
-    const Pose T_robot_cam = lookAt(cv::Vec3d(0.01 * frame_index, 1.30, 0.45), cv::Vec3d(0.0, 0.74, 0.0));
+    const Pose T_robot_cam =
+        lookAt(cv::Vec3d(0.01 * frame_index, 1.30, 0.45), cv::Vec3d(0.0, 0.74, 0.0));
     const Pose T_cam_robot = T_robot_cam.inverse();
     cv::Mat frame(720, 1280, CV_8UC1, cv::Scalar(150));
-    test::drawPosedMarker(frame, k, T_cam_robot * reference.T_robot_ref, reference.size_m, test::MarkerFamily::ArbciBch, 0);
+    test::drawPosedMarker(frame, k, T_cam_robot * reference.T_robot_ref, reference.size_m,
+                          test::MarkerFamily::ArbciBch, 0);
     for (const auto& [id, position] : objects) {
-      test::drawPosedMarker(frame, k, T_cam_robot * Pose{cv::Matx33d::eye(), position}, 0.05, test::MarkerFamily::ArbciBch, id);
+      test::drawPosedMarker(frame, k, T_cam_robot * Pose{cv::Matx33d::eye(), position}, 0.05,
+                            test::MarkerFamily::ArbciBch, id);
     }
     MarkerDetector detector(DetectorConfig{});
     std::map<int, PoseEstimate> poses;
@@ -54,7 +58,8 @@ TEST(RobotFrame, ObjectsOnTheTableComeOutWithin5MillimetresThroughTheReferenceMa
       const auto state = world.object(id);
       ASSERT_TRUE(state.has_value());
       EXPECT_LT(cv::norm(state->T_robot_object.translation - position), 0.005)
-          << "object " << id << " at " << state->T_robot_object.translation << ", truth " << position;
+          << "object " << id << " at " << state->T_robot_object.translation << ", truth "
+          << position;
     }
     EXPECT_TRUE(world.referenceVisible(frame_index / 30.0));
   }

@@ -16,9 +16,11 @@ test::Score run(Condition condition, int frames) {
   test::Score total;
   for (int f = 0; f < frames; ++f) {
     const test::SceneLayout layout = test::makeLayout({}, 5000u + static_cast<unsigned>(f));
-    const test::RenderedScene scene = test::renderScene(layout, test::MarkerFamily::ArbciBch, condition);
+    const test::RenderedScene scene =
+        test::renderScene(layout, test::MarkerFamily::ArbciBch, condition);
     std::vector<test::FoundMarker> found;
-    for (const MarkerDetection& m : detector.detect(scene.image).markers) found.push_back({m.id, m.corners});
+    for (const MarkerDetection& m : detector.detect(scene.image).markers)
+      found.push_back({m.id, m.corners});
     total.add(test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true));
   }
   return total;
@@ -57,8 +59,8 @@ INSTANTIATE_TEST_SUITE_P(Conditions, SyntheticScenes,
 
 TEST(SyntheticScenes, MarkerFreeFramesGiveNoDetections) {
   MarkerDetector detector(DetectorConfig{});
-  for (Condition condition : {Condition::Clean, Condition::Blur, Condition::Noise, Condition::UnevenLight,
-                              Condition::Combined}) {
+  for (Condition condition : {Condition::Clean, Condition::Blur, Condition::Noise,
+                              Condition::UnevenLight, Condition::Combined}) {
     for (int f = 0; f < 15; ++f) {
       test::LayoutOptions options;
       options.decoys = 5;
@@ -74,13 +76,15 @@ TEST(SyntheticScenes, CornersComeInThePrintedOrder) {
   MarkerDetector detector(DetectorConfig{});
   cv::Mat frame(240, 320, CV_8UC1, cv::Scalar(160));
   const int id = 1234;
-  const test::Corners quad{{{200.0f, 60.0f}, {200.0f, 160.0f}, {100.0f, 160.0f}, {100.0f, 60.0f}}};  // turned 90 deg
+  const test::Corners quad{
+      {{200.0f, 60.0f}, {200.0f, 160.0f}, {100.0f, 160.0f}, {100.0f, 60.0f}}};  // turned 90 deg
   const test::Corners outer{{{212.5f, 47.5f}, {212.5f, 172.5f}, {87.5f, 172.5f}, {87.5f, 47.5f}}};
   test::drawWarped(frame, test::markerImage(test::MarkerFamily::ArbciBch, id, 8), outer);
   const auto markers = detector.detect(frame).markers;
   ASSERT_EQ(markers.size(), 1u);
   EXPECT_EQ(markers[0].id, id);
-  for (int k = 0; k < 4; ++k) EXPECT_LT(cv::norm(markers[0].corners[k] - quad[k]), 0.2) << "corner " << k;
+  for (int k = 0; k < 4; ++k)
+    EXPECT_LT(cv::norm(markers[0].corners[k] - quad[k]), 0.2) << "corner " << k;
 }
 
 }  // namespace

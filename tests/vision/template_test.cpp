@@ -28,7 +28,8 @@ cv::Mat templateMarker(const std::string& letter) {
 void draw(cv::Mat& frame, const cv::Mat& marker, const test::Corners& quad) {
   // The black square is 200 of 260 px: extend the quad by 30/200 on each side.
   const std::vector<cv::Point2f> inner{{30, 30}, {230, 30}, {230, 230}, {30, 230}};
-  const cv::Mat h = cv::getPerspectiveTransform(inner, std::vector<cv::Point2f>(quad.begin(), quad.end()));
+  const cv::Mat h =
+      cv::getPerspectiveTransform(inner, std::vector<cv::Point2f>(quad.begin(), quad.end()));
   std::vector<cv::Point2f> outer{{0, 0}, {260, 0}, {260, 260}, {0, 260}}, mapped;
   cv::perspectiveTransform(outer, mapped, h);
   test::drawWarped(frame, marker, {mapped[0], mapped[1], mapped[2], mapped[3]});
@@ -65,7 +66,8 @@ TEST(TemplateMarkers, TrainedPatternsAreRecognisedTiltedAndTurnedWithTheirOrient
     const test::Corners& truth = m.id == 1 ? a_quad : k_quad;
     ASSERT_TRUE(m.id == 1 || m.id == 2);
     EXPECT_GT(m.confidence, 0.8f);
-    for (int c = 0; c < 4; ++c) EXPECT_LT(cv::norm(m.corners[c] - truth[c]), 1.0) << "id " << m.id << " corner " << c;
+    for (int c = 0; c < 4; ++c)
+      EXPECT_LT(cv::norm(m.corners[c] - truth[c]), 1.0) << "id " << m.id << " corner " << c;
   }
 }
 

@@ -25,7 +25,9 @@ cv::Mat card(float corner_gain) {
   const float corner = static_cast<float>(cv::norm(centre));
   for (int y = 0; y < f.rows; ++y) {
     for (int x = 0; x < f.cols; ++x) {
-      const float r = static_cast<float>(cv::norm(cv::Point2f(static_cast<float>(x), static_cast<float>(y)) - centre)) / corner;
+      const float r = static_cast<float>(cv::norm(
+                          cv::Point2f(static_cast<float>(x), static_cast<float>(y)) - centre)) /
+                      corner;
       f.at<float>(y, x) *= 1.0f - (1.0f - corner_gain) * r * r;
     }
   }
@@ -80,7 +82,7 @@ class AutomaticThreshold : public testing::TestWithParam<ThresholdMode> {};
 TEST_P(AutomaticThreshold, ReacquiresALostMarkerWithinAFewFramesAndThenFollowsIt) {
   DetectorConfig config;
   config.threshold.mode = GetParam();
-  config.threshold.value = 3;             // nothing is dark: the marker is lost
+  config.threshold.value = 3;              // nothing is dark: the marker is lost
   config.threshold.retries_per_frame = 0;  // one random threshold per frame, as the original system
   config.threshold.random_seed = 2024;
   MarkerDetector detector(config);
@@ -142,7 +144,7 @@ TEST(ThresholdModes, AdaptiveFindsWhatNoSingleThresholdCan) {
   cv::Mat f;
   frame.convertTo(f, CV_32F);
   f(cv::Rect(0, 0, 320, 480)) = f(cv::Rect(0, 0, 320, 480)) * 0.7 + 80.0;  // glare
-  f(cv::Rect(320, 0, 320, 480)) *= 0.21;                                    // shadow
+  f(cv::Rect(320, 0, 320, 480)) *= 0.21;                                   // shadow
   f.convertTo(frame, CV_8U);
   for (int value = 0; value <= 255; value += 5) {
     DetectorConfig config;

@@ -8,7 +8,8 @@
 
 namespace arbci::ui {
 
-CalibrationPanel::CalibrationPanel(WorkstationModel& model) : model_(model), calibrator_(vision::CalibrationBoard{}) {
+CalibrationPanel::CalibrationPanel(WorkstationModel& model)
+    : model_(model), calibrator_(vision::CalibrationBoard{}) {
   reference_id_ = model.referenceId();
   const cv::Vec3d p = model.referencePosition();
   for (int i = 0; i < 3; ++i) reference_position_[i] = static_cast<float>(p[i]);
@@ -17,7 +18,8 @@ CalibrationPanel::CalibrationPanel(WorkstationModel& model) : model_(model), cal
 void CalibrationPanel::captureView() {
   const cv::Mat image = model_.cameraImage();
   if (image.empty()) return;
-  const vision::ViewResult r = calibrator_.addView(image, "view " + std::to_string(calibrator_.viewCount() + 1));
+  const vision::ViewResult r =
+      calibrator_.addView(image, "view " + std::to_string(calibrator_.viewCount() + 1));
   last_view_ = vision::toString(r.outcome) + (r.reason.empty() ? "" : ": " + r.reason);
   last_corners_ = r.corners;
   if (board_) model_.holdBoard(true);  // the next view from another pose
@@ -39,15 +41,16 @@ void CalibrationPanel::calibrate() {
 
 void CalibrationPanel::draw() {
   const vision::CalibrationBoard& board = calibrator_.board();
-  ImGui::Text("board: chessboard %dx%d inner corners, %.0f mm squares", board.inner_corners.width, board.inner_corners.height,
-              board.square_m * 1000);
+  ImGui::Text("board: chessboard %dx%d inner corners, %.0f mm squares", board.inner_corners.width,
+              board.inner_corners.height, board.square_m * 1000);
   if (model_.canHoldBoard()) {
     if (ImGui::Checkbox("hold the simulated board up", &board_)) model_.holdBoard(board_);
   }
   cv::Mat image = model_.cameraImage();
   if (ImGui::Button("Capture view")) captureView();
   ImGui::SameLine();
-  ImGui::Text("%zu views; coverage %.0f%%", calibrator_.viewCount(), 100.0 * calibrator_.coverageFraction());
+  ImGui::Text("%zu views; coverage %.0f%%", calibrator_.viewCount(),
+              100.0 * calibrator_.coverageFraction());
   if (!last_view_.empty()) ImGui::Text("last view: %s", last_view_.c_str());
   ImGui::BeginDisabled(calibrator_.viewCount() < 3);
   if (ImGui::Button("Calibrate")) calibrate();
@@ -64,8 +67,9 @@ void CalibrationPanel::draw() {
         message_ = error.what();
       }
     }
-    ImGui::Text("overall RMS %.3f px; fx %.1f fy %.1f cx %.1f cy %.1f", result_->rms_px, result_->camera.fx(), result_->camera.fy(),
-                result_->camera.cx(), result_->camera.cy());
+    ImGui::Text("overall RMS %.3f px; fx %.1f fy %.1f cx %.1f cy %.1f", result_->rms_px,
+                result_->camera.fx(), result_->camera.fy(), result_->camera.cx(),
+                result_->camera.cy());
     for (size_t i = 0; i < result_->per_view_rms_px.size(); ++i) {
       ImGui::Text("  %s: %.3f px", result_->view_names[i].c_str(), result_->per_view_rms_px[i]);
     }
@@ -83,9 +87,13 @@ void CalibrationPanel::draw() {
       std::vector<cv::Point2f> corners;
       cv::Mat grey;
       cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-      const bool found = cv::findChessboardCorners(grey, board.inner_corners, corners, cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_ADAPTIVE_THRESH);
+      const bool found =
+          cv::findChessboardCorners(grey, board.inner_corners, corners,
+                                    cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_ADAPTIVE_THRESH);
       cv::drawChessboardCorners(shown, board.inner_corners, corners, found);
-      if (!found) cv::putText(shown, "no board in view", {10, 30}, cv::FONT_HERSHEY_SIMPLEX, 0.8, cv::Scalar(0, 0, 255), 2);
+      if (!found)
+        cv::putText(shown, "no board in view", {10, 30}, cv::FONT_HERSHEY_SIMPLEX, 0.8,
+                    cv::Scalar(0, 0, 255), 2);
     }
   }
   const float width = ImGui::GetContentRegionAvail().x * 0.62f;
@@ -98,7 +106,9 @@ void CalibrationPanel::draw() {
     for (int y = 0; y < counts.rows; ++y) {
       for (int x = 0; x < counts.cols; ++x) {
         const int n = counts.at<int>(y, x);
-        if (n > 0) map(cv::Rect(x * 20, y * 20, 19, 19)).setTo(cv::Scalar(40, std::min(255, 90 + 25 * n), 40));
+        if (n > 0)
+          map(cv::Rect(x * 20, y * 20, 19, 19))
+              .setTo(cv::Scalar(40, std::min(255, 90 + 25 * n), 40));
       }
     }
   }
@@ -111,7 +121,8 @@ void CalibrationPanel::draw() {
   ImGui::InputInt("id", &reference_id_);
   ImGui::InputFloat3("position (m)", reference_position_, "%.3f");
   if (ImGui::Button("Apply reference")) {
-    model_.setReference(reference_id_, cv::Vec3d(reference_position_[0], reference_position_[1], reference_position_[2]));
+    model_.setReference(reference_id_, cv::Vec3d(reference_position_[0], reference_position_[1],
+                                                 reference_position_[2]));
   }
 }
 

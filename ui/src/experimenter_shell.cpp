@@ -12,7 +12,9 @@ constexpr ImGuiWindowFlags kBarFlags = ImGuiWindowFlags_NoDecoration | ImGuiWind
                                        ImGuiWindowFlags_NoBringToFrontOnFocus;
 }
 
-void ExperimenterShell::addPanel(Panel& panel, bool open) { panels_.push_back({&panel, open}); }
+void ExperimenterShell::addPanel(Panel& panel, bool open) {
+  panels_.push_back({&panel, open});
+}
 
 void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
   drawMenuBar();

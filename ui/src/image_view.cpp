@@ -17,12 +17,14 @@ void ImageView::draw(const cv::Mat& image, float width) {
   if (image.channels() == 1) cv::cvtColor(image, colour, cv::COLOR_GRAY2BGR);
   texture_->upload(colour, false);
   const float height = width * static_cast<float>(image.rows) / static_cast<float>(image.cols);
-  ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_->id())), ImVec2(width, height));
+  ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_->id())),
+               ImVec2(width, height));
 }
 
 void ImageView::drawTexture(unsigned int texture, float width, float height, bool flip_vertically) {
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture)), ImVec2(width, height),
-               flip_vertically ? ImVec2(0, 1) : ImVec2(0, 0), flip_vertically ? ImVec2(1, 0) : ImVec2(1, 1));
+               flip_vertically ? ImVec2(0, 1) : ImVec2(0, 0),
+               flip_vertically ? ImVec2(1, 0) : ImVec2(1, 1));
 }
 
 }  // namespace arbci::ui

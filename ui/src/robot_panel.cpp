@@ -25,24 +25,30 @@ void RobotPanel::draw() {
   if (status) {
     ImGui::Text("state: %s", robot::toString(status->state));
     if (status->current_command != robot::MessageType::Status) {
-      ImGui::Text("command: %s #%llu", robot::toString(status->current_command), static_cast<unsigned long long>(status->current_sequence));
+      ImGui::Text("command: %s #%llu", robot::toString(status->current_command),
+                  static_cast<unsigned long long>(status->current_sequence));
       ImGui::ProgressBar(static_cast<float>(status->progress));
     } else {
       ImGui::TextDisabled("no command running");
     }
     ImGui::Text("tool: (%.3f, %.3f, %.3f) m", status->tool.x, status->tool.y, status->tool.z);
-    ImGui::Text("gripper: %s (%.0f%% open)", status->gripper_opening > 0.5 ? "open" : "closed", status->gripper_opening * 100.0);
-    ImGui::Text("holding: %s", status->holding >= 0 ? ("object " + std::to_string(status->holding)).c_str() : "nothing");
+    ImGui::Text("gripper: %s (%.0f%% open)", status->gripper_opening > 0.5 ? "open" : "closed",
+                status->gripper_opening * 100.0);
+    ImGui::Text("holding: %s", status->holding >= 0
+                                   ? ("object " + std::to_string(status->holding)).c_str()
+                                   : "nothing");
     if (status->last_finished_sequence > 0) {
-      ImGui::Text("last finished: #%llu %s %s", static_cast<unsigned long long>(status->last_finished_sequence), robot::toString(status->last_outcome),
-                  status->last_outcome_text.c_str());
+      ImGui::Text("last finished: #%llu %s %s",
+                  static_cast<unsigned long long>(status->last_finished_sequence),
+                  robot::toString(status->last_outcome), status->last_outcome_text.c_str());
     }
   }
   heading("messages");
   const auto log = model_.robotLog();
   ImGui::BeginChild("robot log", ImVec2(0, 0), true);
   for (auto it = log.rbegin(); it != log.rend(); ++it) {
-    const bool bad = it->find("rejected") == 0 || it->find("failed") == 0 || it->find("silent") == 0;
+    const bool bad =
+        it->find("rejected") == 0 || it->find("failed") == 0 || it->find("silent") == 0;
     if (bad) {
       ImGui::TextColored(ImVec4(1, 0.5f, 0.3f, 1), "%s", it->c_str());
     } else {

@@ -7,7 +7,8 @@ namespace arbci::ui {
 
 void SessionPanel::draw() {
   ImGui::Text("%s", model_.phase().c_str());
-  ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", model_.trial(), model_.trials(), model_.sequence(), model_.sessionTime());
+  ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", model_.trial(), model_.trials(),
+              model_.sequence(), model_.sessionTime());
   if (!model_.started()) {
     if (ImGui::Button("Start")) model_.start();
   } else {
@@ -23,7 +24,8 @@ void SessionPanel::draw() {
   heading("cycle");
   ImGui::Text("budget %.1f ms (one EEG block); overruns: %d", model_.budgetMs(), model_.overruns());
   if (ImGui::BeginTable("timing", 6, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {
-    for (const char* h : {"stage", "last ms", "p50", "p90", "p99", "max"}) ImGui::TableSetupColumn(h);
+    for (const char* h : {"stage", "last ms", "p50", "p90", "p99", "max"})
+      ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
     for (const StageTiming& t : timing) {
       ImGui::TableNextRow();

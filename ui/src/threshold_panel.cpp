@@ -8,7 +8,8 @@ namespace arbci::ui {
 
 void ThresholdPanel::draw() {
   vision::ThresholdSettings s = model_.threshold();
-  const char* modes[] = {"constant", "automatic (median of marker pixels)", "automatic (midrange, ARToolKitPlus)", "adaptive (local)"};
+  const char* modes[] = {"constant", "automatic (median of marker pixels)",
+                         "automatic (midrange, ARToolKitPlus)", "adaptive (local)"};
   int mode = static_cast<int>(s.mode);
   bool changed = ImGui::Combo("mode", &mode, modes, 4);
   s.mode = static_cast<vision::ThresholdMode>(mode);
@@ -16,7 +17,9 @@ void ThresholdPanel::draw() {
     changed |= ImGui::SliderInt("value", &s.value, 1, 254);
     bool vignetting = s.vignetting.has_value();
     if (ImGui::Checkbox("vignetting compensation", &vignetting)) {
-      s.vignetting = vignetting ? std::optional<vision::Vignetting>(vision::Vignetting{-20, -10, -10}) : std::nullopt;
+      s.vignetting = vignetting
+                         ? std::optional<vision::Vignetting>(vision::Vignetting{-20, -10, -10})
+                         : std::nullopt;
       changed = true;
     }
     if (s.vignetting) {
@@ -29,8 +32,8 @@ void ThresholdPanel::draw() {
   }
   if (changed) model_.setThreshold(s);
   const vision::DetectionResult d = model_.detection();
-  ImGui::Text("threshold used: %d (%s), %d candidates, %d attempt(s)", d.threshold, d.threshold_mode.c_str(), d.candidates,
-              d.threshold_attempts);
+  ImGui::Text("threshold used: %d (%s), %d candidates, %d attempt(s)", d.threshold,
+              d.threshold_mode.c_str(), d.candidates, d.threshold_attempts);
   const float width = (ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemSpacing.x) / 2.0f;
   camera_.draw(model_.cameraImage(), width);
   ImGui::SameLine();
@@ -58,7 +61,8 @@ void ThresholdPanel::draw() {
         if (o.id == m.id) found = &o;
       }
       if (found) {
-        ImGui::Text("%.1f %.1f %.1f", found->position[0] * 1000, found->position[1] * 1000, found->position[2] * 1000);
+        ImGui::Text("%.1f %.1f %.1f", found->position[0] * 1000, found->position[1] * 1000,
+                    found->position[2] * 1000);
         ImGui::TableNextColumn();
         ImGui::Text("%.2f s / %.2f px", found->age_s, found->reprojection_px);
       } else {

@@ -51,7 +51,9 @@ void TrainingPanel::startTraining() {
   });
 }
 
-void TrainingPanel::setRecordings(const std::string& files) { std::snprintf(files_, sizeof files_, "%s", files.c_str()); }
+void TrainingPanel::setRecordings(const std::string& files) {
+  std::snprintf(files_, sizeof files_, "%s", files.c_str());
+}
 
 void TrainingPanel::train(bool wait) {
   startTraining();
@@ -62,14 +64,16 @@ void TrainingPanel::train(bool wait) {
 }
 
 void TrainingPanel::collect() {
-  if (training_.valid() && training_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+  if (training_.valid() &&
+      training_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     outcome_ = training_.get();
     if (!outcome_->error.empty()) message_ = outcome_->error;
   }
 }
 
 void TrainingPanel::draw() {
-  ImGui::InputTextMultiline("recordings", files_, sizeof files_, ImVec2(-1, ImGui::GetTextLineHeight() * 3));
+  ImGui::InputTextMultiline("recordings", files_, sizeof files_,
+                            ImVec2(-1, ImGui::GetTextLineHeight() * 3));
   const char* methods[] = {"SWLDA (as BCI2000)", "shrinkage LDA", "xDAWN + LDA"};
   ImGui::Combo("method", &method_, methods, 3);
   ImGui::SliderFloat("window end (ms)", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
@@ -90,8 +94,9 @@ void TrainingPanel::draw() {
   if (!outcome_ || !outcome_->result) {
     const auto current = model_.model();
     if (current) {
-      ImGui::Text("session model: %s, trained on %s", current->method.c_str(),
-                  current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
+      ImGui::Text(
+          "session model: %s, trained on %s", current->method.c_str(),
+          current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
     } else {
       ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
     }
@@ -99,22 +104,28 @@ void TrainingPanel::draw() {
   }
   const bci::TrainingResult& r = *outcome_->result;
   const bci::EvaluationReport& cv = r.cross_validation.report;
-  ImGui::Text("cross-validated (%d folds by selection): AUC %.3f; %d selections", r.cross_validation.folds, cv.auc,
-              cv.selections_with_truth);
-  std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()), bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
-  ImGui::PlotLines("accuracy by sequences", accuracy.data(), static_cast<int>(accuracy.size()), 0, nullptr, 0.0f, 1.0f, ImVec2(0, 70));
-  ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0, nullptr, 0.0f, FLT_MAX, ImVec2(0, 70));
+  ImGui::Text("cross-validated (%d folds by selection): AUC %.3f; %d selections",
+              r.cross_validation.folds, cv.auc, cv.selections_with_truth);
+  std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()),
+      bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
+  ImGui::PlotLines("accuracy by sequences", accuracy.data(), static_cast<int>(accuracy.size()), 0,
+                   nullptr, 0.0f, 1.0f, ImVec2(0, 70));
+  ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0, nullptr,
+                   0.0f, FLT_MAX, ImVec2(0, 70));
   const bci::P300Dataset& d = *outcome_->data;
   heading("ERP averages: target (upper) and non-target (lower) per channel");
   // One scale for all channels and both classes, so the averages compare.
-  const float limit = static_cast<float>(std::max({1.0, d.erp_target.cwiseAbs().maxCoeff(), d.erp_other.cwiseAbs().maxCoeff()}));
+  const float limit = static_cast<float>(
+      std::max({1.0, d.erp_target.cwiseAbs().maxCoeff(), d.erp_other.cwiseAbs().maxCoeff()}));
   for (int c = 0; c < static_cast<int>(d.erp_target.rows()); ++c) {
-    std::vector<float> t(d.erp_target.row(c).data(), d.erp_target.row(c).data() + d.erp_target.cols());
+    std::vector<float> t(d.erp_target.row(c).data(),
+                         d.erp_target.row(c).data() + d.erp_target.cols());
     std::vector<float> o(d.erp_other.row(c).data(), d.erp_other.row(c).data() + d.erp_other.cols());
     ImGui::PushID(c);
-    ImGui::PlotLines(d.info.channels[static_cast<size_t>(c)].c_str(), t.data(), static_cast<int>(t.size()), 0, "target", -limit, limit,
-                     ImVec2(0, 40));
-    ImGui::PlotLines("##other", o.data(), static_cast<int>(o.size()), 0, "non-target", -limit, limit, ImVec2(0, 40));
+    ImGui::PlotLines(d.info.channels[static_cast<size_t>(c)].c_str(), t.data(),
+                     static_cast<int>(t.size()), 0, "target", -limit, limit, ImVec2(0, 40));
+    ImGui::PlotLines("##other", o.data(), static_cast<int>(o.size()), 0, "non-target", -limit,
+                     limit, ImVec2(0, 40));
     ImGui::PopID();
   }
   ImGui::InputText("##model", save_path_, sizeof save_path_);

@@ -40,8 +40,8 @@ struct SyndromeTable {
   }
 
   const CodeWord* find(std::uint32_t syndrome) const {
-    auto found = std::lower_bound(entries.begin(), entries.end(),
-                                  std::make_pair(syndrome, CodeWord{0}));
+    auto found =
+        std::lower_bound(entries.begin(), entries.end(), std::make_pair(syndrome, CodeWord{0}));
     return found != entries.end() && found->first == syndrome ? &found->second : nullptr;
   }
 };

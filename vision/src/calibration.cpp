@@ -29,16 +29,18 @@ int flagsOf(const CalibrationFlags& flags) {
 }
 
 cv::Ptr<cv::aruco::CharucoBoard> charucoBoard(const CalibrationBoard& board) {
-  return cv::aruco::CharucoBoard::create(board.squares.width, board.squares.height, static_cast<float>(board.square_m),
-                                         static_cast<float>(board.marker_m),
-                                         cv::aruco::getPredefinedDictionary(dictionaryId(board.dictionary)));
+  return cv::aruco::CharucoBoard::create(
+      board.squares.width, board.squares.height, static_cast<float>(board.square_m),
+      static_cast<float>(board.marker_m),
+      cv::aruco::getPredefinedDictionary(dictionaryId(board.dictionary)));
 }
 
 std::vector<cv::Point3f> chessboardPoints(const CalibrationBoard& board) {
   std::vector<cv::Point3f> points;
   for (int r = 0; r < board.inner_corners.height; ++r) {
     for (int c = 0; c < board.inner_corners.width; ++c) {
-      points.emplace_back(static_cast<float>(c * board.square_m), static_cast<float>(r * board.square_m), 0.0f);
+      points.emplace_back(static_cast<float>(c * board.square_m),
+                          static_cast<float>(r * board.square_m), 0.0f);
     }
   }
   return points;
@@ -48,17 +50,23 @@ std::vector<cv::Point3f> chessboardPoints(const CalibrationBoard& board) {
 
 std::string toString(ViewOutcome outcome) {
   switch (outcome) {
-    case ViewOutcome::Accepted: return "accepted";
-    case ViewOutcome::NoBoard: return "no board";
-    case ViewOutcome::Blurred: return "blurred";
-    case ViewOutcome::Duplicate: return "duplicate";
-    case ViewOutcome::WrongSize: return "wrong size";
+    case ViewOutcome::Accepted:
+      return "accepted";
+    case ViewOutcome::NoBoard:
+      return "no board";
+    case ViewOutcome::Blurred:
+      return "blurred";
+    case ViewOutcome::Duplicate:
+      return "duplicate";
+    case ViewOutcome::WrongSize:
+      return "wrong size";
   }
   return "?";
 }
 
 IncrementalCalibrator::IncrementalCalibrator(CalibrationBoard board) : board_(std::move(board)) {
-  if (board_.square_m <= 0.0) throw std::invalid_argument("calibration board: square size must be positive");
+  if (board_.square_m <= 0.0)
+    throw std::invalid_argument("calibration board: square size must be positive");
   if (board_.kind == CalibrationBoard::Kind::Chessboard &&
       (board_.inner_corners.width < 3 || board_.inner_corners.height < 3)) {
     throw std::invalid_argument("calibration board: at least 3x3 inner corners");
@@ -66,19 +74,23 @@ IncrementalCalibrator::IncrementalCalibrator(CalibrationBoard board) : board_(st
   if (board_.kind == CalibrationBoard::Kind::Charuco) {
     dictionaryId(board_.dictionary);  // throws for an unknown name
     if (!(board_.marker_m > 0.0 && board_.marker_m < board_.square_m)) {
-      throw std::invalid_argument("calibration board: ChArUco markers must be smaller than the squares");
+      throw std::invalid_argument(
+          "calibration board: ChArUco markers must be smaller than the squares");
     }
   }
 }
 
-std::optional<IncrementalCalibrator::View> IncrementalCalibrator::detect(const cv::Mat& gray, ViewResult& result) const {
+std::optional<IncrementalCalibrator::View> IncrementalCalibrator::detect(const cv::Mat& gray,
+                                                                         ViewResult& result) const {
   View view;
   if (board_.kind == CalibrationBoard::Kind::Chessboard) {
     std::vector<cv::Point2f> corners;
     if (!cv::findChessboardCorners(gray, board_.inner_corners, corners,
                                    cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
-      result = {ViewOutcome::NoBoard, "no " + std::to_string(board_.inner_corners.width) + "x" +
-                                          std::to_string(board_.inner_corners.height) + " chessboard found", {}};
+      result = {ViewOutcome::NoBoard,
+                "no " + std::to_string(board_.inner_corners.width) + "x" +
+                    std::to_string(board_.inner_corners.height) + " chessboard found",
+                {}};
       return std::nullopt;
     }
     cv::cornerSubPix(gray, corners, cv::Size(11, 11), cv::Size(-1, -1),
@@ -86,11 +98,13 @@ std::optional<IncrementalCalibrator::View> IncrementalCalibrator::detect(const c
     view.image_points = corners;
     view.object_points = chessboardPoints(board_);
     // Edge sharpness as OpenCV measures it on chessboards (mean edge width in pixels).
-    const cv::Scalar sharpness = cv::estimateChessboardSharpness(gray, board_.inner_corners, corners);
+    const cv::Scalar sharpness =
+        cv::estimateChessboardSharpness(gray, board_.inner_corners, corners);
     if (sharpness[0] > max_edge_width_px) {
       std::ostringstream reason;
       reason.precision(2);
-      reason << std::fixed << "blurred: edges " << sharpness[0] << " px wide (at most " << max_edge_width_px << ")";
+      reason << std::fixed << "blurred: edges " << sharpness[0] << " px wide (at most "
+             << max_edge_width_px << ")";
       result = {ViewOutcome::Blurred, reason.str(), corners};
       return std::nullopt;
     }
@@ -123,8 +137,9 @@ ViewResult IncrementalCalibrator::addView(const cv::Mat& image, const std::strin
   }
   if (!views_.empty() && image.size() != image_size_) {
     result.outcome = ViewOutcome::WrongSize;
-    result.reason = "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) + ", the views so far " +
-                    std::to_string(image_size_.width) + "x" + std::to_string(image_size_.height);
+    result.reason = "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                    ", the views so far " + std::to_string(image_size_.width) + "x" +
+                    std::to_string(image_size_.height);
     return result;
   }
   const cv::Mat gray = toGray(image);
@@ -132,9 +147,11 @@ ViewResult IncrementalCalibrator::addView(const cv::Mat& image, const std::strin
   if (!view) return result;
   // A duplicate: every corner within a few pixels of an earlier view's (same ids).
   for (const View& earlier : views_) {
-    if (earlier.image_points.size() != view->image_points.size() || earlier.ids != view->ids) continue;
+    if (earlier.image_points.size() != view->image_points.size() || earlier.ids != view->ids)
+      continue;
     double sum = 0.0;
-    for (size_t i = 0; i < view->image_points.size(); ++i) sum += cv::norm(view->image_points[i] - earlier.image_points[i]);
+    for (size_t i = 0; i < view->image_points.size(); ++i)
+      sum += cv::norm(view->image_points[i] - earlier.image_points[i]);
     if (sum / static_cast<double>(view->image_points.size()) < min_new_view_px) {
       return {ViewOutcome::Duplicate, "too like view '" + earlier.name + "'", view->image_points};
     }
@@ -150,8 +167,10 @@ cv::Mat IncrementalCalibrator::coverage(cv::Size grid) const {
   if (image_size_.area() == 0) return counts;
   for (const View& view : views_) {
     for (const cv::Point2f& p : view.image_points) {
-      const int gx = std::clamp(static_cast<int>(p.x * grid.width / image_size_.width), 0, grid.width - 1);
-      const int gy = std::clamp(static_cast<int>(p.y * grid.height / image_size_.height), 0, grid.height - 1);
+      const int gx =
+          std::clamp(static_cast<int>(p.x * grid.width / image_size_.width), 0, grid.width - 1);
+      const int gy =
+          std::clamp(static_cast<int>(p.y * grid.height / image_size_.height), 0, grid.height - 1);
       ++counts.at<int>(gy, gx);
     }
   }
@@ -165,7 +184,8 @@ double IncrementalCalibrator::coverageFraction(cv::Size grid) const {
 
 CalibrationResult IncrementalCalibrator::calibrate(const CalibrationFlags& flags) const {
   if (views_.size() < 3) {
-    throw std::runtime_error("calibration needs at least 3 accepted views, have " + std::to_string(views_.size()));
+    throw std::runtime_error("calibration needs at least 3 accepted views, have " +
+                             std::to_string(views_.size()));
   }
   std::vector<std::vector<cv::Point3f>> object;
   std::vector<std::vector<cv::Point2f>> image;
@@ -175,8 +195,8 @@ CalibrationResult IncrementalCalibrator::calibrate(const CalibrationFlags& flags
   }
   cv::Mat k = cv::Mat::eye(3, 3, CV_64F), distortion, per_view;
   std::vector<cv::Mat> rvecs, tvecs;
-  const double rms = cv::calibrateCamera(object, image, image_size_, k, distortion, rvecs, tvecs, cv::noArray(),
-                                         cv::noArray(), per_view, flagsOf(flags));
+  const double rms = cv::calibrateCamera(object, image, image_size_, k, distortion, rvecs, tvecs,
+                                         cv::noArray(), cv::noArray(), per_view, flagsOf(flags));
   CalibrationResult result;
   result.camera.image_size = image_size_;
   result.camera.camera_matrix = cv::Matx33d(k);
@@ -191,7 +211,8 @@ CalibrationResult IncrementalCalibrator::calibrate(const CalibrationFlags& flags
 
 StereoResult calibrateStereo(const CalibrationBoard& board, const std::vector<cv::Mat>& left,
                              const std::vector<cv::Mat>& right, const CalibrationFlags& flags) {
-  if (left.size() != right.size()) throw std::runtime_error("stereo calibration needs as many left as right views");
+  if (left.size() != right.size())
+    throw std::runtime_error("stereo calibration needs as many left as right views");
   if (board.kind != CalibrationBoard::Kind::Chessboard) {
     throw std::runtime_error("stereo calibration takes chessboard views");
   }
@@ -207,12 +228,17 @@ StereoResult calibrateStereo(const CalibrationBoard& board, const std::vector<cv
     right_points.push_back(r.corners);
     object.push_back(chessboardPoints(board));
   }
-  if (object.size() < 3) throw std::runtime_error("stereo calibration needs at least 3 pairs with the board in both views");
-  const CalibrationResult l = left_calibrator.calibrate(flags), r = right_calibrator.calibrate(flags);
-  cv::Mat kl(l.camera.camera_matrix), kr(r.camera.camera_matrix), dl(l.camera.distortion, true), dr(r.camera.distortion, true);
+  if (object.size() < 3)
+    throw std::runtime_error(
+        "stereo calibration needs at least 3 pairs with the board in both views");
+  const CalibrationResult l = left_calibrator.calibrate(flags),
+                          r = right_calibrator.calibrate(flags);
+  cv::Mat kl(l.camera.camera_matrix), kr(r.camera.camera_matrix), dl(l.camera.distortion, true),
+      dr(r.camera.distortion, true);
   cv::Mat rotation, translation, essential, fundamental;
-  const double rms = cv::stereoCalibrate(object, left_points, right_points, kl, dl, kr, dr, left_calibrator.imageSize(),
-                                         rotation, translation, essential, fundamental, cv::CALIB_FIX_INTRINSIC);
+  const double rms = cv::stereoCalibrate(object, left_points, right_points, kl, dl, kr, dr,
+                                         left_calibrator.imageSize(), rotation, translation,
+                                         essential, fundamental, cv::CALIB_FIX_INTRINSIC);
   StereoResult result;
   result.cameras.left = l.camera;
   result.cameras.right = r.camera;

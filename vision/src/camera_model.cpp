@@ -36,7 +36,8 @@ int readInt(const cv::FileNode& node, const std::string& source, const std::stri
   return static_cast<int>(node.real());
 }
 
-CameraModel readCamera(const cv::FileNode& root, const std::string& source, const std::string& prefix = "") {
+CameraModel readCamera(const cv::FileNode& root, const std::string& source,
+                       const std::string& prefix = "") {
   CameraModel model;
   model.source = source;
   model.image_size.width = readInt(root[prefix + "image_width"], source, prefix + "image_width");
@@ -49,7 +50,8 @@ CameraModel readCamera(const cv::FileNode& root, const std::string& source, cons
     const cv::Mat coefficients = readMatrix(d, source, prefix + "distortion_coefficients");
     model.distortion.assign(coefficients.begin<double>(), coefficients.end<double>());
   }
-  if (!root[prefix + "avg_reprojection_error"].empty()) model.rms_px = root[prefix + "avg_reprojection_error"].real();
+  if (!root[prefix + "avg_reprojection_error"].empty())
+    model.rms_px = root[prefix + "avg_reprojection_error"].real();
   model.validate();
   return model;
 }
@@ -112,13 +114,14 @@ void CameraModel::validate() const {
   }
   if (!(cx() >= 0.0 && cx() <= image_size.width && cy() >= 0.0 && cy() <= image_size.height)) {
     std::ostringstream text;
-    text << "principal point (" << cx() << ", " << cy() << ") lies outside the " << image_size.width << "x"
-         << image_size.height << " image";
+    text << "principal point (" << cx() << ", " << cy() << ") lies outside the " << image_size.width
+         << "x" << image_size.height << " image";
     fail(source, text.str());
   }
   const size_t n = distortion.size();
   if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
-    fail(source, "distortion_coefficients must have 4, 5, 8, 12 or 14 values, got " + std::to_string(n));
+    fail(source,
+         "distortion_coefficients must have 4, 5, 8, 12 or 14 values, got " + std::to_string(n));
   }
   for (double d : distortion) {
     if (!std::isfinite(d)) fail(source, "distortion_coefficients contain a non-finite value");

@@ -34,7 +34,8 @@ std::optional<CodeDecode> hardDecode(MarkerKind kind, const CodeGrid& sampled, b
 // Chase decoding of a BCH word (see the header). Accepts a codeword that disagrees with at most
 // kMaxDisagreements cells whose summed reliability is at most kMaxWeight, and that beats every
 // other candidate (another id or orientation) by kMinMargin.
-std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled, const std::array<float, 36>& reliability) {
+std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
+                                      const std::array<float, 36>& reliability) {
   constexpr int kFlipped = 6;
   constexpr float kMaxReliabilityToFlip = 0.5f, kMaxWeight = 1.2f, kMinMargin = 0.6f;
   constexpr int kMaxDisagreements = 5;
@@ -60,7 +61,8 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled, const std::array<
       const auto decoded = BchCode::decode(gridToWord(rotateClockwise(trial, turns)));
       if (!decoded) continue;
       // The codeword as it appears in the sampled orientation, against the cells as read.
-      const CodeWord codeword = gridToWord(rotateClockwise(wordToGrid(BchCode::encode(decoded->id)), 4 - turns));
+      const CodeWord codeword =
+          gridToWord(rotateClockwise(wordToGrid(BchCode::encode(decoded->id)), 4 - turns));
       const CodeWord differ = codeword ^ received;
       float weight = 0.0f;
       for (int p = 0; p < 36; ++p) {
@@ -77,7 +79,8 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled, const std::array<
       }
     }
   }
-  if (best.id < 0 || best.disagreements > kMaxDisagreements || best.weight > kMaxWeight) return std::nullopt;
+  if (best.id < 0 || best.disagreements > kMaxDisagreements || best.weight > kMaxWeight)
+    return std::nullopt;
   if (second.id >= 0 && second.weight - best.weight < kMinMargin) return std::nullopt;
   const float confidence = std::max(0.05f, 0.5f - 0.25f * best.weight);
   return CodeDecode{best.id, best.turns, best.disagreements, confidence};
@@ -89,11 +92,14 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled, const std::array<
 std::array<float, 36> sharpenedLevels(const MarkerSamples& samples) {
   std::array<float, 36> level{}, sharp{};
   const float half_contrast = std::max(1.0f, samples.contrast * 0.5f);
-  for (int i = 0; i < 36; ++i) level[i] = 0.5f + (samples.cells[i] - samples.thresholds[i]) / (2.0f * half_contrast);
+  for (int i = 0; i < 36; ++i)
+    level[i] = 0.5f + (samples.cells[i] - samples.thresholds[i]) / (2.0f * half_contrast);
   constexpr float kAmount = 1.0f;
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 6; ++c) {
-      auto at = [&](int rr, int cc) { return rr < 0 || rr > 5 || cc < 0 || cc > 5 ? 0.0f : level[rr * 6 + cc]; };
+      auto at = [&](int rr, int cc) {
+        return rr < 0 || rr > 5 || cc < 0 || cc > 5 ? 0.0f : level[rr * 6 + cc];
+      };
       const float around = 0.25f * (at(r - 1, c) + at(r + 1, c) + at(r, c - 1) + at(r, c + 1));
       sharp[r * 6 + c] = level[r * 6 + c] + kAmount * (level[r * 6 + c] - around);
     }
@@ -126,8 +132,9 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   }
   if (sharpened != sampled) {
     const std::optional<CodeDecode> again = hardDecode(kind, sharpened, ambiguous);
-    if (again && !ambiguous) return CodeDecode{again->id, again->orientation, again->corrected_bits,
-                                               again->confidence * 0.9f};
+    if (again && !ambiguous)
+      return CodeDecode{again->id, again->orientation, again->corrected_bits,
+                        again->confidence * 0.9f};
   }
   if (auto chase = chaseDecode(sampled, reliability)) return chase;
   return chaseDecode(sharpened, sharp_reliability);

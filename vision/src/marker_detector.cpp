@@ -23,10 +23,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kSmoothAboveNoise = 2.5;  // grey levels of estimated noise
-constexpr size_t kMaxRetries = 12;          // near-miss components re-binarised per frame
-constexpr int kMaxRetrySide = 160;          // px; larger borders are not thinned by blur
-constexpr int kRetryMargin = 14;             // px around a near miss
-constexpr int kRetrySplit = 9;              // sixteenths: a darker split than the usual 7
+constexpr size_t kMaxRetries = 12;         // near-miss components re-binarised per frame
+constexpr int kMaxRetrySide = 160;         // px; larger borders are not thinned by blur
+constexpr int kRetryMargin = 14;           // px around a near miss
+constexpr int kRetrySplit = 9;             // sixteenths: a darker split than the usual 7
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
@@ -54,9 +54,13 @@ float quadArea(const SquareCorners& q) {
   return std::abs(area) * 0.5f;
 }
 
-cv::Point2f centre(const SquareCorners& q) { return (q[0] + q[1] + q[2] + q[3]) * 0.25f; }
+cv::Point2f centre(const SquareCorners& q) {
+  return (q[0] + q[1] + q[2] + q[3]) * 0.25f;
+}
 
-cv::Point2f toFloat(cv::Point2d p) { return {static_cast<float>(p.x), static_cast<float>(p.y)}; }
+cv::Point2f toFloat(cv::Point2d p) {
+  return {static_cast<float>(p.x), static_cast<float>(p.y)};
+}
 
 void validate(const DetectorConfig& config) {
   if (isSquareKind(config.kind) && !(config.border > 0.0 && config.border <= 0.4)) {
@@ -102,7 +106,7 @@ struct MarkerDetector::Impl {
   explicit Impl(DetectorConfig c) : config(std::move(c)) {
     validate(config);
     if (config.kind == MarkerKind::Aruco || config.kind == MarkerKind::AprilTag) {
-      const std::string name = !config.dictionary.empty() ? config.dictionary
+      const std::string name = !config.dictionary.empty()         ? config.dictionary
                                : config.kind == MarkerKind::Aruco ? "DICT_6X6_250"
                                                                   : "DICT_APRILTAG_36h11";
       dictionary = dictionaryId(name);
@@ -130,8 +134,9 @@ struct MarkerDetector::Impl {
       result.threshold = tiles.median();
       result.threshold_mode = "adaptive (contrast >= " + std::to_string(contrast) + ")";
     } else {
-      const auto& vignetting =
-          config.threshold.mode == ThresholdMode::Adaptive ? std::nullopt : config.threshold.vignetting;
+      const auto& vignetting = config.threshold.mode == ThresholdMode::Adaptive
+                                   ? std::nullopt
+                                   : config.threshold.vignetting;
       fillGlobalThresholds(gray.size(), global, vignetting, tiles);
       result.threshold = global;
       result.threshold_mode = toString(config.threshold.mode) + (vignetting ? " + vignetting" : "");
@@ -164,7 +169,8 @@ struct MarkerDetector::Impl {
       const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *binarised, params);
       if (fit.quad) {
         quads.push_back(*fit.quad);
-      } else if (adaptive_mode && std::min(w, h) >= min_side * 0.5f && std::max(w, h) <= kMaxRetrySide) {
+      } else if (adaptive_mode && std::min(w, h) >= min_side * 0.5f &&
+                 std::max(w, h) <= kMaxRetrySide) {
         if (fit.hull_is_quadrilateral) near_misses.emplace_back(c.min_x, c.min_y, w, h);
       }
     }
@@ -195,7 +201,8 @@ struct MarkerDetector::Impl {
   }
 
   // Binarises `roi` of `source` with edge tiles split at `split` sixteenths; adds the new quads.
-  bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split, const QuadFitParams& frame_params) {
+  bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split,
+                   const QuadFitParams& frame_params) {
     QuadFitParams params = frame_params;
     params.lens = nullptr;  // region coordinates; ideal corners are computed below
     const cv::Mat patch = source(roi);
@@ -208,14 +215,16 @@ struct MarkerDetector::Impl {
           std::min(w, h) < params.min_side * 0.5f) {
         continue;
       }
-      if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour)) continue;
+      if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour))
+        continue;
       auto quad = fitQuad(contour, {c.first_x, c.first_y}, patch, params).quad;
       if (!quad) continue;
       const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
       for (cv::Point2f& p : quad->corners) p += offset;
       // The region's ideal corners were computed as if it were the whole image: redo them.
       for (int k = 0; k < 4; ++k) {
-        quad->ideal_corners[k] = config.lens ? toFloat(config.lens->undistort(quad->corners[k])) : quad->corners[k];
+        quad->ideal_corners[k] =
+            config.lens ? toFloat(config.lens->undistort(quad->corners[k])) : quad->corners[k];
       }
       bool known = false;  // already found, from the frame or an earlier retry
       for (size_t q = 0; q < quads.size() && !known; ++q) {
@@ -242,9 +251,9 @@ struct MarkerDetector::Impl {
       MarkerDetection marker;
       marker.kind = config.kind;
       if (config.kind == MarkerKind::Template) {
-        const auto match = matchTemplate(
-            sampleCodeArea(gray, quad, config.border, TemplatePattern::kSize), config.templates,
-            config.template_limits);
+        const auto match =
+            matchTemplate(sampleCodeArea(gray, quad, config.border, TemplatePattern::kSize),
+                          config.templates, config.template_limits);
         if (!match) continue;
         marker.id = match->id;
         marker.orientation = match->orientation;
@@ -312,7 +321,8 @@ struct MarkerDetector::Impl {
       if (!automatic) break;
       // ARToolKitPlus: midrange of all candidates' code samples; the original system: the median
       // of the last seen marker's pixels. While nothing is found, a random threshold.
-      const bool found = mode == ThresholdMode::AutoMidrange ? !quads.empty() : !result.markers.empty();
+      const bool found =
+          mode == ThresholdMode::AutoMidrange ? !quads.empty() : !result.markers.empty();
       if (found) {
         threshold = mode == ThresholdMode::AutoMidrange
                         ? static_cast<int>(std::lround((lowest + highest) * 0.5f))
@@ -341,8 +351,9 @@ struct MarkerDetector::Impl {
     ideal_squares.clear();
     if (!gray.empty() && config.lens && gray.size() != config.lens->camera().image_size) {
       const cv::Size lens = config.lens->camera().image_size;
-      throw std::invalid_argument("frames are " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
-                                  " but the lens model (" + config.lens->camera().source + ") is for " +
+      throw std::invalid_argument("frames are " + std::to_string(gray.cols) + "x" +
+                                  std::to_string(gray.rows) + " but the lens model (" +
+                                  config.lens->camera().source + ") is for " +
                                   std::to_string(lens.width) + "x" + std::to_string(lens.height) +
                                   "; scale the camera model to the frame size");
     }
@@ -354,7 +365,8 @@ struct MarkerDetector::Impl {
       result.markers = detectDictionaryMarkers(gray, dictionary, config.kind);
       for (MarkerDetection& m : result.markers) {
         for (int k = 0; k < 4; ++k) {
-          m.ideal_corners[k] = config.lens ? toFloat(config.lens->undistort(m.corners[k])) : m.corners[k];
+          m.ideal_corners[k] =
+              config.lens ? toFloat(config.lens->undistort(m.corners[k])) : m.corners[k];
         }
       }
       time.decode = microseconds(decode_start, Clock::now());
@@ -368,7 +380,8 @@ struct MarkerDetector::Impl {
   }
 };
 
-MarkerDetector::MarkerDetector(DetectorConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
+MarkerDetector::MarkerDetector(DetectorConfig config)
+    : impl_(std::make_unique<Impl>(std::move(config))) {}
 MarkerDetector::~MarkerDetector() = default;
 MarkerDetector::MarkerDetector(MarkerDetector&&) noexcept = default;
 MarkerDetector& MarkerDetector::operator=(MarkerDetector&&) noexcept = default;
@@ -379,7 +392,8 @@ DetectionResult MarkerDetector::detect(const cv::Mat& image) {
     impl_->gray = image;  // a view; never written
   } else if (impl_->dictionary >= 0 && (image.type() == CV_8UC3 || image.type() == CV_8UC4)) {
     // OpenCV's dictionaries are tuned on its own (BT.601) grey.
-    cv::cvtColor(image, impl_->converted, image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+    cv::cvtColor(image, impl_->converted,
+                 image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
     impl_->gray = impl_->converted;
   } else {
     toLuminance(image, impl_->converted);
@@ -403,7 +417,9 @@ DetectionResult MarkerDetector::detect(const ImageView& image) {
   return result;
 }
 
-const DetectorConfig& MarkerDetector::config() const { return impl_->config; }
+const DetectorConfig& MarkerDetector::config() const {
+  return impl_->config;
+}
 
 void MarkerDetector::setThreshold(const ThresholdSettings& settings) {
   DetectorConfig changed = impl_->config;
@@ -413,15 +429,22 @@ void MarkerDetector::setThreshold(const ThresholdSettings& settings) {
   impl_->resetThreshold();
 }
 
-int MarkerDetector::currentThreshold() const { return impl_->threshold; }
+int MarkerDetector::currentThreshold() const {
+  return impl_->threshold;
+}
 
-const std::vector<SquareCorners>& MarkerDetector::lastSquares() const { return impl_->squares; }
-const std::vector<SquareCorners>& MarkerDetector::lastIdealSquares() const { return impl_->ideal_squares; }
+const std::vector<SquareCorners>& MarkerDetector::lastSquares() const {
+  return impl_->squares;
+}
+const std::vector<SquareCorners>& MarkerDetector::lastIdealSquares() const {
+  return impl_->ideal_squares;
+}
 
 cv::Mat MarkerDetector::lastBinaryImage() const {
   const cv::Mat& gray = impl_->gray;
   cv::Mat binary(gray.rows, gray.cols, CV_8UC1, cv::Scalar(0));
-  if (impl_->dictionary >= 0 || gray.empty() || impl_->labels.maskStride() != gray.cols + 2) return binary;
+  if (impl_->dictionary >= 0 || gray.empty() || impl_->labels.maskStride() != gray.cols + 2)
+    return binary;
   for (int y = 0; y < gray.rows; ++y) {
     std::uint8_t* row = binary.ptr<std::uint8_t>(y);
     for (int x = 0; x < gray.cols; ++x) row[x] = impl_->labels.dark(x, y) ? 255 : 0;
@@ -429,6 +452,8 @@ cv::Mat MarkerDetector::lastBinaryImage() const {
   return binary;
 }
 
-const cv::Mat& MarkerDetector::lastGrayImage() const { return impl_->gray; }
+const cv::Mat& MarkerDetector::lastGrayImage() const {
+  return impl_->gray;
+}
 
 }  // namespace arbci::vision

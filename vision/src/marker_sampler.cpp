@@ -63,7 +63,8 @@ float sampleArea(const BilinearSampler& sample, const SquareToQuad& map, double 
 // the map's vanishing line stays outside it), plus a pixel for interpolation; an empty rectangle
 // (so every sample is clamped) when the map degenerates there.
 cv::Rect2f regionOf(const SquareToQuad& map, double low, double high) {
-  const std::array<cv::Point2f, 4> corners{map(low, low), map(high, low), map(high, high), map(low, high)};
+  const std::array<cv::Point2f, 4> corners{map(low, low), map(high, low), map(high, high),
+                                           map(low, high)};
   if (!map.finiteOn(low, high)) return {-1.0f, -1.0f, 0.0f, 0.0f};
   return boundsOf(corners, 1.0f);
 }
@@ -105,7 +106,8 @@ bool SquareToQuad::finiteOn(double low, double high) const {
 
 cv::Point2f SquareToQuad::operator()(double u, double v) const {
   const double w = g_ * u + h_ * v + 1.0;
-  return {static_cast<float>((a_ * u + b_ * v + c_) / w), static_cast<float>((d_ * u + e_ * v + f_) / w)};
+  return {static_cast<float>((a_ * u + b_ * v + c_) / w),
+          static_cast<float>((d_ * u + e_ * v + f_) / w)};
 }
 
 MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border) {
@@ -134,7 +136,8 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
         black[2 * (4 * k + s) + depth] = {along[s][0], along[s][1], b};
       }
     }
-    const double out[4][2] = {{t, outside}, {1.0 - outside, t}, {1.0 - t, 1.0 - outside}, {outside, 1.0 - t}};
+    const double out[4][2] = {
+        {t, outside}, {1.0 - outside, t}, {1.0 - t, 1.0 - outside}, {outside, 1.0 - t}};
     for (int s = 0; s < 4; ++s) {
       ring_samples[ring] = 0.5f * static_cast<float>(black[2 * ring].z + black[2 * ring + 1].z);
       const cv::Point2f w = map(out[s][0], out[s][1]);
@@ -153,7 +156,8 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
       const double u = border + cell * (c + 0.5), v = border + cell * (r + 0.5);
       const float value = sampleArea(sample, map, u, v, spread);
       out.cells[r * 6 + c] = value;
-      out.thresholds[r * 6 + c] = static_cast<float>(0.5 * (black_level.at(u, v) + white_level.at(u, v)));
+      out.thresholds[r * 6 + c] =
+          static_cast<float>(0.5 * (black_level.at(u, v) + white_level.at(u, v)));
       out.lowest = std::min(out.lowest, value);
       out.highest = std::max(out.highest, value);
     }
@@ -179,8 +183,8 @@ std::vector<float> sampleCodeArea(const cv::Mat& image, const Quad& quad, double
   std::vector<float> values(static_cast<size_t>(n) * n);
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) {
-      values[r * n + c] = sampleArea(sample, map, border + cell * (c + 0.5), border + cell * (r + 0.5),
-                                     cell * 0.25);
+      values[r * n + c] = sampleArea(sample, map, border + cell * (c + 0.5),
+                                     border + cell * (r + 0.5), cell * 0.25);
     }
   }
   return values;

@@ -31,8 +31,8 @@ struct MarkerSamples {
   std::array<float, 36> thresholds{};  // the black/white midpoint at each cell
   float contrast = 0;                  // white minus black level at the marker's centre
   int border_samples = 0;
-  int border_light = 0;                // border samples lighter than their local threshold
-  float lowest = 0, highest = 0;       // extremes of the code cells
+  int border_light = 0;           // border samples lighter than their local threshold
+  float lowest = 0, highest = 0;  // extremes of the code cells
   // Median of the marker's pixels: of its black border and white surround samples, equally many.
   float median = 0;
 };

@@ -50,10 +50,13 @@ MarkerSet MarkerSet::loadArToolKitConfig(const std::filesystem::path& path, doub
     double t[3][4];
     for (int r = 0; r < 3; ++r) {
       std::istringstream row;
-      if (!nextLine(in, line)) throw CalibrationFileError(where + "expected 3 rows of the 3x4 transform");
+      if (!nextLine(in, line))
+        throw CalibrationFileError(where + "expected 3 rows of the 3x4 transform");
       row.str(line);
       for (int c = 0; c < 4; ++c) {
-        if (!(row >> t[r][c])) throw CalibrationFileError(where + "transform row " + std::to_string(r + 1) + " needs 4 numbers");
+        if (!(row >> t[r][c]))
+          throw CalibrationFileError(where + "transform row " + std::to_string(r + 1) +
+                                     " needs 4 numbers");
       }
     }
     placement.size_m = width * unit_m;
@@ -62,7 +65,8 @@ MarkerSet MarkerSet::loadArToolKitConfig(const std::filesystem::path& path, doub
       placement.T_set_marker.translation[r] = t[r][3] * unit_m;
     }
     // ARToolKit places the corners at centre +- width / 2 in the marker's own frame.
-    placement.T_set_marker.translation += placement.T_set_marker.rotation * cv::Vec3d(centre_x * unit_m, centre_y * unit_m, 0.0);
+    placement.T_set_marker.translation +=
+        placement.T_set_marker.rotation * cv::Vec3d(centre_x * unit_m, centre_y * unit_m, 0.0);
     markers.push_back(placement);
   }
   return MarkerSet(std::move(markers));
@@ -93,8 +97,10 @@ bool MarkerSet::planar() const {
   return true;
 }
 
-std::optional<SetPose> estimateSetPose(const MarkerSet& set, const std::vector<MarkerDetection>& detections,
-                                       const cv::Matx33d& camera_matrix, const PoseOptions& options) {
+std::optional<SetPose> estimateSetPose(const MarkerSet& set,
+                                       const std::vector<MarkerDetection>& detections,
+                                       const cv::Matx33d& camera_matrix,
+                                       const PoseOptions& options) {
   std::map<int, int> seen;
   for (const MarkerDetection& d : detections) ++seen[d.id];
   std::vector<cv::Point3d> object;

@@ -8,7 +8,9 @@
 namespace arbci::vision {
 namespace {
 
-cv::Point2f centre(const std::array<cv::Point2f, 4>& q) { return (q[0] + q[1] + q[2] + q[3]) * 0.25f; }
+cv::Point2f centre(const std::array<cv::Point2f, 4>& q) {
+  return (q[0] + q[1] + q[2] + q[3]) * 0.25f;
+}
 
 float area(const std::array<cv::Point2f, 4>& q) {
   float a = 0.0f;
@@ -28,7 +30,8 @@ bool sameSquare(const std::array<cv::Point2f, 4>& a, const std::array<cv::Point2
 }
 
 // The square's corners in the rotation that best matches the previous printed-corner order.
-std::array<cv::Point2f, 4> alignCorners(const SquareCorners& square, const std::array<cv::Point2f, 4>& previous) {
+std::array<cv::Point2f, 4> alignCorners(const SquareCorners& square,
+                                        const std::array<cv::Point2f, 4>& previous) {
   int best = 0;
   float best_distance = std::numeric_limits<float>::max();
   for (int shift = 0; shift < 4; ++shift) {
@@ -79,15 +82,17 @@ void MarkerTracker::smooth(Track& track, MarkerDetection& marker, double dt) {
   if (!options_.smooth_corners) return;
   for (int k = 0; k < 4; ++k) {
     const cv::Point2f before = marker.corners[k];
-    marker.corners[k].x = static_cast<float>(track.filters[2 * k].filter(marker.corners[k].x, dt, options_));
-    marker.corners[k].y = static_cast<float>(track.filters[2 * k + 1].filter(marker.corners[k].y, dt, options_));
+    marker.corners[k].x =
+        static_cast<float>(track.filters[2 * k].filter(marker.corners[k].x, dt, options_));
+    marker.corners[k].y =
+        static_cast<float>(track.filters[2 * k + 1].filter(marker.corners[k].y, dt, options_));
     marker.ideal_corners[k] += marker.corners[k] - before;  // the same correction, locally
   }
 }
 
-std::vector<MarkerDetection> MarkerTracker::update(const std::vector<MarkerDetection>& detections,
-                                                   const std::vector<SquareCorners>& squares, double time_s,
-                                                   const std::vector<SquareCorners>* ideal_squares) {
+std::vector<MarkerDetection> MarkerTracker::update(
+    const std::vector<MarkerDetection>& detections, const std::vector<SquareCorners>& squares,
+    double time_s, const std::vector<SquareCorners>* ideal_squares) {
   ++frame_;
   const double dt = frame_ > 1 ? time_s - last_time_ : 0.0;
   last_time_ = time_s;
@@ -162,7 +167,8 @@ std::vector<MarkerDetection> MarkerTracker::update(const std::vector<MarkerDetec
       if (ideal_squares && s < ideal_squares->size()) {
         for (int shift = 0; shift < 4; ++shift) {
           if (square[shift] == marker.corners[0]) {
-            for (int k = 0; k < 4; ++k) marker.ideal_corners[k] = (*ideal_squares)[s][(k + shift) % 4];
+            for (int k = 0; k < 4; ++k)
+              marker.ideal_corners[k] = (*ideal_squares)[s][(k + shift) % 4];
           }
         }
       }
@@ -175,7 +181,8 @@ std::vector<MarkerDetection> MarkerTracker::update(const std::vector<MarkerDetec
       break;
     }
   }
-  std::erase_if(tracks_, [&](const Track& t) { return frame_ - t.last_frame > options_.keep_frames; });
+  std::erase_if(tracks_,
+                [&](const Track& t) { return frame_ - t.last_frame > options_.keep_frames; });
   return out;
 }
 

@@ -8,11 +8,16 @@ namespace arbci::vision {
 
 std::string toString(MarkerKind kind) {
   switch (kind) {
-    case MarkerKind::Bch: return "bch";
-    case MarkerKind::Simple: return "simple";
-    case MarkerKind::Template: return "template";
-    case MarkerKind::Aruco: return "aruco";
-    case MarkerKind::AprilTag: return "apriltag";
+    case MarkerKind::Bch:
+      return "bch";
+    case MarkerKind::Simple:
+      return "simple";
+    case MarkerKind::Template:
+      return "template";
+    case MarkerKind::Aruco:
+      return "aruco";
+    case MarkerKind::AprilTag:
+      return "apriltag";
   }
   return "unknown";
 }
@@ -28,10 +33,14 @@ MarkerKind markerKindFromString(const std::string& text) {
 
 std::string toString(ThresholdMode mode) {
   switch (mode) {
-    case ThresholdMode::Constant: return "constant";
-    case ThresholdMode::AutoMedian: return "auto-median";
-    case ThresholdMode::AutoMidrange: return "auto-midrange";
-    case ThresholdMode::Adaptive: return "adaptive";
+    case ThresholdMode::Constant:
+      return "constant";
+    case ThresholdMode::AutoMedian:
+      return "auto-median";
+    case ThresholdMode::AutoMidrange:
+      return "auto-midrange";
+    case ThresholdMode::Adaptive:
+      return "adaptive";
   }
   return "unknown";
 }

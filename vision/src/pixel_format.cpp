@@ -11,28 +11,43 @@ struct Channels {
 
 Channels channelsOf(PixelFormat format) {
   switch (format) {
-    case PixelFormat::Rgb: return {0, 1, 2};
-    case PixelFormat::Bgr: return {2, 1, 0};
-    case PixelFormat::Rgba: return {0, 1, 2};
-    case PixelFormat::Bgra: return {2, 1, 0};
-    case PixelFormat::Abgr: return {3, 2, 1};
-    default: return {0, 0, 0};
+    case PixelFormat::Rgb:
+      return {0, 1, 2};
+    case PixelFormat::Bgr:
+      return {2, 1, 0};
+    case PixelFormat::Rgba:
+      return {0, 1, 2};
+    case PixelFormat::Bgra:
+      return {2, 1, 0};
+    case PixelFormat::Abgr:
+      return {3, 2, 1};
+    default:
+      return {0, 0, 0};
   }
 }
 
-inline std::uint8_t luma(int r, int g, int b) { return static_cast<std::uint8_t>((r + 2 * g + b) >> 2); }
+inline std::uint8_t luma(int r, int g, int b) {
+  return static_cast<std::uint8_t>((r + 2 * g + b) >> 2);
+}
 
 }  // namespace
 
 std::string toString(PixelFormat format) {
   switch (format) {
-    case PixelFormat::Gray: return "gray";
-    case PixelFormat::Rgb: return "rgb";
-    case PixelFormat::Bgr: return "bgr";
-    case PixelFormat::Rgba: return "rgba";
-    case PixelFormat::Bgra: return "bgra";
-    case PixelFormat::Abgr: return "abgr";
-    case PixelFormat::Rgb565: return "rgb565";
+    case PixelFormat::Gray:
+      return "gray";
+    case PixelFormat::Rgb:
+      return "rgb";
+    case PixelFormat::Bgr:
+      return "bgr";
+    case PixelFormat::Rgba:
+      return "rgba";
+    case PixelFormat::Bgra:
+      return "bgra";
+    case PixelFormat::Abgr:
+      return "abgr";
+    case PixelFormat::Rgb565:
+      return "rgb565";
   }
   return "unknown";
 }
@@ -48,11 +63,15 @@ PixelFormat pixelFormatFromString(const std::string& text) {
 
 int bytesPerPixel(PixelFormat format) {
   switch (format) {
-    case PixelFormat::Gray: return 1;
-    case PixelFormat::Rgb565: return 2;
+    case PixelFormat::Gray:
+      return 1;
+    case PixelFormat::Rgb565:
+      return 2;
     case PixelFormat::Rgb:
-    case PixelFormat::Bgr: return 3;
-    default: return 4;
+    case PixelFormat::Bgr:
+      return 3;
+    default:
+      return 4;
   }
 }
 
@@ -105,10 +124,17 @@ void toLuminance(const cv::Mat& image, cv::Mat& gray) {
   if (image.depth() != CV_8U) throw std::invalid_argument("image must have 8-bit channels");
   PixelFormat format;
   switch (image.channels()) {
-    case 1: format = PixelFormat::Gray; break;
-    case 3: format = PixelFormat::Bgr; break;
-    case 4: format = PixelFormat::Bgra; break;
-    default: throw std::invalid_argument("image must have 1, 3 or 4 channels");
+    case 1:
+      format = PixelFormat::Gray;
+      break;
+    case 3:
+      format = PixelFormat::Bgr;
+      break;
+    case 4:
+      format = PixelFormat::Bgra;
+      break;
+    default:
+      throw std::invalid_argument("image must have 1, 3 or 4 channels");
   }
   if (format == PixelFormat::Gray) {
     gray = image;  // shares the pixels: no conversion needed

@@ -38,9 +38,12 @@ double rotationAngleDeg(const cv::Matx33d& a, const cv::Matx33d& b) {
 
 std::string toString(PoseMethod method) {
   switch (method) {
-    case PoseMethod::Rpp: return "rpp";
-    case PoseMethod::Ippe: return "ippe";
-    case PoseMethod::Iterative: return "iterative";
+    case PoseMethod::Rpp:
+      return "rpp";
+    case PoseMethod::Ippe:
+      return "ippe";
+    case PoseMethod::Iterative:
+      return "iterative";
   }
   return "?";
 }

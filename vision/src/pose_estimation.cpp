@@ -33,12 +33,14 @@ bool planar(std::span<const cv::Point3d> object) {
   return true;
 }
 
-std::vector<Candidate> solve(std::span<const cv::Point3d> object, std::span<const cv::Point2d> image,
-                             const cv::Matx33d& k, PoseMethod method) {
+std::vector<Candidate> solve(std::span<const cv::Point3d> object,
+                             std::span<const cv::Point2d> image, const cv::Matx33d& k,
+                             PoseMethod method) {
   std::vector<Candidate> candidates;
   if (method == PoseMethod::Rpp) {
     std::vector<cv::Point2d> rays;
-    for (const cv::Point2d& p : image) rays.emplace_back((p.x - k(0, 2)) / k(0, 0), (p.y - k(1, 2)) / k(1, 1));
+    for (const cv::Point2d& p : image)
+      rays.emplace_back((p.x - k(0, 2)) / k(0, 0), (p.y - k(1, 2)) / k(1, 1));
     for (const RppSolution& s : robustPlanarPose(object, rays)) {
       candidates.push_back({{s.rotation, s.translation}, 0.0, s.object_space_error});
     }
@@ -58,7 +60,8 @@ std::vector<Candidate> solve(std::span<const cv::Point3d> object, std::span<cons
   const int flag = method == PoseMethod::Iterative ? cv::SOLVEPNP_ITERATIVE
                    : square                        ? cv::SOLVEPNP_IPPE_SQUARE
                                                    : cv::SOLVEPNP_IPPE;
-  cv::solvePnPGeneric(o, i, k, cv::noArray(), rvecs, tvecs, false, static_cast<cv::SolvePnPMethod>(flag));
+  cv::solvePnPGeneric(o, i, k, cv::noArray(), rvecs, tvecs, false,
+                      static_cast<cv::SolvePnPMethod>(flag));
   for (size_t s = 0; s < rvecs.size(); ++s) {
     const Pose pose = Pose::fromRotationVector(cv::Vec3d(rvecs[s]), cv::Vec3d(tvecs[s]));
     if (pose.translation[2] > 0.0) candidates.push_back({pose, 0.0, 0.0});
@@ -70,7 +73,8 @@ std::vector<Candidate> solve(std::span<const cv::Point3d> object, std::span<cons
 
 std::array<cv::Point3d, 4> markerCorners(double side_m) {
   const double h = side_m / 2.0;
-  return {cv::Point3d(-h, h, 0), cv::Point3d(h, h, 0), cv::Point3d(h, -h, 0), cv::Point3d(-h, -h, 0)};
+  return {cv::Point3d(-h, h, 0), cv::Point3d(h, h, 0), cv::Point3d(h, -h, 0),
+          cv::Point3d(-h, -h, 0)};
 }
 
 cv::Point2d project(const Pose& pose, const cv::Matx33d& k, const cv::Point3d& object) {
@@ -80,7 +84,8 @@ cv::Point2d project(const Pose& pose, const cv::Matx33d& k, const cv::Point3d& o
 
 PoseEstimate estimatePose(std::span<const cv::Point3d> object, std::span<const cv::Point2d> image,
                           const cv::Matx33d& k, const PoseOptions& options) {
-  if (object.size() != image.size()) throw std::invalid_argument("pose: object and image points differ in number");
+  if (object.size() != image.size())
+    throw std::invalid_argument("pose: object and image points differ in number");
   if (object.size() < 4) throw std::invalid_argument("pose: at least 4 points are needed");
   PoseMethod method = options.method;
   if (method != PoseMethod::Iterative && !planar(object)) method = PoseMethod::Iterative;
@@ -103,7 +108,8 @@ PoseEstimate estimatePose(std::span<const cv::Point3d> object, std::span<const c
   estimate.pose = candidates[0].pose;
   estimate.reprojection_rms_px = candidates[0].rms_px;
   estimate.object_space_error = candidates[0].object_space_error;
-  if (candidates.size() > 1 && rotationAngleDeg(candidates[1].pose.rotation, candidates[0].pose.rotation) > 0.5) {
+  if (candidates.size() > 1 &&
+      rotationAngleDeg(candidates[1].pose.rotation, candidates[0].pose.rotation) > 0.5) {
     estimate.alternative = candidates[1].pose;
     estimate.alternative_rms_px = candidates[1].rms_px;
   }

@@ -11,7 +11,8 @@ namespace {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-double cost(const Pose& pose, const cv::Matx33d& k, std::span<const cv::Point3d> object, std::span<const cv::Point2d> image) {
+double cost(const Pose& pose, const cv::Matx33d& k, std::span<const cv::Point3d> object,
+            std::span<const cv::Point2d> image) {
   double sum = 0.0;
   for (size_t i = 0; i < object.size(); ++i) {
     const cv::Point2d d = project(pose, k, object[i]) - image[i];
@@ -22,8 +23,8 @@ double cost(const Pose& pose, const cv::Matx33d& k, std::span<const cv::Point3d>
 
 }  // namespace
 
-Pose refineReprojection(const Pose& start, const cv::Matx33d& k, std::span<const cv::Point3d> object,
-                        std::span<const cv::Point2d> image) {
+Pose refineReprojection(const Pose& start, const cv::Matx33d& k,
+                        std::span<const cv::Point3d> object, std::span<const cv::Point2d> image) {
   Pose pose = start;
   double current = cost(pose, k, object, image);
   double lambda = 1e-3;
@@ -39,8 +40,8 @@ Pose refineReprojection(const Pose& start, const cv::Matx33d& k, std::span<const
       const double v = k(1, 1) * c[1] * z_inv + k(1, 2);
       // d(u, v) / d(point in camera frame)
       Eigen::Matrix<double, 2, 3> dp;
-      dp << k(0, 0) * z_inv, k(0, 1) * z_inv, -(k(0, 0) * c[0] + k(0, 1) * c[1]) * z_inv * z_inv, 0.0,
-          k(1, 1) * z_inv, -k(1, 1) * c[1] * z_inv * z_inv;
+      dp << k(0, 0) * z_inv, k(0, 1) * z_inv, -(k(0, 0) * c[0] + k(0, 1) * c[1]) * z_inv * z_inv,
+          0.0, k(1, 1) * z_inv, -k(1, 1) * c[1] * z_inv * z_inv;
       // d(point) / d(rotation increment w) = -[R p]x; d(point) / d(t) = I.
       Eigen::Matrix3d skew;
       skew << 0, rotated[2], -rotated[1], -rotated[2], 0, rotated[0], rotated[1], -rotated[0], 0;
@@ -58,7 +59,8 @@ Pose refineReprojection(const Pose& start, const cv::Matx33d& k, std::span<const
       const Vector6d step = damped.ldlt().solve(-gradient);
       cv::Matx33d increment;
       cv::Rodrigues(cv::Vec3d(step(0), step(1), step(2)), increment);
-      const Pose candidate{increment * pose.rotation, pose.translation + cv::Vec3d(step(3), step(4), step(5))};
+      const Pose candidate{increment * pose.rotation,
+                           pose.translation + cv::Vec3d(step(3), step(4), step(5))};
       const double candidate_cost = cost(candidate, k, object, image);
       if (candidate_cost < current) {
         improved = true;

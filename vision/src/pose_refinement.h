@@ -9,7 +9,7 @@
 
 namespace arbci::vision {
 
-Pose refineReprojection(const Pose& start, const cv::Matx33d& camera_matrix, std::span<const cv::Point3d> object,
-                        std::span<const cv::Point2d> image);
+Pose refineReprojection(const Pose& start, const cv::Matx33d& camera_matrix,
+                        std::span<const cv::Point3d> object, std::span<const cv::Point2d> image);
 
 }  // namespace arbci::vision

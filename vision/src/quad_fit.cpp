@@ -32,7 +32,9 @@ struct Line {
   cv::Point2f direction;  // unit length
 };
 
-float length(cv::Point2f v) { return std::sqrt(v.dot(v)); }
+float length(cv::Point2f v) {
+  return std::sqrt(v.dot(v));
+}
 
 // Index of the contour point in the forward arc (from, to) farthest from the chord from-to.
 int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, float& distance) {
@@ -48,7 +50,8 @@ int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, f
     const cv::Point p = contour[i] - a;
     const std::int64_t measure =
         point_chord ? static_cast<std::int64_t>(p.x) * p.x + static_cast<std::int64_t>(p.y) * p.y
-                    : std::abs(static_cast<std::int64_t>(chord.x) * p.y - static_cast<std::int64_t>(chord.y) * p.x);
+                    : std::abs(static_cast<std::int64_t>(chord.x) * p.y -
+                               static_cast<std::int64_t>(chord.y) * p.x);
     if (measure > best_measure) {
       best_measure = measure;
       best = i;
@@ -85,7 +88,8 @@ std::array<int, 4> largestQuadrilateral(const std::vector<cv::Point>& contour,
     const cv::Point p[4] = {contour[a], contour[b], contour[c], contour[d]};
     double area = 0.0;
     for (int k = 0; k < 4; ++k) {
-      area += static_cast<double>(p[k].x) * p[(k + 1) % 4].y - static_cast<double>(p[(k + 1) % 4].x) * p[k].y;
+      area += static_cast<double>(p[k].x) * p[(k + 1) % 4].y -
+              static_cast<double>(p[(k + 1) % 4].x) * p[k].y;
     }
     return std::abs(area);
   };
@@ -130,8 +134,8 @@ std::vector<float>& scratchWeights() {
 
 // Appends, in contour order, the vertices of the forward arc (from, to) found by recursive
 // splitting; false once more than `limit` vertices are found (not a quadrilateral).
-bool splitArc(const std::vector<cv::Point>& contour, int from, int to, float tolerance, size_t limit,
-              std::vector<int>& vertices) {
+bool splitArc(const std::vector<cv::Point>& contour, int from, int to, float tolerance,
+              size_t limit, std::vector<int>& vertices) {
   float distance = 0.0f;
   const int split = farthestFromChord(contour, from, to, distance);
   if (split < 0 || distance <= tolerance) return true;
@@ -160,8 +164,9 @@ std::optional<Line> fitLine(const cv::Point2f* points, const float* weights, int
   }
   // Principal axis of the 2x2 scatter matrix.
   const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
-  return Line{cv::Point2f(static_cast<float>(mx), static_cast<float>(my)),
-              cv::Point2f(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)))};
+  return Line{
+      cv::Point2f(static_cast<float>(mx), static_cast<float>(my)),
+      cv::Point2f(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)))};
 }
 
 std::optional<cv::Point2f> intersect(const Line& a, const Line& b) {
@@ -178,8 +183,8 @@ std::optional<cv::Point2f> intersect(const Line& a, const Line& b) {
 // rise.
 // `a` and `b` are ideal coordinates; profiles are sampled in the image across the side as the lens
 // bends it, and the edge points are fitted in ideal coordinates.
-std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& lens, cv::Point2f a, cv::Point2f b,
-                               int radius) {
+std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& lens, cv::Point2f a,
+                               cv::Point2f b, int radius) {
   constexpr int kMaxSamples = 20, kMaxRadius = 4;
   const cv::Point2f d = b - a;
   const float length = std::sqrt(d.dot(d));
@@ -195,12 +200,14 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
   float profile[2 * kMaxRadius + 3], rise[2 * kMaxRadius + 1];
   for (int s = 0; s < samples; ++s) {
     // Stay clear of the corners, where the profile would cross the neighbouring side.
-    const float t = end + (1.0f - 2.0f * end) * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
+    const float t =
+        end + (1.0f - 2.0f * end) * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
     const cv::Point2f ideal_base = a + t * d;
     const cv::Point2f base = lens.toImage(ideal_base);
     cv::Point2f outward = ideal_outward;
     if (lens.lens) {
-      outward = lens.toImage(ideal_base + 0.5f * ideal_outward) - lens.toImage(ideal_base - 0.5f * ideal_outward);
+      outward = lens.toImage(ideal_base + 0.5f * ideal_outward) -
+                lens.toImage(ideal_base - 0.5f * ideal_outward);
       outward /= std::max(1e-6f, std::sqrt(outward.dot(outward)));
     }
     for (int k = -radius - 1; k <= radius + 1; ++k) {
@@ -228,7 +235,8 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
     float offset = static_cast<float>(best);
     for (int k = -radius - 1; k <= radius; ++k) {
       const float a = profile[k + radius + 1], b = profile[k + radius + 2];
-      if (a <= middle && b > middle && std::abs(static_cast<float>(k) + 0.5f - static_cast<float>(best)) <= 1.5f) {
+      if (a <= middle && b > middle &&
+          std::abs(static_cast<float>(k) + 0.5f - static_cast<float>(best)) <= 1.5f) {
         offset = static_cast<float>(k) + (middle - a) / (b - a);
         break;
       }
@@ -321,7 +329,8 @@ void convexHullOfContour(const std::vector<cv::Point>& contour, std::vector<int>
   const size_t right_side = hull.size() + 1;
   for (int k = static_cast<int>(order.size()) - 2; k >= 0; --k) {
     const int i = order[k];
-    while (hull.size() >= right_side && cross(hull[hull.size() - 2], hull.back(), i) <= 0) hull.pop_back();
+    while (hull.size() >= right_side && cross(hull[hull.size() - 2], hull.back(), i) <= 0)
+      hull.pop_back();
     hull.push_back(i);
   }
   hull.pop_back();  // the first point again
@@ -368,7 +377,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   // The contour must follow the hull's sides: the vertices in contour order, and no dent deeper
   // than the tolerance (a broken border or a notch is not a square, though its hull is).
   for (int k = 0; k < 4; ++k) {
-    const int step = (vertex[(k + 1) % 4] - vertex[k] + n) % n, next = (vertex[(k + 2) % 4] - vertex[k] + n) % n;
+    const int step = (vertex[(k + 1) % 4] - vertex[k] + n) % n,
+              next = (vertex[(k + 2) % 4] - vertex[k] + n) % n;
     if (step == 0 || next <= step) return result;
   }
   const float max_deviation = std::max(2.0f, params.max_side_deviation * side_estimate);
@@ -389,9 +399,11 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     const int count = (to - from + n) % n;
     const int trim = std::max(1, count / 8);
     side_points.clear();
-    for (int j = trim; j <= count - trim; ++j) side_points.push_back(lens.toIdeal(contour[(from + j) % n]));
+    for (int j = trim; j <= count - trim; ++j)
+      side_points.push_back(lens.toIdeal(contour[(from + j) % n]));
     unit_weights.assign(side_points.size(), 1.0f);
-    const auto line = fitLine(side_points.data(), unit_weights.data(), static_cast<int>(side_points.size()));
+    const auto line =
+        fitLine(side_points.data(), unit_weights.data(), static_cast<int>(side_points.size()));
     if (!line || side_points.size() < 2) return result;
     lines[k] = *line;
   }
@@ -417,20 +429,23 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   if (params.refine_edges) {
     // The search reaches at most a tenth of the smallest side across the edge (1..3 px).
     float shortest = length(quad.corners[1] - quad.corners[0]);
-    for (int k = 1; k < 4; ++k) shortest = std::min(shortest, length(quad.corners[(k + 1) % 4] - quad.corners[k]));
+    for (int k = 1; k < 4; ++k)
+      shortest = std::min(shortest, length(quad.corners[(k + 1) % 4] - quad.corners[k]));
     const int reach = std::clamp(static_cast<int>(std::lround(0.1f * shortest)), 1, 3);
     for (int radius : {reach, std::min(reach, 2)}) {
       // Samples lie within radius + 1 px of the current sides (as the lens bends them).
       std::array<cv::Point2f, 20> outline;
       for (int k = 0; k < 4; ++k) {
         for (int j = 0; j < 5; ++j) {
-          outline[5 * k + j] = lens.toImage(quad.corners[k] + (quad.corners[(k + 1) % 4] - quad.corners[k]) * (j / 5.0f));
+          outline[5 * k + j] = lens.toImage(
+              quad.corners[k] + (quad.corners[(k + 1) % 4] - quad.corners[k]) * (j / 5.0f));
         }
       }
       const BilinearSampler sample(image, boundsOf(outline, static_cast<float>(radius + 2)));
       std::array<Line, 4> refined = lines;
       for (int k = 0; k < 4; ++k) {
-        const auto line = refineSide(sample, lens, quad.corners[k], quad.corners[(k + 1) % 4], radius);
+        const auto line =
+            refineSide(sample, lens, quad.corners[k], quad.corners[(k + 1) % 4], radius);
         if (line) refined[k] = *line;
       }
       lines = refined;

@@ -24,7 +24,7 @@ struct Quad {
 };
 
 struct QuadFitParams {
-  float min_side = 6.0f;          // px
+  float min_side = 6.0f;  // px
   // Contour points may stray this fraction of a side's length (at least 2 px) from the chord.
   float max_side_deviation = 0.08f;
   bool refine_edges = true;

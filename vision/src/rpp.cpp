@@ -121,7 +121,8 @@ Matrix3d nearestRotation(const Matrix3d& m) {
 }
 
 // A starting rotation from the plane-to-image homography (DLT on the normalised rays).
-Matrix3d homographyRotation(std::span<const cv::Point3d> object, std::span<const cv::Point2d> rays) {
+Matrix3d homographyRotation(std::span<const cv::Point3d> object,
+                            std::span<const cv::Point2d> rays) {
   const size_t n = object.size();
   Eigen::MatrixXd a(2 * n, 9);
   for (size_t i = 0; i < n; ++i) {
@@ -162,7 +163,8 @@ std::vector<double> realRoots(std::vector<double> c) {
 
 }  // namespace
 
-std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object, std::span<const cv::Point2d> rays) {
+std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object,
+                                          std::span<const cv::Point2d> rays) {
   const ObjectSpace space(object, rays);
   const RppSolution first = space.orthogonalIteration(homographyRotation(object, rays));
   Matrix3d r1;
@@ -176,7 +178,8 @@ std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object, s
   Matrix3d r_t = Matrix3d::Identity();
   const Vector3d axis = sight.cross(z);
   if (axis.norm() > 1e-12) {
-    r_t = Eigen::AngleAxisd(std::atan2(axis.norm(), sight.dot(z)), axis.normalized()).toRotationMatrix();
+    r_t = Eigen::AngleAxisd(std::atan2(axis.norm(), sight.dot(z)), axis.normalized())
+              .toRotationMatrix();
   }
   const Matrix3d aligned = r_t * r1;
   // aligned = Rz(gamma) Ry(beta) Rz(alpha).
@@ -213,7 +216,8 @@ std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object, s
   // The first solution sits at one minimum (beta0); refine only the other minima.
   const double beta0 = std::atan2(std::hypot(aligned(0, 2), aligned(1, 2)), aligned(2, 2));
   auto curvature = [&](double b) {
-    return 2.0 * (c2 - c1) * std::cos(2.0 * b) - 2.0 * c3 * std::sin(2.0 * b) - c4 * std::cos(b) - c5 * std::sin(b);
+    return 2.0 * (c2 - c1) * std::cos(2.0 * b) - 2.0 * c3 * std::sin(2.0 * b) - c4 * std::cos(b) -
+           c5 * std::sin(b);
   };
   std::vector<double> betas;
   for (double beta : stationary) {
@@ -232,8 +236,9 @@ std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object, s
     }
     if (!known) solutions.push_back(candidate);
   }
-  std::sort(solutions.begin(), solutions.end(),
-            [](const RppSolution& x, const RppSolution& y) { return x.object_space_error < y.object_space_error; });
+  std::sort(solutions.begin(), solutions.end(), [](const RppSolution& x, const RppSolution& y) {
+    return x.object_space_error < y.object_space_error;
+  });
   if (solutions.size() > 2) solutions.resize(2);
   return solutions;
 }

@@ -24,6 +24,7 @@ struct RppSolution {
 
 // `object` on the plane z = 0; `rays` are normalised image points (x, y) with z = 1.
 // Returns one or two solutions, the smaller object-space error first.
-std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object, std::span<const cv::Point2d> rays);
+std::vector<RppSolution> robustPlanarPose(std::span<const cv::Point3d> object,
+                                          std::span<const cv::Point2d> rays);
 
 }  // namespace arbci::vision

@@ -50,7 +50,7 @@ class RunLabeler {
 
   int width_ = 0, height_ = 0, stride_ = 0;
   std::vector<std::uint8_t> mask_;
-  std::vector<std::uint64_t> bits_;   // the current row's dark pixels, bit x of word x / 64
+  std::vector<std::uint64_t> bits_;  // the current row's dark pixels, bit x of word x / 64
   std::vector<PixelRun> runs_;
   std::vector<int> row_begin_;  // runs of row y are [row_begin_[y], row_begin_[y + 1])
   std::vector<int> component_of_root_;

@@ -15,8 +15,8 @@ inline std::uint8_t average(std::uint8_t a, std::uint8_t b) {
 }
 
 // out[x] = avg(avg(a[x], c[x]), b[x]) ~ (a + 2b + c) / 4 for x in [begin, end).
-void binomial(const std::uint8_t* a, const std::uint8_t* b, const std::uint8_t* c, std::uint8_t* out,
-              int begin, int end) {
+void binomial(const std::uint8_t* a, const std::uint8_t* b, const std::uint8_t* c,
+              std::uint8_t* out, int begin, int end) {
   int x = begin;
 #ifdef __SSE2__
   for (; x + 16 <= end; x += 16) {
@@ -51,7 +51,8 @@ void smoothBinomial3(const cv::Mat& src, cv::Mat& dst) {
     std::uint8_t* out = dst.ptr<std::uint8_t>(y);
     binomial(vertical - 1, vertical, vertical + 1, out, 1, width - 1);
     out[0] = average(average(vertical[0], vertical[1]), vertical[0]);
-    out[width - 1] = average(average(vertical[width - 2], vertical[width - 1]), vertical[width - 1]);
+    out[width - 1] =
+        average(average(vertical[width - 2], vertical[width - 1]), vertical[width - 1]);
   }
 }
 

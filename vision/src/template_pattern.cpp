@@ -40,7 +40,8 @@ float correlation(const std::vector<float>& a, const std::vector<float>& b) {
 
 }  // namespace
 
-TemplatePattern TemplatePattern::fromUpright(int id, std::string name, const std::vector<float>& upright) {
+TemplatePattern TemplatePattern::fromUpright(int id, std::string name,
+                                             const std::vector<float>& upright) {
   if (upright.size() != static_cast<size_t>(kN * kN)) {
     throw std::invalid_argument("a template pattern needs 16 x 16 samples");
   }
@@ -67,7 +68,8 @@ TemplatePattern TemplatePattern::load(const std::filesystem::path& path, int id)
         int value = -1;
         if (!(in >> value) || value < 0 || value > 255) {
           throw std::runtime_error(path.string() + ": expected 4 x 3 x 256 values 0..255, value " +
-                                   std::to_string(t * 768 + plane * 256 + i + 1) + " is missing or bad");
+                                   std::to_string(t * 768 + plane * 256 + i + 1) +
+                                   " is missing or bad");
         }
         grey[i] += weight * static_cast<float>(value);
       }

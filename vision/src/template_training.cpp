@@ -17,7 +17,8 @@ std::optional<TemplatePattern> trainTemplate(const cv::Mat& image, int id, doubl
     Quad quad;
     quad.corners = corners;
     const MarkerSamples samples = sampleMarker(detector.lastGrayImage(), quad, border);
-    if (samples.contrast >= 8.0f && samples.border_light * 10 <= samples.border_samples) squares.push_back(corners);
+    if (samples.contrast >= 8.0f && samples.border_light * 10 <= samples.border_samples)
+      squares.push_back(corners);
   }
   if (squares.empty()) return std::nullopt;
   auto area = [](const SquareCorners& q) {
@@ -25,8 +26,9 @@ std::optional<TemplatePattern> trainTemplate(const cv::Mat& image, int id, doubl
     for (int k = 0; k < 4; ++k) a += q[k].x * q[(k + 1) % 4].y - q[(k + 1) % 4].x * q[k].y;
     return std::abs(a);
   };
-  const SquareCorners& largest = *std::max_element(
-      squares.begin(), squares.end(), [&](const auto& a, const auto& b) { return area(a) < area(b); });
+  const SquareCorners& largest =
+      *std::max_element(squares.begin(), squares.end(),
+                        [&](const auto& a, const auto& b) { return area(a) < area(b); });
   // Upright: the corner nearest the image's top-left is the pattern's top-left.
   int top_left = 0;
   for (int k = 1; k < 4; ++k) {
@@ -34,9 +36,9 @@ std::optional<TemplatePattern> trainTemplate(const cv::Mat& image, int id, doubl
   }
   Quad quad;
   for (int k = 0; k < 4; ++k) quad.corners[k] = largest[(top_left + k) % 4];
-  return TemplatePattern::fromUpright(id, "pattern " + std::to_string(id),
-                                      sampleCodeArea(detector.lastGrayImage(), quad, border,
-                                                     TemplatePattern::kSize));
+  return TemplatePattern::fromUpright(
+      id, "pattern " + std::to_string(id),
+      sampleCodeArea(detector.lastGrayImage(), quad, border, TemplatePattern::kSize));
 }
 
 }  // namespace arbci::vision

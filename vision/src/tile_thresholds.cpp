@@ -13,7 +13,9 @@
 namespace arbci::vision {
 namespace {
 
-std::uint8_t limitOf(int threshold) { return static_cast<std::uint8_t>(std::clamp(threshold + 1, 0, 255)); }
+std::uint8_t limitOf(int threshold) {
+  return static_cast<std::uint8_t>(std::clamp(threshold + 1, 0, 255));
+}
 
 }  // namespace
 
@@ -56,18 +58,26 @@ void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restri
   int x = 0;
 #ifdef __SSE2__
   const __m128i zero = _mm_setzero_si128(), four = _mm_set1_epi16(4);
-  const __m128i wn = _mm_set1_epi16(static_cast<short>(w_near)), wf = _mm_set1_epi16(static_cast<short>(w_far));
+  const __m128i wn = _mm_set1_epi16(static_cast<short>(w_near)),
+                wf = _mm_set1_epi16(static_cast<short>(w_far));
   for (; x + 16 <= n; x += 16) {
     const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(near + x));
     const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(far + x));
-    const __m128i lo = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(a, zero), wn),
-                                                                 _mm_mullo_epi16(_mm_unpacklo_epi8(b, zero), wf)), four), 3);
-    const __m128i hi = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpackhi_epi8(a, zero), wn),
-                                                                 _mm_mullo_epi16(_mm_unpackhi_epi8(b, zero), wf)), four), 3);
+    const __m128i lo =
+        _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(a, zero), wn),
+                                                   _mm_mullo_epi16(_mm_unpacklo_epi8(b, zero), wf)),
+                                     four),
+                       3);
+    const __m128i hi =
+        _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(_mm_unpackhi_epi8(a, zero), wn),
+                                                   _mm_mullo_epi16(_mm_unpackhi_epi8(b, zero), wf)),
+                                     four),
+                       3);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x), _mm_packus_epi16(lo, hi));
   }
 #endif
-  for (; x < n; ++x) out[x] = static_cast<std::uint8_t>((w_near * near[x] + w_far * far[x] + 4) >> 3);
+  for (; x < n; ++x)
+    out[x] = static_cast<std::uint8_t>((w_near * near[x] + w_far * far[x] + 4) >> 3);
 }
 
 }  // namespace
@@ -94,13 +104,14 @@ void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& lim
   for (int y = 0; y < image.height; ++y) {
     const int t = y / tile, k = y % tile;
     const int other = k < 2 ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
-    blendRows(&expanded[static_cast<size_t>(t) * wide], &expanded[static_cast<size_t>(other) * wide],
-              kNear[k], kFar[k], limits.ptr<std::uint8_t>(y), image.width);
+    blendRows(&expanded[static_cast<size_t>(t) * wide],
+              &expanded[static_cast<size_t>(other) * wide], kNear[k], kFar[k],
+              limits.ptr<std::uint8_t>(y), image.width);
   }
 }
 
-void fillGlobalThresholds(cv::Size image, int threshold, const std::optional<Vignetting>& vignetting,
-                          TileThresholds& out) {
+void fillGlobalThresholds(cv::Size image, int threshold,
+                          const std::optional<Vignetting>& vignetting, TileThresholds& out) {
   const int tile = TileThresholds::kTile;
   out.cols = (image.width + tile - 1) / tile;
   out.rows = (image.height + tile - 1) / tile;
@@ -123,8 +134,12 @@ namespace {
 
 // The loops below run over byte rows; __restrict tells the compiler the rows do not overlap, so
 // that it vectorises them.
-inline std::uint8_t minimum(std::uint8_t a, std::uint8_t b) { return a < b ? a : b; }
-inline std::uint8_t maximum(std::uint8_t a, std::uint8_t b) { return a > b ? a : b; }
+inline std::uint8_t minimum(std::uint8_t a, std::uint8_t b) {
+  return a < b ? a : b;
+}
+inline std::uint8_t maximum(std::uint8_t a, std::uint8_t b) {
+  return a > b ? a : b;
+}
 
 // out[x] = op(in[x - 1], in[x], in[x + 1]) with the ends clamped.
 template <bool kMax>
@@ -200,8 +215,10 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
       std::uint8_t* chi = &coarse.hi[static_cast<size_t>(y) * coarse.cols];
       for (int x = 0; x < coarse.cols; ++x) {
         const int x0 = 2 * x, x1 = std::min(2 * x + 1, fine.cols - 1);
-        clo[x] = minimum(minimum(fine.lo[r0 + x0], fine.lo[r0 + x1]), minimum(fine.lo[r1 + x0], fine.lo[r1 + x1]));
-        chi[x] = maximum(maximum(fine.hi[r0 + x0], fine.hi[r0 + x1]), maximum(fine.hi[r1 + x0], fine.hi[r1 + x1]));
+        clo[x] = minimum(minimum(fine.lo[r0 + x0], fine.lo[r0 + x1]),
+                         minimum(fine.lo[r1 + x0], fine.lo[r1 + x1]));
+        chi[x] = maximum(maximum(fine.hi[r0 + x0], fine.hi[r0 + x1]),
+                         maximum(fine.hi[r1 + x0], fine.hi[r1 + x1]));
       }
     }
   }
@@ -219,8 +236,10 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
     for (int y = 0; y < grid.rows; ++y) {
       const size_t up = static_cast<size_t>(std::max(0, y - 1)) * c, here = y * c;
       const size_t down = static_cast<size_t>(std::min(grid.rows - 1, y + 1)) * c;
-      combine3<false>(&scratch_.lo[up], &scratch_.lo[here], &scratch_.lo[down], &dilated.lo[here], grid.cols);
-      combine3<true>(&scratch_.hi[up], &scratch_.hi[here], &scratch_.hi[down], &dilated.hi[here], grid.cols);
+      combine3<false>(&scratch_.lo[up], &scratch_.lo[here], &scratch_.lo[down], &dilated.lo[here],
+                      grid.cols);
+      combine3<true>(&scratch_.hi[up], &scratch_.hi[here], &scratch_.hi[down], &dilated.hi[here],
+                     grid.cols);
     }
   }
   // A tile with contrast in its own 12 px neighbourhood -- at least the noise floor and a third of
@@ -245,7 +264,8 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
         if (hi - lo >= contrast) {
           coarse[i] = static_cast<std::uint8_t>(lo + (hi - lo) / 4 + 1);
         } else if (level + 1 < kLevels) {
-          coarse[i] = coarse_[level + 1][static_cast<size_t>(y / 2) * dilated_[level + 1].cols + x / 2];
+          coarse[i] =
+              coarse_[level + 1][static_cast<size_t>(y / 2) * dilated_[level + 1].cols + x / 2];
         }
       }
     }
@@ -302,7 +322,8 @@ void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) co
   const int ty1 = std::min(rows - 1, (roi.y + roi.height - 1) / tile + 1);
   cv::Mat grid(ty1 - ty0 + 1, tx1 - tx0 + 1, CV_8UC1);
   for (int ty = ty0; ty <= ty1; ++ty) {
-    for (int tx = tx0; tx <= tx1; ++tx) grid.at<std::uint8_t>(ty - ty0, tx - tx0) = tileLimit(tx, ty, split);
+    for (int tx = tx0; tx <= tx1; ++tx)
+      grid.at<std::uint8_t>(ty - ty0, tx - tx0) = tileLimit(tx, ty, split);
   }
   TileThresholds part;
   part.cols = grid.cols;

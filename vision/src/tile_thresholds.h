@@ -31,8 +31,8 @@ struct TileThresholds {
 // tile centres, so that the threshold surface has no steps at tile borders.
 void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits);
 
-void fillGlobalThresholds(cv::Size image, int threshold, const std::optional<Vignetting>& vignetting,
-                          TileThresholds& out);
+void fillGlobalThresholds(cv::Size image, int threshold,
+                          const std::optional<Vignetting>& vignetting, TileThresholds& out);
 
 // Computes adaptive tile thresholds; keeps its pyramids between frames to avoid allocation.
 class AdaptiveThresholder {

@@ -6,7 +6,8 @@ namespace arbci::vision {
 
 WorldModel::WorldModel(ReferenceMarker reference) : reference_(reference) {}
 
-std::vector<int> WorldModel::update(double time_s, const std::map<int, PoseEstimate>& camera_poses) {
+std::vector<int> WorldModel::update(double time_s,
+                                    const std::map<int, PoseEstimate>& camera_poses) {
   std::vector<int> updated;
   const auto reference = camera_poses.find(reference_.id);
   if (reference == camera_poses.end()) return updated;
@@ -41,12 +42,15 @@ bool WorldModel::referenceVisible(double now_s, double max_age_s) const {
 std::string WorldModel::status(double now_s) const {
   char text[160];
   if (reference_seen_at_ < 0.0) {
-    std::snprintf(text, sizeof text, "reference marker %d not seen yet: no robot-frame poses", reference_.id);
+    std::snprintf(text, sizeof text, "reference marker %d not seen yet: no robot-frame poses",
+                  reference_.id);
   } else if (!referenceVisible(now_s)) {
-    std::snprintf(text, sizeof text, "reference marker %d not seen for %.1f s: object poses are that old",
+    std::snprintf(text, sizeof text,
+                  "reference marker %d not seen for %.1f s: object poses are that old",
                   reference_.id, now_s - reference_seen_at_);
   } else {
-    std::snprintf(text, sizeof text, "reference marker %d visible; %zu objects tracked", reference_.id, objects_.size());
+    std::snprintf(text, sizeof text, "reference marker %d visible; %zu objects tracked",
+                  reference_.id, objects_.size());
   }
   return text;
 }

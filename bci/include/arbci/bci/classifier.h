@@ -36,8 +36,8 @@ class Classifier {
   virtual ~Classifier() = default;
   virtual std::string method() const = 0;  // "swlda", "slda" or "xdawn"
   // Throws std::invalid_argument when the data cannot train a model (too few targets, sizes).
-  virtual void train(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape,
-                     const Progress& progress = {}) = 0;
+  virtual void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                     const FeatureShape& shape, const Progress& progress = {}) = 0;
   virtual double score(const Eigen::Ref<const Eigen::VectorXd>& features) const = 0;
   // The equivalent weights on the features (score = weights . x + bias).
   virtual Eigen::VectorXd weights() const = 0;
@@ -46,13 +46,16 @@ class Classifier {
 };
 
 // "swlda", "slda" or "xdawn"; throws std::invalid_argument for anything else.
-std::unique_ptr<Classifier> makeClassifier(const std::string& method, const SwldaSettings& swlda = {},
+std::unique_ptr<Classifier> makeClassifier(const std::string& method,
+                                           const SwldaSettings& swlda = {},
                                            const XdawnSettings& xdawn = {});
 // Throws std::invalid_argument naming what is missing or inconsistent.
-std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json, const FeatureShape& shape);
+std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
+                                               const FeatureShape& shape);
 
 // Shared by the methods: the minimum number of target and non-target examples to train.
 constexpr int kMinimumTargets = 10;
-void checkTrainingData(const Eigen::MatrixXd& features, const std::vector<bool>& target, const FeatureShape& shape);
+void checkTrainingData(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                       const FeatureShape& shape);
 
 }  // namespace arbci::bci

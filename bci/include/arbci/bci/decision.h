@@ -22,9 +22,9 @@ struct ScoreModel {
 };
 
 struct Decision {
-  std::set<int> codes;      // {object} or {row, rows + column}
-  int choice = -1;          // 0-based object or cell (row-major)
-  double certainty = 0.0;   // posterior probability of `codes`
+  std::set<int> codes;     // {object} or {row, rows + column}
+  int choice = -1;         // 0-based object or cell (row-major)
+  double certainty = 0.0;  // posterior probability of `codes`
 };
 
 struct StoppingRule {

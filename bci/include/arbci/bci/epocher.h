@@ -20,7 +20,9 @@ struct Epoch {
   int channels = 0;
   int samples = 0;
   std::vector<float> data;  // channel-major
-  float at(int channel, int sample) const { return data[static_cast<size_t>(channel) * samples + sample]; }
+  float at(int channel, int sample) const {
+    return data[static_cast<size_t>(channel) * samples + sample];
+  }
 };
 
 class Epocher {

@@ -37,15 +37,16 @@ struct EvaluationReport {
   std::vector<SelectionResult> selections;
   int selections_with_truth = 0;
   StoppingRule dynamic_rule;
-  double dynamic_accuracy = 0.0, dynamic_mean_flashes = 0.0, dynamic_seconds = 0.0, dynamic_bits_per_minute = 0.0;
+  double dynamic_accuracy = 0.0, dynamic_mean_flashes = 0.0, dynamic_seconds = 0.0,
+         dynamic_bits_per_minute = 0.0;
 
   // The selections after n sequences as text: the speller's symbols, or "object 2, object 4".
   std::string selected(int sequences) const;
   std::string selectedDynamic() const;
 };
 
-EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<double>& scores, const ScoreModel& model,
-                                const StoppingRule& dynamic);
+EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<double>& scores,
+                                const ScoreModel& model, const StoppingRule& dynamic);
 
 struct TrainingSettings {
   std::string method = "swlda";
@@ -63,6 +64,7 @@ struct CrossValidation {
 };
 
 // Throws std::invalid_argument when fewer than two selections have known targets.
-CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& settings, const Progress& progress = {});
+CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& settings,
+                              const Progress& progress = {});
 
 }  // namespace arbci::bci

@@ -35,11 +35,13 @@ struct P300Model {
 
   // Throws ModelError naming the mismatch (rate, a missing channel).
   void checkCompatible(const SignalInfo& info, const std::string& what) const;
-  FeatureExtractor extractor(const SignalInfo& info) const { return FeatureExtractor(pipeline, info); }
+  FeatureExtractor extractor(const SignalInfo& info) const {
+    return FeatureExtractor(pipeline, info);
+  }
 
   nlohmann::json toJson() const;
   static P300Model fromJson(const nlohmann::json& json, const std::string& source);
-  void save(const std::filesystem::path& path) const;  // throws ModelError
+  void save(const std::filesystem::path& path) const;        // throws ModelError
   static P300Model load(const std::filesystem::path& path);  // throws ModelError
 
   // BCI2000 parameters (LinearClassifier, P3TemporalFilter epoch length, the channels, and the
@@ -54,7 +56,7 @@ struct TrainingResult {
   P300Model model;
   CrossValidation cross_validation;
 };
-TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipeline, const TrainingSettings& settings,
-                          const Progress& progress = {});
+TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipeline,
+                          const TrainingSettings& settings, const Progress& progress = {});
 
 }  // namespace arbci::bci

@@ -27,18 +27,18 @@ struct ParadigmSettings {
   double display_hz = 60.0;
   double flash_ms = 60.0;
   double isi_ms = 120.0;
-  int sequences = 10;          // per online selection (the maximum with dynamic stopping)
+  int sequences = 10;              // per online selection (the maximum with dynamic stopping)
   int calibration_sequences = 10;  // per calibration selection (always all)
-  int min_sequences = 2;       // dynamic stopping never stops earlier
-  double certainty = 0.0;      // dynamic stopping threshold; 0: always `sequences`
-  double cue_s = 1.5;          // calibration: the target is shown before its flashes
-  double result_s = 1.0;       // a selection is shown this long
-  double pause_s = 1.0;        // between selections
+  int min_sequences = 2;           // dynamic stopping never stops earlier
+  double certainty = 0.0;          // dynamic stopping threshold; 0: always `sequences`
+  double cue_s = 1.5;              // calibration: the target is shown before its flashes
+  double result_s = 1.0;           // a selection is shown this long
+  double pause_s = 1.0;            // between selections
   int calibration_selections = 6;
   int trials = 3;
 
-  int flashFrames() const;     // frames a flash lasts (60 ms at 60 Hz: 4)
-  int onsetFrames() const;     // frames from one flash onset to the next (180 ms: 11)
+  int flashFrames() const;  // frames a flash lasts (60 ms at 60 Hz: 4)
+  int onsetFrames() const;  // frames from one flash onset to the next (180 ms: 11)
 };
 
 enum class Phase {
@@ -64,8 +64,8 @@ const char* toString(Phase phase);
 struct FrameStimulus {
   Phase phase = Phase::Setup;
   bool grid_visible = false;
-  std::set<int> lit;                  // codes lit on this frame (objects, or grid rows/columns)
-  std::optional<int> cued_object;     // 1-based object slot
+  std::set<int> lit;               // codes lit on this frame (objects, or grid rows/columns)
+  std::optional<int> cued_object;  // 1-based object slot
   std::optional<int> selected_object;
   std::optional<std::pair<int, int>> cued_cell, selected_cell;  // (row, column)
 };
@@ -99,7 +99,8 @@ struct ParadigmEvent {
 class Paradigm {
  public:
   // `objects`: how many objects can be selected; `grid`: the grid's rows and columns.
-  Paradigm(const ParadigmSettings& settings, int objects, int rows, int columns, std::uint64_t seed);
+  Paradigm(const ParadigmSettings& settings, int objects, int rows, int columns,
+           std::uint64_t seed);
 
   // Experimenter controls (any state).
   void start(bool calibrate);  // from Setup: with a calibration run, or straight to the trials
@@ -143,8 +144,8 @@ class Paradigm {
   std::optional<StimulusSequencer> sequencer_;
   Phase phase_ = Phase::Setup;
   Phase paused_from_ = Phase::Setup;
-  std::int64_t now_ = 0;            // the last frame shown
-  std::int64_t phase_until_ = 0;    // timed phases end at this frame
+  std::int64_t now_ = 0;          // the last frame shown
+  std::int64_t phase_until_ = 0;  // timed phases end at this frame
   // Flashing: onset frame and code of the current sequence's flashes.
   std::vector<std::pair<std::int64_t, int>> schedule_;
   size_t next_flash_ = 0;

@@ -12,10 +12,10 @@ namespace arbci::bci {
 struct ParadigmLayout {
   enum class Kind { SingleStimulus, RowColumn };
   Kind kind = Kind::SingleStimulus;
-  int stimuli = 0;  // single stimulus
-  int rows = 0, columns = 0;  // row/column
+  int stimuli = 0;                   // single stimulus
+  int rows = 0, columns = 0;         // row/column
   std::vector<std::string> symbols;  // row-major, rows * columns, may be empty
-  double soa_s = 0.18;  // stimulus onset asynchrony (flash + inter-stimulus interval)
+  double soa_s = 0.18;               // stimulus onset asynchrony (flash + inter-stimulus interval)
 
   static ParadigmLayout single(int stimuli, double soa_s = 0.18);
   static ParadigmLayout matrix(int rows, int columns, double soa_s = 0.18);

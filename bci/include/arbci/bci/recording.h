@@ -30,13 +30,16 @@ struct Recording {
   std::vector<float> data;  // channel-major microvolts: data[c * samples + s]
   std::vector<StimulusEvent> stimuli;
   std::vector<Annotation> annotations;
-  std::map<std::string, std::string> parameters;  // BCI2000 parameters (value text) or session parameters
+  std::map<std::string, std::string>
+      parameters;  // BCI2000 parameters (value text) or session parameters
   std::map<std::string, std::vector<std::int32_t>> states;  // BCI2000 states, one value per sample
   // The file was cut short and was read up to its last complete record (salvage mode).
   bool truncated = false;
   std::string truncation_note;
 
-  float at(int channel, std::int64_t sample) const { return data[static_cast<size_t>(channel) * samples + sample]; }
+  float at(int channel, std::int64_t sample) const {
+    return data[static_cast<size_t>(channel) * samples + sample];
+  }
   double seconds() const { return samples / info.rate_hz; }
 };
 

@@ -21,8 +21,8 @@ class RingBuffer {
   std::int64_t end() const;  // the index after the newest sample
 
   struct Read {
-    Block block;             // the samples read (possibly none)
-    std::int64_t lost = 0;   // samples overwritten before this reader reached them
+    Block block;            // the samples read (possibly none)
+    std::int64_t lost = 0;  // samples overwritten before this reader reached them
   };
 
   class Reader {

@@ -19,7 +19,8 @@ class WallClock final : public SampleClock {
  public:
   WallClock() : start_(std::chrono::steady_clock::now()) {}
   std::int64_t available(double rate_hz) const override {
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     return static_cast<std::int64_t>(seconds * rate_hz);
   }
 

@@ -26,10 +26,16 @@ struct Block {
 
   Block() = default;
   Block(std::int64_t first, int channel_count, int sample_count)
-      : first_sample(first), channels(channel_count), samples(sample_count),
+      : first_sample(first),
+        channels(channel_count),
+        samples(sample_count),
         data(static_cast<size_t>(channel_count) * sample_count, 0.0f) {}
-  float& at(int channel, int sample) { return data[static_cast<size_t>(channel) * samples + sample]; }
-  float at(int channel, int sample) const { return data[static_cast<size_t>(channel) * samples + sample]; }
+  float& at(int channel, int sample) {
+    return data[static_cast<size_t>(channel) * samples + sample];
+  }
+  float at(int channel, int sample) const {
+    return data[static_cast<size_t>(channel) * samples + sample];
+  }
   std::int64_t endSample() const { return first_sample + samples; }
 };
 

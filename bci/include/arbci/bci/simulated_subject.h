@@ -38,14 +38,14 @@ struct SimulatedSubjectConfig {
   double rate_hz = 256.0;
   int block_size = 15;
   std::uint64_t seed = 1;
-  double background_uv = 7.0;  // RMS of the 1/f background per channel
+  double background_uv = 7.0;      // RMS of the 1/f background per channel
   double shared_background = 0.5;  // fraction of the background's variance common to all channels
   double alpha_hz = 10.0;
   double alpha_uv = 4.0;  // RMS at occipital channels
   double line_hz = 50.0;
   double line_uv = 1.5;
   double blinks_per_minute = 6.0;
-  double blink_uv = 100.0;  // at Fp1/Fp2; less further back
+  double blink_uv = 100.0;                // at Fp1/Fp2; less further back
   std::optional<SubjectProfile> profile;  // default: SubjectProfile::drawn(seed)
 };
 

@@ -13,13 +13,14 @@ namespace arbci::render {
 
 // Clip-space projection of OpenCV camera coordinates (x right, y down, z forward) after
 // `cameraToGl`: pixel (u, v) = (fx x/z + cx, fy y/z + cy) lands on that pixel of the viewport.
-glm::mat4 projectionFromCamera(const cv::Matx33d& camera_matrix, cv::Size image_size, double near_m = 0.05,
-                               double far_m = 20.0);
+glm::mat4 projectionFromCamera(const cv::Matx33d& camera_matrix, cv::Size image_size,
+                               double near_m = 0.05, double far_m = 20.0);
 // OpenCV camera frame to OpenGL eye frame (y and z flipped).
 glm::mat4 cameraToGl();
 // A rigid transform as a matrix (column-major, glm).
 glm::mat4 toMatrix(const vision::Pose& pose);
 // The whole chain for a world point: projection * cameraToGl * T_cam_world.
-glm::mat4 worldToClip(const cv::Matx33d& camera_matrix, cv::Size image_size, const vision::Pose& T_cam_world);
+glm::mat4 worldToClip(const cv::Matx33d& camera_matrix, cv::Size image_size,
+                      const vision::Pose& T_cam_world);
 
 }  // namespace arbci::render

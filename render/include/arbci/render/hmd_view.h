@@ -42,7 +42,7 @@ struct GridLayout {
 };
 
 struct GridHighlight {
-  std::set<int> rows, columns;  // flashing rows and columns (1-based)
+  std::set<int> rows, columns;                        // flashing rows and columns (1-based)
   std::optional<std::pair<int, int>> cued, selected;  // (row, column)
 };
 
@@ -84,7 +84,8 @@ class HmdView {
 
   // Where a world point appears in an eye's viewport (viewport pixels, OpenCV convention), as
   // drawn: through the rectified camera when undistorting, through the lens model otherwise.
-  std::optional<cv::Point2d> project(const EyeImage& eye, const cv::Vec3d& world, Size viewport) const;
+  std::optional<cv::Point2d> project(const EyeImage& eye, const cv::Vec3d& world,
+                                     Size viewport) const;
 
  private:
   struct Impl;

@@ -24,7 +24,8 @@ class PrimitiveRenderer {
   PrimitiveRenderer(const PrimitiveRenderer&) = delete;
   PrimitiveRenderer& operator=(const PrimitiveRenderer&) = delete;
 
-  void draw(Primitive primitive, std::span<const ColoredVertex> vertices, const glm::mat4& transform);
+  void draw(Primitive primitive, std::span<const ColoredVertex> vertices,
+            const glm::mat4& transform);
 
   // A closed or open polyline of `width` pixels; points are in viewport pixels of a viewport of
   // `viewport_size`: x right, y down, pixel (i, j) covers [i, i+1] x [j, j+1] (so an OpenCV

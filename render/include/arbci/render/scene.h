@@ -29,8 +29,8 @@ struct SceneObject {
 };
 
 struct SceneGripper {
-  cv::Vec3d tool;         // fingertips, robot frame
-  double opening = 1.0;   // 0 closed, 1 open
+  cv::Vec3d tool;        // fingertips, robot frame
+  double opening = 1.0;  // 0 closed, 1 open
 };
 
 // A printed chessboard held up for camera calibration (white margin of one square).

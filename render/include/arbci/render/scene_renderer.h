@@ -40,7 +40,8 @@ class SceneRenderer {
   };
   const Texture& markerTexture(const SceneMarker& marker);
   const Texture& boardTexture(const SceneBoard& board);
-  void drawBatches(const std::vector<Vertex>& vertices, const std::vector<Batch>& batches, const glm::mat4& transform);
+  void drawBatches(const std::vector<Vertex>& vertices, const std::vector<Batch>& batches,
+                   const glm::mat4& transform);
 
   ShaderProgram textured_, flat_;
   int textured_transform_ = -1, flat_transform_ = -1, sampler_location_ = -1;

@@ -15,11 +15,11 @@
 namespace arbci::render {
 
 struct CameraEffects {
-  bool distort = false;       // apply the camera model's distortion
-  double blur_sigma = 0.0;    // pixels
-  double noise_sigma = 0.0;   // grey levels
-  double vignetting = 0.0;    // brightness lost at the corners (0-1)
-  double gradient = 0.0;      // brightness lost from left to right (0-1)
+  bool distort = false;      // apply the camera model's distortion
+  double blur_sigma = 0.0;   // pixels
+  double noise_sigma = 0.0;  // grey levels
+  double vignetting = 0.0;   // brightness lost at the corners (0-1)
+  double gradient = 0.0;     // brightness lost from left to right (0-1)
 };
 
 class SimulatedCamera {
@@ -31,17 +31,19 @@ class SimulatedCamera {
   SimulatedCamera& operator=(const SimulatedCamera&) = delete;
 
   // A BGR frame of `scene` seen from `T_cam_world` (x right, y down, z forward in the camera).
-  cv::Mat render(const Scene& scene, const vision::Pose& T_cam_world, const CameraEffects& effects = {});
+  cv::Mat render(const Scene& scene, const vision::Pose& T_cam_world,
+                 const CameraEffects& effects = {});
   const vision::CameraModel& camera() const { return camera_; }
 
  private:
   vision::CameraModel camera_;
   SceneRenderer renderer_;
-  unsigned int multisample_fbo_ = 0, color_rb_ = 0, depth_rb_ = 0, resolve_fbo_ = 0, resolve_rb_ = 0;
+  unsigned int multisample_fbo_ = 0, color_rb_ = 0, depth_rb_ = 0, resolve_fbo_ = 0,
+               resolve_rb_ = 0;
   cv::Mat distort_map1_, distort_map2_;  // fixed-point remap tables of the lens
-  cv::Mat gain_;                         // uneven light (CV_16SC3, 256 = 1), for the last effects used
+  cv::Mat gain_;  // uneven light (CV_16SC3, 256 = 1), for the last effects used
   double gain_vignetting_ = -1.0, gain_gradient_ = -1.0;
-  cv::Mat noise_;                        // a noise field larger than the frame (CV_16SC3)
+  cv::Mat noise_;  // a noise field larger than the frame (CV_16SC3)
   double noise_sigma_ = -1.0;
   cv::RNG random_;
 };

@@ -18,19 +18,19 @@ namespace arbci::robot {
 struct BackendOptions {
   int port = 0;  // 0: any free port (see RobotBackend::port)
   std::string host = "127.0.0.1";
-  double speed_factor = 1.0;  // robot seconds per real second
+  double speed_factor = 1.0;       // robot seconds per real second
   double status_interval_s = 0.2;  // progress pushed to the commanding client
   double max_clock_skew_s = 30.0;  // older or newer timestamps count as replays
-  std::ostream* log = nullptr;  // rejected and ignored datagrams (rate-limited)
+  std::ostream* log = nullptr;     // rejected and ignored datagrams (rate-limited)
 };
 
 struct BackendStats {
   std::uint64_t datagrams = 0;
-  std::uint64_t ignored = 0;       // undecodable or unauthenticated: no answer
-  std::uint64_t replayed = 0;      // authenticated but replayed or stale
-  std::uint64_t duplicates = 0;    // retransmissions answered from the cache
-  std::uint64_t rejected = 0;      // commands refused (workspace, busy, state)
-  std::uint64_t executed = 0;      // motion commands started
+  std::uint64_t ignored = 0;     // undecodable or unauthenticated: no answer
+  std::uint64_t replayed = 0;    // authenticated but replayed or stale
+  std::uint64_t duplicates = 0;  // retransmissions answered from the cache
+  std::uint64_t rejected = 0;    // commands refused (workspace, busy, state)
+  std::uint64_t executed = 0;    // motion commands started
   std::map<DecodeError, std::uint64_t> by_error;
 };
 

@@ -20,19 +20,19 @@ struct ClientOptions {
   double first_retransmit_s = 0.05;
   double max_retransmit_s = 0.4;
   double status_interval_s = 0.2;
-  double silence_s = 1.0;      // no answer for this long: the backend is reported silent
-  double give_up_s = 15.0;     // a command nobody accepted in this long fails
+  double silence_s = 1.0;   // no answer for this long: the backend is reported silent
+  double give_up_s = 15.0;  // a command nobody accepted in this long fails
 };
 
 struct RobotEvent {
   enum class Kind {
     Accepted,
-    Rejected,     // reason, text
-    Finished,     // outcome, text
-    Failed,       // the command's fate is unknown or it was lost: text says why
-    Silent,       // no answer for `silence_s`
-    Reachable,    // answers again after silence
-    Restarted,    // the backend's boot id changed
+    Rejected,   // reason, text
+    Finished,   // outcome, text
+    Failed,     // the command's fate is unknown or it was lost: text says why
+    Silent,     // no answer for `silence_s`
+    Reachable,  // answers again after silence
+    Restarted,  // the backend's boot id changed
   } kind;
   std::uint64_t sequence = 0;
   MessageType command = MessageType::Status;

@@ -58,8 +58,8 @@ struct WorldObject {
 struct StatusPayload {
   RobotState state = RobotState::Idle;
   Vec3 tool;
-  double gripper_opening = 1.0;  // 0 closed, 1 open
-  std::int32_t holding = -1;     // object id, -1: nothing
+  double gripper_opening = 1.0;                       // 0 closed, 1 open
+  std::int32_t holding = -1;                          // object id, -1: nothing
   MessageType current_command = MessageType::Status;  // Status: none
   std::uint64_t current_sequence = 0;
   double progress = 0.0;  // of the current command, 0-1
@@ -72,16 +72,16 @@ struct StatusPayload {
 
 struct Message {
   MessageType type = MessageType::Status;
-  std::uint64_t session = 0;   // the client's random session id
-  std::uint64_t sequence = 0;  // commands: the client's; replies: the command answered
+  std::uint64_t session = 0;       // the client's random session id
+  std::uint64_t sequence = 0;      // commands: the client's; replies: the command answered
   std::uint64_t timestamp_ms = 0;  // sender's wall clock (Unix time)
-  std::uint64_t boot = 0;      // replies: the backend's random id for this run
+  std::uint64_t boot = 0;          // replies: the backend's random id for this run
   // Payloads (which one is used depends on `type`).
-  Vec3 target;            // Grasp, Drop
+  Vec3 target;                                    // Grasp, Drop
   RejectReason reason = RejectReason::Malformed;  // Rejected
   Outcome outcome = Outcome::Success;             // Finished
-  std::string text;       // Rejected, Finished: for people
-  StatusPayload status;   // StatusReply
+  std::string text;                               // Rejected, Finished: for people
+  StatusPayload status;                           // StatusReply
 };
 
 using Key = std::array<std::uint8_t, 32>;

@@ -12,9 +12,9 @@
 namespace arbci::ui {
 
 struct ShellStatus {
-  float frame_ms = 0.0f;       // time of the last displayed frame
-  std::string session_state;   // e.g. "idle", "phase 1: sequence 3/10"
-  std::string message;         // the latest notice for the experimenter
+  float frame_ms = 0.0f;      // time of the last displayed frame
+  std::string session_state;  // e.g. "idle", "phase 1: sequence 3/10"
+  std::string message;        // the latest notice for the experimenter
 };
 
 class ExperimenterShell {

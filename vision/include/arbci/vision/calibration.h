@@ -20,8 +20,8 @@ struct CalibrationBoard {
   cv::Size inner_corners{9, 6};  // chessboard: inner corners per row and column
   cv::Size squares{5, 7};        // ChArUco: squares per row and column
   double square_m = 0.025;
-  double marker_m = 0.0125;                    // ChArUco marker side
-  std::string dictionary = "DICT_6X6_250";     // ChArUco dictionary
+  double marker_m = 0.0125;                 // ChArUco marker side
+  std::string dictionary = "DICT_6X6_250";  // ChArUco dictionary
 };
 
 enum class ViewOutcome { Accepted, NoBoard, Blurred, Duplicate, WrongSize };

@@ -24,8 +24,8 @@ CodeGrid rotateClockwise(const CodeGrid& grid, int turns);
 
 struct DecodedId {
   int id = -1;
-  int corrected_bits = 0;  // bit errors corrected
-  float confidence = 0.0f; // ARToolKitPlus's confidence for this decode
+  int corrected_bits = 0;   // bit errors corrected
+  float confidence = 0.0f;  // ARToolKitPlus's confidence for this decode
 };
 
 class SimpleIdCode {

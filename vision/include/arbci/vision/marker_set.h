@@ -38,13 +38,15 @@ class MarkerSet {
 };
 
 struct SetPose {
-  PoseEstimate estimate;       // T_cam_set
-  std::vector<int> used_ids;   // markers whose corners went into it
+  PoseEstimate estimate;      // T_cam_set
+  std::vector<int> used_ids;  // markers whose corners went into it
 };
 
 // The set's pose from the markers of `detections` that belong to it (an id detected twice in the
 // frame is left out, as ARToolKit does), using their ideal corners. nullopt when none is seen.
-std::optional<SetPose> estimateSetPose(const MarkerSet& set, const std::vector<MarkerDetection>& detections,
-                                       const cv::Matx33d& camera_matrix, const PoseOptions& options = {});
+std::optional<SetPose> estimateSetPose(const MarkerSet& set,
+                                       const std::vector<MarkerDetection>& detections,
+                                       const cv::Matx33d& camera_matrix,
+                                       const PoseOptions& options = {});
 
 }  // namespace arbci::vision

@@ -17,7 +17,7 @@
 namespace arbci::vision {
 
 struct TrackerOptions {
-  int keep_frames = 3;        // how long an identity is kept for squares that fail to decode
+  int keep_frames = 3;  // how long an identity is kept for squares that fail to decode
   bool smooth_corners = false;
   double min_cutoff_hz = 1.0;  // One-Euro: cutoff at rest
   double beta = 0.2;           // One-Euro: cutoff increase per px/s of corner speed
@@ -45,8 +45,8 @@ class MarkerTracker {
   struct Track {
     MarkerDetection marker;  // as last reported
     int last_frame = 0;
-    int seen = 0;            // consecutive frames with a decode
-    int pending_id = -1;     // a different id decoded here once, awaiting confirmation
+    int seen = 0;         // consecutive frames with a decode
+    int pending_id = -1;  // a different id decoded here once, awaiting confirmation
     std::array<OneEuro, 8> filters;
   };
   void smooth(Track& track, MarkerDetection& marker, double dt);

@@ -44,10 +44,10 @@ struct PoseOptions {
 };
 
 struct PoseEstimate {
-  Pose pose;                       // T_cam_object
-  double reprojection_rms_px = 0;  // sqrt of the mean squared corner distance (equation 6.2)
-  double object_space_error = 0;   // Lu-Hager-Mjolsness object-space error (RPP)
-  std::optional<Pose> alternative; // the other local minimum of a planar target, when found
+  Pose pose;                        // T_cam_object
+  double reprojection_rms_px = 0;   // sqrt of the mean squared corner distance (equation 6.2)
+  double object_space_error = 0;    // Lu-Hager-Mjolsness object-space error (RPP)
+  std::optional<Pose> alternative;  // the other local minimum of a planar target, when found
   double alternative_rms_px = 0;
 };
 

@@ -45,7 +45,8 @@ class WorldModel {
   bool referenceVisible(double now_s, double max_age_s = 0.5) const;
   // The camera's pose in the robot frame from the last reference sighting.
   std::optional<Pose> T_robot_cam() const { return robot_cam_; }
-  // A line for the experimenter, e.g. "reference marker 0 not seen for 2.4 s: object poses are 2.4 s old".
+  // A line for the experimenter, e.g. "reference marker 0 not seen for 2.4 s: object poses are 2.4
+  // s old".
   std::string status(double now_s) const;
   const ReferenceMarker& reference() const { return reference_; }
 
