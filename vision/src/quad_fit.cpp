@@ -12,6 +12,10 @@
 namespace arbci::vision {
 namespace {
 
+// The least a side may stray from its chord, px. Blur rounds a small square's corners, bending the
+// ends of its sides: blurred (sigma 1.5) 20-30 px markers stray up to 2.2 px from their chords.
+constexpr float kMinSideDeviation = 2.5f;
+
 // Image <-> ideal coordinates through the lens; the identity without one.
 struct LensMap {
   const Undistorter* lens = nullptr;
@@ -282,7 +286,7 @@ std::optional<std::array<int, 4>> quadVertices(const std::vector<cv::Point>& out
   }
   if (candidates.size() < 4) return std::nullopt;
   const std::array<int, 4> vertex = largestQuadrilateral(outline, candidates);
-  const float max_deviation = std::max(2.0f, max_side_deviation * side_estimate);
+  const float max_deviation = std::max(kMinSideDeviation, max_side_deviation * side_estimate);
   for (int k = 0; k < 4; ++k) {
     float deviation = 0.0f;
     farthestFromChord(outline, vertex[k], vertex[(k + 1) % 4], deviation);
@@ -381,7 +385,7 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
               next = (vertex[(k + 2) % 4] - vertex[k] + n) % n;
     if (step == 0 || next <= step) return result;
   }
-  const float max_deviation = std::max(2.0f, params.max_side_deviation * side_estimate);
+  const float max_deviation = std::max(kMinSideDeviation, params.max_side_deviation * side_estimate);
   for (int k = 0; k < 4; ++k) {
     float deviation = 0.0f;
     farthestFromChord(contour, vertex[k], vertex[(k + 1) % 4], deviation);
