@@ -14,19 +14,6 @@ namespace {
 using namespace arbci::render;
 namespace vision = arbci::vision;
 
-vision::Pose lookAt(const cv::Vec3d& eye, const cv::Vec3d& target) {
-  const cv::Vec3d forward = cv::normalize(target - eye);
-  const cv::Vec3d right = cv::normalize(forward.cross(cv::Vec3d(0, 0, 1)));
-  const cv::Vec3d down = forward.cross(right);
-  cv::Matx33d r;
-  for (int c = 0; c < 3; ++c) {
-    r(0, c) = right[c];
-    r(1, c) = down[c];
-    r(2, c) = forward[c];
-  }
-  return vision::Pose{r, -(r * eye)};
-}
-
 void stereoView(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0)), height = static_cast<int>(state.range(1));
   const bool undistort = state.range(2) != 0, read_back = state.range(3) != 0;
@@ -41,8 +28,8 @@ void stereoView(benchmark::State& state) {
   cv::Mat image(height, width, CV_8UC3);
   cv::randu(image, 0, 255);
   HmdFrame frame;
-  frame.left = {image, camera, lookAt({-0.032, 1.45, 0.45}, {0, 0.65, 0})};
-  frame.right = {image.clone(), camera, lookAt({0.032, 1.45, 0.45}, {0, 0.65, 0})};
+  frame.left = {image, camera, vision::cameraLookingAt({-0.032, 1.45, 0.45}, {0, 0.65, 0})};
+  frame.right = {image.clone(), camera, vision::cameraLookingAt({0.032, 1.45, 0.45}, {0, 0.65, 0})};
   for (int i = 0; i < 4; ++i) {
     ObjectHighlight o;
     o.id = i + 1;

@@ -4,21 +4,6 @@
 
 namespace arbci::app {
 
-vision::Pose lookAt(const cv::Vec3d& eye, const cv::Vec3d& target) {
-  const cv::Vec3d forward = cv::normalize(target - eye);
-  cv::Vec3d right = forward.cross(cv::Vec3d(0, 0, 1));
-  if (cv::norm(right) < 1e-9) right = cv::Vec3d(1, 0, 0);
-  right = cv::normalize(right);
-  const cv::Vec3d down = forward.cross(right);
-  cv::Matx33d r;
-  for (int c = 0; c < 3; ++c) {
-    r(0, c) = right[c];
-    r(1, c) = down[c];
-    r(2, c) = forward[c];
-  }
-  return vision::Pose{r, -(r * eye)};
-}
-
 SimulatedWorld::SimulatedWorld(const SessionConfig& config) : config_(config) {
   const CameraSettings& c = config.cameras;
   camera_.image_size = {c.width, c.height};
@@ -88,7 +73,7 @@ vision::Pose SimulatedWorld::leftCamera(double t) const {
   const double look =
       std::tan(c.head_motion_deg * M_PI / 180.0) * cv::norm(c.look_at - c.head_position);
   const cv::Vec3d gaze(look * std::sin(0.5 * t + 0.3), look * 0.5 * std::sin(0.37 * t), 0.0);
-  const vision::Pose head = lookAt(c.head_position + sway, c.look_at + gaze);
+  const vision::Pose head = vision::cameraLookingAt(c.head_position + sway, c.look_at + gaze);
   // The left camera sits half a baseline to the left (-x of the camera).
   vision::Pose left = head;
   left.translation += cv::Vec3d(c.baseline_m / 2.0, 0, 0);

@@ -61,7 +61,4 @@ class SimulatedWorld {
   Cache left_cache_, right_cache_;
 };
 
-// A camera at `eye` looking at `target` (robot frame, z up), image x to the robot's right.
-vision::Pose lookAt(const cv::Vec3d& eye, const cv::Vec3d& target);
-
 }  // namespace arbci::app

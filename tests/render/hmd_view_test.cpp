@@ -22,19 +22,6 @@ vision::CameraModel camera640() {
   return c;
 }
 
-vision::Pose lookAt(const cv::Vec3d& eye, const cv::Vec3d& target) {
-  const cv::Vec3d forward = cv::normalize(target - eye);
-  const cv::Vec3d right = cv::normalize(forward.cross(cv::Vec3d(0, 0, 1)));
-  const cv::Vec3d down = forward.cross(right);
-  cv::Matx33d r;
-  for (int c = 0; c < 3; ++c) {
-    r(0, c) = right[c];
-    r(1, c) = down[c];
-    r(2, c) = forward[c];
-  }
-  return vision::Pose{r, -(r * eye)};
-}
-
 cv::Mat toMat(const RgbaImage& image) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.pixels.data()));
   cv::Mat bgr;
@@ -75,8 +62,8 @@ cv::Point2d intersect(const cv::Vec4f& l1, const cv::Vec4f& l2) {
 
 struct Rig {
   vision::CameraModel camera = camera640();
-  vision::Pose left = lookAt({-0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
-  vision::Pose right = lookAt({0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
+  vision::Pose left = vision::cameraLookingAt({-0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
+  vision::Pose right = vision::cameraLookingAt({0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
 };
 
 TEST(HmdView, HighlightCornersLieWithinAPixelOfTheProjectedMarkerCorners) {

@@ -21,20 +21,6 @@ vision::CameraModel camera640() {
   return c;
 }
 
-// A camera at `eye` looking at `target` (robot frame, z up), image x to the robot's right.
-vision::Pose lookAt(const cv::Vec3d& eye, const cv::Vec3d& target) {
-  const cv::Vec3d forward = cv::normalize(target - eye);
-  const cv::Vec3d right = cv::normalize(forward.cross(cv::Vec3d(0, 0, 1)));
-  const cv::Vec3d down = forward.cross(right);
-  cv::Matx33d R_cam_world;
-  for (int c = 0; c < 3; ++c) {
-    R_cam_world(0, c) = right[c];
-    R_cam_world(1, c) = down[c];
-    R_cam_world(2, c) = forward[c];
-  }
-  return vision::Pose{R_cam_world, -(R_cam_world * eye)};
-}
-
 Scene oneObject(int id, const vision::Pose& top) {
   Scene scene;
   SceneObject object;
@@ -68,7 +54,7 @@ TEST(SimulatedCamera, AMarkerAtAKnownPoseIsTrackedWithinACentimetreAndADegree) {
   auto context = createHeadlessContext({64, 64});
   const vision::CameraModel camera = camera640();
   SimulatedCamera simulated(camera);
-  const vision::Pose T_cam_world = lookAt({0.05, 1.45, 0.45}, {0.0, 0.65, 0.0});
+  const vision::Pose T_cam_world = vision::cameraLookingAt({0.05, 1.45, 0.45}, {0.0, 0.65, 0.0});
   for (const auto& [x, y, spin] : std::vector<std::tuple<double, double, double>>{
            {0.0, 0.6, 0.0}, {0.15, 0.5, 30.0}, {-0.2, 0.75, -60.0}}) {
     const double a = spin * M_PI / 180.0;
@@ -86,7 +72,7 @@ TEST(SimulatedCamera, ThroughADistortingLensWithNoiseAndBlur) {
   vision::CameraModel camera = camera640();
   camera.distortion = {-0.20, 0.05, 0.0, 0.0, 0.0};
   SimulatedCamera simulated(camera, 7);
-  const vision::Pose T_cam_world = lookAt({-0.05, 1.4, 0.5}, {0.0, 0.6, 0.0});
+  const vision::Pose T_cam_world = vision::cameraLookingAt({-0.05, 1.4, 0.5}, {0.0, 0.6, 0.0});
   const vision::Pose top{cv::Matx33d::eye(), cv::Vec3d(0.2, 0.55, 0.06)};
   CameraEffects effects;
   effects.distort = true;

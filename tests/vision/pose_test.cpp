@@ -251,5 +251,23 @@ TEST(Undistortion, TheThreeModesAgreeOnPointsAndImages) {
   EXPECT_LT(cv::mean(difference(cv::Rect(40, 40, 560, 400)))[0], 0.5);
 }
 
+TEST(CameraLookingAt, TheTargetIsOnTheAxisTheWorldsRightIsImageRightAndUpIsImageUp) {
+  const cv::Matx33d k(900, 0, 639.5, 0, 900, 359.5, 0, 0, 1);
+  const cv::Vec3d eye(0.1, 1.4, 0.5), target(0.0, 0.65, 0.0);
+  const Pose T_cam_world = cameraLookingAt(eye, target);
+  EXPECT_NEAR(cv::norm(T_cam_world.apply(eye)), 0.0, 1e-12);
+  const cv::Point2d centre = project(T_cam_world, k, cv::Point3d(0.0, 0.65, 0.0));
+  EXPECT_NEAR(centre.x, 639.5, 1e-9);
+  EXPECT_NEAR(centre.y, 359.5, 1e-9);
+  // The camera faces -y: the world's -x is on its right; +z (up) is up in the image.
+  EXPECT_GT(project(T_cam_world, k, cv::Point3d(-0.1, 0.65, 0.0)).x, 700.0);
+  EXPECT_LT(project(T_cam_world, k, cv::Point3d(0.0, 0.65, 0.1)).y, 300.0);
+  EXPECT_NEAR(cv::determinant(T_cam_world.rotation), 1.0, 1e-12);
+  // Straight down: still a rotation, image x along the world's x.
+  const Pose down = cameraLookingAt({0.0, 0.6, 1.0}, {0.0, 0.6, 0.0});
+  EXPECT_NEAR(cv::determinant(down.rotation), 1.0, 1e-12);
+  EXPECT_GT(project(down, k, cv::Point3d(0.1, 0.6, 0.0)).x, 700.0);
+}
+
 }  // namespace
 }  // namespace arbci::vision

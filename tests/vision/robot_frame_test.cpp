@@ -11,20 +11,6 @@
 namespace arbci::vision {
 namespace {
 
-// A camera at `eye` looking at `target` (robot frame, z up): T_robot_cam.
-Pose lookAt(const cv::Vec3d& eye, const cv::Vec3d& target) {
-  const cv::Vec3d forward = cv::normalize(target - eye);
-  const cv::Vec3d right = cv::normalize(forward.cross(cv::Vec3d(0, 0, 1)));
-  const cv::Vec3d down = forward.cross(right);
-  cv::Matx33d r;
-  for (int i = 0; i < 3; ++i) {
-    r(i, 0) = right[i];
-    r(i, 1) = down[i];
-    r(i, 2) = forward[i];
-  }
-  return {r, eye};
-}
-
 TEST(RobotFrame, ObjectsOnTheTableComeOutWithin5MillimetresThroughTheReferenceMarker) {
   const cv::Matx33d k(900, 0, 639.5, 0, 900, 359.5, 0, 0, 1);
   const ReferenceMarker reference;  // id 0, 8 cm, at (0, 0.90, 0)
@@ -34,7 +20,8 @@ TEST(RobotFrame, ObjectsOnTheTableComeOutWithin5MillimetresThroughTheReferenceMa
   // Slight head motion over a few frames.
   for (int frame_index = 0; frame_index < 4; ++frame_index) {
     const Pose T_robot_cam =
-        lookAt(cv::Vec3d(0.01 * frame_index, 1.30, 0.45), cv::Vec3d(0.0, 0.74, 0.0));
+        cameraLookingAt(cv::Vec3d(0.01 * frame_index, 1.30, 0.45), cv::Vec3d(0.0, 0.74, 0.0))
+            .inverse();
     const Pose T_cam_robot = T_robot_cam.inverse();
     cv::Mat frame(720, 1280, CV_8UC1, cv::Scalar(150));
     test::drawPosedMarker(frame, k, T_cam_robot * reference.T_robot_ref, reference.size_m,

@@ -77,6 +77,21 @@ std::array<cv::Point3d, 4> markerCorners(double side_m) {
           cv::Point3d(-h, -h, 0)};
 }
 
+Pose cameraLookingAt(const cv::Vec3d& eye, const cv::Vec3d& target) {
+  const cv::Vec3d forward = cv::normalize(target - eye);
+  cv::Vec3d right = forward.cross(cv::Vec3d(0, 0, 1));
+  if (cv::norm(right) < 1e-9) right = cv::Vec3d(1, 0, 0);
+  right = cv::normalize(right);
+  const cv::Vec3d down = forward.cross(right);
+  cv::Matx33d r;  // rows: the camera's axes in world coordinates
+  for (int c = 0; c < 3; ++c) {
+    r(0, c) = right[c];
+    r(1, c) = down[c];
+    r(2, c) = forward[c];
+  }
+  return Pose{r, -(r * eye)};
+}
+
 cv::Point2d project(const Pose& pose, const cv::Matx33d& k, const cv::Point3d& object) {
   const cv::Vec3d c = pose.apply(cv::Vec3d(object.x, object.y, object.z));
   return {k(0, 0) * c[0] / c[2] + k(0, 1) * c[1] / c[2] + k(0, 2), k(1, 1) * c[1] / c[2] + k(1, 2)};

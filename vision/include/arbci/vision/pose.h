@@ -60,6 +60,10 @@ std::array<cv::Point3d, 4> markerCorners(double side_m);
 PoseEstimate estimatePose(std::span<const cv::Point3d> object, std::span<const cv::Point2d> image,
                           const cv::Matx33d& camera_matrix, const PoseOptions& options = {});
 
+// T_cam_world of a camera at `eye` looking at `target`, in a world whose z axis is up: the image's
+// x axis points to the world's right, its y axis down. Looking straight down, x is the world's x.
+Pose cameraLookingAt(const cv::Vec3d& eye, const cv::Vec3d& target);
+
 // Projects `object` with `pose` and the ideal camera matrix.
 cv::Point2d project(const Pose& pose, const cv::Matx33d& camera_matrix, const cv::Point3d& object);
 
