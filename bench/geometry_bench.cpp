@@ -13,6 +13,7 @@
 
 #include "arbci/vision/pose.h"
 #include "arbci/vision/undistortion.h"
+#include "support/posed_markers.h"
 
 using namespace arbci::vision;
 using Clock = std::chrono::steady_clock;
@@ -24,16 +25,6 @@ struct Case {
   std::vector<cv::Point2d> image;
   double tilt_deg;
 };
-
-cv::Matx33d markerRotation(double tilt_deg, double azimuth_deg, double spin_deg) {
-  const double deg = std::numbers::pi / 180.0;
-  cv::Matx33d tilt, spin;
-  cv::Rodrigues(
-      cv::Vec3d(std::cos(azimuth_deg * deg), std::sin(azimuth_deg * deg), 0.0) * (tilt_deg * deg),
-      tilt);
-  cv::Rodrigues(cv::Vec3d(0.0, 0.0, spin_deg * deg), spin);
-  return tilt * spin * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1);
-}
 
 double seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
@@ -60,7 +51,8 @@ int main(int argc, char** argv) {
     const double distance = 0.3 + 0.7 * unit(random), tilt = 60.0 * unit(random);
     Case c;
     c.tilt_deg = tilt;
-    c.truth.rotation = markerRotation(tilt, 360.0 * unit(random), 360.0 * unit(random));
+    c.truth.rotation =
+        arbci::test::markerRotation(tilt, 360.0 * unit(random), 360.0 * unit(random));
     const cv::Vec3d direction((unit(random) - 0.5) * 0.9, (unit(random) - 0.5) * 0.5, 1.0);
     c.truth.translation = direction / cv::norm(direction) * distance;
     for (const cv::Point3d& p : object)

@@ -11,6 +11,7 @@
 #include "eeg/p300_plots.h"
 #include "eeg/p300_report.h"
 #include "support/cli_error.h"
+#include "support/name_list.h"
 #include "support/output_path.h"
 
 namespace arbci::app {
@@ -37,16 +38,6 @@ std::string utcNow() {
   return text;
 }
 
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
 struct TrainOptions {
   std::vector<std::string> files;
   std::string out, channels, window_ms = "0,800", bci2000, plots;
@@ -68,7 +59,7 @@ void train(TrainOptions& o) {
   ensureWritable(o.out);
   if (!o.bci2000.empty()) ensureWritable(o.bci2000);
   o.pipeline.window = parseWindow(o.window_ms);
-  o.pipeline.channels = splitList(o.channels);
+  o.pipeline.channels = splitNameList(o.channels);
   const bci::Progress progress = progressLine(std::cerr);
   bci::TrainingResult result;
   bci::P300Dataset data;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <random>
 #include <set>
-#include <sstream>
 #include <thread>
 
 #include "arbci/bci/recording.h"
@@ -12,6 +11,7 @@
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
 #include "support/cli_error.h"
+#include "support/name_list.h"
 
 namespace arbci::app {
 namespace {
@@ -69,21 +69,11 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
   return schedule;
 }
 
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
 }  // namespace
 
 SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& progress) {
   bci::SimulatedSubjectConfig config;
-  config.montage = split(o.montage);
+  config.montage = splitNameList(o.montage);
   if (config.montage.empty()) throw CliError("--montage names no channels");
   config.rate_hz = o.rate_hz;
   config.seed = o.seed;
