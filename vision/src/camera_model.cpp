@@ -96,6 +96,17 @@ cv::FileStorage openForReading(const std::filesystem::path& path) {
   return in;
 }
 
+cv::FileStorage openForWriting(const std::filesystem::path& path) {
+  cv::FileStorage out;
+  try {
+    out.open(path.string(), cv::FileStorage::WRITE);
+  } catch (const cv::Exception& e) {
+    fail(path.string(), "cannot write (" + e.err + ")");
+  }
+  if (!out.isOpened()) fail(path.string(), "cannot write");
+  return out;
+}
+
 }  // namespace
 
 void CameraModel::validate() const {
@@ -160,13 +171,7 @@ CameraModel CameraModel::load(const std::filesystem::path& path) {
 }
 
 void CameraModel::save(const std::filesystem::path& path) const {
-  cv::FileStorage out;
-  try {
-    out.open(path.string(), cv::FileStorage::WRITE);
-  } catch (const cv::Exception& e) {
-    fail(path.string(), "cannot write (" + e.err + ")");
-  }
-  if (!out.isOpened()) fail(path.string(), "cannot write");
+  cv::FileStorage out = openForWriting(path);
   writeCamera(out, *this);
 }
 
@@ -187,13 +192,7 @@ StereoCameras StereoCameras::load(const std::filesystem::path& path) {
 }
 
 void StereoCameras::save(const std::filesystem::path& path) const {
-  cv::FileStorage out;
-  try {
-    out.open(path.string(), cv::FileStorage::WRITE);
-  } catch (const cv::Exception& e) {
-    fail(path.string(), "cannot write (" + e.err + ")");
-  }
-  if (!out.isOpened()) fail(path.string(), "cannot write");
+  cv::FileStorage out = openForWriting(path);
   writeCamera(out, left, "left_");
   writeCamera(out, right, "right_");
   out << "R" << cv::Mat(rotation) << "T" << cv::Mat(translation);

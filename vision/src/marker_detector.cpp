@@ -343,6 +343,15 @@ struct MarkerDetector::Impl {
     return result;
   }
 
+  // Detection on `gray`, its conversion from the caller's image timed from `start`.
+  DetectionResult runAfterConversion(Clock::time_point start) {
+    const double convert = microseconds(start, Clock::now());
+    DetectionResult result = run();
+    result.timing.convert = convert;
+    result.timing.total += convert;
+    return result;
+  }
+
   DetectionResult run() {
     const auto start = Clock::now();
     StageTimes time;
@@ -399,22 +408,14 @@ DetectionResult MarkerDetector::detect(const cv::Mat& image) {
     toLuminance(image, impl_->converted);
     impl_->gray = impl_->converted;
   }
-  const double convert = microseconds(start, Clock::now());
-  DetectionResult result = impl_->run();
-  result.timing.convert = convert;
-  result.timing.total += convert;
-  return result;
+  return impl_->runAfterConversion(start);
 }
 
 DetectionResult MarkerDetector::detect(const ImageView& image) {
   const auto start = Clock::now();
   toLuminance(image, impl_->converted);
   impl_->gray = impl_->converted;
-  const double convert = microseconds(start, Clock::now());
-  DetectionResult result = impl_->run();
-  result.timing.convert = convert;
-  result.timing.total += convert;
-  return result;
+  return impl_->runAfterConversion(start);
 }
 
 const DetectorConfig& MarkerDetector::config() const {
