@@ -68,6 +68,19 @@ bool backendReceived(const RunningBackend& backend, std::uint64_t count) {
   return true;
 }
 
+// Polls (up to 5 s) until the backend accepts command `sequence`.
+bool waitUntilAccepted(RobotClient& client, std::uint64_t sequence) {
+  const auto end = std::chrono::steady_clock::now() + 5s;
+  while (std::chrono::steady_clock::now() < end) {
+    client.poll();
+    for (const RobotEvent& e : client.takeEvents()) {
+      if (e.kind == RobotEvent::Kind::Accepted && e.sequence == sequence) return true;
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+  return false;
+}
+
 ClientOptions fastClient() {
   ClientOptions o;
   o.first_retransmit_s = 0.01;
@@ -292,15 +305,7 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
   RunningBackend backend(1.0);  // real time: the grasp takes seconds
   RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
   const auto grasp = client.send(MessageType::Grasp, {0.10, 0.60, 0.06});
-  const auto end = Clock::now() + 5s;
-  bool accepted = false;
-  while (Clock::now() < end && !accepted) {
-    client.poll();
-    for (const RobotEvent& e : client.takeEvents())
-      accepted |= e.kind == RobotEvent::Kind::Accepted && e.sequence == grasp;
-    std::this_thread::sleep_for(1ms);
-  }
-  ASSERT_TRUE(accepted);
+  ASSERT_TRUE(waitUntilAccepted(client, grasp));
   std::this_thread::sleep_for(400ms);
   const auto stop = client.send(MessageType::Stop);
   auto events = waitFor(client, grasp, 3s);
@@ -327,15 +332,7 @@ TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {
   const int port = first->port();
   RobotClient client(Endpoint::resolve("127.0.0.1", port), testKey(), fastClient());
   const auto grasp = client.send(MessageType::Grasp, {0.10, 0.60, 0.06});
-  const auto end = Clock::now() + 5s;
-  bool accepted = false;
-  while (Clock::now() < end && !accepted) {
-    client.poll();
-    for (const RobotEvent& e : client.takeEvents())
-      accepted |= e.kind == RobotEvent::Kind::Accepted;
-    std::this_thread::sleep_for(1ms);
-  }
-  ASSERT_TRUE(accepted);
+  ASSERT_TRUE(waitUntilAccepted(client, grasp));
   first.reset();  // the backend dies mid-command
   bool silent = false;
   const auto quiet_end = Clock::now() + 1500ms;

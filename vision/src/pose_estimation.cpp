@@ -18,12 +18,8 @@ struct Candidate {
 
 double reprojectionRms(const Pose& pose, const cv::Matx33d& k, std::span<const cv::Point3d> object,
                        std::span<const cv::Point2d> image) {
-  double sum = 0.0;
-  for (size_t i = 0; i < object.size(); ++i) {
-    const cv::Point2d d = project(pose, k, object[i]) - image[i];
-    sum += d.dot(d);
-  }
-  return std::sqrt(sum / static_cast<double>(object.size()));
+  return std::sqrt(squaredReprojectionError(pose, k, object, image) /
+                   static_cast<double>(object.size()));
 }
 
 bool planar(std::span<const cv::Point3d> object) {

@@ -11,8 +11,11 @@ namespace {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-double cost(const Pose& pose, const cv::Matx33d& k, std::span<const cv::Point3d> object,
-            std::span<const cv::Point2d> image) {
+}  // namespace
+
+double squaredReprojectionError(const Pose& pose, const cv::Matx33d& k,
+                                std::span<const cv::Point3d> object,
+                                std::span<const cv::Point2d> image) {
   double sum = 0.0;
   for (size_t i = 0; i < object.size(); ++i) {
     const cv::Point2d d = project(pose, k, object[i]) - image[i];
@@ -21,12 +24,10 @@ double cost(const Pose& pose, const cv::Matx33d& k, std::span<const cv::Point3d>
   return sum;
 }
 
-}  // namespace
-
 Pose refineReprojection(const Pose& start, const cv::Matx33d& k,
                         std::span<const cv::Point3d> object, std::span<const cv::Point2d> image) {
   Pose pose = start;
-  double current = cost(pose, k, object, image);
+  double current = squaredReprojectionError(pose, k, object, image);
   double lambda = 1e-3;
   for (int iteration = 0; iteration < 20; ++iteration) {
     Matrix6d normal = Matrix6d::Zero();
@@ -61,7 +62,7 @@ Pose refineReprojection(const Pose& start, const cv::Matx33d& k,
       cv::Rodrigues(cv::Vec3d(step(0), step(1), step(2)), increment);
       const Pose candidate{increment * pose.rotation,
                            pose.translation + cv::Vec3d(step(3), step(4), step(5))};
-      const double candidate_cost = cost(candidate, k, object, image);
+      const double candidate_cost = squaredReprojectionError(candidate, k, object, image);
       if (candidate_cost < current) {
         improved = true;
         const bool converged = current - candidate_cost < 1e-12 * (1.0 + current);

@@ -9,6 +9,11 @@
 
 namespace arbci::vision {
 
+// The sum of squared distances between `image` and the projections of `object`, px^2.
+double squaredReprojectionError(const Pose& pose, const cv::Matx33d& camera_matrix,
+                                std::span<const cv::Point3d> object,
+                                std::span<const cv::Point2d> image);
+
 Pose refineReprojection(const Pose& start, const cv::Matx33d& camera_matrix,
                         std::span<const cv::Point3d> object, std::span<const cv::Point2d> image);
 
