@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -54,11 +55,45 @@ struct Session::Impl {
   // While the robot moves, the simulated clock keeps to the robot's pace (its speed factor).
   double robot_started_at = 0.0;
   std::chrono::steady_clock::time_point robot_started_wall;
+  // When the robot last put each object down (session time): its pose from before is stale.
+  std::map<int, double> moved_at;
+  cv::Vec3d grasped_from;  // where the object in the gripper was taken from
+  bool returning = false;  // the object goes back there: its cell was taken
 
   explicit Impl(render::GlContext& c) : context(c) {}
 };
 
 namespace {
+
+// What the subject intends in each trial: the file's list, then random choices for the seed, each
+// an object to a free cell (as a subject would), supposing the earlier trials went as intended.
+std::vector<TrialIntent> intendedTrials(const SessionConfig& config) {
+  std::vector<TrialIntent> intended = config.intended;
+  std::map<int, std::pair<int, int>> cell_of;  // objects standing on the grid
+  for (const TrialIntent& t : intended) cell_of[t.object] = {t.row, t.column};
+  std::mt19937_64 random(config.eeg.seed * 31 + 7);
+  const auto& objects = config.world.objects;
+  while (static_cast<int>(intended.size()) < config.paradigm.trials) {
+    TrialIntent t;
+    t.object = objects[random() % objects.size()].id;
+    std::vector<std::pair<int, int>> free;
+    for (int row = 1; row <= config.world.grid.rows; ++row) {
+      for (int column = 1; column <= config.world.grid.columns; ++column) {
+        bool taken = false;
+        for (const auto& [id, cell] : cell_of)
+          taken |= id != t.object && cell == std::pair{row, column};
+        if (!taken || objects.size() >
+                          static_cast<size_t>(config.world.grid.rows * config.world.grid.columns)) {
+          free.emplace_back(row, column);  // (more objects than cells: any cell)
+        }
+      }
+    }
+    std::tie(t.row, t.column) = free[random() % free.size()];
+    cell_of[t.object] = {t.row, t.column};
+    intended.push_back(t);
+  }
+  return intended;
+}
 
 std::string phaseSlug(bci::Phase phase) {
   switch (phase) {
@@ -107,16 +142,7 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   m.camera_every =
       std::max(1, static_cast<int>(std::lround(config_.display_hz / config_.cameras.rate_hz)));
 
-  // What the subject intends in each trial: the file's list, then random choices for the seed.
-  std::mt19937_64 random(config_.eeg.seed * 31 + 7);
-  m.intended = config_.intended;
-  while (static_cast<int>(m.intended.size()) < config_.paradigm.trials) {
-    TrialIntent t;
-    t.object = config_.world.objects[random() % config_.world.objects.size()].id;
-    t.row = 1 + static_cast<int>(random() % static_cast<unsigned>(config_.world.grid.rows));
-    t.column = 1 + static_cast<int>(random() % static_cast<unsigned>(config_.world.grid.columns));
-    m.intended.push_back(t);
-  }
+  m.intended = intendedTrials(config_);
 
   // The clock: simulated (frames and samples advance together) or the wall clock.
   if (options.simulated_clock) {
@@ -373,6 +399,14 @@ bool Session::step() {
   return !ended_;
 }
 
+void Session::sendRobot(robot::MessageType type, const cv::Vec3d& target) {
+  Impl& m = *impl_;
+  m.robot_command = client_->send(type, {target[0], target[1], target[2]});
+  m.robot_started_at = time_;
+  m.robot_started_wall = std::chrono::steady_clock::now();
+  m.robot_command_type = type;
+}
+
 void Session::handleRobotEvents() {
   Impl& m = *impl_;
   for (const robot::RobotEvent& e : client_->takeEvents()) {
@@ -393,9 +427,17 @@ void Session::handleRobotEvents() {
       m.robot_command.reset();
       const bool success = e.outcome == robot::Outcome::Success;
       if (success && m.robot_command_type == robot::MessageType::Drop) {
-        currentTrial().outcome = "placed";
-        m.placement = std::make_pair(currentTrial().trial, e.sequence);
-        m.placement_since = std::chrono::steady_clock::now();
+        if (!m.returning) {
+          currentTrial().outcome = "placed";
+          m.placement = std::make_pair(currentTrial().trial, e.sequence);
+          m.placement_since = std::chrono::steady_clock::now();
+        }
+        m.moved_at[*m.grasped_id] = time_;
+        // The arm parked over the table hides objects from the cameras: it goes home before the
+        // next trial, and the put-down ends when it is there.
+        sendRobot(robot::MessageType::Home, {});
+        m.log->write("robot_command", time_, {{"command", "HOME"}, {"sequence", *m.robot_command}});
+        continue;
       }
       if (!success)
         currentTrial().outcome = std::string("robot ") + robot::toString(e.outcome) + ": " + e.text;
@@ -439,6 +481,17 @@ void Session::measurePlacement() {
                        {"position", {o.position.x, o.position.y, o.position.z - height}}});
   }
   m.placement.reset();
+}
+
+std::optional<int> Session::objectOnCell(std::pair<int, int> cell) const {
+  const cv::Vec3d centre = gridLayout().cellCentre(cell.first, cell.second);
+  const double half = 0.5 * config_.world.grid.cell_m;
+  for (const vision::ObjectState& o : vision_->world().objects()) {
+    if (impl_->grasped_id && o.id == *impl_->grasped_id) continue;
+    const cv::Vec3d p = o.T_robot_object.translation;
+    if (std::abs(p[0] - centre[0]) < half && std::abs(p[1] - centre[1]) < half) return o.id;
+  }
+  return std::nullopt;
 }
 
 render::GridLayout Session::gridLayout() const {
@@ -568,18 +621,20 @@ void Session::handleParadigmEvents() {
       case Kind::RobotGrasp: {
         const int id = config_.world.objects[static_cast<size_t>(e.object - 1)].id;
         const auto state = vision_->world().object(id);
-        if (!state) {
+        const auto moved = m.moved_at.find(id);
+        if (!state || (moved != m.moved_at.end() && state->seen_at_s <= moved->second)) {
+          // Never a grasp at a stale position: the object was put elsewhere since it was seen.
           currentTrial().outcome =
-              "object " + std::to_string(id) + " was never seen by the cameras";
+              "object " + std::to_string(id) +
+              (state ? " has not been seen by the cameras since the robot moved it"
+                     : " was never seen by the cameras");
           paradigm_->robotFinished(false, currentTrial().outcome);
           break;
         }
         const cv::Vec3d p = state->T_robot_object.translation;
         m.grasped_id = id;
-        m.robot_command = client_->send(robot::MessageType::Grasp, {p[0], p[1], p[2]});
-        m.robot_started_at = time_;
-        m.robot_started_wall = std::chrono::steady_clock::now();
-        m.robot_command_type = robot::MessageType::Grasp;
+        m.grasped_from = p;
+        sendRobot(robot::MessageType::Grasp, p);
         m.log->write("robot_command", time_,
                      {{"command", "GRASP"},
                       {"object", id},
@@ -588,16 +643,24 @@ void Session::handleParadigmEvents() {
         break;
       }
       case Kind::RobotDrop: {
-        const cv::Vec3d p = gridLayout().cellCentre(e.cell.first, e.cell.second);
-        m.robot_command =
-            client_->send(robot::MessageType::Drop, {p[0], p[1], config_.world.table_z});
-        m.robot_started_at = time_;
-        m.robot_started_wall = std::chrono::steady_clock::now();
-        m.robot_command_type = robot::MessageType::Drop;
+        cv::Vec3d p = gridLayout().cellCentre(e.cell.first, e.cell.second);
+        p[2] = config_.world.table_z;
+        m.returning = false;
+        if (const auto other = objectOnCell(e.cell)) {
+          // Never onto another object: it goes back where it came from, and the trial says why.
+          m.returning = true;
+          p = {m.grasped_from[0], m.grasped_from[1], config_.world.table_z};
+          currentTrial().outcome = "returned: cell " + std::to_string(e.cell.first) + "," +
+                                   std::to_string(e.cell.second) + " is taken by object " +
+                                   std::to_string(*other);
+          std::cerr << "trial " << currentTrial().trial << ": " << currentTrial().outcome << "\n";
+        }
+        sendRobot(robot::MessageType::Drop, p);
         m.log->write("robot_command", time_,
                      {{"command", "DROP"},
                       {"cell", {e.cell.first, e.cell.second}},
-                      {"target", {p[0], p[1], config_.world.table_z}},
+                      {"target", {p[0], p[1], p[2]}},
+                      {"returning", m.returning},
                       {"sequence", *m.robot_command}});
         break;
       }

@@ -120,7 +120,11 @@ class Session {
   void handleParadigmEvents();
   void measurePlacement();
   render::GridLayout gridLayout() const;
+  // The tracked object (other than the one in the gripper) standing on a grid cell, if any.
+  std::optional<int> objectOnCell(std::pair<int, int> cell) const;
   void handleRobotEvents();
+  // Sends a command whose end the paradigm waits for; the simulated clock keeps to its pace.
+  void sendRobot(robot::MessageType type, const cv::Vec3d& target);
   void decideIfReady();
   void renderHmd(const bci::FrameStimulus& stimulus);
   void endRun(const std::string& reason);

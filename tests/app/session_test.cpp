@@ -103,8 +103,8 @@ TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimet
     overruns += line["event"] == "overrun";
   }
   EXPECT_EQ(overruns, summary["overruns"].get<int>());  // each one logged
-  EXPECT_EQ(commands, 6);
-  EXPECT_EQ(finished, 6);
+  EXPECT_EQ(commands, 9);  // per trial: grasp, drop, and home to clear the cameras' view
+  EXPECT_EQ(finished, 9);
   EXPECT_GT(cycles, 100);
 }
 
@@ -132,6 +132,52 @@ TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
   for (const auto& line : readLog(folder / "log.jsonl"))
     logged_wrong += line["event"] == "selection" && line["correct"] == false;
   EXPECT_EQ(logged_wrong, wrong);
+}
+
+TEST(Session, AnObjectIsNeverPutOnAnotherAndAMovedObjectIsGraspedWhereItNowStands) {
+  const auto folder = fresh("taken");
+  const auto session = folder.string() + ".json";
+  // A clear responder (as steady_head.json); the second intention is a cell already taken.
+  std::ofstream(session) << R"({"eeg": {"erp_scale": 2.0},
+    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 6, "sequences": 8, "certainty": 0, "trials": 3,
+      "intended": [{"object": 20, "cell": [2, 2]}, {"object": 40, "cell": [2, 2]},
+                   {"object": 20, "cell": [1, 1]}]},
+    "robot": {"speed_factor": 20}})";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session, "--seed", "3", "--out", folder.string()},
+      300.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  ASSERT_EQ(summary["trials"].size(), 3u);
+  for (const auto& t : summary["trials"]) {
+    ASSERT_EQ(t["selected_object"], t["intended_object"]) << t.dump();
+    ASSERT_EQ(t["selected_cell"], t["intended_cell"]) << t.dump();
+  }
+  EXPECT_EQ(summary["trials"][0]["outcome"], "placed");
+  EXPECT_EQ(summary["trials"][1]["outcome"], "returned: cell 2,2 is taken by object 20");
+  EXPECT_TRUE(summary["trials"][1]["placement_error_m"].is_null());
+  // Object 20 was taken from where the robot had put it, and put down at its new cell.
+  EXPECT_EQ(summary["trials"][2]["outcome"], "placed");
+  EXPECT_LT(summary["trials"][2]["placement_error_m"].get<double>(), 0.01);
+  std::vector<nlohmann::json> commands;
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    if (line["event"] == "robot_command") commands.push_back(line);
+  }
+  ASSERT_EQ(commands.size(), 9u);
+  // Trial 2: object 40 goes back where it was grasped.
+  const auto& grasp = commands[3];
+  const auto& drop = commands[4];
+  ASSERT_EQ(grasp["command"], "GRASP");
+  ASSERT_EQ(drop["command"], "DROP");
+  EXPECT_TRUE(drop["returning"].get<bool>());
+  EXPECT_NEAR(drop["target"][0].get<double>(), grasp["target"][0].get<double>(), 1e-9);
+  EXPECT_NEAR(drop["target"][1].get<double>(), grasp["target"][1].get<double>(), 1e-9);
+  // Trial 3 grasps object 20 at cell 2,2 (0, 0.66), where trial 1 put it.
+  const auto& regrasp = commands[6];
+  ASSERT_EQ(regrasp["object"], 20);
+  EXPECT_NEAR(regrasp["target"][0].get<double>(), 0.0, 0.005);
+  EXPECT_NEAR(regrasp["target"][1].get<double>(), 0.66, 0.005);
 }
 
 TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIntact) {
