@@ -1,11 +1,17 @@
 #include "session/image_writer.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 namespace arbci::app {
 
 ImageWriter::ImageWriter() {
   thread_ = std::thread([this] {
+    // PNG encoding must not take the cores from the cycle: the lowest priority (Linux applies a
+    // nice value to one thread). Nothing is lost: flush() waits for every image.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
     std::unique_lock lock(mutex_);
     while (true) {
       wake_.wait(lock, [&] { return stop_ || !queue_.empty(); });
