@@ -1,5 +1,6 @@
 #include "session/session.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -58,6 +59,13 @@ struct Session::Impl {
   // When the robot last put each object down (session time): its pose from before is stale.
   std::map<int, double> moved_at;
   cv::Vec3d grasped_from;  // where the object in the gripper was taken from
+  // The objects a trial's selection offers, as indices into the session's objects: stimulus code
+  // k is slots[k - 1]. Those the cameras see; chosen before each trial.
+  std::vector<size_t> slots;
+  // The arm is home after a put-down (that command), and the frame from which the cameras have
+  // seen the table without it.
+  std::optional<std::uint64_t> homed;
+  std::optional<std::int64_t> clear_view_frame;
   bool returning = false;  // the object goes back there: its cell was taken
 
   explicit Impl(render::GlContext& c) : context(c) {}
@@ -215,6 +223,7 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   paradigm_ = std::make_unique<bci::Paradigm>(
       config_.paradigm, static_cast<int>(config_.world.objects.size()), config_.world.grid.rows,
       config_.world.grid.columns, config_.eeg.seed + 11);
+  for (size_t i = 0; i < config_.world.objects.size(); ++i) m.slots.push_back(i);
   m.hmd = std::make_unique<render::HmdView>();
   m.hmd->setUndistort(config_.undistort);
   m.hmd_fbo =
@@ -258,6 +267,7 @@ Session::~Session() {
 
 void Session::start() {
   if (paradigm_->phase() != bci::Phase::Setup) return;
+  chooseSelectableObjects();
   paradigm_->start(!eeg_->hasModel());
 }
 void Session::pause() {
@@ -337,6 +347,7 @@ bool Session::step() {
   client_->poll();
   handleRobotEvents();
   measurePlacement();
+  endPutDownOnceInView();
   timing_.mark("robot");
 
   // Paradigm: this frame's stimuli, and what it asks for.
@@ -441,6 +452,10 @@ void Session::handleRobotEvents() {
       }
       if (!success)
         currentTrial().outcome = std::string("robot ") + robot::toString(e.outcome) + ": " + e.text;
+      if (success && m.robot_command_type == robot::MessageType::Home) {
+        m.homed = e.sequence;  // the put-down ends once the cameras have looked again
+        continue;
+      }
       paradigm_->robotFinished(success, e.text);
     } else if (ours && (e.kind == Kind::Rejected || e.kind == Kind::Failed)) {
       m.robot_command.reset();
@@ -452,6 +467,7 @@ void Session::handleRobotEvents() {
       paradigm_->robotFinished(false, why);
     } else if (e.kind == Kind::Silent) {
       m.robot_command.reset();
+      m.homed.reset();
       currentTrial().outcome = "robot fault: the backend went silent";
       paradigm_->robotFinished(false, "the robot backend went silent (stopped or unreachable)");
     }
@@ -481,6 +497,54 @@ void Session::measurePlacement() {
                        {"position", {o.position.x, o.position.y, o.position.z - height}}});
   }
   m.placement.reset();
+}
+
+const WorldObjectSettings& Session::objectOfCode(int code) const {
+  return config_.world.objects[impl_->slots.at(static_cast<size_t>(code - 1))];
+}
+
+void Session::endPutDownOnceInView() {
+  Impl& m = *impl_;
+  if (!m.homed) return;
+  if (!m.clear_view_frame) {
+    // The scene follows the robot's status: once it shows the arm home, two camera frames.
+    const auto& status = client_->status();
+    if (status && status->last_finished_sequence >= *m.homed)
+      m.clear_view_frame = frame_ + 2 * m.camera_every + 1;
+    return;
+  }
+  if (frame_ < *m.clear_view_frame) return;
+  m.homed.reset();
+  m.clear_view_frame.reset();
+  chooseSelectableObjects();
+  paradigm_->robotFinished(true, "");
+}
+
+void Session::chooseSelectableObjects() {
+  Impl& m = *impl_;
+  // In view: seen in the last 2 s, or just put down by the robot (seen again once the arm is
+  // home, a frame or two later). An object hidden or gone does not flash.
+  constexpr double kRecentS = 2.0;
+  std::vector<size_t> slots;
+  std::vector<int> ids;
+  for (size_t i = 0; i < config_.world.objects.size(); ++i) {
+    const int id = config_.world.objects[i].id;
+    const auto state = vision_->world().object(id);
+    const auto moved = m.moved_at.find(id);
+    const bool just_moved = moved != m.moved_at.end() && time_ - moved->second < kRecentS;
+    if ((state && state->age(time_) < kRecentS) || (state && just_moved)) {
+      slots.push_back(i);
+      ids.push_back(id);
+    }
+  }
+  if (slots == m.slots) return;
+  if (slots.size() < 2) {
+    m.log->write("objects_in_view", time_, {{"objects", ids}, {"kept", "fewer than 2 in view"}});
+    return;
+  }
+  m.slots = slots;
+  paradigm_->setObjectCount(static_cast<int>(slots.size()));
+  m.log->write("objects_in_view", time_, {{"objects", ids}});
 }
 
 std::optional<int> Session::objectOnCell(std::pair<int, int> cell) const {
@@ -537,14 +601,19 @@ void Session::handleParadigmEvents() {
             paradigm_->phase() == bci::Phase::CalibrationFlashing) {
           attended = e.codes;
           target = *e.codes.begin();
-          m.log->write("calibration_target", time_,
-                       {{"object", config_.world.objects[static_cast<size_t>(*target - 1)].id}});
+          m.log->write("calibration_target", time_, {{"object", objectOfCode(*target).id}});
         } else {
           const TrialRecord& trial = currentTrial();
           if (e.objects_layout) {
-            for (size_t i = 0; i < config_.world.objects.size(); ++i) {
-              if (config_.world.objects[i].id == trial.intended_object)
-                attended = {static_cast<int>(i) + 1};
+            for (size_t k = 0; k < m.slots.size(); ++k) {
+              if (config_.world.objects[m.slots[k]].id == trial.intended_object)
+                attended = {static_cast<int>(k) + 1};
+            }
+            if (attended.empty()) {
+              std::cerr << "trial " << trial.trial << ": the intended object "
+                        << trial.intended_object << " is not in view, so it does not flash\n";
+              m.log->write("intended_not_in_view", time_,
+                           {{"trial", trial.trial}, {"object", trial.intended_object}});
             }
           } else {
             attended = {trial.intended_cell.first,
@@ -566,7 +635,7 @@ void Session::handleParadigmEvents() {
       case Kind::SelectionMade: {
         TrialRecord& trial = currentTrial();
         if (e.objects_layout) {
-          trial.selected_object = config_.world.objects[static_cast<size_t>(e.object - 1)].id;
+          trial.selected_object = objectOfCode(e.object).id;
           trial.object_certainty = e.certainty;
           trial.object_flashes = m.selection_flashes;
         } else {
@@ -610,6 +679,7 @@ void Session::handleParadigmEvents() {
                        {{"method", config_.classifier_method},
                         {"auc", calibration_report_->auc},
                         {"accuracy_by_sequences", calibration_report_->accuracy}});
+          chooseSelectableObjects();
           paradigm_->modelTrained(true, "");
         } catch (const std::exception& error) {
           m.log->write("training_failed", time_, {{"reason", error.what()}});
@@ -619,7 +689,7 @@ void Session::handleParadigmEvents() {
         break;
       }
       case Kind::RobotGrasp: {
-        const int id = config_.world.objects[static_cast<size_t>(e.object - 1)].id;
+        const int id = objectOfCode(e.object).id;
         const auto state = vision_->world().object(id);
         const auto moved = m.moved_at.find(id);
         if (!state || (moved != m.moved_at.end() && state->seen_at_s <= moved->second)) {
@@ -704,7 +774,9 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
     h.id = o.id;
     h.T_world_top = state->T_robot_object;
     h.side_m = o.marker_m;
-    const int slot = static_cast<int>(i) + 1;
+    const auto in_slots = std::find(m.slots.begin(), m.slots.end(), i);
+    const int slot =
+        in_slots == m.slots.end() ? 0 : static_cast<int>(in_slots - m.slots.begin()) + 1;
     if (objects_phase && stimulus.lit.count(slot)) h.state = render::HighlightState::Flashing;
     if (stimulus.cued_object == slot)
       h.state = stimulus.lit.count(slot) ? render::HighlightState::Flashing

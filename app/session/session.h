@@ -120,6 +120,12 @@ class Session {
   void handleParadigmEvents();
   void measurePlacement();
   render::GridLayout gridLayout() const;
+  // The object a selection's stimulus code stands for this trial.
+  const WorldObjectSettings& objectOfCode(int code) const;
+  // After a put-down and homing: ends the robot phase once the cameras have seen the table.
+  void endPutDownOnceInView();
+  // Offers the next trials the objects the cameras see (every one unless some are hidden).
+  void chooseSelectableObjects();
   // The tracked object (other than the one in the gripper) standing on a grid cell, if any.
   std::optional<int> objectOnCell(std::pair<int, int> cell) const;
   void handleRobotEvents();

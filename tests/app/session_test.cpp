@@ -180,6 +180,45 @@ TEST(Session, AnObjectIsNeverPutOnAnotherAndAMovedObjectIsGraspedWhereItNowStand
   EXPECT_NEAR(regrasp["target"][1].get<double>(), 0.66, 0.005);
 }
 
+TEST(Session, OnlyTheObjectsTheCamerasSeeFlash) {
+  const auto folder = fresh("out_of_view");
+  const auto session = folder.string() + ".json";
+  // The four default objects and a fifth, 50, beside the robot where the cameras do not look.
+  std::ofstream(session) << R"({"eeg": {"erp_scale": 2.0},
+    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "world": {"objects": [
+      {"id": 10, "position": [-0.27, 0.42, 0.06]}, {"id": 20, "position": [-0.09, 0.42, 0.06]},
+      {"id": 30, "position": [0.09, 0.42, 0.06]}, {"id": 40, "position": [0.27, 0.42, 0.06]},
+      {"id": 50, "position": [0.55, 0.15, 0.06]}]},
+    "paradigm": {"calibration_selections": 4, "sequences": 8, "certainty": 0, "trials": 1,
+      "intended": [{"object": 30, "cell": [2, 2]}]},
+    "robot": {"speed_factor": 20}})";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session, "--seed", "3", "--out", folder.string()},
+      300.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<int> in_view;
+  int calibration_targets = 0;
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    if (line["event"] == "objects_in_view") in_view = line["objects"].get<std::vector<int>>();
+    if (line["event"] == "calibration_target") {
+      EXPECT_NE(line["object"], 50);
+      ++calibration_targets;
+    }
+  }
+  EXPECT_EQ(in_view, (std::vector<int>{10, 20, 30, 40}));
+  EXPECT_EQ(calibration_targets, 4);
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  ASSERT_EQ(summary["trials"].size(), 1u);
+  EXPECT_EQ(summary["trials"][0]["object_flashes"], 8 * 4);  // four objects a sequence, not five
+  EXPECT_EQ(summary["trials"][0]["selected_object"], 30);
+  EXPECT_EQ(summary["trials"][0]["outcome"], "placed");
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  for (const auto& stimulus : recording.stimuli) {
+    EXPECT_TRUE(stimulus.code <= 4 || stimulus.code > 100) << stimulus.code;
+  }
+}
+
 TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIntact) {
   const auto folder = fresh("robot_fault");
   const auto session = folder.string() + ".json";
