@@ -56,8 +56,6 @@ struct Session::Impl {
   // While the robot moves, the simulated clock keeps to the robot's pace (its speed factor).
   double robot_started_at = 0.0;
   std::chrono::steady_clock::time_point robot_started_wall;
-  // When the robot last put each object down (session time): its pose from before is stale.
-  std::map<int, double> moved_at;
   cv::Vec3d grasped_from;  // where the object in the gripper was taken from
   // The objects a trial's selection offers, as indices into the session's objects: stimulus code
   // k is slots[k - 1]. Those the cameras see; chosen before each trial.
@@ -81,19 +79,19 @@ std::vector<TrialIntent> intendedTrials(const SessionConfig& config) {
   for (const TrialIntent& t : intended) cell_of[t.object] = {t.row, t.column};
   std::mt19937_64 random(config.eeg.seed * 31 + 7);
   const auto& objects = config.world.objects;
+  const int rows = config.world.grid.rows, columns = config.world.grid.columns;
+  // With more objects than cells some must share: then any cell will do.
+  const bool any_cell = objects.size() > static_cast<size_t>(rows * columns);
   while (static_cast<int>(intended.size()) < config.paradigm.trials) {
     TrialIntent t;
     t.object = objects[random() % objects.size()].id;
     std::vector<std::pair<int, int>> free;
-    for (int row = 1; row <= config.world.grid.rows; ++row) {
-      for (int column = 1; column <= config.world.grid.columns; ++column) {
+    for (int row = 1; row <= rows; ++row) {
+      for (int column = 1; column <= columns; ++column) {
         bool taken = false;
         for (const auto& [id, cell] : cell_of)
           taken |= id != t.object && cell == std::pair{row, column};
-        if (!taken || objects.size() >
-                          static_cast<size_t>(config.world.grid.rows * config.world.grid.columns)) {
-          free.emplace_back(row, column);  // (more objects than cells: any cell)
-        }
+        if (!taken || any_cell) free.emplace_back(row, column);
       }
     }
     std::tie(t.row, t.column) = free[random() % free.size()];
@@ -443,7 +441,7 @@ void Session::handleRobotEvents() {
           m.placement = std::make_pair(currentTrial().trial, e.sequence);
           m.placement_since = std::chrono::steady_clock::now();
         }
-        m.moved_at[*m.grasped_id] = time_;
+        vision_->objectMoved(*m.grasped_id);
         // The arm parked over the table hides objects from the cameras: it goes home before the
         // next trial, and the put-down ends when it is there.
         sendRobot(robot::MessageType::Home, {});
@@ -522,17 +520,15 @@ void Session::endPutDownOnceInView() {
 
 void Session::chooseSelectableObjects() {
   Impl& m = *impl_;
-  // In view: seen in the last 2 s, or just put down by the robot (seen again once the arm is
-  // home, a frame or two later). An object hidden or gone does not flash.
+  // In view: seen in the last 2 s (an object the robot moved, since it was moved). An object
+  // hidden or gone does not flash.
   constexpr double kRecentS = 2.0;
   std::vector<size_t> slots;
   std::vector<int> ids;
   for (size_t i = 0; i < config_.world.objects.size(); ++i) {
     const int id = config_.world.objects[i].id;
     const auto state = vision_->world().object(id);
-    const auto moved = m.moved_at.find(id);
-    const bool just_moved = moved != m.moved_at.end() && time_ - moved->second < kRecentS;
-    if ((state && state->age(time_) < kRecentS) || (state && just_moved)) {
+    if (state && state->age(time_) < kRecentS) {
       slots.push_back(i);
       ids.push_back(id);
     }
@@ -691,13 +687,10 @@ void Session::handleParadigmEvents() {
       case Kind::RobotGrasp: {
         const int id = objectOfCode(e.object).id;
         const auto state = vision_->world().object(id);
-        const auto moved = m.moved_at.find(id);
-        if (!state || (moved != m.moved_at.end() && state->seen_at_s <= moved->second)) {
-          // Never a grasp at a stale position: the object was put elsewhere since it was seen.
-          currentTrial().outcome =
-              "object " + std::to_string(id) +
-              (state ? " has not been seen by the cameras since the robot moved it"
-                     : " was never seen by the cameras");
+        if (!state) {
+          // Never a grasp at a stale position: a moved object is grasped once seen again.
+          currentTrial().outcome = "object " + std::to_string(id) +
+                                   " is not in view (never seen, or not since the robot moved it)";
           paradigm_->robotFinished(false, currentTrial().outcome);
           break;
         }

@@ -89,6 +89,11 @@ void VisionStage::repeat(double t) {
   world_.update(t, last_poses_);
 }
 
+void VisionStage::objectMoved(int id) {
+  world_.forget(id);
+  last_poses_.erase(id);
+}
+
 std::optional<vision::Pose> VisionStage::T_cam_world_left() const {
   const auto T_robot_cam = world_.T_robot_cam();
   if (!T_robot_cam) return std::nullopt;

@@ -23,6 +23,8 @@ class VisionStage {
   void setRightImage(const cv::Mat& right) { right_image_ = right; }
   // The same frames as last time, at time `t`: the last poses are seen again without tracking.
   void repeat(double t);
+  // The robot has moved object `id`: its pose is unknown until a new frame shows it.
+  void objectMoved(int id);
 
   const cv::Mat& leftImage() const { return left_image_; }
   const cv::Mat& rightImage() const { return right_image_.empty() ? left_image_ : right_image_; }

@@ -11,16 +11,10 @@
 #include "arbci/render/hmd_view.h"
 #include "arbci/render/simulated_camera.h"
 #include "arbci/vision/marker_detector.h"
+#include "render/test_camera.h"
 
 namespace arbci::render {
 namespace {
-
-vision::CameraModel camera640() {
-  vision::CameraModel c;
-  c.image_size = {640, 480};
-  c.camera_matrix = cv::Matx33d(700, 0, 319.5, 0, 700, 239.5, 0, 0, 1);
-  return c;
-}
 
 cv::Mat toMat(const RgbaImage& image) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.pixels.data()));
@@ -61,7 +55,7 @@ cv::Point2d intersect(const cv::Vec4f& l1, const cv::Vec4f& l2) {
 }
 
 struct Rig {
-  vision::CameraModel camera = camera640();
+  vision::CameraModel camera = test::camera640();
   vision::Pose left = vision::cameraLookingAt({-0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
   vision::Pose right = vision::cameraLookingAt({0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
 };
@@ -169,7 +163,7 @@ TEST(HmdView, AScheduledFlashAppearsOnItsFramesAndNoOther) {
 
 TEST(HmdView, UndistortedBackgroundMatchesItsRectifiedVirtualCamera) {
   auto context = createHeadlessContext({1280, 480});
-  vision::CameraModel lens = camera640();
+  vision::CameraModel lens = test::camera640();
   lens.distortion = {-0.25, 0.08, 0.0, 0.0, 0.0};
   Rig rig;
   SimulatedCamera camera(lens);

@@ -10,16 +10,10 @@
 #include "arbci/render/simulated_camera.h"
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/undistortion.h"
+#include "render/test_camera.h"
 
 namespace arbci::render {
 namespace {
-
-vision::CameraModel camera640() {
-  vision::CameraModel c;
-  c.image_size = {640, 480};
-  c.camera_matrix = cv::Matx33d(700, 0, 319.5, 0, 700, 239.5, 0, 0, 1);
-  return c;
-}
 
 Scene oneObject(int id, const vision::Pose& top) {
   Scene scene;
@@ -52,7 +46,7 @@ void expectDetectedAt(const cv::Mat& frame, const vision::CameraModel& camera, b
 
 TEST(SimulatedCamera, AMarkerAtAKnownPoseIsTrackedWithinACentimetreAndADegree) {
   auto context = createHeadlessContext({64, 64});
-  const vision::CameraModel camera = camera640();
+  const vision::CameraModel camera = test::camera640();
   SimulatedCamera simulated(camera);
   const vision::Pose T_cam_world = vision::cameraLookingAt({0.05, 1.45, 0.45}, {0.0, 0.65, 0.0});
   for (const auto& [x, y, spin] : std::vector<std::tuple<double, double, double>>{
@@ -69,7 +63,7 @@ TEST(SimulatedCamera, AMarkerAtAKnownPoseIsTrackedWithinACentimetreAndADegree) {
 
 TEST(SimulatedCamera, ThroughADistortingLensWithNoiseAndBlur) {
   auto context = createHeadlessContext({64, 64});
-  vision::CameraModel camera = camera640();
+  vision::CameraModel camera = test::camera640();
   camera.distortion = {-0.20, 0.05, 0.0, 0.0, 0.0};
   SimulatedCamera simulated(camera, 7);
   const vision::Pose T_cam_world = vision::cameraLookingAt({-0.05, 1.4, 0.5}, {0.0, 0.6, 0.0});

@@ -66,5 +66,22 @@ TEST(RobotFrame, WithoutTheReferenceObjectsAgeAndTheStatusSaysSo) {
   EXPECT_NE(world.status(3.0).find("not seen for 2.0 s"), std::string::npos) << world.status(3.0);
 }
 
+TEST(RobotFrame, AMovedObjectHasNoPoseUntilSeenAgain) {
+  WorldModel world;
+  PoseEstimate reference, object;
+  reference.pose.translation = {0, 0, 0.5};
+  object.pose.translation = {0.1, 0, 0.5};
+  world.update(1.0, {{0, reference}, {5, object}});
+  ASSERT_TRUE(world.object(5));
+  world.forget(5);
+  EXPECT_FALSE(world.object(5));
+  EXPECT_TRUE(world.objects().empty());
+  object.pose.translation = {-0.1, 0, 0.5};
+  world.update(2.0, {{0, reference}, {5, object}});
+  ASSERT_TRUE(world.object(5));
+  EXPECT_NEAR(world.object(5)->T_robot_object.translation[0],
+              world.T_robot_cam()->apply(object.pose.translation)[0], 1e-12);
+}
+
 }  // namespace
 }  // namespace arbci::vision

@@ -23,6 +23,10 @@ std::vector<int> WorldModel::update(double time_s,
   return updated;
 }
 
+void WorldModel::forget(int id) {
+  objects_.erase(id);
+}
+
 std::optional<ObjectState> WorldModel::object(int id) const {
   const auto found = objects_.find(id);
   if (found == objects_.end()) return std::nullopt;

@@ -40,6 +40,9 @@ class WorldModel {
   // Returns the ids whose robot-frame pose this frame updated.
   std::vector<int> update(double time_s, const std::map<int, PoseEstimate>& camera_poses);
 
+  // The object has been moved (by the robot): its pose is unknown until the cameras see it again.
+  void forget(int id);
+
   std::optional<ObjectState> object(int id) const;
   std::vector<ObjectState> objects() const;
   bool referenceVisible(double now_s, double max_age_s = 0.5) const;
