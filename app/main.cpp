@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   arbci::app::addP300Commands(root, exit_code);
   arbci::app::addRobotCommand(root, exit_code);
   arbci::app::addRunCommand(root, exit_code);
+  arbci::app::addTimingCheckCommand(root, exit_code);
 
   try {
     root.parse(argc, argv);

@@ -1,56 +1,106 @@
 #include "session/eeg_stage.h"
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 #include "arbci/bci/file_source.h"
 #include "arbci/bci/filters.h"
 #include "arbci/bci/simulated_subject.h"
 
 namespace arbci::app {
+namespace {
 
-EegStage::EegStage(const SessionConfig& config, const std::filesystem::path& recording_path,
-                   std::shared_ptr<bci::SampleClock> clock,
-                   const std::map<std::string, std::string>& parameters)
-    : config_(config), clock_(std::move(clock)) {
+// A live simulated subject holds each block back this long, as a USB amplifier's buffer does;
+// it knows its own delay, so its stamps stay true (a real amplifier's is measured by
+// `arbci timing-check` and set as eeg.latency_ms).
+constexpr double kSimulatedTransportS = 0.020;
+
+std::unique_ptr<bci::EegSource> openSource(const SessionConfig& config,
+                                           std::shared_ptr<bci::SampleClock> clock) {
   if (config.eeg.source == "file") {
     bci::Recording replay = bci::readRecording(config.eeg.file);
     replay.stimuli.clear();  // the session presents its own stimuli
-    source_ = std::make_unique<bci::FileSource>(std::move(replay), clock_, config.eeg.block_size);
-  } else {
-    bci::SimulatedSubjectConfig subject;
-    subject.montage = config.eeg.montage;
-    subject.rate_hz = config.eeg.rate_hz;
-    subject.block_size = config.eeg.block_size;
-    subject.seed = config.eeg.seed;
-    subject.line_hz = config.eeg.line_hz;
-    bci::SubjectProfile profile = bci::SubjectProfile::drawn(config.eeg.seed);
-    profile.p3_amplitude_uv *= config.eeg.erp_scale;
-    profile.n2_amplitude_uv *= config.eeg.erp_scale;
-    subject.profile = profile;
-    source_ = std::make_unique<bci::SimulatedSubject>(subject, clock_);
+    return std::make_unique<bci::FileSource>(std::move(replay), clock, config.eeg.block_size);
   }
-  writer_ = std::make_unique<bci::RecordingWriter>(recording_path, source_->info(), parameters);
-  filters_ = std::make_unique<bci::FilterChain>(config.pipeline.filter, source_->info());
-  epocher_ = std::make_unique<bci::Epocher>(source_->info().channelCount(), source_->info().rate_hz,
+  bci::SimulatedSubjectConfig subject;
+  subject.montage = config.eeg.montage;
+  subject.rate_hz = config.eeg.rate_hz;
+  subject.block_size = config.eeg.block_size;
+  subject.seed = config.eeg.seed;
+  subject.line_hz = config.eeg.line_hz;
+  subject.photodiode = !config.eeg.photodiode_channel.empty();
+  subject.photodiode_channel = config.eeg.photodiode_channel;
+  bci::SubjectProfile profile = bci::SubjectProfile::drawn(config.eeg.seed);
+  profile.p3_amplitude_uv *= config.eeg.erp_scale;
+  profile.n2_amplitude_uv *= config.eeg.erp_scale;
+  subject.profile = profile;
+  return std::make_unique<bci::SimulatedSubject>(subject, clock);
+}
+
+}  // namespace
+
+EegStage::EegStage(const SessionConfig& config, const std::filesystem::path& recording_path,
+                   bool stepped, const std::map<std::string, std::string>& parameters)
+    : config_(config) {
+  std::shared_ptr<bci::SampleClock> clock;
+  if (stepped)
+    clock = std::make_shared<bci::ManualClock>();
+  else
+    clock = std::make_shared<bci::WallClock>(config.eeg.source == "simulated" ? kSimulatedTransportS
+                                                                              : 0.0);
+  bci::AcquisitionSettings settings;
+  settings.latency_s = config.eeg.latency_ms / 1000.0;
+  acquisition_ = std::make_unique<bci::Acquisition>(
+      openSource(config, clock), clock,
+      stepped ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live, settings);
+  const bci::SignalInfo& all = acquisition_->info();
+  eeg_info_ = all;
+  if (!config.eeg.photodiode_channel.empty()) {
+    const auto found =
+        std::find(all.channels.begin(), all.channels.end(), config.eeg.photodiode_channel);
+    if (found == all.channels.end()) {
+      std::string names;
+      for (const auto& c : all.channels) names += (names.empty() ? "" : ", ") + c;
+      throw SessionConfigError(
+          config.source + ": eeg.photodiode_channel = \"" + config.eeg.photodiode_channel +
+          "\": the EEG source has no such channel (it has: " + names + "; use \"\" for none)");
+    }
+    photodiode_ = static_cast<int>(found - all.channels.begin());
+    eeg_info_.channels.erase(eeg_info_.channels.begin() + photodiode_);
+  }
+  writer_ = std::make_unique<bci::RecordingWriter>(recording_path, all, parameters);
+  filters_ = std::make_unique<bci::FilterChain>(config.pipeline.filter, eeg_info_);
+  epocher_ = std::make_unique<bci::Epocher>(eeg_info_.channelCount(), eeg_info_.rate_hz,
                                             config.pipeline.window, 10.0);
   calibration_.source = "calibration run";
   calibration_.format = "memory";
-  calibration_.info = source_->info();
+  calibration_.info = eeg_info_;
   calibration_.parameters["Paradigm"] =
       "single stimulus, " + std::to_string(config.world.objects.size()) + " stimuli";
-  recent_.assign(static_cast<size_t>(source_->info().channelCount()), {});
+  recent_.assign(static_cast<size_t>(eeg_info_.channelCount()), {});
+  acquisition_->start();
 }
 
 EegStage::~EegStage() {
   try {
+    if (training_.valid()) training_.wait();
     close();
   } catch (const std::exception&) {
     // A destructor does not throw; the recording holds what was written.
   }
 }
 
-std::int64_t EegStage::sampleAt(double seconds) const {
-  return static_cast<std::int64_t>(seconds * info().rate_hz);
+void EegStage::advanceTo(double seconds) {
+  acquisition_->advanceTo(seconds);
+}
+
+std::int64_t EegStage::sampleAt(double host_s) const {
+  return acquisition_->firstSampleAtOrAfter(host_s);
+}
+
+void EegStage::displayed(double host_s, bool patch_lit) {
+  acquisition_->withSource([&](bci::EegSource& s) { s.displayed(host_s, patch_lit); });
 }
 
 void EegStage::setModel(bci::P300Model model) {
@@ -64,11 +114,26 @@ void EegStage::setModel(bci::P300Model model) {
   calibration_.data.shrink_to_fit();
 }
 
+bci::Block EegStage::eegOnly(const bci::Block& block) const {
+  if (photodiode_ < 0) return block;
+  bci::Block out(block.first_sample, block.channels - 1, block.samples);
+  for (int c = 0, o = 0; c < block.channels; ++c) {
+    if (c == photodiode_) continue;
+    std::copy_n(block.data.begin() + static_cast<std::ptrdiff_t>(c) * block.samples, block.samples,
+                out.data.begin() + static_cast<std::ptrdiff_t>(o++) * block.samples);
+  }
+  return out;
+}
+
 void EegStage::poll() {
-  for (bci::Block& block : source_->poll(256)) {
-    if (block.first_sample != next_sample_) lost_ += block.first_sample - next_sample_;
-    next_sample_ = block.endSample();
-    writer_->write(block);
+  for (const bci::SampleLoss& loss : acquisition_->takeLosses()) {
+    writer_->addAnnotation({loss.first_sample,
+                            "Lost " + std::to_string(loss.samples) + " samples: " + loss.reason,
+                            static_cast<int>(loss.samples)});
+  }
+  for (const bci::Block& recorded : acquisition_->take()) {
+    writer_->write(recorded);
+    bci::Block block = eegOnly(recorded);
     if (keep_signal_) {
       // Stored sample-major while collecting (appending is cheap); transposed when training.
       for (int s = 0; s < block.samples; ++s) {
@@ -101,29 +166,40 @@ void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,
   selection_objects_ = objects;
   target_ = target;
   presented_ = scored_ = 0;
-  source_->attend(attended);
+  acquisition_->withSource([&](bci::EegSource& s) { s.attend(attended); });
   accumulator_.reset();
   if (model_) accumulator_.emplace(layout, model_->score_model);
 }
 
-void EegStage::flash(int code, std::int64_t sample, int duration_samples) {
-  bci::StimulusEvent event{sample, code, target_ && *target_ == code, duration_samples};
-  source_->present(event);
-  bci::StimulusEvent recorded = event;
-  if (!selection_objects_) recorded.code += 100;
-  writer_->addStimulus(recorded);
+void EegStage::flash(int code, std::int64_t sample) {
+  const bool target = target_ && *target_ == code;
+  const int nominal_duration =
+      static_cast<int>(config_.paradigm.flashSeconds() * eeg_info_.rate_hz + 0.5);
+  bci::StimulusEvent event{sample, code, target, nominal_duration};
+  acquisition_->withSource([&](bci::EegSource& s) { s.present(event); });
   if (target_ && keep_signal_) calibration_.stimuli.push_back(event);
-  flashes_[sample] = {selection_, code};
+  const FlashRecord record{selection_, code, target, selection_objects_};
+  flashes_[sample] = record;
+  unrecorded_[sample] = record;
   epocher_->addEvent(event);
   ++presented_;
+}
+
+void EegStage::flashEnded(std::int64_t onset_sample, int duration_samples) {
+  const auto found = unrecorded_.find(onset_sample);
+  if (found == unrecorded_.end()) return;
+  const FlashRecord& r = found->second;
+  writer_->addStimulus(
+      {onset_sample, r.objects ? r.code : r.code + 100, r.target, duration_samples});
+  unrecorded_.erase(found);
 }
 
 void EegStage::annotate(std::int64_t sample, const std::string& text) {
   writer_->addAnnotation({sample, text, 0});
 }
 
-bci::EvaluationReport EegStage::train(const std::string& method, const bci::Progress& progress) {
-  // Channel-major, as a recording holds its samples.
+void EegStage::startTraining(const std::string& method) {
+  // A copy, channel-major as a recording holds its samples: the cycle keeps recording meanwhile.
   bci::Recording recording = calibration_;
   const int channels = info().channelCount();
   recording.data.assign(calibration_.data.size(), 0.0f);
@@ -133,14 +209,26 @@ bci::EvaluationReport EegStage::train(const std::string& method, const bci::Prog
           calibration_.data[static_cast<size_t>(s * channels + c)];
     }
   }
-  bci::TrainingSettings settings;
-  settings.method = method;
-  settings.folds = 4;
-  const bci::P300Dataset data = bci::buildDataset({recording}, config_.pipeline, progress);
-  bci::TrainingResult result = bci::trainModel(data, config_.pipeline, settings, progress);
-  result.model.provenance["training_files"] = {"this session's calibration run"};
-  setModel(std::move(result.model));
-  return result.cross_validation.report;
+  const bci::PipelineSettings pipeline = config_.pipeline;
+  training_ =
+      std::async(std::launch::async, [recording = std::move(recording), pipeline, method]() {
+        bci::TrainingSettings settings;
+        settings.method = method;
+        settings.folds = 4;
+        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+        bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
+        result.model.provenance["training_files"] = {"this session's calibration run"};
+        return TrainingOutcome{std::move(result.model), result.cross_validation.report};
+      });
+}
+
+std::optional<TrainingOutcome> EegStage::trainingResult(bool wait) {
+  if (!training_.valid()) return std::nullopt;
+  if (!wait && training_.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+    return std::nullopt;
+  TrainingOutcome outcome = training_.get();  // rethrows the worker's error
+  setModel(outcome.model);
+  return outcome;
 }
 
 bool EegStage::selectionScored() const {
@@ -163,8 +251,24 @@ std::int64_t EegStage::samplesRecorded() const {
   return writer_ ? writer_->samplesWritten() : 0;
 }
 
+void EegStage::drainUntil(double host_s, double timeout_s) {
+  if (acquisition_->mode() != bci::Acquisition::Mode::Live) return;
+  const std::int64_t wanted = sampleAt(host_s);
+  const double give_up = bci::hostSeconds() + timeout_s;
+  while (samplesRecorded() < wanted && bci::hostSeconds() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    poll();
+  }
+}
+
 void EegStage::close() {
-  if (writer_) writer_->close();
+  if (acquisition_) acquisition_->stop();
+  if (writer_) {
+    for (const auto& [sample, r] : unrecorded_)
+      writer_->addStimulus({sample, r.objects ? r.code : r.code + 100, r.target, 0});
+    unrecorded_.clear();
+    writer_->close();
+  }
 }
 
 std::vector<std::vector<float>> EegStage::recentSignal(int samples) const {

@@ -1,61 +1,86 @@
-// The EEG half of the cycle: polls the source, records every block and event to the session's
-// BDF+ file, filters, cuts epochs around the flashes actually presented, scores them with the
-// model and accumulates the scores of the current selection. It also keeps the calibration run's
-// signal and trains the model from it, exactly as `arbci train` would.
+// The EEG half of the cycle: takes the blocks the acquisition delivered (on the EEG sample clock),
+// records every block and event to the session's BDF+ file, filters, cuts epochs around the
+// flashes actually presented, scores them with the model and accumulates the scores of the
+// current selection. It keeps the calibration run's signal and trains the model from it on a
+// worker thread, exactly as `arbci train` would. A photodiode channel, when there is one, is
+// recorded but kept out of the filters, epochs and classifier.
 #pragma once
 
 #include <filesystem>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
 #include <set>
 
+#include "arbci/bci/acquisition.h"
 #include "arbci/bci/decision.h"
-#include "arbci/bci/eeg_source.h"
 #include "arbci/bci/epocher.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
-#include "arbci/bci/sample_clock.h"
 #include "session/session_config.h"
 
 namespace arbci::app {
 
+struct TrainingOutcome {
+  bci::P300Model model;
+  bci::EvaluationReport report;
+};
+
 class EegStage {
  public:
-  // Opens the source named by the session and starts the recording. Throws std::runtime_error.
-  EegStage(const SessionConfig& config, const std::filesystem::path& recording_path,
-           std::shared_ptr<bci::SampleClock> clock,
+  // Opens the source named by the session and starts the recording. `stepped`: the source runs
+  // in lock-step with a simulated clock (advanceTo); otherwise on its own clock, acquired by a
+  // thread. Throws std::runtime_error (SessionConfigError naming the key for a bad channel).
+  EegStage(const SessionConfig& config, const std::filesystem::path& recording_path, bool stepped,
            const std::map<std::string, std::string>& parameters);
   ~EegStage();
 
-  const bci::SignalInfo& info() const { return source_->info(); }
+  // The EEG channels (without the photodiode): what filters, epochs and models see.
+  const bci::SignalInfo& info() const { return eeg_info_; }
+  bool hasPhotodiode() const { return photodiode_ >= 0; }
+  // Stepped: the simulated clock is now at `seconds`.
+  void advanceTo(double seconds);
   void poll();
-  // The sample index at `seconds` of the experiment's clock.
-  std::int64_t sampleAt(double seconds) const;
+  // The first EEG sample taken at or after host instant `host_s` (the clock model).
+  std::int64_t sampleAt(double host_s) const;
+  // What the screen showed from `host_s` on (the simulated subject's virtual photodiode).
+  void displayed(double host_s, bool patch_lit);
 
   // A new selection: its stimuli (objects, or grid rows and columns), what the subject attends
   // (the simulated subject looks there), and for the calibration run the cued target.
   void startSelection(bool objects, const bci::ParadigmLayout& layout,
                       const std::set<int>& attended, std::optional<int> target);
-  // A flash presented at `sample`; grid codes are recorded as 100 + code.
-  void flash(int code, std::int64_t sample, int duration_samples);
+  // A flash first presented at `sample` (its onset); epoched and shown to the subject now.
+  void flash(int code, std::int64_t sample);
+  // Its measured duration, once the frame after its last is presented: recorded then, as
+  // "Stim <code> T|N" (grid codes as 100 + code) with the duration.
+  void flashEnded(std::int64_t onset_sample, int duration_samples);
   void annotate(std::int64_t sample, const std::string& text);
 
   bool hasModel() const { return model_.has_value(); }
   const std::optional<bci::P300Model>& model() const { return model_; }
   void setModel(bci::P300Model model);
-  // Trains on the calibration run; returns the cross-validation report or throws with the reason.
-  bci::EvaluationReport train(const std::string& method, const bci::Progress& progress = {});
+  // Trains on the calibration run on a worker thread; trainingResult() returns it once done
+  // (rethrowing a training error), waiting for it when `wait`.
+  void startTraining(const std::string& method);
+  bool training() const { return training_.valid(); }
+  std::optional<TrainingOutcome> trainingResult(bool wait);
 
   // Every presented flash of the current selection has been scored.
   bool selectionScored() const;
   int scoredSequences() const;
   bci::Decision decide() const;
 
-  std::int64_t lostSamples() const { return lost_; }
+  std::int64_t lostSamples() const { return acquisition_->lostSamples(); }
   std::int64_t missedEpochs() const;
   std::int64_t samplesRecorded() const;
+  double clockDriftPpm() const { return acquisition_->driftPpm(); }
+  double clockJitterMs() const { return acquisition_->jitterS() * 1000.0; }
+  // Live: waits (at most `timeout_s`) until the samples taken up to host instant `host_s` have
+  // arrived and are recorded, so the last flashes' EEG and photodiode edges are in the file.
+  void drainUntil(double host_s, double timeout_s);
   void close();
 
   // For the panels: the latest filtered samples of each channel (up to `samples`).
@@ -65,10 +90,15 @@ class EegStage {
   struct FlashRecord {
     int selection = 0;
     int code = 0;
+    bool target = false;
+    bool objects = true;
   };
+  bci::Block eegOnly(const bci::Block& block) const;
+
   const SessionConfig& config_;
-  std::shared_ptr<bci::SampleClock> clock_;
-  std::unique_ptr<bci::EegSource> source_;
+  std::unique_ptr<bci::Acquisition> acquisition_;
+  bci::SignalInfo eeg_info_;
+  int photodiode_ = -1;  // the photodiode's channel in the source's blocks
   std::unique_ptr<bci::RecordingWriter> writer_;
   std::unique_ptr<bci::FilterChain> filters_;
   std::unique_ptr<bci::Epocher> epocher_;
@@ -77,9 +107,9 @@ class EegStage {
   // Calibration data, for training.
   bci::Recording calibration_;
   bool keep_signal_ = true;
-  std::int64_t next_sample_ = 0;
-  std::int64_t lost_ = 0;
-  std::map<std::int64_t, FlashRecord> flashes_;  // by onset sample, until epoched
+  std::future<TrainingOutcome> training_;
+  std::map<std::int64_t, FlashRecord> flashes_;     // by onset sample, until epoched
+  std::map<std::int64_t, FlashRecord> unrecorded_;  // by onset sample, until its duration is known
   int selection_ = 0;
   bool selection_objects_ = true;
   std::optional<int> target_;

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -20,6 +21,7 @@
 #include "session/robot_process.h"
 #include "session/session_log.h"
 #include "session/simulated_world.h"
+#include "session/stimulus_timing.h"
 
 namespace arbci::app {
 
@@ -31,8 +33,17 @@ struct Session::Impl {
   std::unique_ptr<CameraCapture> left_capture, right_capture;
   std::uint64_t left_seen = 0;
   std::unique_ptr<RobotProcess> robotd;
-  std::shared_ptr<bci::ManualClock> manual_clock;
-  std::shared_ptr<bci::SampleClock> clock;
+  // Session second 0 on the host clock (0 for a simulated clock, which is its own host clock).
+  double host_origin = 0.0;
+  // The frame being drawn: when it is due on screen, what it lights, which flashes it shows first.
+  double due = 0.0;
+  std::set<int> lit;
+  std::vector<int> first_shown;
+  bool frame_pending = false;
+  std::optional<double> last_presented;
+  bool patch_lit = false;  // as last told to the EEG source
+  bool warned_slow_display = false;
+  std::unique_ptr<StimulusTiming> stimulus_timing;
   std::unique_ptr<SessionLog> log;
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
   int camera_every = 2;  // display frames per camera frame
@@ -136,6 +147,11 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   Impl& m = *impl_;
   if (options.seed) config_.eeg.seed = *options.seed;
   if (options.trials) config_.paradigm.trials = *options.trials;
+  if (options.flashes_only_s > 0.0) {
+    // Cued flashing without end: the run is over before the calibration run would be.
+    config_.paradigm.calibration_selections = 200;
+    config_.model_file.clear();
+  }
   config_.checkResources();
   timing_ = CycleTiming(1000.0 * config_.eeg.block_size / config_.eeg.rate_hz);
   folder_ = options.folder;
@@ -149,14 +165,6 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
       std::max(1, static_cast<int>(std::lround(config_.display_hz / config_.cameras.rate_hz)));
 
   m.intended = intendedTrials(config_);
-
-  // The clock: simulated (frames and samples advance together) or the wall clock.
-  if (options.simulated_clock) {
-    m.manual_clock = std::make_shared<bci::ManualClock>();
-    m.clock = m.manual_clock;
-  } else {
-    m.clock = std::make_shared<bci::WallClock>();
-  }
 
   // Cameras.
   context.makeCurrent();
@@ -215,7 +223,13 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
       {"DisplayHz", std::to_string(config_.display_hz)},
       {"Classifier", config_.classifier_method},
   };
-  eeg_ = std::make_unique<EegStage>(config_, folder_ / "recording.bdf", m.clock, parameters);
+  parameters["PhotodiodeChannel"] = config_.eeg.photodiode_channel;
+  parameters["SoaMs"] = std::to_string(config_.paradigm.soaSeconds() * 1000.0);
+  // Simulated clock: the EEG advances in lock-step with the frames; otherwise the source runs on
+  // its own clock and a thread acquires it.
+  eeg_ = std::make_unique<EegStage>(config_, folder_ / "recording.bdf", options.simulated_clock,
+                                    parameters);
+  m.stimulus_timing = std::make_unique<StimulusTiming>(config_.paradigm, eeg_->info().rate_hz);
   if (!config_.model_file.empty()) eeg_->setModel(bci::P300Model::load(config_.model_file));
 
   paradigm_ = std::make_unique<bci::Paradigm>(
@@ -252,6 +266,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   m.log->write(
       "session_started", 0.0,
       {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
+  m.wall_start = std::chrono::steady_clock::now();
+  m.host_origin = options.simulated_clock ? 0.0 : bci::hostSeconds();
   if (options.start_immediately) start();
 }
 
@@ -266,7 +282,7 @@ Session::~Session() {
 void Session::start() {
   if (paradigm_->phase() != bci::Phase::Setup) return;
   chooseSelectableObjects();
-  paradigm_->start(!eeg_->hasModel());
+  paradigm_->start(!eeg_->hasModel() || options_.flashes_only_s > 0.0);
 }
 void Session::pause() {
   paradigm_->pause();
@@ -300,16 +316,20 @@ bool Session::step() {
   if (ended_) return false;
   Impl& m = *impl_;
   m.context.makeCurrent();
-  time_ =
-      options_.simulated_clock
-          ? static_cast<double>(frame_) / config_.display_hz
-          : std::chrono::duration<double>(std::chrono::steady_clock::now() - m.wall_start).count();
+  time_ = options_.simulated_clock ? static_cast<double>(frame_) / config_.display_hz
+                                   : bci::hostSeconds() - m.host_origin;
+  // When this frame will be on screen: simulated, now; in a window, a period after the last one
+  // (or now, when the cycle itself is late).
+  m.due = time_;
+  if (!options_.simulated_clock && m.last_presented)
+    m.due = std::max(time_, *m.last_presented + 1.0 / config_.display_hz);
   timing_.beginCycle();
 
-  // EEG: everything up to now.
-  if (m.manual_clock) m.manual_clock->advanceTo(time_);
+  // EEG: everything that has arrived (simulated: generated up to now).
+  if (options_.simulated_clock) eeg_->advanceTo(time_);
   eeg_->poll();
   timing_.mark("eeg");
+  collectTraining();
 
   // Cameras and tracking.
   const bool left_due = frame_ % m.camera_every == 0;
@@ -349,16 +369,21 @@ bool Session::step() {
   timing_.mark("robot");
 
   // Paradigm: this frame's stimuli, and what it asks for.
-  const bci::FrameStimulus stimulus = paradigm_->frame(frame_);
+  const bci::FrameStimulus stimulus = paradigm_->frame(frame_, m.due);
   m.last_stimulus = stimulus;
+  m.lit = stimulus.lit;
+  m.first_shown.clear();
+  m.frame_pending = true;
   handleParadigmEvents();
   decideIfReady();
   timing_.mark("paradigm");
 
   renderHmd(stimulus);
   timing_.mark("render");
-  if (m.context.isHeadless())
+  if (m.context.isHeadless()) {
     m.context.present();  // a window is presented by its owner, with the panels
+    presented(options_.simulated_clock ? time_ : bci::hostSeconds());
+  }
   timing_.mark("present");
   const double total = timing_.endCycle();
   if (total > timing_.budgetMs()) {
@@ -386,6 +411,8 @@ bool Session::step() {
     endRun("finished");
   }
   if (phase == bci::Phase::Aborted) endRun("aborted");
+  if (options_.flashes_only_s > 0.0 && time_ >= options_.flashes_only_s)
+    endRun("timing check done");
   if (options_.start_immediately && time_ > options_.max_session_s)
     endRun("the session ran past its time limit");
   if (options_.progress && frame_ % 600 == 0)
@@ -406,6 +433,83 @@ bool Session::step() {
     std::this_thread::sleep_until(due);
   }
   return !ended_;
+}
+
+void Session::collectTraining() {
+  if (!eeg_->training()) return;
+  // A simulated clock waits for it (the same frame every run); a live cycle looks each frame.
+  try {
+    const auto outcome = eeg_->trainingResult(options_.simulated_clock);
+    if (!outcome) return;
+    calibration_report_ = outcome->report;
+    eeg_->model()->save(folder_ / "model.json");
+    impl_->log->write("trained", time_,
+                      {{"method", config_.classifier_method},
+                       {"auc", calibration_report_->auc},
+                       {"accuracy_by_sequences", calibration_report_->accuracy}});
+    chooseSelectableObjects();
+    paradigm_->modelTrained(true, "");
+  } catch (const std::exception& error) {
+    impl_->log->write("training_failed", time_, {{"reason", error.what()}});
+    paradigm_->modelTrained(false, error.what());
+  }
+  timing_.mark("training");
+}
+
+void Session::presented(double host_s) {
+  Impl& m = *impl_;
+  if (!m.frame_pending) return;
+  m.frame_pending = false;
+  const double at = host_s - m.host_origin;
+  const std::int64_t sample = eeg_->sampleAt(host_s);
+  // What the patch really shows, read back from the frame: a diode would see the same.
+  bool patch_lit = false;
+  if (eeg_->hasPhotodiode()) {
+    const int middle = render::HmdFrame::kPatchPx / 2;
+    patch_lit = render::readGrey(m.hmd_fbo->id(), m.hmd_fbo->size(), middle, middle) > 127;
+  }
+  const StimulusTiming::Frame frame =
+      m.stimulus_timing->presented(m.due, at, sample, m.lit, m.first_shown);
+  if (eeg_->hasPhotodiode() && patch_lit != m.patch_lit) {
+    eeg_->displayed(host_s, patch_lit);
+    m.patch_lit = patch_lit;
+  }
+  for (const StimulusTiming::Ended& ended : frame.ended)
+    eeg_->flashEnded(ended.onset_sample, ended.duration_samples);
+  for (const StimulusTiming::Onset& onset : frame.onsets) eeg_->flash(onset.code, onset.sample);
+  if (frame.late) {
+    m.log->write("late_frame", at,
+                 {{"frame", frame_},
+                  {"due_s", m.due},
+                  {"late_ms", 1000.0 * (at - m.due)},
+                  {"stages", timing_.lastCycle()}});
+  }
+  m.last_presented = at;
+  if (!m.warned_slow_display && m.stimulus_timing->displayTooSlow()) {
+    m.warned_slow_display = true;
+    const double median = *m.stimulus_timing->medianFrameIntervalMs();
+    m.log->write("display_too_slow", at,
+                 {{"configured_hz", config_.display_hz},
+                  {"median_frame_ms", median},
+                  {"text",
+                   "the display cannot hold display_hz: flashes are stamped as presented, "
+                   "so the recorded SOA and durations are longer than configured"}});
+    std::cerr << "\nwarning: the display shows a frame every " << median << " ms, not every "
+              << 1000.0 / config_.display_hz
+              << " ms: flash onsets are stamped as presented; the SOA is longer than configured\n";
+  }
+}
+
+std::string Session::timingWarning() const {
+  if (!impl_->stimulus_timing->displayTooSlow()) return "";
+  char text[160];
+  std::snprintf(text, sizeof text, "display too slow: a frame every %.1f ms (configured %.1f ms)",
+                *impl_->stimulus_timing->medianFrameIntervalMs(), 1000.0 / config_.display_hz);
+  return text;
+}
+
+std::int64_t Session::lateFrames() const {
+  return impl_->stimulus_timing->lateFrames();
 }
 
 void Session::sendRobot(robot::MessageType type, const cv::Vec3d& target) {
@@ -567,7 +671,7 @@ void Session::handleParadigmEvents() {
   Impl& m = *impl_;
   using Kind = bci::ParadigmEvent::Kind;
   for (const bci::ParadigmEvent& e : paradigm_->takeEvents()) {
-    const std::int64_t sample = eeg_->sampleAt(time_);
+    const std::int64_t sample = eeg_->sampleAt(m.host_origin + time_);
     switch (e.kind) {
       case Kind::PhaseChanged: {
         m.log->write("phase", time_,
@@ -590,6 +694,7 @@ void Session::handleParadigmEvents() {
       }
       case Kind::SelectionStarted: {
         m.selection_flashes = 0;
+        m.stimulus_timing->startSelection();
         m.selection_objects = e.objects_layout;
         std::set<int> attended;
         std::optional<int> target;
@@ -621,23 +726,23 @@ void Session::handleParadigmEvents() {
                              attended, target);
         break;
       }
-      case Kind::Flash: {
-        const int duration = static_cast<int>(std::lround(
-            config_.paradigm.flashFrames() / config_.display_hz * eeg_->info().rate_hz));
-        eeg_->flash(e.code, sample, duration);
+      case Kind::Flash:
+        // Stamped when the frame that shows it is presented.
+        m.first_shown.push_back(e.code);
         ++m.selection_flashes;
         break;
-      }
       case Kind::SelectionMade: {
         TrialRecord& trial = currentTrial();
         if (e.objects_layout) {
           trial.selected_object = objectOfCode(e.object).id;
           trial.object_certainty = e.certainty;
           trial.object_flashes = m.selection_flashes;
+          trial.object_selection_s = m.stimulus_timing->selectionSeconds();
         } else {
           trial.selected_cell = e.cell;
           trial.cell_certainty = e.certainty;
           trial.cell_flashes = m.selection_flashes;
+          trial.cell_selection_s = m.stimulus_timing->selectionSeconds();
         }
         const bool correct = e.objects_layout ? trial.selected_object == trial.intended_object
                                               : trial.selected_cell == trial.intended_cell;
@@ -667,23 +772,11 @@ void Session::handleParadigmEvents() {
         }
         break;
       }
-      case Kind::TrainModel: {
-        try {
-          calibration_report_ = eeg_->train(config_.classifier_method);
-          eeg_->model()->save(folder_ / "model.json");
-          m.log->write("trained", time_,
-                       {{"method", config_.classifier_method},
-                        {"auc", calibration_report_->auc},
-                        {"accuracy_by_sequences", calibration_report_->accuracy}});
-          chooseSelectableObjects();
-          paradigm_->modelTrained(true, "");
-        } catch (const std::exception& error) {
-          m.log->write("training_failed", time_, {{"reason", error.what()}});
-          paradigm_->modelTrained(false, error.what());
-        }
-        timing_.mark("training");
+      case Kind::TrainModel:
+        // On a worker thread: the cycle (and the window) goes on; collectTraining() takes it.
+        eeg_->startTraining(config_.classifier_method);
+        m.log->write("training_started", time_, {{"method", config_.classifier_method}});
         break;
-      }
       case Kind::RobotGrasp: {
         const int id = objectOfCode(e.object).id;
         const auto state = vision_->world().object(id);
@@ -791,8 +884,10 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
     }
     frame.grid_highlight.selected = stimulus.selected_cell;
   }
+  if (eeg_->hasPhotodiode()) frame.photodiode_patch = !stimulus.lit.empty();
   // What this frame shows; unchanged, the framebuffer already holds it.
   std::ostringstream signature;
+  if (frame.photodiode_patch) signature << (*frame.photodiode_patch ? "P" : "p");
   signature << static_cast<const void*>(frame.left.image.data)
             << static_cast<const void*>(frame.right.image.data);
   for (const auto* eye : {&frame.left, &frame.right}) {
@@ -880,11 +975,13 @@ void Session::screenshot(const std::filesystem::path& path) {
 
 std::string Session::statusLine() const {
   char text[256];
-  std::snprintf(text, sizeof text, "t=%.1f s  trial %d/%d  %s  cycle p50 %.1f ms  overruns %d",
+  std::snprintf(text, sizeof text,
+                "t=%.1f s  trial %d/%d  %s  cycle p50 %.1f ms  overruns %d  late frames %lld",
                 time_, std::max(paradigm_->trial(), 0), config_.paradigm.trials,
                 bci::toString(paradigm_->phase()), timing_.totalPercentiles().p50,
-                timing_.overruns());
-  return text;
+                timing_.overruns(), static_cast<long long>(lateFrames()));
+  const std::string warning = timingWarning();
+  return warning.empty() ? std::string(text) : std::string(text) + "  [" + warning + "]";
 }
 
 void Session::endRun(const std::string& reason) {
@@ -892,7 +989,9 @@ void Session::endRun(const std::string& reason) {
   ended_ = true;
   end_reason_ = reason;
   Impl& m = *impl_;
-  eeg_->annotate(eeg_->sampleAt(time_), "Session ended: " + reason);
+  // Live: the EEG of the last frames (their flashes' responses begin later) is still on its way.
+  if (!options_.simulated_clock) eeg_->drainUntil(bci::hostSeconds() + 0.1, 1.0);
+  eeg_->annotate(eeg_->sampleAt(m.host_origin + time_), "Session ended: " + reason);
   eeg_->close();
   m.images.flush();
   m.log->write("session_ended", time_, {{"reason", reason}});
@@ -904,38 +1003,36 @@ void Session::endRun(const std::string& reason) {
 nlohmann::json Session::summary() const {
   nlohmann::json trials = nlohmann::json::array();
   int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0;
-  double object_flashes = 0, cell_flashes = 0;
+  double object_seconds = 0, cell_seconds = 0;
   for (const TrialRecord& t : trials_) {
-    nlohmann::json j = {
-        {"trial", t.trial},
-        {"intended_object", t.intended_object},
-        {"selected_object", t.selected_object},
-        {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
-        {"selected_cell", {t.selected_cell.first, t.selected_cell.second}},
-        {"object_flashes", t.object_flashes},
-        {"cell_flashes", t.cell_flashes},
-        {"object_selection_s",
-         t.object_flashes * config_.paradigm.onsetFrames() / config_.display_hz},
-        {"cell_selection_s", t.cell_flashes * config_.paradigm.onsetFrames() / config_.display_hz},
-        {"outcome", t.outcome}};
+    nlohmann::json j = {{"trial", t.trial},
+                        {"intended_object", t.intended_object},
+                        {"selected_object", t.selected_object},
+                        {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
+                        {"selected_cell", {t.selected_cell.first, t.selected_cell.second}},
+                        {"object_flashes", t.object_flashes},
+                        {"cell_flashes", t.cell_flashes},
+                        {"object_selection_s", t.object_selection_s},
+                        {"cell_selection_s", t.cell_selection_s},
+                        {"outcome", t.outcome}};
     j["placement_error_m"] =
         t.placement_error_m >= 0.0 ? nlohmann::json(t.placement_error_m) : nlohmann::json(nullptr);
     trials.push_back(j);
     if (t.selected_object >= 0) {
       ++objects_made;
       objects_right += t.selected_object == t.intended_object;
-      object_flashes += t.object_flashes;
+      object_seconds += t.object_selection_s;
     }
     if (t.selected_cell.first > 0) {
       ++cells_made;
       cells_right += t.selected_cell == t.intended_cell;
-      cell_flashes += t.cell_flashes;
+      cell_seconds += t.cell_selection_s;
     }
   }
-  const double soa = config_.paradigm.onsetFrames() / config_.display_hz;
-  auto rate = [&](int choices, int right, int made, double flashes) {
+  // Selection times are measured from the flash onsets as presented, never from the settings.
+  auto rate = [&](int choices, int right, int made, double total_seconds) {
     if (made == 0) return nlohmann::json(nullptr);
-    const double seconds = flashes / made * soa;
+    const double seconds = total_seconds / made;
     return nlohmann::json{
         {"accuracy", static_cast<double>(right) / made},
         {"seconds_per_selection", seconds},
@@ -950,11 +1047,13 @@ nlohmann::json Session::summary() const {
       {"frames", frame_},
       {"trials", trials},
       {"objects", rate(static_cast<int>(config_.world.objects.size()), objects_right, objects_made,
-                       object_flashes)},
+                       object_seconds)},
       {"cells", rate(config_.world.grid.rows * config_.world.grid.columns, cells_right, cells_made,
-                     cell_flashes)},
+                     cell_seconds)},
       {"cycle", timing_.toJson()},
       {"overruns", timing_.overruns()},
+      {"timing", impl_->stimulus_timing->summary(eeg_->lostSamples(), eeg_->clockDriftPpm(),
+                                                 eeg_->clockJitterMs())},
       {"eeg",
        {{"recording", "recording.bdf"},
         {"samples", eeg_->samplesRecorded()},

@@ -36,6 +36,10 @@ struct SessionOptions {
   double fault_wait_s = 5.0;
   double max_session_s = 3600.0;  // a safety bound on a headless run
   bool start_immediately = true;  // headless: no experimenter presses Start
+  // The timing check: flashes only (a calibration run that never ends) for this many seconds of
+  // session time, then the session ends ("timing check done"); 0: a normal session.
+  double flashes_only_s = 0.0;
+  bool close_window_when_ended = false;
   std::ostream* progress = nullptr;
 };
 
@@ -45,6 +49,7 @@ struct TrialRecord {
   std::pair<int, int> intended_cell{0, 0}, selected_cell{0, 0};
   double object_certainty = 0.0, cell_certainty = 0.0;
   int object_flashes = 0, cell_flashes = 0;
+  double object_selection_s = 0.0, cell_selection_s = 0.0;  // from the presented onsets
   double placement_error_m = -1.0;
   std::string outcome = "incomplete";
 };
@@ -58,6 +63,13 @@ class Session {
 
   // One displayed frame. Returns false once the session has ended.
   bool step();
+  // The frame the last step() drew reached the screen at `host_s` (bci::hostSeconds(); a window's
+  // owner calls it once the buffer swap is done). Its flashes are stamped with this instant's EEG
+  // sample; headless runs call it themselves.
+  void presented(double host_s);
+  std::int64_t lateFrames() const;
+  // Non-empty while the display cannot hold display_hz.
+  std::string timingWarning() const;
   // Steps until the end (headless). Returns the summary.
   nlohmann::json run();
 
@@ -118,6 +130,7 @@ class Session {
   std::string end_reason_;
 
   void handleParadigmEvents();
+  void collectTraining();
   void measurePlacement();
   render::GridLayout gridLayout() const;
   // The object a selection's stimulus code stands for this trial.

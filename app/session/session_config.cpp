@@ -213,7 +213,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   if (c.world.objects.size() < 2) world_section.fail("objects", "must name at least 2 objects");
 
   const Section eeg = root.section("eeg");
-  eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale", "file"});
+  eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale", "file",
+             "photodiode_channel", "latency_ms"});
   c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file"});
   c.eeg.seed =
       static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
@@ -227,6 +228,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   c.eeg.line_hz = eeg.number("line_hz", c.eeg.line_hz, 0.0, 70.0);
   c.eeg.erp_scale = eeg.number("erp_scale", c.eeg.erp_scale, 0.0, 10.0);
   c.eeg.file = eeg.text("file", c.eeg.file);
+  c.eeg.photodiode_channel = eeg.text("photodiode_channel", c.eeg.photodiode_channel);
+  c.eeg.latency_ms = eeg.number("latency_ms", c.eeg.latency_ms, 0.0, 1000.0);
   if (c.eeg.source == "file" && c.eeg.file.empty())
     eeg.fail("file", "is required when source is \"file\"");
 
@@ -236,17 +239,18 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
            "result_s", "pause_s"});
   bci::ParadigmSettings& ps = c.paradigm;
   ps.display_hz = c.display_hz;
-  ps.flash_ms = p.number("flash_ms", 60.0, 5.0, 2000.0);
-  ps.isi_ms = p.number("isi_ms", 120.0, 0.0, 5000.0);
-  ps.sequences = p.integer("sequences", 8, 1, 100);
-  ps.min_sequences = p.integer("min_sequences", 3, 1, ps.sequences);
-  ps.certainty = p.number("certainty", 0.999, 0.0, 1.0);
-  ps.calibration_selections = p.integer("calibration_selections", 8, 2, 200);
-  ps.calibration_sequences = p.integer("calibration_sequences", 8, 1, 100);
-  ps.trials = p.integer("trials", 3, 1, 1000);
-  ps.cue_s = p.number("cue_s", 1.5, 0.0, 60.0);
-  ps.result_s = p.number("result_s", 1.0, 0.0, 60.0);
-  ps.pause_s = p.number("pause_s", 1.0, 0.0, 60.0);
+  ps.flash_ms = p.number("flash_ms", ps.flash_ms, 5.0, 2000.0);
+  ps.isi_ms = p.number("isi_ms", ps.isi_ms, 0.0, 5000.0);
+  ps.sequences = p.integer("sequences", ps.sequences, 1, 100);
+  ps.min_sequences = p.integer("min_sequences", ps.min_sequences, 1, ps.sequences);
+  ps.certainty = p.number("certainty", ps.certainty, 0.0, 1.0);
+  ps.calibration_selections =
+      p.integer("calibration_selections", ps.calibration_selections, 2, 200);
+  ps.calibration_sequences = p.integer("calibration_sequences", ps.calibration_sequences, 1, 100);
+  ps.trials = p.integer("trials", ps.trials, 1, 1000);
+  ps.cue_s = p.number("cue_s", ps.cue_s, 0.0, 60.0);
+  ps.result_s = p.number("result_s", ps.result_s, 0.0, 60.0);
+  ps.pause_s = p.number("pause_s", ps.pause_s, 0.0, 60.0);
   if (p.has("intended")) {
     if (!p.at("intended").is_array())
       p.fail("intended", "must be a list of {\"object\": id, \"cell\": [row, column]}");
@@ -276,14 +280,16 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
   cl.known(
       {"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz", "notch_hz", "model"});
   c.classifier_method = cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn"});
-  const auto window = cl.numbers("window_ms", {0, 800}, 2, 2);
+  const auto window = cl.numbers(
+      "window_ms", {c.pipeline.window.start_s * 1000.0, c.pipeline.window.end_s * 1000.0}, 2, 2);
   if (!(window[1] > window[0])) cl.fail("window_ms", "must end after it starts");
   c.pipeline.window = {window[0] / 1000.0, window[1] / 1000.0};
-  c.pipeline.decimate_hz = cl.number("decimate_hz", 20.0, 1.0, 500.0);
-  c.pipeline.filter.highpass_hz = cl.number("highpass_hz", 0.5, 0.0, 100.0);
-  c.pipeline.filter.lowpass_hz = cl.number("lowpass_hz", 20.0, 0.0, 500.0);
-  c.pipeline.filter.notch_hz = cl.number("notch_hz", 0.0, 0.0, 500.0);
-  c.model_file = cl.text("model", "");
+  c.pipeline.decimate_hz = cl.number("decimate_hz", c.pipeline.decimate_hz, 1.0, 500.0);
+  c.pipeline.filter.highpass_hz =
+      cl.number("highpass_hz", c.pipeline.filter.highpass_hz, 0.0, 100.0);
+  c.pipeline.filter.lowpass_hz = cl.number("lowpass_hz", c.pipeline.filter.lowpass_hz, 0.0, 500.0);
+  c.pipeline.filter.notch_hz = cl.number("notch_hz", c.pipeline.filter.notch_hz, 0.0, 500.0);
+  c.model_file = cl.text("model", c.model_file);
 
   const Section r = root.section("robot");
   r.known({"backend", "speed_factor", "host", "port", "key_file"});

@@ -76,6 +76,10 @@ struct EegSettings {
   double line_hz = 50.0;
   double erp_scale = 1.0;  // the simulated subject's ERP amplitude factor (weak subjects < 1)
   std::string file;        // source "file": a recording replayed in real time
+  // The channel a photodiode on the HMD's patch feeds (simulated: a virtual channel of this name
+  // is added); empty: none.
+  std::string photodiode_channel;
+  double latency_ms = 0.0;  // the amplifier's delivery latency, as timing-check measured it
 };
 
 struct TrialIntent {

@@ -41,6 +41,7 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
   options.simulated_clock = false;
   const bool wait = !options.start_immediately;  // --wait-for-start: the experimenter presses Start
   options.start_immediately = false;
+  const bool close_when_ended = options.close_window_when_ended;
   render::WindowOptions window;
   window.title = "ARBCI workstation";
   render::WindowContext main_window(window);
@@ -78,7 +79,7 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
   std::signal(SIGTERM, onSignal);
   auto last = std::chrono::steady_clock::now();
   while (!main_window.shouldClose()) {
-    if (close_requested) main_window.requestClose();
+    if (close_requested || (close_when_ended && session.ended())) main_window.requestClose();
     render::WindowContext::pollEvents();
     session.step();
     main_window.makeCurrent();
@@ -91,6 +92,7 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
     render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
     imgui.endFrame();
     main_window.present();
+    session.presented(bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
     if (mirror) {
       mirror->makeCurrent();
       render::blitTexture(session.hmdTexture(), session.hmdSize(), mirror->framebufferSize());

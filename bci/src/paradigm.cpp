@@ -54,22 +54,19 @@ const char* toString(Phase phase) {
 Paradigm::Paradigm(const ParadigmSettings& settings, int objects, int rows, int columns,
                    std::uint64_t seed)
     : settings_(settings),
-      object_layout_(ParadigmLayout::single(std::max(objects, 2),
-                                            settings.onsetFrames() / settings.display_hz)),
-      grid_layout_(
-          ParadigmLayout::matrix(rows, columns, settings.onsetFrames() / settings.display_hz)),
+      object_layout_(ParadigmLayout::single(std::max(objects, 2), settings.soaSeconds())),
+      grid_layout_(ParadigmLayout::matrix(rows, columns, settings.soaSeconds())),
       random_(seed) {}
 
 void Paradigm::event(ParadigmEvent e) {
-  e.frame = now_;
+  e.frame = frame_;
   e.phase = phase_;
   e.trial = trial_;
   events_.push_back(std::move(e));
 }
 
-void Paradigm::enter(Phase phase, std::int64_t frame, const std::string& text) {
+void Paradigm::enter(Phase phase, const std::string& text) {
   phase_ = phase;
-  now_ = std::max(now_, frame);
   ParadigmEvent e{ParadigmEvent::Kind::PhaseChanged};
   e.text = text.empty() ? toString(phase) : std::string(toString(phase)) + ": " + text;
   event(e);
@@ -80,20 +77,19 @@ void Paradigm::start(bool calibrate) {
   calibrating_ = calibrate;
   if (calibrate && settings_.calibration_selections > 0) {
     calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
-    phase_until_ =
-        now_ + static_cast<std::int64_t>(std::lround(settings_.cue_s * settings_.display_hz));
-    enter(Phase::CalibrationCue, now_, "object " + std::to_string(*calibration_target_));
+    phase_until_ = now_ + settings_.cue_s;
+    enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
     ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
     e.codes = {*calibration_target_};
     event(e);
   } else {
     calibrating_ = false;
     trial_ = 1;
-    startFlashing(now_ + 1, true);
+    startFlashing(nextFrame(), true);
   }
 }
 
-void Paradigm::startFlashing(std::int64_t frame, bool objects) {
+void Paradigm::startFlashing(double at_s, bool objects) {
   flashing_objects_ = objects;
   const ParadigmLayout& layout = objects ? object_layout_ : grid_layout_;
   sequencer_.emplace(layout.codes(), random_());
@@ -102,73 +98,84 @@ void Paradigm::startFlashing(std::int64_t frame, bool objects) {
   awaiting_decision_ = false;
   if (objects) selected_cell_.reset();
   enter(calibrating_ ? Phase::CalibrationFlashing
-                     : (objects ? Phase::ObjectFlashing : Phase::CellFlashing),
-        frame);
+                     : (objects ? Phase::ObjectFlashing : Phase::CellFlashing));
   if (!calibrating_) {
     ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
     e.objects_layout = objects;
     event(e);
   }
-  scheduleSequence(frame);
+  scheduleSequence(at_s);
 }
 
-void Paradigm::scheduleSequence(std::int64_t first_frame) {
+void Paradigm::scheduleSequence(double first_onset_s) {
   schedule_.clear();
   next_flash_ = 0;
   ++sequence_;
-  std::int64_t onset = first_frame;
+  double onset = first_onset_s;
   for (int code : sequencer_->next()) {
-    schedule_.emplace_back(onset, code);
-    onset += settings_.onsetFrames();
+    schedule_.push_back({onset, code});
+    onset += settings_.soaSeconds();
   }
 }
 
-FrameStimulus Paradigm::frame(std::int64_t index) {
-  now_ = index;
+FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
+  // Frame times are exact multiples of the frame period only on paper: a microsecond of slack.
+  constexpr double kSlack = 1e-6;
+  frame_ = index;
+  now_ = due_s;
   FrameStimulus out;
   const bool flashing = phase_ == Phase::CalibrationFlashing || phase_ == Phase::ObjectFlashing ||
                         phase_ == Phase::CellFlashing;
   if (flashing && !awaiting_decision_) {
-    for (size_t i = 0; i < schedule_.size(); ++i) {
-      const auto [onset, code] = schedule_[i];
-      if (index == onset && i >= next_flash_) {
-        ParadigmEvent e{ParadigmEvent::Kind::Flash};
-        e.code = code;
-        e.objects_layout = flashing_objects_;
-        event(e);
-        next_flash_ = i + 1;
-      }
-      if (index >= onset && index < onset + settings_.flashFrames()) out.lit.insert(code);
-    }
-    // The sequence's last interval is over: another sequence, or the end of flashing.
-    if (!schedule_.empty() && index >= schedule_.back().first + settings_.onsetFrames() - 1) {
+    // The sequence's last interval is over (and its every flash shown): another sequence, or the
+    // end of flashing.
+    if (!schedule_.empty() && next_flash_ == schedule_.size() &&
+        due_s >= schedule_.back().onset_s + settings_.soaSeconds() - kSlack) {
       const bool dynamic_stop =
           !calibrating_ && stop_requested_ && sequence_ >= settings_.min_sequences;
       const int most = calibrating_ ? settings_.calibration_sequences : settings_.sequences;
       if (sequence_ < most && !dynamic_stop) {
-        scheduleSequence(index + 1);
+        scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
       } else {
         awaiting_decision_ = true;
       }
     }
   }
+  if (flashing && !awaiting_decision_) {
+    for (size_t i = 0; i < schedule_.size(); ++i) {
+      ScheduledFlash& f = schedule_[i];
+      if (due_s < f.onset_s - kSlack) break;
+      if (i == next_flash_) {
+        // Its first frame. A display too slow for the SOA shows one new flash per frame.
+        ParadigmEvent e{ParadigmEvent::Kind::Flash};
+        e.code = f.code;
+        e.objects_layout = flashing_objects_;
+        event(e);
+        f.shown_s = due_s;
+        next_flash_ = i + 1;
+        out.lit.insert(f.code);
+        break;
+      }
+      if (i < next_flash_ && due_s < f.shown_s + settings_.flashSeconds() - kSlack)
+        out.lit.insert(f.code);
+    }
+  }
   switch (phase_) {
     case Phase::CalibrationCue:
-      if (index >= phase_until_) startFlashing(index + 1, true);
+      if (due_s >= phase_until_ - 1e-6) startFlashing(nextFrame(), true);
       break;
     case Phase::ObjectSelected:
-      if (index >= phase_until_) {
-        enter(Phase::Grasping, index, "object " + std::to_string(*selected_object_));
+      if (due_s >= phase_until_ - 1e-6) {
+        enter(Phase::Grasping, "object " + std::to_string(*selected_object_));
         ParadigmEvent e{ParadigmEvent::Kind::RobotGrasp};
         e.object = *selected_object_;
         event(e);
       }
       break;
     case Phase::CellSelected:
-      if (index >= phase_until_) {
-        enter(Phase::Dropping, index,
-              "row " + std::to_string(selected_cell_->first) + " column " +
-                  std::to_string(selected_cell_->second));
+      if (due_s >= phase_until_ - 1e-6) {
+        enter(Phase::Dropping, "row " + std::to_string(selected_cell_->first) + " column " +
+                                   std::to_string(selected_cell_->second));
         ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
         e.cell = *selected_cell_;
         event(e);
@@ -203,16 +210,15 @@ void Paradigm::decide(const Decision& decision) {
     ++calibration_done_;
     if (calibration_done_ < settings_.calibration_selections) {
       calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
-      phase_until_ = now_ + static_cast<std::int64_t>(std::lround(
-                                (settings_.pause_s + settings_.cue_s) * settings_.display_hz));
-      enter(Phase::CalibrationCue, now_, "object " + std::to_string(*calibration_target_));
+      phase_until_ = now_ + settings_.pause_s + settings_.cue_s;
+      enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
       ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
       e.codes = {*calibration_target_};
       event(e);
     } else {
       calibration_target_.reset();
       calibrating_ = false;
-      enter(Phase::Training, now_);
+      enter(Phase::Training);
       event(ParadigmEvent{ParadigmEvent::Kind::TrainModel});
     }
     return;
@@ -221,45 +227,43 @@ void Paradigm::decide(const Decision& decision) {
   made.codes = decision.codes;
   made.certainty = decision.certainty;
   made.objects_layout = phase_ == Phase::ObjectFlashing;
-  const std::int64_t show =
-      static_cast<std::int64_t>(std::lround(settings_.result_s * settings_.display_hz));
+  const double show = settings_.result_s;
   if (phase_ == Phase::ObjectFlashing) {
     selected_object_ = decision.choice + 1;
     made.object = *selected_object_;
     event(made);
     phase_until_ = now_ + show;
-    enter(Phase::ObjectSelected, now_, "object " + std::to_string(*selected_object_));
+    enter(Phase::ObjectSelected, "object " + std::to_string(*selected_object_));
   } else if (phase_ == Phase::CellFlashing) {
     selected_cell_ = {decision.choice / grid_layout_.columns + 1,
                       decision.choice % grid_layout_.columns + 1};
     made.cell = *selected_cell_;
     event(made);
     phase_until_ = now_ + show;
-    enter(Phase::CellSelected, now_,
-          "row " + std::to_string(selected_cell_->first) + " column " +
-              std::to_string(selected_cell_->second));
+    enter(Phase::CellSelected, "row " + std::to_string(selected_cell_->first) + " column " +
+                                   std::to_string(selected_cell_->second));
   }
 }
 
 void Paradigm::modelTrained(bool ok, const std::string& text) {
   if (phase_ != Phase::Training) return;
   if (!ok) {
-    enter(Phase::Aborted, now_, "training failed: " + text);
+    enter(Phase::Aborted, "training failed: " + text);
     return;
   }
   trial_ = 1;
-  startFlashing(now_ + 1, true);
+  startFlashing(nextFrame(), true);
 }
 
 void Paradigm::robotFinished(bool success, const std::string& text) {
   if (phase_ != Phase::Grasping && phase_ != Phase::Dropping) return;
   if (!success) {
     paused_from_ = phase_;
-    enter(Phase::RobotFault, now_, text);
+    enter(Phase::RobotFault, text);
     return;
   }
   if (phase_ == Phase::Grasping) {
-    startFlashing(now_ + 1, false);
+    startFlashing(nextFrame(), false);
     return;
   }
   ParadigmEvent done{ParadigmEvent::Kind::TrialDone};
@@ -267,12 +271,10 @@ void Paradigm::robotFinished(bool success, const std::string& text) {
   selected_object_.reset();
   selected_cell_.reset();
   if (trial_ >= settings_.trials) {
-    enter(Phase::Finished, now_);
+    enter(Phase::Finished);
   } else {
     ++trial_;
-    startFlashing(
-        now_ + static_cast<std::int64_t>(std::lround(settings_.pause_s * settings_.display_hz)),
-        true);
+    startFlashing(now_ + settings_.pause_s, true);
   }
 }
 
@@ -286,21 +288,21 @@ void Paradigm::pause() {
     return;
   }
   paused_from_ = phase_;
-  phase_until_ -= now_;  // kept as the frames still to go
-  enter(Phase::Paused, now_);
+  phase_until_ -= now_;  // kept as the time still to go
+  enter(Phase::Paused);
 }
 
 void Paradigm::resume() {
   if (phase_ == Phase::Paused) {
     const Phase back = paused_from_;
     phase_until_ += now_;
-    enter(back, now_, "resumed");
+    enter(back, "resumed");
     if ((back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing ||
          back == Phase::CellFlashing) &&
         !awaiting_decision_) {
       // The interrupted sequence is shown again from its start.
       --sequence_;
-      scheduleSequence(now_ + 1);
+      scheduleSequence(nextFrame());
     }
     return;
   }
@@ -308,11 +310,11 @@ void Paradigm::resume() {
     const Phase was = paused_from_;
     const bool robot_phase = was == Phase::Grasping || was == Phase::Dropping;
     if (!robot_phase && phase_ == Phase::EmergencyStop) {
-      enter(was, now_, "resumed after the stop");
+      enter(was, "resumed after the stop");
       if (was == Phase::CalibrationFlashing || was == Phase::ObjectFlashing ||
           was == Phase::CellFlashing) {
         --sequence_;
-        scheduleSequence(now_ + 1);
+        scheduleSequence(nextFrame());
       }
       return;
     }
@@ -320,10 +322,10 @@ void Paradigm::resume() {
     selected_object_.reset();
     selected_cell_.reset();
     if (trial_ >= settings_.trials) {
-      enter(Phase::Finished, now_, "after a robot fault");
+      enter(Phase::Finished, "after a robot fault");
     } else {
       ++trial_;
-      startFlashing(now_ + 1, true);
+      startFlashing(nextFrame(), true);
     }
   }
 }
@@ -333,7 +335,7 @@ void Paradigm::abort() {
   if (phase_ == Phase::Grasping || phase_ == Phase::Dropping)
     event(ParadigmEvent{ParadigmEvent::Kind::RobotStop});
   schedule_.clear();
-  enter(Phase::Aborted, now_, "by the experimenter");
+  enter(Phase::Aborted, "by the experimenter");
 }
 
 void Paradigm::emergencyStop() {
@@ -342,7 +344,7 @@ void Paradigm::emergencyStop() {
   if (phase_ != Phase::EmergencyStop && phase_ != Phase::RobotFault && phase_ != Phase::Paused)
     paused_from_ = phase_;
   schedule_.clear();
-  enter(Phase::EmergencyStop, now_);
+  enter(Phase::EmergencyStop);
 }
 
 std::vector<ParadigmEvent> Paradigm::takeEvents() {

@@ -128,6 +128,7 @@ SimulatedSubject::SimulatedSubject(const SimulatedSubjectConfig& config,
   info_.rate_hz = config.rate_hz;
   info_.block_size = config.block_size;
   info_.channels = config.montage;
+  if (config.photodiode) info_.channels.push_back(config.photodiode_channel);
   generator_ = std::make_unique<Generator>(config_);
 }
 
@@ -144,6 +145,12 @@ void SimulatedSubject::present(const StimulusEvent& event) {
                0.5 * profile_.amplitude_variability * profile_.amplitude_variability);
   response.n2_scale = std::exp(0.3 * normal(trial_random_));
   responses_.push_back(response);
+}
+
+void SimulatedSubject::displayed(double host_s, bool patch_lit) {
+  const auto first =
+      static_cast<std::int64_t>(std::ceil(clock_->sampleAtHost(host_s, config_.rate_hz) - 1e-6));
+  screen_.emplace_back(std::max(first, generated_), patch_lit);
 }
 
 float SimulatedSubject::evoked(int channel, std::int64_t sample) const {
@@ -169,13 +176,13 @@ std::vector<Block> SimulatedSubject::poll(int max_blocks) {
   std::vector<Block> blocks;
   const std::int64_t available = clock_->available(config_.rate_hz);
   Generator& g = *generator_;
-  const int channels = info_.channelCount();
+  const int channels = static_cast<int>(config_.montage.size());
   const double blink_mean_gap =
       config_.blinks_per_minute > 0.0 ? 60.0 / config_.blinks_per_minute * config_.rate_hz : 0.0;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   while (static_cast<int>(blocks.size()) < max_blocks &&
          generated_ + config_.block_size <= available) {
-    Block block(generated_, channels, config_.block_size);
+    Block block(generated_, info_.channelCount(), config_.block_size);
     for (int s = 0; s < config_.block_size; ++s) {
       const std::int64_t n = generated_ + s;
       const double time = n / config_.rate_hz;
@@ -214,6 +221,13 @@ std::vector<Block> SimulatedSubject::poll(int max_blocks) {
         v += w.blink * blink;
         v += evoked(c, n);
         block.at(c, s) = static_cast<float>(v);
+      }
+      if (config_.photodiode) {
+        size_t used = 0;
+        while (used < screen_.size() && screen_[used].first <= n)
+          screen_lit_ = screen_[used++].second;
+        screen_.erase(screen_.begin(), screen_.begin() + static_cast<std::ptrdiff_t>(used));
+        block.at(channels, s) = screen_lit_ ? static_cast<float>(config_.photodiode_lit_uv) : 0.0f;
       }
     }
     generated_ += config_.block_size;

@@ -61,6 +61,14 @@ void clearFramebuffer(unsigned int framebuffer, Size size, const float (&rgba)[4
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
 }
 
+int readGrey(unsigned int framebuffer, Size size, int x, int y) {
+  std::uint8_t pixel[4] = {0, 0, 0, 0};
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(x, size.height - 1 - y, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
+  return (pixel[0] + pixel[1] + pixel[2]) / 3;
+}
+
 RgbaImage readPixels(unsigned int framebuffer, Size size) {
   RgbaImage image{size.width, size.height, {}};
   image.pixels.resize(static_cast<size_t>(size.width) * size.height * 4);

@@ -238,6 +238,12 @@ void HmdView::draw(const HmdFrame& frame, unsigned int framebuffer, Size size) {
       }
     }
     glDisable(GL_BLEND);
+    if (frame.photodiode_patch) {
+      const float side = static_cast<float>(HmdFrame::kPatchPx);
+      const glm::vec2 patch[4] = {{0.0f, 0.0f}, {side, 0.0f}, {side, side}, {0.0f, side}};
+      const float level = *frame.photodiode_patch ? 1.0f : 0.0f;
+      m.primitives.fillPolygon(patch, glm::vec4(level, level, level, 1.0f), viewport);
+    }
   }
   glViewport(0, 0, size.width, size.height);
 }

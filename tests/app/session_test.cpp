@@ -82,7 +82,8 @@ TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimet
   // The recording is readable, with every flash and the selections.
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
   EXPECT_EQ(recording.format, "BDF+");
-  EXPECT_EQ(recording.info.channelCount(), 8);
+  ASSERT_EQ(recording.info.channelCount(), 9);  // the montage and the virtual photodiode
+  EXPECT_EQ(recording.info.channels.back(), "Photodiode");
   EXPECT_NEAR(recording.seconds(), summary["duration_s"].get<double>(), 0.1);
   int calibration_targets = 0, grid_flashes = 0;
   for (const auto& s : recording.stimuli) {

@@ -183,3 +183,41 @@ TEST(Paradigm, PauseAbortEmergencyStopAndRobotFaults) {
 
 }  // namespace
 }  // namespace arbci::bci
+
+namespace arbci::bci {
+namespace {
+
+// A display that manages a frame every 28 ms, not the 16.7 ms of its nominal 60 Hz: the onsets
+// keep to the 183 ms SOA (each on the first frame due at or after it), no frame shows two flashes,
+// and every flash is shown.
+TEST(Paradigm, OnASlowDisplayFlashesKeepTheirScheduleInTime) {
+  ParadigmSettings s = fast();
+  Paradigm p(s, 4, 3, 3, 5);
+  p.start(false);
+  const double period = 0.028;
+  std::vector<double> onsets;
+  int frames_with_two = 0, lit_frames = 0;
+  for (std::int64_t frame = 0; frame < 200; ++frame) {
+    const double due = frame * period;
+    const FrameStimulus shown = p.frame(frame, due);
+    frames_with_two += shown.lit.size() > 1;
+    lit_frames += !shown.lit.empty();
+    for (const ParadigmEvent& e : p.takeEvents())
+      if (e.kind == Kind::Flash) onsets.push_back(due);
+  }
+  ASSERT_EQ(onsets.size(), 12u);  // 3 sequences of 4 objects
+  const double soa = s.soaSeconds();
+  for (size_t i = 0; i < onsets.size(); ++i) {
+    // Flashing starts a nominal frame after start() (frame 0, at 0 s).
+    const double scheduled = 1.0 / s.display_hz + static_cast<double>(i) * soa;
+    EXPECT_GE(onsets[i], scheduled - 1e-9) << i;
+    EXPECT_LT(onsets[i], scheduled + period) << i;
+  }
+  EXPECT_EQ(frames_with_two, 0);
+  // 66.7 ms of flash on 28 ms frames: 2 or 3 frames each.
+  EXPECT_GE(lit_frames, 24);
+  EXPECT_LE(lit_frames, 36);
+}
+
+}  // namespace
+}  // namespace arbci::bci

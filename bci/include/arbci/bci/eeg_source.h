@@ -21,6 +21,11 @@ class EegSource {
   // Which stimulus codes the subject attends from now on (empty: none). A row/column paradigm
   // attends the target's row and its column.
   virtual void attend(const std::set<int>&) {}
+  // What the screen showed from host instant `host_s` on: the photodiode patch lit or dark. A
+  // simulated amplifier puts it on its virtual photodiode channel; a real one has a real diode.
+  virtual void displayed(double /*host_s*/, bool /*patch_lit*/) {}
+  // The delivery delay the source itself knows of (a simulated transport), in seconds.
+  virtual double knownLatencyS() const { return 0.0; }
   // Stimuli the source itself carries (a replayed file's events) up to the samples delivered so
   // far; each is returned once.
   virtual std::vector<StimulusEvent> takeRecordedStimuli() { return {}; }

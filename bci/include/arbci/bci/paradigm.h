@@ -4,8 +4,12 @@
 // grasp it, selects a place (rows and columns of the grid flash as in the P300 speller) and has
 // the robot put the object there. Pause, abort and emergency stop work in every state.
 //
-// It is driven by displayed frames: frame(i) says what frame i shows; timing is counted in frames
-// (60 ms flash, 120 ms interval at the display rate), decided ahead. The cycle feeds it the
+// It is driven by displayed frames but scheduled in time: frame(i, due_s) says what frame i, due
+// on screen at `due_s`, shows. Flash onsets follow the SOA (60 ms flash, 120 ms interval, each
+// rounded to whole frames of the nominal display rate), decided ahead; a display slower than its
+// nominal rate shows each flash on the first frame due at or after its onset (never two new
+// flashes on one frame), for the flash's duration from there. The cycle stamps each flash with the
+// presentation time of the frame that first shows it. The cycle feeds it the
 // classifier's decisions, the end of training and the robot's outcomes, and takes its events
 // (flash onsets, phase changes, selections, robot commands).
 #pragma once
@@ -39,6 +43,8 @@ struct ParadigmSettings {
 
   int flashFrames() const;  // frames a flash lasts (60 ms at 60 Hz: 4)
   int onsetFrames() const;  // frames from one flash onset to the next (180 ms: 11)
+  double flashSeconds() const { return flashFrames() / display_hz; }
+  double soaSeconds() const { return onsetFrames() / display_hz; }
 };
 
 enum class Phase {
@@ -109,8 +115,10 @@ class Paradigm {
   void abort();
   void emergencyStop();
 
-  // What frame `index` shows; call once per displayed frame in order.
-  FrameStimulus frame(std::int64_t index);
+  // What frame `index`, due on screen at `due_s` (seconds of the session's clock), shows; call
+  // once per displayed frame in order. Without `due_s`: the nominal rate's time of the frame.
+  FrameStimulus frame(std::int64_t index, double due_s);
+  FrameStimulus frame(std::int64_t index) { return frame(index, index / settings_.display_hz); }
 
   // From the cycle: the classifier may end flashing early (dynamic stopping).
   void requestStopFlashing();
@@ -133,9 +141,10 @@ class Paradigm {
   const ParadigmSettings& settings() const { return settings_; }
 
  private:
-  void enter(Phase phase, std::int64_t frame, const std::string& text = "");
-  void startFlashing(std::int64_t frame, bool objects);
-  void scheduleSequence(std::int64_t first_frame);
+  void enter(Phase phase, const std::string& text = "");
+  void startFlashing(double at_s, bool objects);
+  void scheduleSequence(double first_onset_s);
+  double nextFrame() const { return now_ + 1.0 / settings_.display_hz; }
   void event(ParadigmEvent e);
 
   ParadigmSettings settings_;
@@ -144,10 +153,16 @@ class Paradigm {
   std::optional<StimulusSequencer> sequencer_;
   Phase phase_ = Phase::Setup;
   Phase paused_from_ = Phase::Setup;
-  std::int64_t now_ = 0;          // the last frame shown
-  std::int64_t phase_until_ = 0;  // timed phases end at this frame
-  // Flashing: onset frame and code of the current sequence's flashes.
-  std::vector<std::pair<std::int64_t, int>> schedule_;
+  std::int64_t frame_ = 0;    // the last frame shown
+  double now_ = 0.0;          // its due time
+  double phase_until_ = 0.0;  // timed phases end then (while paused: the time still to go)
+  // Flashing: the current sequence's flashes, and when each was first shown.
+  struct ScheduledFlash {
+    double onset_s;
+    int code;
+    double shown_s = -1.0;
+  };
+  std::vector<ScheduledFlash> schedule_;
   size_t next_flash_ = 0;
   int sequence_ = 0;
   bool stop_requested_ = false;

@@ -47,6 +47,12 @@ struct SimulatedSubjectConfig {
   double blinks_per_minute = 6.0;
   double blink_uv = 100.0;                // at Fp1/Fp2; less further back
   std::optional<SubjectProfile> profile;  // default: SubjectProfile::drawn(seed)
+  // A virtual photodiode on the HMD's patch, as an extra channel after the montage: 0 while the
+  // patch is dark, `photodiode_lit_uv` while it is lit, switching on the first sample taken at or
+  // after the presentation that changed it.
+  bool photodiode = false;
+  std::string photodiode_channel = "Photodiode";
+  double photodiode_lit_uv = 1000.0;
 };
 
 class SimulatedSubject final : public EegSource {
@@ -60,6 +66,8 @@ class SimulatedSubject final : public EegSource {
   std::vector<Block> poll(int max_blocks = 64) override;
   void present(const StimulusEvent& event) override;
   void attend(const std::set<int>& codes) override { attended_ = codes; }
+  void displayed(double host_s, bool patch_lit) override;
+  double knownLatencyS() const override { return clock_->deliveryLagS(); }
   const SubjectProfile& profile() const { return profile_; }
   std::int64_t samplesGenerated() const { return generated_; }
 
@@ -79,6 +87,10 @@ class SimulatedSubject final : public EegSource {
   std::unique_ptr<Generator> generator_;
   std::set<int> attended_;
   std::vector<ActiveResponse> responses_;
+  // Photodiode level changes (first sample, lit), in order; the last one before `generated_` is
+  // kept as the current level.
+  std::vector<std::pair<std::int64_t, bool>> screen_;
+  bool screen_lit_ = false;
   std::mt19937_64 trial_random_;
   std::int64_t generated_ = 0;
 };

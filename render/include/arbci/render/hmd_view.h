@@ -57,6 +57,10 @@ struct HmdFrame {
   std::vector<ObjectHighlight> objects;
   std::optional<GridLayout> grid;
   GridHighlight grid_highlight;
+  // The photodiode patch in the top-left corner of each eye: white on frames that show a flash,
+  // black on the others, so a diode taped there sees exactly what the subject saw. nullopt: none.
+  std::optional<bool> photodiode_patch;
+  static constexpr int kPatchPx = 32;  // its side in pixels of the eye's viewport
 };
 
 struct HmdColors {

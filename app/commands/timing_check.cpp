@@ -1,0 +1,122 @@
+// `arbci timing-check`: flashes only, for a while, then the recorded flash onsets against the
+// photodiode's rising edges: timing.json and a histogram.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "arbci/bci/photodiode_check.h"
+#include "arbci/render/window_context.h"
+#include "commands/commands.h"
+#include "eeg/timing_plot.h"
+#include "session/session.h"
+#include "session/workstation.h"
+#include "support/cli_error.h"
+
+namespace arbci::app {
+namespace {
+
+struct TimingCheckOptions {
+  std::string session, out;
+  bool headless = false;
+  double seconds = 30.0;
+};
+
+nlohmann::json toJson(const bci::PhotodiodeReport& r, double target_sd_ms) {
+  return {
+      {"channel", r.channel},
+      {"rate_hz", r.rate_hz},
+      {"offset_ms", {{"mean", r.mean_ms}, {"sd", r.sd_ms}, {"min", r.min_ms}, {"max", r.max_ms}}},
+      {"count", r.count},
+      {"flashes", r.flashes},
+      {"photodiode_edges", r.edges},
+      {"unmatched_flashes", r.unmatched_flashes},
+      {"unmatched_edges", r.unmatched_edges},
+      {"target", {{"abs_mean_ms", 1.0}, {"sd_ms", target_sd_ms}}},
+      {"within_target", std::abs(r.mean_ms) <= 1.0 && r.sd_ms <= target_sd_ms &&
+                            r.count == r.flashes && r.unmatched_edges == 0}};
+}
+
+int runTimingCheck(const TimingCheckOptions& o) {
+  SessionConfig config;
+  try {
+    config = SessionConfig::load(
+        o.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.session));
+  } catch (const SessionConfigError& error) {
+    throw CliError(error.what());
+  }
+  if (config.eeg.photodiode_channel.empty())
+    throw CliError(config.source +
+                   ": eeg.photodiode_channel is empty: the timing check needs a photodiode "
+                   "channel (simulated: any name adds a virtual one)");
+  if (std::filesystem::exists(o.out) && !std::filesystem::is_empty(o.out))
+    throw CliError(o.out + ": exists and is not empty; choose a new folder");
+  SessionOptions options;
+  options.folder = o.out;
+  options.flashes_only_s = o.seconds;
+  options.close_window_when_ended = true;
+  options.progress = &std::cerr;
+  const bool headless = o.headless || !render::displayAvailable();
+  try {
+    if (headless) {
+      auto context = render::createHeadlessContext({64, 64});
+      Session session(config, options, *context);
+      session.run();
+    } else {
+      runWorkstation(config, options);
+    }
+  } catch (const std::runtime_error& error) {
+    throw CliError(error.what());
+  }
+  const auto folder = std::filesystem::path(o.out);
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  bci::PhotodiodeReport report;
+  try {
+    report = bci::checkPhotodiode(recording, config.eeg.photodiode_channel,
+                                  0.5 * config.paradigm.soaSeconds());
+  } catch (const std::invalid_argument& error) {
+    throw CliError(error.what());
+  }
+  const double sample_ms = 1000.0 / recording.info.rate_hz;
+  nlohmann::json out = toJson(report, sample_ms);
+  out["mode"] = headless ? "headless" : "window";
+  out["seconds"] = o.seconds;
+  std::ofstream(folder / "timing.json") << out.dump(2) << "\n";
+  writeTimingHistogram(folder / "timing.png", report);
+  std::cout << "timing check (" << (headless ? "headless" : "window") << "): " << report.count
+            << " of " << report.flashes << " flashes paired with photodiode edges (" << report.edges
+            << " edges); offset mean " << report.mean_ms << " ms, SD " << report.sd_ms
+            << " ms, min " << report.min_ms << " ms, max " << report.max_ms << " ms\n"
+            << "target: |mean| <= 1 ms, SD <= " << sample_ms
+            << " ms (one sample): " << (out["within_target"].get<bool>() ? "met" : "NOT met")
+            << "\n"
+            << "wrote " << (folder / "timing.json").string() << " and "
+            << (folder / "timing.png").string() << "\n";
+  return out["within_target"].get<bool>() ? 0 : 4;
+}
+
+}  // namespace
+
+void addTimingCheckCommand(CLI::App& root, int& exit_code) {
+  auto o = std::make_shared<TimingCheckOptions>();
+  CLI::App* cmd = root.add_subcommand(
+      "timing-check",
+      "Check the stimulus time stamps against a photodiode: runs flashes only (the calibration\n"
+      "paradigm) for --seconds, with the photodiode patch in a corner of each eye's view, then\n"
+      "pairs every recorded flash onset with the photodiode channel's nearest rising edge.\n"
+      "Writes DIR/timing.json (offset mean, SD, min, max in ms, count) and DIR/timing.png (a\n"
+      "histogram) beside the session's files. A real photodiode goes on the patch and into the\n"
+      "amplifier channel named eeg.photodiode_channel; the simulated subject has a virtual one.\n"
+      "Exit status: 0 within the target (|mean| <= 1 ms, SD <= one sample, every flash paired),\n"
+      "4 outside it, 2 on bad input.");
+  cmd->add_option("--session", o->session, "session file (default: the embedded simulated one)");
+  cmd->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
+  cmd->add_option("--seconds", o->seconds, "how long to flash (session seconds)")
+      ->check(CLI::Range(2.0, 3600.0))
+      ->capture_default_str();
+  cmd->add_option("--out", o->out, "output folder (new or empty)")->required();
+  cmd->callback([o, &exit_code] { exit_code = runTimingCheck(*o); });
+}
+
+}  // namespace arbci::app

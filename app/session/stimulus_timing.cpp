@@ -1,0 +1,116 @@
+#include "session/stimulus_timing.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace arbci::app {
+namespace {
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::nan("");
+  const size_t k = static_cast<size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+nlohmann::json orNull(double value) {
+  return std::isnan(value) ? nlohmann::json(nullptr) : nlohmann::json(value);
+}
+
+}  // namespace
+
+StimulusTiming::StimulusTiming(const bci::ParadigmSettings& paradigm, double eeg_rate_hz)
+    : paradigm_(paradigm), rate_hz_(eeg_rate_hz) {}
+
+StimulusTiming::Frame StimulusTiming::presented(double due_s, double presented_s,
+                                                std::int64_t sample, const std::set<int>& lit,
+                                                const std::vector<int>& first_shown) {
+  Frame frame;
+  const double period = 1.0 / paradigm_.display_hz;
+  ++frames_;
+  // Late: later than one frame period after it was due (a microsecond's grace for arithmetic).
+  frame.late = presented_s > due_s + period + 1e-6;
+  late_frames_ += frame.late;
+  if (last_presented_) {
+    frame_intervals_s_.push_back(presented_s - *last_presented_);
+    if (frame_intervals_s_.size() > 600)
+      frame_intervals_s_.erase(frame_intervals_s_.begin(), frame_intervals_s_.begin() + 300);
+  }
+  last_presented_ = presented_s;
+
+  // Flashes no longer shown have ended on this frame.
+  for (auto it = active_.begin(); it != active_.end();) {
+    if (lit.count(it->first)) {
+      ++it;
+      continue;
+    }
+    const auto duration = static_cast<int>(sample - it->second.onset_sample);
+    frame.ended.push_back({it->second.onset_sample, duration});
+    duration_samples_.push_back(duration);
+    it = active_.erase(it);
+  }
+  for (int code : first_shown) {
+    frame.onsets.push_back({code, sample});
+    active_.emplace_back(code, Active{sample});
+    if (!selection_onsets_.empty())
+      soa_samples_.push_back(static_cast<double>(sample - selection_onsets_.back()));
+    selection_onsets_.push_back(sample);
+  }
+  frame.patch_lit = !lit.empty();
+  return frame;
+}
+
+void StimulusTiming::startSelection() {
+  selection_onsets_.clear();
+}
+
+double StimulusTiming::medianSoaS() const {
+  const double median = quantile(soa_samples_, 0.5);
+  return std::isnan(median) ? paradigm_.soaSeconds() : median / rate_hz_;
+}
+
+double StimulusTiming::selectionSeconds() const {
+  if (selection_onsets_.empty()) return 0.0;
+  return static_cast<double>(selection_onsets_.back() - selection_onsets_.front()) / rate_hz_ +
+         medianSoaS();
+}
+
+std::optional<double> StimulusTiming::medianFrameIntervalMs() const {
+  if (frame_intervals_s_.size() < 60) return std::nullopt;
+  return 1000.0 * quantile(frame_intervals_s_, 0.5);
+}
+
+bool StimulusTiming::displayTooSlow() const {
+  const auto median = medianFrameIntervalMs();
+  return median && *median > 1.5 * 1000.0 / paradigm_.display_hz;
+}
+
+nlohmann::json StimulusTiming::summary(std::int64_t lost_samples, double clock_drift_ppm,
+                                       double clock_jitter_ms) const {
+  const double to_ms = 1000.0 / rate_hz_;
+  const double soa_median = quantile(soa_samples_, 0.5), soa_p95 = quantile(soa_samples_, 0.95);
+  const double flash_median = quantile(duration_samples_, 0.5);
+  const auto frame_median = medianFrameIntervalMs();
+  return {
+      {"soa_ms",
+       {{"configured", paradigm_.flash_ms + paradigm_.isi_ms},
+        {"median", orNull(soa_median * to_ms)},
+        {"p95", orNull(soa_p95 * to_ms)},
+        {"count", soa_samples_.size()}}},
+      {"flash_ms",
+       {{"configured", paradigm_.flash_ms},
+        {"median", orNull(flash_median * to_ms)},
+        {"count", duration_samples_.size()}}},
+      {"display",
+       {{"configured_hz", paradigm_.display_hz},
+        {"median_frame_ms", frame_median ? nlohmann::json(*frame_median) : nlohmann::json(nullptr)},
+        {"holds_rate", !displayTooSlow()}}},
+      {"frames", frames_},
+      {"late_frames", late_frames_},
+      {"lost_samples", lost_samples},
+      {"clock_drift_ppm", clock_drift_ppm},
+      {"clock_jitter_ms", clock_jitter_ms},
+  };
+}
+
+}  // namespace arbci::app

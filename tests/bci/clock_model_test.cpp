@@ -1,0 +1,171 @@
+// The EEG clock as the time base: the clock model against an amplifier whose clock runs 200 ppm
+// fast with late, jittered arrivals, and the acquisition's lock-step, gap, overflow and live paths
+// with the simulated subject's virtual photodiode.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include "arbci/bci/acquisition.h"
+#include "arbci/bci/clock_model.h"
+#include "arbci/bci/simulated_subject.h"
+
+namespace arbci::bci {
+namespace {
+
+TEST(ClockModel, StampsStayWithinOneSampleOfAClock200PpmFastOverTenMinutes) {
+  const double nominal = 256.0, true_rate = 256.0 * (1.0 + 200e-6);
+  const double latency = 0.004;  // known (measured) part of the delivery delay
+  ClockModel model(nominal, 120.0, latency);
+  std::mt19937_64 random(7);
+  std::exponential_distribution<double> late(1.0 / 0.0008);  // USB scheduling: mean 0.8 ms late
+  std::uniform_real_distribution<double> instant(0.0, 1.0);
+  const double t0 = 5000.0;  // host time of sample 0
+  int checked = 0, worst = 0;
+  double worst_drift_error = 0.0;
+  for (std::int64_t end = 15; end <= static_cast<std::int64_t>(600 * true_rate); end += 15) {
+    model.observe(end, t0 + end / true_rate + latency + late(random));
+    if (end < static_cast<std::int64_t>(10 * true_rate)) continue;  // warming up
+    // A host instant within this block: which sample was taken then?
+    const double host = t0 + (end - 15 * instant(random)) / true_rate;
+    const auto truth = static_cast<std::int64_t>(std::ceil((host - t0) * true_rate - 1e-9));
+    const auto error = static_cast<int>(std::llabs(model.firstSampleAtOrAfter(host) - truth));
+    worst = std::max(worst, error);
+    ++checked;
+    if (end > static_cast<std::int64_t>(60 * true_rate))
+      worst_drift_error = std::max(worst_drift_error, std::abs(model.driftPpm() - 200.0));
+  }
+  EXPECT_GT(checked, 9000);
+  EXPECT_LE(worst, 1) << "a stamp more than one sample from the truth";
+  EXPECT_LT(worst_drift_error, 20.0) << "fitted drift " << model.driftPpm() << " ppm";
+  EXPECT_NEAR(model.driftPpm(), 200.0, 20.0);
+  EXPECT_GT(model.jitterS(), 0.0003);  // the arrival jitter is reported, not hidden
+  EXPECT_LT(model.jitterS(), 0.002);
+}
+
+TEST(ClockModel, RefusesNonsense) {
+  EXPECT_THROW(ClockModel(0.0), std::invalid_argument);
+  EXPECT_THROW(ClockModel(256.0, -1.0), std::invalid_argument);
+}
+
+// A source that numbers its blocks with a gap (a lost USB transfer) after the fourth block.
+class GappySource final : public EegSource {
+ public:
+  explicit GappySource(std::shared_ptr<const SampleClock> clock) : clock_(std::move(clock)) {
+    info_.channels = {"Cz"};
+  }
+  const SignalInfo& info() const override { return info_; }
+  std::vector<Block> poll(int) override {
+    std::vector<Block> out;
+    while (next_ + 15 <= clock_->available(256.0)) {
+      if (blocks_++ != 4) {
+        Block b(next_, 1, 15);
+        for (int s = 0; s < 15; ++s) b.at(0, s) = 1.0f;
+        out.push_back(b);
+      }
+      next_ += 15;
+    }
+    return out;
+  }
+
+ private:
+  SignalInfo info_;
+  std::shared_ptr<const SampleClock> clock_;
+  std::int64_t next_ = 0;
+  int blocks_ = 0;
+};
+
+TEST(Acquisition, AGapIsFilledWithZerosCountedAndNamed) {
+  auto clock = std::make_shared<ManualClock>();
+  Acquisition acquisition(std::make_unique<GappySource>(clock), clock, Acquisition::Mode::Stepped);
+  acquisition.advanceTo(1.0);
+  std::int64_t next = 0, zeros = 0;
+  for (const Block& b : acquisition.take()) {
+    EXPECT_EQ(b.first_sample, next);
+    next = b.endSample();
+    for (float v : b.data) zeros += v == 0.0f;
+  }
+  EXPECT_EQ(next, 255);
+  EXPECT_EQ(zeros, 15);
+  EXPECT_EQ(acquisition.lostSamples(), 15);
+  const auto losses = acquisition.takeLosses();
+  ASSERT_EQ(losses.size(), 1u);
+  EXPECT_EQ(losses[0].first_sample, 60);
+  EXPECT_EQ(losses[0].samples, 15);
+}
+
+TEST(Acquisition, ACycleThatFallsBehindLosesTheOldestAndSaysHowMany) {
+  auto clock = std::make_shared<ManualClock>();
+  SimulatedSubjectConfig config;
+  AcquisitionSettings settings;
+  settings.queue_s = 0.5;
+  Acquisition acquisition(std::make_unique<SimulatedSubject>(config, clock), clock,
+                          Acquisition::Mode::Stepped, settings);
+  for (int i = 1; i <= 20; ++i) acquisition.advanceTo(0.1 * i);  // 2 s, never taken
+  const auto blocks = acquisition.take();
+  ASSERT_FALSE(blocks.empty());
+  EXPECT_EQ(blocks.front().first_sample, 0);  // the lost stretch comes back as zeros
+  std::int64_t next = 0;
+  for (const Block& b : blocks) {
+    EXPECT_EQ(b.first_sample, next);
+    next = b.endSample();
+  }
+  EXPECT_EQ(next, 510);
+  EXPECT_GE(acquisition.lostSamples(), 510 - 128 - 15);
+  EXPECT_LE(acquisition.lostSamples(), 510 - 128 + 15);
+  EXPECT_FALSE(acquisition.takeLosses().empty());
+}
+
+TEST(Acquisition, SteppedStampsAreExactAndTheSameEveryRun) {
+  auto run = [] {
+    auto clock = std::make_shared<ManualClock>();
+    SimulatedSubjectConfig config;
+    config.photodiode = true;
+    Acquisition acquisition(std::make_unique<SimulatedSubject>(config, clock), clock,
+                            Acquisition::Mode::Stepped);
+    std::vector<float> all;
+    for (int frame = 1; frame <= 120; ++frame) {
+      acquisition.advanceTo(frame / 60.0);
+      if (frame == 30) acquisition.withSource([](EegSource& s) { s.displayed(30 / 60.0, true); });
+      for (const Block& b : acquisition.take()) all.insert(all.end(), b.data.begin(), b.data.end());
+    }
+    EXPECT_EQ(acquisition.firstSampleAtOrAfter(0.5), 128);
+    EXPECT_EQ(acquisition.firstSampleAtOrAfter(30 / 60.0 + 1e-4), 129);
+    EXPECT_DOUBLE_EQ(acquisition.driftPpm(), 0.0);
+    return all;
+  };
+  EXPECT_EQ(run(), run());
+}
+
+TEST(Acquisition, LiveSubjectRunsOnItsOwnClockAndItsPhotodiodeRisesOnTheStampedSample) {
+  auto clock = std::make_shared<WallClock>(0.02);
+  SimulatedSubjectConfig config;
+  config.photodiode = true;
+  Acquisition acquisition(std::make_unique<SimulatedSubject>(config, clock), clock,
+                          Acquisition::Mode::Live);
+  acquisition.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const double lit_at = hostSeconds();
+  acquisition.withSource([&](EegSource& s) { s.displayed(lit_at, true); });
+  const std::int64_t stamp = acquisition.firstSampleAtOrAfter(lit_at);
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  acquisition.stop();
+  const auto blocks = acquisition.take();
+  std::int64_t rise = -1, samples = 0;
+  const int diode = config.montage.size();
+  for (const Block& b : blocks) {
+    samples += b.samples;
+    for (int s = 0; s < b.samples && rise < 0; ++s)
+      if (b.at(diode, s) > 500.0f) rise = b.first_sample + s;
+  }
+  EXPECT_GT(samples, 120);  // about 0.7 s at 256 Hz, minus the 20 ms transport
+  EXPECT_LT(samples, 256);
+  ASSERT_GE(rise, 0) << "the photodiode never rose";
+  EXPECT_LE(std::llabs(rise - stamp), 1) << "rise " << rise << ", stamp " << stamp;
+  EXPECT_EQ(acquisition.lostSamples(), 0);
+}
+
+}  // namespace
+}  // namespace arbci::bci
