@@ -15,7 +15,7 @@ namespace {
 
 struct RunOptions {
   std::string session, out;
-  bool headless = false, realtime = false, wait_for_start = false;
+  bool headless = false, realtime = false, wait_for_start = false, exit_when_done = false;
   int trials = 0;
   long long seed = -1;
   double fault_wait_s = 5.0;
@@ -68,6 +68,7 @@ int runSession(const RunOptions& o) {
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
   options.fault_wait_s = o.fault_wait_s;
   options.start_immediately = !o.wait_for_start;
+  options.close_window_when_ended = o.exit_when_done;
   options.progress = &std::cerr;
   const bool headless = o.headless || !render::displayAvailable();
   try {
@@ -108,6 +109,8 @@ void addRunCommand(CLI::App& root, int& exit_code) {
   run->add_option("--out", o->out, "session folder (default: arbci-session-<date>-<time>)");
   run->add_flag("--realtime", o->realtime,
                 "headless: pace to the wall clock instead of running as fast as possible");
+  run->add_flag("--exit-when-done", o->exit_when_done,
+                "windowed: close the window once the session has ended (scripted runs)");
   run->add_flag("--wait-for-start", o->wait_for_start,
                 "windowed: wait for the experimenter to press Start");
   run->add_option("--fault-wait", o->fault_wait_s,

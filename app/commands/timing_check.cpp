@@ -109,7 +109,7 @@ void addTimingCheckCommand(CLI::App& root, int& exit_code) {
       "histogram) beside the session's files. A real photodiode goes on the patch and into the\n"
       "amplifier channel named eeg.photodiode_channel; the simulated subject has a virtual one.\n"
       "Exit status: 0 within the target (|mean| <= 1 ms, SD <= one sample, every flash paired),\n"
-      "4 outside it, 2 on bad input.");
+      "4 outside it, 1 on bad input.");
   cmd->add_option("--session", o->session, "session file (default: the embedded simulated one)");
   cmd->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
   cmd->add_option("--seconds", o->seconds, "how long to flash (session seconds)")
