@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   int port = 47800;
   std::string host = "127.0.0.1", key_file, config_file, port_file;
   double speed = 0.0;
+  bool stepped = false;
   app.add_option("--port", port, "UDP port to listen on (0: any free port)")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
@@ -45,6 +46,9 @@ int main(int argc, char** argv) {
   app.add_option("--speed", speed,
                  "simulated seconds per real second (overrides the config's speed_factor)")
       ->check(CLI::Range(0.01, 1000.0));
+  app.add_flag("--stepped", stepped,
+               "move the arm only when a STATUS carries the client's clock (reproducible "
+               "simulations: arbci run headless starts it so), never on the wall clock");
   app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);
   app.failure_message([](const CLI::App*, const CLI::Error& error) {
     return std::string("arbci-robotd: ") + error.what() + "\n";
@@ -60,6 +64,7 @@ int main(int argc, char** argv) {
     options.host = host;
     options.speed_factor = speed > 0.0 ? speed : config.speed_factor;
     options.log = &std::cerr;
+    options.stepped = stepped;
     arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config),
                                        options);
     if (!port_file.empty()) {

@@ -44,6 +44,11 @@ struct Session::Impl {
   bool patch_lit = false;  // as last told to the EEG source
   bool warned_slow_display = false;
   std::unique_ptr<StimulusTiming> stimulus_timing;
+  double last_trial_end = 0.0;  // where the next trial's time starts (session seconds)
+  // The arm runs on this session's clock (a stepped arbci-robotd); false once it stops answering.
+  bool stepped_robot = false;
+  std::int64_t lost_logged = 0;               // lost EEG samples already in the log
+  double longest_frame_while_training = 0.0;  // seconds between presentations
   std::unique_ptr<SessionLog> log;
   std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
   int camera_every = 2;  // display frames per camera frame
@@ -201,8 +206,11 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     robot::saveKey(key_file, key);
     robot::RobotConfig robot_config = m.world ? m.world->robotConfig() : robot::RobotConfig{};
     std::ofstream(folder_ / "robot.json") << robot_config.toJson();
+    // A simulated clock steps the arm too (the robot follows the session, frame by frame).
     m.robotd = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder_ / "robot.json",
-                                              config_.robot_speed_factor, folder_);
+                                              config_.robot_speed_factor, folder_,
+                                              options.simulated_clock);
+    m.stepped_robot = options.simulated_clock;
     std::ofstream(folder_ / "robotd.pid") << m.robotd->pid() << "\n";
     endpoint = robot::Endpoint::resolve("127.0.0.1", m.robotd->port());
   } else {
@@ -307,6 +315,7 @@ TrialRecord& Session::currentTrial() {
     const TrialIntent& intent = impl_->intended[static_cast<size_t>(r.trial - 1)];
     r.intended_object = intent.object;
     r.intended_cell = {intent.row, intent.column};
+    r.started_s = impl_->last_trial_end;
     trials_.push_back(r);
   }
   return trials_[static_cast<size_t>(trial - 1)];
@@ -328,6 +337,14 @@ bool Session::step() {
   // EEG: everything that has arrived (simulated: generated up to now).
   if (options_.simulated_clock) eeg_->advanceTo(time_);
   eeg_->poll();
+  if (eeg_->lostSamples() != m.lost_logged) {
+    m.log->write("lost_samples", time_,
+                 {{"total", eeg_->lostSamples()}, {"new", eeg_->lostSamples() - m.lost_logged}});
+    if (options_.progress)
+      *options_.progress << "\nwarning: " << eeg_->lostSamples() - m.lost_logged
+                         << " EEG samples lost (see the recording's annotations)\n";
+    m.lost_logged = eeg_->lostSamples();
+  }
   timing_.mark("eeg");
   collectTraining();
 
@@ -361,7 +378,13 @@ bool Session::step() {
     }
   }
 
-  // Robot.
+  // Robot: a stepped arm is moved to this frame's time first, while it has anything to do (idle,
+  // it does not move; sendRobot() brings its clock up to date before a command).
+  const bool robot_matters = m.robot_command || (m.homed && !m.clear_view_frame) || m.placement;
+  if (m.stepped_robot && robot_matters && !client_->syncClock(time_)) {
+    m.stepped_robot = false;  // it stopped answering: the client reports it silent
+    m.log->write("robot_clock_lost", time_, {{"text", "the stepped robot backend did not answer"}});
+  }
   client_->poll();
   handleRobotEvents();
   measurePlacement();
@@ -418,7 +441,10 @@ bool Session::step() {
   if (options_.progress && frame_ % 600 == 0)
     *options_.progress << "\r" << statusLine() << "      " << std::flush;
   ++frame_;
-  if (options_.simulated_clock && m.robot_command && m.robotd) {
+  // While the robot works (or its status after homing is awaited), simulated time keeps to the
+  // robot's pace: its status arrives on the wall clock.
+  const bool awaiting_robot = m.robot_command || (m.homed && !m.clear_view_frame);
+  if (options_.simulated_clock && awaiting_robot && m.robotd && !m.stepped_robot) {
     const double robot_seconds = (time_ - m.robot_started_at) / config_.robot_speed_factor;
     std::this_thread::sleep_until(m.robot_started_wall +
                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -445,9 +471,11 @@ void Session::collectTraining() {
     eeg_->model()->save(folder_ / "model.json");
     impl_->log->write("trained", time_,
                       {{"method", config_.classifier_method},
+                       {"longest_frame_ms", 1000.0 * impl_->longest_frame_while_training},
                        {"auc", calibration_report_->auc},
                        {"accuracy_by_sequences", calibration_report_->accuracy}});
     chooseSelectableObjects();
+    impl_->last_trial_end = time_;  // the first trial's time counts from here
     paradigm_->modelTrained(true, "");
   } catch (const std::exception& error) {
     impl_->log->write("training_failed", time_, {{"reason", error.what()}});
@@ -484,6 +512,9 @@ void Session::presented(double host_s) {
                   {"late_ms", 1000.0 * (at - m.due)},
                   {"stages", timing_.lastCycle()}});
   }
+  if (m.last_presented && eeg_->training())
+    m.longest_frame_while_training =
+        std::max(m.longest_frame_while_training, at - *m.last_presented);
   m.last_presented = at;
   if (!m.warned_slow_display && m.stimulus_timing->displayTooSlow()) {
     m.warned_slow_display = true;
@@ -508,12 +539,21 @@ std::string Session::timingWarning() const {
   return text;
 }
 
+std::string Session::eegClockLine() const {
+  char text[160];
+  std::snprintf(text, sizeof text, "EEG: lost samples %lld, clock drift %+.1f ppm, jitter %.2f ms",
+                static_cast<long long>(eeg_->lostSamples()), eeg_->clockDriftPpm(),
+                eeg_->clockJitterMs());
+  return text;
+}
+
 std::int64_t Session::lateFrames() const {
   return impl_->stimulus_timing->lateFrames();
 }
 
 void Session::sendRobot(robot::MessageType type, const cv::Vec3d& target) {
   Impl& m = *impl_;
+  if (m.stepped_robot) client_->syncClock(time_);  // the command starts now, not at the last sync
   m.robot_command = client_->send(type, {target[0], target[1], target[2]});
   m.robot_started_at = time_;
   m.robot_started_wall = std::chrono::steady_clock::now();
@@ -538,6 +578,7 @@ void Session::handleRobotEvents() {
     using Kind = robot::RobotEvent::Kind;
     if (ours && e.kind == Kind::Finished) {
       m.robot_command.reset();
+      client_->requestStatus();  // the world as the robot left it, without waiting
       const bool success = e.outcome == robot::Outcome::Success;
       if (success && m.robot_command_type == robot::MessageType::Drop) {
         if (!m.returning) {
@@ -826,6 +867,9 @@ void Session::handleParadigmEvents() {
         m.log->write("robot_command", time_, {{"command", "STOP"}});
         break;
       case Kind::TrialDone:
+        if (e.trial >= 1 && e.trial <= static_cast<int>(trials_.size()))
+          trials_[static_cast<size_t>(e.trial - 1)].ended_s = time_;
+        m.last_trial_end = time_;
         m.log->write("trial_done", time_, {{"trial", e.trial}});
         break;
     }
@@ -1014,7 +1058,9 @@ nlohmann::json Session::summary() const {
                         {"cell_flashes", t.cell_flashes},
                         {"object_selection_s", t.object_selection_s},
                         {"cell_selection_s", t.cell_selection_s},
-                        {"outcome", t.outcome}};
+                        {"outcome", t.outcome},
+                        {"duration_s", t.ended_s >= 0.0 ? nlohmann::json(t.ended_s - t.started_s)
+                                                        : nlohmann::json(nullptr)}};
     j["placement_error_m"] =
         t.placement_error_m >= 0.0 ? nlohmann::json(t.placement_error_m) : nlohmann::json(nullptr);
     trials.push_back(j);
@@ -1028,6 +1074,22 @@ nlohmann::json Session::summary() const {
       cells_right += t.selected_cell == t.intended_cell;
       cell_seconds += t.cell_selection_s;
     }
+  }
+  // All of a trial's time (cues, pauses, both selections, the robot) for completed trials.
+  double trial_seconds = 0.0, trial_bits = 0.0;
+  const int object_choices = static_cast<int>(config_.world.objects.size());
+  const int cell_choices = config_.world.grid.rows * config_.world.grid.columns;
+  int completed = 0;
+  for (const TrialRecord& t : trials_) {
+    if (t.ended_s < 0.0) continue;
+    ++completed;
+    trial_seconds += t.ended_s - t.started_s;
+  }
+  if (objects_made > 0 && cells_made > 0) {
+    trial_bits =
+        completed *
+        (bci::wolpawBits(object_choices, static_cast<double>(objects_right) / objects_made) +
+         bci::wolpawBits(cell_choices, static_cast<double>(cells_right) / cells_made));
   }
   // Selection times are measured from the flash onsets as presented, never from the settings.
   auto rate = [&](int choices, int right, int made, double total_seconds) {
@@ -1052,6 +1114,12 @@ nlohmann::json Session::summary() const {
                      cell_seconds)},
       {"cycle", timing_.toJson()},
       {"overruns", timing_.overruns()},
+      {"all_inclusive",
+       completed == 0 ? nlohmann::json(nullptr)
+                      : nlohmann::json{{"completed_trials", completed},
+                                       {"seconds_per_trial", trial_seconds / completed},
+                                       {"seconds_per_selection", trial_seconds / (2 * completed)},
+                                       {"bits_per_minute", trial_bits / trial_seconds * 60.0}}},
       {"timing", impl_->stimulus_timing->summary(eeg_->lostSamples(), eeg_->clockDriftPpm(),
                                                  eeg_->clockJitterMs())},
       {"eeg",

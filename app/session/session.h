@@ -50,6 +50,7 @@ struct TrialRecord {
   double object_certainty = 0.0, cell_certainty = 0.0;
   int object_flashes = 0, cell_flashes = 0;
   double object_selection_s = 0.0, cell_selection_s = 0.0;  // from the presented onsets
+  double started_s = 0.0, ended_s = -1.0;  // session time: after the last trial, its put-down
   double placement_error_m = -1.0;
   std::string outcome = "incomplete";
 };
@@ -70,6 +71,8 @@ class Session {
   std::int64_t lateFrames() const;
   // Non-empty while the display cannot hold display_hz.
   std::string timingWarning() const;
+  // "EEG: lost samples N, clock drift X ppm, jitter Y ms".
+  std::string eegClockLine() const;
   // Steps until the end (headless). Returns the summary.
   nlohmann::json run();
 

@@ -49,6 +49,9 @@ class SessionModel final : public ui::WorkstationModel {
   double sessionTime() override { return session_.time(); }
   double budgetMs() override { return session_.timing().budgetMs(); }
   int overruns() override { return session_.timing().overruns(); }
+  long long lateFrames() override { return session_.lateFrames(); }
+  std::string timingWarning() override { return session_.timingWarning(); }
+  std::string eegClockLine() override { return session_.eegClockLine(); }
   std::vector<ui::StageTiming> timing() override;
   std::vector<std::string> selections() override { return session_.selectionLines(); }
 

@@ -47,6 +47,7 @@ struct RobotBackend::Impl {
     MessageType type = MessageType::Home;
   };
   std::optional<Running> running;
+  std::optional<double> stepped_clock;  // stepped: the clock the robot has reached
   SteadyClock::time_point last_step = SteadyClock::now(), last_push = SteadyClock::now();
   BackendStats stats;
   mutable std::mutex stats_mutex;
@@ -206,6 +207,7 @@ struct RobotBackend::Impl {
   void process(const Message& m, Session& s, const Endpoint& from) {
     switch (m.type) {
       case MessageType::Status:
+        if (options.stepped && m.clock_s) stepTo(*m.clock_s);
         send(statusFor(m.session, m.sequence), from);
         return;
       case MessageType::Stop: {
@@ -242,11 +244,25 @@ struct RobotBackend::Impl {
     }
   }
 
+  // Stepped: the robot's time follows the requester's clock.
+  void stepTo(double clock_s) {
+    if (stepped_clock && clock_s > *stepped_clock && running) {
+      double remaining = clock_s - *stepped_clock;  // robot seconds are clock seconds
+      // In the wall-clock loop's steps (at most 0.1 s), so both move the arm alike.
+      while (running && remaining > 1e-12) {
+        const double dt = std::min(remaining, 0.1);
+        remaining -= dt;
+        if (const auto result = driver->step(dt)) finish(result->outcome, result->text);
+      }
+    }
+    if (!stepped_clock || clock_s > *stepped_clock) stepped_clock = clock_s;
+  }
+
   void advance() {
     const auto now = SteadyClock::now();
     const double elapsed = std::chrono::duration<double>(now - last_step).count();
     last_step = now;
-    if (running) {
+    if (running && !options.stepped) {
       if (const auto result = driver->step(std::min(elapsed, 0.1) * options.speed_factor))
         finish(result->outcome, result->text);
     }

@@ -138,6 +138,7 @@ void RobotClient::handle(const Message& m) {
       break;
     case MessageType::StatusReply: {
       status_ = m.status;
+      if (sync_sequence_ != 0 && m.sequence == sync_sequence_) synced_ = true;
       // A lost FINISHED shows in the status as this session's last finished command.
       Pending* done = find(m.status.last_finished_sequence);
       if (done && done->accepted && done->accepted_boot == m.boot) {
@@ -201,6 +202,31 @@ void RobotClient::poll() {
                        {},
                        "no answer from the backend for a second"});
   }
+}
+
+bool RobotClient::syncClock(double clock_s, double timeout_s) {
+  Message m;
+  m.type = MessageType::Status;
+  m.session = session_;
+  m.sequence = sync_sequence_ = next_sequence_++;
+  m.clock_s = clock_s;
+  synced_ = false;
+  const auto give_up = Clock::now() + seconds(timeout_s);
+  auto resend = Clock::now();
+  while (!synced_ && Clock::now() < give_up) {
+    if (Clock::now() >= resend) {
+      m.timestamp_ms = wallClockMs();
+      socket_.sendTo(encode(m, key_), backend_);
+      resend = Clock::now() + seconds(0.05);
+    }
+    socket_.wait(2);
+    poll();
+  }
+  return synced_;
+}
+
+void RobotClient::requestStatus() {
+  next_status_ = Clock::now();
 }
 
 std::vector<RobotEvent> RobotClient::takeEvents() {

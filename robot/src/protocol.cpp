@@ -107,6 +107,9 @@ void writePayload(Writer& w, const Message& m) {
     case MessageType::Drop:
       w.vec(m.target);
       break;
+    case MessageType::Status:
+      if (m.clock_s) w.real(*m.clock_s);
+      break;
     case MessageType::Rejected:
       w.integer(static_cast<std::uint8_t>(m.reason));
       w.text(m.text);
@@ -147,6 +150,11 @@ bool readPayload(Reader& r, Message& m) {
     case MessageType::Drop:
       m.target = r.vec();
       return !r.failed && finite(m.target);
+    case MessageType::Status:
+      // Empty, or the requester's clock for a stepped backend.
+      if (r.done()) return true;
+      m.clock_s = r.real();
+      return !r.failed && std::isfinite(*m.clock_s) && *m.clock_s >= 0.0;
     case MessageType::Rejected: {
       const auto reason = r.integer<std::uint8_t>();
       if (reason < 1 || reason > 7) return false;

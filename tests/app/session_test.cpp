@@ -109,6 +109,49 @@ TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimet
   EXPECT_GT(cycles, 100);
 }
 
+// The data records of a BDF (everything after the header: samples and annotations, Stim events
+// among them) and its Stim events.
+std::string dataRecords(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const int header = std::stoi(bytes.substr(184, 8));
+  return bytes.substr(static_cast<size_t>(header));
+}
+
+std::vector<std::pair<std::int64_t, int>> stims(const std::filesystem::path& file) {
+  std::vector<std::pair<std::int64_t, int>> out;
+  for (const auto& s : bci::readRecording(file).stimuli) out.emplace_back(s.sample, s.code);
+  return out;
+}
+
+// The default world (head motion, camera noise) and subject, with dynamic stopping, through a
+// trial with the robot: the same seed gives the same recording; another seed, another one.
+TEST(Session, AHeadlessRunIsReproducibleForASeed) {
+  const auto session = fresh("repro").string() + ".json";
+  std::ofstream(session) << R"({"paradigm": {"calibration_selections": 4, "trials": 1}})";
+  auto run = [&](const std::string& name, const std::string& seed) {
+    const auto folder = fresh(name);
+    const ProcessResult r = runProcess(
+        kArbci,
+        {"run", "--headless", "--session", session, "--seed", seed, "--out", folder.string()},
+        400.0);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return folder / "recording.bdf";
+  };
+  const auto first = run("repro_a", "4"), second = run("repro_b", "4"), other = run("repro_c", "5");
+  const std::string a = dataRecords(first), b = dataRecords(second), c = dataRecords(other);
+  EXPECT_GT(a.size(), 400000u);  // about a minute of 9 channels at 256 Hz, 3 bytes a sample
+  EXPECT_TRUE(a == b) << "the same seed gave different data records";
+  EXPECT_EQ(stims(first), stims(second));
+  EXPECT_FALSE(a == c);
+  EXPECT_NE(stims(first), stims(other));
+  // The robot acted in it: the trial's grasp and put-down are in the recording.
+  int robot_phases = 0;
+  for (const auto& note : bci::readRecording(first).annotations)
+    robot_phases += note.text.find("robot ") != std::string::npos;
+  EXPECT_GE(robot_phases, 2);
+}
+
 TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
   const auto folder = fresh("weak");
   const auto session = folder.string() + ".json";

@@ -35,9 +35,11 @@ RobotConfig twoObjects() {
 // A backend on its own thread.
 class RunningBackend {
  public:
-  explicit RunningBackend(double speed, int port = 0, RobotConfig config = twoObjects()) {
+  explicit RunningBackend(double speed, int port = 0, RobotConfig config = twoObjects(),
+                          bool stepped = false) {
     BackendOptions options;
     options.port = port;
+    options.stepped = stepped;
     options.speed_factor = speed;
     options.status_interval_s = 0.05;
     backend_ =
@@ -130,6 +132,41 @@ StatusPayload freshStatus(RobotClient& client) {
     std::this_thread::sleep_for(1ms);
   }
   return client.status().value_or(StatusPayload{});
+}
+
+// A stepped backend moves its arm only to the clock the client's STATUS carries: nothing happens
+// on the wall clock, and the same clock steps give the same arm, to the last bit, every time.
+TEST(RobotBackend, ASteppedArmFollowsTheClientsClockAndNothingElse) {
+  auto run = [] {
+    RunningBackend backend(1.0, 0, twoObjects(), true);
+    RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
+    EXPECT_TRUE(client.syncClock(10.0));
+    const StatusPayload before = *client.status();
+    const std::uint64_t grasp = client.send(MessageType::Grasp, {0.10, 0.60, 0.06});
+    EXPECT_TRUE(waitUntilAccepted(client, grasp));
+    std::this_thread::sleep_for(300ms);  // wall time passes: the arm stays where it was
+    EXPECT_TRUE(client.syncClock(10.0));
+    EXPECT_EQ(client.status()->tool.x, before.tool.x);
+    EXPECT_EQ(client.status()->tool.z, before.tool.z);
+    std::vector<Vec3> path;
+    bool finished = false;
+    for (int frame = 1; frame <= 60 * 30 && !finished; ++frame) {
+      EXPECT_TRUE(client.syncClock(10.0 + frame / 60.0));
+      path.push_back(client.status()->tool);
+      for (const RobotEvent& e : client.takeEvents())
+        finished |= e.sequence == grasp && e.kind == RobotEvent::Kind::Finished;
+    }
+    EXPECT_TRUE(finished);
+    EXPECT_EQ(client.status()->holding, 1);
+    return path;
+  };
+  const std::vector<Vec3> first = run(), second = run();
+  ASSERT_EQ(first.size(), second.size());
+  EXPECT_GT(first.size(), 60u);  // a grasp takes seconds of robot time, not one step
+  for (size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].x, second[i].x) << i;
+    EXPECT_EQ(first[i].z, second[i].z) << i;
+  }
 }
 
 TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {

@@ -76,6 +76,27 @@ TEST(Protocol, EveryMessageSurvivesARoundTrip) {
   EXPECT_EQ(d.message.text, rejected.text);
 }
 
+TEST(Protocol, AStatusCarriesTheRequestersClockOrNothing) {
+  const Key key = testKey();
+  Message status;
+  status.type = MessageType::Status;
+  status.sequence = 3;
+  auto bytes = encode(status, key);
+  Decoded plain = decode(bytes.data(), bytes.size(), key);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain.message.clock_s.has_value());
+  status.clock_s = 12.345;
+  const auto with_clock = encode(status, key);
+  EXPECT_EQ(with_clock.size(), bytes.size() + 8);
+  Decoded clocked = decode(with_clock.data(), with_clock.size(), key);
+  ASSERT_TRUE(clocked.ok());
+  ASSERT_TRUE(clocked.message.clock_s.has_value());
+  EXPECT_EQ(*clocked.message.clock_s, 12.345);
+  status.clock_s = -1.0;  // a clock before its start is refused
+  const auto negative = encode(status, key);
+  EXPECT_FALSE(decode(negative.data(), negative.size(), key).ok());
+}
+
 TEST(Protocol, TamperingOtherKeysVersionsAndCutsAreCaught) {
   const Key key = testKey();
   const auto bytes = encode(statusMessage(), key);

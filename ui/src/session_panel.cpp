@@ -22,7 +22,12 @@ void SessionPanel::draw() {
   emergencyStopButton(model_);
   const auto timing = model_.timing();
   heading("cycle");
-  ImGui::Text("budget %.1f ms (one EEG block); overruns: %d", model_.budgetMs(), model_.overruns());
+  ImGui::Text("budget %.1f ms (one EEG block); overruns: %d; late frames: %lld", model_.budgetMs(),
+              model_.overruns(), model_.lateFrames());
+  if (const std::string clock = model_.eegClockLine(); !clock.empty())
+    ImGui::TextUnformatted(clock.c_str());
+  if (const std::string warning = model_.timingWarning(); !warning.empty())
+    ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", warning.c_str());
   if (ImGui::BeginTable("timing", 6, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {
     for (const char* h : {"stage", "last ms", "p50", "p90", "p99", "max"})
       ImGui::TableSetupColumn(h);

@@ -18,7 +18,11 @@ namespace arbci::robot {
 struct BackendOptions {
   int port = 0;  // 0: any free port (see RobotBackend::port)
   std::string host = "127.0.0.1";
-  double speed_factor = 1.0;       // robot seconds per real second
+  double speed_factor = 1.0;  // robot seconds per real second
+  // Stepped: the robot moves only when a STATUS carries the requester's clock (to that time; its
+  // seconds are robot seconds, speed_factor does not apply), never on the wall clock: a simulated
+  // session then gets the same robot, frame for frame, run after run.
+  bool stepped = false;
   double status_interval_s = 0.2;  // progress pushed to the commanding client
   double max_clock_skew_s = 30.0;  // older or newer timestamps count as replays
   std::ostream* log = nullptr;     // rejected and ignored datagrams (rate-limited)

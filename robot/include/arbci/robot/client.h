@@ -53,6 +53,14 @@ class RobotClient {
   // Queues a command (GRASP, DROP, HOME, STOP); returns its sequence number.
   std::uint64_t send(MessageType type, const Vec3& target = {});
   void poll();
+  // The next poll() asks for a status at once rather than at the status interval (the session
+  // wants to see the world right after a command finished).
+  void requestStatus();
+  // For a stepped backend (a reproducible simulation): asks for a status at `clock_s` of the
+  // session's clock, so the robot moves to that time, and waits for the answer (at most
+  // `timeout_s`, resending every 50 ms). Events and status are up to that instant on return.
+  // False if no answer came.
+  bool syncClock(double clock_s, double timeout_s = 2.0);
   std::vector<RobotEvent> takeEvents();
   // The latest status the backend sent (state, tool, gripper, world).
   const std::optional<StatusPayload>& status() const { return status_; }
@@ -85,6 +93,8 @@ class RobotClient {
   std::optional<StatusPayload> status_;
   std::uint64_t boot_ = 0;
   bool heard_ = false, silent_ = false;
+  std::uint64_t sync_sequence_ = 0;  // the clock request awaited
+  bool synced_ = false;
   std::chrono::steady_clock::time_point last_heard_, next_status_, created_;
 };
 

@@ -77,7 +77,10 @@ struct Message {
   std::uint64_t timestamp_ms = 0;  // sender's wall clock (Unix time)
   std::uint64_t boot = 0;          // replies: the backend's random id for this run
   // Payloads (which one is used depends on `type`).
-  Vec3 target;                                    // Grasp, Drop
+  Vec3 target;  // Grasp, Drop
+  // Status, optional: the requester's clock (seconds); a stepped backend advances its robot to
+  // it before answering, so a simulation runs on the session's clock.
+  std::optional<double> clock_s;
   RejectReason reason = RejectReason::Malformed;  // Rejected
   Outcome outcome = Outcome::Success;             // Finished
   std::string text;                               // Rejected, Finished: for people

@@ -73,6 +73,12 @@ class WorkstationModel {
   virtual double sessionTime() = 0;
   virtual double budgetMs() = 0;
   virtual int overruns() = 0;
+  // Frames presented more than a period late, and a warning while the display cannot hold its
+  // rate (empty otherwise).
+  virtual long long lateFrames() { return 0; }
+  virtual std::string timingWarning() { return ""; }
+  // The EEG time base: samples lost (gaps, overflows), the amplifier clock's drift and jitter.
+  virtual std::string eegClockLine() { return ""; }
   virtual std::vector<StageTiming> timing() = 0;
   virtual std::vector<std::string> selections() = 0;  // one line per selection made
 };

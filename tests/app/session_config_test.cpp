@@ -1,0 +1,75 @@
+// The session file: the embedded session is the one source of defaults (a file that names one key
+// leaves every other as the embedded file has it), and a bad value or key is refused with a
+// message naming the key, the value and what is allowed.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "session/session_config.h"
+
+namespace arbci::app {
+namespace {
+
+std::filesystem::path sessionFile(const std::string& name, const std::string& json) {
+  const auto path =
+      std::filesystem::temp_directory_path() / ("arbci_config_test_" + name + ".json");
+  std::ofstream(path) << json;
+  return path;
+}
+
+std::string errorOf(const std::string& json) {
+  try {
+    SessionConfig::load(sessionFile("bad", json));
+  } catch (const SessionConfigError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(SessionConfig, AFileNamingOneKeyKeepsEveryOtherEmbeddedDefault) {
+  const SessionConfig embedded = SessionConfig::load(std::nullopt);
+  const SessionConfig c =
+      SessionConfig::load(sessionFile("one_key", R"({"paradigm": {"trials": 7}})"));
+  EXPECT_EQ(c.paradigm.trials, 7);
+  EXPECT_NE(embedded.paradigm.trials, 7);
+  EXPECT_EQ(c.paradigm.flash_ms, embedded.paradigm.flash_ms);
+  EXPECT_EQ(c.paradigm.isi_ms, embedded.paradigm.isi_ms);
+  EXPECT_EQ(c.paradigm.sequences, embedded.paradigm.sequences);
+  EXPECT_EQ(c.paradigm.min_sequences, embedded.paradigm.min_sequences);
+  EXPECT_EQ(c.paradigm.certainty, embedded.paradigm.certainty);
+  EXPECT_EQ(c.paradigm.calibration_selections, embedded.paradigm.calibration_selections);
+  EXPECT_EQ(c.paradigm.cue_s, embedded.paradigm.cue_s);
+  EXPECT_EQ(c.pipeline.window.end_s, embedded.pipeline.window.end_s);
+  EXPECT_EQ(c.pipeline.decimate_hz, embedded.pipeline.decimate_hz);
+  EXPECT_EQ(c.pipeline.filter.lowpass_hz, embedded.pipeline.filter.lowpass_hz);
+  EXPECT_EQ(c.eeg.photodiode_channel, "Photodiode");
+  EXPECT_EQ(c.eeg.latency_ms, 0.0);
+}
+
+TEST(SessionConfig, TheEmbeddedFileSetsWhatTheParserWouldOtherwiseDefault) {
+  // Changing a default in the embedded file (not in code) is what a change of default means:
+  // a file that sets a classifier value keeps the embedded window.
+  const SessionConfig c =
+      SessionConfig::load(sessionFile("classifier", R"({"classifier": {"decimate_hz": 32}})"));
+  EXPECT_EQ(c.pipeline.decimate_hz, 32.0);
+  EXPECT_EQ(c.pipeline.window.start_s, 0.0);
+  EXPECT_EQ(c.pipeline.window.end_s, 0.8);
+}
+
+TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
+  const std::string range = errorOf(R"({"paradigm": {"flash_ms": 1}})");
+  EXPECT_NE(range.find("paradigm.flash_ms = 1"), std::string::npos) << range;
+  EXPECT_NE(range.find("[5, 2000]"), std::string::npos) << range;
+  const std::string unknown = errorOf(R"({"paradigm": {"flashms": 60}})");
+  EXPECT_NE(unknown.find("paradigm.flashms is not a known key"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("flash_ms"), std::string::npos) << unknown;
+  const std::string latency = errorOf(R"({"eeg": {"latency_ms": -3}})");
+  EXPECT_NE(latency.find("eeg.latency_ms = -3"), std::string::npos) << latency;
+  const std::string source = errorOf(R"({"eeg": {"source": "lsl"}})");
+  EXPECT_NE(source.find("eeg.source"), std::string::npos) << source;
+  EXPECT_NE(source.find("simulated"), std::string::npos) << source;
+}
+
+}  // namespace
+}  // namespace arbci::app
