@@ -32,25 +32,18 @@ std::string defaultFolder() {
 
 void printSummary(const Session& session) {
   std::cout << "session folder: " << session.folder().string() << "\n";
-  for (const TrialRecord& t : session.trials()) {
-    std::cout << "trial " << t.trial << ": object " << t.selected_object
-              << (t.selected_object == t.intended_object
-                      ? " (intended)"
-                      : " (intended " + std::to_string(t.intended_object) + ")")
-              << ", cell " << t.selected_cell.first << "," << t.selected_cell.second
-              << (t.selected_cell == t.intended_cell
-                      ? " (intended)"
-                      : " (intended " + std::to_string(t.intended_cell.first) + "," +
-                            std::to_string(t.intended_cell.second) + ")");
-    if (t.placement_error_m >= 0.0)
-      std::cout << ", placed " << std::fixed << std::setprecision(1) << t.placement_error_m * 1000.0
-                << " mm from the cell centre";
-    std::cout << " [" << t.outcome << "]\n";
-  }
+  // The same lines as the Session panel's.
+  for (const std::string& line : session.selectionLines()) std::cout << line << "\n";
   const Percentiles p = session.timing().totalPercentiles();
   std::cout << std::fixed << std::setprecision(2) << "cycle compute time: p50 " << p.p50
             << " ms, p99 " << p.p99 << " ms, max " << p.max << " ms; overruns (> "
             << session.timing().budgetMs() << " ms): " << session.timing().overruns() << "\n";
+  const nlohmann::json timing = session.summary()["timing"];
+  auto ms = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : 0.0; };
+  std::cout << "flashes as presented: SOA median " << ms(timing["soa_ms"]["median"])
+            << " ms (configured " << ms(timing["soa_ms"]["configured"]) << "), flash median "
+            << ms(timing["flash_ms"]["median"]) << " ms; late frames " << timing["late_frames"]
+            << ", lost EEG samples " << timing["lost_samples"] << "\n";
   std::cout << "ended: " << session.endReason() << "\n";
 }
 

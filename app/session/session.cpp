@@ -17,6 +17,7 @@
 #include "arbci/render/framebuffer.h"
 #include "arbci/robot/key_file.h"
 #include "session/camera_capture.h"
+#include "session/hmd_composition.h"
 #include "session/image_writer.h"
 #include "session/robot_process.h"
 #include "session/session_log.h"
@@ -890,69 +891,15 @@ void Session::decideIfReady() {
 
 void Session::renderHmd(const bci::FrameStimulus& stimulus) {
   Impl& m = *impl_;
-  render::HmdFrame frame;
-  frame.left = {vision_->leftImage(), vision_->leftCamera(), vision_->T_cam_world_left()};
-  frame.right = {vision_->rightImage(), vision_->rightCamera(), vision_->T_cam_world_right()};
-  const bool objects_phase = stimulus.phase == bci::Phase::ObjectFlashing ||
-                             stimulus.phase == bci::Phase::CalibrationFlashing;
-  const int holding = client_->status() ? client_->status()->holding : -1;
-  for (size_t i = 0; i < config_.world.objects.size(); ++i) {
-    const WorldObjectSettings& o = config_.world.objects[i];
-    const auto state = vision_->world().object(o.id);
-    if (!state) continue;
-    render::ObjectHighlight h;
-    h.id = o.id;
-    h.T_world_top = state->T_robot_object;
-    h.side_m = o.marker_m;
-    const auto in_slots = std::find(m.slots.begin(), m.slots.end(), i);
-    const int slot =
-        in_slots == m.slots.end() ? 0 : static_cast<int>(in_slots - m.slots.begin()) + 1;
-    if (objects_phase && stimulus.lit.count(slot)) h.state = render::HighlightState::Flashing;
-    if (stimulus.cued_object == slot)
-      h.state = stimulus.lit.count(slot) ? render::HighlightState::Flashing
-                                         : render::HighlightState::Cued;
-    if (stimulus.selected_object == slot) h.state = render::HighlightState::Selected;
-    if (holding == o.id) h.state = render::HighlightState::Held;
-    frame.objects.push_back(h);
-  }
-  if (stimulus.grid_visible) {
-    const render::GridLayout grid = gridLayout();
-    frame.grid = grid;
-    if (stimulus.phase == bci::Phase::CellFlashing) {
-      for (int code : stimulus.lit) {
-        if (code <= grid.rows)
-          frame.grid_highlight.rows.insert(code);
-        else
-          frame.grid_highlight.columns.insert(code - grid.rows);
-      }
-    }
-    frame.grid_highlight.selected = stimulus.selected_cell;
-  }
-  if (eeg_->hasPhotodiode()) frame.photodiode_patch = !stimulus.lit.empty();
+  const HmdScene scene{config_,      *vision_,
+                       m.slots,      client_->status() ? client_->status()->holding : -1,
+                       gridLayout(), eeg_->hasPhotodiode()};
+  const render::HmdFrame frame = composeHmdFrame(stimulus, scene);
   // What this frame shows; unchanged, the framebuffer already holds it.
-  std::ostringstream signature;
-  if (frame.photodiode_patch) signature << (*frame.photodiode_patch ? "P" : "p");
-  signature << static_cast<const void*>(frame.left.image.data)
-            << static_cast<const void*>(frame.right.image.data);
-  for (const auto* eye : {&frame.left, &frame.right}) {
-    if (eye->T_cam_world)
-      signature << cv::Mat(eye->T_cam_world->rotation) << cv::Mat(eye->T_cam_world->translation);
-  }
-  for (const render::ObjectHighlight& h : frame.objects) {
-    signature << h.id << static_cast<int>(h.state) << cv::Mat(h.T_world_top.rotation)
-              << cv::Mat(h.T_world_top.translation);
-  }
-  if (frame.grid) {
-    signature << "grid";
-    for (int r : frame.grid_highlight.rows) signature << 'r' << r;
-    for (int c : frame.grid_highlight.columns) signature << 'c' << c;
-    if (frame.grid_highlight.selected)
-      signature << 's' << frame.grid_highlight.selected->first
-                << frame.grid_highlight.selected->second;
-  }
-  if (signature.str() != m.last_hmd_signature) {
+  const std::string signature = hmdFrameSignature(frame);
+  if (signature != m.last_hmd_signature) {
     m.hmd->draw(frame, m.hmd_fbo->id(), m.hmd_fbo->size());
-    m.last_hmd_signature = signature.str();
+    m.last_hmd_signature = signature;
   }
   if (m.screenshot_name && (!m.screenshot_needs_flash || !stimulus.lit.empty())) {
     screenshot(folder_ / *m.screenshot_name);
@@ -989,23 +936,7 @@ void Session::useModel(const bci::P300Model& model) {
 
 std::vector<std::string> Session::selectionLines() const {
   std::vector<std::string> lines;
-  for (const TrialRecord& t : trials_) {
-    std::string line = "trial " + std::to_string(t.trial) + ": object ";
-    line += t.selected_object >= 0
-                ? std::to_string(t.selected_object) +
-                      (t.selected_object == t.intended_object ? " (intended)" : " (not intended)")
-                : "-";
-    line += ", cell ";
-    line += t.selected_cell.first > 0
-                ? std::to_string(t.selected_cell.first) + "," +
-                      std::to_string(t.selected_cell.second) +
-                      (t.selected_cell == t.intended_cell ? " (intended)" : " (not intended)")
-                : "-";
-    if (t.placement_error_m >= 0.0)
-      line += ", placed " + std::to_string(static_cast<int>(t.placement_error_m * 1000.0 + 0.5)) +
-              " mm off";
-    lines.push_back(line + " [" + t.outcome + "]");
-  }
+  for (const TrialRecord& t : trials_) lines.push_back(selectionLine(t));
   return lines;
 }
 
@@ -1045,81 +976,14 @@ void Session::endRun(const std::string& reason) {
 }
 
 nlohmann::json Session::summary() const {
-  nlohmann::json trials = nlohmann::json::array();
-  int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0;
-  double object_seconds = 0, cell_seconds = 0;
-  for (const TrialRecord& t : trials_) {
-    nlohmann::json j = {{"trial", t.trial},
-                        {"intended_object", t.intended_object},
-                        {"selected_object", t.selected_object},
-                        {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
-                        {"selected_cell", {t.selected_cell.first, t.selected_cell.second}},
-                        {"object_flashes", t.object_flashes},
-                        {"cell_flashes", t.cell_flashes},
-                        {"object_selection_s", t.object_selection_s},
-                        {"cell_selection_s", t.cell_selection_s},
-                        {"outcome", t.outcome},
-                        {"duration_s", t.ended_s >= 0.0 ? nlohmann::json(t.ended_s - t.started_s)
-                                                        : nlohmann::json(nullptr)}};
-    j["placement_error_m"] =
-        t.placement_error_m >= 0.0 ? nlohmann::json(t.placement_error_m) : nlohmann::json(nullptr);
-    trials.push_back(j);
-    if (t.selected_object >= 0) {
-      ++objects_made;
-      objects_right += t.selected_object == t.intended_object;
-      object_seconds += t.object_selection_s;
-    }
-    if (t.selected_cell.first > 0) {
-      ++cells_made;
-      cells_right += t.selected_cell == t.intended_cell;
-      cell_seconds += t.cell_selection_s;
-    }
-  }
-  // All of a trial's time (cues, pauses, both selections, the robot) for completed trials.
-  double trial_seconds = 0.0, trial_bits = 0.0;
-  const int object_choices = static_cast<int>(config_.world.objects.size());
-  const int cell_choices = config_.world.grid.rows * config_.world.grid.columns;
-  int completed = 0;
-  for (const TrialRecord& t : trials_) {
-    if (t.ended_s < 0.0) continue;
-    ++completed;
-    trial_seconds += t.ended_s - t.started_s;
-  }
-  if (objects_made > 0 && cells_made > 0) {
-    trial_bits =
-        completed *
-        (bci::wolpawBits(object_choices, static_cast<double>(objects_right) / objects_made) +
-         bci::wolpawBits(cell_choices, static_cast<double>(cells_right) / cells_made));
-  }
-  // Selection times are measured from the flash onsets as presented, never from the settings.
-  auto rate = [&](int choices, int right, int made, double total_seconds) {
-    if (made == 0) return nlohmann::json(nullptr);
-    const double seconds = total_seconds / made;
-    return nlohmann::json{
-        {"accuracy", static_cast<double>(right) / made},
-        {"seconds_per_selection", seconds},
-        {"bits_per_minute",
-         bci::wolpawBits(choices, static_cast<double>(right) / made) * 60.0 / seconds}};
-  };
   nlohmann::json out = {
       {"session", config_.source},
       {"seed", config_.eeg.seed},
       {"ended", end_reason_},
       {"duration_s", time_},
       {"frames", frame_},
-      {"trials", trials},
-      {"objects", rate(static_cast<int>(config_.world.objects.size()), objects_right, objects_made,
-                       object_seconds)},
-      {"cells", rate(config_.world.grid.rows * config_.world.grid.columns, cells_right, cells_made,
-                     cell_seconds)},
       {"cycle", timing_.toJson()},
       {"overruns", timing_.overruns()},
-      {"all_inclusive",
-       completed == 0 ? nlohmann::json(nullptr)
-                      : nlohmann::json{{"completed_trials", completed},
-                                       {"seconds_per_trial", trial_seconds / completed},
-                                       {"seconds_per_selection", trial_seconds / (2 * completed)},
-                                       {"bits_per_minute", trial_bits / trial_seconds * 60.0}}},
       {"timing", impl_->stimulus_timing->summary(eeg_->lostSamples(), eeg_->clockDriftPpm(),
                                                  eeg_->clockJitterMs())},
       {"eeg",
@@ -1128,6 +992,8 @@ nlohmann::json Session::summary() const {
         {"lost_samples", eeg_->lostSamples()},
         {"missed_epochs", eeg_->missedEpochs()}}},
   };
+  out.update(trialsSummary(trials_, static_cast<int>(config_.world.objects.size()),
+                           config_.world.grid.rows * config_.world.grid.columns));
   if (calibration_report_) {
     out["calibration"] = {{"selections", calibration_report_->selections.size()},
                           {"auc", calibration_report_->auc},

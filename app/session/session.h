@@ -22,6 +22,7 @@
 #include "session/cycle_timing.h"
 #include "session/eeg_stage.h"
 #include "session/session_config.h"
+#include "session/trial_record.h"
 #include "session/vision_stage.h"
 
 namespace arbci::app {
@@ -41,18 +42,6 @@ struct SessionOptions {
   double flashes_only_s = 0.0;
   bool close_window_when_ended = false;
   std::ostream* progress = nullptr;
-};
-
-struct TrialRecord {
-  int trial = 0;
-  int intended_object = -1, selected_object = -1;
-  std::pair<int, int> intended_cell{0, 0}, selected_cell{0, 0};
-  double object_certainty = 0.0, cell_certainty = 0.0;
-  int object_flashes = 0, cell_flashes = 0;
-  double object_selection_s = 0.0, cell_selection_s = 0.0;  // from the presented onsets
-  double started_s = 0.0, ended_s = -1.0;  // session time: after the last trial, its put-down
-  double placement_error_m = -1.0;
-  std::string outcome = "incomplete";
 };
 
 class Session {

@@ -1,0 +1,76 @@
+#include "session/hmd_composition.h"
+
+#include <algorithm>
+#include <opencv2/core.hpp>
+#include <sstream>
+
+namespace arbci::app {
+
+render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdScene& scene) {
+  const VisionStage& vision = scene.vision;
+  render::HmdFrame frame;
+  frame.left = {vision.leftImage(), vision.leftCamera(), vision.T_cam_world_left()};
+  frame.right = {vision.rightImage(), vision.rightCamera(), vision.T_cam_world_right()};
+  const bool objects_phase = stimulus.phase == bci::Phase::ObjectFlashing ||
+                             stimulus.phase == bci::Phase::CalibrationFlashing;
+  const auto& objects = scene.config.world.objects;
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const WorldObjectSettings& o = objects[i];
+    const auto state = vision.world().object(o.id);
+    if (!state) continue;
+    render::ObjectHighlight h;
+    h.id = o.id;
+    h.T_world_top = state->T_robot_object;
+    h.side_m = o.marker_m;
+    const auto in_slots = std::find(scene.slots.begin(), scene.slots.end(), i);
+    const int slot =
+        in_slots == scene.slots.end() ? 0 : static_cast<int>(in_slots - scene.slots.begin()) + 1;
+    if (objects_phase && stimulus.lit.count(slot)) h.state = render::HighlightState::Flashing;
+    if (stimulus.cued_object == slot)
+      h.state = stimulus.lit.count(slot) ? render::HighlightState::Flashing
+                                         : render::HighlightState::Cued;
+    if (stimulus.selected_object == slot) h.state = render::HighlightState::Selected;
+    if (scene.holding == o.id) h.state = render::HighlightState::Held;
+    frame.objects.push_back(h);
+  }
+  if (stimulus.grid_visible) {
+    frame.grid = scene.grid;
+    if (stimulus.phase == bci::Phase::CellFlashing) {
+      for (int code : stimulus.lit) {
+        if (code <= scene.grid.rows)
+          frame.grid_highlight.rows.insert(code);
+        else
+          frame.grid_highlight.columns.insert(code - scene.grid.rows);
+      }
+    }
+    frame.grid_highlight.selected = stimulus.selected_cell;
+  }
+  if (scene.photodiode_patch) frame.photodiode_patch = !stimulus.lit.empty();
+  return frame;
+}
+
+std::string hmdFrameSignature(const render::HmdFrame& frame) {
+  std::ostringstream signature;
+  if (frame.photodiode_patch) signature << (*frame.photodiode_patch ? "P" : "p");
+  signature << static_cast<const void*>(frame.left.image.data)
+            << static_cast<const void*>(frame.right.image.data);
+  for (const auto* eye : {&frame.left, &frame.right}) {
+    if (eye->T_cam_world)
+      signature << cv::Mat(eye->T_cam_world->rotation) << cv::Mat(eye->T_cam_world->translation);
+  }
+  for (const render::ObjectHighlight& h : frame.objects) {
+    signature << h.id << static_cast<int>(h.state) << cv::Mat(h.T_world_top.rotation)
+              << cv::Mat(h.T_world_top.translation);
+  }
+  if (frame.grid) {
+    signature << "grid";
+    for (int r : frame.grid_highlight.rows) signature << 'r' << r;
+    for (int c : frame.grid_highlight.columns) signature << 'c' << c;
+    if (frame.grid_highlight.selected)
+      signature << 's' << frame.grid_highlight.selected->first
+                << frame.grid_highlight.selected->second;
+  }
+  return signature.str();
+}
+
+}  // namespace arbci::app

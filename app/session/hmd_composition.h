@@ -1,0 +1,30 @@
+// What the HMD shows on a frame, composed from the paradigm's stimulus and the tracked world:
+// each tracked object's highlight (idle, cued, flashing, selected, held), the grid with its lit
+// rows and columns and the selected cell, and the photodiode patch. And the frame's signature:
+// an unchanged frame need not be drawn again.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "arbci/bci/paradigm.h"
+#include "arbci/render/hmd_view.h"
+#include "session/session_config.h"
+#include "session/vision_stage.h"
+
+namespace arbci::app {
+
+struct HmdScene {
+  const SessionConfig& config;
+  const VisionStage& vision;
+  // Stimulus code k stands for config.world.objects[slots[k - 1]].
+  const std::vector<size_t>& slots;
+  int holding = -1;  // the marker id of the object in the gripper, -1: none
+  render::GridLayout grid;
+  bool photodiode_patch = false;
+};
+
+render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdScene& scene);
+std::string hmdFrameSignature(const render::HmdFrame& frame);
+
+}  // namespace arbci::app
