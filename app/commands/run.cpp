@@ -9,6 +9,7 @@
 #include "session/session.h"
 #include "session/workstation.h"
 #include "support/cli_error.h"
+#include "support/session_file.h"
 
 namespace arbci::app {
 namespace {
@@ -48,13 +49,7 @@ void printSummary(const Session& session) {
 }
 
 int runSession(const RunOptions& o) {
-  SessionConfig config;
-  try {
-    config = SessionConfig::load(
-        o.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.session));
-  } catch (const SessionConfigError& error) {
-    throw CliError(error.what());
-  }
+  const SessionConfig config = loadSessionOption(o.session);
   SessionOptions options;
   options.folder = o.out.empty() ? defaultFolder() : o.out;
   if (o.trials > 0) options.trials = o.trials;

@@ -18,6 +18,7 @@
 #include "session/session.h"
 #include "session/session_model.h"
 #include "support/cli_error.h"
+#include "support/session_file.h"
 #include "support/output_path.h"
 #include "support/png.h"
 
@@ -75,14 +76,7 @@ void renderShell(const ScreenshotOptions& options, render::Size size) {
 
 // Runs a simulated session (a still head, so it goes fast) until `ready`, then shows a panel.
 void renderPanel(const ScreenshotOptions& options, render::Size size) {
-  SessionConfig config;
-  try {
-    config = SessionConfig::load(options.session.empty()
-                                     ? std::nullopt
-                                     : std::optional<std::filesystem::path>(options.session));
-  } catch (const SessionConfigError& error) {
-    throw CliError(error.what());
-  }
+  SessionConfig config = loadSessionOption(options.session);
   if (options.session.empty()) {
     config.cameras.head_motion_m = 0.0;
     config.cameras.head_motion_deg = 0.0;

@@ -13,6 +13,7 @@
 #include "session/session.h"
 #include "session/workstation.h"
 #include "support/cli_error.h"
+#include "support/session_file.h"
 
 namespace arbci::app {
 namespace {
@@ -39,13 +40,7 @@ nlohmann::json toJson(const bci::PhotodiodeReport& r, double target_sd_ms) {
 }
 
 int runTimingCheck(const TimingCheckOptions& o) {
-  SessionConfig config;
-  try {
-    config = SessionConfig::load(
-        o.session.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.session));
-  } catch (const SessionConfigError& error) {
-    throw CliError(error.what());
-  }
+  const SessionConfig config = loadSessionOption(o.session);
   if (config.eeg.photodiode_channel.empty())
     throw CliError(config.source +
                    ": eeg.photodiode_channel is empty: the timing check needs a photodiode "

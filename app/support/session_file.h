@@ -1,0 +1,13 @@
+// The --session option of the commands that run a session: the embedded default when empty,
+// else that file over the defaults; a bad file is a CliError naming the key.
+#pragma once
+
+#include <string>
+
+#include "session/session_config.h"
+
+namespace arbci::app {
+
+SessionConfig loadSessionOption(const std::string& path);
+
+}  // namespace arbci::app
