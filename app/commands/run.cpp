@@ -9,6 +9,7 @@
 #include "session/session.h"
 #include "session/workstation.h"
 #include "support/cli_error.h"
+#include "support/interrupt.h"
 #include "support/session_file.h"
 
 namespace arbci::app {
@@ -63,8 +64,11 @@ int runSession(const RunOptions& o) {
     if (!headless) return runWorkstation(config, options);
     options.simulated_clock = !o.realtime;
     auto context = render::createHeadlessContext({64, 64});
+    watchInterrupts();
     Session session(config, options, *context);
-    session.run();
+    while (session.step()) {
+      if (interruptRequested()) session.abort();  // ends at the next frame, summary saved
+    }
     printSummary(session);
     return session.endReason() == "finished" ? 0 : 3;
   } catch (const SessionConfigError& error) {

@@ -18,9 +18,9 @@
 #include "session/session.h"
 #include "session/session_model.h"
 #include "support/cli_error.h"
-#include "support/session_file.h"
 #include "support/output_path.h"
 #include "support/png.h"
+#include "support/session_file.h"
 
 namespace arbci::app {
 namespace {

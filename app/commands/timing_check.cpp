@@ -13,6 +13,7 @@
 #include "session/session.h"
 #include "session/workstation.h"
 #include "support/cli_error.h"
+#include "support/interrupt.h"
 #include "support/session_file.h"
 
 namespace arbci::app {
@@ -56,8 +57,11 @@ int runTimingCheck(const TimingCheckOptions& o) {
   try {
     if (headless) {
       auto context = render::createHeadlessContext({64, 64});
+      watchInterrupts();
       Session session(config, options, *context);
-      session.run();
+      while (session.step()) {
+        if (interruptRequested()) session.abort();
+      }
     } else {
       runWorkstation(config, options);
     }

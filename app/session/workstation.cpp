@@ -1,8 +1,6 @@
 #include "session/workstation.h"
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -13,14 +11,10 @@
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panels.h"
 #include "session/session_model.h"
+#include "support/interrupt.h"
 
 namespace arbci::app {
 namespace {
-
-std::atomic<bool> close_requested{false};
-void onSignal(int) {
-  close_requested = true;
-}
 
 // Where the panel layout is kept between runs.
 std::string layoutFile() {
@@ -75,11 +69,10 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
   shell.setEmergencyStop([&] { model.emergencyStop(); });
   shell.setQuitHandler([&] { main_window.requestClose(); });
   // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  watchInterrupts();
   auto last = std::chrono::steady_clock::now();
   while (!main_window.shouldClose()) {
-    if (close_requested || (close_when_ended && session.ended())) main_window.requestClose();
+    if (interruptRequested() || (close_when_ended && session.ended())) main_window.requestClose();
     render::WindowContext::pollEvents();
     session.step();
     main_window.makeCurrent();

@@ -1,6 +1,7 @@
 // The simulated session end to end, headless, through the real executables: a calibration run,
 // training, then online trials with given intentions; a subject without ERP (selections fail,
 // the session says so and carries on); and the robot backend killed during a grasp.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -325,6 +326,43 @@ TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIn
   for (const auto& a : recording.annotations)
     ended_note |= a.text.find("Session ended") != std::string::npos;
   EXPECT_TRUE(ended_note);
+}
+
+}  // namespace
+}  // namespace arbci::test
+
+namespace arbci::test {
+namespace {
+
+// Ctrl+C or a TERM ends a headless run like an abort: the summary is written, the recording
+// closed, and the exit status says it did not finish.
+TEST(Session, ATermSignalEndsAHeadlessRunWithItsSummarySaved) {
+  const auto folder = fresh("term");
+  const pid_t child = fork();
+  if (child == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+    execl(kArbci.c_str(), kArbci.c_str(), "run", "--headless", "--session",
+          (kSessions + "/steady_head.json").c_str(), "--out", folder.c_str(), nullptr);
+    _exit(127);
+  }
+  // Once the recording has data, ask it to stop.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::error_code error;  // (file_size is -1 with an error: not there yet)
+    const auto size = std::filesystem::file_size(folder / "recording.bdf", error);
+    if (!error && size > 20000) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(kill(child, SIGTERM), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of ending the session";
+  EXPECT_EQ(WEXITSTATUS(status), 3);
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "aborted");
+  EXPECT_GT(bci::readRecording(folder / "recording.bdf").samples, 0);
 }
 
 }  // namespace
