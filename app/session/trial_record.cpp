@@ -1,5 +1,7 @@
 #include "session/trial_record.h"
 
+#include <cstdio>
+
 #include "arbci/bci/evaluation.h"
 
 namespace arbci::app {
@@ -21,9 +23,11 @@ std::string selectionLine(const TrialRecord& t) {
                          : " (intended " + std::to_string(t.intended_cell.first) + "," +
                                std::to_string(t.intended_cell.second) + ")")
               : "-";
-  if (t.placement_error_m >= 0.0)
-    line += ", placed " + std::to_string(static_cast<int>(t.placement_error_m * 1000.0 + 0.5)) +
-            " mm off";
+  if (t.placement_error_m >= 0.0) {
+    char placed[48];
+    std::snprintf(placed, sizeof placed, ", placed %.1f mm off", t.placement_error_m * 1000.0);
+    line += placed;
+  }
   return line + " [" + t.outcome + "]";
 }
 

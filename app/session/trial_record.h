@@ -23,7 +23,7 @@ struct TrialRecord {
   std::string outcome = "incomplete";
 };
 
-// "trial 2: object 40 (intended), cell 3,1 (intended 2,2), placed 2 mm off [placed]".
+// "trial 2: object 40 (intended), cell 3,1 (intended 2,2), placed 2.2 mm off [placed]".
 std::string selectionLine(const TrialRecord& trial);
 
 // The summary's "trials", "objects" and "cells" (accuracy, seconds per selection and bits per
