@@ -90,7 +90,10 @@ void addRunCommand(CLI::App& root, int& exit_code) {
       "trials (select an object, the robot grasps it, select a cell, the robot puts it\n"
       "down). Without --session the embedded simulated world runs: simulated cameras,\n"
       "subject and arm. Writes a session folder (recording.bdf, log.jsonl, HMD\n"
-      "screenshots, summary.json). Exit status: 0 finished, 3 ended by a fault or abort.");
+      "screenshots, summary.json). Headless runs use a simulated clock that the EEG and\n"
+      "the arm follow: the same session file and seed give the same recording. Ctrl+C ends\n"
+      "the session and saves its summary. Exit status: 0 finished, 3 ended by a fault,\n"
+      "an abort or an interrupt.");
   run->add_option("--session", o->session,
                   "session file (JSON; see assets/sessions/simulated.json)");
   run->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
@@ -100,7 +103,8 @@ void addRunCommand(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(0LL, 1LL << 30));
   run->add_option("--out", o->out, "session folder (default: arbci-session-<date>-<time>)");
   run->add_flag("--realtime", o->realtime,
-                "headless: pace to the wall clock instead of running as fast as possible");
+                "headless: the EEG, the frames and the arm on the wall clock (not reproducible)\n"
+                "instead of a simulated clock as fast as the machine allows");
   run->add_flag("--exit-when-done", o->exit_when_done,
                 "windowed: close the window once the session has ended (scripted runs)");
   run->add_flag("--wait-for-start", o->wait_for_start,
