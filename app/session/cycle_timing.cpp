@@ -15,6 +15,7 @@ Percentiles percentiles(std::vector<double> v) {
   };
   p.p50 = at(0.5);
   p.p90 = at(0.9);
+  p.p95 = at(0.95);
   p.p99 = at(0.99);
   p.max = v.back();
   p.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());

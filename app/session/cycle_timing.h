@@ -12,8 +12,9 @@
 namespace arbci::app {
 
 struct Percentiles {
-  double p50 = 0, p90 = 0, p99 = 0, max = 0, mean = 0;
+  double p50 = 0, p90 = 0, p95 = 0, p99 = 0, max = 0, mean = 0;
 };
+// Of `values` (all zeros when there are none).
 Percentiles percentiles(std::vector<double> values);
 
 class CycleTiming {

@@ -51,7 +51,6 @@ struct Session::Impl {
   std::int64_t lost_logged = 0;               // lost EEG samples already in the log
   double longest_frame_while_training = 0.0;  // seconds between presentations
   std::unique_ptr<SessionLog> log;
-  std::chrono::steady_clock::time_point wall_start = std::chrono::steady_clock::now();
   int camera_every = 2;  // display frames per camera frame
   std::vector<TrialIntent> intended;
   std::optional<std::uint64_t> robot_command;
@@ -64,16 +63,14 @@ struct Session::Impl {
   ImageWriter images;
   // The last frame drawn: an identical frame is not drawn again (the framebuffer still holds it).
   std::string last_hmd_signature;
+  bool hmd_redrawn = false;  // this frame drew the HMD view (else the framebuffer still holds it)
   bool screenshot_needs_flash = false;
   double fault_since = -1.0;
   bci::FrameStimulus last_stimulus;
   // A placement to measure once the robot reports the world after the drop: (trial, command).
   std::optional<std::pair<int, std::uint64_t>> placement;
-  std::chrono::steady_clock::time_point placement_since;
-  // While the robot moves, the simulated clock keeps to the robot's pace (its speed factor).
-  double robot_started_at = 0.0;
-  std::chrono::steady_clock::time_point robot_started_wall;
-  cv::Vec3d grasped_from;  // where the object in the gripper was taken from
+  double placement_since = 0.0;  // session seconds
+  cv::Vec3d grasped_from;        // where the object in the gripper was taken from
   // The objects a trial's selection offers, as indices into the session's objects: stimulus code
   // k is slots[k - 1]. Those the cameras see; chosen before each trial.
   std::vector<size_t> slots;
@@ -153,11 +150,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   Impl& m = *impl_;
   if (options.seed) config_.eeg.seed = *options.seed;
   if (options.trials) config_.paradigm.trials = *options.trials;
-  if (options.flashes_only_s > 0.0) {
-    // Cued flashing without end: the run is over before the calibration run would be.
-    config_.paradigm.calibration_selections = 200;
-    config_.model_file.clear();
-  }
+  // The timing check: cued flashing until flashes_only_s, when the session ends.
+  if (options.flashes_only_s > 0.0) config_.paradigm.flashes_only = true;
   config_.checkResources();
   timing_ = CycleTiming(1000.0 * config_.eeg.block_size / config_.eeg.rate_hz);
   folder_ = options.folder;
@@ -275,7 +269,6 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   m.log->write(
       "session_started", 0.0,
       {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
-  m.wall_start = std::chrono::steady_clock::now();
   m.host_origin = options.simulated_clock ? 0.0 : bci::hostSeconds();
   if (options.start_immediately) start();
 }
@@ -291,7 +284,7 @@ Session::~Session() {
 void Session::start() {
   if (paradigm_->phase() != bci::Phase::Setup) return;
   chooseSelectableObjects();
-  paradigm_->start(!eeg_->hasModel() || options_.flashes_only_s > 0.0);
+  paradigm_->start(!eeg_->hasModel());
 }
 void Session::pause() {
   paradigm_->pause();
@@ -429,9 +422,7 @@ bool Session::step() {
     m.fault_since = -1.0;
   }
   // The last placement is measured before the run ends (a status after the drop, or 3 s).
-  if (phase == bci::Phase::Finished &&
-      (!m.placement ||
-       std::chrono::steady_clock::now() - m.placement_since > std::chrono::seconds(3))) {
+  if (phase == bci::Phase::Finished && (!m.placement || time_ - m.placement_since > 3.0)) {
     endRun("finished");
   }
   if (phase == bci::Phase::Aborted) endRun("aborted");
@@ -442,22 +433,10 @@ bool Session::step() {
   if (options_.progress && frame_ % 600 == 0)
     *options_.progress << "\r" << statusLine() << "      " << std::flush;
   ++frame_;
-  // While the robot works (or its status after homing is awaited), simulated time keeps to the
-  // robot's pace: its status arrives on the wall clock.
-  const bool awaiting_robot = m.robot_command || (m.homed && !m.clear_view_frame);
-  if (options_.simulated_clock && awaiting_robot && m.robotd && !m.stepped_robot) {
-    const double robot_seconds = (time_ - m.robot_started_at) / config_.robot_speed_factor;
-    std::this_thread::sleep_until(m.robot_started_wall +
-                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                      std::chrono::duration<double>(robot_seconds)));
-  }
   if (!options_.simulated_clock && m.context.isHeadless()) {
     // --realtime without a display: pace the frames to the wall clock.
-    const auto due =
-        m.wall_start +
-        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-            std::chrono::duration<double>(static_cast<double>(frame_) / config_.display_hz));
-    std::this_thread::sleep_until(due);
+    const double wait = m.host_origin + frame_ / config_.display_hz - bci::hostSeconds();
+    if (wait > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
   }
   return !ended_;
 }
@@ -491,9 +470,10 @@ void Session::presented(double host_s) {
   m.frame_pending = false;
   const double at = host_s - m.host_origin;
   const std::int64_t sample = eeg_->sampleAt(host_s);
-  // What the patch really shows, read back from the frame: a diode would see the same.
-  bool patch_lit = false;
-  if (eeg_->hasPhotodiode()) {
+  // What the patch really shows, read back from the frame (a diode would see the same); an
+  // unchanged frame shows what the last one did.
+  bool patch_lit = m.patch_lit;
+  if (eeg_->hasPhotodiode() && m.hmd_redrawn) {
     const int middle = render::HmdFrame::kPatchPx / 2;
     patch_lit = render::readGrey(m.hmd_fbo->id(), m.hmd_fbo->size(), middle, middle) > 127;
   }
@@ -517,7 +497,9 @@ void Session::presented(double host_s) {
     m.longest_frame_while_training =
         std::max(m.longest_frame_while_training, at - *m.last_presented);
   m.last_presented = at;
-  if (!m.warned_slow_display && m.stimulus_timing->displayTooSlow()) {
+  // Checked once a second or so (it takes a median of the last frame intervals).
+  if (!m.warned_slow_display && m.stimulus_timing->framesPresented() % 60 == 0 &&
+      m.stimulus_timing->displayTooSlow()) {
     m.warned_slow_display = true;
     const double median = *m.stimulus_timing->medianFrameIntervalMs();
     m.log->write("display_too_slow", at,
@@ -526,9 +508,11 @@ void Session::presented(double host_s) {
                   {"text",
                    "the display cannot hold display_hz: flashes are stamped as presented, "
                    "so the recorded SOA and durations are longer than configured"}});
-    std::cerr << "\nwarning: the display shows a frame every " << median << " ms, not every "
-              << 1000.0 / config_.display_hz
-              << " ms: flash onsets are stamped as presented; the SOA is longer than configured\n";
+    if (options_.progress)
+      *options_.progress << "\nwarning: the display shows a frame every " << median
+                         << " ms, not every " << 1000.0 / config_.display_hz
+                         << " ms: flash onsets are stamped as presented; the SOA is longer than "
+                            "configured\n";
   }
 }
 
@@ -556,8 +540,6 @@ void Session::sendRobot(robot::MessageType type, const cv::Vec3d& target) {
   Impl& m = *impl_;
   if (m.stepped_robot) client_->syncClock(time_);  // the command starts now, not at the last sync
   m.robot_command = client_->send(type, {target[0], target[1], target[2]});
-  m.robot_started_at = time_;
-  m.robot_started_wall = std::chrono::steady_clock::now();
   m.robot_command_type = type;
 }
 
@@ -585,7 +567,7 @@ void Session::handleRobotEvents() {
         if (!m.returning) {
           currentTrial().outcome = "placed";
           m.placement = std::make_pair(currentTrial().trial, e.sequence);
-          m.placement_since = std::chrono::steady_clock::now();
+          m.placement_since = time_;
         }
         vision_->objectMoved(*m.grasped_id);
         // The arm parked over the table hides objects from the cameras: it goes home before the
@@ -897,7 +879,8 @@ void Session::renderHmd(const bci::FrameStimulus& stimulus) {
   const render::HmdFrame frame = composeHmdFrame(stimulus, scene);
   // What this frame shows; unchanged, the framebuffer already holds it.
   const std::string signature = hmdFrameSignature(frame);
-  if (signature != m.last_hmd_signature) {
+  m.hmd_redrawn = signature != m.last_hmd_signature;
+  if (m.hmd_redrawn) {
     m.hmd->draw(frame, m.hmd_fbo->id(), m.hmd_fbo->size());
     m.last_hmd_signature = signature;
   }

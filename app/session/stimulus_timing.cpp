@@ -1,20 +1,15 @@
 #include "session/stimulus_timing.h"
 
-#include <algorithm>
-#include <cmath>
+#include "session/cycle_timing.h"
 
 namespace arbci::app {
 namespace {
 
-double quantile(std::vector<double> values, double q) {
-  if (values.empty()) return std::nan("");
-  const size_t k = static_cast<size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
-}
-
-nlohmann::json orNull(double value) {
-  return std::isnan(value) ? nlohmann::json(nullptr) : nlohmann::json(value);
+// A statistic of `values` in ms (they are in samples), or null when there are none.
+nlohmann::json inMs(const std::vector<double>& values, double Percentiles::*statistic,
+                    double samples_to_ms) {
+  if (values.empty()) return nullptr;
+  return percentiles(values).*statistic * samples_to_ms;
 }
 
 }  // namespace
@@ -65,8 +60,8 @@ void StimulusTiming::startSelection() {
 }
 
 double StimulusTiming::medianSoaS() const {
-  const double median = quantile(soa_samples_, 0.5);
-  return std::isnan(median) ? paradigm_.soaSeconds() : median / rate_hz_;
+  if (soa_samples_.empty()) return paradigm_.soaSeconds();
+  return percentiles(soa_samples_).p50 / rate_hz_;
 }
 
 double StimulusTiming::selectionSeconds() const {
@@ -77,7 +72,7 @@ double StimulusTiming::selectionSeconds() const {
 
 std::optional<double> StimulusTiming::medianFrameIntervalMs() const {
   if (frame_intervals_s_.size() < 60) return std::nullopt;
-  return 1000.0 * quantile(frame_intervals_s_, 0.5);
+  return 1000.0 * percentiles(frame_intervals_s_).p50;
 }
 
 bool StimulusTiming::displayTooSlow() const {
@@ -88,18 +83,16 @@ bool StimulusTiming::displayTooSlow() const {
 nlohmann::json StimulusTiming::summary(std::int64_t lost_samples, double clock_drift_ppm,
                                        double clock_jitter_ms) const {
   const double to_ms = 1000.0 / rate_hz_;
-  const double soa_median = quantile(soa_samples_, 0.5), soa_p95 = quantile(soa_samples_, 0.95);
-  const double flash_median = quantile(duration_samples_, 0.5);
   const auto frame_median = medianFrameIntervalMs();
   return {
       {"soa_ms",
        {{"configured", paradigm_.flash_ms + paradigm_.isi_ms},
-        {"median", orNull(soa_median * to_ms)},
-        {"p95", orNull(soa_p95 * to_ms)},
+        {"median", inMs(soa_samples_, &Percentiles::p50, to_ms)},
+        {"p95", inMs(soa_samples_, &Percentiles::p95, to_ms)},
         {"count", soa_samples_.size()}}},
       {"flash_ms",
        {{"configured", paradigm_.flash_ms},
-        {"median", orNull(flash_median * to_ms)},
+        {"median", inMs(duration_samples_, &Percentiles::p50, to_ms)},
         {"count", duration_samples_.size()}}},
       {"display",
        {{"configured_hz", paradigm_.display_hz},

@@ -91,11 +91,6 @@ std::int64_t ClockModel::firstSampleAtOrAfter(double host_s) const {
   return static_cast<std::int64_t>(std::ceil(sampleAt(host_s) - 1e-6));
 }
 
-double ClockModel::hostAt(double sample) const {
-  if (points_.empty()) return sample / nominal_rate_;
-  return anchor_host_ + intercept_ + slope_ * (sample - anchor_sample_);
-}
-
 double ClockModel::rateHz() const {
   return 1.0 / slope_;
 }

@@ -5,6 +5,10 @@
 #include <utility>
 
 namespace arbci::bci {
+namespace {
+// Frame times are exact multiples of the frame period only on paper: a microsecond of slack.
+constexpr double kSlack = 1e-6;
+}  // namespace
 
 int ParadigmSettings::flashFrames() const {
   return std::max(1, static_cast<int>(std::lround(flash_ms * display_hz / 1000.0)));
@@ -74,8 +78,8 @@ void Paradigm::enter(Phase phase, const std::string& text) {
 
 void Paradigm::start(bool calibrate) {
   if (phase_ != Phase::Setup) return;
-  calibrating_ = calibrate;
-  if (calibrate && settings_.calibration_selections > 0) {
+  calibrating_ = calibrate || settings_.flashes_only;
+  if (calibrating_ && settings_.calibration_selections > 0) {
     calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
     phase_until_ = now_ + settings_.cue_s;
     enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
@@ -119,8 +123,6 @@ void Paradigm::scheduleSequence(double first_onset_s) {
 }
 
 FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
-  // Frame times are exact multiples of the frame period only on paper: a microsecond of slack.
-  constexpr double kSlack = 1e-6;
   frame_ = index;
   now_ = due_s;
   FrameStimulus out;
@@ -162,10 +164,10 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   }
   switch (phase_) {
     case Phase::CalibrationCue:
-      if (due_s >= phase_until_ - 1e-6) startFlashing(nextFrame(), true);
+      if (due_s >= phase_until_ - kSlack) startFlashing(nextFrame(), true);
       break;
     case Phase::ObjectSelected:
-      if (due_s >= phase_until_ - 1e-6) {
+      if (due_s >= phase_until_ - kSlack) {
         enter(Phase::Grasping, "object " + std::to_string(*selected_object_));
         ParadigmEvent e{ParadigmEvent::Kind::RobotGrasp};
         e.object = *selected_object_;
@@ -173,7 +175,7 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
       }
       break;
     case Phase::CellSelected:
-      if (due_s >= phase_until_ - 1e-6) {
+      if (due_s >= phase_until_ - kSlack) {
         enter(Phase::Dropping, "row " + std::to_string(selected_cell_->first) + " column " +
                                    std::to_string(selected_cell_->second));
         ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
@@ -208,7 +210,7 @@ void Paradigm::decide(const Decision& decision) {
   schedule_.clear();
   if (phase_ == Phase::CalibrationFlashing) {
     ++calibration_done_;
-    if (calibration_done_ < settings_.calibration_selections) {
+    if (settings_.flashes_only || calibration_done_ < settings_.calibration_selections) {
       calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
       phase_until_ = now_ + settings_.pause_s + settings_.cue_s;
       enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));

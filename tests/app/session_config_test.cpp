@@ -7,13 +7,13 @@
 #include <fstream>
 
 #include "session/session_config.h"
+#include "support/test_files.h"
 
 namespace arbci::app {
 namespace {
 
 std::filesystem::path sessionFile(const std::string& name, const std::string& json) {
-  const auto path =
-      std::filesystem::temp_directory_path() / ("arbci_config_test_" + name + ".json");
+  const auto path = test::freshTempPath("config_test", name + ".json");
   std::ofstream(path) << json;
   return path;
 }

@@ -16,6 +16,7 @@
 
 #include "arbci/bci/recording.h"
 #include "support/run_process.h"
+#include "support/test_files.h"
 
 namespace arbci::test {
 namespace {
@@ -24,14 +25,7 @@ const std::string kArbci = ARBCI_EXECUTABLE;
 const std::string kSessions = ARBCI_TEST_SESSIONS;
 
 std::filesystem::path fresh(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("arbci_session_test_" + name);
-  std::filesystem::remove_all(dir);
-  return dir;
-}
-
-nlohmann::json readJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
+  return freshTempPath("session_test", name);
 }
 
 std::vector<nlohmann::json> readLog(const std::filesystem::path& path) {

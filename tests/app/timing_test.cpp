@@ -10,6 +10,7 @@
 
 #include "arbci/bci/recording.h"
 #include "support/run_process.h"
+#include "support/test_files.h"
 
 namespace arbci::test {
 namespace {
@@ -18,14 +19,7 @@ const std::string kArbci = ARBCI_EXECUTABLE;
 const std::string kXvfbRun = XVFB_RUN_EXECUTABLE;
 
 std::filesystem::path fresh(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("arbci_timing_test_" + name);
-  std::filesystem::remove_all(dir);
-  return dir;
-}
-
-nlohmann::json readJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
+  return freshTempPath("timing_test", name);
 }
 
 std::vector<std::string> inWindow(std::vector<std::string> arguments) {
@@ -91,8 +85,7 @@ TEST(WindowedSession, SummaryTimingAgreesWithTheRecordedOnsets) {
     "robot": {"speed_factor": 20}})";
   const ProcessResult r = runProcess(
       kXvfbRun,
-      inWindow({"run", "--session", session, "--exit-when-done", "--out", folder.string()}),
-      400.0);
+      inWindow({"run", "--session", session, "--exit-when-done", "--out", folder.string()}), 400.0);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   const nlohmann::json summary = readJson(folder / "summary.json");
   const nlohmann::json& timing = summary["timing"];

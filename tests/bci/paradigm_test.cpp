@@ -221,3 +221,30 @@ TEST(Paradigm, OnASlowDisplayFlashesKeepTheirScheduleInTime) {
 
 }  // namespace
 }  // namespace arbci::bci
+
+namespace arbci::bci {
+namespace {
+
+// The timing check's paradigm: cued calibration selections that go on, never to training.
+TEST(Paradigm, FlashesOnlyNeverEndsTheCalibrationRun) {
+  ParadigmSettings s = fast();  // 2 calibration selections
+  s.flashes_only = true;
+  Paradigm p(s, 4, 3, 3, 9);
+  p.start(false);  // even when a model exists
+  std::int64_t frame = 0;
+  int selections = 0, flashes = 0;
+  for (; frame < 60 * 60 && p.phase() != Phase::Training; ++frame) {
+    p.frame(frame);
+    for (const ParadigmEvent& e : p.takeEvents()) flashes += e.kind == Kind::Flash;
+    if (p.awaitingDecision()) {
+      p.decide(choose(0, {1}));
+      ++selections;
+    }
+  }
+  EXPECT_NE(p.phase(), Phase::Training);
+  EXPECT_GE(selections, 5);
+  EXPECT_GE(flashes, selections * 3 * 4);  // every decided selection had its 3 sequences of 4
+}
+
+}  // namespace
+}  // namespace arbci::bci

@@ -1,6 +1,7 @@
-// EEG acquisition: the source delivers blocks on its own clock into a bounded queue, each with its
-// first sample index and the host time it arrived, and a clock model learns the mapping from host
-// time to samples. The cycle takes what has arrived; it never paces the source.
+// EEG acquisition: the source delivers blocks on its own clock into a ring buffer (the last
+// `queue_s` of signal), each block's first sample index and the host time it arrived feeding a
+// clock model that learns the mapping from host time to samples. The cycle takes what has
+// arrived; it never paces the source.
 //
 // Live (a real or real-time source): a thread polls the source every millisecond and stamps each
 // block with hostSeconds(). Stepped (a headless simulated run): the cycle advances the simulated
@@ -8,21 +9,22 @@
 // available, so the same inputs give the same samples and stamps, run after run.
 //
 // Nothing is dropped silently: a gap in the source's sample numbers is filled with zeros and
-// counted as lost, and so is a queue overflow (a cycle that did not take its blocks for longer
-// than the queue holds).
+// counted as lost, and so is what the ring overwrote before the cycle took it (a cycle that fell
+// more than `queue_s` behind).
 #pragma once
 
 #include <atomic>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "arbci/bci/clock_model.h"
 #include "arbci/bci/eeg_source.h"
+#include "arbci/bci/ring_buffer.h"
 #include "arbci/bci/sample_clock.h"
 
 namespace arbci::bci {
@@ -59,25 +61,24 @@ class Acquisition {
   // Stepped: the simulated clock is now at `host_s`; takes the blocks due.
   void advanceTo(double host_s);
 
-  // The blocks that arrived since the last call, in order and without gaps.
+  // The signal that arrived since the last call, in order and without gaps (lost stretches as
+  // zeros). Call from one thread (the cycle's).
   std::vector<Block> take();
   std::vector<SampleLoss> takeLosses();
   std::int64_t lostSamples() const { return lost_.load(); }
-  std::int64_t samplesArrived() const { return arrived_.load(); }
 
   // The clock model (thread-safe copies of what the cycle needs).
   std::int64_t firstSampleAtOrAfter(double host_s) const;
   double sampleAt(double host_s) const;
   double driftPpm() const;
   double jitterS() const;
-  bool clockFitted() const;
 
   // Calls into the source from the cycle's thread (stimuli, attention, the screen).
   void withSource(const std::function<void(EegSource&)>& call);
 
  private:
-  void pump(bool stepped);
-  void deliver(Block block, double host_s);
+  void pump();
+  void deliver(const Block& block, double host_s);
   void loop();
 
   std::unique_ptr<EegSource> source_;
@@ -86,14 +87,14 @@ class Acquisition {
   AcquisitionSettings settings_;
   SignalInfo info_;
   mutable std::mutex source_mutex_;  // the source, and the pump
-  mutable std::mutex queue_mutex_;   // the queue, losses and the clock model
-  std::deque<Block> queue_;
-  std::int64_t queued_samples_ = 0;
+  mutable std::mutex state_mutex_;   // losses, the clock model, where the stream starts
+  RingBuffer ring_;
+  std::optional<RingBuffer::Reader> reader_;  // the cycle's; from the stream's first sample
   std::vector<SampleLoss> losses_;
   ClockModel model_;
-  std::int64_t next_sample_ = -1;  // after the newest block delivered
-  std::int64_t taken_end_ = 0;     // after the newest sample handed to the cycle
-  std::atomic<std::int64_t> lost_{0}, arrived_{0};
+  std::int64_t first_sample_ = 0;  // of the stream
+  std::int64_t next_sample_ = -1;  // after the newest block delivered (-1: none yet)
+  std::atomic<std::int64_t> lost_{0};
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -29,14 +29,12 @@ class ClockModel {
   double sampleAt(double host_s) const;
   // The first whole sample taken at or after `host_s`: what a stimulus presented then is stamped.
   std::int64_t firstSampleAtOrAfter(double host_s) const;
-  double hostAt(double sample) const;
 
   // (fitted rate / nominal rate - 1) * 1e6: positive when the amplifier's clock runs fast.
   double driftPpm() const;
   double rateHz() const;
   // RMS of the arrival times about the fitted line, in seconds.
   double jitterS() const { return jitter_s_; }
-  std::int64_t blocksObserved() const { return observed_; }
 
  private:
   struct Point {

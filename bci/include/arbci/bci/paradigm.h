@@ -40,6 +40,8 @@ struct ParadigmSettings {
   double pause_s = 1.0;            // between selections
   int calibration_selections = 6;
   int trials = 3;
+  // The timing check: cued calibration selections without end (never training, never trials).
+  bool flashes_only = false;
 
   int flashFrames() const;  // frames a flash lasts (60 ms at 60 Hz: 4)
   int onsetFrames() const;  // frames from one flash onset to the next (180 ms: 11)

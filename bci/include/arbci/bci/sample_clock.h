@@ -28,27 +28,24 @@ class SampleClock {
   virtual double deliveryLagS() const { return 0.0; }
 };
 
-// Real time from construction; `rate_factor` above 1 runs the amplifier's clock fast (200 ppm:
-// 1.0002), `lag_s` holds every block back as an amplifier's buffer would.
+// Real time from construction; `lag_s` holds every block back as an amplifier's buffer would.
 class WallClock final : public SampleClock {
  public:
-  explicit WallClock(double lag_s = 0.0, double rate_factor = 1.0)
-      : start_(hostSeconds()), lag_(lag_s), factor_(rate_factor) {}
+  explicit WallClock(double lag_s = 0.0) : start_(hostSeconds()), lag_(lag_s) {}
   std::int64_t available(double rate_hz) const override {
-    const double samples = (hostSeconds() - start_ - lag_) * rate_hz * factor_;
+    const double samples = (hostSeconds() - start_ - lag_) * rate_hz;
     return samples > 0.0 ? static_cast<std::int64_t>(samples) : 0;
   }
   double sampleAtHost(double host_s, double rate_hz) const override {
-    return (host_s - start_) * rate_hz * factor_;
+    return (host_s - start_) * rate_hz;
   }
   double availableAtHost(std::int64_t end_sample, double rate_hz) const override {
-    return start_ + lag_ + static_cast<double>(end_sample) / (rate_hz * factor_);
+    return start_ + lag_ + static_cast<double>(end_sample) / rate_hz;
   }
   double deliveryLagS() const override { return lag_; }
-  double startHost() const { return start_; }
 
  private:
-  double start_, lag_, factor_;
+  double start_, lag_;
 };
 
 // Advanced by the caller, in seconds of simulated time (which is then also the host time).

@@ -1,0 +1,16 @@
+// Files the executable tests make and read: a fresh (removed) temporary path, and JSON files.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace arbci::test {
+
+// <temp>/arbci_<suite>_<name>, removed if it exists (a folder or file the test then makes).
+std::filesystem::path freshTempPath(const std::string& suite, const std::string& name);
+// Throws (through nlohmann::json) when the file is missing or not JSON.
+nlohmann::json readJson(const std::filesystem::path& path);
+
+}  // namespace arbci::test
