@@ -66,9 +66,7 @@ int runSession(const RunOptions& o) {
     auto context = render::createHeadlessContext({64, 64});
     watchInterrupts();
     Session session(config, options, *context);
-    while (session.step()) {
-      if (interruptRequested()) session.abort();  // ends at the next frame, summary saved
-    }
+    session.run();
     printSummary(session);
     return session.endReason() == "finished" ? 0 : 3;
   } catch (const SessionConfigError& error) {

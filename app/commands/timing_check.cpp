@@ -59,9 +59,7 @@ int runTimingCheck(const TimingCheckOptions& o) {
       auto context = render::createHeadlessContext({64, 64});
       watchInterrupts();
       Session session(config, options, *context);
-      while (session.step()) {
-        if (interruptRequested()) session.abort();
-      }
+      session.run();
     } else {
       runWorkstation(config, options);
     }

@@ -23,6 +23,7 @@
 #include "session/session_log.h"
 #include "session/simulated_world.h"
 #include "session/stimulus_timing.h"
+#include "support/interrupt.h"
 
 namespace arbci::app {
 
@@ -987,6 +988,7 @@ nlohmann::json Session::summary() const {
 
 nlohmann::json Session::run() {
   while (step()) {
+    if (interruptRequested()) abort();  // ends at the next frame, its summary saved
   }
   return summary();
 }

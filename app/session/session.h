@@ -62,7 +62,8 @@ class Session {
   std::string timingWarning() const;
   // "EEG: lost samples N, clock drift X ppm, jitter Y ms".
   std::string eegClockLine() const;
-  // Steps until the end (headless). Returns the summary.
+  // Steps until the end (headless); an interrupt (support/interrupt.h, when the caller watches
+  // for one) aborts it. Returns the summary.
   nlohmann::json run();
 
   // Experimenter controls.
