@@ -1,5 +1,7 @@
-// `arbci robot keygen` writes a shared key; `arbci robot ... status|home|stop|grasp|drop` talks
-// to a backend from the shell, waits for the outcome and exits 0 only on success.
+// `arbci robot keygen` writes a shared key; `arbci robot ... status|home|stop|reset|grasp|drop`
+// talks to a backend from the shell, waits for the outcome and exits 0 only on success. It says
+// whether a motion ran: 1 when it did not (or shows no sign of it), 3 when it ran but its answer
+// was lost; a motion it cannot confirm is STOPped, so it never runs on unsupervised.
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -18,6 +20,7 @@ struct RobotOptions {
   std::string host = "127.0.0.1", key_file, out;
   int port = 47800;
   double timeout_s = 120.0;
+  double retry_budget_s = 15.0;
   std::vector<double> xyz;
 };
 
@@ -27,6 +30,8 @@ void printStatus(const robot::StatusPayload& s) {
             << ") m\ngripper: " << (s.gripper_opening > 0.5 ? "open" : "closed")
             << "\nholding: " << (s.holding >= 0 ? "object " + std::to_string(s.holding) : "nothing")
             << "\n";
+  if (!s.stop_reason.empty())
+    std::cout << "stopped: " << s.stop_reason << " (motion refused until `arbci robot reset`)\n";
   if (s.current_command != robot::MessageType::Status) {
     std::cout << "command: " << robot::toString(s.current_command) << " " << s.current_sequence
               << ", " << std::setprecision(0) << s.progress * 100.0 << "% done\n"
@@ -38,40 +43,100 @@ void printStatus(const robot::StatusPayload& s) {
   }
 }
 
-int talk(const RobotOptions& o, robot::MessageType type) {
+using Seconds = std::chrono::duration<double>;
+
+robot::RobotClient connect(const RobotOptions& o, robot::Endpoint& endpoint) {
   robot::Key key;
-  robot::Endpoint endpoint;
   try {
     key = robot::loadKey(o.key_file);
     endpoint = robot::Endpoint::resolve(o.host, o.port);
   } catch (const std::exception& error) {
     throw CliError(error.what());
   }
-  robot::RobotClient client(endpoint, key);
+  robot::ClientOptions options;
+  options.give_up_s = o.retry_budget_s;
+  return robot::RobotClient(endpoint, key, options);
+}
+
+// Polls for `seconds`, or until `done` says so.
+template <typename Done>
+void pollFor(robot::RobotClient& client, double seconds, Done done) {
+  const auto end = std::chrono::steady_clock::now() + Seconds(seconds);
+  while (std::chrono::steady_clock::now() < end && !done()) {
+    client.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+// The motion could not be confirmed: STOP it (so it never runs on, or later), then ask the
+// backend whether it ran. Always throws: exit 3 when it ran, 1 when there is no sign it did.
+[[noreturn]] void stopUnconfirmed(robot::RobotClient& client, robot::MessageType type,
+                                  std::uint64_t sequence, const std::string& why) {
+  const std::string name = robot::toString(type);
+  client.takeEvents();
+  const std::uint64_t stop = client.send(robot::MessageType::Stop);
+  bool stopped = false;
+  pollFor(client, 5.0, [&] {
+    for (const robot::RobotEvent& e : client.takeEvents())
+      stopped |= e.sequence == stop && e.kind == robot::RobotEvent::Kind::Finished;
+    return stopped;
+  });
+  bool ran = client.accepted(sequence);
+  if (stopped) {
+    client.requestStatus();
+    pollFor(client, 1.0, [&] {
+      const auto& s = client.status();
+      ran |= s && s->last_finished_sequence == sequence;
+      return ran;
+    });
+  }
+  const std::string stop_note =
+      stopped ? "STOP sent and accepted: motion is refused until `arbci robot reset`"
+              : "STOP sent but not confirmed either: check the arm";
+  if (ran) throw CliError(name + " ran, but the answer was lost (" + why + "); " + stop_note, 3);
+  throw CliError(name + " not run: " + why + "; " + stop_note, 1);
+}
+
+int talk(const RobotOptions& o, robot::MessageType type) {
+  robot::Endpoint endpoint;
+  robot::RobotClient client = connect(o, endpoint);
+  const std::string name = robot::toString(type);
   const robot::Vec3 target =
       o.xyz.size() == 3 ? robot::Vec3{o.xyz[0], o.xyz[1], o.xyz[2]} : robot::Vec3{};
+  const bool motion = type == robot::MessageType::Grasp || type == robot::MessageType::Drop ||
+                      type == robot::MessageType::Home;
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t sequence = type == robot::MessageType::Status ? 0 : client.send(type, target);
-  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
-         o.timeout_s) {
+  bool told_silent = false, ever_connected = false;
+  using Kind = robot::RobotEvent::Kind;
+  while (Seconds(std::chrono::steady_clock::now() - start).count() < o.timeout_s) {
     client.poll();
     for (const robot::RobotEvent& e : client.takeEvents()) {
-      using Kind = robot::RobotEvent::Kind;
-      if (e.kind == Kind::Silent && (sequence == 0 || client.busy())) {
-        throw CliError("no answer from the backend at " + endpoint.toString() +
-                       " (is arbci-robotd running, with the same key?)");
+      if (e.kind == Kind::Silent && !told_silent) {
+        // Not fatal: the retry budget is used in full (a lossy link answers eventually).
+        told_silent = true;
+        std::cerr << "no answer yet from the backend at " << endpoint.toString()
+                  << "; retrying for up to " << o.retry_budget_s << " s\n";
       }
+      if (e.kind == Kind::Restarted) std::cerr << "the backend restarted\n";
+      ever_connected |= e.kind == Kind::Connected;
       if (e.sequence != sequence || sequence == 0) continue;
-      if (e.kind == Kind::Accepted) std::cerr << robot::toString(type) << " accepted\n";
+      if (e.kind == Kind::Accepted) std::cerr << name << " accepted\n";
       if (e.kind == Kind::Rejected)
-        throw CliError(std::string(robot::toString(type)) +
-                       " rejected: " + robot::toString(e.reason) + ": " + e.text);
-      if (e.kind == Kind::Failed) throw CliError(e.text);
+        throw CliError(name + " not run: rejected: " + robot::toString(e.reason) + ": " + e.text);
+      if (e.kind == Kind::Failed) {
+        // Commands go out only once bound to a backend run: never bound, never sent.
+        if (!ever_connected)
+          throw CliError(name + " not run: no answer from the backend at " + endpoint.toString() +
+                         " in " + std::to_string(static_cast<int>(o.retry_budget_s)) +
+                         " s (is arbci-robotd running, with the same key?)");
+        if (motion) stopUnconfirmed(client, type, sequence, e.text);
+        throw CliError(name + " not confirmed: " + e.text);
+      }
       if (e.kind == Kind::Finished) {
         if (e.outcome != robot::Outcome::Success)
-          throw CliError(std::string(robot::toString(type)) + " " + robot::toString(e.outcome) +
-                         ": " + e.text);
-        std::cout << robot::toString(type) << " finished: " << e.text << "\n";
+          throw CliError(name + " ran: " + robot::toString(e.outcome) + ": " + e.text);
+        std::cout << name << " finished: " << e.text << "\n";
         return 0;
       }
     }
@@ -79,10 +144,21 @@ int talk(const RobotOptions& o, robot::MessageType type) {
       printStatus(*client.status());
       return 0;
     }
+    if (sequence == 0 && !client.connected() &&
+        Seconds(std::chrono::steady_clock::now() - start).count() > o.retry_budget_s) {
+      break;
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  throw CliError(std::string(robot::toString(type)) + ": no outcome within " +
-                 std::to_string(static_cast<int>(o.timeout_s)) + " s");
+  if (sequence == 0 || !client.connected())
+    throw CliError("no answer from the backend at " + endpoint.toString() + " in " +
+                   std::to_string(static_cast<int>(o.retry_budget_s)) +
+                   " s (is arbci-robotd running, with the same key?)");
+  if (motion)
+    stopUnconfirmed(client, type, sequence,
+                    "no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) + " s");
+  throw CliError(name + ": no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) +
+                 " s");
 }
 
 }  // namespace
@@ -92,7 +168,10 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
   CLI::App* robot_cmd = root.add_subcommand(
       "robot",
       "Talk to a robot backend (arbci-robotd) or make a key for it.\n"
-      "Commands wait for FINISHED: exit 0 on success, 1 with the reason otherwise.");
+      "Commands wait for FINISHED: exit 0 on success; 1 when the command did not run (rejected,\n"
+      "or no answer within the retry budget) or ran and failed or was stopped; 3 when it ran\n"
+      "but its answer was lost. A motion that cannot be confirmed is followed by a STOP, which\n"
+      "stays in force until `arbci robot reset`.");
   robot_cmd->require_subcommand(1);
   robot_cmd->add_option("--host", o->host, "backend address")->capture_default_str();
   robot_cmd->add_option("--port", o->port, "backend UDP port")
@@ -101,6 +180,11 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
   robot_cmd->add_option("--key-file", o->key_file, "the shared key (arbci robot keygen)");
   robot_cmd->add_option("--timeout", o->timeout_s, "seconds to wait for the outcome")
       ->capture_default_str();
+  robot_cmd
+      ->add_option("--retry-budget", o->retry_budget_s,
+                   "seconds to keep retransmitting a command nobody has accepted yet")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 600.0));
 
   CLI::App* keygen = robot_cmd->add_subcommand(
       "keygen", "Write a fresh random key (64 hex characters, mode 0600)");
@@ -128,7 +212,11 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
   command("status", "Print the backend's state, tool position, gripper and world",
           robot::MessageType::Status, false);
   command("home", "Move to the home position", robot::MessageType::Home, false);
-  command("stop", "Emergency stop: halt at once", robot::MessageType::Stop, false);
+  command("stop",
+          "Emergency stop: halt at once; motion commands are refused until `arbci robot reset`",
+          robot::MessageType::Stop, false);
+  command("reset", "End a stop (STOP or the watchdog's halt): motion commands are taken again",
+          robot::MessageType::Reset, false);
   command("grasp", "Grasp the object at X Y Z and lift it", robot::MessageType::Grasp, true);
   command("drop", "Put the held object down at X Y Z", robot::MessageType::Drop, true);
 }

@@ -23,8 +23,8 @@ void onSignal(int) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "arbci-robotd: the ARBCI robot backend. Accepts GRASP, DROP, HOME, STOP and STATUS over "
-      "UDP,\n"
+      "arbci-robotd: the ARBCI robot backend. Accepts HELLO, GRASP, DROP, HOME, STOP, RESET, "
+      "HEARTBEAT and STATUS over UDP,\n"
       "authenticated with the shared key (make one with `arbci robot keygen`), and drives a\n"
       "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: "
       "docs/robot-protocol.md.",
@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   std::string host = "127.0.0.1", key_file, config_file, port_file;
   double speed = 0.0;
   bool stepped = false;
+  int watchdog_ms = 100;
   app.add_option("--port", port, "UDP port to listen on (0: any free port)")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
@@ -49,6 +50,11 @@ int main(int argc, char** argv) {
   app.add_flag("--stepped", stepped,
                "move the arm only when a STATUS carries the client's clock (reproducible "
                "simulations: arbci run headless starts it so), never on the wall clock");
+  app.add_option("--watchdog-ms", watchdog_ms,
+                 "halt a running motion (and latch the stop) when the commanding client has sent "
+                 "nothing authenticated for this long; 0: off (not for a real arm)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 60000));
   app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);
   app.failure_message([](const CLI::App*, const CLI::Error& error) {
     return std::string("arbci-robotd: ") + error.what() + "\n";
@@ -65,6 +71,7 @@ int main(int argc, char** argv) {
     options.speed_factor = speed > 0.0 ? speed : config.speed_factor;
     options.log = &std::cerr;
     options.stepped = stepped;
+    options.watchdog_s = watchdog_ms / 1000.0;
     arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config),
                                        options);
     if (!port_file.empty()) {
@@ -76,12 +83,22 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, onSignal);
     std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port()
               << " (simulated arm, speed x" << options.speed_factor << ", " << config.objects.size()
-              << " objects)" << std::endl;
+              << " objects, watchdog "
+              << (stepped           ? std::string("off (stepped)")
+                  : watchdog_ms > 0 ? std::to_string(watchdog_ms) + " ms"
+                                    : "off")
+              << ", receive buffer " << backend.receiveBufferBytes() / 1024 << " KiB)" << std::endl;
+    if (backend.receiveBufferBytes() < options.receive_buffer_bytes)
+      std::cerr << "arbci-robotd: the kernel granted a smaller receive buffer than the "
+                << options.receive_buffer_bytes / 1024
+                << " KiB asked; a burst of junk datagrams may crowd out commands (raise "
+                   "net.core.rmem_max)"
+                << std::endl;
     backend.run(stop_requested);
     const arbci::robot::BackendStats s = backend.stats();
     std::cerr << "arbci-robotd: stopped; " << s.datagrams << " datagrams, " << s.executed
               << " commands run, " << s.rejected << " rejected, " << s.replayed << " replayed, "
-              << s.ignored << " ignored" << std::endl;
+              << s.ignored << " ignored, " << s.watchdog_halts << " watchdog halts" << std::endl;
   } catch (const std::exception& error) {
     std::cerr << "arbci-robotd: " << error.what() << "\n";
     return 1;

@@ -15,6 +15,18 @@ Clock::duration seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
+bool isMotion(MessageType type) {
+  return type == MessageType::Grasp || type == MessageType::Drop || type == MessageType::Home;
+}
+
+RobotEvent event(RobotEvent::Kind kind, std::string text) {
+  return {kind, 0, MessageType::Status, {}, {}, std::move(text)};
+}
+
+RobotEvent failure(std::uint64_t sequence, MessageType type, std::string text) {
+  return {RobotEvent::Kind::Failed, sequence, type, {}, Outcome::Failed, std::move(text)};
+}
+
 }  // namespace
 
 const char* toString(RobotEvent::Kind kind) {
@@ -33,6 +45,8 @@ const char* toString(RobotEvent::Kind kind) {
       return "reachable";
     case RobotEvent::Kind::Restarted:
       return "restarted";
+    case RobotEvent::Kind::Connected:
+      return "connected";
   }
   return "unknown";
 }
@@ -41,19 +55,68 @@ RobotClient::RobotClient(const Endpoint& backend, const Key& key, const ClientOp
     : backend_(backend), key_(key), options_(options), socket_(0, "0.0.0.0") {
   RAND_bytes(reinterpret_cast<unsigned char*>(&session_), sizeof session_);
   created_ = last_heard_ = next_status_ = Clock::now();
+  sendHello();
+  if (options_.heartbeat_hz > 0.0) heartbeat_ = std::thread([this] { heartbeatLoop(); });
 }
 
-RobotClient::~RobotClient() = default;
+RobotClient::~RobotClient() {
+  {
+    std::lock_guard lock(heartbeat_mutex_);
+    stopping_ = true;
+  }
+  heartbeat_wake_.notify_all();
+  if (heartbeat_.joinable()) heartbeat_.join();
+}
+
+// While connected, whatever the cycle is doing: the backend halts a motion when these stop.
+void RobotClient::heartbeatLoop() {
+  const auto period = seconds(1.0 / options_.heartbeat_hz);
+  std::unique_lock lock(heartbeat_mutex_);
+  while (!heartbeat_wake_.wait_for(lock, period, [this] { return stopping_; })) {
+    if (!connected_) continue;
+    Message m;
+    m.type = MessageType::Heartbeat;
+    m.session = session_;
+    m.sequence = next_sequence_++;
+    m.timestamp_ms = wallClockMs();
+    m.boot = boot_;
+    m.abandon_below = abandon_below_;
+    socket_.sendTo(encode(m, key_), backend_);
+  }
+}
+
+void RobotClient::sendHello() {
+  Message m;
+  m.type = MessageType::Hello;
+  m.session = session_;
+  m.sequence = next_sequence_++;
+  m.timestamp_ms = wallClockMs();
+  socket_.sendTo(encode(m, key_), backend_);
+  next_hello_ = Clock::now() + seconds(hello_interval_);
+  hello_interval_ = std::min(hello_interval_ * 2.0, options_.max_retransmit_s);
+}
 
 std::uint64_t RobotClient::send(MessageType type, const Vec3& target) {
+  if (type == MessageType::Stop) {
+    // Nothing sent before a STOP may start after it: the backend refuses it too, however late.
+    // (An accepted one is halted by the STOP and finishes "stopped".)
+    std::vector<Pending> cancelled;
+    for (const Pending& p : pending_) {
+      if (isMotion(p.type) && !p.accepted) cancelled.push_back(p);
+    }
+    for (const Pending& p : cancelled)
+      complete(p.sequence, failure(p.sequence, p.type,
+                                   std::string(toString(p.type)) + " cancelled: STOP sent"));
+  }
   Pending p;
   p.sequence = next_sequence_++;
   p.type = type;
   p.target = target;
   p.first_sent = Clock::now();
   p.interval = options_.first_retransmit_s;
-  transmit(p);
   pending_.push_back(p);
+  updateAbandonFloor();
+  if (connected_) transmit(pending_.back());
   return p.sequence;
 }
 
@@ -63,6 +126,7 @@ void RobotClient::transmit(Pending& p) {
   m.session = session_;
   m.sequence = p.sequence;
   m.timestamp_ms = wallClockMs();
+  m.boot = boot_;
   m.target = p.target;
   socket_.sendTo(encode(m, key_), backend_);
   p.next_send = Clock::now() + seconds(p.interval);
@@ -76,9 +140,57 @@ RobotClient::Pending* RobotClient::find(std::uint64_t sequence) {
   return nullptr;
 }
 
-void RobotClient::complete(std::uint64_t sequence, RobotEvent event) {
+bool RobotClient::accepted(std::uint64_t sequence) const {
+  return std::find(accepted_.begin(), accepted_.end(), sequence) != accepted_.end();
+}
+
+void RobotClient::complete(std::uint64_t sequence, RobotEvent e) {
   std::erase_if(pending_, [&](const Pending& p) { return p.sequence == sequence; });
-  events_.push_back(std::move(event));
+  events_.push_back(std::move(e));
+  updateAbandonFloor();
+}
+
+// Every motion command below the floor is one this client no longer wants: the lowest still
+// pending, or (none pending) everything sent so far.
+void RobotClient::updateAbandonFloor() {
+  std::uint64_t floor = next_sequence_;
+  for (const Pending& p : pending_) {
+    if (isMotion(p.type)) floor = std::min(floor, p.sequence);
+  }
+  abandon_below_ = std::max(abandon_below_.load(), floor);
+}
+
+void RobotClient::markAccepted(Pending& p) {
+  if (p.accepted) return;
+  p.accepted = true;
+  accepted_.push_back(p.sequence);
+  if (accepted_.size() > 64) accepted_.erase(accepted_.begin());
+  events_.push_back({RobotEvent::Kind::Accepted, p.sequence, p.type, {}, {}, ""});
+  if (p.type == MessageType::Stop || p.type == MessageType::Reset) {
+    const char* text = p.type == MessageType::Stop ? "stopped" : "reset";
+    complete(p.sequence,
+             {RobotEvent::Kind::Finished, p.sequence, p.type, {}, Outcome::Success, text});
+  }
+}
+
+// The backend run this client was bound to is gone: whatever was pending fails (an accepted
+// command died with it; one not yet accepted is never sent to the new run), and the client
+// binds to the new run.
+void RobotClient::restarted() {
+  events_.push_back(event(RobotEvent::Kind::Restarted, "the backend restarted"));
+  const std::vector<Pending> lost = pending_;
+  for (const Pending& p : lost) {
+    const std::string name = toString(p.type);
+    complete(p.sequence,
+             failure(p.sequence, p.type,
+                     p.accepted ? name + " lost: the backend restarted during the command"
+                                : name + " not confirmed: the backend restarted before accepting "
+                                         "it; it is not sent to the new run"));
+  }
+  connected_ = false;
+  boot_ = 0;
+  hello_interval_ = options_.first_retransmit_s;
+  sendHello();
 }
 
 void RobotClient::handle(const Message& m) {
@@ -90,40 +202,27 @@ void RobotClient::handle(const Message& m) {
   heard_ = true;
   if (silent_) {
     silent_ = false;
-    events_.push_back(
-        {RobotEvent::Kind::Reachable, 0, MessageType::Status, {}, {}, "the backend answers again"});
+    events_.push_back(event(RobotEvent::Kind::Reachable, "the backend answers again"));
   }
-  if (boot_ != 0 && m.boot != boot_) {
+  if (boot_ != 0 && m.boot != boot_) restarted();
+  if (m.type == MessageType::Welcome) {
+    if (connected_) return;  // a copy of the answer to an earlier HELLO
+    boot_ = m.boot;
+    connected_ = true;
     events_.push_back(
-        {RobotEvent::Kind::Restarted, 0, MessageType::Status, {}, {}, "the backend restarted"});
-    // Accepted commands died with the old backend: they must not be taken for done.
-    std::vector<Pending> lost;
-    for (const Pending& p : pending_) {
-      if (p.accepted && p.accepted_boot != m.boot) lost.push_back(p);
-    }
-    for (const Pending& p : lost) {
-      complete(p.sequence,
-               {RobotEvent::Kind::Failed,
-                p.sequence,
-                p.type,
-                {},
-                Outcome::Failed,
-                std::string(toString(p.type)) + " lost: the backend restarted during the command"});
-    }
+        event(RobotEvent::Kind::Connected,
+              "bound to backend run " + std::to_string(m.boot) +
+                  (m.watchdog_ms ? ", watchdog " + std::to_string(m.watchdog_ms) + " ms"
+                                 : ", no watchdog")));
+    next_status_ = Clock::now();
+    for (Pending& p : pending_) transmit(p);
+    return;
   }
-  boot_ = m.boot;
+  if (!connected_ || m.boot != boot_) return;  // from a run this client is not bound to
   Pending* p = find(m.sequence);
   switch (m.type) {
     case MessageType::Accepted:
-      if (p && !p->accepted) {
-        p->accepted = true;
-        p->accepted_boot = m.boot;
-        events_.push_back({RobotEvent::Kind::Accepted, p->sequence, p->type, {}, {}, ""});
-        if (p->type == MessageType::Stop)
-          complete(
-              p->sequence,
-              {RobotEvent::Kind::Finished, p->sequence, p->type, {}, Outcome::Success, "stopped"});
-      }
+      if (p) markAccepted(*p);
       break;
     case MessageType::Rejected:
       if (p)
@@ -131,23 +230,33 @@ void RobotClient::handle(const Message& m) {
                  {RobotEvent::Kind::Rejected, p->sequence, p->type, m.reason, {}, m.text});
       break;
     case MessageType::Finished:
-      if (p && (!p->accepted || p->accepted_boot == m.boot)) {
-        complete(p->sequence,
-                 {RobotEvent::Kind::Finished, p->sequence, p->type, {}, m.outcome, m.text});
+      if (p) {
+        const std::uint64_t sequence = p->sequence;
+        const MessageType type = p->type;
+        markAccepted(*p);  // (a STOP or RESET completes there)
+        if (find(sequence))
+          complete(sequence, {RobotEvent::Kind::Finished, sequence, type, {}, m.outcome, m.text});
       }
       break;
     case MessageType::StatusReply: {
       status_ = m.status;
       if (sync_sequence_ != 0 && m.sequence == sync_sequence_) synced_ = true;
-      // A lost FINISHED shows in the status as this session's last finished command.
-      Pending* done = find(m.status.last_finished_sequence);
-      if (done && done->accepted && done->accepted_boot == m.boot) {
-        complete(done->sequence, {RobotEvent::Kind::Finished,
-                                  done->sequence,
-                                  done->type,
-                                  {},
-                                  m.status.last_outcome,
-                                  m.status.last_outcome_text});
+      // A lost ACCEPTED shows in the status as this session's running command...
+      if (m.status.current_is_yours) {
+        if (Pending* running = find(m.status.current_sequence)) markAccepted(*running);
+      }
+      // ...and a lost FINISHED as this session's last finished command.
+      if (Pending* done = find(m.status.last_finished_sequence)) {
+        const std::uint64_t sequence = done->sequence;
+        const MessageType type = done->type;
+        markAccepted(*done);
+        if (find(sequence))
+          complete(sequence, {RobotEvent::Kind::Finished,
+                              sequence,
+                              type,
+                              {},
+                              m.status.last_outcome,
+                              m.status.last_outcome_text});
       }
       break;
     }
@@ -165,42 +274,39 @@ void RobotClient::poll() {
     if (decoded.ok()) handle(decoded.message);
   }
   const auto now = Clock::now();
+  // Not bound (or silent, when the backend may have lost our address): HELLO, with back-off.
+  if ((!connected_ || silent_) && now >= next_hello_) sendHello();
   std::vector<Pending> expired;
   for (Pending& p : pending_) {
     if (p.accepted) continue;
     if (now - p.first_sent > seconds(options_.give_up_s)) {
       expired.push_back(p);
-    } else if (now >= p.next_send) {
+    } else if (connected_ && now >= p.next_send) {
       transmit(p);
     }
   }
   for (const Pending& p : expired) {
     complete(p.sequence,
-             {RobotEvent::Kind::Failed,
-              p.sequence,
-              p.type,
-              {},
-              Outcome::Failed,
-              std::string(toString(p.type)) + " was never accepted: no answer from the backend"});
+             failure(p.sequence, p.type,
+                     std::string(toString(p.type)) +
+                         " was never accepted: no answer from the backend (given up; it will "
+                         "not run later)"));
   }
-  if (now >= next_status_) {
+  if (connected_ && now >= next_status_) {
     next_status_ = now + seconds(options_.status_interval_s);
     Message m;
     m.type = MessageType::Status;
     m.session = session_;
     m.sequence = next_sequence_++;
     m.timestamp_ms = wallClockMs();
+    m.boot = boot_;
     socket_.sendTo(encode(m, key_), backend_);
   }
   const auto quiet_since = heard_ ? last_heard_ : created_;
   if (!silent_ && now - quiet_since > seconds(options_.silence_s)) {
     silent_ = true;
-    events_.push_back({RobotEvent::Kind::Silent,
-                       0,
-                       MessageType::Status,
-                       {},
-                       {},
-                       "no answer from the backend for a second"});
+    hello_interval_ = options_.max_retransmit_s;
+    events_.push_back(event(RobotEvent::Kind::Silent, "no answer from the backend for a second"));
   }
 }
 
@@ -208,14 +314,16 @@ bool RobotClient::syncClock(double clock_s, double timeout_s) {
   Message m;
   m.type = MessageType::Status;
   m.session = session_;
-  m.sequence = sync_sequence_ = next_sequence_++;
   m.clock_s = clock_s;
+  sync_sequence_ = 0;  // assigned at the first send; resends reuse it (answered from the cache)
   synced_ = false;
   const auto give_up = Clock::now() + seconds(timeout_s);
   auto resend = Clock::now();
   while (!synced_ && Clock::now() < give_up) {
-    if (Clock::now() >= resend) {
+    if (connected_ && Clock::now() >= resend) {
+      if (sync_sequence_ == 0) m.sequence = sync_sequence_ = next_sequence_++;
       m.timestamp_ms = wallClockMs();
+      m.boot = boot_;
       socket_.sendTo(encode(m, key_), backend_);
       resend = Clock::now() + seconds(0.05);
     }

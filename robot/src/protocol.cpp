@@ -95,7 +95,7 @@ std::array<std::uint8_t, kMacBytes> mac(const std::uint8_t* data, size_t size, c
 }
 
 bool validType(std::uint8_t t) {
-  return (t >= 1 && t <= 5) || (t >= 0x81 && t <= 0x84);
+  return (t >= 1 && t <= 8) || (t >= 0x81 && t <= 0x85);
 }
 bool finite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -109,6 +109,12 @@ void writePayload(Writer& w, const Message& m) {
       break;
     case MessageType::Status:
       if (m.clock_s) w.real(*m.clock_s);
+      break;
+    case MessageType::Heartbeat:
+      w.integer(m.abandon_below);
+      break;
+    case MessageType::Welcome:
+      w.integer(m.watchdog_ms);
       break;
     case MessageType::Rejected:
       w.integer(static_cast<std::uint8_t>(m.reason));
@@ -126,10 +132,12 @@ void writePayload(Writer& w, const Message& m) {
       w.integer(s.holding);
       w.integer(static_cast<std::uint8_t>(s.current_command));
       w.integer(s.current_sequence);
+      w.integer(static_cast<std::uint8_t>(s.current_is_yours ? 1 : 0));
       w.real(s.progress);
       w.integer(s.last_finished_sequence);
       w.integer(static_cast<std::uint8_t>(s.last_outcome));
       w.text(s.last_outcome_text.substr(0, 200));
+      w.text(s.stop_reason.substr(0, 200));
       const size_t n = std::min<size_t>(s.objects.size(), kMaxWorldObjects);
       w.integer(static_cast<std::uint8_t>(n));
       for (size_t i = 0; i < n; ++i) {
@@ -155,9 +163,15 @@ bool readPayload(Reader& r, Message& m) {
       if (r.done()) return true;
       m.clock_s = r.real();
       return !r.failed && std::isfinite(*m.clock_s) && *m.clock_s >= 0.0;
+    case MessageType::Heartbeat:
+      m.abandon_below = r.integer<std::uint64_t>();
+      return !r.failed;
+    case MessageType::Welcome:
+      m.watchdog_ms = r.integer<std::uint32_t>();
+      return !r.failed;
     case MessageType::Rejected: {
       const auto reason = r.integer<std::uint8_t>();
-      if (reason < 1 || reason > 7) return false;
+      if (reason < 1 || reason > 10) return false;
       m.reason = static_cast<RejectReason>(reason);
       m.text = r.text();
       return !r.failed;
@@ -178,15 +192,19 @@ bool readPayload(Reader& r, Message& m) {
       s.gripper_opening = r.real();
       s.holding = r.integer<std::int32_t>();
       const auto command = r.integer<std::uint8_t>();
-      if (command < 1 || command > 5) return false;
+      if (command < 1 || command > 8) return false;
       s.current_command = static_cast<MessageType>(command);
       s.current_sequence = r.integer<std::uint64_t>();
+      const auto yours = r.integer<std::uint8_t>();
+      if (yours > 1) return false;
+      s.current_is_yours = yours == 1;
       s.progress = r.real();
       s.last_finished_sequence = r.integer<std::uint64_t>();
       const auto outcome = r.integer<std::uint8_t>();
       if (outcome > 2) return false;
       s.last_outcome = static_cast<Outcome>(outcome);
       s.last_outcome_text = r.text();
+      s.stop_reason = r.text();
       const auto n = r.integer<std::uint8_t>();
       if (n > kMaxWorldObjects) return false;
       for (int i = 0; i < n && !r.failed; ++i) {
@@ -233,6 +251,7 @@ Decoded decode(const std::uint8_t* data, size_t size, const Key& key) {
   if (size > kMaxDatagram) return {DecodeError::TooLong, {}};
   if (std::memcmp(data, "ARBR", 4) != 0) return {DecodeError::BadMagic, {}};
   if (data[4] != kProtocolVersion) return {DecodeError::BadVersion, {}};
+  if (data[6] != 0 || data[7] != 0) return {DecodeError::BadReserved, {}};
   const size_t payload = static_cast<size_t>(data[40]) | (static_cast<size_t>(data[41]) << 8);
   if (kHeaderBytes + payload + kMacBytes != size) return {DecodeError::BadLength, {}};
   const auto expected = mac(data, kHeaderBytes + payload, key);
@@ -270,6 +289,14 @@ const char* toString(MessageType type) {
       return "STOP";
     case MessageType::Status:
       return "STATUS";
+    case MessageType::Hello:
+      return "HELLO";
+    case MessageType::Reset:
+      return "RESET";
+    case MessageType::Heartbeat:
+      return "HEARTBEAT";
+    case MessageType::Welcome:
+      return "WELCOME";
     case MessageType::Accepted:
       return "ACCEPTED";
     case MessageType::Finished:
@@ -298,6 +325,12 @@ const char* toString(RejectReason reason) {
       return "unreachable";
     case RejectReason::InvalidState:
       return "invalid in this state";
+    case RejectReason::Stopped:
+      return "stopped";
+    case RejectReason::UnknownBoot:
+      return "another backend run";
+    case RejectReason::Cancelled:
+      return "cancelled";
   }
   return "unknown";
 }
@@ -340,6 +373,8 @@ const char* toString(DecodeError error) {
       return "not an ARBCI robot message";
     case DecodeError::BadVersion:
       return "unsupported protocol version";
+    case DecodeError::BadReserved:
+      return "reserved field not zero";
     case DecodeError::BadLength:
       return "length field does not match";
     case DecodeError::BadMac:

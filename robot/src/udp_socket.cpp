@@ -66,6 +66,18 @@ int UdpSocket::port() const {
   return ntohs(local.sin_port);
 }
 
+int UdpSocket::setReceiveBuffer(int bytes) {
+  ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &bytes, sizeof bytes);
+  return receiveBuffer();
+}
+
+int UdpSocket::receiveBuffer() const {
+  int bytes = 0;
+  socklen_t length = sizeof bytes;
+  ::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &bytes, &length);
+  return bytes;
+}
+
 void UdpSocket::sendTo(const std::vector<std::uint8_t>& bytes, const Endpoint& to) {
   // UDP may drop; a full send buffer is the same as a lost datagram, which the protocol handles.
   ::sendto(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT,

@@ -1,17 +1,25 @@
 // `arbci robot keygen`, `arbci-robotd` and `arbci robot ...` from the shell: a private key, a
-// grasp and drop that exit 0, rejections and a missing backend that exit 1 with the reason.
+// grasp and drop that exit 0, rejections and a missing backend that exit 1 with the reason, a
+// STOP that holds until `reset`, and at 50 % loss each way every command that ran reported as
+// run; a motion whose answer was lost is told apart from one that did not run.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <thread>
 
+#include "arbci/robot/backend.h"
+#include "arbci/robot/key_file.h"
+#include "arbci/robot/simulated_arm.h"
 #include "support/run_process.h"
+#include "support/udp_relay.h"
 
 namespace arbci::test {
 namespace {
@@ -95,15 +103,140 @@ TEST(RobotCommand, NoBackendOrWrongKeyGivesAReason) {
   const auto key = scratch("lonely.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
   const auto start = std::chrono::steady_clock::now();
-  const ProcessResult r =
-      runProcess(kArbci, {"robot", "--port", "47999", "--key-file", key.string(), "home"}, 30.0);
+  const ProcessResult r = runProcess(
+      kArbci,
+      {"robot", "--port", "47999", "--key-file", key.string(), "--retry-budget", "2", "home"},
+      30.0);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("no answer from the backend"), std::string::npos) << r.err;
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  EXPECT_NE(r.err.find("HOME not run: no answer from the backend"), std::string::npos) << r.err;
+  // The whole retry budget, and no more.
+  const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GT(took, 2.0);
+  EXPECT_LT(took, 5.0);
   const ProcessResult missing =
       runProcess(kArbci, {"robot", "--key-file", scratch("none.key").string(), "status"});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("no key file"), std::string::npos) << missing.err;
+}
+
+TEST(RobotCommand, AStopHoldsUntilReset) {
+  const auto key = scratch("stop.key");
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
+  const std::string port = "47914";
+  Robotd robotd({"--port", port, "--key-file", key.string(), "--speed", "20"});
+  const std::vector<std::string> base{"robot", "--port", port, "--key-file", key.string()};
+  auto run = [&](const std::string& command) {
+    std::vector<std::string> args = base;
+    args.push_back(command);
+    return runProcess(kArbci, args, 60.0);
+  };
+  ProcessResult r = run("stop");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  r = run("status");
+  EXPECT_NE(r.out.find("stopped: emergency stop"), std::string::npos) << r.out;
+  r = run("home");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("HOME not run: rejected: stopped"), std::string::npos) << r.err;
+  EXPECT_EQ(run("reset").exit_code, 0);
+  r = run("home");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+// An in-process backend (its counts are the ground truth) behind a relay the test controls.
+class BackendThread {
+ public:
+  explicit BackendThread(const robot::Key& key, double speed) {
+    robot::BackendOptions options;
+    options.speed_factor = speed;
+    robot::RobotConfig config;
+    config.objects = {{4, {0.1, 0.6, 0.06}, 0.06, 0.03}};
+    backend_ = std::make_unique<robot::RobotBackend>(
+        key, std::make_unique<robot::SimulatedArm>(config), options);
+    thread_ = std::thread([this] { backend_->run(stop_); });
+  }
+  ~BackendThread() {
+    stop_ = true;
+    thread_.join();
+  }
+  int port() const { return backend_->port(); }
+  robot::BackendStats stats() const { return backend_->stats(); }
+
+ private:
+  std::unique_ptr<robot::RobotBackend> backend_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// 100 commands in four lanes of 25 (a backend and a relay each, run side by side to save time).
+TEST(RobotCommand, AtHalfTheDatagramsLostEachWayEveryCommandThatRanIsReportedAsRun) {
+  const auto key_file = scratch("lossy.key");
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const robot::Key key = robot::loadKey(key_file);
+  struct Lane {
+    Lane(const robot::Key& key, unsigned seed)
+        : backend(key, 50.0), relay(backend.port(), key, seed) {
+      relay.setLoss(0.5, 0.5);
+    }
+    BackendThread backend;
+    test::UdpRelay relay;
+    int reported_run = 0, reported_not_run = 0;
+    std::string first_failure;
+  };
+  std::vector<std::unique_ptr<Lane>> lanes;
+  for (unsigned seed = 1; seed <= 4; ++seed) lanes.push_back(std::make_unique<Lane>(key, seed));
+  std::vector<std::thread> threads;
+  for (auto& lane : lanes) {
+    threads.emplace_back([&, l = lane.get()] {
+      for (int i = 0; i < 25; ++i) {
+        const ProcessResult r = runProcess(kArbci,
+                                           {"robot", "--port", std::to_string(l->relay.port()),
+                                            "--key-file", key_file.string(), "home"},
+                                           60.0);
+        const bool ran = r.exit_code == 0 || r.exit_code == 3;
+        (ran ? l->reported_run : l->reported_not_run)++;
+        if (!ran && l->first_failure.empty()) l->first_failure = r.err;
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  std::uint64_t executed = 0, dropped = 0;
+  int reported_run = 0;
+  for (const auto& lane : lanes) {
+    EXPECT_EQ(lane->backend.stats().executed, 25u) << lane->first_failure;  // each exactly once
+    EXPECT_EQ(lane->reported_run, static_cast<int>(lane->backend.stats().executed))
+        << lane->first_failure;
+    executed += lane->backend.stats().executed;
+    dropped += lane->relay.dropped();
+    reported_run += lane->reported_run;
+  }
+  std::cout << "100 HOME commands at 50 % loss each way: " << executed << " ran, " << reported_run
+            << " reported as run, " << dropped << " datagrams dropped\n";
+  EXPECT_GT(dropped, 500u);
+}
+
+TEST(RobotCommand, AMotionWhoseAnswersWereLostIsReportedAsRunAndStopped) {
+  const auto key_file = scratch("deaf.key");
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const robot::Key key = robot::loadKey(key_file);
+  BackendThread backend(key, 1.0);  // real time: the grasp takes seconds
+  test::UdpRelay relay(backend.port(), key);
+  relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
+                     robot::MessageType::Finished});
+  auto cli = std::async(std::launch::async, [&] {
+    return runProcess(kArbci,
+                      {"robot", "--port", std::to_string(relay.port()), "--key-file",
+                       key_file.string(), "--retry-budget", "1", "grasp", "0.1", "0.6", "0.06"},
+                      60.0);
+  });
+  // Answers come back once the client has given up: the STOP and the status get through.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  relay.dropReplies({});
+  const ProcessResult r = cli.get();
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("GRASP ran, but the answer was lost"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("STOP sent and accepted"), std::string::npos) << r.err;
+  EXPECT_EQ(backend.stats().executed, 1u);
 }
 
 }  // namespace

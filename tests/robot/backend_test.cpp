@@ -1,6 +1,7 @@
 // The backend and the client over real UDP on 127.0.0.1: a grasp-then-drop moves the object,
 // commands run exactly once through a lossy relay, floods of bad datagrams change nothing, the
-// workspace and STOP are obeyed, and a backend restarted mid-command is reported as a failure.
+// workspace and STOP are obeyed (and latched until RESET), and a backend restarted mid-command
+// is reported as a failure.
 // Every wait is bounded.
 #include <gtest/gtest.h>
 
@@ -10,129 +11,14 @@
 #include <random>
 #include <thread>
 
-#include "arbci/robot/backend.h"
-#include "arbci/robot/client.h"
-#include "arbci/robot/simulated_arm.h"
+#include "robot/robot_test_support.h"
+#include "support/udp_relay.h"
 
 namespace arbci::robot {
 namespace {
 
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
-
-Key testKey() {
-  Key key{};
-  for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<std::uint8_t>(i * 31 + 5);
-  return key;
-}
-
-RobotConfig twoObjects() {
-  RobotConfig c;
-  c.objects = {{1, {0.10, 0.60, 0.06}, 0.06, 0.03}, {2, {-0.15, 0.55, 0.06}, 0.06, 0.03}};
-  return c;
-}
-
-// A backend on its own thread.
-class RunningBackend {
- public:
-  explicit RunningBackend(double speed, int port = 0, RobotConfig config = twoObjects(),
-                          bool stepped = false) {
-    BackendOptions options;
-    options.port = port;
-    options.stepped = stepped;
-    options.speed_factor = speed;
-    options.status_interval_s = 0.05;
-    backend_ =
-        std::make_unique<RobotBackend>(testKey(), std::make_unique<SimulatedArm>(config), options);
-    thread_ = std::thread([this] { backend_->run(stop_); });
-  }
-  ~RunningBackend() { halt(); }
-  void halt() {
-    stop_ = true;
-    if (thread_.joinable()) thread_.join();
-  }
-  int port() const { return backend_->port(); }
-  BackendStats stats() const { return backend_->stats(); }
-
- private:
-  std::unique_ptr<RobotBackend> backend_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
-};
-
-// Waits (up to 5 s) until the backend has taken `count` datagrams off its socket.
-bool backendReceived(const RunningBackend& backend, std::uint64_t count) {
-  const auto deadline = std::chrono::steady_clock::now() + 5s;
-  while (backend.stats().datagrams < count) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(1ms);
-  }
-  return true;
-}
-
-// Polls (up to 5 s) until the backend accepts command `sequence`.
-bool waitUntilAccepted(RobotClient& client, std::uint64_t sequence) {
-  const auto end = std::chrono::steady_clock::now() + 5s;
-  while (std::chrono::steady_clock::now() < end) {
-    client.poll();
-    for (const RobotEvent& e : client.takeEvents()) {
-      if (e.kind == RobotEvent::Kind::Accepted && e.sequence == sequence) return true;
-    }
-    std::this_thread::sleep_for(1ms);
-  }
-  return false;
-}
-
-ClientOptions fastClient() {
-  ClientOptions o;
-  o.first_retransmit_s = 0.01;
-  o.max_retransmit_s = 0.05;
-  o.status_interval_s = 0.02;
-  return o;
-}
-
-// Polls until an event for `sequence` ends it (finished, rejected, failed) or `timeout` passes.
-std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence,
-                                std::chrono::milliseconds timeout = 20s) {
-  std::vector<RobotEvent> seen;
-  const auto end = Clock::now() + timeout;
-  while (Clock::now() < end) {
-    client.poll();
-    for (RobotEvent& e : client.takeEvents()) {
-      const bool final = e.sequence == sequence && (e.kind == RobotEvent::Kind::Finished ||
-                                                    e.kind == RobotEvent::Kind::Rejected ||
-                                                    e.kind == RobotEvent::Kind::Failed);
-      seen.push_back(std::move(e));
-      if (final) return seen;
-    }
-    std::this_thread::sleep_for(1ms);
-  }
-  return seen;
-}
-
-const RobotEvent* finalEvent(const std::vector<RobotEvent>& events) {
-  return events.empty() ? nullptr : &events.back();
-}
-
-StatusPayload freshStatus(RobotClient& client) {
-  const auto end = Clock::now() + 3s;
-  client.takeEvents();
-  const auto before = client.status();
-  while (Clock::now() < end) {
-    client.poll();
-    if (client.status() &&
-        (!before || client.status()->tool.x != before->tool.x || Clock::now() > end - 2900ms))
-      break;
-    std::this_thread::sleep_for(1ms);
-  }
-  // Let two more status replies arrive so the one returned is current.
-  const auto settle = Clock::now() + 60ms;
-  while (Clock::now() < settle) {
-    client.poll();
-    std::this_thread::sleep_for(1ms);
-  }
-  return client.status().value_or(StatusPayload{});
-}
 
 // A stepped backend moves its arm only to the clock the client's STATUS carries: nothing happens
 // on the wall clock, and the same clock steps give the same arm, to the last bit, every time.
@@ -192,54 +78,10 @@ TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {
   EXPECT_EQ(backend.stats().executed, 2u);
 }
 
-// Forwards datagrams between one client and the backend, dropping `loss` of them each way.
-class LossyRelay {
- public:
-  LossyRelay(int backend_port, double loss)
-      : backend_(Endpoint::resolve("127.0.0.1", backend_port)), loss_(loss) {
-    thread_ = std::thread([this] { run(); });
-  }
-  ~LossyRelay() {
-    stop_ = true;
-    thread_.join();
-  }
-  int port() const { return front_.port(); }
-  std::uint64_t dropped() const { return dropped_; }
-
- private:
-  void run() {
-    std::mt19937 random(1234);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    std::optional<Endpoint> client;
-    while (!stop_) {
-      front_.wait(2);
-      while (auto d = front_.receive()) {
-        client = d->from;
-        if (unit(random) < loss_)
-          ++dropped_;
-        else
-          back_.sendTo(d->bytes, backend_);
-      }
-      while (auto d = back_.receive()) {
-        if (!client) continue;
-        if (unit(random) < loss_)
-          ++dropped_;
-        else
-          front_.sendTo(d->bytes, *client);
-      }
-    }
-  }
-  UdpSocket front_, back_;
-  Endpoint backend_;
-  double loss_;
-  std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> dropped_{0};
-  std::thread thread_;
-};
-
 TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
   RunningBackend backend(50.0);
-  LossyRelay relay(backend.port(), 0.30);
+  test::UdpRelay relay(backend.port(), testKey());
+  relay.setLoss(0.30, 0.30);
   RobotClient client(Endpoint::resolve("127.0.0.1", relay.port()), testKey(), fastClient());
   int finished = 0;
   for (int i = 0; i < 100; ++i) {
@@ -360,8 +202,18 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
   EXPECT_GT(
       std::abs(halted.tool.x) + std::abs(halted.tool.y - 0.45) + std::abs(halted.tool.z - 0.45),
       0.01);
+  // The stop is latched: no motion until an explicit RESET.
+  events = waitFor(client, client.send(MessageType::Home), 3s);
+  ASSERT_NE(finalEvent(events), nullptr);
+  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Rejected);
+  EXPECT_EQ(finalEvent(events)->reason, RejectReason::Stopped) << finalEvent(events)->text;
+  EXPECT_EQ(halted.stop_reason, "emergency stop");
+  events = waitFor(client, client.send(MessageType::Reset), 3s);
+  ASSERT_NE(finalEvent(events), nullptr);
+  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
   events = waitFor(client, client.send(MessageType::Home), 15s);
   EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success);
 }
 
 TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {

@@ -1,7 +1,9 @@
 // The wire format: every message survives a round trip; any change to the bytes, another key,
-// another version or a cut is caught; key files are private and checked.
+// another version, a reserved field set or a cut is caught; key files are private, regular,
+// exactly 64 hex digits and random-looking.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/types.h>
 
 #include <cmath>
 #include <filesystem>
@@ -36,6 +38,8 @@ Message statusMessage() {
   m.status.last_finished_sequence = 40;
   m.status.last_outcome = Outcome::Stopped;
   m.status.last_outcome_text = "stopped by STOP";
+  m.status.current_is_yours = true;
+  m.status.stop_reason = "halted: link lost";
   m.status.objects = {{1, {0.1, 0.6, 0.06}, false}, {3, {0.1, 0.5, 0.25}, true}};
   return m;
 }
@@ -64,6 +68,33 @@ TEST(Protocol, EveryMessageSurvivesARoundTrip) {
   ASSERT_EQ(d.message.status.objects.size(), 2u);
   EXPECT_TRUE(d.message.status.objects[1].held);
   EXPECT_EQ(d.message.boot, 99u);
+  EXPECT_TRUE(d.message.status.current_is_yours);
+  EXPECT_EQ(d.message.status.stop_reason, "halted: link lost");
+
+  Message heartbeat;
+  heartbeat.type = MessageType::Heartbeat;
+  heartbeat.abandon_below = 0xfffffffffffffff0ULL;
+  bytes = encode(heartbeat, key);
+  d = decode(bytes.data(), bytes.size(), key);
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d.message.abandon_below, heartbeat.abandon_below);
+  Message welcome;
+  welcome.type = MessageType::Welcome;
+  welcome.watchdog_ms = 100;
+  welcome.boot = 0x0123456789abcdefULL;
+  bytes = encode(welcome, key);
+  d = decode(bytes.data(), bytes.size(), key);
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d.message.watchdog_ms, 100u);
+  EXPECT_EQ(d.message.boot, welcome.boot);
+  for (const MessageType type : {MessageType::Hello, MessageType::Reset}) {
+    Message bare;
+    bare.type = type;
+    bytes = encode(bare, key);
+    d = decode(bytes.data(), bytes.size(), key);
+    ASSERT_TRUE(d.ok());
+    EXPECT_EQ(d.message.type, type);
+  }
 
   Message rejected;
   rejected.type = MessageType::Rejected;
@@ -107,8 +138,13 @@ TEST(Protocol, TamperingOtherKeysVersionsAndCutsAreCaught) {
   }
   EXPECT_EQ(decode(bytes.data(), bytes.size(), testKey(8)).error, DecodeError::BadMac);
   auto version = bytes;
-  version[4] = 2;
+  version[4] = 1;  // the first protocol: no boot ids, no latched stop
   EXPECT_EQ(decode(version.data(), version.size(), key).error, DecodeError::BadVersion);
+  for (const size_t at : {6u, 7u}) {
+    auto reserved = bytes;
+    reserved[at] = 1;
+    EXPECT_EQ(decode(reserved.data(), reserved.size(), key).error, DecodeError::BadReserved);
+  }
   EXPECT_EQ(decode(bytes.data(), bytes.size() - 1, key).error, DecodeError::BadLength);
   EXPECT_EQ(decode(bytes.data(), 20, key).error, DecodeError::TooShort);
   std::vector<std::uint8_t> huge(5000, 0);
@@ -142,6 +178,45 @@ TEST(KeyFile, WrittenPrivateAndCheckedOnLoad) {
     EXPECT_NE(std::string(error.what()).find("64 hex"), std::string::npos);
   }
   EXPECT_THROW(loadKey(path.string() + ".missing"), KeyError);
+}
+
+// What a hand-made key file gets wrong: each refused with a reason, none read as a key.
+TEST(KeyFile, RefusesWeakKeysTrailingTextFifosAndDevices) {
+  const auto dir = std::filesystem::temp_directory_path() / "arbci_key_checks";
+  std::filesystem::create_directories(dir);
+  auto write = [&](const std::string& name, const std::string& text) {
+    const auto path = dir / name;
+    std::filesystem::remove(path);
+    std::ofstream(path) << text;
+    chmod(path.c_str(), 0600);
+    return path;
+  };
+  auto refusal = [](const std::filesystem::path& path) -> std::string {
+    try {
+      loadKey(path);
+    } catch (const KeyError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  const std::string good = "3f9a1c77e20b5d4468f1a0c93e7b2d5106a8e4f19c3b7d20e5a6f8014c9d2b73";
+  EXPECT_EQ(refusal(write("good.key", good + "\n")), "");
+  EXPECT_NE(refusal(write("zero.key", std::string(64, '0') + "\n")).find("does not look random"),
+            std::string::npos);
+  std::string pattern;
+  for (int i = 0; i < 16; ++i) pattern += "abcd";
+  EXPECT_NE(refusal(write("pattern.key", pattern + "\n")).find("does not look random"),
+            std::string::npos);
+  EXPECT_NE(refusal(write("trailing.key", good + "ff\n")).find("64 hex"), std::string::npos);
+  EXPECT_NE(refusal(write("second.key", good + "\n" + good + "\n")).find("64 hex"),
+            std::string::npos);
+  // A FIFO would block a reader forever; a device is not a key.
+  const auto fifo = dir / "fifo.key";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(refusal(fifo).find("not a regular file"), std::string::npos);
+  EXPECT_NE(refusal("/dev/null").find("not a regular file"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // The robot backend: authenticates every datagram, drops replays, runs each command exactly
-// once however many copies arrive, answers only the sender, and reports progress and the outcome
-// to the client that gave the command.
+// once however many copies arrive and only in the backend run (boot) it was sent to, answers
+// only the address each session bound at its HELLO, and reports progress and the outcome to the
+// client that gave the command. A STOP (or the watchdog, when the commanding client falls
+// silent during a motion) latches: motion commands are refused until a RESET.
 #pragma once
 
 #include <atomic>
@@ -25,7 +27,13 @@ struct BackendOptions {
   bool stepped = false;
   double status_interval_s = 0.2;  // progress pushed to the commanding client
   double max_clock_skew_s = 30.0;  // older or newer timestamps count as replays
-  std::ostream* log = nullptr;     // rejected and ignored datagrams (rate-limited)
+  // While a motion runs, the arm halts (and the stop latches) when no authenticated datagram
+  // from the commanding session has arrived for this long; 0 turns it off. A stepped backend
+  // needs none: its arm moves only when the client's clock says so.
+  double watchdog_s = 0.1;
+  // Asked of the kernel for the socket; it grants at most net.core.rmem_max (times 2).
+  int receive_buffer_bytes = 4 << 20;
+  std::ostream* log = nullptr;  // rejected and ignored datagrams (rate-limited)
 };
 
 struct BackendStats {
@@ -35,6 +43,7 @@ struct BackendStats {
   std::uint64_t duplicates = 0;  // retransmissions answered from the cache
   std::uint64_t rejected = 0;    // commands refused (workspace, busy, state)
   std::uint64_t executed = 0;    // motion commands started
+  std::uint64_t watchdog_halts = 0;
   std::map<DecodeError, std::uint64_t> by_error;
 };
 
@@ -45,6 +54,7 @@ class RobotBackend {
 
   int port() const;
   std::uint64_t boot() const;
+  int receiveBufferBytes() const;  // what the kernel granted
   // Handles what has arrived and advances the robot; waits at most `wait_ms` for datagrams.
   void poll(int wait_ms = 5);
   // Polls until `stop` is set.

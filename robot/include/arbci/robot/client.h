@@ -1,14 +1,22 @@
-// The client the session's cycle uses: never blocks. send() queues a command; poll() (once a
-// frame) retransmits with back-off until the backend accepts, asks for the status five times a
-// second, and turns what arrives into events: accepted, rejected (with the reason), finished
-// (with the outcome), and failures the backend cannot report itself: silence for a second, a
-// restart during a command (never taken for success), no answer at all.
+// The client the session's cycle uses: never blocks. It binds to one run of the backend (HELLO;
+// the WELCOME's boot id goes with every command), and a thread of its own sends heartbeats while
+// connected, so the backend's watchdog halts the arm when this process or the link dies. send()
+// queues a command; poll() (once a frame) retransmits with back-off until the backend accepts,
+// asks for the status five times a second, and turns what arrives into events: accepted
+// (from the reply or from a status showing the command running), rejected (with the reason),
+// finished (with the outcome), and failures the backend cannot report itself: silence for a
+// second, a restart (every pending command fails and is never sent to the new run), no answer
+// at all (the command is given up and, through the heartbeat, never started later).
 #pragma once
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "arbci/robot/protocol.h"
@@ -20,8 +28,9 @@ struct ClientOptions {
   double first_retransmit_s = 0.05;
   double max_retransmit_s = 0.4;
   double status_interval_s = 0.2;
-  double silence_s = 1.0;   // no answer for this long: the backend is reported silent
-  double give_up_s = 15.0;  // a command nobody accepted in this long fails
+  double silence_s = 1.0;      // no answer for this long: the backend is reported silent
+  double give_up_s = 15.0;     // a command nobody accepted in this long fails
+  double heartbeat_hz = 50.0;  // while connected; 0: none (a test of the watchdog)
 };
 
 struct RobotEvent {
@@ -33,6 +42,7 @@ struct RobotEvent {
     Silent,     // no answer for `silence_s`
     Reachable,  // answers again after silence
     Restarted,  // the backend's boot id changed
+    Connected,  // the handshake with a backend run completed
   } kind;
   std::uint64_t sequence = 0;
   MessageType command = MessageType::Status;
@@ -50,7 +60,8 @@ class RobotClient {
   RobotClient(const RobotClient&) = delete;
   RobotClient& operator=(const RobotClient&) = delete;
 
-  // Queues a command (GRASP, DROP, HOME, STOP); returns its sequence number.
+  // Queues a command (GRASP, DROP, HOME, STOP, RESET); returns its sequence number. It goes out
+  // once connected. A STOP cancels every other pending command: they fail and never run.
   std::uint64_t send(MessageType type, const Vec3& target = {});
   void poll();
   // The next poll() asks for a status at once rather than at the status interval (the session
@@ -65,7 +76,10 @@ class RobotClient {
   // The latest status the backend sent (state, tool, gripper, world).
   const std::optional<StatusPayload>& status() const { return status_; }
   bool silent() const { return silent_; }
+  bool connected() const { return connected_; }
   bool busy() const { return !pending_.empty(); }  // commands not yet finished
+  // Whether command `sequence` is known to have been accepted (and so may have moved the arm).
+  bool accepted(std::uint64_t sequence) const;
 
  private:
   struct Pending {
@@ -73,29 +87,42 @@ class RobotClient {
     MessageType type = MessageType::Home;
     Vec3 target;
     bool accepted = false;
-    std::uint64_t accepted_boot = 0;
     std::chrono::steady_clock::time_point first_sent, next_send;
     double interval = 0.05;
   };
   void transmit(Pending& p);
+  void sendHello();
   void handle(const Message& m);
+  void restarted();
   Pending* find(std::uint64_t sequence);
   void complete(std::uint64_t sequence, RobotEvent event);
+  void markAccepted(Pending& p);
+  void updateAbandonFloor();
+  void heartbeatLoop();
 
   Endpoint backend_;
   Key key_;
   ClientOptions options_;
   UdpSocket socket_;
   std::uint64_t session_;
-  std::uint64_t next_sequence_ = 1;
+  std::atomic<std::uint64_t> next_sequence_{1};
   std::vector<Pending> pending_;
+  std::vector<std::uint64_t> accepted_;  // recent accepted sequences (bounded)
   std::vector<RobotEvent> events_;
   std::optional<StatusPayload> status_;
-  std::uint64_t boot_ = 0;
+  // Shared with the heartbeat thread.
+  std::atomic<std::uint64_t> boot_{0};
+  std::atomic<bool> connected_{false};
+  std::atomic<std::uint64_t> abandon_below_{1};
   bool heard_ = false, silent_ = false;
+  double hello_interval_ = 0.05;
   std::uint64_t sync_sequence_ = 0;  // the clock request awaited
   bool synced_ = false;
-  std::chrono::steady_clock::time_point last_heard_, next_status_, created_;
+  std::chrono::steady_clock::time_point last_heard_, next_status_, next_hello_, created_;
+  std::mutex heartbeat_mutex_;
+  std::condition_variable heartbeat_wake_;
+  bool stopping_ = false;
+  std::thread heartbeat_;
 };
 
 }  // namespace arbci::robot

@@ -1,6 +1,8 @@
-// The ARBCI robot protocol, version 1: UDP datagrams, little-endian, each authenticated with
-// HMAC-SHA256 over its content under a shared key. docs/robot-protocol.md describes it for
-// anyone writing a backend.
+// The ARBCI robot protocol, version 2: UDP datagrams, little-endian, each authenticated with
+// HMAC-SHA256 over its content under a shared key. A client binds its session to one run of the
+// backend (HELLO/WELCOME: the backend's random boot id, carried by every later command), keeps
+// a watchdog fed with HEARTBEATs while connected, and a STOP stays in force until a RESET.
+// docs/robot-protocol.md describes it for anyone writing a backend.
 #pragma once
 
 #include <array>
@@ -11,7 +13,7 @@
 
 namespace arbci::robot {
 
-constexpr std::uint8_t kProtocolVersion = 1;
+constexpr std::uint8_t kProtocolVersion = 2;
 constexpr size_t kHeaderBytes = 42;
 constexpr size_t kMacBytes = 32;
 constexpr size_t kMaxDatagram = 1400;
@@ -24,11 +26,15 @@ enum class MessageType : std::uint8_t {
   Home = 3,
   Stop = 4,
   Status = 5,
+  Hello = 6,      // binds the session to this backend run and to the sender's address
+  Reset = 7,      // ends a latched stop (an experimenter's decision)
+  Heartbeat = 8,  // feeds the watchdog; carries the lowest command sequence still wanted
   // Replies (backend to client).
   Accepted = 0x81,
   Finished = 0x82,
   Rejected = 0x83,
   StatusReply = 0x84,
+  Welcome = 0x85,  // answers HELLO; its header's boot field is the id every command must carry
 };
 
 enum class RejectReason : std::uint8_t {
@@ -39,10 +45,15 @@ enum class RejectReason : std::uint8_t {
   Replayed = 5,
   Unreachable = 6,
   InvalidState = 7,  // e.g. a DROP while holding nothing
+  Stopped = 8,       // a latched stop is in force: RESET first
+  UnknownBoot = 9,   // sent to another run of the backend (it restarted): HELLO again
+  Cancelled = 10,    // the client gave up on it, or a STOP came after it: never runs
 };
 
 enum class Outcome : std::uint8_t { Success = 0, Failed = 1, Stopped = 2 };
 
+// Stopped: a latched stop (STOP, or the watchdog) is in force; StatusPayload::stop_reason says
+// which.
 enum class RobotState : std::uint8_t { Idle = 0, Moving = 1, Stopped = 2, Fault = 3 };
 
 struct Vec3 {
@@ -62,11 +73,15 @@ struct StatusPayload {
   std::int32_t holding = -1;                          // object id, -1: nothing
   MessageType current_command = MessageType::Status;  // Status: none
   std::uint64_t current_sequence = 0;
-  double progress = 0.0;  // of the current command, 0-1
+  bool current_is_yours = false;  // the running command is the asking session's
+  double progress = 0.0;          // of the current command, 0-1
   // The last command of the asking session that finished, with its outcome.
   std::uint64_t last_finished_sequence = 0;
   Outcome last_outcome = Outcome::Success;
   std::string last_outcome_text;
+  // Why motion commands are refused until a RESET ("emergency stop", "halted: link lost"); empty
+  // when no stop is latched.
+  std::string stop_reason;
   std::vector<WorldObject> objects;
 };
 
@@ -75,12 +90,16 @@ struct Message {
   std::uint64_t session = 0;       // the client's random session id
   std::uint64_t sequence = 0;      // commands: the client's; replies: the command answered
   std::uint64_t timestamp_ms = 0;  // sender's wall clock (Unix time)
-  std::uint64_t boot = 0;          // replies: the backend's random id for this run
+  // The backend's random id for its run: replies carry it, and so must every command but HELLO.
+  std::uint64_t boot = 0;
   // Payloads (which one is used depends on `type`).
   Vec3 target;  // Grasp, Drop
   // Status, optional: the requester's clock (seconds); a stepped backend advances its robot to
   // it before answering, so a simulation runs on the session's clock.
   std::optional<double> clock_s;
+  // Heartbeat: motion commands of this session below this sequence are abandoned by the client.
+  std::uint64_t abandon_below = 0;
+  std::uint32_t watchdog_ms = 0;                  // Welcome: the backend's watchdog (0: none)
   RejectReason reason = RejectReason::Malformed;  // Rejected
   Outcome outcome = Outcome::Success;             // Finished
   std::string text;                               // Rejected, Finished: for people
@@ -95,6 +114,7 @@ enum class DecodeError {
   TooLong,
   BadMagic,
   BadVersion,
+  BadReserved,
   BadLength,
   BadMac,
   BadType,

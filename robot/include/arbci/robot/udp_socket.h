@@ -38,6 +38,9 @@ class UdpSocket {
   UdpSocket& operator=(const UdpSocket&) = delete;
 
   int port() const;
+  // Asks the kernel for a receive buffer of `bytes` (it may grant less); returns what it granted.
+  int setReceiveBuffer(int bytes);
+  int receiveBuffer() const;
   void sendTo(const std::vector<std::uint8_t>& bytes, const Endpoint& to);
   // One datagram if any is waiting (never blocks).
   std::optional<Datagram> receive();

@@ -1,0 +1,383 @@
+// The robot link when things go wrong, over real UDP on 127.0.0.1 through a relay that loses,
+// cuts, holds back and captures datagrams: a command is bound to one backend run (a replay after
+// a restart never runs; a restart never runs a command twice), a STOP stays in force until a
+// RESET, the watchdog halts the arm when the link is cut, a command given up never starts later,
+// and the replay window, reply address and receive buffer hold at their edges. Every wait is
+// bounded.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <iostream>
+#include <limits>
+
+#include "robot/robot_test_support.h"
+#include "support/udp_relay.h"
+
+namespace arbci::robot {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+constexpr Vec3 kObject1{0.10, 0.60, 0.06}, kObject2{-0.15, 0.55, 0.06};
+
+Endpoint local(int port) {
+  return Endpoint::resolve("127.0.0.1", port);
+}
+
+bool waitUntil(const std::function<bool()>& done, std::chrono::milliseconds timeout = 5s) {
+  const auto end = Clock::now() + timeout;
+  while (!done()) {
+    if (Clock::now() > end) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
+bool connect(RobotClient& client) {
+  const auto end = Clock::now() + 5s;
+  while (!client.connected() && Clock::now() < end) {
+    client.poll();
+    std::this_thread::sleep_for(1ms);
+  }
+  return client.connected();
+}
+
+// The backend's rejection of command `sequence`, as the relay saw it go back (up to 3 s).
+std::optional<Message> rejectionSeen(const test::UdpRelay& relay, std::uint64_t sequence) {
+  std::optional<Message> found;
+  waitUntil(
+      [&] {
+        for (const Message& m : relay.replies()) {
+          if (m.type == MessageType::Rejected && m.sequence == sequence) found = m;
+        }
+        return found.has_value();
+      },
+      3s);
+  return found;
+}
+
+bool has(const std::vector<RobotEvent>& events, RobotEvent::Kind kind) {
+  return std::any_of(events.begin(), events.end(),
+                     [&](const RobotEvent& e) { return e.kind == kind; });
+}
+
+// Speaks the protocol by hand, byte for byte as a client would, to probe the backend's edges.
+class RawSession {
+ public:
+  explicit RawSession(int backend_port) : backend_(local(backend_port)) {}
+  Message message(MessageType type, std::uint64_t sequence) const {
+    Message m;
+    m.type = type;
+    m.session = kSession;
+    m.sequence = sequence;
+    m.timestamp_ms = wallClockMs();
+    m.boot = type == MessageType::Hello ? 0 : boot_;
+    return m;
+  }
+  void send(const Message& m) { send(m, socket); }
+  void send(const Message& m, UdpSocket& from) { from.sendTo(encode(m, testKey()), backend_); }
+  // The next message for this session arriving on `on` within `timeout`.
+  std::optional<Message> receive(std::chrono::milliseconds timeout, UdpSocket& on) {
+    const auto end = Clock::now() + timeout;
+    while (Clock::now() < end) {
+      on.wait(2);
+      while (auto d = on.receive()) {
+        const Decoded decoded = decode(d->bytes.data(), d->bytes.size(), testKey());
+        if (decoded.ok() && decoded.message.session == kSession) return decoded.message;
+      }
+    }
+    return std::nullopt;
+  }
+  std::optional<Message> receive(std::chrono::milliseconds timeout) {
+    return receive(timeout, socket);
+  }
+  // The next reply answering `sequence` (status pushes answer 0).
+  std::optional<Message> answer(std::uint64_t sequence, std::chrono::milliseconds timeout = 2s) {
+    const auto end = Clock::now() + timeout;
+    while (Clock::now() < end) {
+      const auto m =
+          receive(std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now() + 1ms));
+      if (m && m->sequence == sequence) return m;
+    }
+    return std::nullopt;
+  }
+  bool hello(std::uint64_t sequence) {
+    send(message(MessageType::Hello, sequence));
+    const auto welcome = answer(sequence);
+    if (!welcome || welcome->type != MessageType::Welcome) return false;
+    boot_ = welcome->boot;
+    return true;
+  }
+  UdpSocket socket;
+
+ private:
+  static constexpr std::uint64_t kSession = 4242;
+  Endpoint backend_;
+  std::uint64_t boot_ = 0;
+};
+
+// The simulated arm, noting when it was halted.
+class HaltRecordingArm : public RobotDriver {
+ public:
+  explicit HaltRecordingArm(std::shared_ptr<std::atomic<Clock::rep>> halted_at)
+      : arm_(twoObjects()), halted_at_(std::move(halted_at)) {}
+  std::optional<Rejection> check(const DriverCommand& c) const override { return arm_.check(c); }
+  void start(const DriverCommand& c) override { arm_.start(c); }
+  void stop() override {
+    if (*halted_at_ == 0) *halted_at_ = Clock::now().time_since_epoch().count();
+    arm_.stop();
+  }
+  std::optional<DriverResult> step(double seconds) override { return arm_.step(seconds); }
+  DriverStatus status() const override { return arm_.status(); }
+  std::vector<WorldObject> world() const override { return arm_.world(); }
+
+ private:
+  SimulatedArm arm_;
+  std::shared_ptr<std::atomic<Clock::rep>> halted_at_;
+};
+
+TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
+  auto first = std::make_unique<RunningBackend>(20.0);
+  const int port = first->port();
+  std::vector<test::UdpRelay::Bytes> captured;
+  {
+    test::UdpRelay relay(port, testKey());
+    RobotClient client(local(relay.port()), testKey(), fastClient());
+    const auto events = waitFor(client, client.send(MessageType::Grasp, kObject1));
+    ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+    captured = relay.captured(MessageType::Grasp);
+  }
+  ASSERT_FALSE(captured.empty());
+  const std::uint64_t first_boot = first->boot();
+  first.reset();
+  RunningBackend second(20.0, port);
+  EXPECT_NE(second.boot(), first_boot);
+  // Five copies at different ages, as an attacker would try them.
+  UdpSocket attacker;
+  for (int i = 0; i < 5; ++i) {
+    attacker.sendTo(captured[static_cast<size_t>(i) % captured.size()], local(port));
+    std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_TRUE(backendReceived(second, 5));
+  EXPECT_EQ(second.stats().executed, 0u);
+  EXPECT_EQ(second.stats().replayed, 5u);
+  RobotClient observer(local(port), testKey(), fastClient());
+  const StatusPayload status = freshStatus(observer);
+  EXPECT_EQ(status.holding, -1);
+  ASSERT_EQ(status.objects.size(), 2u);
+  EXPECT_NEAR(status.objects[0].position.x, kObject1.x, 1e-9);  // never touched
+  EXPECT_EQ(status.state, RobotState::Idle);
+}
+
+TEST(RobotLink, LostAcceptancesAndARestartRunTheCommandAtMostOnce) {
+  auto first = std::make_unique<RunningBackend>(1.0);  // real time: the grasp takes seconds
+  const int port = first->port();
+  test::UdpRelay relay(port, testKey());
+  relay.dropReplies({MessageType::Accepted, MessageType::StatusReply, MessageType::Finished});
+  RobotClient client(local(relay.port()), testKey(), fastClient());
+  const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);
+  std::vector<RobotEvent> events;
+  ASSERT_TRUE(waitUntil([&] {
+    client.poll();
+    for (RobotEvent& e : client.takeEvents()) events.push_back(std::move(e));
+    return first->stats().executed == 1;
+  }));
+  for (RobotEvent& e : pollFor(client, 300ms)) events.push_back(std::move(e));  // retransmits
+  first.reset();  // killed mid-grasp, its acceptances all lost
+  RunningBackend second(1.0, port);
+  for (RobotEvent& e : waitFor(client, grasp, 5s)) events.push_back(std::move(e));
+  ASSERT_FALSE(events.empty());
+  const auto failed = std::find_if(events.begin(), events.end(), [&](const RobotEvent& e) {
+    return e.sequence == grasp && e.kind == RobotEvent::Kind::Failed;
+  });
+  ASSERT_NE(failed, events.end());
+  EXPECT_NE(failed->text.find("restarted"), std::string::npos) << failed->text;
+  EXPECT_TRUE(has(events, RobotEvent::Kind::Restarted));
+  EXPECT_FALSE(has(events, RobotEvent::Kind::Finished));
+  pollFor(client, 500ms);
+  EXPECT_EQ(second.stats().executed, 0u);  // once in all: on the first run only
+  EXPECT_TRUE(client.connected());         // bound to the new run
+}
+
+TEST(RobotLink, AStopStaysInForceUntilAResetAndEarlierCommandsNeverRun) {
+  RunningBackend backend(20.0);
+  test::UdpRelay relay(backend.port(), testKey());
+  RobotClient client(local(relay.port()), testKey(), fastClient());
+  ASSERT_TRUE(connect(client));
+  relay.hold(MessageType::Grasp);
+  const std::uint64_t a = client.send(MessageType::Grasp, kObject1);
+  const std::uint64_t b = client.send(MessageType::Grasp, kObject2);
+  pollFor(client, 100ms);
+  const std::uint64_t stop = client.send(MessageType::Stop);
+  const auto events = waitFor(client, stop, 3s);
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  int cancelled = 0;
+  for (const RobotEvent& e : events) {
+    if ((e.sequence == a || e.sequence == b) && e.kind == RobotEvent::Kind::Failed) ++cancelled;
+  }
+  EXPECT_EQ(cancelled, 2);  // the client cancels what is pending when it sends STOP
+  // An earlier GRASP delivered after the STOP: refused, the stop is latched.
+  relay.release(a);
+  const auto refused = rejectionSeen(relay, a);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->reason, RejectReason::Stopped) << refused->text;
+  EXPECT_EQ(freshStatus(client).stop_reason, "emergency stop");
+  const auto reset = waitFor(client, client.send(MessageType::Reset), 3s);
+  ASSERT_EQ(finalEvent(reset)->kind, RobotEvent::Kind::Finished);
+  // After the RESET, a GRASP sent before the STOP still never runs.
+  relay.release(b);
+  const auto late = rejectionSeen(relay, b);
+  ASSERT_TRUE(late);
+  EXPECT_EQ(late->reason, RejectReason::Cancelled) << late->text;
+  EXPECT_EQ(backend.stats().executed, 0u);
+  // A new GRASP works.
+  relay.stopHolding();
+  const auto fresh = waitFor(client, client.send(MessageType::Grasp, kObject1));
+  ASSERT_EQ(finalEvent(fresh)->kind, RobotEvent::Kind::Finished) << finalEvent(fresh)->text;
+  EXPECT_EQ(finalEvent(fresh)->outcome, Outcome::Success);
+  EXPECT_EQ(backend.stats().executed, 1u);
+  EXPECT_TRUE(freshStatus(client).stop_reason.empty());
+}
+
+TEST(RobotLink, TheWatchdogHaltsTheArmWithin150msOfTheLinkBeingCut) {
+  auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
+  BackendOptions options;
+  options.status_interval_s = 0.05;
+  options.speed_factor = 1.0;                 // real time: the grasp takes seconds
+  ASSERT_DOUBLE_EQ(options.watchdog_s, 0.1);  // the default
+  RunningBackend backend(std::make_unique<HaltRecordingArm>(halted_at), options);
+  test::UdpRelay relay(backend.port(), testKey());
+  RobotClient client(local(relay.port()), testKey(), fastClient());
+  const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);
+  ASSERT_TRUE(waitUntilAccepted(client, grasp));
+  pollFor(client, 300ms);  // moving, heartbeats flowing
+  ASSERT_EQ(*halted_at, 0);
+  const Clock::time_point cut = Clock::now();
+  relay.setCut(true);
+  std::this_thread::sleep_for(400ms);
+  ASSERT_NE(*halted_at, 0) << "the arm was not halted";
+  const double latency_ms = std::chrono::duration<double, std::milli>(
+                                Clock::time_point(Clock::duration(halted_at->load())) - cut)
+                                .count();
+  std::cout << "halt latency after the cut: " << latency_ms << " ms\n";
+  EXPECT_GT(latency_ms, 0.0);
+  EXPECT_LE(latency_ms, 150.0);
+  relay.setCut(false);
+  const auto events = waitFor(client, grasp, 5s);
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Stopped);
+  EXPECT_NE(finalEvent(events)->text.find("link lost"), std::string::npos);
+  const StatusPayload halted = freshStatus(client);
+  EXPECT_EQ(halted.state, RobotState::Stopped);
+  EXPECT_EQ(halted.stop_reason, "halted: link lost");
+  EXPECT_EQ(backend.stats().watchdog_halts, 1u);
+  std::this_thread::sleep_for(200ms);
+  const StatusPayload later = freshStatus(client);
+  EXPECT_EQ(later.tool.x, halted.tool.x);  // still where it halted
+  EXPECT_EQ(later.tool.z, halted.tool.z);
+  // Latched: a motion needs a RESET first.
+  auto next = waitFor(client, client.send(MessageType::Home), 3s);
+  EXPECT_EQ(finalEvent(next)->reason, RejectReason::Stopped);
+  ASSERT_EQ(finalEvent(waitFor(client, client.send(MessageType::Reset), 3s))->kind,
+            RobotEvent::Kind::Finished);
+  next = waitFor(client, client.send(MessageType::Home), 15s);
+  EXPECT_EQ(finalEvent(next)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(next)->outcome, Outcome::Success);
+}
+
+TEST(RobotLink, ACommandTheClientGaveUpOnNeverStartsLater) {
+  RunningBackend backend(20.0);
+  test::UdpRelay relay(backend.port(), testKey());
+  ClientOptions options = fastClient();
+  options.give_up_s = 0.5;
+  RobotClient client(local(relay.port()), testKey(), options);
+  ASSERT_TRUE(connect(client));
+  relay.hold(MessageType::Grasp);
+  const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);
+  const auto events = waitFor(client, grasp, 3s);
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Failed);
+  EXPECT_NE(finalEvent(events)->text.find("will not run later"), std::string::npos);
+  pollFor(client, 100ms);  // heartbeats tell the backend what the client gave up
+  relay.release(grasp);    // the copies arrive late
+  const auto refused = rejectionSeen(relay, grasp);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->reason, RejectReason::Cancelled) << refused->text;
+  EXPECT_EQ(backend.stats().executed, 0u);
+}
+
+TEST(RobotLink, TheReplayWindowHoldsAtTheTopOfTheSequenceRange) {
+  RunningBackend backend(50.0);
+  RawSession raw(backend.port());
+  constexpr std::uint64_t kTop = std::numeric_limits<std::uint64_t>::max();
+  ASSERT_TRUE(raw.hello(kTop - 2000));
+  // A command at the very top runs once, however many copies arrive.
+  const Message home = raw.message(MessageType::Home, kTop);
+  for (int i = 0; i < 3; ++i) raw.send(home);
+  const auto accepted = raw.answer(kTop);
+  ASSERT_TRUE(accepted);
+  EXPECT_EQ(accepted->type, MessageType::Accepted);
+  ASSERT_TRUE(waitUntil([&] { return backend.stats().duplicates >= 2; }));
+  for (int i = 0; i < 3; ++i) raw.send(home);
+  ASSERT_TRUE(waitUntil([&] { return backend.stats().duplicates >= 5; }));
+  EXPECT_EQ(backend.stats().executed, 1u);
+  // A whole window below the highest: refused as a replay; just inside it: a new command.
+  raw.send(raw.message(MessageType::Status, kTop - 1024));
+  const auto old = raw.answer(kTop - 1024);
+  ASSERT_TRUE(old);
+  EXPECT_EQ(old->type, MessageType::Rejected);
+  EXPECT_EQ(old->reason, RejectReason::Replayed);
+  raw.send(raw.message(MessageType::Status, kTop - 1023));
+  const auto inside = raw.answer(kTop - 1023, 2s);
+  EXPECT_FALSE(inside && inside->type == MessageType::Rejected);
+}
+
+TEST(RobotLink, RepliesGoOnlyToTheAddressBoundAtTheHello) {
+  RunningBackend backend(20.0);
+  RawSession raw(backend.port());
+  ASSERT_TRUE(raw.hello(100));
+  UdpSocket other;
+  // An authenticated STATUS from another address is answered at the bound address.
+  raw.send(raw.message(MessageType::Status, 101), other);
+  const auto answer = raw.answer(101);
+  ASSERT_TRUE(answer);
+  EXPECT_EQ(answer->type, MessageType::StatusReply);
+  EXPECT_FALSE(raw.receive(200ms, other));
+  // A replayed HELLO from the other address does not move the binding.
+  raw.send(raw.message(MessageType::Hello, 100), other);
+  raw.send(raw.message(MessageType::Status, 102), other);
+  EXPECT_FALSE(raw.receive(300ms, other));
+  const auto still = raw.answer(102);
+  ASSERT_TRUE(still);
+  EXPECT_EQ(still->type, MessageType::StatusReply);
+}
+
+// The flood the issue measured (250 junk datagrams of the largest size, then one STATUS, sent
+// once) and larger ones, to report where the receive buffer gives out.
+TEST(RobotLink, AStatusSentOnceAfterABurstOf250JunkDatagramsIsAnswered) {
+  RunningBackend backend(20.0);
+  RawSession raw(backend.port());
+  ASSERT_TRUE(raw.hello(1));
+  std::cout << "receive buffer granted: " << backend.backend().receiveBufferBytes() / 1024
+            << " KiB\n";
+  UdpSocket junk;
+  const std::vector<std::uint8_t> bytes(kMaxDatagram, 0x5a);
+  std::uint64_t sequence = 10;
+  for (const int burst : {250, 1000, 4000}) {
+    for (int i = 0; i < burst; ++i) junk.sendTo(bytes, local(backend.port()));
+    raw.send(raw.message(MessageType::Status, ++sequence));
+    const auto reply = raw.answer(sequence, 2s);
+    const bool answered = reply && reply->type == MessageType::StatusReply;
+    std::cout << "burst of " << burst << " junk datagrams: the STATUS after it was "
+              << (answered ? "answered" : "lost") << "\n";
+    if (burst == 250) {
+      EXPECT_TRUE(answered);
+    }
+    std::this_thread::sleep_for(200ms);  // drained before the next burst
+  }
+}
+
+}  // namespace
+}  // namespace arbci::robot

@@ -1,0 +1,98 @@
+#include "support/udp_relay.h"
+
+namespace arbci::test {
+
+UdpRelay::UdpRelay(int backend_port, const robot::Key& key, unsigned seed)
+    : backend_(robot::Endpoint::resolve("127.0.0.1", backend_port)), key_(key), random_(seed) {
+  thread_ = std::thread([this] { run(); });
+}
+
+UdpRelay::~UdpRelay() {
+  stop_ = true;
+  thread_.join();
+}
+
+void UdpRelay::setLoss(double to_backend, double to_client) {
+  std::lock_guard lock(mutex_);
+  loss_to_backend_ = to_backend;
+  loss_to_client_ = to_client;
+}
+
+void UdpRelay::setCut(bool cut) {
+  std::lock_guard lock(mutex_);
+  cut_ = cut;
+}
+
+void UdpRelay::hold(robot::MessageType command) {
+  std::lock_guard lock(mutex_);
+  holding_.insert(command);
+}
+
+void UdpRelay::release(std::uint64_t sequence) {
+  std::lock_guard lock(mutex_);
+  for (const auto& [held_sequence, bytes] : held_) {
+    if (held_sequence == sequence) back_.sendTo(bytes, backend_);
+  }
+  std::erase_if(held_, [&](const auto& held) { return held.first == sequence; });
+}
+
+void UdpRelay::stopHolding() {
+  std::lock_guard lock(mutex_);
+  holding_.clear();
+}
+
+void UdpRelay::dropReplies(std::set<robot::MessageType> types) {
+  std::lock_guard lock(mutex_);
+  dropping_ = std::move(types);
+}
+
+std::vector<UdpRelay::Bytes> UdpRelay::captured(robot::MessageType command) const {
+  std::lock_guard lock(mutex_);
+  std::vector<Bytes> out;
+  for (const auto& [type, bytes] : captured_) {
+    if (type == command) out.push_back(bytes);
+  }
+  return out;
+}
+
+std::vector<robot::Message> UdpRelay::replies() const {
+  std::lock_guard lock(mutex_);
+  return replies_;
+}
+
+bool UdpRelay::lose(double probability) {
+  return probability > 0.0 &&
+         std::uniform_real_distribution<double>(0.0, 1.0)(random_) < probability;
+}
+
+void UdpRelay::run() {
+  std::optional<robot::Endpoint> client;
+  while (!stop_) {
+    front_.wait(1);
+    std::lock_guard lock(mutex_);
+    while (auto d = front_.receive()) {
+      client = d->from;
+      const robot::Decoded decoded = robot::decode(d->bytes.data(), d->bytes.size(), key_);
+      if (decoded.ok()) captured_.emplace_back(decoded.message.type, d->bytes);
+      if (cut_ || lose(loss_to_backend_)) {
+        ++dropped_;
+      } else if (decoded.ok() && holding_.count(decoded.message.type)) {
+        held_.emplace_back(decoded.message.sequence, d->bytes);
+      } else {
+        back_.sendTo(d->bytes, backend_);
+      }
+    }
+    while (auto d = back_.receive()) {
+      const robot::Decoded decoded = robot::decode(d->bytes.data(), d->bytes.size(), key_);
+      if (decoded.ok()) replies_.push_back(decoded.message);
+      if (!client || cut_ || lose(loss_to_client_) ||
+          (decoded.ok() && dropping_.count(decoded.message.type))) {
+        ++dropped_;
+      } else {
+        front_.sendTo(d->bytes, *client);
+      }
+    }
+  }
+}
+
+}  // namespace arbci::test

@@ -1,0 +1,67 @@
+// A relay between one robot client and a backend on 127.0.0.1, on its own thread, that can do to
+// the link what a bad network or an attacker does: lose datagrams each way, cut the link, hold
+// commands back and deliver them late, drop chosen replies, and keep copies of what it forwarded
+// (to replay them). It decodes with the shared key only to choose; it never forges.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <random>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "arbci/robot/protocol.h"
+#include "arbci/robot/udp_socket.h"
+
+namespace arbci::test {
+
+class UdpRelay {
+ public:
+  using Bytes = std::vector<std::uint8_t>;
+  UdpRelay(int backend_port, const robot::Key& key, unsigned seed = 1234);
+  ~UdpRelay();
+  UdpRelay(const UdpRelay&) = delete;
+  UdpRelay& operator=(const UdpRelay&) = delete;
+
+  int port() const { return front_.port(); }
+  void setLoss(double to_backend, double to_client);
+  // Everything, both ways, is dropped while cut.
+  void setCut(bool cut);
+  // Commands of this type from the client are held back from now on until release().
+  void hold(robot::MessageType command);
+  // Sends the held copies of command `sequence` to the backend (in arrival order).
+  void release(std::uint64_t sequence);
+  void stopHolding();
+  // Replies of these types from the backend are dropped.
+  void dropReplies(std::set<robot::MessageType> types);
+  // Copies of the client's datagrams of this type that reached the relay (held ones included).
+  std::vector<Bytes> captured(robot::MessageType command) const;
+  // The backend's replies that reached the relay (dropped ones included).
+  std::vector<robot::Message> replies() const;
+  std::uint64_t dropped() const { return dropped_; }
+
+ private:
+  void run();
+  bool lose(double probability);
+
+  robot::UdpSocket front_, back_;
+  robot::Endpoint backend_;
+  robot::Key key_;
+  std::mt19937 random_;
+  mutable std::mutex mutex_;
+  double loss_to_backend_ = 0.0, loss_to_client_ = 0.0;
+  bool cut_ = false;
+  std::set<robot::MessageType> holding_, dropping_;
+  std::vector<std::pair<std::uint64_t, Bytes>> held_;  // by command sequence
+  std::vector<std::pair<robot::MessageType, Bytes>> captured_;
+  std::vector<robot::Message> replies_;
+  std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace arbci::test
