@@ -299,7 +299,21 @@ void Session::abort() {
 }
 void Session::emergencyStop() {
   client_->send(robot::MessageType::Stop);
+  impl_->robot_command.reset();  // the client cancelled it; the backend refuses it
+  impl_->log->write("robot_command", time_, {{"command", "STOP"}, {"by", "experimenter"}});
   paradigm_->emergencyStop();
+}
+
+void Session::resetRobot() {
+  const auto sequence = client_->send(robot::MessageType::Reset);
+  impl_->log->write("robot_command", time_,
+                    {{"command", "RESET"}, {"by", "experimenter"}, {"sequence", sequence}});
+}
+
+void Session::homeRobot() {
+  const auto sequence = client_->send(robot::MessageType::Home);
+  impl_->log->write("robot_command", time_,
+                    {{"command", "HOME"}, {"by", "experimenter"}, {"sequence", sequence}});
 }
 
 TrialRecord& Session::currentTrial() {

@@ -72,6 +72,10 @@ class Session {
   void resume();
   void abort();
   void emergencyStop();
+  // The experimenter's recovery after a latched stop: RESET lifts it, HOME parks the arm. Neither
+  // is part of a trial: the paradigm goes on only with Resume.
+  void resetRobot();
+  void homeRobot();
 
   // For the panels and the windowed app.
   const SessionConfig& config() const { return config_; }

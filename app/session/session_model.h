@@ -36,6 +36,8 @@ class SessionModel final : public ui::WorkstationModel {
   bool robotSilent() override { return session_.robotSilent(); }
   std::vector<std::string> robotLog() override { return session_.robotLog(); }
   void emergencyStop() override { session_.emergencyStop(); }
+  void robotReset() override { session_.resetRobot(); }
+  void robotHome() override { session_.homeRobot(); }
 
   std::string phase() override;
   int trial() override { return session_.paradigm().trial(); }

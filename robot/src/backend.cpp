@@ -400,13 +400,12 @@ int RobotBackend::receiveBufferBytes() const {
 void RobotBackend::poll(int wait_ms) {
   Impl& m = *impl_;
   // Never sleep past the watchdog's deadline: the halt comes on time, not a poll later.
+  auto wait = std::chrono::microseconds(wait_ms * 1000LL);
   if (const auto deadline = m.watchdogDeadline()) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(*deadline - SteadyClock::now())
-            .count();
-    wait_ms = static_cast<int>(std::clamp<long long>(left + 1, 0, wait_ms));
+    wait = std::clamp(std::chrono::ceil<std::chrono::microseconds>(*deadline - SteadyClock::now()),
+                      std::chrono::microseconds(0), wait);
   }
-  m.socket.wait(wait_ms);
+  m.socket.wait(wait);
   for (int i = 0; i < 256; ++i) {  // bounded, so a flood cannot starve the arm
     auto datagram = m.socket.receive();
     if (!datagram) break;

@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -98,6 +99,13 @@ std::optional<Datagram> UdpSocket::receive() {
 bool UdpSocket::wait(int milliseconds) {
   pollfd p{fd_, POLLIN, 0};
   return ::poll(&p, 1, milliseconds) > 0;
+}
+
+bool UdpSocket::wait(std::chrono::microseconds timeout) {
+  pollfd p{fd_, POLLIN, 0};
+  const long long us = std::max<long long>(0, timeout.count());
+  const timespec t{static_cast<time_t>(us / 1000000), static_cast<long>(us % 1000000) * 1000};
+  return ::ppoll(&p, 1, &t, nullptr) > 0;
 }
 
 }  // namespace arbci::robot

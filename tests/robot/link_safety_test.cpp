@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "robot/robot_test_support.h"
+#include "support/halt_recording_arm.h"
 #include "support/udp_relay.h"
 
 namespace arbci::robot {
@@ -117,26 +118,6 @@ class RawSession {
   static constexpr std::uint64_t kSession = 4242;
   Endpoint backend_;
   std::uint64_t boot_ = 0;
-};
-
-// The simulated arm, noting when it was halted.
-class HaltRecordingArm : public RobotDriver {
- public:
-  explicit HaltRecordingArm(std::shared_ptr<std::atomic<Clock::rep>> halted_at)
-      : arm_(twoObjects()), halted_at_(std::move(halted_at)) {}
-  std::optional<Rejection> check(const DriverCommand& c) const override { return arm_.check(c); }
-  void start(const DriverCommand& c) override { arm_.start(c); }
-  void stop() override {
-    if (*halted_at_ == 0) *halted_at_ = Clock::now().time_since_epoch().count();
-    arm_.stop();
-  }
-  std::optional<DriverResult> step(double seconds) override { return arm_.step(seconds); }
-  DriverStatus status() const override { return arm_.status(); }
-  std::vector<WorldObject> world() const override { return arm_.world(); }
-
- private:
-  SimulatedArm arm_;
-  std::shared_ptr<std::atomic<Clock::rep>> halted_at_;
 };
 
 TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
@@ -248,7 +229,8 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWithin150msOfTheLinkBeingCut) {
   options.status_interval_s = 0.05;
   options.speed_factor = 1.0;                 // real time: the grasp takes seconds
   ASSERT_DOUBLE_EQ(options.watchdog_s, 0.1);  // the default
-  RunningBackend backend(std::make_unique<HaltRecordingArm>(halted_at), options);
+  RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
+                         options);
   test::UdpRelay relay(backend.port(), testKey());
   RobotClient client(local(relay.port()), testKey(), fastClient());
   const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);

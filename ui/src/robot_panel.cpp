@@ -22,7 +22,22 @@ void RobotPanel::draw() {
   } else {
     ImGui::TextColored(ImVec4(0.4f, 1, 0.4f, 1), "connected");
   }
+  if (status && !status->stop_reason.empty()) {
+    ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "STOPPED: %s", status->stop_reason.c_str());
+    ImGui::TextWrapped(
+        "The arm refuses every motion until Reset. Check the arm and the scene, "
+        "then Reset, Home, and Resume the session.");
+  }
   if (status) {
+    const bool latched = !status->stop_reason.empty();
+    const bool running = status->current_command != robot::MessageType::Status;
+    ImGui::BeginDisabled(!latched);
+    if (ImGui::Button("Reset")) model_.robotReset();
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    ImGui::BeginDisabled(latched || running);
+    if (ImGui::Button("Home")) model_.robotHome();
+    ImGui::EndDisabled();
     ImGui::Text("state: %s", robot::toString(status->state));
     if (status->current_command != robot::MessageType::Status) {
       ImGui::Text("command: %s #%llu", robot::toString(status->current_command),

@@ -20,6 +20,11 @@ void SessionPanel::draw() {
   }
   ImGui::SameLine();
   emergencyStopButton(model_);
+  if (const auto robot = model_.robotStatus(); robot && !robot->stop_reason.empty()) {
+    ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1),
+                       "robot fault: %s. Robot panel: Reset, then Home; then Resume.",
+                       robot->stop_reason.c_str());
+  }
   const auto timing = model_.timing();
   heading("cycle");
   ImGui::Text("budget %.1f ms (one EEG block); overruns: %d; late frames: %lld", model_.budgetMs(),

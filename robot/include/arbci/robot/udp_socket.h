@@ -3,6 +3,7 @@
 
 #include <netinet/in.h>
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -46,6 +47,7 @@ class UdpSocket {
   std::optional<Datagram> receive();
   // Waits up to `milliseconds` for a datagram to arrive.
   bool wait(int milliseconds);
+  bool wait(std::chrono::microseconds timeout);  // finer, for deadlines
 
  private:
   int fd_ = -1;

@@ -59,6 +59,9 @@ class WorkstationModel {
   virtual bool robotSilent() = 0;
   virtual std::vector<std::string> robotLog() = 0;
   virtual void emergencyStop() = 0;
+  // After a latched stop (STOP or the watchdog): lift it, then send the arm home.
+  virtual void robotReset() = 0;
+  virtual void robotHome() = 0;
 
   // Session.
   virtual std::string phase() = 0;
