@@ -568,8 +568,11 @@ void Session::handleRobotEvents() {
     if (e.kind == robot::RobotEvent::Kind::Rejected) fields["reason"] = robot::toString(e.reason);
     if (e.kind == robot::RobotEvent::Kind::Finished) fields["outcome"] = robot::toString(e.outcome);
     m.log->write("robot", time_, fields);
-    robot_log_.push_back(std::string(robot::toString(e.kind)) + " " + robot::toString(e.command) +
-                         (e.text.empty() ? "" : ": " + e.text));
+    // Link events (connected, silent, restarted) belong to no command.
+    const std::string what =
+        e.sequence == 0 ? std::string(robot::toString(e.kind))
+                        : std::string(robot::toString(e.kind)) + " " + robot::toString(e.command);
+    robot_log_.push_back(what + (e.text.empty() ? "" : ": " + e.text));
     if (robot_log_.size() > 200) robot_log_.erase(robot_log_.begin());
     if (!m.robot_command) continue;
     const bool ours = e.sequence == *m.robot_command;
