@@ -74,24 +74,24 @@ void RobotClient::heartbeatLoop() {
   std::unique_lock lock(heartbeat_mutex_);
   while (!heartbeat_wake_.wait_for(lock, period, [this] { return stopping_; })) {
     if (!connected_) continue;
-    Message m;
-    m.type = MessageType::Heartbeat;
-    m.session = session_;
-    m.sequence = next_sequence_++;
-    m.timestamp_ms = wallClockMs();
-    m.boot = boot_;
+    Message m = fresh(MessageType::Heartbeat, next_sequence_++);
     m.abandon_below = abandon_below_;
     socket_.sendTo(encode(m, key_), backend_);
   }
 }
 
-void RobotClient::sendHello() {
+Message RobotClient::fresh(MessageType type, std::uint64_t sequence) const {
   Message m;
-  m.type = MessageType::Hello;
+  m.type = type;
   m.session = session_;
-  m.sequence = next_sequence_++;
+  m.sequence = sequence;
   m.timestamp_ms = wallClockMs();
-  socket_.sendTo(encode(m, key_), backend_);
+  m.boot = type == MessageType::Hello ? 0 : boot_.load();  // HELLO asks for the boot id
+  return m;
+}
+
+void RobotClient::sendHello() {
+  socket_.sendTo(encode(fresh(MessageType::Hello, next_sequence_++), key_), backend_);
   next_hello_ = Clock::now() + seconds(hello_interval_);
   hello_interval_ = std::min(hello_interval_ * 2.0, options_.max_retransmit_s);
 }
@@ -121,12 +121,7 @@ std::uint64_t RobotClient::send(MessageType type, const Vec3& target) {
 }
 
 void RobotClient::transmit(Pending& p) {
-  Message m;
-  m.type = p.type;
-  m.session = session_;
-  m.sequence = p.sequence;
-  m.timestamp_ms = wallClockMs();
-  m.boot = boot_;
+  Message m = fresh(p.type, p.sequence);
   m.target = p.target;
   socket_.sendTo(encode(m, key_), backend_);
   p.next_send = Clock::now() + seconds(p.interval);
@@ -294,13 +289,7 @@ void RobotClient::poll() {
   }
   if (connected_ && now >= next_status_) {
     next_status_ = now + seconds(options_.status_interval_s);
-    Message m;
-    m.type = MessageType::Status;
-    m.session = session_;
-    m.sequence = next_sequence_++;
-    m.timestamp_ms = wallClockMs();
-    m.boot = boot_;
-    socket_.sendTo(encode(m, key_), backend_);
+    socket_.sendTo(encode(fresh(MessageType::Status, next_sequence_++), key_), backend_);
   }
   const auto quiet_since = heard_ ? last_heard_ : created_;
   if (!silent_ && now - quiet_since > seconds(options_.silence_s)) {
@@ -311,19 +300,15 @@ void RobotClient::poll() {
 }
 
 bool RobotClient::syncClock(double clock_s, double timeout_s) {
-  Message m;
-  m.type = MessageType::Status;
-  m.session = session_;
-  m.clock_s = clock_s;
   sync_sequence_ = 0;  // assigned at the first send; resends reuse it (answered from the cache)
   synced_ = false;
   const auto give_up = Clock::now() + seconds(timeout_s);
   auto resend = Clock::now();
   while (!synced_ && Clock::now() < give_up) {
     if (connected_ && Clock::now() >= resend) {
-      if (sync_sequence_ == 0) m.sequence = sync_sequence_ = next_sequence_++;
-      m.timestamp_ms = wallClockMs();
-      m.boot = boot_;
+      if (sync_sequence_ == 0) sync_sequence_ = next_sequence_++;
+      Message m = fresh(MessageType::Status, sync_sequence_);
+      m.clock_s = clock_s;
       socket_.sendTo(encode(m, key_), backend_);
       resend = Clock::now() + seconds(0.05);
     }

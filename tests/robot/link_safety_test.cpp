@@ -183,6 +183,27 @@ TEST(RobotLink, LostAcceptancesAndARestartRunTheCommandAtMostOnce) {
   EXPECT_TRUE(client.connected());         // bound to the new run
 }
 
+// With every ACCEPTED lost, the status's running command tells the client its command runs: it
+// stops retransmitting, and the command finishes once.
+TEST(RobotLink, AcceptanceIsReadFromTheStatusWhenEveryAcceptedIsLost) {
+  RunningBackend backend(5.0);
+  test::UdpRelay relay(backend.port(), testKey());
+  relay.dropReplies({MessageType::Accepted});
+  RobotClient client(local(relay.port()), testKey(), fastClient());
+  const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);
+  ASSERT_TRUE(waitUntilAccepted(client, grasp));
+  EXPECT_TRUE(client.accepted(grasp));
+  EXPECT_TRUE(client.busy());  // known accepted while it runs, not only when it finished
+  const std::uint64_t copies = backend.stats().duplicates;
+  pollFor(client, 300ms);
+  EXPECT_EQ(backend.stats().duplicates, copies);  // no more retransmissions
+  const auto events = waitFor(client, grasp, 10s);
+  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success);
+  EXPECT_EQ(backend.stats().executed, 1u);
+  for (const Message& m : relay.replies()) EXPECT_NE(m.type, MessageType::Rejected);
+}
+
 TEST(RobotLink, AStopStaysInForceUntilAResetAndEarlierCommandsNeverRun) {
   RunningBackend backend(20.0);
   test::UdpRelay relay(backend.port(), testKey());

@@ -90,6 +90,8 @@ class RobotClient {
     std::chrono::steady_clock::time_point first_sent, next_send;
     double interval = 0.05;
   };
+  // A message of this session with a fresh timestamp and the bound run's boot id.
+  Message fresh(MessageType type, std::uint64_t sequence) const;
   void transmit(Pending& p);
   void sendHello();
   void handle(const Message& m);
