@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -33,6 +34,36 @@ std::vector<std::vector<std::string>> bci2000Matrix(const Recording& r, const st
     }
   }
   return matrix;
+}
+
+// A session's photodiode channel (named by its PhotodiodeChannel parameter) is recorded for the
+// timing check and never classified: the recording without it, or nothing when it has none.
+std::optional<Recording> withoutPhotodiode(const Recording& r) {
+  const auto named = r.parameters.find("PhotodiodeChannel");
+  if (named == r.parameters.end() || named->second.empty()) return std::nullopt;
+  const auto& channels = r.info.channels;
+  const auto found = std::find(channels.begin(), channels.end(), named->second);
+  if (found == channels.end()) return std::nullopt;
+  const auto drop = static_cast<size_t>(found - channels.begin());
+  Recording eeg;
+  eeg.source = r.source;
+  eeg.format = r.format;
+  eeg.info = r.info;
+  eeg.info.channels.erase(eeg.info.channels.begin() + static_cast<std::ptrdiff_t>(drop));
+  eeg.samples = r.samples;
+  eeg.data.reserve(r.data.size() - static_cast<size_t>(r.samples));
+  for (size_t c = 0; c < channels.size(); ++c) {
+    if (c == drop) continue;
+    const auto begin = r.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples);
+    eeg.data.insert(eeg.data.end(), begin, begin + r.samples);
+  }
+  eeg.stimuli = r.stimuli;
+  eeg.annotations = r.annotations;
+  eeg.parameters = r.parameters;
+  eeg.states = r.states;
+  eeg.truncated = r.truncated;
+  eeg.truncation_note = r.truncation_note;
+  return eeg;
 }
 
 double medianGap(const std::vector<StimulusEvent>& stimuli, double rate) {
@@ -72,12 +103,25 @@ ParadigmLayout layoutOf(const Recording& r) {
   return ParadigmLayout::single(std::max(highest, 2), soa);
 }
 
-P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings,
+P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSettings& settings,
                          const Progress& progress) {
-  if (recordings.empty()) throw std::invalid_argument("no recordings given");
+  if (given.empty()) throw std::invalid_argument("no recordings given");
+  std::vector<Recording> eeg_only;  // copies, only of recordings that carry a photodiode
+  std::vector<const Recording*> chosen;
+  eeg_only.reserve(given.size());
+  for (const Recording& r : given) {
+    if (auto stripped = withoutPhotodiode(r)) {
+      eeg_only.push_back(std::move(*stripped));
+      chosen.push_back(&eeg_only.back());
+    } else {
+      chosen.push_back(&r);
+    }
+  }
+  auto recording = [&](size_t f) -> const Recording& { return *chosen[f]; };
+  const size_t count = given.size();
   P300Dataset data;
-  data.info = recordings.front().info;
-  data.layout = layoutOf(recordings.front());
+  data.info = recording(0).info;
+  data.layout = layoutOf(recording(0));
   const FeatureExtractor extractor(settings, data.info);
   data.shape = extractor.shape();
   for (int c : extractor.channelIndices())
@@ -90,10 +134,10 @@ P300Dataset buildDataset(const std::vector<Recording>& recordings, const Pipelin
   data.erp_other = Eigen::MatrixXd::Zero(data.info.channelCount(), length);
   data.erp_start_s = settings.window.start_s;
   int n_target = 0, n_other = 0;
-  for (size_t f = 0; f < recordings.size(); ++f) {
-    const Recording& r = recordings[f];
+  for (size_t f = 0; f < count; ++f) {
+    const Recording& r = recording(f);
     if (progress)
-      progress(static_cast<double>(f) / recordings.size(), "filtering and epoching " + r.source);
+      progress(static_cast<double>(f) / count, "filtering and epoching " + r.source);
     if (r.stimuli.empty())
       throw std::invalid_argument(r.source + ": no stimulus events (StimulusCode) to classify");
     if (r.info.rate_hz != data.info.rate_hz) {

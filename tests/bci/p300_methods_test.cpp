@@ -228,6 +228,31 @@ TEST(P300Model, JsonRoundTripScoresTheSameAndKeepsItsProvenance) {
   EXPECT_DOUBLE_EQ(loaded.score_model.sd, trained.model.score_model.sd);
 }
 
+// A session records its photodiode (flash-locked, 1000 uV while lit) for the timing check;
+// training on that recording must use the EEG alone, exactly as if the channel were not there.
+TEST(P300Dataset, ASessionsPhotodiodeChannelIsNeverClassified) {
+  const Recording eeg = simulatedCopyTask(6, 6);
+  Recording with_diode = eeg;
+  with_diode.info.channels.push_back("Photodiode");
+  with_diode.parameters["PhotodiodeChannel"] = "Photodiode";
+  std::vector<float> diode(static_cast<size_t>(eeg.samples), 0.0f);
+  for (const StimulusEvent& e : eeg.stimuli) {
+    for (std::int64_t s = e.sample; s < std::min<std::int64_t>(e.sample + e.duration_samples, eeg.samples); ++s)
+      diode[static_cast<size_t>(s)] = 1000.0f;
+  }
+  with_diode.data.insert(with_diode.data.end(), diode.begin(), diode.end());
+  const P300Dataset plain = buildDataset({eeg}, PipelineSettings{});
+  const P300Dataset session = buildDataset({with_diode}, PipelineSettings{});
+  EXPECT_EQ(session.info.channels, eeg.info.channels);
+  EXPECT_EQ(session.feature_channels, plain.feature_channels);
+  EXPECT_EQ(std::count(session.feature_channels.begin(), session.feature_channels.end(),
+                       "Photodiode"),
+            0);
+  ASSERT_EQ(session.features.rows(), plain.features.rows());
+  ASSERT_EQ(session.features.cols(), plain.features.cols());
+  EXPECT_EQ((session.features - plain.features).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(P300Model, RefusesTheWrongSignalAndBrokenFiles) {
   const P300Dataset data = buildDataset({simulatedCopyTask(6, 6)}, PipelineSettings{});
   TrainingSettings settings;
