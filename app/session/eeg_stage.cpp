@@ -1,5 +1,8 @@
 #include "session/eeg_stage.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <thread>
@@ -212,6 +215,9 @@ void EegStage::startTraining(const std::string& method) {
   const bci::PipelineSettings pipeline = config_.pipeline;
   training_ =
       std::async(std::launch::async, [recording = std::move(recording), pipeline, method]() {
+        // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
+        // frames come first and the training takes what is left.
+        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
         bci::TrainingSettings settings;
         settings.method = method;
         settings.folds = 4;

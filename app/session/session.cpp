@@ -51,6 +51,8 @@ struct Session::Impl {
   bool stepped_robot = false;
   std::int64_t lost_logged = 0;               // lost EEG samples already in the log
   double longest_frame_while_training = 0.0;  // seconds between presentations
+  int frames_while_training = 0;
+  double training_since = 0.0;  // session seconds
   std::unique_ptr<SessionLog> log;
   int camera_every = 2;  // display frames per camera frame
   std::vector<TrialIntent> intended;
@@ -464,11 +466,15 @@ void Session::collectTraining() {
     if (!outcome) return;
     calibration_report_ = outcome->report;
     eeg_->model()->save(folder_ / "model.json");
-    impl_->log->write("trained", time_,
-                      {{"method", config_.classifier_method},
-                       {"longest_frame_ms", 1000.0 * impl_->longest_frame_while_training},
-                       {"auc", calibration_report_->auc},
-                       {"accuracy_by_sequences", calibration_report_->accuracy}});
+    impl_->log->write(
+        "trained", time_,
+        {{"method", config_.classifier_method},
+         {"training_s", time_ - impl_->training_since},
+         {"frames_while_training", impl_->frames_while_training},
+         {"longest_frame_ms", 1000.0 * impl_->longest_frame_while_training},
+         {"median_frame_ms", impl_->stimulus_timing->medianFrameIntervalMs().value_or(0.0)},
+         {"auc", calibration_report_->auc},
+         {"accuracy_by_sequences", calibration_report_->accuracy}});
     chooseSelectableObjects();
     impl_->last_trial_end = time_;  // the first trial's time counts from here
     paradigm_->modelTrained(true, "");
@@ -508,9 +514,11 @@ void Session::presented(double host_s) {
                   {"late_ms", 1000.0 * (at - m.due)},
                   {"stages", timing_.lastCycle()}});
   }
-  if (m.last_presented && eeg_->training())
+  if (m.last_presented && eeg_->training()) {
     m.longest_frame_while_training =
         std::max(m.longest_frame_while_training, at - *m.last_presented);
+    ++m.frames_while_training;
+  }
   m.last_presented = at;
   // Checked once a second or so (it takes a median of the last frame intervals).
   if (!m.warned_slow_display && m.stimulus_timing->framesPresented() % 60 == 0 &&
@@ -817,6 +825,7 @@ void Session::handleParadigmEvents() {
       case Kind::TrainModel:
         // On a worker thread: the cycle (and the window) goes on; collectTraining() takes it.
         eeg_->startTraining(config_.classifier_method);
+        m.training_since = time_;
         m.log->write("training_started", time_, {{"method", config_.classifier_method}});
         break;
       case Kind::RobotGrasp: {

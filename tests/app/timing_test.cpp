@@ -80,8 +80,9 @@ TEST(WindowedSession, SummaryTimingAgreesWithTheRecordedOnsets) {
   const auto session = folder.string() + ".json";
   std::ofstream(session) << R"({
     "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
-    "paradigm": {"calibration_selections": 3, "calibration_sequences": 5, "sequences": 5,
+    "paradigm": {"calibration_selections": 6, "calibration_sequences": 5, "sequences": 5,
                  "min_sequences": 5, "certainty": 0.0, "trials": 1, "cue_s": 1.0, "pause_s": 0.5},
+    "classifier": {"method": "swlda", "decimate_hz": 64, "window_ms": [0, 1000]},
     "robot": {"speed_factor": 20}})";
   const ProcessResult r = runProcess(
       kXvfbRun,
@@ -121,6 +122,23 @@ TEST(WindowedSession, SummaryTimingAgreesWithTheRecordedOnsets) {
       (last - first) / 256.0 + timing["soa_ms"]["median"].get<double>() / 1000.0;
   EXPECT_NEAR(summary["objects"]["seconds_per_selection"].get<double>(), from_onsets, 0.01)
       << summary["objects"].dump();
+  // Training (SWLDA over 512 features, cross-validated, on 120 calibration epochs: a heavy one,
+  // so it spans frames) ran on a worker thread while the
+  // window went on presenting frames: none of them took two frame periods (the configured 60 Hz,
+  // or the period this display achieves when it is slower).
+  std::optional<nlohmann::json> trained_event;
+  std::ifstream log(folder / "log.jsonl");
+  for (std::string line; std::getline(log, line);) {
+    const nlohmann::json event = nlohmann::json::parse(line);
+    if (event.value("event", "") == "trained") trained_event = event;
+  }
+  ASSERT_TRUE(trained_event);
+  std::cout << "training: " << trained_event->dump() << "\n";
+  EXPECT_GE((*trained_event)["frames_while_training"].get<int>(), 3) << trained_event->dump();
+  const double period_ms =
+      std::max(1000.0 / 60.0, (*trained_event)["median_frame_ms"].get<double>());
+  EXPECT_LT((*trained_event)["longest_frame_ms"].get<double>(), 2.0 * period_ms)
+      << trained_event->dump();
 }
 
 }  // namespace
