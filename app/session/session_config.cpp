@@ -12,11 +12,13 @@ namespace {
 
 using Json = nlohmann::json;
 
-// One object of the file with its dotted path, for messages.
+// One object of the file with its dotted path, for messages. Reading the embedded defaults, every
+// key must be there: the embedded file is the one place a default lives (a value in code would
+// be a second one that could disagree).
 class Section {
  public:
-  Section(const Json& json, std::string path, std::string file)
-      : json_(json), path_(std::move(path)), file_(std::move(file)) {
+  Section(const Json& json, std::string path, std::string file, bool defaults = false)
+      : json_(json), path_(std::move(path)), file_(std::move(file)), defaults_(defaults) {
     if (!json_.is_object()) fail("", "must be an object");
   }
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
@@ -29,7 +31,13 @@ class Section {
   const Json& at(const std::string& key) const { return json_.at(key); }
   Section section(const std::string& key) const {
     static const Json empty = Json::object();
-    return Section(has(key) ? json_.at(key) : empty, name(key), file_);
+    if (!has(key)) missing(key);
+    return Section(has(key) ? json_.at(key) : empty, name(key), file_, defaults_);
+  }
+  // A key the file leaves out keeps its value; the embedded defaults may leave none out.
+  void missing(const std::string& key) const {
+    if (defaults_)
+      fail(key, "has no default: the embedded session file must set every key (add it there)");
   }
   void known(std::initializer_list<const char*> keys) const {
     std::set<std::string> allowed(keys.begin(), keys.end());
@@ -42,7 +50,10 @@ class Section {
     }
   }
   double number(const std::string& key, double fallback, double low, double high) const {
-    if (!has(key)) return fallback;
+    if (!has(key)) {
+      missing(key);
+      return fallback;
+    }
     if (!at(key).is_number()) fail(key, "= " + at(key).dump() + " must be a number");
     const double v = at(key).get<double>();
     if (!(v >= low && v <= high))
@@ -50,7 +61,10 @@ class Section {
     return v;
   }
   int integer(const std::string& key, int fallback, int low, int high) const {
-    if (!has(key)) return fallback;
+    if (!has(key)) {
+      missing(key);
+      return fallback;
+    }
     if (!at(key).is_number_integer()) fail(key, "= " + at(key).dump() + " must be an integer");
     const int v = at(key).get<int>();
     if (v < low || v > high)
@@ -59,13 +73,19 @@ class Section {
     return v;
   }
   bool boolean(const std::string& key, bool fallback) const {
-    if (!has(key)) return fallback;
+    if (!has(key)) {
+      missing(key);
+      return fallback;
+    }
     if (!at(key).is_boolean()) fail(key, "= " + at(key).dump() + " must be true or false");
     return at(key).get<bool>();
   }
   std::string text(const std::string& key, const std::string& fallback,
                    std::initializer_list<const char*> allowed = {}) const {
-    if (!has(key)) return fallback;
+    if (!has(key)) {
+      missing(key);
+      return fallback;
+    }
     if (!at(key).is_string()) fail(key, "= " + at(key).dump() + " must be a string");
     const std::string v = at(key).get<std::string>();
     if (allowed.size() > 0) {
@@ -81,7 +101,10 @@ class Section {
   }
   std::vector<double> numbers(const std::string& key, const std::vector<double>& fallback,
                               size_t min_size, size_t max_size) const {
-    if (!has(key)) return fallback;
+    if (!has(key)) {
+      missing(key);
+      return fallback;
+    }
     const Json& j = at(key);
     if (!j.is_array() || j.size() < min_size || j.size() > max_size) {
       std::string count = std::to_string(min_size);
@@ -112,6 +135,7 @@ class Section {
   }
   const Json& json_;
   std::string path_, file_;
+  bool defaults_ = false;
 };
 
 void parseCameras(const Section& s, CameraSettings& c) {
@@ -192,8 +216,9 @@ void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
   w.grid.centre = g.vec3("centre", w.grid.centre);
 }
 
-void parse(const Json& json, const std::string& file, SessionConfig& c) {
-  const Section root(json, "", file);
+// `defaults`: this is the embedded session file, which must set every key.
+void parse(const Json& json, const std::string& file, SessionConfig& c, bool defaults) {
+  const Section root(json, "", file, defaults);
   root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "paradigm",
               "classifier", "robot"});
   c.display_hz = root.number("display_hz", c.display_hz, 10.0, 500.0);
@@ -304,10 +329,21 @@ void parse(const Json& json, const std::string& file, SessionConfig& c) {
 
 }  // namespace
 
-SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& path) {
+SessionConfig SessionConfig::defaults(const std::string& json_text, const std::string& name) {
   SessionConfig config;
-  const Json defaults = Json::parse(assets::embedded("sessions/simulated.json"));
-  parse(defaults, "embedded default session", config);
+  Json json;
+  try {
+    json = Json::parse(json_text);
+  } catch (const Json::exception& error) {
+    throw SessionConfigError(name + ": not JSON (" + std::string(error.what()) + ")");
+  }
+  parse(json, name, config, true);
+  return config;
+}
+
+SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& path) {
+  SessionConfig config = defaults(std::string(assets::embedded("sessions/simulated.json")),
+                                  "embedded default session");
   if (!path) return config;
   std::ifstream in(*path);
   if (!in) throw SessionConfigError(path->string() + ": cannot open the session file");
@@ -318,7 +354,7 @@ SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& pa
     throw SessionConfigError(path->string() + ": not JSON (" + std::string(error.what()) + ")");
   }
   config.source = path->string();
-  parse(json, path->string(), config);
+  parse(json, path->string(), config, false);
   return config;
 }
 

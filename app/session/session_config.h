@@ -111,6 +111,10 @@ struct SessionConfig {
 
   // The embedded default, or `path` over the defaults. Throws SessionConfigError.
   static SessionConfig load(const std::optional<std::filesystem::path>& path);
+  // The defaults from a session file's text that must set every key (the embedded one is
+  // assets/sessions/simulated.json): the one place a default lives. Throws SessionConfigError
+  // naming a key it lacks.
+  static SessionConfig defaults(const std::string& json_text, const std::string& name);
   // Checks that what the file names can be opened (files, devices); throws naming the key.
   void checkResources() const;
 };

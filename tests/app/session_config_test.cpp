@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "arbci/assets.h"
 #include "session/session_config.h"
 #include "support/test_files.h"
 
@@ -55,6 +56,31 @@ TEST(SessionConfig, TheEmbeddedFileSetsWhatTheParserWouldOtherwiseDefault) {
   EXPECT_EQ(c.pipeline.decimate_hz, 32.0);
   EXPECT_EQ(c.pipeline.window.start_s, 0.0);
   EXPECT_EQ(c.pipeline.window.end_s, 0.8);
+}
+
+// The embedded file is the one source of defaults: it must set every key the parser reads, so no
+// value in code is ever a session's default. Taking any key out of it is refused, naming the key.
+TEST(SessionConfig, TheEmbeddedDefaultsMustSetEveryKey) {
+  const std::string embedded(assets::embedded("sessions/simulated.json"));
+  EXPECT_NO_THROW(SessionConfig::defaults(embedded, "embedded"));
+  for (const auto& [setting, dotted] :
+       {std::pair{"\"cue_s\": 1.5,", "paradigm.cue_s"},
+        std::pair{"\"notch_hz\": 50, ", "classifier.notch_hz"},
+        std::pair{"\"speed_factor\": 8, ", "robot.speed_factor"},
+        std::pair{"\"photodiode_channel\": \"Photodiode\",", "eeg.photodiode_channel"},
+        std::pair{"\"blur_px\": 0.5,", "cameras.blur_px"}}) {
+    std::string lacking = embedded;
+    const size_t at = lacking.find(setting);
+    ASSERT_NE(at, std::string::npos) << setting;
+    lacking.erase(at, std::string(setting).size());
+    std::string message;
+    try {
+      SessionConfig::defaults(lacking, "embedded");
+    } catch (const SessionConfigError& error) {
+      message = error.what();
+    }
+    EXPECT_NE(message.find(std::string(dotted) + " has no default"), std::string::npos) << message;
+  }
 }
 
 TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
