@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_poses.h"
 #include "arbci/vision/marker_set.h"
 #include "arbci/vision/marker_tracker.h"
 #include "commands/commands.h"
@@ -50,7 +51,7 @@ struct Geometry {
   vision::PoseOptions pose;
   double marker_size_m = 0.05;
   std::optional<vision::MarkerSet> set;
-  std::map<int, vision::Pose> previous;  // by marker id, so poses do not flip between frames
+  std::optional<vision::MarkerPoses> poses;  // remembers each marker's last pose (no flips)
 };
 
 nlohmann::json poseJson(const vision::PoseEstimate& estimate) {
@@ -179,6 +180,7 @@ Geometry makeGeometry(const DetectOptions& options, cv::Size frame_size) {
     throw CliError(error.what());
   }
   geometry.marker_size_m = options.marker_size_mm / 1000.0;
+  geometry.poses.emplace(geometry.camera.camera_matrix, geometry.pose);
   return geometry;
 }
 
@@ -252,26 +254,19 @@ int runDetect(const DetectOptions& options) {
                         {"threshold", result.threshold},
                         {"threshold_mode", result.threshold_mode},
                         {"markers", nlohmann::json::array()}};
+    std::map<int, vision::PoseEstimate> poses;
+    if (geometry) {
+      poses = geometry->poses->estimate(markers, [&](int) { return geometry->marker_size_m; });
+    }
     for (const auto& m : markers) {
       nlohmann::json marker = markerJson(m);
       if (geometry) {
         nlohmann::json ideal = nlohmann::json::array();
-        std::vector<cv::Point2d> corners;
-        for (const cv::Point2f& p : m.ideal_corners) {
+        for (const cv::Point2f& p : m.ideal_corners)
           ideal.push_back({std::round(p.x * 1000.0) / 1000.0, std::round(p.y * 1000.0) / 1000.0});
-          corners.emplace_back(p.x, p.y);
-        }
         marker["ideal_corners"] = ideal;
-        vision::PoseOptions pose = geometry->pose;
-        if (const auto previous = geometry->previous.find(m.id);
-            previous != geometry->previous.end()) {
-          pose.previous = previous->second;
-        }
-        const vision::PoseEstimate estimate =
-            vision::estimatePose(vision::markerCorners(geometry->marker_size_m), corners,
-                                 geometry->camera.camera_matrix, pose);
-        geometry->previous[m.id] = estimate.pose;
-        marker["pose"] = poseJson(estimate);
+        if (const auto pose = poses.find(m.id); pose != poses.end())
+          marker["pose"] = poseJson(pose->second);
       }
       line["markers"].push_back(marker);
     }

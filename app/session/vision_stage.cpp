@@ -2,7 +2,6 @@
 
 #include <memory>
 
-#include "arbci/vision/pose.h"
 #include "arbci/vision/undistortion.h"
 
 namespace arbci::app {
@@ -36,6 +35,7 @@ VisionStage::VisionStage(const SessionConfig& config, const vision::CameraModel&
       right_camera_(right),
       T_right_left_(T_right_left),
       detector_(detectorFor(config, left)),
+      poses_(left.camera_matrix),
       world_(referenceOf(config)) {}
 
 void VisionStage::setReference(int id, double size_m, const cv::Vec3d& position) {
@@ -46,7 +46,7 @@ void VisionStage::setReference(int id, double size_m, const cv::Vec3d& position)
   reference_id_ = id;
   reference_size_m_ = size_m;
   world_ = vision::WorldModel(reference);
-  previous_.clear();
+  poses_.clear();
   last_poses_.clear();
 }
 
@@ -62,25 +62,8 @@ void VisionStage::process(double t, const cv::Mat& left, const cv::Mat& right) {
   left_image_ = left;
   if (!right.empty()) right_image_ = right;
   last_ = detector_.detect(left);
-  std::map<int, vision::PoseEstimate> poses;
-  for (const vision::MarkerDetection& m : last_.markers) {
-    const double side = markerSize(m.id);
-    if (side <= 0.0) continue;  // a marker this session does not know
-    std::vector<cv::Point2d> image;
-    for (const auto& p : m.ideal_corners) image.emplace_back(p.x, p.y);
-    const auto object = vision::markerCorners(side);
-    vision::PoseOptions options;
-    const auto previous = previous_.find(m.id);
-    if (previous != previous_.end()) options.previous = previous->second;
-    try {
-      const vision::PoseEstimate estimate =
-          vision::estimatePose(object, image, left_camera_.camera_matrix, options);
-      poses[m.id] = estimate;
-      previous_[m.id] = estimate.pose;
-    } catch (const std::exception&) {
-      // A degenerate quad: no pose this frame.
-    }
-  }
+  std::map<int, vision::PoseEstimate> poses =
+      poses_.estimate(last_.markers, [this](int id) { return markerSize(id); });
   world_.update(t, poses);
   last_poses_ = std::move(poses);
 }
@@ -91,6 +74,7 @@ void VisionStage::repeat(double t) {
 
 void VisionStage::objectMoved(int id) {
   world_.forget(id);
+  poses_.forget(id);
   last_poses_.erase(id);
 }
 

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_poses.h"
 #include "arbci/vision/world_model.h"
 #include "session/session_config.h"
 
@@ -50,8 +51,8 @@ class VisionStage {
   vision::CameraModel left_camera_, right_camera_;
   vision::Pose T_right_left_;
   vision::MarkerDetector detector_;
+  vision::MarkerPoses poses_;
   vision::WorldModel world_;
-  std::map<int, vision::Pose> previous_;  // for the pose's anti-flip rule
   std::map<int, vision::PoseEstimate> last_poses_;
   vision::DetectionResult last_;
   cv::Mat left_image_, right_image_;
