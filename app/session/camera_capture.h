@@ -1,5 +1,6 @@
-// A real camera (V4L2 device or video file) read by OpenCV on its own thread, so the cycle never
-// waits for a frame: latest() returns the newest frame at once.
+// A real camera (V4L2 device or video file, opened by support/frame_source, the one reader) read
+// on its own thread, so the cycle never waits for a frame: latest() returns the newest frame at
+// once. A video file plays at its own frame rate.
 #pragma once
 
 #include <atomic>
@@ -7,8 +8,10 @@
 #include <string>
 #include <thread>
 
+#include <memory>
 #include <opencv2/core/mat.hpp>
-#include <opencv2/videoio.hpp>
+
+#include "support/frame_source.h"
 
 namespace arbci::app {
 
@@ -26,12 +29,11 @@ class CameraCapture {
   bool finished() const { return finished_; }
 
  private:
-  cv::VideoCapture capture_;
+  std::unique_ptr<FrameSource> source_;
   mutable std::mutex mutex_;
   cv::Mat frame_;
   std::uint64_t count_ = 0;
   std::atomic<bool> stop_{false}, finished_{false};
-  bool file_ = false;
   std::thread thread_;
 };
 

@@ -1,5 +1,6 @@
 #include "support/frame_source.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -79,8 +80,11 @@ class ImageFiles final : public FrameSource {
 
 class Capture final : public FrameSource {
  public:
-  Capture(cv::VideoCapture capture, int max_frames)
-      : capture_(std::move(capture)), max_frames_(max_frames) {}
+  Capture(cv::VideoCapture capture, int max_frames, bool file)
+      : capture_(std::move(capture)), max_frames_(max_frames), file_(file) {}
+  double fileRateHz() const override {
+    return file_ ? std::max(0.0, capture_.get(cv::CAP_PROP_FPS)) : 0.0;
+  }
   std::optional<Frame> next() override {
     if (max_frames_ > 0 && index_ >= max_frames_) return std::nullopt;
     Frame frame{std::to_string(index_), {}, {}};
@@ -92,6 +96,7 @@ class Capture final : public FrameSource {
  private:
   cv::VideoCapture capture_;
   int max_frames_;
+  bool file_;
   int index_ = 0;
 };
 
@@ -129,13 +134,13 @@ std::unique_ptr<FrameSource> videoFile(const std::string& path, int max_frames) 
   cv::VideoCapture capture(path);
   if (!capture.isOpened())
     throw CliError("cannot open video " + path + " (unknown format or codec)");
-  return std::make_unique<Capture>(std::move(capture), max_frames);
+  return std::make_unique<Capture>(std::move(capture), max_frames, true);
 }
 
 std::unique_ptr<FrameSource> camera(int device, int max_frames) {
-  cv::VideoCapture capture(device);
-  if (!capture.isOpened()) throw CliError("cannot open camera " + std::to_string(device));
-  return std::make_unique<Capture>(std::move(capture), max_frames);
+  cv::VideoCapture capture(device, cv::CAP_V4L2);
+  if (!capture.isOpened()) throw CliError("cannot open camera /dev/video" + std::to_string(device));
+  return std::make_unique<Capture>(std::move(capture), max_frames, false);
 }
 
 }  // namespace arbci::app

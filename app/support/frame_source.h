@@ -1,6 +1,7 @@
 // Frames to process, from image files (any format OpenCV reads, or headerless raw files of a
 // given size and pixel format), a video file or a camera. A frame that cannot be read carries its
-// error instead of an image; opening a video or camera that fails throws CliError.
+// error instead of an image; opening a video or camera that fails throws CliError. The one camera
+// and video reader: `arbci detect` reads it in order, a session through CameraCapture's thread.
 #pragma once
 
 #include <memory>
@@ -32,6 +33,9 @@ class FrameSource {
  public:
   virtual ~FrameSource() = default;
   virtual std::optional<Frame> next() = 0;
+  // A video file's own frame rate (to play it in real time); 0 for a camera, which delivers at
+  // its own pace, and for image files.
+  virtual double fileRateHz() const { return 0.0; }
 };
 
 std::unique_ptr<FrameSource> imageFiles(std::vector<std::string> paths,
