@@ -47,20 +47,14 @@ struct Session::Impl {
   bool patch_lit = false;  // as last told to the EEG source
   bool warned_slow_display = false;
   std::unique_ptr<StimulusTiming> stimulus_timing;
-  double last_trial_end = 0.0;  // where the next trial's time starts (session seconds)
-  // The arm runs on this session's clock (a stepped arbci-robotd); false once it stops answering.
-  bool stepped_robot = false;
-  std::int64_t lost_logged = 0;               // lost EEG samples already in the log
+  double last_trial_end = 0.0;   // where the next trial's time starts (session seconds)
+  std::int64_t lost_logged = 0;  // lost EEG samples already in the log
   double longest_frame_while_training = 0.0;  // seconds between presentations
   int frames_while_training = 0;
   double training_since = 0.0;  // session seconds
   std::unique_ptr<SessionLog> log;
   int camera_every = 2;  // display frames per camera frame
   std::vector<TrialIntent> intended;
-  std::optional<std::uint64_t> robot_command;
-  robot::MessageType robot_command_type = robot::MessageType::Home;
-  std::optional<int> grasped_id;
-  std::optional<std::pair<int, int>> drop_cell;
   int selection_flashes = 0;
   bool selection_objects = true;
   std::optional<std::string> screenshot_name;
@@ -71,18 +65,9 @@ struct Session::Impl {
   bool screenshot_needs_flash = false;
   double fault_since = -1.0;
   bci::FrameStimulus last_stimulus;
-  // A placement to measure once the robot reports the world after the drop: (trial, command).
-  std::optional<std::pair<int, std::uint64_t>> placement;
-  double placement_since = 0.0;  // session seconds
-  cv::Vec3d grasped_from;        // where the object in the gripper was taken from
   // The objects a trial's selection offers, as indices into the session's objects: stimulus code
   // k is slots[k - 1]. Those the cameras see; chosen before each trial.
   std::vector<size_t> slots;
-  // The arm is home after a put-down (that command), and the frame from which the cameras have
-  // seen the table without it.
-  std::optional<std::uint64_t> homed;
-  std::optional<std::int64_t> clear_view_frame;
-  bool returning = false;  // the object goes back there: its cell was taken
 
   explicit Impl(render::GlContext& c) : context(c) {}
 };
@@ -179,14 +164,30 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     m.robotd = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder_ / "robot.json",
                                               config_.robot_speed_factor, folder_,
                                               options.simulated_clock);
-    m.stepped_robot = options.simulated_clock;
     std::ofstream(folder_ / "robotd.pid") << m.robotd->pid() << "\n";
     endpoint = robot::Endpoint::resolve("127.0.0.1", m.robotd->port());
   } else {
     key = robot::loadKey(config_.robot_key_file);
     endpoint = robot::Endpoint::resolve(config_.robot_host, config_.robot_port);
   }
-  client_ = std::make_unique<robot::RobotClient>(endpoint, key);
+  RobotChoreography::Hooks hooks;
+  hooks.current_trial = [this]() -> TrialRecord& { return currentTrial(); };
+  hooks.trial = [this](int trial) -> TrialRecord& {
+    return trials_.at(static_cast<size_t>(trial - 1));
+  };
+  hooks.finished = [this](bool success, const std::string& why) {
+    paradigm_->robotFinished(success, why);
+  };
+  hooks.object_moved = [this](int id) { vision_->objectMoved(id); };
+  hooks.put_down_ended = [this] {
+    chooseSelectableObjects();
+    paradigm_->robotFinished(true, "");
+  };
+  // A simulated clock steps the arm too (the robot follows the session, frame by frame).
+  const bool stepped = config_.robot_backend == "simulated" && options.simulated_clock;
+  robot_ = std::make_unique<RobotChoreography>(std::make_unique<robot::RobotClient>(endpoint, key),
+                                               stepped, *m.log, config_.world, gridLayout(),
+                                               m.camera_every, std::move(hooks));
 
   // EEG and the recording.
   std::map<std::string, std::string> parameters = {
@@ -271,22 +272,16 @@ void Session::abort() {
   paradigm_->abort();
 }
 void Session::emergencyStop() {
-  client_->send(robot::MessageType::Stop);
-  impl_->robot_command.reset();  // the client cancelled it; the backend refuses it
-  impl_->log->write("robot_command", time_, {{"command", "STOP"}, {"by", "experimenter"}});
+  robot_->emergencyStop(time_);
   paradigm_->emergencyStop();
 }
 
 void Session::resetRobot() {
-  const auto sequence = client_->send(robot::MessageType::Reset);
-  impl_->log->write("robot_command", time_,
-                    {{"command", "RESET"}, {"by", "experimenter"}, {"sequence", sequence}});
+  robot_->reset(time_);
 }
 
 void Session::homeRobot() {
-  const auto sequence = client_->send(robot::MessageType::Home);
-  impl_->log->write("robot_command", time_,
-                    {{"command", "HOME"}, {"by", "experimenter"}, {"sequence", sequence}});
+  robot_->home(time_);
 }
 
 TrialRecord& Session::currentTrial() {
@@ -335,7 +330,7 @@ bool Session::step() {
   // The right camera half a camera period later, so no cycle renders both (at 60 Hz, both).
   const bool right_due = m.camera_every == 1 || frame_ % m.camera_every == 1;
   if (m.world && left_due) {
-    if (client_->status()) m.world->update(*client_->status());
+    if (robot_->status()) m.world->update(*robot_->status());
     const SimulatedWorld::Frame left = m.world->captureLeft(time_);
     timing_.mark("cameras");
     if (left.changed) {
@@ -360,17 +355,8 @@ bool Session::step() {
     }
   }
 
-  // Robot: a stepped arm is moved to this frame's time first, while it has anything to do (idle,
-  // it does not move; sendRobot() brings its clock up to date before a command).
-  const bool robot_matters = m.robot_command || (m.homed && !m.clear_view_frame) || m.placement;
-  if (m.stepped_robot && robot_matters && !client_->syncClock(time_)) {
-    m.stepped_robot = false;  // it stopped answering: the client reports it silent
-    m.log->write("robot_clock_lost", time_, {{"text", "the stepped robot backend did not answer"}});
-  }
-  client_->poll();
-  handleRobotEvents();
-  measurePlacement();
-  endPutDownOnceInView();
+  // Robot: up to this frame's time (a stepped arm too), its events, a placement to measure.
+  robot_->step(frame_, time_);
   timing_.mark("robot");
 
   // Paradigm: this frame's stimuli, and what it asks for.
@@ -410,7 +396,7 @@ bool Session::step() {
     m.fault_since = -1.0;
   }
   // The last placement is measured before the run ends (a status after the drop, or 3 s).
-  if (phase == bci::Phase::Finished && (!m.placement || time_ - m.placement_since > 3.0)) {
+  if (phase == bci::Phase::Finished && !robot_->measuring(time_)) {
     endRun("finished");
   }
   if (phase == bci::Phase::Aborted) endRun("aborted");
@@ -530,117 +516,8 @@ std::int64_t Session::lateFrames() const {
   return impl_->stimulus_timing->lateFrames();
 }
 
-void Session::sendRobot(robot::MessageType type, const cv::Vec3d& target) {
-  Impl& m = *impl_;
-  if (m.stepped_robot) client_->syncClock(time_);  // the command starts now, not at the last sync
-  m.robot_command = client_->send(type, {target[0], target[1], target[2]});
-  m.robot_command_type = type;
-}
-
-void Session::handleRobotEvents() {
-  Impl& m = *impl_;
-  for (const robot::RobotEvent& e : client_->takeEvents()) {
-    nlohmann::json fields = {{"kind", robot::toString(e.kind)},
-                             {"sequence", e.sequence},
-                             {"command", robot::toString(e.command)},
-                             {"text", e.text}};
-    if (e.kind == robot::RobotEvent::Kind::Rejected) fields["reason"] = robot::toString(e.reason);
-    if (e.kind == robot::RobotEvent::Kind::Finished) fields["outcome"] = robot::toString(e.outcome);
-    m.log->write("robot", time_, fields);
-    // Link events (connected, silent, restarted) belong to no command.
-    const std::string what =
-        e.sequence == 0 ? std::string(robot::toString(e.kind))
-                        : std::string(robot::toString(e.kind)) + " " + robot::toString(e.command);
-    robot_log_.push_back(what + (e.text.empty() ? "" : ": " + e.text));
-    if (robot_log_.size() > 200) robot_log_.erase(robot_log_.begin());
-    if (!m.robot_command) continue;
-    const bool ours = e.sequence == *m.robot_command;
-    using Kind = robot::RobotEvent::Kind;
-    if (ours && e.kind == Kind::Finished) {
-      m.robot_command.reset();
-      client_->requestStatus();  // the world as the robot left it, without waiting
-      const bool success = e.outcome == robot::Outcome::Success;
-      if (success && m.robot_command_type == robot::MessageType::Drop) {
-        if (!m.returning) {
-          currentTrial().outcome = "placed";
-          m.placement = std::make_pair(currentTrial().trial, e.sequence);
-          m.placement_since = time_;
-        }
-        vision_->objectMoved(*m.grasped_id);
-        // The arm parked over the table hides objects from the cameras: it goes home before the
-        // next trial, and the put-down ends when it is there.
-        sendRobot(robot::MessageType::Home, {});
-        m.log->write("robot_command", time_, {{"command", "HOME"}, {"sequence", *m.robot_command}});
-        continue;
-      }
-      if (!success)
-        currentTrial().outcome = std::string("robot ") + robot::toString(e.outcome) + ": " + e.text;
-      if (success && m.robot_command_type == robot::MessageType::Home) {
-        m.homed = e.sequence;  // the put-down ends once the cameras have looked again
-        continue;
-      }
-      paradigm_->robotFinished(success, e.text);
-    } else if (ours && (e.kind == Kind::Rejected || e.kind == Kind::Failed)) {
-      m.robot_command.reset();
-      const std::string why =
-          e.kind == Kind::Rejected
-              ? std::string("rejected (") + robot::toString(e.reason) + "): " + e.text
-              : e.text;
-      currentTrial().outcome = "robot " + why;
-      paradigm_->robotFinished(false, why);
-    } else if (e.kind == Kind::Silent) {
-      m.robot_command.reset();
-      m.homed.reset();
-      currentTrial().outcome = "robot fault: the backend went silent";
-      paradigm_->robotFinished(false, "the robot backend went silent (stopped or unreachable)");
-    }
-  }
-}
-
-void Session::measurePlacement() {
-  Impl& m = *impl_;
-  const auto& status = client_->status();
-  // Only a status that knows the drop finished shows where the object stands.
-  if (!m.placement || !status || status->last_finished_sequence < m.placement->second) return;
-  TrialRecord& trial = trials_[static_cast<size_t>(m.placement->first - 1)];
-  for (const robot::WorldObject& o : status->objects) {
-    if (!m.grasped_id || o.id != *m.grasped_id) continue;
-    double height = 0.0;
-    for (const auto& s : config_.world.objects) {
-      if (s.id == o.id) height = s.height_m;
-    }
-    const cv::Vec3d centre =
-        gridLayout().cellCentre(trial.selected_cell.first, trial.selected_cell.second);
-    trial.placement_error_m =
-        cv::norm(cv::Vec3d(o.position.x, o.position.y, o.position.z - height) - centre);
-    impl_->log->write("placement", time_,
-                      {{"trial", trial.trial},
-                       {"object", o.id},
-                       {"error_m", trial.placement_error_m},
-                       {"position", {o.position.x, o.position.y, o.position.z - height}}});
-  }
-  m.placement.reset();
-}
-
 const WorldObjectSettings& Session::objectOfCode(int code) const {
   return config_.world.objects[impl_->slots.at(static_cast<size_t>(code - 1))];
-}
-
-void Session::endPutDownOnceInView() {
-  Impl& m = *impl_;
-  if (!m.homed) return;
-  if (!m.clear_view_frame) {
-    // The scene follows the robot's status: once it shows the arm home, two camera frames.
-    const auto& status = client_->status();
-    if (status && status->last_finished_sequence >= *m.homed)
-      m.clear_view_frame = frame_ + 2 * m.camera_every + 1;
-    return;
-  }
-  if (frame_ < *m.clear_view_frame) return;
-  m.homed.reset();
-  m.clear_view_frame.reset();
-  chooseSelectableObjects();
-  paradigm_->robotFinished(true, "");
 }
 
 void Session::chooseSelectableObjects() {
@@ -672,7 +549,7 @@ std::optional<int> Session::objectOnCell(std::pair<int, int> cell) const {
   const cv::Vec3d centre = gridLayout().cellCentre(cell.first, cell.second);
   const double half = 0.5 * config_.world.grid.cell_m;
   for (const vision::ObjectState& o : vision_->world().objects()) {
-    if (impl_->grasped_id && o.id == *impl_->grasped_id) continue;
+    if (robot_->grasped() && o.id == *robot_->grasped()) continue;
     const cv::Vec3d p = o.T_robot_object.translation;
     if (std::abs(p[0] - centre[0]) < half && std::abs(p[1] - centre[1]) < half) return o.id;
   }
@@ -809,43 +686,23 @@ void Session::handleParadigmEvents() {
           paradigm_->robotFinished(false, currentTrial().outcome);
           break;
         }
-        const cv::Vec3d p = state->T_robot_object.translation;
-        m.grasped_id = id;
-        m.grasped_from = p;
-        sendRobot(robot::MessageType::Grasp, p);
-        m.log->write("robot_command", time_,
-                     {{"command", "GRASP"},
-                      {"object", id},
-                      {"target", {p[0], p[1], p[2]}},
-                      {"sequence", *m.robot_command}});
+        robot_->grasp(id, state->T_robot_object.translation, time_);
         break;
       }
       case Kind::RobotDrop: {
-        cv::Vec3d p = gridLayout().cellCentre(e.cell.first, e.cell.second);
-        p[2] = config_.world.table_z;
-        m.returning = false;
-        if (const auto other = objectOnCell(e.cell)) {
+        const auto other = objectOnCell(e.cell);
+        if (other) {
           // Never onto another object: it goes back where it came from, and the trial says why.
-          m.returning = true;
-          p = {m.grasped_from[0], m.grasped_from[1], config_.world.table_z};
           currentTrial().outcome = "returned: cell " + std::to_string(e.cell.first) + "," +
                                    std::to_string(e.cell.second) + " is taken by object " +
                                    std::to_string(*other);
           std::cerr << "trial " << currentTrial().trial << ": " << currentTrial().outcome << "\n";
         }
-        sendRobot(robot::MessageType::Drop, p);
-        m.log->write("robot_command", time_,
-                     {{"command", "DROP"},
-                      {"cell", {e.cell.first, e.cell.second}},
-                      {"target", {p[0], p[1], p[2]}},
-                      {"returning", m.returning},
-                      {"sequence", *m.robot_command}});
+        robot_->drop(e.cell, other.has_value(), time_);
         break;
       }
       case Kind::RobotStop:
-        client_->send(robot::MessageType::Stop);
-        m.robot_command.reset();
-        m.log->write("robot_command", time_, {{"command", "STOP"}});
+        robot_->stop(time_);
         break;
       case Kind::TrialDone:
         if (e.trial >= 1 && e.trial <= static_cast<int>(trials_.size()))
@@ -872,7 +729,7 @@ void Session::decideIfReady() {
 void Session::renderHmd(const bci::FrameStimulus& stimulus) {
   Impl& m = *impl_;
   const HmdScene scene{config_,      *vision_,
-                       m.slots,      client_->status() ? client_->status()->holding : -1,
+                       m.slots,      robot_->status() ? robot_->status()->holding : -1,
                        gridLayout(), eeg_->hasPhotodiode()};
   const render::HmdFrame frame = composeHmdFrame(stimulus, scene);
   // What this frame shows; unchanged, the framebuffer already holds it.

@@ -21,6 +21,7 @@
 #include "arbci/robot/client.h"
 #include "session/cycle_timing.h"
 #include "session/eeg_stage.h"
+#include "session/robot_choreography.h"
 #include "session/session_config.h"
 #include "session/trial_record.h"
 #include "session/vision_stage.h"
@@ -83,9 +84,9 @@ class Session {
   VisionStage& vision() { return *vision_; }
   EegStage& eeg() { return *eeg_; }
   const CycleTiming& timing() const { return timing_; }
-  const std::optional<robot::StatusPayload>& robotStatus() const { return client_->status(); }
-  bool robotSilent() const { return client_->silent(); }
-  const std::vector<std::string>& robotLog() const { return robot_log_; }
+  const std::optional<robot::StatusPayload>& robotStatus() const { return robot_->status(); }
+  bool robotSilent() const { return robot_->silent(); }
+  const std::vector<std::string>& robotLog() const { return robot_->messages(); }
   const std::vector<TrialRecord>& trials() const { return trials_; }
   std::optional<bci::EvaluationReport> calibrationReport() const { return calibration_report_; }
   unsigned int hmdTexture() const;  // the last HMD frame, for the UI
@@ -116,9 +117,8 @@ class Session {
   std::unique_ptr<bci::Paradigm> paradigm_;
   std::unique_ptr<VisionStage> vision_;
   std::unique_ptr<EegStage> eeg_;
-  std::unique_ptr<robot::RobotClient> client_;
+  std::unique_ptr<RobotChoreography> robot_;
   CycleTiming timing_;
-  std::vector<std::string> robot_log_;
   std::vector<TrialRecord> trials_;
   std::optional<bci::EvaluationReport> calibration_report_;
   double time_ = 0.0;
@@ -128,19 +128,13 @@ class Session {
 
   void handleParadigmEvents();
   void collectTraining();
-  void measurePlacement();
   render::GridLayout gridLayout() const;
   // The object a selection's stimulus code stands for this trial.
   const WorldObjectSettings& objectOfCode(int code) const;
-  // After a put-down and homing: ends the robot phase once the cameras have seen the table.
-  void endPutDownOnceInView();
   // Offers the next trials the objects the cameras see (every one unless some are hidden).
   void chooseSelectableObjects();
   // The tracked object (other than the one in the gripper) standing on a grid cell, if any.
   std::optional<int> objectOnCell(std::pair<int, int> cell) const;
-  void handleRobotEvents();
-  // Sends a command whose end the paradigm waits for; the simulated clock keeps to its pace.
-  void sendRobot(robot::MessageType type, const cv::Vec3d& target);
   void decideIfReady();
   void renderHmd(const bci::FrameStimulus& stimulus);
   void endRun(const std::string& reason);
