@@ -16,12 +16,11 @@
 #include "arbci/bci/evaluation.h"
 #include "arbci/render/framebuffer.h"
 #include "arbci/robot/key_file.h"
-#include "session/camera_capture.h"
 #include "session/hmd_composition.h"
 #include "session/image_writer.h"
 #include "session/robot_process.h"
+#include "session/scene_source.h"
 #include "session/session_log.h"
-#include "session/simulated_world.h"
 #include "session/stimulus_timing.h"
 #include "session/trial_intents.h"
 #include "support/interrupt.h"
@@ -32,9 +31,7 @@ struct Session::Impl {
   render::GlContext& context;
   std::unique_ptr<render::Framebuffer> hmd_fbo;
   std::unique_ptr<render::HmdView> hmd;
-  std::unique_ptr<SimulatedWorld> world;
-  std::unique_ptr<CameraCapture> left_capture, right_capture;
-  std::uint64_t left_seen = 0;
+  std::unique_ptr<SceneSource> scene;  // what the cameras see: simulated or real
   std::unique_ptr<RobotProcess> robotd;
   // Session second 0 on the host clock (0 for a simulated clock, which is its own host clock).
   double host_origin = 0.0;
@@ -127,29 +124,9 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
 
   // Cameras.
   context.makeCurrent();
-  vision::CameraModel left_camera, right_camera;
-  vision::Pose T_right_left;
-  if (config_.cameras.source == "simulated") {
-    m.world = std::make_unique<SimulatedWorld>(config_);
-    left_camera = right_camera = m.world->camera();
-    T_right_left = m.world->T_right_left();
-  } else {
-    left_camera = vision::CameraModel::load(config_.cameras.left.calibration);
-    m.left_capture = std::make_unique<CameraCapture>(config_.cameras.left.device,
-                                                     config_.cameras.left.video, "cameras.left");
-    right_camera = left_camera;
-    if (!config_.cameras.right.calibration.empty()) {
-      right_camera = vision::CameraModel::load(config_.cameras.right.calibration);
-      m.right_capture = std::make_unique<CameraCapture>(
-          config_.cameras.right.device, config_.cameras.right.video, "cameras.right");
-      if (!config_.cameras.stereo_calibration.empty()) {
-        const vision::StereoCameras stereo =
-            vision::StereoCameras::load(config_.cameras.stereo_calibration);
-        T_right_left = {stereo.rotation, stereo.translation};
-      }
-    }
-  }
-  vision_ = std::make_unique<VisionStage>(config_, left_camera, right_camera, T_right_left);
+  m.scene = openScene(config_);
+  vision_ = std::make_unique<VisionStage>(config_, m.scene->leftCamera(), m.scene->rightCamera(),
+                                          m.scene->T_right_left());
 
   // The robot: arbci-robotd on 127.0.0.1 with a fresh key, or a remote backend.
   robot::Key key;
@@ -158,7 +135,7 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     key = robot::generateKey();
     const auto key_file = folder_ / "robot.key";
     robot::saveKey(key_file, key);
-    robot::RobotConfig robot_config = m.world ? m.world->robotConfig() : robot::RobotConfig{};
+    const robot::RobotConfig robot_config = m.scene->simulatedRobot();
     std::ofstream(folder_ / "robot.json") << robot_config.toJson();
     // A simulated clock steps the arm too (the robot follows the session, frame by frame).
     m.robotd = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder_ / "robot.json",
@@ -224,10 +201,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
       {"trials", config_.paradigm.trials}}.dump(2);
   // Warm-up: Mesa compiles its shader variants and the tracker builds its tables on first use;
   // that happens here, before the cycle's time is measured.
-  if (m.world) {
-    for (int i = 0; i < 3; ++i)
-      vision_->process(0.0, m.world->captureLeft(-1.0 - i).image,
-                       m.world->captureRight(-1.0 - i).image);
+  {
+    for (const auto& [left, right] : m.scene->warmUpFrames()) vision_->process(0.0, left, right);
     // Every kind of overlay once: highlights in each state, the grid with rows, columns and cells.
     bci::FrameStimulus all;
     all.grid_visible = true;
@@ -326,33 +301,19 @@ bool Session::step() {
   collectTraining();
 
   // Cameras and tracking.
-  const bool left_due = frame_ % m.camera_every == 0;
-  // The right camera half a camera period later, so no cycle renders both (at 60 Hz, both).
-  const bool right_due = m.camera_every == 1 || frame_ % m.camera_every == 1;
-  if (m.world && left_due) {
-    if (robot_->status()) m.world->update(*robot_->status());
-    const SimulatedWorld::Frame left = m.world->captureLeft(time_);
-    timing_.mark("cameras");
-    if (left.changed) {
-      vision_->process(time_, left.image, cv::Mat());
+  if (robot_->status()) m.scene->robotReported(*robot_->status());
+  const SceneSource::Frames frames = m.scene->capture(frame_, time_);
+  if (!frames.left.empty() || !frames.right.empty()) timing_.mark("cameras");
+  if (!frames.left.empty()) {
+    if (frames.left_changed) {
+      vision_->process(time_, frames.left, frames.right);
     } else {
       vision_->repeat(time_);
+      if (!frames.right.empty()) vision_->setRightImage(frames.right);
     }
     timing_.mark("tracking");
-  }
-  if (m.world && right_due) {
-    vision_->setRightImage(m.world->captureRight(time_).image);
-    timing_.mark("cameras");
-  }
-  if (m.left_capture) {
-    const auto [left, count] = m.left_capture->latest();
-    if (count != m.left_seen && !left.empty()) {
-      m.left_seen = count;
-      const cv::Mat right = m.right_capture ? m.right_capture->latest().first : cv::Mat();
-      timing_.mark("cameras");
-      vision_->process(time_, left, right);
-      timing_.mark("tracking");
-    }
+  } else if (!frames.right.empty()) {
+    vision_->setRightImage(frames.right);
   }
 
   // Robot: up to this frame's time (a stepped arm too), its events, a placement to measure.
@@ -760,11 +721,11 @@ void Session::setReference(int id, const cv::Vec3d& position) {
 }
 
 bool Session::canHoldBoard() const {
-  return impl_->world != nullptr;
+  return impl_->scene->canHoldBoard();
 }
 
 void Session::holdBoard(bool show) {
-  if (impl_->world) impl_->world->holdBoard(show, time_);
+  impl_->scene->holdBoard(show, time_);
 }
 
 void Session::useModel(const bci::P300Model& model) {

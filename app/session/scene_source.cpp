@@ -1,0 +1,100 @@
+#include "session/scene_source.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "session/camera_capture.h"
+#include "session/simulated_world.h"
+
+namespace arbci::app {
+namespace {
+
+// The simulated world's cameras, rendered on alternate display frames (no cycle pays for both).
+class SimulatedScene final : public SceneSource {
+ public:
+  explicit SimulatedScene(const SessionConfig& config)
+      : world_(config),
+        camera_every_(std::max(
+            1, static_cast<int>(std::lround(config.display_hz / config.cameras.rate_hz)))) {
+    left_camera_ = right_camera_ = world_.camera();
+    T_right_left_ = world_.T_right_left();
+  }
+  Frames capture(std::int64_t frame, double time_s) override {
+    Frames frames;
+    // The right camera half a camera period later (at 60 Hz, both every frame).
+    const bool left_due = frame % camera_every_ == 0;
+    const bool right_due = camera_every_ == 1 || frame % camera_every_ == 1;
+    if (left_due) {
+      // The objects and the gripper where the robot last reported them (the right camera, half
+      // a camera period later, sees the same scene).
+      if (reported_) world_.update(*reported_);
+      const SimulatedWorld::Frame left = world_.captureLeft(time_s);
+      frames.left = left.image;
+      frames.left_changed = left.changed;
+    }
+    if (right_due) frames.right = world_.captureRight(time_s).image;
+    return frames;
+  }
+  std::vector<std::pair<cv::Mat, cv::Mat>> warmUpFrames() override {
+    std::vector<std::pair<cv::Mat, cv::Mat>> frames;
+    for (int i = 0; i < 3; ++i)
+      frames.emplace_back(world_.captureLeft(-1.0 - i).image, world_.captureRight(-1.0 - i).image);
+    return frames;
+  }
+  void robotReported(const robot::StatusPayload& status) override { reported_ = status; }
+  robot::RobotConfig simulatedRobot() const override { return world_.robotConfig(); }
+  bool canHoldBoard() const override { return true; }
+  void holdBoard(bool show, double time_s) override { world_.holdBoard(show, time_s); }
+
+ private:
+  SimulatedWorld world_;
+  int camera_every_;
+  std::optional<robot::StatusPayload> reported_;
+};
+
+// Camera devices or video files, each read on its own thread; a new left frame is tracked with
+// the right camera's latest.
+class DeviceScene final : public SceneSource {
+ public:
+  explicit DeviceScene(const SessionConfig& config) {
+    const CameraSettings& c = config.cameras;
+    left_camera_ = vision::CameraModel::load(c.left.calibration);
+    left_ = std::make_unique<CameraCapture>(c.left.device, c.left.video, "cameras.left");
+    right_camera_ = left_camera_;
+    if (!c.right.calibration.empty()) {
+      right_camera_ = vision::CameraModel::load(c.right.calibration);
+      right_ = std::make_unique<CameraCapture>(c.right.device, c.right.video, "cameras.right");
+      if (!c.stereo_calibration.empty()) {
+        const vision::StereoCameras stereo = vision::StereoCameras::load(c.stereo_calibration);
+        T_right_left_ = {stereo.rotation, stereo.translation};
+      }
+    }
+  }
+  // A black frame of the calibrated size: the tracker builds its lens tables before the cycle.
+  std::vector<std::pair<cv::Mat, cv::Mat>> warmUpFrames() override {
+    return {{cv::Mat::zeros(left_camera_.image_size, CV_8UC3), cv::Mat()}};
+  }
+  Frames capture(std::int64_t, double) override {
+    Frames frames;
+    const auto [left, count] = left_->latest();
+    if (count != left_seen_ && !left.empty()) {
+      left_seen_ = count;
+      frames.left = left;
+      if (right_) frames.right = right_->latest().first;
+    }
+    return frames;
+  }
+
+ private:
+  std::unique_ptr<CameraCapture> left_, right_;
+  std::uint64_t left_seen_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<SceneSource> openScene(const SessionConfig& config) {
+  if (config.cameras.source == "simulated") return std::make_unique<SimulatedScene>(config);
+  return std::make_unique<DeviceScene>(config);
+}
+
+}  // namespace arbci::app

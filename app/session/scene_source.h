@@ -1,0 +1,53 @@
+// What the session's cameras look at, behind one interface: the simulated world (rendered table,
+// objects that follow the simulated arm, a head that moves) or the real scene through two camera
+// devices or video files. The cycle asks for this frame's images and never asks which it is.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "arbci/robot/protocol.h"
+#include "arbci/robot/robot_config.h"
+#include "arbci/vision/camera_model.h"
+#include "arbci/vision/pose.h"
+#include "session/session_config.h"
+
+namespace arbci::app {
+
+class SceneSource {
+ public:
+  virtual ~SceneSource() = default;
+  const vision::CameraModel& leftCamera() const { return left_camera_; }
+  const vision::CameraModel& rightCamera() const { return right_camera_; }
+  const vision::Pose& T_right_left() const { return T_right_left_; }
+
+  struct Frames {
+    cv::Mat left;              // a new left frame (empty: none this cycle)
+    bool left_changed = true;  // false: the same picture as the last left frame
+    cv::Mat right;             // a new right frame (empty: none this cycle)
+  };
+  // This display frame's camera images, at session time `time_s`.
+  virtual Frames capture(std::int64_t frame, double time_s) = 0;
+  // Left and right images to warm the tracker up with before the cycle is timed (none: nothing).
+  virtual std::vector<std::pair<cv::Mat, cv::Mat>> warmUpFrames() { return {}; }
+  // The robot's report of its world (a simulated scene puts its objects and gripper there).
+  virtual void robotReported(const robot::StatusPayload&) {}
+  // The objects a simulated arm should know (the simulated scene's); none for a real scene.
+  virtual robot::RobotConfig simulatedRobot() const { return {}; }
+  // A simulated scene can hold a chessboard up for calibration (a new pose each call).
+  virtual bool canHoldBoard() const { return false; }
+  virtual void holdBoard(bool /*show*/, double /*time_s*/) {}
+
+ protected:
+  vision::CameraModel left_camera_, right_camera_;
+  vision::Pose T_right_left_;
+};
+
+// `cameras.source`: "simulated" (needs a current GL context) or "devices". Throws naming the key.
+std::unique_ptr<SceneSource> openScene(const SessionConfig& config);
+
+}  // namespace arbci::app
