@@ -19,68 +19,73 @@ namespace {
 // `arbci timing-check` and set as eeg.latency_ms).
 constexpr double kSimulatedTransportS = 0.020;
 
-std::unique_ptr<bci::EegSource> openSource(const SessionConfig& config,
+std::unique_ptr<bci::EegSource> openSource(const EegSettings& eeg,
                                            std::shared_ptr<bci::SampleClock> clock) {
-  if (config.eeg.source == "file") {
-    bci::Recording replay = bci::readRecording(config.eeg.file);
+  if (eeg.source == "file") {
+    bci::Recording replay = bci::readRecording(eeg.file);
     replay.stimuli.clear();  // the session presents its own stimuli
-    return std::make_unique<bci::FileSource>(std::move(replay), clock, config.eeg.block_size);
+    return std::make_unique<bci::FileSource>(std::move(replay), clock, eeg.block_size);
   }
   bci::SimulatedSubjectConfig subject;
-  subject.montage = config.eeg.montage;
-  subject.rate_hz = config.eeg.rate_hz;
-  subject.block_size = config.eeg.block_size;
-  subject.seed = config.eeg.seed;
-  subject.line_hz = config.eeg.line_hz;
-  subject.photodiode = !config.eeg.photodiode_channel.empty();
-  subject.photodiode_channel = config.eeg.photodiode_channel;
-  bci::SubjectProfile profile = bci::SubjectProfile::drawn(config.eeg.seed);
-  profile.p3_amplitude_uv *= config.eeg.erp_scale;
-  profile.n2_amplitude_uv *= config.eeg.erp_scale;
+  subject.montage = eeg.montage;
+  subject.rate_hz = eeg.rate_hz;
+  subject.block_size = eeg.block_size;
+  subject.seed = eeg.seed;
+  subject.line_hz = eeg.line_hz;
+  subject.photodiode = !eeg.photodiode_channel.empty();
+  subject.photodiode_channel = eeg.photodiode_channel;
+  bci::SubjectProfile profile = bci::SubjectProfile::drawn(eeg.seed);
+  profile.p3_amplitude_uv *= eeg.erp_scale;
+  profile.n2_amplitude_uv *= eeg.erp_scale;
   subject.profile = profile;
   return std::make_unique<bci::SimulatedSubject>(subject, clock);
 }
 
 }  // namespace
 
-EegStage::EegStage(const SessionConfig& config, const std::filesystem::path& recording_path,
+EegStageSettings EegStageSettings::of(const SessionConfig& config) {
+  return {config.eeg, config.pipeline, config.paradigm.flashSeconds(),
+          static_cast<int>(config.world.objects.size()), config.source};
+}
+
+EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path& recording_path,
                    bool stepped, const std::map<std::string, std::string>& parameters)
-    : config_(config) {
+    : settings_(settings) {
+  const EegSettings& eeg = settings_.eeg;
   std::shared_ptr<bci::SampleClock> clock;
   if (stepped)
     clock = std::make_shared<bci::ManualClock>();
   else
-    clock = std::make_shared<bci::WallClock>(config.eeg.source == "simulated" ? kSimulatedTransportS
-                                                                              : 0.0);
-  bci::AcquisitionSettings settings;
-  settings.latency_s = config.eeg.latency_ms / 1000.0;
+    clock =
+        std::make_shared<bci::WallClock>(eeg.source == "simulated" ? kSimulatedTransportS : 0.0);
+  bci::AcquisitionSettings acquisition;
+  acquisition.latency_s = eeg.latency_ms / 1000.0;
   acquisition_ = std::make_unique<bci::Acquisition>(
-      openSource(config, clock), clock,
-      stepped ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live, settings);
+      openSource(eeg, clock), clock,
+      stepped ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live, acquisition);
   const bci::SignalInfo& all = acquisition_->info();
   eeg_info_ = all;
-  if (!config.eeg.photodiode_channel.empty()) {
-    const auto found =
-        std::find(all.channels.begin(), all.channels.end(), config.eeg.photodiode_channel);
+  if (!eeg.photodiode_channel.empty()) {
+    const auto found = std::find(all.channels.begin(), all.channels.end(), eeg.photodiode_channel);
     if (found == all.channels.end()) {
       std::string names;
       for (const auto& c : all.channels) names += (names.empty() ? "" : ", ") + c;
       throw SessionConfigError(
-          config.source + ": eeg.photodiode_channel = \"" + config.eeg.photodiode_channel +
+          settings_.session_file + ": eeg.photodiode_channel = \"" + eeg.photodiode_channel +
           "\": the EEG source has no such channel (it has: " + names + "; use \"\" for none)");
     }
     photodiode_ = static_cast<int>(found - all.channels.begin());
     eeg_info_.channels.erase(eeg_info_.channels.begin() + photodiode_);
   }
   writer_ = std::make_unique<bci::RecordingWriter>(recording_path, all, parameters);
-  filters_ = std::make_unique<bci::FilterChain>(config.pipeline.filter, eeg_info_);
+  filters_ = std::make_unique<bci::FilterChain>(settings_.pipeline.filter, eeg_info_);
   epocher_ = std::make_unique<bci::Epocher>(eeg_info_.channelCount(), eeg_info_.rate_hz,
-                                            config.pipeline.window, 10.0);
+                                            settings_.pipeline.window, 10.0);
   calibration_.source = "calibration run";
   calibration_.format = "memory";
   calibration_.info = eeg_info_;
   calibration_.parameters["Paradigm"] =
-      "single stimulus, " + std::to_string(config.world.objects.size()) + " stimuli";
+      "single stimulus, " + std::to_string(settings_.object_stimuli) + " stimuli";
   recent_.assign(static_cast<size_t>(eeg_info_.channelCount()), {});
   acquisition_->start();
 }
@@ -176,8 +181,7 @@ void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,
 
 void EegStage::flash(int code, std::int64_t sample) {
   const bool target = target_ && *target_ == code;
-  const int nominal_duration =
-      static_cast<int>(config_.paradigm.flashSeconds() * eeg_info_.rate_hz + 0.5);
+  const int nominal_duration = static_cast<int>(settings_.flash_s * eeg_info_.rate_hz + 0.5);
   bci::StimulusEvent event{sample, code, target, nominal_duration};
   acquisition_->withSource([&](bci::EegSource& s) { s.present(event); });
   if (target_ && keep_signal_) calibration_.stimuli.push_back(event);
@@ -212,7 +216,7 @@ void EegStage::startTraining(const std::string& method) {
           calibration_.data[static_cast<size_t>(s * channels + c)];
     }
   }
-  const bci::PipelineSettings pipeline = config_.pipeline;
+  const bci::PipelineSettings pipeline = settings_.pipeline;
   training_ =
       std::async(std::launch::async, [recording = std::move(recording), pipeline, method]() {
         // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the

@@ -23,6 +23,16 @@
 
 namespace arbci::app {
 
+// What the EEG stage needs of the session file, and nothing else.
+struct EegStageSettings {
+  EegSettings eeg;
+  bci::PipelineSettings pipeline;
+  double flash_s;            // a flash's nominal duration (the paradigm's, in whole frames)
+  int object_stimuli;        // stimuli of the calibration run (the objects)
+  std::string session_file;  // for messages naming a key
+  static EegStageSettings of(const SessionConfig& config);
+};
+
 struct TrainingOutcome {
   bci::P300Model model;
   bci::EvaluationReport report;
@@ -33,8 +43,8 @@ class EegStage {
   // Opens the source named by the session and starts the recording. `stepped`: the source runs
   // in lock-step with a simulated clock (advanceTo); otherwise on its own clock, acquired by a
   // thread. Throws std::runtime_error (SessionConfigError naming the key for a bad channel).
-  EegStage(const SessionConfig& config, const std::filesystem::path& recording_path, bool stepped,
-           const std::map<std::string, std::string>& parameters);
+  EegStage(const EegStageSettings& settings, const std::filesystem::path& recording_path,
+           bool stepped, const std::map<std::string, std::string>& parameters);
   ~EegStage();
 
   // The EEG channels (without the photodiode): what filters, epochs and models see.
@@ -95,7 +105,7 @@ class EegStage {
   };
   bci::Block eegOnly(const bci::Block& block) const;
 
-  const SessionConfig& config_;
+  EegStageSettings settings_;
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;
   int photodiode_ = -1;  // the photodiode's channel in the source's blocks

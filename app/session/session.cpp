@@ -125,8 +125,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   // Cameras.
   context.makeCurrent();
   m.scene = openScene(config_);
-  vision_ = std::make_unique<VisionStage>(config_, m.scene->leftCamera(), m.scene->rightCamera(),
-                                          m.scene->T_right_left());
+  vision_ = std::make_unique<VisionStage>(TrackingSettings::of(config_), m.scene->leftCamera(),
+                                          m.scene->rightCamera(), m.scene->T_right_left());
 
   // The robot: arbci-robotd on 127.0.0.1 with a fresh key, or a remote backend.
   robot::Key key;
@@ -182,8 +182,8 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   parameters["SoaMs"] = std::to_string(config_.paradigm.soaSeconds() * 1000.0);
   // Simulated clock: the EEG advances in lock-step with the frames; otherwise the source runs on
   // its own clock and a thread acquires it.
-  eeg_ = std::make_unique<EegStage>(config_, folder_ / "recording.bdf", options.simulated_clock,
-                                    parameters);
+  eeg_ = std::make_unique<EegStage>(EegStageSettings::of(config_), folder_ / "recording.bdf",
+                                    options.simulated_clock, parameters);
   m.stimulus_timing = std::make_unique<StimulusTiming>(config_.paradigm, eeg_->info().rate_hz);
   if (!config_.model_file.empty()) eeg_->setModel(bci::P300Model::load(config_.model_file));
 

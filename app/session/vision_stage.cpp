@@ -7,55 +7,64 @@
 namespace arbci::app {
 namespace {
 
-vision::DetectorConfig detectorFor(const SessionConfig& config, const vision::CameraModel& camera) {
+vision::DetectorConfig detectorFor(const TrackingSettings& settings,
+                                   const vision::CameraModel& camera) {
   vision::DetectorConfig d;
-  d.kind = vision::markerKindFromString(config.tracker_kind);
-  d.border = config.tracker_border;
+  d.kind = settings.kind;
+  d.border = settings.border;
   if (!camera.distortion.empty())
     d.lens = std::make_shared<vision::Undistorter>(camera, vision::UndistortMode::LookupTable);
   return d;
 }
 
-vision::ReferenceMarker referenceOf(const SessionConfig& config) {
+vision::ReferenceMarker referenceOf(const TrackingSettings& settings) {
   vision::ReferenceMarker r;
-  r.id = config.world.reference_id;
-  r.size_m = config.world.reference_size_m;
-  r.T_robot_ref = {cv::Matx33d::eye(), config.world.reference_position};
+  r.id = settings.reference_id;
+  r.size_m = settings.reference_size_m;
+  r.T_robot_ref = {cv::Matx33d::eye(), settings.reference_position};
   return r;
 }
 
 }  // namespace
 
-VisionStage::VisionStage(const SessionConfig& config, const vision::CameraModel& left,
+TrackingSettings TrackingSettings::of(const SessionConfig& config) {
+  TrackingSettings t{vision::markerKindFromString(config.tracker_kind),
+                     config.tracker_border,
+                     config.world.reference_id,
+                     config.world.reference_size_m,
+                     config.world.reference_position,
+                     {}};
+  for (const WorldObjectSettings& o : config.world.objects) t.marker_size[o.id] = o.marker_m;
+  return t;
+}
+
+VisionStage::VisionStage(const TrackingSettings& settings, const vision::CameraModel& left,
                          const vision::CameraModel& right, const vision::Pose& T_right_left)
-    : config_(config),
-      reference_id_(config.world.reference_id),
-      reference_size_m_(config.world.reference_size_m),
+    : settings_(settings),
       left_camera_(left),
       right_camera_(right),
       T_right_left_(T_right_left),
-      detector_(detectorFor(config, left)),
+      detector_(detectorFor(settings, left)),
       poses_(left.camera_matrix),
-      world_(referenceOf(config)) {}
+      world_(referenceOf(settings)) {}
 
 void VisionStage::setReference(int id, double size_m, const cv::Vec3d& position) {
   vision::ReferenceMarker reference;
   reference.id = id;
   reference.size_m = size_m;
   reference.T_robot_ref = {cv::Matx33d::eye(), position};
-  reference_id_ = id;
-  reference_size_m_ = size_m;
+  settings_.reference_id = id;
+  settings_.reference_size_m = size_m;
+  settings_.reference_position = position;
   world_ = vision::WorldModel(reference);
   poses_.clear();
   last_poses_.clear();
 }
 
 double VisionStage::markerSize(int id) const {
-  if (id == reference_id_) return reference_size_m_;
-  for (const WorldObjectSettings& o : config_.world.objects) {
-    if (o.id == id) return o.marker_m;
-  }
-  return 0.0;
+  if (id == settings_.reference_id) return settings_.reference_size_m;
+  const auto found = settings_.marker_size.find(id);
+  return found == settings_.marker_size.end() ? 0.0 : found->second;
 }
 
 void VisionStage::process(double t, const cv::Mat& left, const cv::Mat& right) {

@@ -13,9 +13,20 @@
 
 namespace arbci::app {
 
+// What tracking needs of the session file, and nothing else.
+struct TrackingSettings {
+  vision::MarkerKind kind;
+  double border;  // of the markers' black square, as a fraction of its side
+  int reference_id;
+  double reference_size_m;
+  cv::Vec3d reference_position;       // robot frame
+  std::map<int, double> marker_size;  // the objects' marker sides (metres) by id
+  static TrackingSettings of(const SessionConfig& config);
+};
+
 class VisionStage {
  public:
-  VisionStage(const SessionConfig& config, const vision::CameraModel& left,
+  VisionStage(const TrackingSettings& settings, const vision::CameraModel& left,
               const vision::CameraModel& right, const vision::Pose& T_right_left);
 
   // A new pair of frames at time `t` (seconds); the right one may be empty (mono).
@@ -45,9 +56,7 @@ class VisionStage {
   double markerSize(int id) const;
 
  private:
-  const SessionConfig& config_;
-  int reference_id_;
-  double reference_size_m_;
+  TrackingSettings settings_;
   vision::CameraModel left_camera_, right_camera_;
   vision::Pose T_right_left_;
   vision::MarkerDetector detector_;
