@@ -10,9 +10,8 @@
 #include <thread>
 #include <vector>
 
-#include "arbci/robot/backend.h"
-#include "arbci/robot/client.h"
 #include "support/halt_recording_arm.h"
+#include "support/robot_test_support.h"
 #include "support/udp_relay.h"
 
 namespace {
@@ -21,56 +20,13 @@ using namespace arbci;
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-robot::Key benchKey() {
-  robot::Key key{};
-  for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<std::uint8_t>(i * 37 + 11);
-  return key;
-}
-
-robot::RobotConfig oneObject() {
-  robot::RobotConfig c;
-  c.objects = {{1, {0.10, 0.60, 0.06}, 0.06, 0.03}};
-  return c;
-}
-
-// A backend (real time, default watchdog) on its own thread, its arm noting its halt.
+// A backend (real time, the default 100 ms watchdog) whose arm notes when it was halted.
 struct Rig {
   std::shared_ptr<std::atomic<Clock::rep>> halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
-  std::unique_ptr<robot::RobotBackend> backend;
-  std::atomic<bool> stop{false};
-  std::thread thread;
-  explicit Rig(double watchdog_s) {
-    robot::BackendOptions options;
-    options.watchdog_s = watchdog_s;
-    backend = std::make_unique<robot::RobotBackend>(
-        benchKey(), std::make_unique<test::HaltRecordingArm>(oneObject(), halted_at), options);
-    thread = std::thread([this] { backend->run(stop); });
-  }
-  ~Rig() {
-    stop = true;
-    thread.join();
-  }
+  robot::RunningBackend backend{
+      std::make_unique<test::HaltRecordingArm>(robot::twoObjects(), halted_at),
+      robot::BackendOptions{}};
 };
-
-void pollFor(robot::RobotClient& client, std::chrono::milliseconds duration) {
-  const auto end = Clock::now() + duration;
-  while (Clock::now() < end) {
-    client.poll();
-    std::this_thread::sleep_for(1ms);
-  }
-}
-
-bool accepted(robot::RobotClient& client, std::uint64_t sequence) {
-  const auto end = Clock::now() + 5s;
-  while (Clock::now() < end) {
-    client.poll();
-    for (const auto& e : client.takeEvents()) {
-      if (e.sequence == sequence && e.kind == robot::RobotEvent::Kind::Accepted) return true;
-    }
-    std::this_thread::sleep_for(1ms);
-  }
-  return false;
-}
 
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
@@ -92,16 +48,17 @@ int main(int argc, char** argv) {
   std::vector<double> latencies;
   int not_halted = 0;
   for (int i = 0; i < cuts; ++i) {
-    Rig rig(0.1);
-    test::UdpRelay relay(rig.backend->port(), benchKey(), static_cast<unsigned>(i + 1));
-    robot::RobotClient client(robot::Endpoint::resolve("127.0.0.1", relay.port()), benchKey());
+    Rig rig;
+    test::UdpRelay relay(rig.backend.port(), robot::testKey(), static_cast<unsigned>(i + 1));
+    robot::RobotClient client(robot::Endpoint::resolve("127.0.0.1", relay.port()),
+                              robot::testKey());
     const auto grasp = client.send(robot::MessageType::Grasp, {0.10, 0.60, 0.06});
-    if (!accepted(client, grasp)) {
+    if (!robot::waitUntilAccepted(client, grasp)) {
       std::fprintf(stderr, "cut %d: the grasp was not accepted\n", i);
       return 1;
     }
     // Cut at a random phase of the heartbeat and of the backend's poll.
-    pollFor(client, std::chrono::milliseconds(100 + random() % 300));
+    robot::pollFor(client, std::chrono::milliseconds(100 + random() % 300));
     const auto cut = Clock::now();
     relay.setCut(true);
     std::this_thread::sleep_for(400ms);
@@ -130,27 +87,18 @@ int main(int argc, char** argv) {
   for (const double loss : {0.1, 0.3, 0.5}) {
     int halted = 0, finished = 0;
     for (int i = 0; i < lossy_runs; ++i) {
-      Rig rig(0.1);
-      test::UdpRelay relay(rig.backend->port(), benchKey(), static_cast<unsigned>(100 + i));
+      Rig rig;
+      test::UdpRelay relay(rig.backend.port(), robot::testKey(), static_cast<unsigned>(100 + i));
       relay.setLoss(loss, loss);
-      robot::RobotClient client(robot::Endpoint::resolve("127.0.0.1", relay.port()), benchKey());
-      const auto grasp = client.send(robot::MessageType::Grasp, {0.10, 0.60, 0.06});
-      const auto end = Clock::now() + 20s;
-      bool done = false;
-      while (!done && Clock::now() < end) {
-        client.poll();
-        for (const auto& e : client.takeEvents()) {
-          if (e.sequence != grasp) continue;
-          if (e.kind == robot::RobotEvent::Kind::Finished) {
-            done = true;
-            if (e.outcome == robot::Outcome::Success) ++finished;
-          }
-          done |= e.kind == robot::RobotEvent::Kind::Rejected ||
-                  e.kind == robot::RobotEvent::Kind::Failed;
-        }
-        std::this_thread::sleep_for(1ms);
-      }
-      halted += rig.backend->stats().watchdog_halts > 0 ? 1 : 0;
+      robot::RobotClient client(robot::Endpoint::resolve("127.0.0.1", relay.port()),
+                                robot::testKey());
+      const auto events =
+          robot::waitFor(client, client.send(robot::MessageType::Grasp, {0.10, 0.60, 0.06}));
+      const robot::RobotEvent* last = robot::finalEvent(events);
+      if (last && last->kind == robot::RobotEvent::Kind::Finished &&
+          last->outcome == robot::Outcome::Success)
+        ++finished;
+      halted += rig.backend.stats().watchdog_halts > 0 ? 1 : 0;
     }
     std::printf("| %.0f %% | %d | %d | %d |\n", loss * 100.0, lossy_runs, halted, finished);
   }

@@ -103,8 +103,7 @@ int talk(const RobotOptions& o, robot::MessageType type) {
   const std::string name = robot::toString(type);
   const robot::Vec3 target =
       o.xyz.size() == 3 ? robot::Vec3{o.xyz[0], o.xyz[1], o.xyz[2]} : robot::Vec3{};
-  const bool motion = type == robot::MessageType::Grasp || type == robot::MessageType::Drop ||
-                      type == robot::MessageType::Home;
+  const bool motion = robot::isMotion(type);
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t sequence = type == robot::MessageType::Status ? 0 : client.send(type, target);
   bool told_silent = false, ever_connected = false;

@@ -125,11 +125,7 @@ void EegStage::setModel(bci::P300Model model) {
 bci::Block EegStage::eegOnly(const bci::Block& block) const {
   if (photodiode_ < 0) return block;
   bci::Block out(block.first_sample, block.channels - 1, block.samples);
-  for (int c = 0, o = 0; c < block.channels; ++c) {
-    if (c == photodiode_) continue;
-    std::copy_n(block.data.begin() + static_cast<std::ptrdiff_t>(c) * block.samples, block.samples,
-                out.data.begin() + static_cast<std::ptrdiff_t>(o++) * block.samples);
-  }
+  out.data = bci::withoutChannel(block.data, block.channels, block.samples, photodiode_);
   return out;
 }
 

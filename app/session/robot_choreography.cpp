@@ -61,15 +61,9 @@ void RobotChoreography::drop(std::pair<int, int> cell, bool give_back, double ti
 }
 
 void RobotChoreography::stop(double time_s) {
-  client_->send(robot::MessageType::Stop);
-  command_.reset();
-  log_.write("robot_command", time_s, {{"command", "STOP"}});
-}
-
-void RobotChoreography::emergencyStop(double time_s) {
-  client_->send(robot::MessageType::Stop);
+  const auto sequence = client_->send(robot::MessageType::Stop);
   command_.reset();  // the client cancelled it; the backend refuses it
-  log_.write("robot_command", time_s, {{"command", "STOP"}, {"by", "experimenter"}});
+  log_.write("robot_command", time_s, {{"command", "STOP"}, {"sequence", sequence}});
 }
 
 void RobotChoreography::reset(double time_s) {

@@ -43,10 +43,9 @@ class RobotChoreography {
   void grasp(int object_id, const cv::Vec3d& at, double time_s);
   // Onto `cell`, or (`give_back`) back where the object was grasped.
   void drop(std::pair<int, int> cell, bool give_back, double time_s);
-  // The paradigm's stop (a STOP, nothing pending).
+  // STOP (the paradigm's, an emergency stop among them): the client cancels what is pending.
   void stop(double time_s);
-  // The experimenter's: emergency stop, and after it RESET and HOME (outside any trial).
-  void emergencyStop(double time_s);
+  // The experimenter's recovery after a latched stop: RESET and HOME (outside any trial).
   void reset(double time_s);
   void home(double time_s);
 

@@ -19,7 +19,8 @@ class SimulatedScene final : public SceneSource {
     left_camera_ = right_camera_ = world_.camera();
     T_right_left_ = world_.T_right_left();
   }
-  Frames capture(std::int64_t frame, double time_s) override {
+  Frames capture(std::int64_t frame, double time_s,
+                 const std::optional<robot::StatusPayload>& robot) override {
     Frames frames;
     // The right camera half a camera period later (at 60 Hz, both every frame).
     const bool left_due = frame % camera_every_ == 0;
@@ -27,7 +28,7 @@ class SimulatedScene final : public SceneSource {
     if (left_due) {
       // The objects and the gripper where the robot last reported them (the right camera, half
       // a camera period later, sees the same scene).
-      if (reported_) world_.update(*reported_);
+      if (robot) world_.update(*robot);
       const SimulatedWorld::Frame left = world_.captureLeft(time_s);
       frames.left = left.image;
       frames.left_changed = left.changed;
@@ -41,7 +42,6 @@ class SimulatedScene final : public SceneSource {
       frames.emplace_back(world_.captureLeft(-1.0 - i).image, world_.captureRight(-1.0 - i).image);
     return frames;
   }
-  void robotReported(const robot::StatusPayload& status) override { reported_ = status; }
   robot::RobotConfig simulatedRobot() const override { return world_.robotConfig(); }
   bool canHoldBoard() const override { return true; }
   void holdBoard(bool show, double time_s) override { world_.holdBoard(show, time_s); }
@@ -49,7 +49,6 @@ class SimulatedScene final : public SceneSource {
  private:
   SimulatedWorld world_;
   int camera_every_;
-  std::optional<robot::StatusPayload> reported_;
 };
 
 // Camera devices or video files, each read on its own thread; a new left frame is tracked with
@@ -74,7 +73,7 @@ class DeviceScene final : public SceneSource {
   std::vector<std::pair<cv::Mat, cv::Mat>> warmUpFrames() override {
     return {{cv::Mat::zeros(left_camera_.image_size, CV_8UC3), cv::Mat()}};
   }
-  Frames capture(std::int64_t, double) override {
+  Frames capture(std::int64_t, double, const std::optional<robot::StatusPayload>&) override {
     Frames frames;
     const auto [left, count] = left_->latest();
     if (count != left_seen_ && !left.empty()) {

@@ -29,13 +29,14 @@ class SceneSource {
     cv::Mat left;              // a new left frame (empty: none this cycle)
     bool left_changed = true;  // false: the same picture as the last left frame
     cv::Mat right;             // a new right frame (empty: none this cycle)
+    bool any() const { return !left.empty() || !right.empty(); }
   };
-  // This display frame's camera images, at session time `time_s`.
-  virtual Frames capture(std::int64_t frame, double time_s) = 0;
+  // This display frame's camera images, at session time `time_s`; `robot` is the robot's latest
+  // report of its world (a simulated scene puts its objects and gripper there).
+  virtual Frames capture(std::int64_t frame, double time_s,
+                         const std::optional<robot::StatusPayload>& robot) = 0;
   // Left and right images to warm the tracker up with before the cycle is timed (none: nothing).
   virtual std::vector<std::pair<cv::Mat, cv::Mat>> warmUpFrames() { return {}; }
-  // The robot's report of its world (a simulated scene puts its objects and gripper there).
-  virtual void robotReported(const robot::StatusPayload&) {}
   // The objects a simulated arm should know (the simulated scene's); none for a real scene.
   virtual robot::RobotConfig simulatedRobot() const { return {}; }
   // A simulated scene can hold a chessboard up for calibration (a new pose each call).

@@ -160,7 +160,6 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
     chooseSelectableObjects();
     paradigm_->robotFinished(true, "");
   };
-  // A simulated clock steps the arm too (the robot follows the session, frame by frame).
   const bool stepped = config_.robot_backend == "simulated" && options.simulated_clock;
   robot_ = std::make_unique<RobotChoreography>(std::make_unique<robot::RobotClient>(endpoint, key),
                                                stepped, *m.log, config_.world, gridLayout(),
@@ -201,21 +200,19 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
       {"trials", config_.paradigm.trials}}.dump(2);
   // Warm-up: Mesa compiles its shader variants and the tracker builds its tables on first use;
   // that happens here, before the cycle's time is measured.
-  {
-    for (const auto& [left, right] : m.scene->warmUpFrames()) vision_->process(0.0, left, right);
-    // Every kind of overlay once: highlights in each state, the grid with rows, columns and cells.
-    bci::FrameStimulus all;
-    all.grid_visible = true;
-    all.phase = bci::Phase::CellFlashing;
-    all.lit = {1, config_.world.grid.rows + 1};
-    all.cued_object = 1;
-    all.selected_object = 2;
-    all.selected_cell = std::make_pair(1, 1);
-    renderHmd(all);
-    all.phase = bci::Phase::ObjectFlashing;
-    renderHmd(all);
-    renderHmd(bci::FrameStimulus{});
-  }
+  for (const auto& [left, right] : m.scene->warmUpFrames()) vision_->process(0.0, left, right);
+  // Every kind of overlay once: highlights in each state, the grid with rows, columns and cells.
+  bci::FrameStimulus all;
+  all.grid_visible = true;
+  all.phase = bci::Phase::CellFlashing;
+  all.lit = {1, config_.world.grid.rows + 1};
+  all.cued_object = 1;
+  all.selected_object = 2;
+  all.selected_cell = std::make_pair(1, 1);
+  renderHmd(all);
+  all.phase = bci::Phase::ObjectFlashing;
+  renderHmd(all);
+  renderHmd(bci::FrameStimulus{});
   m.log->write(
       "session_started", 0.0,
       {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
@@ -247,8 +244,10 @@ void Session::abort() {
   paradigm_->abort();
 }
 void Session::emergencyStop() {
-  robot_->emergencyStop(time_);
+  impl_->log->write("emergency_stop", time_, {{"by", "experimenter"}});
   paradigm_->emergencyStop();
+  // The paradigm asks for the robot's STOP; it goes out now, not a frame later.
+  handleParadigmEvents();
 }
 
 void Session::resetRobot() {
@@ -301,19 +300,11 @@ bool Session::step() {
   collectTraining();
 
   // Cameras and tracking.
-  if (robot_->status()) m.scene->robotReported(*robot_->status());
-  const SceneSource::Frames frames = m.scene->capture(frame_, time_);
-  if (!frames.left.empty() || !frames.right.empty()) timing_.mark("cameras");
-  if (!frames.left.empty()) {
-    if (frames.left_changed) {
-      vision_->process(time_, frames.left, frames.right);
-    } else {
-      vision_->repeat(time_);
-      if (!frames.right.empty()) vision_->setRightImage(frames.right);
-    }
+  const SceneSource::Frames frames = m.scene->capture(frame_, time_, robot_->status());
+  if (frames.any()) {
+    timing_.mark("cameras");
+    vision_->take(time_, frames);
     timing_.mark("tracking");
-  } else if (!frames.right.empty()) {
-    vision_->setRightImage(frames.right);
   }
 
   // Robot: up to this frame's time (a stepped arm too), its events, a placement to measure.

@@ -77,6 +77,17 @@ void VisionStage::process(double t, const cv::Mat& left, const cv::Mat& right) {
   last_poses_ = std::move(poses);
 }
 
+void VisionStage::take(double t, const SceneSource::Frames& frames) {
+  if (frames.left.empty()) {
+    if (!frames.right.empty()) right_image_ = frames.right;
+  } else if (frames.left_changed) {
+    process(t, frames.left, frames.right);
+  } else {
+    repeat(t);
+    if (!frames.right.empty()) right_image_ = frames.right;
+  }
+}
+
 void VisionStage::repeat(double t) {
   world_.update(t, last_poses_);
 }

@@ -9,6 +9,7 @@
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/marker_poses.h"
 #include "arbci/vision/world_model.h"
+#include "session/scene_source.h"
 #include "session/session_config.h"
 
 namespace arbci::app {
@@ -31,10 +32,9 @@ class VisionStage {
 
   // A new pair of frames at time `t` (seconds); the right one may be empty (mono).
   void process(double t, const cv::Mat& left, const cv::Mat& right);
-  // A new right frame (shown in the HMD; the left camera is the one tracked).
-  void setRightImage(const cv::Mat& right) { right_image_ = right; }
-  // The same frames as last time, at time `t`: the last poses are seen again without tracking.
-  void repeat(double t);
+  // What the scene delivered this cycle: a new left frame is tracked (an unchanged one counts as
+  // seen again), a right one is kept for the HMD.
+  void take(double t, const SceneSource::Frames& frames);
   // The robot has moved object `id`: its pose is unknown until a new frame shows it.
   void objectMoved(int id);
 
@@ -56,6 +56,8 @@ class VisionStage {
   double markerSize(int id) const;
 
  private:
+  // The same frames as last time, at time `t`: the last poses are seen again without tracking.
+  void repeat(double t);
   TrackingSettings settings_;
   vision::CameraModel left_camera_, right_camera_;
   vision::Pose T_right_left_;

@@ -44,25 +44,10 @@ std::optional<Recording> withoutPhotodiode(const Recording& r) {
   const auto& channels = r.info.channels;
   const auto found = std::find(channels.begin(), channels.end(), named->second);
   if (found == channels.end()) return std::nullopt;
-  const auto drop = static_cast<size_t>(found - channels.begin());
-  Recording eeg;
-  eeg.source = r.source;
-  eeg.format = r.format;
-  eeg.info = r.info;
-  eeg.info.channels.erase(eeg.info.channels.begin() + static_cast<std::ptrdiff_t>(drop));
-  eeg.samples = r.samples;
-  eeg.data.reserve(r.data.size() - static_cast<size_t>(r.samples));
-  for (size_t c = 0; c < channels.size(); ++c) {
-    if (c == drop) continue;
-    const auto begin = r.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples);
-    eeg.data.insert(eeg.data.end(), begin, begin + r.samples);
-  }
-  eeg.stimuli = r.stimuli;
-  eeg.annotations = r.annotations;
-  eeg.parameters = r.parameters;
-  eeg.states = r.states;
-  eeg.truncated = r.truncated;
-  eeg.truncation_note = r.truncation_note;
+  const auto drop = static_cast<int>(found - channels.begin());
+  Recording eeg = r;  // (offline: one copy more keeps every other field as it is)
+  eeg.info.channels.erase(eeg.info.channels.begin() + drop);
+  eeg.data = withoutChannel(r.data, r.info.channelCount(), r.samples, drop);
   return eeg;
 }
 
@@ -136,8 +121,7 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   int n_target = 0, n_other = 0;
   for (size_t f = 0; f < count; ++f) {
     const Recording& r = recording(f);
-    if (progress)
-      progress(static_cast<double>(f) / count, "filtering and epoching " + r.source);
+    if (progress) progress(static_cast<double>(f) / count, "filtering and epoching " + r.source);
     if (r.stimuli.empty())
       throw std::invalid_argument(r.source + ": no stimulus events (StimulusCode) to classify");
     if (r.info.rate_hz != data.info.rate_hz) {

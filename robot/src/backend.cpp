@@ -22,10 +22,6 @@ std::uint64_t randomId() {
   return id;
 }
 
-bool isMotion(MessageType type) {
-  return type == MessageType::Grasp || type == MessageType::Drop || type == MessageType::Home;
-}
-
 // True when `sequence` is at least a whole replay window below `highest`, without overflowing
 // anywhere in the 64-bit range.
 bool belowWindow(std::uint64_t sequence, std::uint64_t highest) {

@@ -15,10 +15,6 @@ Clock::duration seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
-bool isMotion(MessageType type) {
-  return type == MessageType::Grasp || type == MessageType::Drop || type == MessageType::Home;
-}
-
 RobotEvent event(RobotEvent::Kind kind, std::string text) {
   return {kind, 0, MessageType::Status, {}, {}, std::move(text)};
 }

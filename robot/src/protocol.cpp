@@ -277,6 +277,10 @@ bool isCommand(MessageType type) {
   return static_cast<std::uint8_t>(type) < 0x80;
 }
 
+bool isMotion(MessageType type) {
+  return type == MessageType::Grasp || type == MessageType::Drop || type == MessageType::Home;
+}
+
 const char* toString(MessageType type) {
   switch (type) {
     case MessageType::Grasp:

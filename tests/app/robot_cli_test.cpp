@@ -15,9 +15,8 @@
 #include <future>
 #include <thread>
 
-#include "arbci/robot/backend.h"
 #include "arbci/robot/key_file.h"
-#include "arbci/robot/simulated_arm.h"
+#include "support/robot_test_support.h"
 #include "support/run_process.h"
 #include "support/udp_relay.h"
 
@@ -143,30 +142,15 @@ TEST(RobotCommand, AStopHoldsUntilReset) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
-// An in-process backend (its counts are the ground truth) behind a relay the test controls.
-class BackendThread {
- public:
-  explicit BackendThread(const robot::Key& key, double speed) {
-    robot::BackendOptions options;
-    options.speed_factor = speed;
-    robot::RobotConfig config;
-    config.objects = {{4, {0.1, 0.6, 0.06}, 0.06, 0.03}};
-    backend_ = std::make_unique<robot::RobotBackend>(
-        key, std::make_unique<robot::SimulatedArm>(config), options);
-    thread_ = std::thread([this] { backend_->run(stop_); });
-  }
-  ~BackendThread() {
-    stop_ = true;
-    thread_.join();
-  }
-  int port() const { return backend_->port(); }
-  robot::BackendStats stats() const { return backend_->stats(); }
-
- private:
-  std::unique_ptr<robot::RobotBackend> backend_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
-};
+// An in-process backend (its counts are the ground truth), with one object, behind a relay the
+// test controls.
+robot::RunningBackend backendWith(const robot::Key& key, double speed) {
+  robot::BackendOptions options;
+  options.speed_factor = speed;
+  robot::RobotConfig config;
+  config.objects = {{4, {0.1, 0.6, 0.06}, 0.06, 0.03}};
+  return robot::RunningBackend(std::make_unique<robot::SimulatedArm>(config), options, key);
+}
 
 // 100 commands in four lanes of 25 (a backend and a relay each, run side by side to save time).
 TEST(RobotCommand, AtHalfTheDatagramsLostEachWayEveryCommandThatRanIsReportedAsRun) {
@@ -175,10 +159,10 @@ TEST(RobotCommand, AtHalfTheDatagramsLostEachWayEveryCommandThatRanIsReportedAsR
   const robot::Key key = robot::loadKey(key_file);
   struct Lane {
     Lane(const robot::Key& key, unsigned seed)
-        : backend(key, 50.0), relay(backend.port(), key, seed) {
+        : backend(backendWith(key, 50.0)), relay(backend.port(), key, seed) {
       relay.setLoss(0.5, 0.5);
     }
-    BackendThread backend;
+    robot::RunningBackend backend;
     test::UdpRelay relay;
     int reported_run = 0, reported_not_run = 0;
     std::string first_failure;
@@ -219,7 +203,7 @@ TEST(RobotCommand, AMotionWhoseAnswersWereLostIsReportedAsRunAndStopped) {
   const auto key_file = scratch("deaf.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
   const robot::Key key = robot::loadKey(key_file);
-  BackendThread backend(key, 1.0);  // real time: the grasp takes seconds
+  robot::RunningBackend backend = backendWith(key, 1.0);  // real time: the grasp takes seconds
   test::UdpRelay relay(backend.port(), key);
   relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
                      robot::MessageType::Finished});

@@ -11,7 +11,7 @@
 #include <random>
 #include <thread>
 
-#include "robot/robot_test_support.h"
+#include "support/robot_test_support.h"
 #include "support/udp_relay.h"
 
 namespace arbci::robot {

@@ -12,7 +12,7 @@
 #include <iostream>
 #include <limits>
 
-#include "robot/robot_test_support.h"
+#include "support/robot_test_support.h"
 #include "support/halt_recording_arm.h"
 #include "support/udp_relay.h"
 

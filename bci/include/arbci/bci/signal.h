@@ -39,6 +39,20 @@ struct Block {
   std::int64_t endSample() const { return first_sample + samples; }
 };
 
+// Channel-major samples without one channel (a photodiode kept out of the EEG): blocks and whole
+// recordings alike.
+inline std::vector<float> withoutChannel(const std::vector<float>& data, int channels,
+                                         std::int64_t samples, int drop) {
+  std::vector<float> out;
+  out.reserve(data.size() - static_cast<size_t>(samples));
+  for (int c = 0; c < channels; ++c) {
+    if (c == drop) continue;
+    const auto begin = data.begin() + static_cast<std::ptrdiff_t>(c * samples);
+    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(samples));
+  }
+  return out;
+}
+
 // A stimulus presented to the subject (or any other event of the session).
 struct StimulusEvent {
   std::int64_t sample = 0;  // the EEG sample at which it was presented

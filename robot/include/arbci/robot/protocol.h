@@ -137,6 +137,7 @@ const char* toString(Outcome outcome);
 const char* toString(RobotState state);
 const char* toString(DecodeError error);
 bool isCommand(MessageType type);
+bool isMotion(MessageType type);  // GRASP, DROP, HOME: they move the arm
 
 std::uint64_t wallClockMs();
 

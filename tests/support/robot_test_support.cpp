@@ -1,4 +1,4 @@
-#include "robot/robot_test_support.h"
+#include "support/robot_test_support.h"
 
 namespace arbci::robot {
 
@@ -31,8 +31,9 @@ BackendOptions testOptions(double speed, int port, bool stepped) {
 RunningBackend::RunningBackend(double speed, int port, RobotConfig config, bool stepped)
     : RunningBackend(std::make_unique<SimulatedArm>(config), testOptions(speed, port, stepped)) {}
 
-RunningBackend::RunningBackend(std::unique_ptr<RobotDriver> driver, const BackendOptions& options)
-    : backend_(std::make_unique<RobotBackend>(testKey(), std::move(driver), options)) {
+RunningBackend::RunningBackend(std::unique_ptr<RobotDriver> driver, const BackendOptions& options,
+                               const Key& key)
+    : backend_(std::make_unique<RobotBackend>(key, std::move(driver), options)) {
   thread_ = std::thread([this] { backend_->run(stop_); });
 }
 

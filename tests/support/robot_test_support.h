@@ -1,5 +1,5 @@
-// What the robot tests share: a backend on its own thread (real UDP on 127.0.0.1), a fast client,
-// and bounded waits for events and statuses.
+// What the robot tests and the link bench share: a backend on its own thread (real UDP on
+// 127.0.0.1), a fast client, and bounded waits for events and statuses.
 #pragma once
 
 #include <atomic>
@@ -22,8 +22,9 @@ class RunningBackend {
  public:
   explicit RunningBackend(double speed, int port = 0, RobotConfig config = twoObjects(),
                           bool stepped = false);
-  // With any driver and options (the key is testKey()).
-  RunningBackend(std::unique_ptr<RobotDriver> driver, const BackendOptions& options);
+  // With any driver, options and key.
+  RunningBackend(std::unique_ptr<RobotDriver> driver, const BackendOptions& options,
+                 const Key& key = testKey());
   ~RunningBackend() { halt(); }
   void halt();
   int port() const { return backend_->port(); }
