@@ -79,7 +79,8 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
     const int panel_w = 260, panel_h = 170, margin = 50;
     cv::Mat image(rows * (panel_h + margin) + 60, columns * (panel_w + margin) + margin, CV_8UC3,
                   kWhite);
-    text(image, "ERP averages (" + title + "): target (red) vs non-target (blue), uV against ms",
+    // The ERPs are plain averages of every epoch; `title` names the accuracy figure's source.
+    text(image, "ERP averages of all epochs: target (red) vs non-target (blue), uV against ms",
          {margin, 28}, 0.5);
     const double limit = std::max(
         {1.0, data.erp_target.cwiseAbs().maxCoeff(), data.erp_other.cwiseAbs().maxCoeff()});
@@ -94,8 +95,10 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
                         -limit,
                         limit};
       panel.axes(image, data.info.channels[static_cast<size_t>(c)], 0, 1);
-      std::vector<double> t(data.erp_target.row(c).data(), data.erp_target.row(c).data() + samples);
-      std::vector<double> o(data.erp_other.row(c).data(), data.erp_other.row(c).data() + samples);
+      // A row of a column-major matrix is strided: read it element by element.
+      const auto target_row = data.erp_target.row(c), other_row = data.erp_other.row(c);
+      std::vector<double> t(target_row.begin(), target_row.end());
+      std::vector<double> o(other_row.begin(), other_row.end());
       panel.curve(image, ms, o, kOther);
       panel.curve(image, ms, t, kTarget);
     }

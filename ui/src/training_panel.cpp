@@ -118,9 +118,10 @@ void TrainingPanel::draw() {
   const float limit = static_cast<float>(
       std::max({1.0, d.erp_target.cwiseAbs().maxCoeff(), d.erp_other.cwiseAbs().maxCoeff()}));
   for (int c = 0; c < static_cast<int>(d.erp_target.rows()); ++c) {
-    std::vector<float> t(d.erp_target.row(c).data(),
-                         d.erp_target.row(c).data() + d.erp_target.cols());
-    std::vector<float> o(d.erp_other.row(c).data(), d.erp_other.row(c).data() + d.erp_other.cols());
+    // A row of a column-major matrix is strided: read it element by element.
+    const auto target_row = d.erp_target.row(c), other_row = d.erp_other.row(c);
+    std::vector<float> t(target_row.begin(), target_row.end());
+    std::vector<float> o(other_row.begin(), other_row.end());
     ImGui::PushID(c);
     ImGui::PlotLines(d.info.channels[static_cast<size_t>(c)].c_str(), t.data(),
                      static_cast<int>(t.size()), 0, "target", -limit, limit, ImVec2(0, 40));
