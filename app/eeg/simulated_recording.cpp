@@ -6,6 +6,7 @@
 #include <set>
 #include <thread>
 
+#include "arbci/bci/paradigm_layout.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
 #include "arbci/bci/simulated_subject.h"
@@ -30,7 +31,9 @@ struct Schedule {
 Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
   Schedule schedule;
   const bool matrix = o.rows > 0 && o.columns > 0;
-  const int codes = matrix ? o.rows + o.columns : o.stimuli;
+  const bci::ParadigmLayout layout = matrix ? bci::ParadigmLayout::matrix(o.rows, o.columns)
+                                            : bci::ParadigmLayout::single(o.stimuli);
+  const int codes = layout.codes();
   const double soa = (o.flash_ms + o.isi_ms) / 1000.0;
   const double selection_seconds = 1.0 + o.sequences * codes * soa + 1.0;  // cue, flashes, rest
   bci::StimulusSequencer sequencer(codes, o.seed + 1);
@@ -39,17 +42,13 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
   while ((t + selection_seconds) * o.rate_hz <= static_cast<double>(total_samples)) {
     Selection selection;
     selection.start = static_cast<std::int64_t>(std::llround(t * o.rate_hz));
+    selection.attended = layout.drawTarget(random);
+    selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) + " target ";
     if (matrix) {
-      const int row = std::uniform_int_distribution<int>(1, o.rows)(random);
-      const int column = std::uniform_int_distribution<int>(1, o.columns)(random);
-      selection.attended = {row, o.rows + column};
-      selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) +
-                        " target row " + std::to_string(row) + " column " + std::to_string(column);
+      const int row = *selection.attended.begin(), column = *selection.attended.rbegin() - o.rows;
+      selection.label += "row " + std::to_string(row) + " column " + std::to_string(column);
     } else {
-      const int target = std::uniform_int_distribution<int>(1, o.stimuli)(random);
-      selection.attended = {target};
-      selection.label = "Selection " + std::to_string(schedule.selections.size() + 1) + " target " +
-                        std::to_string(target);
+      selection.label += std::to_string(*selection.attended.begin());
     }
     double onset = t + 1.0;
     for (int sequence = 0; sequence < o.sequences; ++sequence) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ostream>
 #include <thread>
 
 #include "arbci/bci/file_source.h"
@@ -44,13 +45,26 @@ std::unique_ptr<bci::EegSource> openSource(const EegSettings& eeg,
 }  // namespace
 
 EegStageSettings EegStageSettings::of(const SessionConfig& config) {
-  return {config.eeg, config.pipeline, config.paradigm.flashSeconds(),
-          static_cast<int>(config.world.objects.size()), config.source};
+  return {config.eeg,
+          config.pipeline,
+          config.paradigm.flashSeconds(),
+          static_cast<int>(config.world.objects.size()),
+          config.model_file,
+          config.source};
+}
+
+void EegStageSettings::validate() const {
+  for (const auto& [key, file] :
+       {std::pair{"eeg.file", eeg.file}, std::pair{"classifier.model", model_file}}) {
+    if (!file.empty() && !std::filesystem::exists(file))
+      throw SessionConfigError(session_file + ": " + key + " = \"" + file + "\": no such file");
+  }
 }
 
 EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path& recording_path,
-                   bool stepped, const std::map<std::string, std::string>& parameters)
-    : settings_(settings) {
+                   bool stepped, const std::map<std::string, std::string>& parameters,
+                   SessionLog& log, std::ostream* progress)
+    : settings_(settings), stepped_(stepped), log_(log), progress_(progress) {
   const EegSettings& eeg = settings_.eeg;
   std::shared_ptr<bci::SampleClock> clock;
   if (stepped)
@@ -87,7 +101,28 @@ EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path
   calibration_.parameters["Paradigm"] =
       "single stimulus, " + std::to_string(settings_.object_stimuli) + " stimuli";
   recent_.assign(static_cast<size_t>(eeg_info_.channelCount()), {});
+  if (!settings_.model_file.empty()) setModel(bci::P300Model::load(settings_.model_file));
   acquisition_->start();
+}
+
+void EegStage::step(CycleContext& cycle) {
+  if (stepped_) advanceTo(cycle.time_s);
+  poll();
+  if (lostSamples() != lost_logged_) {
+    log_.write("lost_samples", cycle.time_s,
+               {{"total", lostSamples()}, {"new", lostSamples() - lost_logged_}});
+    if (progress_)
+      *progress_ << "\nwarning: " << lostSamples() - lost_logged_
+                 << " EEG samples lost (see the recording's annotations)\n";
+    lost_logged_ = lostSamples();
+  }
+  cycle.eeg_sample = sampleAt(cycle.host_s);
+}
+
+void EegStage::stop(const CycleContext& cycle, const std::string& reason) {
+  if (!stepped_) drainUntil(bci::hostSeconds() + 0.1, 1.0);
+  annotate(sampleAt(cycle.host_s), "Session ended: " + reason);
+  close();
 }
 
 EegStage::~EegStage() {

@@ -20,6 +20,8 @@
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
 #include "session/session_config.h"
+#include "session/session_log.h"
+#include "session/stage.h"
 
 namespace arbci::app {
 
@@ -29,8 +31,11 @@ struct EegStageSettings {
   bci::PipelineSettings pipeline;
   double flash_s;            // a flash's nominal duration (the paradigm's, in whole frames)
   int object_stimuli;        // stimuli of the calibration run (the objects)
+  std::string model_file;    // a trained model (empty: none, the calibration run trains one)
   std::string session_file;  // for messages naming a key
   static EegStageSettings of(const SessionConfig& config);
+  // Before the run: the files named exist; throws SessionConfigError naming the key and value.
+  void validate() const;
 };
 
 struct TrainingOutcome {
@@ -38,14 +43,24 @@ struct TrainingOutcome {
   bci::EvaluationReport report;
 };
 
-class EegStage {
+class EegStage final : public Stage {
  public:
-  // Opens the source named by the session and starts the recording. `stepped`: the source runs
-  // in lock-step with a simulated clock (advanceTo); otherwise on its own clock, acquired by a
-  // thread. Throws std::runtime_error (SessionConfigError naming the key for a bad channel).
+  // Opens the source named by the session, loads the model when one is named, and starts the
+  // recording. `stepped`: the source runs in lock-step with a simulated clock; otherwise on its
+  // own clock, acquired by a thread. Lost samples are logged and said on `progress` (when given).
+  // Throws std::runtime_error (SessionConfigError naming the key for a bad channel).
   EegStage(const EegStageSettings& settings, const std::filesystem::path& recording_path,
-           bool stepped, const std::map<std::string, std::string>& parameters);
+           bool stepped, const std::map<std::string, std::string>& parameters, SessionLog& log,
+           std::ostream* progress);
   ~EegStage();
+
+  const char* name() const override { return "eeg"; }
+  // Takes everything that has arrived (stepped: generated up to the cycle's time) and fills in
+  // the cycle's EEG sample.
+  void step(CycleContext& cycle) override;
+  // Live, the EEG of the last frames is still on its way: waits for it (at most 1 s), notes the
+  // end in the recording and closes it.
+  void stop(const CycleContext& cycle, const std::string& reason) override;
 
   // The EEG channels (without the photodiode): what filters, epochs and models see.
   const bci::SignalInfo& info() const { return eeg_info_; }
@@ -106,6 +121,10 @@ class EegStage {
   bci::Block eegOnly(const bci::Block& block) const;
 
   EegStageSettings settings_;
+  bool stepped_;
+  SessionLog& log_;
+  std::ostream* progress_;
+  std::int64_t lost_logged_ = 0;  // lost samples already in the log
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;
   int photodiode_ = -1;  // the photodiode's channel in the source's blocks

@@ -6,6 +6,15 @@
 
 namespace arbci::app {
 
+render::GridLayout gridLayoutOf(const GridSettings& grid) {
+  render::GridLayout layout;
+  layout.T_world_grid = {cv::Matx33d::eye(), grid.centre};
+  layout.rows = grid.rows;
+  layout.columns = grid.columns;
+  layout.cell_m = grid.cell_m;
+  return layout;
+}
+
 render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdScene& scene) {
   const VisionStage& vision = scene.vision;
   render::HmdFrame frame;
@@ -13,7 +22,7 @@ render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdSc
   frame.right = {vision.rightImage(), vision.rightCamera(), vision.T_cam_world_right()};
   const bool objects_phase = stimulus.phase == bci::Phase::ObjectFlashing ||
                              stimulus.phase == bci::Phase::CalibrationFlashing;
-  const auto& objects = scene.config.world.objects;
+  const auto& objects = scene.objects;
   for (size_t i = 0; i < objects.size(); ++i) {
     const WorldObjectSettings& o = objects[i];
     const auto state = vision.world().object(o.id);

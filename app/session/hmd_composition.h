@@ -15,14 +15,17 @@
 namespace arbci::app {
 
 struct HmdScene {
-  const SessionConfig& config;
+  const std::vector<WorldObjectSettings>& objects;
   const VisionStage& vision;
-  // Stimulus code k stands for config.world.objects[slots[k - 1]].
+  // Stimulus code k stands for objects[slots[k - 1]].
   const std::vector<size_t>& slots;
   int holding = -1;  // the marker id of the object in the gripper, -1: none
   render::GridLayout grid;
   bool photodiode_patch = false;
 };
+
+// The session file's grid as the renderer draws it (on the table, in the robot frame).
+render::GridLayout gridLayoutOf(const GridSettings& grid);
 
 render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdScene& scene);
 std::string hmdFrameSignature(const render::HmdFrame& frame);

@@ -15,7 +15,8 @@ RobotChoreography::RobotChoreography(std::unique_ptr<robot::RobotClient> client,
       camera_every_(camera_every),
       hooks_(std::move(hooks)) {}
 
-void RobotChoreography::step(std::int64_t frame, double time_s) {
+void RobotChoreography::step(CycleContext& cycle) {
+  const double time_s = cycle.time_s;
   // A stepped arm is moved to this frame's time while it has anything to do (idle, it does not
   // move; send() brings its clock up to date before a command).
   const bool matters = command_ || (homed_ && !clear_view_frame_) || placement_;
@@ -26,7 +27,7 @@ void RobotChoreography::step(std::int64_t frame, double time_s) {
   client_->poll();
   handleEvents(time_s);
   measurePlacement(time_s);
-  endPutDownOnceInView(frame);
+  endPutDownOnceInView(cycle.frame);
 }
 
 void RobotChoreography::send(robot::MessageType type, const cv::Vec3d& target, double time_s) {

@@ -19,11 +19,12 @@
 #include "arbci/robot/client.h"
 #include "session/session_config.h"
 #include "session/session_log.h"
+#include "session/stage.h"
 #include "session/trial_record.h"
 
 namespace arbci::app {
 
-class RobotChoreography {
+class RobotChoreography final : public Stage {
  public:
   struct Hooks {
     std::function<TrialRecord&()> current_trial;
@@ -37,9 +38,10 @@ class RobotChoreography {
                     const WorldSettings& world, const render::GridLayout& grid, int camera_every,
                     Hooks hooks);
 
-  // Each frame, before the paradigm: the robot brought up to `time_s`, its events handled, a
-  // finished placement measured.
-  void step(std::int64_t frame, double time_s);
+  const char* name() const override { return "robot"; }
+  // Each frame, before the paradigm: the robot brought up to the cycle's time, its events
+  // handled, a finished placement measured.
+  void step(CycleContext& cycle) override;
   void grasp(int object_id, const cv::Vec3d& at, double time_s);
   // Onto `cell`, or (`give_back`) back where the object was grasped.
   void drop(std::pair<int, int> cell, bool give_back, double time_s);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "session/camera_capture.h"
 #include "session/simulated_world.h"
@@ -12,10 +13,10 @@ namespace {
 // The simulated world's cameras, rendered on alternate display frames (no cycle pays for both).
 class SimulatedScene final : public SceneSource {
  public:
-  explicit SimulatedScene(const SessionConfig& config)
-      : world_(config),
+  explicit SimulatedScene(const SceneSettings& settings)
+      : world_(settings),
         camera_every_(std::max(
-            1, static_cast<int>(std::lround(config.display_hz / config.cameras.rate_hz)))) {
+            1, static_cast<int>(std::lround(settings.display_hz / settings.cameras.rate_hz)))) {
     left_camera_ = right_camera_ = world_.camera();
     T_right_left_ = world_.T_right_left();
   }
@@ -55,8 +56,8 @@ class SimulatedScene final : public SceneSource {
 // the right camera's latest.
 class DeviceScene final : public SceneSource {
  public:
-  explicit DeviceScene(const SessionConfig& config) {
-    const CameraSettings& c = config.cameras;
+  explicit DeviceScene(const SceneSettings& settings) {
+    const CameraSettings& c = settings.cameras;
     left_camera_ = vision::CameraModel::load(c.left.calibration);
     left_ = std::make_unique<CameraCapture>(c.left.device, c.left.video, "cameras.left");
     right_camera_ = left_camera_;
@@ -91,9 +92,39 @@ class DeviceScene final : public SceneSource {
 
 }  // namespace
 
-std::unique_ptr<SceneSource> openScene(const SessionConfig& config) {
-  if (config.cameras.source == "simulated") return std::make_unique<SimulatedScene>(config);
-  return std::make_unique<DeviceScene>(config);
+SceneSettings SceneSettings::of(const SessionConfig& config) {
+  return {config.cameras,  config.world,      config.tracker_kind,       config.tracker_border,
+          config.eeg.seed, config.display_hz, config.robot_speed_factor, config.source};
+}
+
+void SceneSettings::validate() const {
+  auto exists = [&](const std::string& key, const std::string& file) {
+    if (!file.empty() && !std::filesystem::exists(file))
+      throw SessionConfigError(session_file + ": " + key + " = \"" + file + "\": no such file");
+  };
+  exists("cameras.stereo_calibration", cameras.stereo_calibration);
+  for (const auto& [side, cam] :
+       {std::pair{"cameras.left", &cameras.left}, std::pair{"cameras.right", &cameras.right}}) {
+    exists(std::string(side) + ".video", cam->video);
+    exists(std::string(side) + ".calibration", cam->calibration);
+    if (!cam->calibration.empty()) {
+      try {
+        vision::CameraModel::load(cam->calibration);
+      } catch (const std::exception& error) {
+        throw SessionConfigError(session_file + ": " + side + ".calibration: " + error.what());
+      }
+    }
+    if (cam->device >= 0 && !std::filesystem::exists("/dev/video" + std::to_string(cam->device))) {
+      throw SessionConfigError(session_file + ": " + side +
+                               ".device = " + std::to_string(cam->device) + ": /dev/video" +
+                               std::to_string(cam->device) + " does not exist");
+    }
+  }
+}
+
+std::unique_ptr<SceneSource> openScene(const SceneSettings& settings) {
+  if (settings.cameras.source == "simulated") return std::make_unique<SimulatedScene>(settings);
+  return std::make_unique<DeviceScene>(settings);
 }
 
 }  // namespace arbci::app

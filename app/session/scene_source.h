@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -17,6 +18,22 @@
 #include "session/session_config.h"
 
 namespace arbci::app {
+
+// What the scene needs of the session file, and nothing else.
+struct SceneSettings {
+  CameraSettings cameras;
+  WorldSettings world;  // a simulated scene builds its table from it
+  std::string tracker_kind;
+  double tracker_border;
+  std::uint64_t seed;         // the simulated cameras' noise
+  double display_hz;          // display frames per camera frame
+  double robot_speed_factor;  // the simulated arm's
+  std::string session_file;   // for messages naming a key
+  static SceneSettings of(const SessionConfig& config);
+  // Before the run: the files and devices named can be opened; throws SessionConfigError naming
+  // the key and the value.
+  void validate() const;
+};
 
 class SceneSource {
  public:
@@ -49,6 +66,6 @@ class SceneSource {
 };
 
 // `cameras.source`: "simulated" (needs a current GL context) or "devices". Throws naming the key.
-std::unique_ptr<SceneSource> openScene(const SessionConfig& config);
+std::unique_ptr<SceneSource> openScene(const SceneSettings& settings);
 
 }  // namespace arbci::app

@@ -1,8 +1,9 @@
-// A session: the render-loop-synchronised cycle that ties every part together. Each displayed
-// frame it polls the EEG source, filters, epochs and classifies; grabs the camera frames and
-// tracks the markers; updates the world model, the robot and the paradigm; renders the HMD view.
-// Every flash is stamped with the EEG sample index at its presentation. Each stage is timed; a
-// cycle whose compute time exceeds the block budget is an overrun, counted and logged.
+// A session: the render-loop-synchronised cycle that ties every part together, a short loop over
+// its stages (session/stage.h), in the order data flows: the EEG (acquired, recorded, filtered,
+// epoched, scored), the cameras, tracking, the robot, the paradigm (what the frame shows and what
+// is decided), the HMD view. Every flash is stamped with the EEG sample index at its presentation.
+// Each stage is timed; a cycle whose compute time exceeds the block budget is an overrun, counted
+// and logged; a frame presented more than a period late is a late frame.
 //
 // Headless runs advance a simulated clock (display frames and EEG samples together) as fast as
 // the machine allows, unless real time is asked for; windowed runs follow the wall clock.
@@ -18,11 +19,17 @@
 #include "arbci/bci/paradigm.h"
 #include "arbci/render/gl_context.h"
 #include "arbci/render/hmd_view.h"
-#include "arbci/robot/client.h"
+#include "session/camera_stage.h"
 #include "session/cycle_timing.h"
 #include "session/eeg_stage.h"
+#include "session/hmd_stage.h"
+#include "session/paradigm_stage.h"
 #include "session/robot_choreography.h"
+#include "session/robot_process.h"
 #include "session/session_config.h"
+#include "session/session_log.h"
+#include "session/stage.h"
+#include "session/stimulus_timing.h"
 #include "session/trial_record.h"
 #include "session/vision_stage.h"
 
@@ -47,8 +54,9 @@ struct SessionOptions {
 
 class Session {
  public:
-  // Creates the session folder, starts the robot backend (simulated) and the recording. Throws
-  // std::runtime_error (or SessionConfigError) with the reason.
+  // Validates every stage's settings, creates the session folder, starts the robot backend
+  // (simulated) and the recording. Throws std::runtime_error (or SessionConfigError naming the
+  // key) with the reason.
   Session(SessionConfig config, const SessionOptions& options, render::GlContext& context);
   ~Session();
 
@@ -80,19 +88,21 @@ class Session {
 
   // For the panels and the windowed app.
   const SessionConfig& config() const { return config_; }
-  const bci::Paradigm& paradigm() const { return *paradigm_; }
+  const bci::Paradigm& paradigm() const { return paradigm_->paradigm(); }
   VisionStage& vision() { return *vision_; }
   EegStage& eeg() { return *eeg_; }
   const CycleTiming& timing() const { return timing_; }
   const std::optional<robot::StatusPayload>& robotStatus() const { return robot_->status(); }
   bool robotSilent() const { return robot_->silent(); }
   const std::vector<std::string>& robotLog() const { return robot_->messages(); }
-  const std::vector<TrialRecord>& trials() const { return trials_; }
-  std::optional<bci::EvaluationReport> calibrationReport() const { return calibration_report_; }
-  unsigned int hmdTexture() const;  // the last HMD frame, for the UI
-  render::Size hmdSize() const { return {config_.hmd_width, config_.hmd_height}; }
+  const std::vector<TrialRecord>& trials() const { return paradigm_->trials(); }
+  std::optional<bci::EvaluationReport> calibrationReport() const {
+    return paradigm_->calibrationReport();
+  }
+  unsigned int hmdTexture() const { return hmd_->texture(); }  // the last HMD frame, for the UI
+  render::Size hmdSize() const { return hmd_->size(); }
   const std::filesystem::path& folder() const { return folder_; }
-  double time() const { return time_; }
+  double time() const { return cycle_.time_s; }
   std::int64_t frame() const { return frame_; }
   std::string statusLine() const;
   bool ended() const { return ended_; }
@@ -105,40 +115,39 @@ class Session {
   void useModel(const bci::P300Model& model);
   std::vector<std::string> selectionLines() const;
   // Writes the HMD view as it is now.
-  void screenshot(const std::filesystem::path& path);
+  void screenshot(const std::filesystem::path& path) { hmd_->screenshot(path); }
   nlohmann::json summary() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  // This cycle's frame number, time and due time.
+  void beginCycle();
+  void recordCycleTime();
+  // A run without an experimenter ends on a fault after a while; every run at its end.
+  void endIfDone();
+  void endRun(const std::string& reason);
+
   SessionConfig config_;
   SessionOptions options_;
+  render::GlContext& context_;
   std::filesystem::path folder_;
-  std::unique_ptr<bci::Paradigm> paradigm_;
-  std::unique_ptr<VisionStage> vision_;
-  std::unique_ptr<EegStage> eeg_;
-  std::unique_ptr<RobotChoreography> robot_;
+  std::unique_ptr<SessionLog> log_;
+  std::unique_ptr<RobotProcess> robotd_;  // arbci-robotd, for a simulated robot
   CycleTiming timing_;
-  std::vector<TrialRecord> trials_;
-  std::optional<bci::EvaluationReport> calibration_report_;
-  double time_ = 0.0;
-  std::int64_t frame_ = 0;
+  std::unique_ptr<StimulusTiming> stimulus_timing_;
+  CycleContext cycle_;        // the cycle being made (the last one, between frames)
+  double host_origin_ = 0.0;  // session second 0 on the host clock (0 for a simulated clock)
+  std::int64_t frame_ = 0;    // the next frame
+  double fault_since_ = -1.0;
   bool ended_ = false;
   std::string end_reason_;
-
-  void handleParadigmEvents();
-  void collectTraining();
-  render::GridLayout gridLayout() const;
-  // The object a selection's stimulus code stands for this trial.
-  const WorldObjectSettings& objectOfCode(int code) const;
-  // Offers the next trials the objects the cameras see (every one unless some are hidden).
-  void chooseSelectableObjects();
-  // The tracked object (other than the one in the gripper) standing on a grid cell, if any.
-  std::optional<int> objectOnCell(std::pair<int, int> cell) const;
-  void decideIfReady();
-  void renderHmd(const bci::FrameStimulus& stimulus);
-  void endRun(const std::string& reason);
-  TrialRecord& currentTrial();
+  // The stages, constructed in this order (each may use those before it).
+  std::unique_ptr<RobotChoreography> robot_;
+  std::unique_ptr<CameraStage> cameras_;
+  std::unique_ptr<VisionStage> vision_;
+  std::unique_ptr<EegStage> eeg_;
+  std::unique_ptr<ParadigmStage> paradigm_;
+  std::unique_ptr<HmdStage> hmd_;
+  std::vector<Stage*> stages_;  // in the order they run
 };
 
 }  // namespace arbci::app

@@ -5,7 +5,6 @@
 #include <set>
 
 #include "arbci/assets.h"
-#include "arbci/vision/camera_model.h"
 
 namespace arbci::app {
 namespace {
@@ -356,33 +355,6 @@ SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& pa
   config.source = path->string();
   parse(json, path->string(), config, false);
   return config;
-}
-
-void SessionConfig::checkResources() const {
-  auto exists = [&](const std::string& key, const std::string& file) {
-    if (!file.empty() && !std::filesystem::exists(file))
-      throw SessionConfigError(source + ": " + key + " = \"" + file + "\": no such file");
-  };
-  exists("eeg.file", eeg.file);
-  exists("classifier.model", model_file);
-  exists("robot.key_file", robot_key_file);
-  exists("cameras.stereo_calibration", cameras.stereo_calibration);
-  for (const auto& [side, cam] :
-       {std::pair{"cameras.left", &cameras.left}, std::pair{"cameras.right", &cameras.right}}) {
-    exists(std::string(side) + ".video", cam->video);
-    exists(std::string(side) + ".calibration", cam->calibration);
-    if (!cam->calibration.empty()) {
-      try {
-        vision::CameraModel::load(cam->calibration);
-      } catch (const std::exception& error) {
-        throw SessionConfigError(source + ": " + side + ".calibration: " + error.what());
-      }
-    }
-    if (cam->device >= 0 && !std::filesystem::exists("/dev/video" + std::to_string(cam->device))) {
-      throw SessionConfigError(source + ": " + side + ".device = " + std::to_string(cam->device) +
-                               ": /dev/video" + std::to_string(cam->device) + " does not exist");
-    }
-  }
 }
 
 }  // namespace arbci::app

@@ -115,8 +115,6 @@ struct SessionConfig {
   // assets/sessions/simulated.json): the one place a default lives. Throws SessionConfigError
   // naming a key it lacks.
   static SessionConfig defaults(const std::string& json_text, const std::string& name);
-  // Checks that what the file names can be opened (files, devices); throws naming the key.
-  void checkResources() const;
 };
 
 }  // namespace arbci::app

@@ -4,42 +4,42 @@
 
 namespace arbci::app {
 
-SimulatedWorld::SimulatedWorld(const SessionConfig& config) : config_(config) {
-  const CameraSettings& c = config.cameras;
+SimulatedWorld::SimulatedWorld(const SceneSettings& settings) : settings_(settings) {
+  const CameraSettings& c = settings.cameras;
   camera_.image_size = {c.width, c.height};
   camera_.camera_matrix =
       cv::Matx33d(c.focal_px, 0, c.width / 2.0 - 0.5, 0, c.focal_px, c.height / 2.0 - 0.5, 0, 0, 1);
   camera_.distortion = c.distortion;
   camera_.source = "simulated camera";
-  const WorldSettings& w = config.world;
+  const WorldSettings& w = settings.world;
   scene_.table_z = w.table_z;
   scene_.reference = {vision::MarkerKind::Bch, w.reference_id, w.reference_size_m,
-                      config.tracker_border};
+                      settings.tracker_border};
   scene_.T_world_reference = {cv::Matx33d::eye(), w.reference_position};
   for (const WorldObjectSettings& o : w.objects) {
     render::SceneObject object;
     object.marker = {
-        config.tracker_kind == "simple" ? vision::MarkerKind::Simple : vision::MarkerKind::Bch,
-        o.id, o.marker_m, config.tracker_border};
+        settings.tracker_kind == "simple" ? vision::MarkerKind::Simple : vision::MarkerKind::Bch,
+        o.id, o.marker_m, settings.tracker_border};
     object.T_world_top = {cv::Matx33d::eye(), o.position};
     object.width_m = o.width_m;
     object.height_m = o.height_m;
     object.color = glm::vec3(o.color[0], o.color[1], o.color[2]);
     scene_.objects.push_back(object);
   }
-  left_ = std::make_unique<render::SimulatedCamera>(camera_, config.eeg.seed * 7 + 1);
-  right_ = std::make_unique<render::SimulatedCamera>(camera_, config.eeg.seed * 7 + 2);
+  left_ = std::make_unique<render::SimulatedCamera>(camera_, settings.seed * 7 + 1);
+  right_ = std::make_unique<render::SimulatedCamera>(camera_, settings.seed * 7 + 2);
 }
 
 SimulatedWorld::~SimulatedWorld() = default;
 
 robot::RobotConfig SimulatedWorld::robotConfig() const {
   robot::RobotConfig r;
-  r.table_z = config_.world.table_z;
-  r.workspace_min = {-0.7, 0.2, config_.world.table_z};
-  r.workspace_max = {0.7, 1.0, config_.world.table_z + 0.6};
-  r.speed_factor = config_.robot_speed_factor;
-  for (const WorldObjectSettings& o : config_.world.objects) {
+  r.table_z = settings_.world.table_z;
+  r.workspace_min = {-0.7, 0.2, settings_.world.table_z};
+  r.workspace_max = {0.7, 1.0, settings_.world.table_z + 0.6};
+  r.speed_factor = settings_.robot_speed_factor;
+  for (const WorldObjectSettings& o : settings_.world.objects) {
     r.objects.push_back(
         {o.id, {o.position[0], o.position[1], o.position[2]}, o.height_m, o.width_m / 2.0});
   }
@@ -65,7 +65,7 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
 }
 
 vision::Pose SimulatedWorld::leftCamera(double t) const {
-  const CameraSettings& c = config_.cameras;
+  const CameraSettings& c = settings_.cameras;
   // Slow, small head motion: a few millimetres and a fraction of a degree.
   const cv::Vec3d sway(c.head_motion_m * std::sin(0.7 * t),
                        c.head_motion_m * 0.6 * std::sin(0.45 * t + 1.0),
@@ -81,7 +81,7 @@ vision::Pose SimulatedWorld::leftCamera(double t) const {
 }
 
 vision::Pose SimulatedWorld::T_right_left() const {
-  return vision::Pose{cv::Matx33d::eye(), cv::Vec3d(-config_.cameras.baseline_m, 0, 0)};
+  return vision::Pose{cv::Matx33d::eye(), cv::Vec3d(-settings_.cameras.baseline_m, 0, 0)};
 }
 
 vision::Pose SimulatedWorld::rightCamera(double t) const {
@@ -96,8 +96,8 @@ SimulatedWorld::Frame SimulatedWorld::capture(render::SimulatedCamera& camera, C
     return {cache.image, false};
   render::CameraEffects effects;
   effects.distort = !camera_.distortion.empty();
-  effects.noise_sigma = config_.cameras.noise;
-  effects.blur_sigma = config_.cameras.blur_px;
+  effects.noise_sigma = settings_.cameras.noise;
+  effects.blur_sigma = settings_.cameras.blur_px;
   effects.vignetting = 0.15;
   cache.image = camera.render(scene_, pose, effects);
   cache.pose = pose;

@@ -11,13 +11,13 @@
 #include "arbci/render/simulated_camera.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/robot/robot_config.h"
-#include "session/session_config.h"
+#include "session/scene_source.h"
 
 namespace arbci::app {
 
 class SimulatedWorld {
  public:
-  explicit SimulatedWorld(const SessionConfig& config);  // needs a current GL context
+  explicit SimulatedWorld(const SceneSettings& settings);  // needs a current GL context
   ~SimulatedWorld();
 
   // The arbci-robotd configuration for this world (objects, table, workspace).
@@ -46,7 +46,7 @@ class SimulatedWorld {
   std::optional<cv::Vec3d> objectPosition(int id) const;
 
  private:
-  const SessionConfig& config_;
+  SceneSettings settings_;
   vision::CameraModel camera_;
   render::Scene scene_;
   std::unique_ptr<render::SimulatedCamera> left_, right_;

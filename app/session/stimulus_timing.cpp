@@ -1,5 +1,7 @@
 #include "session/stimulus_timing.h"
 
+#include <algorithm>
+
 #include "session/cycle_timing.h"
 
 namespace arbci::app {
@@ -27,6 +29,10 @@ StimulusTiming::Frame StimulusTiming::presented(double due_s, double presented_s
   frame.late = presented_s > due_s + period + 1e-6;
   late_frames_ += frame.late;
   if (last_presented_) {
+    if (watch_) {
+      ++watch_->frames;
+      watch_->longest_s = std::max(watch_->longest_s, presented_s - *last_presented_);
+    }
     frame_intervals_s_.push_back(presented_s - *last_presented_);
     if (frame_intervals_s_.size() > 600)
       frame_intervals_s_.erase(frame_intervals_s_.begin(), frame_intervals_s_.begin() + 300);

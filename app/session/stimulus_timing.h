@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -53,6 +54,14 @@ class StimulusTiming {
   nlohmann::json summary(std::int64_t lost_samples, double clock_drift_ppm,
                          double clock_jitter_ms) const;
   double medianSoaS() const;
+  // The frames presented from startWatch() on: how many, and the longest interval between two
+  // (what training on a worker thread costs the display).
+  struct Watch {
+    int frames = 0;
+    double longest_s = 0.0;
+  };
+  void startWatch() { watch_ = Watch{}; }
+  std::optional<Watch> stopWatch() { return std::exchange(watch_, std::nullopt); }
 
  private:
   struct Active {
@@ -66,6 +75,7 @@ class StimulusTiming {
   std::vector<std::pair<int, Active>> active_;  // code, its onset, while lit
   std::vector<double> soa_samples_, duration_samples_;
   std::vector<std::int64_t> selection_onsets_;
+  std::optional<Watch> watch_;
 };
 
 }  // namespace arbci::app

@@ -38,15 +38,21 @@ TrackingSettings TrackingSettings::of(const SessionConfig& config) {
   return t;
 }
 
-VisionStage::VisionStage(const TrackingSettings& settings, const vision::CameraModel& left,
-                         const vision::CameraModel& right, const vision::Pose& T_right_left)
+VisionStage::VisionStage(const TrackingSettings& settings, CameraStage& cameras)
     : settings_(settings),
-      left_camera_(left),
-      right_camera_(right),
-      T_right_left_(T_right_left),
-      detector_(detectorFor(settings, left)),
-      poses_(left.camera_matrix),
-      world_(referenceOf(settings)) {}
+      cameras_(cameras),
+      left_camera_(cameras.scene().leftCamera()),
+      right_camera_(cameras.scene().rightCamera()),
+      T_right_left_(cameras.scene().T_right_left()),
+      detector_(detectorFor(settings, left_camera_)),
+      poses_(left_camera_.camera_matrix),
+      world_(referenceOf(settings)) {
+  for (const auto& [left, right] : cameras.scene().warmUpFrames()) process(0.0, left, right);
+}
+
+void VisionStage::step(CycleContext& cycle) {
+  if (cameras_.frames().any()) take(cycle.time_s, cameras_.frames());
+}
 
 void VisionStage::setReference(int id, double size_m, const cv::Vec3d& position) {
   vision::ReferenceMarker reference;

@@ -9,8 +9,9 @@
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/marker_poses.h"
 #include "arbci/vision/world_model.h"
-#include "session/scene_source.h"
+#include "session/camera_stage.h"
 #include "session/session_config.h"
+#include "session/stage.h"
 
 namespace arbci::app {
 
@@ -25,10 +26,14 @@ struct TrackingSettings {
   static TrackingSettings of(const SessionConfig& config);
 };
 
-class VisionStage {
+class VisionStage final : public Stage {
  public:
-  VisionStage(const TrackingSettings& settings, const vision::CameraModel& left,
-              const vision::CameraModel& right, const vision::Pose& T_right_left);
+  // Tracks what `cameras` capture; warms the tracker up on the scene's warm-up frames first (the
+  // tracker builds its tables on first use, before the cycle is timed).
+  VisionStage(const TrackingSettings& settings, CameraStage& cameras);
+
+  const char* name() const override { return "tracking"; }
+  void step(CycleContext& cycle) override;
 
   // A new pair of frames at time `t` (seconds); the right one may be empty (mono).
   void process(double t, const cv::Mat& left, const cv::Mat& right);
@@ -59,6 +64,7 @@ class VisionStage {
   // The same frames as last time, at time `t`: the last poses are seen again without tracking.
   void repeat(double t);
   TrackingSettings settings_;
+  const CameraStage& cameras_;
   vision::CameraModel left_camera_, right_camera_;
   vision::Pose T_right_left_;
   vision::MarkerDetector detector_;

@@ -80,7 +80,7 @@ void Paradigm::start(bool calibrate) {
   if (phase_ != Phase::Setup) return;
   calibrating_ = calibrate || settings_.flashes_only;
   if (calibrating_ && settings_.calibration_selections > 0) {
-    calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
+    calibration_target_ = *object_layout_.drawTarget(random_).begin();
     phase_until_ = now_ + settings_.cue_s;
     enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
     ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
@@ -211,7 +211,7 @@ void Paradigm::decide(const Decision& decision) {
   if (phase_ == Phase::CalibrationFlashing) {
     ++calibration_done_;
     if (settings_.flashes_only || calibration_done_ < settings_.calibration_selections) {
-      calibration_target_ = std::uniform_int_distribution<int>(1, object_layout_.stimuli)(random_);
+      calibration_target_ = *object_layout_.drawTarget(random_).begin();
       phase_until_ = now_ + settings_.pause_s + settings_.cue_s;
       enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
       ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};

@@ -29,6 +29,13 @@ std::set<int> ParadigmLayout::codesOf(int choice) const {
   return {choice + 1};
 }
 
+std::set<int> ParadigmLayout::drawTarget(std::mt19937_64& random) const {
+  if (kind == Kind::SingleStimulus) return {std::uniform_int_distribution<int>(1, stimuli)(random)};
+  const int row = std::uniform_int_distribution<int>(1, rows)(random);
+  const int column = std::uniform_int_distribution<int>(1, columns)(random);
+  return {row, rows + column};
+}
+
 std::string ParadigmLayout::describe(const std::set<int>& codes) const {
   if (kind == Kind::SingleStimulus)
     return codes.size() == 1 ? "object " + std::to_string(*codes.begin()) : "?";

@@ -7,6 +7,9 @@
 #include <fstream>
 
 #include "arbci/assets.h"
+#include "session/eeg_stage.h"
+#include "session/robot_connection.h"
+#include "session/scene_source.h"
 #include "session/session_config.h"
 #include "support/test_files.h"
 
@@ -95,6 +98,45 @@ TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
   const std::string source = errorOf(R"({"eeg": {"source": "lsl"}})");
   EXPECT_NE(source.find("eeg.source"), std::string::npos) << source;
   EXPECT_NE(source.find("simulated"), std::string::npos) << source;
+}
+
+// Before the run each stage checks what its settings name can be used, and says which key.
+std::string validationErrorOf(const std::string& json) {
+  const SessionConfig config = SessionConfig::load(sessionFile("resources", json));
+  try {
+    SceneSettings::of(config).validate();
+    EegStageSettings::of(config).validate();
+    RobotSettings::of(config).validate();
+  } catch (const SessionConfigError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(StageSettings, EachStageNamesTheKeyOfAFileOrDeviceItCannotUse) {
+  EXPECT_EQ(validationErrorOf("{}"), "");
+  const std::string missing = "/nonexistent/arbci/file";
+  EXPECT_NE(validationErrorOf(R"({"eeg": {"source": "file", "file": ")" + missing + R"("}})")
+                .find("eeg.file = \"" + missing + "\": no such file"),
+            std::string::npos);
+  EXPECT_NE(validationErrorOf(R"({"classifier": {"model": ")" + missing + R"("}})")
+                .find("classifier.model = \"" + missing + "\": no such file"),
+            std::string::npos);
+  EXPECT_NE(
+      validationErrorOf(R"({"robot": {"backend": "remote", "key_file": ")" + missing + R"("}})")
+          .find("robot.key_file = \"" + missing + "\": no such file"),
+      std::string::npos);
+  EXPECT_NE(validationErrorOf(R"({"cameras": {"source": "devices", "left": {"video": ")" + missing +
+                              R"(", "calibration": ")" + missing + R"("}}})")
+                .find("cameras.left.video = \"" + missing + "\": no such file"),
+            std::string::npos);
+  const std::string calibration =
+      ARBCI_SHARED_DATA_DIR "/vision/opencv_samples_chessboard/left_intrinsics.yml";
+  EXPECT_NE(validationErrorOf(R"({"cameras": {"source": "devices", "left": {"device": 63, )"
+                              R"("calibration": ")" +
+                              calibration + R"("}}})")
+                .find("cameras.left.device = 63: /dev/video63 does not exist"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // rows+columns columns, as BCI2000's P3Speller), with the symbol of each cell when known.
 #pragma once
 
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -26,6 +27,9 @@ struct ParadigmLayout {
   int choices() const { return kind == Kind::RowColumn ? rows * columns : stimuli; }
   // Codes selecting one choice: {object} or {row, rows + column}.
   std::set<int> codesOf(int choice) const;  // choice 0-based
+  // A copy task's next target, drawn uniformly: an object, or a row and then a column. The one
+  // target draw of the session's calibration run and of `arbci eeg simulate`.
+  std::set<int> drawTarget(std::mt19937_64& random) const;
   // "object 3", "row 2 column 5", or the cell's symbol.
   std::string describe(const std::set<int>& codes) const;
   std::string describeShape() const;  // "single stimulus, 4 stimuli" / "row/column 6x6"

@@ -1,0 +1,33 @@
+#include "session/session_summary.h"
+
+namespace arbci::app {
+
+nlohmann::json sessionSummary(const SessionFacts& facts, const CycleTiming& cycle,
+                              const StimulusTiming& stimuli, const EegStage& eeg,
+                              const std::vector<TrialRecord>& trials,
+                              const std::optional<bci::EvaluationReport>& calibration) {
+  nlohmann::json out = {
+      {"session", facts.session_file},
+      {"seed", facts.seed},
+      {"ended", facts.ended},
+      {"duration_s", facts.duration_s},
+      {"frames", facts.frames},
+      {"cycle", cycle.toJson()},
+      {"overruns", cycle.overruns()},
+      {"timing", stimuli.summary(eeg.lostSamples(), eeg.clockDriftPpm(), eeg.clockJitterMs())},
+      {"eeg",
+       {{"recording", "recording.bdf"},
+        {"samples", eeg.samplesRecorded()},
+        {"lost_samples", eeg.lostSamples()},
+        {"missed_epochs", eeg.missedEpochs()}}},
+  };
+  out.update(trialsSummary(trials, facts.object_choices, facts.cell_choices));
+  if (calibration) {
+    out["calibration"] = {{"selections", calibration->selections.size()},
+                          {"auc", calibration->auc},
+                          {"accuracy_by_sequences", calibration->accuracy}};
+  }
+  return out;
+}
+
+}  // namespace arbci::app
