@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -12,7 +13,7 @@ namespace arbci::app {
 namespace {
 
 const cv::Scalar kBlack(0, 0, 0), kGrey(200, 200, 200), kTarget(40, 40, 220), kOther(180, 110, 30),
-    kWhite(255, 255, 255);
+    kWhite(255, 255, 255), kWindow(215, 245, 250);
 
 std::string format(double value, int decimals) {
   char text[32];
@@ -45,21 +46,127 @@ struct Panel {
          0.35);
   }
   void curve(cv::Mat& image, const std::vector<double>& xs, const std::vector<double>& ys,
-             const cv::Scalar& colour, bool dots = false) const {
+             const cv::Scalar& colour, bool dots = false, int thickness = 2) const {
     std::vector<cv::Point> points;
     for (size_t i = 0; i < xs.size(); ++i) points.push_back(map(xs[i], ys[i]));
-    cv::polylines(image, points, false, colour, 2, cv::LINE_AA);
+    cv::polylines(image, points, false, colour, thickness, cv::LINE_AA);
     if (dots) {
       for (const cv::Point& p : points) cv::circle(image, p, 3, colour, cv::FILLED, cv::LINE_AA);
     }
   }
+  void band(cv::Mat& image, const std::vector<double>& xs, const std::vector<double>& ys,
+            const std::vector<double>& half_widths, const cv::Scalar& colour) const;
 };
+
+// A translucent band of ys +/- half_widths.
+void Panel::band(cv::Mat& image, const std::vector<double>& xs, const std::vector<double>& ys,
+                 const std::vector<double>& half_widths, const cv::Scalar& colour) const {
+  std::vector<cv::Point> outline;
+  for (size_t i = 0; i < xs.size(); ++i) outline.push_back(map(xs[i], ys[i] + half_widths[i]));
+  for (size_t i = xs.size(); i-- > 0;) outline.push_back(map(xs[i], ys[i] - half_widths[i]));
+  cv::Mat layer = image.clone();
+  cv::fillPoly(layer, std::vector<std::vector<cv::Point>>{outline}, colour, cv::LINE_AA);
+  cv::addWeighted(layer, 0.25, image, 0.75, 0.0, image);
+}
 
 void save(const std::filesystem::path& path, const cv::Mat& image) {
   if (!cv::imwrite(path.string(), image)) throw CliError("cannot write " + path.string());
 }
 
+// The ERP figure: per channel, target and non-target averages overlaid on one scale with their
+// standard-error bands, the difference wave, the baseline and the analysis window marked.
+std::filesystem::path writeErpFigure(const std::filesystem::path& folder,
+                                     const bci::ErpCurves& erp) {
+  const int channels = static_cast<int>(erp.channels.size());
+  const int samples = erp.samples();
+  if (channels == 0 || samples < 2) return {};
+  const int columns = std::min(4, channels), rows = (channels + columns - 1) / columns;
+  const int panel_w = 300, panel_h = 190, left = 70, gap_x = 70, gap_y = 62, top = 84;
+  cv::Mat image(top + rows * (panel_h + gap_y), left + columns * (panel_w + gap_x), CV_8UC3,
+                kWhite);
+  text(image,
+       "ERP averages (mean +/- 1.96 SE over epochs, baseline " + format(erp.start_s * 1000.0, 0) +
+           " to " + format((erp.start_s + erp.baseline_s) * 1000.0, 0) +
+           " ms subtracted): " + std::to_string(erp.targets) + " target, " +
+           std::to_string(erp.others) + " non-target epochs",
+       {left, 26}, 0.5);
+  // Legend.
+  const std::pair<const char*, cv::Scalar> legend[] = {
+      {"target", kTarget}, {"non-target", kOther}, {"difference", kBlack}};
+  int x = left;
+  for (const auto& [name, colour] : legend) {
+    cv::line(image, {x, 48}, {x + 24, 48}, colour, 2, cv::LINE_AA);
+    text(image, name, {x + 30, 52}, 0.45);
+    x += 150;
+  }
+  cv::rectangle(image, cv::Rect(x, 41, 24, 14), kWindow, cv::FILLED);
+  text(image, "analysis window", {x + 30, 52}, 0.45);
+
+  const Eigen::MatrixXd difference = erp.difference();
+  const Eigen::MatrixXd band_t = 1.96 * erp.target_se, band_o = 1.96 * erp.other_se;
+  const double limit = std::ceil(std::max({1.0, (erp.target_mean.cwiseAbs() + band_t).maxCoeff(),
+                                           (erp.other_mean.cwiseAbs() + band_o).maxCoeff(),
+                                           difference.cwiseAbs().maxCoeff()}));
+  std::vector<double> ms(static_cast<size_t>(samples));
+  for (int s = 0; s < samples; ++s) ms[static_cast<size_t>(s)] = erp.timeS(s) * 1000.0;
+  for (int c = 0; c < channels; ++c) {
+    const Panel panel{{left + (c % columns) * (panel_w + gap_x),
+                       top + (c / columns) * (panel_h + gap_y), panel_w, panel_h},
+                      ms.front(),
+                      ms.back(),
+                      -limit,
+                      limit};
+    cv::rectangle(image,
+                  cv::Rect(panel.map(erp.window_start_s * 1000.0, limit),
+                           panel.map(std::min(erp.window_end_s * 1000.0, ms.back()), -limit)),
+                  kWindow, cv::FILLED);
+    panel.axes(image, erp.channels[static_cast<size_t>(c)], 0, 0);
+    // Time ticks every 200 ms; the stimulus (0 ms) is the vertical line.
+    for (double t = 0.0; t <= ms.back(); t += 200.0) {
+      const cv::Point at = panel.map(t, -limit);
+      cv::line(image, at, at + cv::Point(0, 4), kBlack, 1);
+      if (t > 0.0 && t < ms.back() - 60.0) text(image, format(t, 0), at + cv::Point(-12, 16), 0.35);
+    }
+    cv::line(image, panel.map(0.0, -limit), panel.map(0.0, limit), kGrey, 1);
+    text(image, "ms", panel.map(ms.back(), -limit) + cv::Point(-18, 30), 0.35);
+    text(image, "uV", panel.map(ms.front(), 0.0) + cv::Point(-30, 4), 0.35);
+    panel.band(image, ms, bci::ErpCurves::row(erp.other_mean, c), bci::ErpCurves::row(band_o, c),
+               kOther);
+    panel.band(image, ms, bci::ErpCurves::row(erp.target_mean, c), bci::ErpCurves::row(band_t, c),
+               kTarget);
+    panel.curve(image, ms, bci::ErpCurves::row(erp.other_mean, c), kOther);
+    panel.curve(image, ms, bci::ErpCurves::row(erp.target_mean, c), kTarget);
+    panel.curve(image, ms, bci::ErpCurves::row(difference, c), kBlack, false, 1);
+  }
+  const std::filesystem::path path = folder / "erp.png";
+  save(path, image);
+  return path;
+}
+
 }  // namespace
+
+nlohmann::json erpJson(const bci::ErpCurves& erp) {
+  const Eigen::MatrixXd difference = erp.difference();
+  std::vector<double> ms(static_cast<size_t>(erp.samples()));
+  for (int s = 0; s < erp.samples(); ++s) ms[static_cast<size_t>(s)] = erp.timeS(s) * 1000.0;
+  nlohmann::json channels = nlohmann::json::array();
+  for (int c = 0; c < static_cast<int>(erp.channels.size()); ++c) {
+    channels.push_back({{"name", erp.channels[static_cast<size_t>(c)]},
+                        {"time_ms", ms},
+                        {"target", bci::ErpCurves::row(erp.target_mean, c)},
+                        {"non_target", bci::ErpCurves::row(erp.other_mean, c)},
+                        {"difference", bci::ErpCurves::row(difference, c)},
+                        {"target_se", bci::ErpCurves::row(erp.target_se, c)},
+                        {"non_target_se", bci::ErpCurves::row(erp.other_se, c)}});
+  }
+  return {{"units", "uV"},
+          {"rate_hz", erp.rate_hz},
+          {"baseline_ms", {erp.start_s * 1000.0, (erp.start_s + erp.baseline_s) * 1000.0}},
+          {"window_ms", {erp.window_start_s * 1000.0, erp.window_end_s * 1000.0}},
+          {"target_epochs", erp.targets},
+          {"non_target_epochs", erp.others},
+          {"channels", channels}};
+}
 
 std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,
                                                   const bci::P300Dataset& data,
@@ -71,39 +178,13 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
     throw CliError(folder.string() + ": cannot create the plot folder (" + error.message() + ")");
   std::vector<std::filesystem::path> written;
 
-  // ERPs: one panel per channel, target red, non-target blue, microvolts against milliseconds.
-  const int channels = static_cast<int>(data.erp_target.rows());
-  const int samples = static_cast<int>(data.erp_target.cols());
-  if (channels > 0 && samples > 1) {
-    const int columns = std::min(4, channels), rows = (channels + columns - 1) / columns;
-    const int panel_w = 260, panel_h = 170, margin = 50;
-    cv::Mat image(rows * (panel_h + margin) + 60, columns * (panel_w + margin) + margin, CV_8UC3,
-                  kWhite);
-    // The ERPs are plain averages of every epoch; `title` names the accuracy figure's source.
-    text(image, "ERP averages of all epochs: target (red) vs non-target (blue), uV against ms",
-         {margin, 28}, 0.5);
-    const double limit = std::max(
-        {1.0, data.erp_target.cwiseAbs().maxCoeff(), data.erp_other.cwiseAbs().maxCoeff()});
-    std::vector<double> ms(static_cast<size_t>(samples));
-    for (int s = 0; s < samples; ++s)
-      ms[static_cast<size_t>(s)] = (data.erp_start_s + s / data.info.rate_hz) * 1000.0;
-    for (int c = 0; c < channels; ++c) {
-      const Panel panel{{margin + (c % columns) * (panel_w + margin),
-                         50 + (c / columns) * (panel_h + margin), panel_w, panel_h},
-                        ms.front(),
-                        ms.back(),
-                        -limit,
-                        limit};
-      panel.axes(image, data.info.channels[static_cast<size_t>(c)], 0, 1);
-      // A row of a column-major matrix is strided: read it element by element.
-      const auto target_row = data.erp_target.row(c), other_row = data.erp_other.row(c);
-      std::vector<double> t(target_row.begin(), target_row.end());
-      std::vector<double> o(other_row.begin(), other_row.end());
-      panel.curve(image, ms, o, kOther);
-      panel.curve(image, ms, t, kTarget);
-    }
-    written.push_back(folder / "erp.png");
-    save(written.back(), image);
+  const std::filesystem::path erp_png = writeErpFigure(folder, data.erp);
+  if (!erp_png.empty()) {
+    written.push_back(erp_png);
+    written.push_back(folder / "erp.json");
+    std::ofstream out(written.back());
+    out << erpJson(data.erp).dump() << "\n";
+    if (!out) throw CliError("cannot write " + written.back().string());
   }
 
   // Accuracy and bit rate against the number of sequences.

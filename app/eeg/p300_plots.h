@@ -1,21 +1,28 @@
-// PNG plots for the training panel and for papers: the ERP averages (target against non-target)
-// per channel, and accuracy and bit rate against the number of sequences.
+// Plots for papers: the ERPs per channel (target and non-target averages with their standard-error
+// bands and the difference wave; the numbers in erp.json), and accuracy and bit rate against the
+// number of sequences.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/p300_dataset.h"
 
 namespace arbci::app {
 
-// Writes erp.png and accuracy.png into `folder` (created if missing); returns their paths.
+// Writes erp.png, erp.json (the figure's numbers) and accuracy.png into `folder` (created if
+// missing); returns their paths.
 // Throws CliError when the folder cannot be written.
 std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,
                                                   const bci::P300Dataset& data,
                                                   const bci::EvaluationReport& report,
                                                   const std::string& title);
+
+// erp.json: per channel the time axis (ms), the target and non-target averages, their difference
+// and standard errors (uV), with the baseline, the analysis window and the epoch counts.
+nlohmann::json erpJson(const bci::ErpCurves& erp);
 
 }  // namespace arbci::app

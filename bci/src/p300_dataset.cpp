@@ -115,10 +115,10 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   const int offset = window_shape.offsetSamples(), length = window_shape.samplesPerEpoch();
 
   std::vector<Eigen::VectorXd> rows;
-  data.erp_target = Eigen::MatrixXd::Zero(data.info.channelCount(), length);
-  data.erp_other = Eigen::MatrixXd::Zero(data.info.channelCount(), length);
-  data.erp_start_s = settings.window.start_s;
-  int n_target = 0, n_other = 0;
+  // ERPs: a 100 ms baseline before the stimulus, to the end of the analysis window.
+  const int erp_baseline = std::max(1, static_cast<int>(std::lround(0.1 * data.info.rate_hz)));
+  const int erp_length = erp_baseline + offset + length;
+  ErpAccumulator erps(data.info.channelCount(), erp_length, erp_baseline);
   for (size_t f = 0; f < count; ++f) {
     const Recording& r = recording(f);
     if (progress) progress(static_cast<double>(f) / count, "filtering and epoching " + r.source);
@@ -169,10 +169,14 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
                     length, epoch.data.begin() + static_cast<std::ptrdiff_t>(c) * length);
       }
       rows.push_back(extractor.features(epoch));
-      Eigen::MatrixXd& erp = e.target ? data.erp_target : data.erp_other;
-      (e.target ? n_target : n_other)++;
-      for (int c = 0; c < signal.channels; ++c) {
-        for (int s = 0; s < length; ++s) erp(c, s) += epoch.at(c, s);
+      const std::int64_t erp_first = e.sample - erp_baseline;
+      if (erp_first >= 0 && erp_first + erp_length <= r.samples) {
+        std::vector<float> span(static_cast<size_t>(signal.channels) * erp_length);
+        for (int c = 0; c < signal.channels; ++c) {
+          std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + erp_first),
+                      erp_length, span.begin() + static_cast<std::ptrdiff_t>(c) * erp_length);
+        }
+        erps.add(span, e.target);
       }
       data.target.push_back(e.target);
       data.code.push_back(e.code);
@@ -186,8 +190,13 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   data.features.resize(static_cast<Eigen::Index>(rows.size()), data.shape.size());
   for (size_t i = 0; i < rows.size(); ++i)
     data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
-  if (n_target > 0) data.erp_target /= n_target;
-  if (n_other > 0) data.erp_other /= n_other;
+  data.erp = erps.curves();
+  data.erp.channels = data.info.channels;
+  data.erp.rate_hz = data.info.rate_hz;
+  data.erp.start_s = -erp_baseline / data.info.rate_hz;
+  data.erp.baseline_s = erp_baseline / data.info.rate_hz;
+  data.erp.window_start_s = settings.window.start_s;
+  data.erp.window_end_s = settings.window.start_s + length / data.info.rate_hz;
   if (progress) progress(1.0, "epochs ready");
   return data;
 }

@@ -2,11 +2,14 @@
 // table, a model with provenance, plots and a BCI2000 fragment; 6MK? spelled; clear errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "arbci/bci/recording.h"
 #include "support/run_process.h"
 #include "support/shared_data.h"
 
@@ -23,6 +26,72 @@ std::filesystem::path scratch(const std::string& name) {
 
 std::string eeg(const std::string& name) {
   return sharedData("eeg/bci2000_samplefiles/" + name);
+}
+
+// The ERP figure's numbers (erp.json) against ERPs averaged here from the raw file: every epoch of
+// -100 ms (the baseline, its mean subtracted) to the window's end, averaged per class. Unfiltered,
+// so nothing of ARBCI's signal path enters the reference but the file reader.
+TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
+  const auto model = scratch("erp_model.json"), plots = scratch("erp_plots");
+  std::filesystem::remove_all(plots);
+  const ProcessResult r =
+      runProcess(kArbci, {"train", "--method", "slda", "--highpass-hz", "0", "--lowpass-hz", "0",
+                          eeg("eeg3_1.dat"), "--out", model.string(), "--plots", plots.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("plot: " + (plots / "erp.json").string()), std::string::npos) << r.out;
+  std::ifstream in(plots / "erp.json");
+  const nlohmann::json erp = nlohmann::json::parse(in);
+
+  const bci::Recording raw = bci::readRecording(eeg("eeg3_1.dat"));
+  const int channels = raw.info.channelCount();
+  const double rate = raw.info.rate_hz;
+  const int baseline = static_cast<int>(std::lround(0.1 * rate));
+  ASSERT_EQ(erp["channels"].size(), static_cast<size_t>(channels));
+  // The span: the baseline, then the 0-800 ms window (its length as the classifier cuts it).
+  const int length = static_cast<int>(erp["channels"][0]["time_ms"].size());
+  EXPECT_NEAR(length - baseline, 0.8 * rate, 1.0);
+  for (int i = 0; i < length; ++i)
+    ASSERT_NEAR(erp["channels"][0]["time_ms"][i].get<double>(), (i - baseline) * 1000.0 / rate,
+                1e-6);
+  std::vector<std::vector<double>> sum[2];
+  for (auto& s : sum) s.assign(channels, std::vector<double>(length, 0.0));
+  int count[2] = {0, 0};
+  for (const bci::StimulusEvent& e : raw.stimuli) {
+    const std::int64_t first = e.sample - baseline;
+    if (first < 0 || first + length > raw.samples) continue;
+    const int k = e.target ? 0 : 1;
+    ++count[k];
+    for (int c = 0; c < channels; ++c) {
+      const float* x = raw.data.data() + c * raw.samples + first;
+      double mean = 0.0;
+      for (int i = 0; i < baseline; ++i) mean += x[i];
+      mean /= baseline;
+      for (int i = 0; i < length; ++i) sum[k][c][i] += x[i] - mean;
+    }
+  }
+  EXPECT_EQ(erp["target_epochs"], count[0]);
+  EXPECT_EQ(erp["non_target_epochs"], count[1]);
+  double worst = 0.0;
+  for (int c = 0; c < channels; ++c) {
+    const nlohmann::json& channel = erp["channels"][c];
+    EXPECT_EQ(channel["name"], raw.info.channels[c]);
+    for (int i = 0; i < length; ++i) {
+      const double target = sum[0][c][i] / count[0], other = sum[1][c][i] / count[1];
+      worst = std::max({worst, std::abs(channel["target"][i].get<double>() - target),
+                        std::abs(channel["non_target"][i].get<double>() - other),
+                        std::abs(channel["difference"][i].get<double>() - (target - other))});
+    }
+  }
+  EXPECT_LT(worst, 0.1) << "largest difference from the independent average, uV";
+  // Fz's target average peaks positive between 150 and 350 ms (the P300 of this subject).
+  const nlohmann::json& fz = erp["channels"][0];
+  ASSERT_EQ(fz["name"], "Fz");
+  int peak = 0;
+  for (int i = 0; i < length; ++i)
+    if (fz["target"][i].get<double>() > fz["target"][peak].get<double>()) peak = i;
+  EXPECT_GT(fz["target"][peak].get<double>(), 5.0);
+  EXPECT_GE(fz["time_ms"][peak].get<double>(), 150.0);
+  EXPECT_LE(fz["time_ms"][peak].get<double>(), 350.0);
 }
 
 TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {

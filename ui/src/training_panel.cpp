@@ -112,18 +112,17 @@ void TrainingPanel::draw() {
                    nullptr, 0.0f, 1.0f, ImVec2(0, 70));
   ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0, nullptr,
                    0.0f, FLT_MAX, ImVec2(0, 70));
-  const bci::P300Dataset& d = *outcome_->data;
-  heading("ERP averages: target (upper) and non-target (lower) per channel");
+  const bci::ErpCurves& erp = outcome_->data->erp;
+  heading("ERP averages (baseline-corrected): target (upper) and non-target (lower) per channel");
   // One scale for all channels and both classes, so the averages compare.
   const float limit = static_cast<float>(
-      std::max({1.0, d.erp_target.cwiseAbs().maxCoeff(), d.erp_other.cwiseAbs().maxCoeff()}));
-  for (int c = 0; c < static_cast<int>(d.erp_target.rows()); ++c) {
-    // A row of a column-major matrix is strided: read it element by element.
-    const auto target_row = d.erp_target.row(c), other_row = d.erp_other.row(c);
-    std::vector<float> t(target_row.begin(), target_row.end());
-    std::vector<float> o(other_row.begin(), other_row.end());
+      std::max({1.0, erp.target_mean.cwiseAbs().maxCoeff(), erp.other_mean.cwiseAbs().maxCoeff()}));
+  for (int c = 0; c < static_cast<int>(erp.channels.size()); ++c) {
+    const std::vector<double> target = bci::ErpCurves::row(erp.target_mean, c),
+                              other = bci::ErpCurves::row(erp.other_mean, c);
+    const std::vector<float> t(target.begin(), target.end()), o(other.begin(), other.end());
     ImGui::PushID(c);
-    ImGui::PlotLines(d.info.channels[static_cast<size_t>(c)].c_str(), t.data(),
+    ImGui::PlotLines(erp.channels[static_cast<size_t>(c)].c_str(), t.data(),
                      static_cast<int>(t.size()), 0, "target", -limit, limit, ImVec2(0, 40));
     ImGui::PlotLines("##other", o.data(), static_cast<int>(o.size()), 0, "non-target", -limit,
                      limit, ImVec2(0, 40));

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "arbci/bci/classifier.h"
+#include "arbci/bci/erp.h"
 #include "arbci/bci/paradigm_layout.h"
 #include "arbci/bci/recording.h"
 
@@ -33,9 +34,9 @@ struct P300Dataset {
   std::vector<SelectionEpochs> selections;
   std::vector<std::string> sources;
   int dropped_epochs = 0;  // flashes too close to the end of a file for a whole window
-  // Averages of the filtered response windows at the full rate, all channels (rows), for plots.
-  Eigen::MatrixXd erp_target, erp_other;
-  double erp_start_s = 0.0;
+  // The ERPs of the filtered signal at the full rate, all channels, from 100 ms before each
+  // stimulus (the baseline) to the end of the analysis window, for the figures.
+  ErpCurves erp;
 
   int epochs() const { return static_cast<int>(features.rows()); }
 };

@@ -1,0 +1,46 @@
+// Event-related potentials as a reviewer expects them: per channel the average response to
+// targets and to non-targets on the filtered signal, each epoch baseline-corrected (the mean of
+// its pre-stimulus interval subtracted), with the standard error of each average across epochs.
+// The numbers behind the ERP figures (erp.png, erp.json, the Training panel).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace arbci::bci {
+
+struct ErpCurves {
+  std::vector<std::string> channels;
+  double rate_hz = 0.0;
+  double start_s = 0.0;     // the first sample's time after the stimulus (negative: the baseline)
+  double baseline_s = 0.0;  // [start_s, start_s + baseline_s) is each epoch's baseline
+  double window_start_s = 0.0, window_end_s = 0.0;  // the classifier's analysis window
+  int targets = 0, others = 0;                      // epochs averaged
+  // Channels (rows) x samples (columns), microvolts.
+  Eigen::MatrixXd target_mean, other_mean, target_se, other_se;
+
+  int samples() const { return static_cast<int>(target_mean.cols()); }
+  double timeS(int sample) const { return start_s + sample / rate_hz; }
+  Eigen::MatrixXd difference() const { return target_mean - other_mean; }
+  // One channel's row as a vector (a row of a column-major matrix is strided).
+  static std::vector<double> row(const Eigen::MatrixXd& m, int channel);
+};
+
+// Sums epochs of `channels` x `samples` (channel-major: channel c's samples at c * samples).
+class ErpAccumulator {
+ public:
+  ErpAccumulator(int channels, int samples, int baseline_samples);
+  void add(const std::vector<float>& epoch, bool target);
+  // Means and standard errors (0 where an average has fewer than 2 epochs). The caller fills in
+  // the names and times.
+  ErpCurves curves() const;
+
+ private:
+  int channels_, samples_, baseline_samples_;
+  int n_[2] = {0, 0};
+  Eigen::MatrixXd sum_[2], sum_sq_[2];
+};
+
+}  // namespace arbci::bci

@@ -1,0 +1,58 @@
+#include "arbci/bci/erp.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace arbci::bci {
+
+std::vector<double> ErpCurves::row(const Eigen::MatrixXd& m, int channel) {
+  const auto r = m.row(channel);
+  return std::vector<double>(r.begin(), r.end());
+}
+
+ErpAccumulator::ErpAccumulator(int channels, int samples, int baseline_samples)
+    : channels_(channels), samples_(samples), baseline_samples_(baseline_samples) {
+  if (baseline_samples < 1 || baseline_samples >= samples)
+    throw std::invalid_argument("an ERP epoch needs a baseline of at least one sample before it");
+  for (int k = 0; k < 2; ++k) {
+    sum_[k] = Eigen::MatrixXd::Zero(channels, samples);
+    sum_sq_[k] = Eigen::MatrixXd::Zero(channels, samples);
+  }
+}
+
+void ErpAccumulator::add(const std::vector<float>& epoch, bool target) {
+  const int k = target ? 0 : 1;
+  ++n_[k];
+  for (int c = 0; c < channels_; ++c) {
+    const float* x = epoch.data() + static_cast<size_t>(c) * samples_;
+    double baseline = 0.0;
+    for (int s = 0; s < baseline_samples_; ++s) baseline += x[s];
+    baseline /= baseline_samples_;
+    for (int s = 0; s < samples_; ++s) {
+      const double v = x[s] - baseline;
+      sum_[k](c, s) += v;
+      sum_sq_[k](c, s) += v * v;
+    }
+  }
+}
+
+ErpCurves ErpAccumulator::curves() const {
+  ErpCurves out;
+  out.targets = n_[0];
+  out.others = n_[1];
+  Eigen::MatrixXd* means[2] = {&out.target_mean, &out.other_mean};
+  Eigen::MatrixXd* errors[2] = {&out.target_se, &out.other_se};
+  for (int k = 0; k < 2; ++k) {
+    const double n = n_[k];
+    *means[k] = n > 0 ? Eigen::MatrixXd(sum_[k] / n) : Eigen::MatrixXd::Zero(channels_, samples_);
+    *errors[k] = Eigen::MatrixXd::Zero(channels_, samples_);
+    if (n < 2) continue;
+    // Sample variance from the sums; clamped at 0 against rounding.
+    const Eigen::MatrixXd variance =
+        ((sum_sq_[k] - sum_[k].cwiseProduct(sum_[k]) / n) / (n - 1.0)).cwiseMax(0.0);
+    *errors[k] = (variance / n).cwiseSqrt();
+  }
+  return out;
+}
+
+}  // namespace arbci::bci
