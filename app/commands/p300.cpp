@@ -1,8 +1,10 @@
 // `arbci train` and `arbci evaluate`: P300 models from recordings, cross-validated by selection,
 // and their accuracy, selections and bit rate on other recordings.
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -40,7 +42,7 @@ std::string utcNow() {
 
 struct TrainOptions {
   std::vector<std::string> files;
-  std::string out, channels, window_ms = "0,800", bci2000, plots;
+  std::string out, channels, window_ms = "0,800", bci2000, plots, report, scores;
   bci::TrainingSettings training;
   bci::PipelineSettings pipeline;
 };
@@ -55,9 +57,39 @@ bci::EpochWindow parseWindow(const std::string& text) {
   return {start / 1000.0, end / 1000.0};
 }
 
+// Every output is checked before any work: a typo in a path costs no training.
+void checkOutputs(const std::string& plots, const std::vector<std::string>& files) {
+  if (!plots.empty()) ensureWritableFolder(plots);
+  for (const std::string& file : files) {
+    if (!file.empty()) ensureWritable(file);
+  }
+}
+
+void writeReportFiles(const std::string& report_path, const std::string& scores_path,
+                      const bci::EvaluationReport& report, nlohmann::json extra,
+                      const bci::P300Dataset& data, const std::vector<double>& scores,
+                      const std::vector<int>& fold) {
+  if (!report_path.empty()) {
+    extra.update(reportJson(report));
+    std::ofstream out(report_path);
+    out << extra.dump(2) << "\n";
+    if (!out) throw CliError("cannot write " + report_path);
+    std::cout << "report: " << report_path << "\n";
+  }
+  if (!scores_path.empty()) {
+    writeScoresCsv(scores_path, data, scores, fold);
+    std::cout << "scores: " << scores_path << "\n";
+  }
+}
+
 void train(TrainOptions& o) {
-  ensureWritable(o.out);
-  if (!o.bci2000.empty()) ensureWritable(o.bci2000);
+  if (o.training.swlda.p_remove <= o.training.swlda.p_enter) {
+    std::ostringstream message;
+    message << "--p-remove " << o.training.swlda.p_remove << " must exceed --p-enter "
+            << o.training.swlda.p_enter << " (or a feature could enter and leave forever)";
+    throw CliError(message.str());
+  }
+  checkOutputs(o.plots, {o.out, o.bci2000, o.report, o.scores});
   o.pipeline.window = parseWindow(o.window_ms);
   o.pipeline.channels = splitNameList(o.channels);
   const bci::Progress progress = progressLine(std::cerr);
@@ -65,6 +97,11 @@ void train(TrainOptions& o) {
   bci::P300Dataset data;
   try {
     data = bci::buildDataset(readAll(o.files), o.pipeline, progress);
+    if (o.training.method == "xdawn" && o.training.xdawn.filters > data.shape.channels) {
+      throw CliError("--xdawn-filters " + std::to_string(o.training.xdawn.filters) +
+                     ": the features have " + std::to_string(data.shape.channels) +
+                     " channels (1 to " + std::to_string(data.shape.channels) + " allowed)");
+    }
     result = bci::trainModel(data, o.pipeline, o.training, progress);
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
@@ -86,9 +123,18 @@ void train(TrainOptions& o) {
             << data.sources.size() << " file(s)";
   if (data.dropped_epochs > 0)
     std::cout << "; " << data.dropped_epochs << " flashes too close to a file's end left out";
-  std::cout << "\n\ncross-validation, " << result.cross_validation.folds
-            << " folds split by selection:\n";
-  printReport(std::cout, result.cross_validation.report);
+  const bci::CrossValidation& cv = result.cross_validation;
+  std::cout << "\n\ncross-validation, " << cv.folds << " folds by " << cv.folds_by
+            << (o.training.folds_by.empty() ? " (the default here; --folds-by to change)" : "")
+            << ":\n";
+  printReport(std::cout, cv.report);
+  writeReportFiles(o.report, o.scores, cv.report,
+                   {{"command", "train"},
+                    {"method", o.training.method},
+                    {"files", data.sources},
+                    {"folds", cv.folds},
+                    {"folds_by", cv.folds_by}},
+                   data, cv.scores, cv.fold);
   if (!o.plots.empty()) {
     const auto written = writeP300Plots(o.plots, data, result.cross_validation.report,
                                         "cross-validated " + o.training.method);
@@ -99,13 +145,15 @@ void train(TrainOptions& o) {
 }
 
 struct EvaluateOptions {
-  std::string model, plots;
+  std::string model, plots, report, scores;
   std::vector<std::string> files;
   int sequences = 0;
   bci::StoppingRule dynamic{15, 2, 0.99};
+  std::string align = "per-file";
 };
 
 void evaluate(EvaluateOptions& o) {
+  checkOutputs(o.plots, {o.report, o.scores});
   bci::P300Model model;
   try {
     model = bci::P300Model::load(o.model);
@@ -125,6 +173,8 @@ void evaluate(EvaluateOptions& o) {
     std::vector<double> scores(static_cast<size_t>(data.epochs()));
     for (int i = 0; i < data.epochs(); ++i)
       scores[static_cast<size_t>(i)] = model.classifier->score(data.features.row(i).transpose());
+    std::vector<double> shifts;
+    if (o.align == "per-file") shifts = bci::alignScoresPerFile(data, scores, model.score_model);
     if (o.sequences > 0) {
       for (auto& s : data.selections) {
         std::erase_if(s.epochs, [&](int row) {
@@ -140,7 +190,24 @@ void evaluate(EvaluateOptions& o) {
     for (const auto& f : model.provenance.value("training_files", nlohmann::json::array()))
       std::cout << " " << f.get<std::string>();
     std::cout << ")\n";
+    if (o.align == "per-file" && std::isnan(model.score_model.median)) {
+      std::cout << "scores not aligned: the model predates the score median (train it again)\n";
+    } else if (o.align == "per-file") {
+      std::cout << "scores aligned per file to the training median (--align-scores none: off):";
+      for (size_t f = 0; f < shifts.size(); ++f)
+        std::cout << (f ? "," : "") << " " << std::showpos << std::fixed << std::setprecision(3)
+                  << shifts[f] << std::noshowpos << " (" << data.sources[f] << ")";
+      std::cout.unsetf(std::ios::fixed);
+      std::cout << "\n";
+    }
     printReport(std::cout, report);
+    writeReportFiles(o.report, o.scores, report,
+                     {{"command", "evaluate"},
+                      {"method", model.method},
+                      {"model", o.model},
+                      {"align_scores", o.align},
+                      {"files", data.sources}},
+                     data, scores, {});
     if (!o.plots.empty()) {
       for (const auto& file : writeP300Plots(o.plots, data, report, "evaluated " + model.method))
         std::cout << "plot: " << file.string() << "\n";
@@ -170,34 +237,59 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->capture_default_str();
   train_cmd
       ->add_option("--decimate-hz", t->pipeline.decimate_hz,
-                   "feature rate after moving-average decimation")
-      ->capture_default_str();
+                   "feature rate after moving-average decimation (at most the signal's rate)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 10000.0));
   train_cmd
       ->add_option("--highpass-hz", t->pipeline.filter.highpass_hz,
                    "Butterworth high-pass (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10000.0));
   train_cmd
       ->add_option("--lowpass-hz", t->pipeline.filter.lowpass_hz, "Butterworth low-pass (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10000.0));
   train_cmd->add_option("--notch-hz", t->pipeline.filter.notch_hz, "notch (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10000.0));
   train_cmd->add_flag("--car", t->pipeline.filter.common_average, "common average reference first");
-  train_cmd->add_option("--folds", t->training.folds, "cross-validation folds (split by selection)")
+  train_cmd
+      ->add_option("--folds", t->training.folds,
+                   "cross-validation folds (at most one per selection or file)")
       ->capture_default_str()
       ->check(CLI::Range(2, 100));
+  train_cmd
+      ->add_option("--folds-by", t->training.folds_by,
+                   "selection, block (contiguous flashes) or file; default: by selection, or by "
+                   "block for one selection or codes that are classes (an oddball)")
+      ->check(CLI::IsMember({"selection", "block", "file"}));
+  train_cmd->add_option("--report", t->report,
+                        "also write the cross-validation report as JSON (everything printed)");
+  train_cmd->add_option("--scores", t->scores,
+                        "also write the out-of-fold score of every flash as CSV "
+                        "(file,sample,code,label,score,fold)");
   train_cmd->add_option("--p-enter", t->training.swlda.p_enter, "SWLDA: p-value to enter")
-      ->capture_default_str();
-  train_cmd->add_option("--p-remove", t->training.swlda.p_remove, "SWLDA: p-value to remove")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(1e-12, 1.0));
+  train_cmd
+      ->add_option("--p-remove", t->training.swlda.p_remove,
+                   "SWLDA: p-value to remove (above --p-enter)")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-12, 1.0));
   train_cmd
       ->add_option("--max-features", t->training.swlda.max_features, "SWLDA: most features kept")
-      ->capture_default_str();
-  train_cmd->add_option("--xdawn-filters", t->training.xdawn.filters, "xDAWN: spatial filters kept")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  train_cmd
+      ->add_option("--xdawn-filters", t->training.xdawn.filters,
+                   "xDAWN: spatial filters kept (1 to the number of channels)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 256));
   train_cmd
       ->add_option("--certainty", t->training.dynamic.certainty,
-                   "dynamic stopping: stop at this posterior probability")
-      ->capture_default_str();
+                   "dynamic stopping: stop at this posterior probability (0: never early)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.999999));
   train_cmd->add_option("--bci2000", t->bci2000,
                         "also write the model as a BCI2000 parameter fragment (.prm)");
   train_cmd->add_option("--plots", t->plots,
@@ -214,17 +306,30 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                           "sequences, bit rate, and dynamic stopping.");
   eval_cmd->add_option("--model", e->model, "model file (from arbci train)")->required();
   eval_cmd->add_option("FILES", e->files, "recordings to evaluate")->required();
-  eval_cmd->add_option("--sequences", e->sequences,
-                       "use at most this many sequences per selection");
+  eval_cmd
+      ->add_option("--sequences", e->sequences,
+                   "use at most this many sequences per selection (0: all)")
+      ->check(CLI::Range(0, 1000));
   eval_cmd
       ->add_option("--certainty", e->dynamic.certainty,
-                   "dynamic stopping: stop at this posterior probability")
-      ->capture_default_str();
+                   "dynamic stopping: stop at this posterior probability (0: never early)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.999999));
   eval_cmd
       ->add_option("--min-sequences", e->dynamic.min_sequences,
                    "dynamic stopping: never before this many sequences")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   eval_cmd->add_option("--plots", e->plots, "folder for PNG plots");
+  eval_cmd
+      ->add_option("--align-scores", e->align,
+                   "per-file: shift each file's scores so their median is the training scores' "
+                   "(scores drift between sessions); none: as the model gives them")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"per-file", "none"}));
+  eval_cmd->add_option("--report", e->report, "also write the report as JSON (everything printed)");
+  eval_cmd->add_option("--scores", e->scores,
+                       "also write every flash's score as CSV (file,sample,code,label,score,fold)");
   eval_cmd->callback([e, &exit_code] {
     evaluate(*e);
     exit_code = 0;

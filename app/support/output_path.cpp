@@ -28,4 +28,11 @@ void ensureWritable(const std::filesystem::path& path, bool create_parents) {
   if (!existed) std::filesystem::remove(path);
 }
 
+void ensureWritableFolder(const std::filesystem::path& folder) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw CliError("cannot create folder " + folder.string() + ": " + error.message());
+  ensureWritable(folder / ".arbci-write-check");
+}
+
 }  // namespace arbci::app

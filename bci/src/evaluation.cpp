@@ -79,6 +79,14 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     }
   }
   report.auc = areaUnderCurve(tested_scores, tested_labels);
+  report.target_flashes =
+      static_cast<int>(std::count(tested_labels.begin(), tested_labels.end(), true));
+  report.other_flashes = static_cast<int>(tested_labels.size()) - report.target_flashes;
+  report.auc_interval = aucInterval(report.auc, report.target_flashes, report.other_flashes);
+  if (data.codes_are_classes) {
+    report.selection_metrics = false;
+    return report;
+  }
   // Sequences every selection has.
   report.max_sequences = std::numeric_limits<int>::max();
   for (const SelectionEpochs& s : data.selections) {
@@ -91,9 +99,10 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
   if (data.selections.empty() || report.max_sequences < 1)
     throw std::invalid_argument("no selection has a whole sequence");
   const int n_max = report.max_sequences;
-  report.accuracy.assign(static_cast<size_t>(n_max), 0.0);
+  std::vector<int> correct(static_cast<size_t>(n_max), 0);
 
-  double dynamic_correct = 0.0, dynamic_flashes = 0.0;
+  int dynamic_correct = 0;
+  double dynamic_flashes = 0.0;
   for (const SelectionEpochs& s : data.selections) {
     SelectionResult result;
     result.truth = s.target_codes;
@@ -119,27 +128,88 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     if (!result.truth.empty()) {
       ++report.selections_with_truth;
       for (int n = 0; n < n_max; ++n)
-        report.accuracy[static_cast<size_t>(n)] +=
+        correct[static_cast<size_t>(n)] +=
             result.by_sequences[static_cast<size_t>(n)].codes == result.truth;
       dynamic_correct += result.dynamic.codes == result.truth;
     }
     report.selections.push_back(std::move(result));
   }
-  const double known = std::max(1, report.selections_with_truth);
+  const int known = std::max(1, report.selections_with_truth);
+  const int choices = data.layout.choices();
+  report.chance = 1.0 / choices;
+  report.chance_95 = chanceLevel95(choices, report.selections_with_truth);
   for (int n = 0; n < n_max; ++n) {
-    report.accuracy[static_cast<size_t>(n)] /= known;
+    const int right = correct[static_cast<size_t>(n)];
+    report.accuracy.push_back(static_cast<double>(right) / known);
+    report.accuracy_interval.push_back(wilsonInterval(right, report.selections_with_truth));
     const double seconds = (n + 1) * data.layout.codes() * data.layout.soa_s;
     report.seconds_per_selection.push_back(seconds);
-    report.bits_per_minute.push_back(
-        wolpawBits(data.layout.choices(), report.accuracy[static_cast<size_t>(n)]) * 60.0 /
-        seconds);
+    report.bits_per_minute.push_back(wolpawBits(choices, report.accuracy.back()) * 60.0 / seconds);
   }
-  report.dynamic_accuracy = dynamic_correct / known;
+  report.dynamic_accuracy = static_cast<double>(dynamic_correct) / known;
+  report.dynamic_accuracy_interval = wilsonInterval(dynamic_correct, report.selections_with_truth);
   report.dynamic_mean_flashes = dynamic_flashes / static_cast<double>(data.selections.size());
   report.dynamic_seconds = report.dynamic_mean_flashes * data.layout.soa_s;
   report.dynamic_bits_per_minute =
-      wolpawBits(data.layout.choices(), report.dynamic_accuracy) * 60.0 / report.dynamic_seconds;
+      wolpawBits(choices, report.dynamic_accuracy) * 60.0 / report.dynamic_seconds;
+  // As recorded: from each selection's first flash to the next one's in the same file.
+  double recorded = 0.0;
+  int gaps = 0;
+  const bool timed = data.sample.size() == data.target.size() && data.info.rate_hz > 0.0;
+  for (size_t k = 1; timed && k < data.selections.size(); ++k) {
+    const SelectionEpochs &a = data.selections[k - 1], &b = data.selections[k];
+    if (a.epochs.empty() || b.epochs.empty() || a.file != b.file) continue;
+    recorded += static_cast<double>(data.sample[static_cast<size_t>(b.epochs.front())] -
+                                    data.sample[static_cast<size_t>(a.epochs.front())]);
+    ++gaps;
+  }
+  if (gaps > 0) {
+    report.recorded_seconds_per_selection = recorded / gaps / data.info.rate_hz;
+    report.recorded_bits_per_minute =
+        wolpawBits(choices, report.accuracy.back()) * 60.0 / report.recorded_seconds_per_selection;
+  }
   return report;
+}
+
+std::vector<double> alignScoresPerFile(const P300Dataset& data, std::vector<double>& scores,
+                                       const ScoreModel& model) {
+  std::vector<double> shifts(data.sources.size(), 0.0);
+  if (std::isnan(model.median) || data.file.size() != scores.size()) return shifts;
+  for (size_t f = 0; f < data.sources.size(); ++f) {
+    std::vector<double> own;
+    for (size_t i = 0; i < scores.size(); ++i)
+      if (data.file[i] == static_cast<int>(f)) own.push_back(scores[i]);
+    if (own.empty()) continue;
+    std::nth_element(own.begin(), own.begin() + own.size() / 2, own.end());
+    shifts[f] = model.median - own[own.size() / 2];
+    for (size_t i = 0; i < scores.size(); ++i)
+      if (data.file[i] == static_cast<int>(f)) scores[i] += shifts[f];
+  }
+  return shifts;
+}
+
+std::string foldScheme(const P300Dataset& data, const std::string& requested) {
+  int labelled = 0;
+  for (const SelectionEpochs& s : data.selections) labelled += !s.target_codes.empty();
+  const std::string scheme =
+      !requested.empty() ? requested
+                         : (!data.codes_are_classes && labelled >= 2 ? "selection" : "block");
+  if (scheme == "selection" && labelled < 2) {
+    throw std::invalid_argument(
+        "cross-validation by selection needs at least 2 selections with known targets, the data "
+        "have " +
+        std::to_string(labelled) + " (folds by block or by file do not)");
+  }
+  if (scheme == "file" &&
+      (data.sources.size() < 2 || data.file.size() != static_cast<size_t>(data.epochs()))) {
+    throw std::invalid_argument("cross-validation by file needs at least 2 files, there is " +
+                                std::to_string(data.sources.size()));
+  }
+  if (scheme == "block" && data.epochs() < 4)
+    throw std::invalid_argument("cross-validation by block needs at least 4 flashes");
+  if (scheme != "selection" && scheme != "file" && scheme != "block")
+    throw std::invalid_argument("folds by \"" + scheme + "\": must be selection, block or file");
+  return scheme;
 }
 
 CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& settings,
@@ -148,21 +218,33 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
   for (size_t s = 0; s < data.selections.size(); ++s) {
     if (!data.selections[s].target_codes.empty()) labelled.push_back(static_cast<int>(s));
   }
-  if (labelled.size() < 2) {
-    throw std::invalid_argument(
-        "cross-validation needs at least 2 selections with known targets, the data have " +
-        std::to_string(labelled.size()));
-  }
   CrossValidation cv;
-  cv.folds = std::clamp(settings.folds, 2, static_cast<int>(labelled.size()));
+  cv.folds_by = foldScheme(data, settings.folds_by);
   cv.scores.assign(static_cast<size_t>(data.epochs()), 0.0);
-  std::vector<int> fold_of(data.selections.size(), -1);
-  for (size_t k = 0; k < labelled.size(); ++k)
-    fold_of[static_cast<size_t>(labelled[k])] = static_cast<int>(k * cv.folds / labelled.size());
+  cv.fold.assign(static_cast<size_t>(data.epochs()), -1);
+  std::vector<int> rows;  // the labelled epochs, in time order within each file
+  for (int s : labelled) {
+    for (int row : data.selections[static_cast<size_t>(s)].epochs) rows.push_back(row);
+  }
+  std::sort(rows.begin(), rows.end());
+  if (cv.folds_by == "selection") {
+    cv.folds = std::clamp(settings.folds, 2, static_cast<int>(labelled.size()));
+    for (size_t k = 0; k < labelled.size(); ++k) {
+      for (int row : data.selections[static_cast<size_t>(labelled[k])].epochs)
+        cv.fold[static_cast<size_t>(row)] = static_cast<int>(k * cv.folds / labelled.size());
+    }
+  } else if (cv.folds_by == "file") {
+    cv.folds = static_cast<int>(data.sources.size());
+    for (int row : rows) cv.fold[static_cast<size_t>(row)] = data.file[static_cast<size_t>(row)];
+  } else {
+    cv.folds = std::clamp(settings.folds, 2, std::max(2, static_cast<int>(rows.size()) / 2));
+    for (size_t k = 0; k < rows.size(); ++k)
+      cv.fold[static_cast<size_t>(rows[k])] = static_cast<int>(k * cv.folds / rows.size());
+  }
   for (int fold = 0; fold < cv.folds; ++fold) {
     std::vector<int> train_rows, test_rows;
     for (int row = 0; row < data.epochs(); ++row) {
-      const int f = fold_of[static_cast<size_t>(data.selection[static_cast<size_t>(row)])];
+      const int f = cv.fold[static_cast<size_t>(row)];
       if (f < 0) continue;
       (f == fold ? test_rows : train_rows).push_back(row);
     }

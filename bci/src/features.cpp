@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace arbci::bci {
@@ -13,6 +14,12 @@ int PipelineSettings::decimationFactor(double rate_hz) const {
 
 FeatureExtractor::FeatureExtractor(const PipelineSettings& settings, const SignalInfo& info)
     : factor_(settings.decimationFactor(info.rate_hz)) {
+  if (settings.decimate_hz > info.rate_hz) {
+    std::ostringstream message;
+    message << "decimate_hz " << settings.decimate_hz << " Hz exceeds the signal's rate "
+            << info.rate_hz << " Hz: decimation can only lower the rate";
+    throw std::invalid_argument(message.str());
+  }
   if (settings.channels.empty()) {
     for (int c = 0; c < info.channelCount(); ++c) channel_indices_.push_back(c);
   } else {

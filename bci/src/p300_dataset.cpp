@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -182,6 +183,8 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       data.code.push_back(e.code);
       data.sequence.push_back(in_selection / layout.codes());
       data.selection.push_back(static_cast<int>(data.selections.size()) - 1);
+      data.file.push_back(static_cast<int>(f));
+      data.sample.push_back(e.sample);
       data.selections.back().epochs.push_back(static_cast<int>(rows.size()) - 1);
       if (e.target) data.selections.back().target_codes.insert(e.code);
       ++in_selection;
@@ -190,6 +193,18 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   data.features.resize(static_cast<Eigen::Index>(rows.size()), data.shape.size());
   for (size_t i = 0; i < rows.size(); ++i)
     data.features.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  std::map<int, std::pair<int, int>> by_code;  // code: targets, flashes
+  for (size_t i = 0; i < data.code.size(); ++i) {
+    auto& [targets, flashes] = by_code[data.code[i]];
+    targets += data.target[i];
+    ++flashes;
+  }
+  data.codes_are_classes =
+      data.layout.kind == ParadigmLayout::Kind::SingleStimulus && !by_code.empty() &&
+      std::all_of(
+          by_code.begin(), by_code.end(),
+          [](const auto& c) { return c.second.first == 0 || c.second.first == c.second.second; }) &&
+      std::any_of(by_code.begin(), by_code.end(), [](const auto& c) { return c.second.first > 0; });
   data.erp = erps.curves();
   data.erp.channels = data.info.channels;
   data.erp.rate_hz = data.info.rate_hz;

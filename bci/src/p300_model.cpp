@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace arbci::bci {
@@ -41,6 +42,7 @@ nlohmann::json P300Model::toJson() const {
   json["score_model"] = {{"target_mean", score_model.target_mean},
                          {"other_mean", score_model.other_mean},
                          {"sd", score_model.sd}};
+  if (!std::isnan(score_model.median)) json["score_model"]["median"] = score_model.median;
   json["paradigm"] = {
       {"kind", layout.kind == ParadigmLayout::Kind::RowColumn ? "row/column" : "single stimulus"},
       {"stimuli", layout.stimuli},
@@ -82,7 +84,9 @@ P300Model P300Model::fromJson(const nlohmann::json& json, const std::string& sou
     model.classifier = classifierFromJson(json.at("classifier"), model.shape);
     const auto& s = json.at("score_model");
     model.score_model = {s.at("target_mean").get<double>(), s.at("other_mean").get<double>(),
-                         s.at("sd").get<double>()};
+                         s.at("sd").get<double>(),
+                         s.contains("median") ? s.at("median").get<double>()
+                                              : std::numeric_limits<double>::quiet_NaN()};
     const auto& l = json.at("paradigm");
     if (l.at("kind").get<std::string>() == "row/column") {
       model.layout = ParadigmLayout::matrix(l.at("rows").get<int>(), l.at("columns").get<int>(),

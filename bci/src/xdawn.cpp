@@ -37,7 +37,13 @@ void XdawnClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
                                                                          signal_covariance);
   if (solver.info() != Eigen::Success)
     throw std::invalid_argument("xDAWN: the signal covariance is singular");
-  const int kept = std::clamp(settings_.filters, 1, channels);
+  if (settings_.filters < 1 || settings_.filters > channels) {
+    throw std::invalid_argument("xDAWN: " + std::to_string(settings_.filters) +
+                                " spatial filters asked for, the features have " +
+                                std::to_string(channels) + " channels (1 to " +
+                                std::to_string(channels) + " allowed)");
+  }
+  const int kept = settings_.filters;
   const Eigen::MatrixXd filters =
       solver.eigenvectors().rightCols(kept);  // largest eigenvalues last
 

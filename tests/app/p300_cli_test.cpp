@@ -4,12 +4,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <sstream>
 
 #include "arbci/bci/recording.h"
+#include "arbci/bci/recording_writer.h"
 #include "support/run_process.h"
 #include "support/shared_data.h"
 
@@ -102,7 +106,7 @@ TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
                           "--bci2000", prm.string(), "--plots", plots.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("100%"), std::string::npos);
-  EXPECT_NE(r.out.find("cross-validation, 4 folds split by selection"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cross-validation, 4 folds by selection"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("selected with 15 sequences: T3OF"), std::string::npos) << r.out;
   std::ifstream in(model);
   const nlohmann::json json = nlohmann::json::parse(in);
@@ -130,6 +134,92 @@ TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
   EXPECT_NE(r.out.find("bits/min"), std::string::npos);
 }
 
+// --report holds what is printed; --scores has one row per flash with its out-of-fold score.
+TEST(TrainAndEvaluate, ReportAndScoresFilesHoldWhatIsPrinted) {
+  const auto model = scratch("report_model.json"), report = scratch("report.json"),
+             scores = scratch("scores.csv");
+  const ProcessResult r =
+      runProcess(kArbci, {"train", "--method", "slda", eeg("eeg3_1.dat"), "--out", model.string(),
+                          "--report", report.string(), "--scores", scores.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(report);
+  const nlohmann::json json = nlohmann::json::parse(in);
+  char auc[64];
+  std::snprintf(auc, sizeof auc, "single-flash AUC: %.3f (95 %% interval [%.3f, %.3f]",
+                json["auc"].get<double>(), json["auc_interval_95"][0].get<double>(),
+                json["auc_interval_95"][1].get<double>());
+  EXPECT_NE(r.out.find(auc), std::string::npos) << auc << "\n" << r.out;
+  EXPECT_LT(json["auc_interval_95"][0].get<double>(), json["auc"].get<double>());
+  EXPECT_EQ(json["folds_by"], "selection");
+  EXPECT_EQ(json["target_flashes"], 120);
+  EXPECT_EQ(json["non_target_flashes"], 600);
+  EXPECT_EQ(json["choices"], 36);
+  EXPECT_NEAR(json["chance"].get<double>(), 1.0 / 36.0, 1e-12);
+  ASSERT_EQ(json["by_sequences"].size(), 15u);
+  EXPECT_EQ(json["by_sequences"][14]["selected"], "T3OF");
+  char row[96];
+  const nlohmann::json& first = json["by_sequences"][0];
+  std::snprintf(row, sizeof row, "%9d%10.3f  [%.3f, %.3f]", 1, first["accuracy"].get<double>(),
+                first["accuracy_interval_95"][0].get<double>(),
+                first["accuracy_interval_95"][1].get<double>());
+  EXPECT_NE(r.out.find(row), std::string::npos) << row << "\n" << r.out;
+  EXPECT_GT(json["all_inclusive"]["seconds_per_selection"].get<double>(),
+            json["by_sequences"][14]["seconds_per_selection"].get<double>());
+
+  std::ifstream csv(scores);
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "file,sample,code,label,score,fold");
+  int rows = 0, targets = 0;
+  std::set<int> folds;
+  while (std::getline(csv, line)) {
+    ++rows;
+    std::vector<std::string> cells;
+    std::stringstream cells_in(line);
+    for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 6u) << line;
+    targets += cells[3] == "1";
+    folds.insert(std::stoi(cells[5]));
+  }
+  EXPECT_EQ(rows, 720);  // every flash of eeg3_1
+  EXPECT_EQ(targets, 120);
+  EXPECT_EQ(folds, (std::set<int>{0, 1, 2, 3}));  // 4 selections, 4 folds
+}
+
+// A recording whose codes are the classes (target / non-target only, as Brain Invaders or an
+// oddball): single-flash AUC over contiguous blocks, and no selection metrics.
+TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
+  const auto simulated = scratch("by_selection.bdf"), by_class = scratch("by_class.bdf");
+  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "60", "--seed", "4", "--out",
+                                simulated.string()})
+                .exit_code,
+            0);
+  {
+    const bci::Recording r = bci::readRecording(simulated.string());
+    bci::RecordingWriter writer(by_class, r.info);
+    bci::Block block(0, r.info.channelCount(), static_cast<int>(r.samples));
+    block.data = r.data;
+    writer.write(block);
+    for (bci::StimulusEvent e : r.stimuli) {
+      e.code = e.target ? 1 : 2;
+      writer.addStimulus(e);
+    }
+  }
+  const auto report = scratch("by_class_report.json");
+  const ProcessResult r =
+      runProcess(kArbci, {"train", "--method", "slda", by_class.string(), "--out",
+                          scratch("by_class.json").string(), "--report", report.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("10 folds by block (the default here"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no selection metrics"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("bits/min"), std::string::npos) << r.out;
+  std::ifstream in(report);
+  const nlohmann::json json = nlohmann::json::parse(in);
+  EXPECT_FALSE(json["selection_metrics"].get<bool>());
+  EXPECT_FALSE(json.contains("by_sequences"));
+  EXPECT_GT(json["auc"].get<double>(), 0.8);  // the simulated subject's P300 is clear
+}
+
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
   ASSERT_EQ(
@@ -149,14 +239,41 @@ TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   r = runProcess(kArbci, {"train", quiet.string(), "--out", scratch("none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no stimulus events"), std::string::npos) << r.err;
-  // Too little to train on: a single selection.
+  // Folds by selection need two selections; one selection is cross-validated by block instead.
   const auto short_file = scratch("short.bdf");
   ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "10", "--out", short_file.string()})
                 .exit_code,
             0);
-  r = runProcess(kArbci, {"train", short_file.string(), "--out", scratch("none.json").string()});
+  r = runProcess(kArbci, {"train", short_file.string(), "--folds-by", "selection", "--out",
+                          scratch("none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("at least 2 selections"), std::string::npos) << r.err;
+  r = runProcess(kArbci, {"train", short_file.string(), "--folds-by", "file", "--out",
+                          scratch("none.json").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("by file needs at least 2 files"), std::string::npos) << r.err;
+  // Numeric options out of range are refused with the option's name.
+  for (const auto& [option, expected] :
+       std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--certainty", "2"}, "--certainty"},
+           {{"--xdawn-filters", "0"}, "--xdawn-filters"},
+           {{"--method", "xdawn", "--xdawn-filters", "99"}, "the features have 8 channels"},
+           {{"--decimate-hz", "1000"}, "exceeds the signal's rate 256 Hz"},
+           {{"--p-enter", "0.2", "--p-remove", "0.1"}, "must exceed --p-enter"},
+           {{"--folds-by", "trial"}, "--folds-by"}}) {
+    std::vector<std::string> args = {"train", eeg("eeg3_1.dat"), "--out",
+                                     scratch("bad.json").string()};
+    args.insert(args.end(), option.begin(), option.end());
+    r = runProcess(kArbci, args);
+    EXPECT_NE(r.exit_code, 0) << option[0];  // 1, or CLI11's code for a bad option value
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
+  // Outputs that cannot be written are refused before any training.
+  r = runProcess(kArbci, {"train", eeg("eeg3_1.dat"), "--out", scratch("m.json").string(),
+                          "--plots", "/proc/arbci-plots"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("/proc/arbci-plots"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("fold 1"), std::string::npos) << "trained before failing: " << r.err;
   // A broken model file.
   std::ofstream(scratch("broken.json")) << "{\"format\": \"arbci-p300-model\"";
   r = runProcess(kArbci,

@@ -104,14 +104,21 @@ void TrainingPanel::draw() {
   }
   const bci::TrainingResult& r = *outcome_->result;
   const bci::EvaluationReport& cv = r.cross_validation.report;
-  ImGui::Text("cross-validated (%d folds by selection): AUC %.3f; %d selections",
-              r.cross_validation.folds, cv.auc, cv.selections_with_truth);
-  std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()),
-      bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
-  ImGui::PlotLines("accuracy by sequences", accuracy.data(), static_cast<int>(accuracy.size()), 0,
-                   nullptr, 0.0f, 1.0f, ImVec2(0, 70));
-  ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0, nullptr,
-                   0.0f, FLT_MAX, ImVec2(0, 70));
+  ImGui::Text("cross-validated (%d folds by %s): AUC %.3f (95 %% interval %.3f-%.3f)",
+              r.cross_validation.folds, r.cross_validation.folds_by.c_str(), cv.auc,
+              cv.auc_interval.low, cv.auc_interval.high);
+  if (cv.selection_metrics) {
+    ImGui::Text("%d selections; chance %.3f, beaten at p < 0.05 from %.3f",
+                cv.selections_with_truth, cv.chance, cv.chance_95);
+    std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()),
+        bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
+    ImGui::PlotLines("accuracy by sequences", accuracy.data(), static_cast<int>(accuracy.size()), 0,
+                     nullptr, 0.0f, 1.0f, ImVec2(0, 70));
+    ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0,
+                     nullptr, 0.0f, FLT_MAX, ImVec2(0, 70));
+  } else {
+    ImGui::TextWrapped("no selection metrics: the stimulus codes are classes, not choices");
+  }
   const bci::ErpCurves& erp = outcome_->data->erp;
   heading("ERP averages (baseline-corrected): target (upper) and non-target (lower) per channel");
   // One scale for all channels and both classes, so the averages compare.

@@ -5,6 +5,7 @@
 // stopping.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <set>
 #include <vector>
@@ -17,6 +18,10 @@ struct ScoreModel {
   double target_mean = 1.0;
   double other_mean = -1.0;
   double sd = 1.0;  // pooled within-class standard deviation
+  // The median of all training scores (mostly non-targets in any P300 paradigm): another run's
+  // scores are shifted so their median lands here (scores drift between sessions; see
+  // alignScoresPerFile in evaluation.h). NaN: unknown (a model from before it was kept).
+  double median = std::numeric_limits<double>::quiet_NaN();
   // Fitted to scores and labels; throws std::invalid_argument without both classes.
   static ScoreModel fit(const std::vector<double>& scores, const std::vector<bool>& target);
 };

@@ -10,6 +10,7 @@
 
 #include "arbci/bci/classifier.h"
 #include "arbci/bci/decision.h"
+#include "arbci/bci/intervals.h"
 #include "arbci/bci/p300_dataset.h"
 
 namespace arbci::bci {
@@ -29,9 +30,17 @@ struct SelectionResult {
 
 struct EvaluationReport {
   ParadigmLayout layout;
+  // False when the stimulus codes are classes, not choices (P300Dataset::codes_are_classes):
+  // then only the single-flash figures mean anything.
+  bool selection_metrics = true;
   int max_sequences = 0;
   double auc = 0.0;
-  std::vector<double> accuracy;  // [n - 1]
+  Interval auc_interval;  // 95 %
+  int target_flashes = 0, other_flashes = 0;
+  std::vector<double> accuracy;             // [n - 1]
+  std::vector<Interval> accuracy_interval;  // 95 % (Wilson), [n - 1]
+  double chance = 0.0;                      // 1 / choices
+  double chance_95 = 0.0;  // an accuracy at or above this beats guessing (p < 0.05)
   std::vector<double> seconds_per_selection;
   std::vector<double> bits_per_minute;
   std::vector<SelectionResult> selections;
@@ -39,11 +48,23 @@ struct EvaluationReport {
   StoppingRule dynamic_rule;
   double dynamic_accuracy = 0.0, dynamic_mean_flashes = 0.0, dynamic_seconds = 0.0,
          dynamic_bits_per_minute = 0.0;
+  Interval dynamic_accuracy_interval;
+  // All inclusive: the recording's time per selection (first flash to the next selection's first,
+  // pauses and cues included) and the bit rate at the full number of sequences over it; 0 when
+  // the recording has one selection.
+  double recorded_seconds_per_selection = 0.0, recorded_bits_per_minute = 0.0;
 
   // The selections after n sequences as text: the speller's symbols, or "object 2, object 4".
   std::string selected(int sequences) const;
   std::string selectedDynamic() const;
 };
+
+// Scores drift between sessions (electrode impedances, the subject's state) by an offset that
+// sums into every code's evidence in proportion to its flash count: a whole run's scores are
+// shifted so their median equals the training scores' median (`model.median`), per file. Returns
+// the shift applied to each file (none when the model has no median).
+std::vector<double> alignScoresPerFile(const P300Dataset& data, std::vector<double>& scores,
+                                       const ScoreModel& model);
 
 EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<double>& scores,
                                 const ScoreModel& model, const StoppingRule& dynamic);
@@ -52,16 +73,26 @@ struct TrainingSettings {
   std::string method = "swlda";
   SwldaSettings swlda;
   XdawnSettings xdawn;
-  int folds = 10;  // at most one per selection
+  int folds = 10;  // at most one per selection (or file)
+  // "selection" (no selection's flashes both trained on and tested), "block" (k contiguous blocks
+  // of flashes in time), "file", or "" for the default: by selection, or by block where the data
+  // have fewer than 2 selections or their codes are classes.
+  std::string folds_by;
   StoppingRule dynamic{15, 2, 0.99};
 };
 
 struct CrossValidation {
   EvaluationReport report;
   std::vector<double> scores;  // out-of-fold, one per epoch
+  std::vector<int> fold;       // each epoch's test fold (0-based), -1: not tested
   ScoreModel score_model;
   int folds = 0;
+  std::string folds_by;  // the scheme used
 };
+
+// The scheme `requested` ("" for the default) resolves to for `data`; throws
+// std::invalid_argument when it cannot make 2 folds.
+std::string foldScheme(const P300Dataset& data, const std::string& requested);
 
 // Throws std::invalid_argument when fewer than two selections have known targets.
 CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& settings,

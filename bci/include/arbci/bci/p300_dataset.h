@@ -31,9 +31,14 @@ struct P300Dataset {
   std::vector<int> code;
   std::vector<int> sequence;  // 0-based, within the selection
   std::vector<int> selection;
+  std::vector<int> file;             // index into `sources`
+  std::vector<std::int64_t> sample;  // the stimulus onset in its file
   std::vector<SelectionEpochs> selections;
   std::vector<std::string> sources;
   int dropped_epochs = 0;  // flashes too close to the end of a file for a whole window
+  // Every stimulus code is always a target or never one (an oddball, or a recording coded by
+  // class): the codes are the classes, not choices, so there are no selections to score.
+  bool codes_are_classes = false;
   // The ERPs of the filtered signal at the full rate, all channels, from 100 ms before each
   // stimulus (the baseline) to the end of the analysis window, for the figures.
   ErpCurves erp;

@@ -1,0 +1,41 @@
+#include "arbci/bci/intervals.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace arbci::bci {
+
+Interval aucInterval(double auc, int targets, int others) {
+  if (targets < 1 || others < 1) return {0.0, 1.0};
+  const double a = auc, q1 = a / (2.0 - a), q2 = 2.0 * a * a / (1.0 + a);
+  const double variance =
+      (a * (1.0 - a) + (targets - 1.0) * (q1 - a * a) + (others - 1.0) * (q2 - a * a)) /
+      (static_cast<double>(targets) * others);
+  const double half = 1.96 * std::sqrt(std::max(variance, 0.0));
+  return {std::max(0.0, a - half), std::min(1.0, a + half)};
+}
+
+Interval wilsonInterval(int successes, int trials) {
+  if (trials < 1) return {0.0, 1.0};
+  const double z = 1.96, n = trials, p = successes / n;
+  const double centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+  const double half = z * std::sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / (1.0 + z * z / n);
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
+double chanceLevel95(int choices, int trials) {
+  if (choices < 2 || trials < 1) return 1.0;
+  const double p = 1.0 / choices;
+  // P(X >= k) for X ~ Binomial(trials, p), from k = trials down.
+  double tail = 0.0;
+  for (int k = trials; k >= 0; --k) {
+    const double log_term = std::lgamma(trials + 1.0) - std::lgamma(k + 1.0) -
+                            std::lgamma(trials - k + 1.0) + k * std::log(p) +
+                            (trials - k) * std::log1p(-p);
+    tail += std::exp(log_term);
+    if (tail >= 0.05) return std::min(1.0, (k + 1.0) / trials);
+  }
+  return 0.0;
+}
+
+}  // namespace arbci::bci
