@@ -187,7 +187,8 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
     if (!out) throw CliError("cannot write " + written.back().string());
   }
 
-  // Accuracy and bit rate against the number of sequences.
+  // Accuracy and bit rate against the number of sequences, where codes are choices.
+  if (!report.selection_metrics || report.max_sequences < 1) return written;
   std::vector<double> n, percent;
   for (int k = 1; k <= report.max_sequences; ++k) {
     n.push_back(k);
@@ -198,7 +199,19 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
        0.5);
   const double x1 = std::max(2.0, static_cast<double>(report.max_sequences));
   const Panel accuracy{{60, 50, 320, 230}, 1.0, x1, 0.0, 100.0};
-  accuracy.axes(image, "accuracy %", 0, 0);
+  accuracy.axes(image, "accuracy % (95 % intervals)", 0, 0);
+  // Guessing: the chance level, and the accuracy that beats it at p < 0.05 (dashed).
+  cv::line(image, accuracy.map(1.0, 100.0 * report.chance), accuracy.map(x1, 100.0 * report.chance),
+           kGrey, 1);
+  for (double x = 1.0; x < x1; x += (x1 - 1.0) / 40.0) {
+    cv::line(image, accuracy.map(x, 100.0 * report.chance_95),
+             accuracy.map(std::min(x1, x + (x1 - 1.0) / 80.0), 100.0 * report.chance_95), kBlack, 1);
+  }
+  text(image, "p < 0.05", accuracy.map(x1, 100.0 * report.chance_95) + cv::Point(-60, -4), 0.35);
+  for (int k = 1; k <= report.max_sequences; ++k) {
+    const bci::Interval& i = report.accuracy_interval[static_cast<size_t>(k - 1)];
+    cv::line(image, accuracy.map(k, 100.0 * i.low), accuracy.map(k, 100.0 * i.high), kTarget, 1);
+  }
   accuracy.curve(image, n, percent, kTarget, true);
   const double top = std::max(
       1.0, *std::max_element(report.bits_per_minute.begin(), report.bits_per_minute.end()) * 1.1);
