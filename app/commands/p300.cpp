@@ -89,6 +89,11 @@ void train(TrainOptions& o) {
             << o.training.swlda.p_enter << " (or a feature could enter and leave forever)";
     throw CliError(message.str());
   }
+  if (o.training.method == "riemann" && !o.bci2000.empty()) {
+    throw CliError(
+        "--bci2000: a riemann model is not linear in its features, so BCI2000's "
+        "LinearClassifier cannot run it (train swlda, slda or xdawn for BCI2000)");
+  }
   checkOutputs(o.plots, {o.out, o.bci2000, o.report, o.scores});
   o.pipeline.window = parseWindow(o.window_ms);
   o.pipeline.channels = splitNameList(o.channels);
@@ -97,7 +102,8 @@ void train(TrainOptions& o) {
   bci::P300Dataset data;
   try {
     data = bci::buildDataset(readAll(o.files), o.pipeline, progress);
-    if (o.training.method == "xdawn" && o.training.xdawn.filters > data.shape.channels) {
+    if ((o.training.method == "xdawn" || o.training.method == "riemann") &&
+        o.training.xdawn.filters > data.shape.channels) {
       throw CliError("--xdawn-filters " + std::to_string(o.training.xdawn.filters) +
                      ": the features have " + std::to_string(data.shape.channels) +
                      " channels (1 to " + std::to_string(data.shape.channels) + " allowed)");
@@ -223,13 +229,14 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   auto t = std::make_shared<TrainOptions>();
   CLI::App* train_cmd = root.add_subcommand(
       "train",
-      "Train a P300 model (SWLDA as BCI2000, shrinkage LDA, or xDAWN + LDA) on\n"
+      "Train a P300 model (SWLDA as BCI2000, shrinkage LDA, xDAWN + LDA, or the\n"
+      "Riemannian method: xDAWN covariances in the tangent space, then LDA) on\n"
       "recordings with known targets (BCI2000 .dat, ARBCI BDF+), cross-validated\n"
       "by selection.");
   train_cmd->add_option("FILES", t->files, "training recordings")->required();
-  train_cmd->add_option("--method", t->training.method, "swlda, slda or xdawn")
+  train_cmd->add_option("--method", t->training.method, "swlda, slda, xdawn or riemann")
       ->capture_default_str()
-      ->check(CLI::IsMember({"swlda", "slda", "xdawn"}));
+      ->check(CLI::IsMember({"swlda", "slda", "xdawn", "riemann"}));
   train_cmd->add_option("--out", t->out, "model file to write (JSON)")->required();
   train_cmd->add_option("--channels", t->channels,
                         "comma-separated channels to use (default: all)");
@@ -282,7 +289,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(1, 100000));
   train_cmd
       ->add_option("--xdawn-filters", t->training.xdawn.filters,
-                   "xDAWN: spatial filters kept (1 to the number of channels)")
+                   "xDAWN: spatial filters kept; riemann: per class (1 to the number of channels)")
       ->capture_default_str()
       ->check(CLI::Range(1, 256));
   train_cmd

@@ -303,7 +303,7 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   const Section cl = root.section("classifier");
   cl.known(
       {"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz", "notch_hz", "model"});
-  c.classifier_method = cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn"});
+  c.classifier_method = cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn", "riemann"});
   const auto window = cl.numbers(
       "window_ms", {c.pipeline.window.start_s * 1000.0, c.pipeline.window.end_s * 1000.0}, 2, 2);
   if (!(window[1] > window[0])) cl.fail("window_ms", "must end after it starts");

@@ -1,6 +1,7 @@
 #include <stdexcept>
 
 #include "linear_classifiers.h"
+#include "riemann_classifier.h"
 
 namespace arbci::bci {
 
@@ -61,8 +62,9 @@ std::unique_ptr<Classifier> makeClassifier(const std::string& method, const Swld
   if (method == "swlda") return std::make_unique<SwldaClassifier>(swlda);
   if (method == "slda") return std::make_unique<ShrinkageLdaClassifier>();
   if (method == "xdawn") return std::make_unique<XdawnClassifier>(xdawn);
+  if (method == "riemann") return std::make_unique<RiemannClassifier>(xdawn);
   throw std::invalid_argument("unknown classification method '" + method +
-                              "' (swlda, slda or xdawn)");
+                              "' (swlda, slda, xdawn or riemann)");
 }
 
 std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
@@ -70,7 +72,13 @@ std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
   if (!json.is_object() || !json.contains("method") || !json["method"].is_string()) {
     throw std::invalid_argument("classifier: no method");
   }
-  std::unique_ptr<Classifier> classifier = makeClassifier(json["method"].get<std::string>());
+  const std::string method = json["method"].get<std::string>();
+  if (method == "riemann") {
+    auto riemann = std::make_unique<RiemannClassifier>(XdawnSettings{});
+    riemann->restore(json, shape);
+    return riemann;
+  }
+  std::unique_ptr<Classifier> classifier = makeClassifier(method);
   static_cast<LinearClassifierBase&>(*classifier).restore(json, shape);
   return classifier;
 }

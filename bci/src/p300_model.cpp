@@ -133,6 +133,11 @@ std::string P300Model::bci2000Fragment() const {
   }
   const int factor = pipeline.decimationFactor(rate_hz);
   const Eigen::VectorXd w = classifier->weights();
+  if (w.size() != shape.size()) {
+    throw ModelError("a " + method +
+                     " model is not linear in its features: BCI2000's LinearClassifier cannot "
+                     "run it (train swlda, slda or xdawn for BCI2000)");
+  }
   std::ostringstream entries;
   int count = 0;
   for (int c = 0; c < shape.channels; ++c) {

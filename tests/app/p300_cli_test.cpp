@@ -220,6 +220,28 @@ TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
   EXPECT_GT(json["auc"].get<double>(), 0.8);  // the simulated subject's P300 is clear
 }
 
+// The Riemannian method through the CLI: trained, saved, loaded and applied to the other session.
+TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
+  const auto model = scratch("riemann.json");
+  ProcessResult r = runProcess(
+      kArbci, {"train", "--method", "riemann", eeg("eeg3_1.dat"), "--out", model.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(model);
+  EXPECT_EQ(nlohmann::json::parse(in)["classifier"]["method"], "riemann");
+  const auto report = scratch("riemann_report.json");
+  r = runProcess(kArbci, {"evaluate", "--model", model.string(), eeg("eeg3_2.dat"), "--report",
+                          report.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("selected with 15 sequences: 6MK?"), std::string::npos) << r.out;
+  std::ifstream report_in(report);
+  EXPECT_GT(nlohmann::json::parse(report_in)["auc"].get<double>(), 0.85);
+  // Not linear: no BCI2000 fragment, refused before training.
+  r = runProcess(kArbci, {"train", "--method", "riemann", eeg("eeg3_1.dat"), "--out",
+                          model.string(), "--bci2000", scratch("riemann.prm").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("not linear"), std::string::npos) << r.err;
+}
+
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
   ASSERT_EQ(

@@ -23,7 +23,7 @@ void TrainingPanel::startTraining() {
     message_ = "name at least one recording (BCI2000 .dat or ARBCI .bdf)";
     return;
   }
-  const char* methods[] = {"swlda", "slda", "xdawn"};
+  const char* methods[] = {"swlda", "slda", "xdawn", "riemann"};
   bci::TrainingSettings settings;
   settings.method = methods[method_];
   bci::PipelineSettings pipeline;
@@ -74,8 +74,9 @@ void TrainingPanel::collect() {
 void TrainingPanel::draw() {
   ImGui::InputTextMultiline("recordings", files_, sizeof files_,
                             ImVec2(-1, ImGui::GetTextLineHeight() * 3));
-  const char* methods[] = {"SWLDA (as BCI2000)", "shrinkage LDA", "xDAWN + LDA"};
-  ImGui::Combo("method", &method_, methods, 3);
+  const char* methods[] = {"SWLDA (as BCI2000)", "shrinkage LDA", "xDAWN + LDA",
+                           "Riemannian (xDAWN covariances, tangent space)"};
+  ImGui::Combo("method", &method_, methods, 4);
   ImGui::SliderFloat("window end (ms)", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
   ImGui::SliderFloat("decimate to (Hz)", &decimate_hz_, 10.0f, 64.0f, "%.0f");
   collect();

@@ -1,0 +1,182 @@
+#include "riemann_classifier.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "linear_classifiers.h"
+#include "xdawn_filters.h"
+
+namespace arbci::bci {
+namespace {
+
+// f(S) of a symmetric matrix through its eigenvalues.
+template <typename F>
+Eigen::MatrixXd spectral(const Eigen::MatrixXd& s, F f) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(s);
+  const Eigen::VectorXd values = solver.eigenvalues().unaryExpr(f);
+  return solver.eigenvectors() * values.asDiagonal() * solver.eigenvectors().transpose();
+}
+
+// The covariance of the rows of `z` (variables) over its columns (samples), shrunk towards a
+// multiple of the identity with the Ledoit-Wolf intensity: positive definite however few samples.
+Eigen::MatrixXd shrunkCovariance(const Eigen::MatrixXd& raw) {
+  const Eigen::MatrixXd z = raw.colwise() - raw.rowwise().mean();  // each row about its mean
+  const double n = static_cast<double>(z.cols()), p = static_cast<double>(z.rows());
+  const Eigen::MatrixXd sample = z * z.transpose() / n;
+  const double mu = sample.trace() / p;
+  const double d2 = sample.squaredNorm() - p * mu * mu;
+  double b2 = 0.0;
+  for (Eigen::Index t = 0; t < z.cols(); ++t) {
+    const Eigen::VectorXd x = z.col(t);
+    b2 += (x * x.transpose() - sample).squaredNorm();
+  }
+  b2 /= n * n;
+  const double shrinkage = d2 > 0.0 ? std::clamp(b2 / d2, 0.0, 1.0) : 1.0;
+  Eigen::MatrixXd out = (1.0 - shrinkage) * sample;
+  out.diagonal().array() += shrinkage * mu + 1e-12;
+  return out;
+}
+
+// The upper triangle of a symmetric matrix, off-diagonal entries times sqrt(2) (so the vector's
+// norm is the matrix's Frobenius norm).
+Eigen::VectorXd upperTriangle(const Eigen::MatrixXd& s) {
+  const Eigen::Index d = s.rows();
+  Eigen::VectorXd v(d * (d + 1) / 2);
+  Eigen::Index k = 0;
+  for (Eigen::Index i = 0; i < d; ++i) {
+    for (Eigen::Index j = i; j < d; ++j) v[k++] = i == j ? s(i, j) : std::sqrt(2.0) * s(i, j);
+  }
+  return v;
+}
+
+std::vector<double> flatten(const Eigen::MatrixXd& m) {  // row-major
+  std::vector<double> out;
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out.push_back(m(i, j));
+  return out;
+}
+
+Eigen::MatrixXd unflatten(const nlohmann::json& json, const char* key, Eigen::Index rows,
+                          Eigen::Index cols) {
+  if (!json.contains(key) || !json[key].is_array())
+    throw std::invalid_argument(std::string("riemann classifier: ") + key + " missing");
+  const std::vector<double> v = json[key].get<std::vector<double>>();
+  if (static_cast<Eigen::Index>(v.size()) != rows * cols) {
+    throw std::invalid_argument(std::string("riemann classifier: ") + key + " has " +
+                                std::to_string(v.size()) + " values, not " +
+                                std::to_string(rows * cols));
+  }
+  Eigen::MatrixXd m(rows, cols);
+  for (Eigen::Index i = 0; i < rows; ++i)
+    for (Eigen::Index j = 0; j < cols; ++j) m(i, j) = v[static_cast<size_t>(i * cols + j)];
+  return m;
+}
+
+}  // namespace
+
+Eigen::VectorXd RiemannClassifier::tangentVector(
+    const Eigen::Ref<const Eigen::RowVectorXd>& features) const {
+  const Eigen::MatrixXd filtered = filters_.transpose() * epochOf(features, shape_);
+  Eigen::MatrixXd stacked(prototypes_.rows() + filtered.rows(), shape_.bins);
+  stacked << prototypes_, filtered;
+  const Eigen::MatrixXd whitened = reference_isqrt_ * shrunkCovariance(stacked) * reference_isqrt_;
+  return upperTriangle(spectral(whitened, [](double x) { return std::log(x); }));
+}
+
+void RiemannClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+                              const FeatureShape& shape, const Progress& progress) {
+  checkTrainingData(features, target, shape);
+  shape_ = shape;
+  if (progress) progress(0.0, "Riemannian: xDAWN filters");
+  std::vector<bool> other(target.size());
+  std::transform(target.begin(), target.end(), other.begin(), [](bool t) { return !t; });
+  const int kept = settings_.filters;
+  const XdawnFilters for_target = xdawnFilters(features, shape, target, kept);
+  const XdawnFilters for_other = xdawnFilters(features, shape, other, kept);
+  filters_.resize(shape.channels, 2 * kept);
+  filters_ << for_target.filters, for_other.filters;
+  prototypes_.resize(2 * kept, shape.bins);
+  prototypes_ << for_target.filters.transpose() * for_target.evoked,
+      for_other.filters.transpose() * for_other.evoked;
+
+  // Each epoch's augmented covariance.
+  const Eigen::Index n = features.rows();
+  const int d = 4 * kept;
+  std::vector<Eigen::MatrixXd> covariances;
+  covariances.reserve(static_cast<size_t>(n));
+  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(d, d);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::MatrixXd filtered = filters_.transpose() * epochOf(features.row(i), shape);
+    Eigen::MatrixXd stacked(d, shape.bins);
+    stacked << prototypes_, filtered;
+    covariances.push_back(shrunkCovariance(stacked));
+    mean += covariances.back();
+  }
+  mean /= static_cast<double>(n);
+  // The Karcher mean: from the arithmetic one, step along the mean of the logarithms until the
+  // step vanishes (a few iterations).
+  if (progress) progress(0.3, "Riemannian mean");
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const Eigen::MatrixXd root = spectral(mean, [](double x) { return std::sqrt(x); });
+    const Eigen::MatrixXd inverse_root =
+        spectral(mean, [](double x) { return 1.0 / std::sqrt(x); });
+    Eigen::MatrixXd step = Eigen::MatrixXd::Zero(d, d);
+    for (const Eigen::MatrixXd& c : covariances)
+      step += spectral(inverse_root * c * inverse_root, [](double x) { return std::log(x); });
+    step /= static_cast<double>(n);
+    mean = root * spectral(step, [](double x) { return std::exp(x); }) * root;
+    mean = 0.5 * (mean + mean.transpose());
+    if (step.norm() < 1e-9) break;
+  }
+  reference_isqrt_ = spectral(mean, [](double x) { return 1.0 / std::sqrt(x); });
+
+  if (progress) progress(0.6, "Riemannian: tangent space, shrinkage LDA");
+  Eigen::MatrixXd tangent(n, d * (d + 1) / 2);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::MatrixXd whitened =
+        reference_isqrt_ * covariances[static_cast<size_t>(i)] * reference_isqrt_;
+    tangent.row(i) = upperTriangle(spectral(whitened, [](double x) { return std::log(x); }));
+  }
+  trainShrinkageLda(tangent, target, weights_, bias_);
+  if (progress) progress(1.0, "Riemannian");
+}
+
+double RiemannClassifier::score(const Eigen::Ref<const Eigen::VectorXd>& features) const {
+  if (features.size() != shape_.size()) {
+    throw std::invalid_argument("classifier: " + std::to_string(features.size()) +
+                                " features given, the model has " + std::to_string(shape_.size()));
+  }
+  return weights_.dot(tangentVector(features.transpose())) + bias_;
+}
+
+nlohmann::json RiemannClassifier::toJson() const {
+  return {{"method", method()},
+          {"filters_per_class", filters_.cols() / 2},
+          {"spatial_filters", flatten(filters_)},
+          {"prototypes", flatten(prototypes_)},
+          {"reference_inverse_sqrt", flatten(reference_isqrt_)},
+          {"weights", std::vector<double>(weights_.data(), weights_.data() + weights_.size())},
+          {"bias", bias_}};
+}
+
+void RiemannClassifier::restore(const nlohmann::json& json, const FeatureShape& shape) {
+  if (!json.contains("filters_per_class") || !json["filters_per_class"].is_number_integer())
+    throw std::invalid_argument("riemann classifier: filters_per_class missing");
+  const int kept = json["filters_per_class"].get<int>();
+  if (kept < 1 || kept > shape.channels)
+    throw std::invalid_argument("riemann classifier: filters_per_class out of range");
+  shape_ = shape;
+  const int d = 4 * kept;
+  filters_ = unflatten(json, "spatial_filters", shape.channels, 2 * kept);
+  prototypes_ = unflatten(json, "prototypes", 2 * kept, shape.bins);
+  reference_isqrt_ = unflatten(json, "reference_inverse_sqrt", d, d);
+  const Eigen::MatrixXd w = unflatten(json, "weights", 1, d * (d + 1) / 2);
+  weights_ = w.row(0).transpose();
+  if (!json.contains("bias") || !json["bias"].is_number())
+    throw std::invalid_argument("riemann classifier: bias missing");
+  bias_ = json["bias"].get<double>();
+}
+
+}  // namespace arbci::bci
