@@ -6,8 +6,10 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <set>
 #include <sstream>
 
+#include "arbci/bci/channel_quality.h"
 #include "arbci/bci/p300_model.h"
 #include "commands/commands.h"
 #include "eeg/p300_plots.h"
@@ -31,6 +33,33 @@ std::vector<bci::Recording> readAll(const std::vector<std::string>& files) {
   return recordings;
 }
 
+// Flat and drifting channels of each recording, said; with `exclude`, taken out of every
+// recording. Returns the report's "channels" block.
+nlohmann::json checkChannels(std::vector<bci::Recording>& recordings, bool exclude) {
+  std::set<std::string> flat, drifting;
+  for (const bci::Recording& r : recordings) {
+    for (const bci::ChannelQuality& q : bci::assessChannels(r)) {
+      if (q.flat) flat.insert(q.channel);
+      if (q.drifting) drifting.insert(q.channel);
+    }
+  }
+  std::vector<std::string> bad(flat.begin(), flat.end());
+  bad.insert(bad.end(), drifting.begin(), drifting.end());
+  if (!bad.empty()) {
+    std::cout << "channels: "
+              << (flat.empty() ? "" : "flat " + joinNames({flat.begin(), flat.end()}))
+              << (flat.empty() || drifting.empty() ? "" : "; ")
+              << (drifting.empty() ? ""
+                                   : "drifting " + joinNames({drifting.begin(), drifting.end()}))
+              << (exclude ? ": excluded" : ": used (--exclude-bad-channels to leave them out)")
+              << "\n";
+  }
+  if (exclude && !bad.empty()) {
+    for (bci::Recording& r : recordings) r = bci::withoutChannels(r, bad);
+  }
+  return {{"flat", flat}, {"drifting", drifting}, {"excluded", exclude && !bad.empty()}};
+}
+
 std::string utcNow() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
@@ -43,6 +72,8 @@ std::string utcNow() {
 struct TrainOptions {
   std::vector<std::string> files;
   std::string out, channels, window_ms = "0,800", bci2000, plots, report, scores;
+  double reject_uv = 0.0;
+  bool exclude_bad_channels = false;
   bci::TrainingSettings training;
   bci::PipelineSettings pipeline;
 };
@@ -100,8 +131,11 @@ void train(TrainOptions& o) {
   const bci::Progress progress = progressLine(std::cerr);
   bci::TrainingResult result;
   bci::P300Dataset data;
+  nlohmann::json quality;
   try {
-    data = bci::buildDataset(readAll(o.files), o.pipeline, progress);
+    std::vector<bci::Recording> recordings = readAll(o.files);
+    quality = checkChannels(recordings, o.exclude_bad_channels);
+    data = bci::buildDataset(recordings, o.pipeline, progress, o.reject_uv);
     if ((o.training.method == "xdawn" || o.training.method == "riemann") &&
         o.training.xdawn.filters > data.shape.channels) {
       throw CliError("--xdawn-filters " + std::to_string(o.training.xdawn.filters) +
@@ -129,6 +163,11 @@ void train(TrainOptions& o) {
             << data.sources.size() << " file(s)";
   if (data.dropped_epochs > 0)
     std::cout << "; " << data.dropped_epochs << " flashes too close to a file's end left out";
+  if (o.reject_uv > 0.0) {
+    std::cout << "; " << data.rejected_epochs << " epochs over " << o.reject_uv
+              << " uV peak-to-peak rejected";
+  }
+  if (o.pipeline.zero_phase) std::cout << "; zero-phase filters (offline only)";
   const bci::CrossValidation& cv = result.cross_validation;
   std::cout << "\n\ncross-validation, " << cv.folds << " folds by " << cv.folds_by
             << (o.training.folds_by.empty() ? " (the default here; --folds-by to change)" : "")
@@ -139,7 +178,11 @@ void train(TrainOptions& o) {
                     {"method", o.training.method},
                     {"files", data.sources},
                     {"folds", cv.folds},
-                    {"folds_by", cv.folds_by}},
+                    {"folds_by", cv.folds_by},
+                    {"zero_phase", o.pipeline.zero_phase},
+                    {"channels", quality},
+                    {"rejected_epochs", data.rejected_epochs},
+                    {"reject_uv", o.reject_uv}},
                    data, cv.scores, cv.fold);
   if (!o.plots.empty()) {
     const auto written = writeP300Plots(o.plots, data, result.cross_validation.report,
@@ -152,6 +195,7 @@ void train(TrainOptions& o) {
 
 struct EvaluateOptions {
   std::string model, plots, report, scores;
+  double reject_uv = 0.0;
   std::vector<std::string> files;
   int sequences = 0;
   bci::StoppingRule dynamic{15, 2, 0.99};
@@ -166,7 +210,8 @@ void evaluate(EvaluateOptions& o) {
   } catch (const bci::ModelError& error) {
     throw CliError(error.what());
   }
-  const std::vector<bci::Recording> recordings = readAll(o.files);
+  std::vector<bci::Recording> recordings = readAll(o.files);
+  const nlohmann::json quality = checkChannels(recordings, false);
   for (const bci::Recording& r : recordings) {
     try {
       model.checkCompatible(r.info, r.source);
@@ -175,7 +220,11 @@ void evaluate(EvaluateOptions& o) {
     }
   }
   try {
-    bci::P300Dataset data = bci::buildDataset(recordings, model.pipeline);
+    bci::P300Dataset data = bci::buildDataset(recordings, model.pipeline, {}, o.reject_uv);
+    if (o.reject_uv > 0.0) {
+      std::cout << data.rejected_epochs << " epochs over " << o.reject_uv
+                << " uV peak-to-peak rejected\n";
+    }
     std::vector<double> scores(static_cast<size_t>(data.epochs()));
     for (int i = 0; i < data.epochs(); ++i)
       scores[static_cast<size_t>(i)] = model.classifier->score(data.features.row(i).transpose());
@@ -212,6 +261,10 @@ void evaluate(EvaluateOptions& o) {
                       {"method", model.method},
                       {"model", o.model},
                       {"align_scores", o.align},
+                      {"zero_phase", model.pipeline.zero_phase},
+                      {"channels", quality},
+                      {"rejected_epochs", data.rejected_epochs},
+                      {"reject_uv", o.reject_uv},
                       {"files", data.sources}},
                      data, scores, {});
     if (!o.plots.empty()) {
@@ -260,6 +313,18 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10000.0));
   train_cmd->add_flag("--car", t->pipeline.filter.common_average, "common average reference first");
+  train_cmd->add_flag("--zero-phase", t->pipeline.zero_phase,
+                      "filter forward and backward (no phase lag; offline only: the model says "
+                      "so, and a session filters causally)");
+  train_cmd
+      ->add_option("--reject-uv", t->reject_uv,
+                   "leave out epochs whose filtered peak-to-peak amplitude exceeds this (0: keep "
+                   "all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e7));
+  train_cmd->add_flag("--exclude-bad-channels", t->exclude_bad_channels,
+                      "leave out flat (SD < 0.5 uV) and drifting (SD > 20x the median channel's) "
+                      "channels, which are always reported");
   train_cmd
       ->add_option("--folds", t->training.folds,
                    "cross-validation folds (at most one per selection or file)")
@@ -334,6 +399,12 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                    "(scores drift between sessions); none: as the model gives them")
       ->capture_default_str()
       ->check(CLI::IsMember({"per-file", "none"}));
+  eval_cmd
+      ->add_option("--reject-uv", e->reject_uv,
+                   "leave out epochs whose filtered peak-to-peak amplitude exceeds this (0: keep "
+                   "all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e7));
   eval_cmd->add_option("--report", e->report, "also write the report as JSON (everything printed)");
   eval_cmd->add_option("--scores", e->scores,
                        "also write every flash's score as CSV (file,sample,code,label,score,fold)");

@@ -148,6 +148,14 @@ void EegStage::displayed(double host_s, bool patch_lit) {
 
 void EegStage::setModel(bci::P300Model model) {
   model.checkCompatible(info(), "the EEG source");
+  if (model.pipeline.zero_phase) {
+    // Online filtering must be causal: the features lag where the model's did not.
+    const std::string text =
+        "the model was trained with zero-phase (offline) filters; the session filters causally, "
+        "so its features lag the model's: train without --zero-phase for online use";
+    log_.write("model_warning", 0.0, {{"text", text}});
+    if (progress_) *progress_ << "\nwarning: " << text << "\n";
+  }
   extractor_.emplace(model.extractor(info()));
   // The online filter and window follow the model's pipeline.
   filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, info());

@@ -14,4 +14,10 @@ std::vector<std::string> splitNameList(const std::string& text) {
   return names;
 }
 
+std::string joinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
 }  // namespace arbci::app

@@ -1,5 +1,7 @@
 #include "arbci/bci/p300_dataset.h"
 
+#include "arbci/bci/channel_quality.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -9,6 +11,27 @@
 
 namespace arbci::bci {
 namespace {
+
+void reverseInTime(Block& block) {
+  for (int c = 0; c < block.channels; ++c) {
+    auto first = block.data.begin() + static_cast<std::ptrdiff_t>(c) * block.samples;
+    std::reverse(first, first + block.samples);
+  }
+}
+
+// The largest peak-to-peak amplitude of `channels` in the epoch.
+double peakToPeak(const Epoch& epoch, const std::vector<int>& channels) {
+  double largest = 0.0;
+  for (int c : channels) {
+    float low = epoch.at(c, 0), high = low;
+    for (int s = 1; s < epoch.samples; ++s) {
+      low = std::min(low, epoch.at(c, s));
+      high = std::max(high, epoch.at(c, s));
+    }
+    largest = std::max(largest, static_cast<double>(high - low));
+  }
+  return largest;
+}
 
 // BCI2000 matrix parameters: "matrix R C v..." where R or C may be "{ labels }".
 std::vector<std::vector<std::string>> bci2000Matrix(const Recording& r, const std::string& name) {
@@ -43,13 +66,9 @@ std::optional<Recording> withoutPhotodiode(const Recording& r) {
   const auto named = r.parameters.find("PhotodiodeChannel");
   if (named == r.parameters.end() || named->second.empty()) return std::nullopt;
   const auto& channels = r.info.channels;
-  const auto found = std::find(channels.begin(), channels.end(), named->second);
-  if (found == channels.end()) return std::nullopt;
-  const auto drop = static_cast<int>(found - channels.begin());
-  Recording eeg = r;  // (offline: one copy more keeps every other field as it is)
-  eeg.info.channels.erase(eeg.info.channels.begin() + drop);
-  eeg.data = withoutChannel(r.data, r.info.channelCount(), r.samples, drop);
-  return eeg;
+  if (std::find(channels.begin(), channels.end(), named->second) == channels.end())
+    return std::nullopt;
+  return withoutChannels(r, {named->second});
 }
 
 double medianGap(const std::vector<StimulusEvent>& stimuli, double rate) {
@@ -90,7 +109,7 @@ ParadigmLayout layoutOf(const Recording& r) {
 }
 
 P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSettings& settings,
-                         const Progress& progress) {
+                         const Progress& progress, double reject_uv) {
   if (given.empty()) throw std::invalid_argument("no recordings given");
   std::vector<Recording> eeg_only;  // copies, only of recordings that carry a photodiode
   std::vector<const Recording*> chosen;
@@ -143,6 +162,12 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
     Block signal(0, r.info.channelCount(), static_cast<int>(r.samples));
     signal.data = r.data;
     FilterChain(settings.filter, r.info).process(signal);
+    if (settings.zero_phase) {
+      // Backward through a fresh chain: the phase lags of the two passes cancel.
+      reverseInTime(signal);
+      FilterChain(settings.filter, r.info).process(signal);
+      reverseInTime(signal);
+    }
 
     // Selections: runs of flashes separated by pauses longer than four stimulus intervals.
     const double gap_limit = std::max(1.0, 4.0 * layout.soa_s) * r.info.rate_hz;
@@ -168,6 +193,11 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       for (int c = 0; c < signal.channels; ++c) {
         std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + first),
                     length, epoch.data.begin() + static_cast<std::ptrdiff_t>(c) * length);
+      }
+      if (reject_uv > 0.0 && peakToPeak(epoch, extractor.channelIndices()) > reject_uv) {
+        ++data.rejected_epochs;
+        ++in_selection;
+        continue;
       }
       rows.push_back(extractor.features(epoch));
       const std::int64_t erp_first = e.sample - erp_baseline;
@@ -205,6 +235,7 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
           by_code.begin(), by_code.end(),
           [](const auto& c) { return c.second.first == 0 || c.second.first == c.second.second; }) &&
       std::any_of(by_code.begin(), by_code.end(), [](const auto& c) { return c.second.first > 0; });
+  data.reject_uv = reject_uv;
   data.erp = erps.curves();
   data.erp.channels = data.info.channels;
   data.erp.rate_hz = data.info.rate_hz;

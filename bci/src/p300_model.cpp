@@ -36,7 +36,8 @@ nlohmann::json P300Model::toJson() const {
                       {"window_s", {pipeline.window.start_s, pipeline.window.end_s}},
                       {"decimate_hz", pipeline.decimate_hz},
                       {"decimation_factor", pipeline.decimationFactor(rate_hz)},
-                      {"channels", pipeline.channels}};
+                      {"channels", pipeline.channels},
+                      {"zero_phase", pipeline.zero_phase}};
   json["shape"] = {{"channels", shape.channels}, {"bins", shape.bins}};
   json["classifier"] = classifier->toJson();
   json["score_model"] = {{"target_mean", score_model.target_mean},
@@ -76,6 +77,7 @@ P300Model P300Model::fromJson(const nlohmann::json& json, const std::string& sou
     model.pipeline.window = {window[0], window[1]};
     model.pipeline.decimate_hz = p.at("decimate_hz").get<double>();
     model.pipeline.channels = p.at("channels").get<std::vector<std::string>>();
+    model.pipeline.zero_phase = p.value("zero_phase", false);
     model.shape = {json.at("shape").at("channels").get<int>(),
                    json.at("shape").at("bins").get<int>()};
     if (model.shape.channels != static_cast<int>(model.pipeline.channels.size())) {

@@ -242,6 +242,85 @@ TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
   EXPECT_NE(r.err.find("not linear"), std::string::npos) << r.err;
 }
 
+// Flat and drifting channels are reported, and left out on request; epochs over an amplitude
+// limit are rejected and counted; zero-phase filtering is recorded in the model.
+TEST(TrainAndEvaluate, BadChannelsAndLargeEpochsAreReportedAndLeftOutOnRequest) {
+  const auto simulated = scratch("artifacts_clean.bdf"), damaged = scratch("artifacts.bdf");
+  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "90", "--seed", "5", "--out",
+                                simulated.string()})
+                .exit_code,
+            0);
+  const bci::Recording clean = bci::readRecording(simulated.string());
+  const std::string flat = clean.info.channels[1], drifting = clean.info.channels[2];
+  {
+    bci::Recording r = clean;
+    for (std::int64_t s = 0; s < r.samples; ++s) {
+      r.data[static_cast<size_t>(1 * r.samples + s)] = 0.0f;  // a shorted electrode
+      r.data[static_cast<size_t>(2 * r.samples + s)] +=
+          static_cast<float>(1e5 * s / r.samples);  // a contact drifting by 1e5 uV
+    }
+    bci::RecordingWriter writer(damaged, r.info);
+    bci::Block block(0, r.info.channelCount(), static_cast<int>(r.samples));
+    block.data = r.data;
+    writer.write(block);
+    for (const bci::StimulusEvent& e : r.stimuli) writer.addStimulus(e);
+  }
+  const auto model = scratch("artifacts.json"), report = scratch("artifacts_report.json");
+  ProcessResult r =
+      runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out", model.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("channels: flat " + flat + "; drifting " + drifting +
+                       ": used (--exclude-bad-channels to leave them out)"),
+            std::string::npos)
+      << r.out;
+  r = runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out", model.string(),
+                          "--exclude-bad-channels", "--reject-uv", "60", "--zero-phase", "--report",
+                          report.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(": excluded"), std::string::npos) << r.out;
+  std::ifstream model_in(model);
+  const nlohmann::json m = nlohmann::json::parse(model_in);
+  const auto channels = m["pipeline"]["channels"].get<std::vector<std::string>>();
+  EXPECT_EQ(channels.size(), clean.info.channels.size() - 2);
+  EXPECT_EQ(std::count(channels.begin(), channels.end(), flat), 0);
+  EXPECT_EQ(std::count(channels.begin(), channels.end(), drifting), 0);
+  EXPECT_TRUE(m["pipeline"]["zero_phase"].get<bool>());
+  std::ifstream report_in(report);
+  const nlohmann::json j = nlohmann::json::parse(report_in);
+  EXPECT_EQ(j["channels"]["flat"], nlohmann::json::array({flat}));
+  EXPECT_EQ(j["channels"]["drifting"], nlohmann::json::array({drifting}));
+  const int rejected = j["rejected_epochs"].get<int>();
+  EXPECT_GT(rejected, 0);  // the simulated subject blinks
+  EXPECT_EQ(j["target_flashes"].get<int>() + j["non_target_flashes"].get<int>() + rejected,
+            static_cast<int>(clean.stimuli.size()));
+  EXPECT_NE(r.out.find(std::to_string(rejected) + " epochs over 60 uV peak-to-peak rejected"),
+            std::string::npos)
+      << r.out;
+}
+
+// Zero-phase filters take the causal filter's phase lag out of offline analysis: on eeg3 every
+// linear method gains AUC from eeg3_1 to eeg3_2.
+TEST(TrainAndEvaluate, ZeroPhaseFilteringRaisesTheOfflineAucOnEeg3) {
+  for (const char* method : {"swlda", "slda"}) {
+    double auc[2] = {0.0, 0.0};
+    for (int zero_phase = 0; zero_phase < 2; ++zero_phase) {
+      const auto model = scratch(std::string("zp_") + method + ".json"),
+                 report = scratch(std::string("zp_") + method + "_report.json");
+      std::vector<std::string> args = {"train",           "--method", method,
+                                       eeg("eeg3_1.dat"), "--out",    model.string()};
+      if (zero_phase) args.push_back("--zero-phase");
+      ASSERT_EQ(runProcess(kArbci, args).exit_code, 0);
+      ASSERT_EQ(runProcess(kArbci, {"evaluate", "--model", model.string(), eeg("eeg3_2.dat"),
+                                    "--report", report.string()})
+                    .exit_code,
+                0);
+      std::ifstream in(report);
+      auc[zero_phase] = nlohmann::json::parse(in)["auc"].get<double>();
+    }
+    EXPECT_GT(auc[1], auc[0] + 0.005) << method;
+  }
+}
+
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
   ASSERT_EQ(

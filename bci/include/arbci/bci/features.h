@@ -21,6 +21,9 @@ struct PipelineSettings {
   EpochWindow window{0.0, 0.8};
   double decimate_hz = 20.0;
   std::vector<std::string> channels;  // empty: all of the recording's
+  // Offline only (arbci train/evaluate): the filters run forward and backward, so no phase lag;
+  // the model records it, and the online cycle, which must stay causal, says so.
+  bool zero_phase = false;
 
   int decimationFactor(double rate_hz) const;  // samples per bin: 13 at 256 Hz
 };

@@ -35,7 +35,9 @@ struct P300Dataset {
   std::vector<std::int64_t> sample;  // the stimulus onset in its file
   std::vector<SelectionEpochs> selections;
   std::vector<std::string> sources;
-  int dropped_epochs = 0;  // flashes too close to the end of a file for a whole window
+  int dropped_epochs = 0;   // flashes too close to the end of a file for a whole window
+  int rejected_epochs = 0;  // over the amplitude limit (buildDataset's reject_uv)
+  double reject_uv = 0.0;
   // Every stimulus code is always a target or never one (an oddball, or a recording coded by
   // class): the codes are the classes, not choices, so there are no selections to score.
   bool codes_are_classes = false;
@@ -53,7 +55,9 @@ ParadigmLayout layoutOf(const Recording& recording);
 // Filters each recording as the online cycle does, cuts the response windows and computes the
 // features. Throws std::invalid_argument naming the file for recordings without stimuli, with
 // other channels or rates than the first, or another paradigm.
+// `reject_uv` > 0: epochs whose filtered peak-to-peak amplitude exceeds it on any feature channel
+// are left out (counted in rejected_epochs).
 P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings,
-                         const Progress& progress = {});
+                         const Progress& progress = {}, double reject_uv = 0.0);
 
 }  // namespace arbci::bci

@@ -1,0 +1,48 @@
+#include "arbci/bci/channel_quality.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "arbci/bci/signal.h"
+
+namespace arbci::bci {
+
+std::vector<ChannelQuality> assessChannels(const Recording& r) {
+  std::vector<ChannelQuality> out;
+  const int channels = r.info.channelCount();
+  if (r.samples < 2) return out;
+  for (int c = 0; c < channels; ++c) {
+    const float* x = r.data.data() + static_cast<std::ptrdiff_t>(c) * r.samples;
+    double mean = 0.0;
+    for (std::int64_t s = 0; s < r.samples; ++s) mean += x[s];
+    mean /= static_cast<double>(r.samples);
+    double variance = 0.0;
+    for (std::int64_t s = 0; s < r.samples; ++s) variance += (x[s] - mean) * (x[s] - mean);
+    out.push_back({r.info.channels[static_cast<size_t>(c)],
+                   std::sqrt(variance / static_cast<double>(r.samples - 1))});
+  }
+  std::vector<double> sds;
+  for (const ChannelQuality& q : out) sds.push_back(q.sd_uv);
+  std::nth_element(sds.begin(), sds.begin() + sds.size() / 2, sds.end());
+  const double median = sds[sds.size() / 2];
+  for (ChannelQuality& q : out) {
+    q.flat = q.sd_uv < 0.5;
+    q.drifting = channels >= 3 && median > 0.0 && q.sd_uv > 20.0 * median;
+  }
+  return out;
+}
+
+Recording withoutChannels(const Recording& recording, const std::vector<std::string>& channels) {
+  Recording out = recording;
+  for (const std::string& name : channels) {
+    const auto found = std::find(out.info.channels.begin(), out.info.channels.end(), name);
+    if (found == out.info.channels.end()) continue;
+    const int index = static_cast<int>(found - out.info.channels.begin());
+    out.data =
+        withoutChannel(out.data, out.info.channelCount(), static_cast<int>(out.samples), index);
+    out.info.channels.erase(found);
+  }
+  return out;
+}
+
+}  // namespace arbci::bci
