@@ -60,6 +60,15 @@ nlohmann::json checkChannels(std::vector<bci::Recording>& recordings, bool exclu
   return {{"flat", flat}, {"drifting", drifting}, {"excluded", exclude && !bad.empty()}};
 }
 
+void printPlots(const std::vector<std::filesystem::path>& written) {
+  bool scalp = false;
+  for (const auto& file : written) {
+    std::cout << "plot: " << file.string() << "\n";
+    scalp |= file.filename() == "scalp.png";
+  }
+  if (!scalp) std::cout << "(no scalp map: fewer than 3 channels have 10-20 names)\n";
+}
+
 std::string utcNow() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
@@ -187,7 +196,7 @@ void train(TrainOptions& o) {
   if (!o.plots.empty()) {
     const auto written = writeP300Plots(o.plots, data, result.cross_validation.report,
                                         "cross-validated " + o.training.method);
-    for (const auto& file : written) std::cout << "plot: " << file.string() << "\n";
+    printPlots(written);
   }
   std::cout << "model: " << o.out << "\n";
   if (!o.bci2000.empty()) std::cout << "BCI2000 parameters: " << o.bci2000 << "\n";
@@ -268,8 +277,7 @@ void evaluate(EvaluateOptions& o) {
                       {"files", data.sources}},
                      data, scores, {});
     if (!o.plots.empty()) {
-      for (const auto& file : writeP300Plots(o.plots, data, report, "evaluated " + model.method))
-        std::cout << "plot: " << file.string() << "\n";
+      printPlots(writeP300Plots(o.plots, data, report, "evaluated " + model.method));
     }
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "arbci/bci/electrode_positions.h"
 #include "support/cli_error.h"
 
 namespace arbci::app {
@@ -71,6 +72,132 @@ void Panel::band(cv::Mat& image, const std::vector<double>& xs, const std::vecto
 
 void save(const std::filesystem::path& path, const cv::Mat& image) {
   if (!cv::imwrite(path.string(), image)) throw CliError("cannot write " + path.string());
+}
+
+// Blue (negative) through white to red (positive), for `v` in [-1, 1].
+cv::Scalar diverging(double v) {
+  v = std::clamp(v, -1.0, 1.0);
+  const double fade = 255.0 * (1.0 - std::abs(v));
+  return v < 0.0 ? cv::Scalar(255, fade, fade) : cv::Scalar(fade, fade, 255);
+}
+
+// A colour bar from -limit to +limit at `area`, labelled.
+void colourBar(cv::Mat& image, const cv::Rect& area, double limit, const std::string& unit,
+               int decimals) {
+  for (int y = 0; y < area.height; ++y) {
+    const double v = 1.0 - 2.0 * y / std::max(1, area.height - 1);
+    cv::line(image, {area.x, area.y + y}, {area.x + area.width, area.y + y}, diverging(v), 1);
+  }
+  cv::rectangle(image, area, kGrey, 1);
+  char top[32];
+  std::snprintf(top, sizeof top, "%+.*f", decimals, limit);
+  text(image, top, {area.x + area.width + 4, area.y + 10}, 0.35);
+  text(image, "0", {area.x + area.width + 4, area.y + area.height / 2 + 4}, 0.35);
+  text(image, format(-limit, decimals), {area.x + area.width + 4, area.y + area.height}, 0.35);
+  text(image, unit, {area.x - 4, area.y - 8}, 0.35);
+}
+
+// Signed r^2 per channel (rows) and time (columns).
+std::filesystem::path writeR2Figure(const std::filesystem::path& folder,
+                                    const bci::ErpCurves& erp) {
+  const int channels = static_cast<int>(erp.channels.size()), samples = erp.samples();
+  if (channels == 0 || samples < 2) return {};
+  const int left = 80, top = 60, row_h = std::clamp(320 / channels, 6, 28), width = 720;
+  cv::Mat image(top + channels * row_h + 70, left + width + 120, CV_8UC3, kWhite);
+  text(image,
+       "signed r^2 (target vs non-target) per channel and time: " + std::to_string(erp.targets) +
+           " target, " + std::to_string(erp.others) + " non-target epochs",
+       {left, 28}, 0.5);
+  const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
+  const double t0 = erp.timeS(0) * 1000.0, t1 = erp.timeS(samples - 1) * 1000.0;
+  for (int c = 0; c < channels; ++c) {
+    for (int s = 0; s < samples; ++s) {
+      const int x0 = left + s * width / samples, x1 = left + (s + 1) * width / samples;
+      cv::rectangle(image, cv::Rect(x0, top + c * row_h, std::max(1, x1 - x0), row_h),
+                    diverging(erp.signed_r2(c, s) / limit), cv::FILLED);
+    }
+    if (row_h >= 10 || c % std::max(1, 10 / row_h) == 0)
+      text(image, erp.channels[static_cast<size_t>(c)], {8, top + c * row_h + row_h / 2 + 4}, 0.35);
+  }
+  const int bottom = top + channels * row_h;
+  cv::rectangle(image, cv::Rect(left, top, width, channels * row_h), kGrey, 1);
+  for (double t = 0.0; t <= t1; t += 200.0) {
+    const int x = left + static_cast<int>(std::lround((t - t0) / (t1 - t0) * width));
+    cv::line(image, {x, top}, {x, bottom + 4}, t == 0.0 ? kBlack : kGrey, 1);
+    text(image, format(t, 0), {x - 10, bottom + 18}, 0.35);
+  }
+  text(image, "ms after the stimulus", {left + width / 2 - 60, bottom + 40}, 0.4);
+  colourBar(image, cv::Rect(left + width + 20, top, 16, std::max(60, channels * row_h)), limit,
+            "r^2", 3);
+  const std::filesystem::path path = folder / "r2.png";
+  save(path, image);
+  return path;
+}
+
+// The difference wave at its peak on a head map, where the channels' 10-20 positions are known.
+std::filesystem::path writeScalpMap(const std::filesystem::path& folder,
+                                    const bci::ErpCurves& erp) {
+  std::vector<std::pair<std::string, std::pair<double, double>>> known;
+  std::vector<double> values;
+  const int peak = erp.peakSample();
+  const Eigen::MatrixXd difference = erp.difference();
+  for (size_t c = 0; c < erp.channels.size(); ++c) {
+    if (const auto at = bci::electrodePosition(erp.channels[c])) {
+      known.emplace_back(erp.channels[c], *at);
+      values.push_back(difference(static_cast<Eigen::Index>(c), peak));
+    }
+  }
+  if (known.size() < 3) return {};
+  const int size = 360, margin = 50;
+  cv::Mat image(size + 2 * margin + 40, size + 2 * margin + 90, CV_8UC3, kWhite);
+  const cv::Point centre(margin + size / 2, margin + 30 + size / 2);
+  const double radius = size / 2.0, head = 0.55;  // the map's edge, in position units
+  double limit = 1e-6;
+  for (double v : values) limit = std::max(limit, std::abs(v));
+  // Inverse-distance weighting (power 2) inside the head.
+  for (int y = -size / 2; y <= size / 2; ++y) {
+    for (int x = -size / 2; x <= size / 2; ++x) {
+      const double px = x / radius * head, py = -y / radius * head;
+      if (px * px + py * py > head * head) continue;
+      double weighted = 0.0, weights = 0.0;
+      for (size_t k = 0; k < known.size(); ++k) {
+        const double dx = px - known[k].second.first, dy = py - known[k].second.second;
+        const double d2 = dx * dx + dy * dy;
+        if (d2 < 1e-9) {
+          weighted = values[k];
+          weights = 1.0;
+          break;
+        }
+        weighted += values[k] / d2;
+        weights += 1.0 / d2;
+      }
+      image.at<cv::Vec3b>(centre.y + y, centre.x + x) = [&] {
+        const cv::Scalar c = diverging(weighted / weights / limit);
+        return cv::Vec3b(static_cast<uchar>(c[0]), static_cast<uchar>(c[1]),
+                         static_cast<uchar>(c[2]));
+      }();
+    }
+  }
+  cv::circle(image, centre, static_cast<int>(radius), kBlack, 1, cv::LINE_AA);
+  const std::vector<cv::Point> nose = {centre + cv::Point(-12, -static_cast<int>(radius) + 2),
+                                       centre + cv::Point(0, -static_cast<int>(radius) - 16),
+                                       centre + cv::Point(12, -static_cast<int>(radius) + 2)};
+  cv::polylines(image, nose, false, kBlack, 1, cv::LINE_AA);
+  for (const auto& [name, at] : known) {
+    const cv::Point p =
+        centre + cv::Point(static_cast<int>(std::lround(at.first / head * radius)),
+                           static_cast<int>(-std::lround(at.second / head * radius)));
+    cv::circle(image, p, 3, kBlack, cv::FILLED, cv::LINE_AA);
+    text(image, name, p + cv::Point(5, -4), 0.35);
+  }
+  text(image,
+       "target - non-target at " + format(erp.timeS(peak) * 1000.0, 0) +
+           " ms (the difference's peak over channels)",
+       {10, 24}, 0.45);
+  colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40, 16, size - 40), limit, "uV", 1);
+  const std::filesystem::path path = folder / "scalp.png";
+  save(path, image);
+  return path;
 }
 
 // The ERP figure: per channel, target and non-target averages overlaid on one scale with their
@@ -157,7 +284,8 @@ nlohmann::json erpJson(const bci::ErpCurves& erp) {
                         {"non_target", bci::ErpCurves::row(erp.other_mean, c)},
                         {"difference", bci::ErpCurves::row(difference, c)},
                         {"target_se", bci::ErpCurves::row(erp.target_se, c)},
-                        {"non_target_se", bci::ErpCurves::row(erp.other_se, c)}});
+                        {"non_target_se", bci::ErpCurves::row(erp.other_se, c)},
+                        {"signed_r2", bci::ErpCurves::row(erp.signed_r2, c)}});
   }
   return {{"units", "uV"},
           {"rate_hz", erp.rate_hz},
@@ -165,6 +293,7 @@ nlohmann::json erpJson(const bci::ErpCurves& erp) {
           {"window_ms", {erp.window_start_s * 1000.0, erp.window_end_s * 1000.0}},
           {"target_epochs", erp.targets},
           {"non_target_epochs", erp.others},
+          {"peak_ms", erp.samples() > 0 ? erp.timeS(erp.peakSample()) * 1000.0 : 0.0},
           {"channels", channels}};
 }
 
@@ -181,6 +310,8 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
   const std::filesystem::path erp_png = writeErpFigure(folder, data.erp);
   if (!erp_png.empty()) {
     written.push_back(erp_png);
+    for (const auto& extra : {writeR2Figure(folder, data.erp), writeScalpMap(folder, data.erp)})
+      if (!extra.empty()) written.push_back(extra);
     written.push_back(folder / "erp.json");
     std::ofstream out(written.back());
     out << erpJson(data.erp).dump() << "\n";
@@ -205,7 +336,8 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
            kGrey, 1);
   for (double x = 1.0; x < x1; x += (x1 - 1.0) / 40.0) {
     cv::line(image, accuracy.map(x, 100.0 * report.chance_95),
-             accuracy.map(std::min(x1, x + (x1 - 1.0) / 80.0), 100.0 * report.chance_95), kBlack, 1);
+             accuracy.map(std::min(x1, x + (x1 - 1.0) / 80.0), 100.0 * report.chance_95), kBlack,
+             1);
   }
   text(image, "p < 0.05", accuracy.map(x1, 100.0 * report.chance_95) + cv::Point(-60, -4), 0.35);
   for (int k = 1; k <= report.max_sequences; ++k) {

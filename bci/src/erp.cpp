@@ -36,6 +36,13 @@ void ErpAccumulator::add(const std::vector<float>& epoch, bool target) {
   }
 }
 
+int ErpCurves::peakSample() const {
+  if (samples() == 0) return 0;
+  Eigen::Index peak = 0;
+  difference().colwise().squaredNorm().maxCoeff(&peak);
+  return static_cast<int>(peak);
+}
+
 ErpCurves ErpAccumulator::curves() const {
   ErpCurves out;
   out.targets = n_[0];
@@ -51,6 +58,18 @@ ErpCurves ErpAccumulator::curves() const {
     const Eigen::MatrixXd variance =
         ((sum_sq_[k] - sum_[k].cwiseProduct(sum_[k]) / n) / (n - 1.0)).cwiseMax(0.0);
     *errors[k] = (variance / n).cwiseSqrt();
+  }
+  // Point-biserial r over both classes: (m1 - m0) sqrt(n1 n0) / (n s), s the pooled SD about
+  // the grand mean (population form).
+  out.signed_r2 = Eigen::MatrixXd::Zero(channels_, samples_);
+  const double n1 = n_[0], n0 = n_[1], n = n1 + n0;
+  if (n1 > 0 && n0 > 0) {
+    const Eigen::MatrixXd mean = (sum_[0] + sum_[1]) / n;
+    const Eigen::MatrixXd variance =
+        ((sum_sq_[0] + sum_sq_[1]) / n - mean.cwiseProduct(mean)).cwiseMax(1e-30);
+    const Eigen::MatrixXd r = (out.target_mean - out.other_mean) * std::sqrt(n1 * n0) / n;
+    const Eigen::MatrixXd r_scaled = r.cwiseQuotient(variance.cwiseSqrt());
+    out.signed_r2 = r_scaled.cwiseProduct(r_scaled.cwiseAbs());
   }
   return out;
 }

@@ -43,6 +43,8 @@ TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
                           eeg("eeg3_1.dat"), "--out", model.string(), "--plots", plots.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("plot: " + (plots / "erp.json").string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("plot: " + (plots / "scalp.png").string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("plot: " + (plots / "r2.png").string()), std::string::npos) << r.out;
   std::ifstream in(plots / "erp.json");
   const nlohmann::json erp = nlohmann::json::parse(in);
 
@@ -57,8 +59,9 @@ TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
   for (int i = 0; i < length; ++i)
     ASSERT_NEAR(erp["channels"][0]["time_ms"][i].get<double>(), (i - baseline) * 1000.0 / rate,
                 1e-6);
-  std::vector<std::vector<double>> sum[2];
+  std::vector<std::vector<double>> sum[2], sum_sq[2];
   for (auto& s : sum) s.assign(channels, std::vector<double>(length, 0.0));
+  for (auto& s : sum_sq) s.assign(channels, std::vector<double>(length, 0.0));
   int count[2] = {0, 0};
   for (const bci::StimulusEvent& e : raw.stimuli) {
     const std::int64_t first = e.sample - baseline;
@@ -70,7 +73,10 @@ TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
       double mean = 0.0;
       for (int i = 0; i < baseline; ++i) mean += x[i];
       mean /= baseline;
-      for (int i = 0; i < length; ++i) sum[k][c][i] += x[i] - mean;
+      for (int i = 0; i < length; ++i) {
+        sum[k][c][i] += x[i] - mean;
+        sum_sq[k][c][i] += (x[i] - mean) * (x[i] - mean);
+      }
     }
   }
   EXPECT_EQ(erp["target_epochs"], count[0]);
@@ -87,6 +93,29 @@ TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
     }
   }
   EXPECT_LT(worst, 0.1) << "largest difference from the independent average, uV";
+  // Signed r^2 (point-biserial, squared with its sign) and the peak of the difference's RMS
+  // over channels, where the scalp map is drawn.
+  double worst_r2 = 0.0, peak_power = -1.0;
+  int peak_sample = 0;
+  const double n1 = count[0], n0 = count[1], n = n1 + n0;
+  for (int i = 0; i < length; ++i) {
+    double power = 0.0;
+    for (int c = 0; c < channels; ++c) {
+      const double m1 = sum[0][c][i] / n1, m0 = sum[1][c][i] / n0;
+      const double grand = (sum[0][c][i] + sum[1][c][i]) / n;
+      const double sd = std::sqrt((sum_sq[0][c][i] + sum_sq[1][c][i]) / n - grand * grand);
+      const double r = (m1 - m0) * std::sqrt(n1 * n0) / (n * sd);
+      worst_r2 = std::max(
+          worst_r2, std::abs(erp["channels"][c]["signed_r2"][i].get<double>() - r * std::abs(r)));
+      power += (m1 - m0) * (m1 - m0);
+    }
+    if (power > peak_power) {
+      peak_power = power;
+      peak_sample = i;
+    }
+  }
+  EXPECT_LT(worst_r2, 1e-4);
+  EXPECT_NEAR(erp["peak_ms"].get<double>(), (peak_sample - baseline) * 1000.0 / rate, 1e-6);
   // Fz's target average peaks positive between 150 and 350 ms (the P300 of this subject).
   const nlohmann::json& fz = erp["channels"][0];
   ASSERT_EQ(fz["name"], "Fz");

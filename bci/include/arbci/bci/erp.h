@@ -20,10 +20,15 @@ struct ErpCurves {
   int targets = 0, others = 0;                      // epochs averaged
   // Channels (rows) x samples (columns), microvolts.
   Eigen::MatrixXd target_mean, other_mean, target_se, other_se;
+  // Signed r^2 (the point-biserial correlation of amplitude with target/non-target, squared,
+  // with the sign of the difference): how much of each sample's variance the class explains.
+  Eigen::MatrixXd signed_r2;
 
   int samples() const { return static_cast<int>(target_mean.cols()); }
   double timeS(int sample) const { return start_s + sample / rate_hz; }
   Eigen::MatrixXd difference() const { return target_mean - other_mean; }
+  // The sample where the difference's root mean square over channels peaks.
+  int peakSample() const;
   // One channel's row as a vector (a row of a column-major matrix is strided).
   static std::vector<double> row(const Eigen::MatrixXd& m, int channel);
 };
