@@ -6,6 +6,7 @@
 
 #include "arbci/bci/p300_model.h"
 #include "arbci/ui/panels.h"
+#include "erp_plots.h"
 #include "widgets.h"
 
 namespace arbci::ui {
@@ -120,22 +121,9 @@ void TrainingPanel::draw() {
   } else {
     ImGui::TextWrapped("no selection metrics: the stimulus codes are classes, not choices");
   }
-  const bci::ErpCurves& erp = outcome_->data->erp;
-  heading("ERP averages (baseline-corrected): target (upper) and non-target (lower) per channel");
-  // One scale for all channels and both classes, so the averages compare.
-  const float limit = static_cast<float>(
-      std::max({1.0, erp.target_mean.cwiseAbs().maxCoeff(), erp.other_mean.cwiseAbs().maxCoeff()}));
-  for (int c = 0; c < static_cast<int>(erp.channels.size()); ++c) {
-    const std::vector<double> target = bci::ErpCurves::row(erp.target_mean, c),
-                              other = bci::ErpCurves::row(erp.other_mean, c);
-    const std::vector<float> t(target.begin(), target.end()), o(other.begin(), other.end());
-    ImGui::PushID(c);
-    ImGui::PlotLines(erp.channels[static_cast<size_t>(c)].c_str(), t.data(),
-                     static_cast<int>(t.size()), 0, "target", -limit, limit, ImVec2(0, 40));
-    ImGui::PlotLines("##other", o.data(), static_cast<int>(o.size()), 0, "non-target", -limit,
-                     limit, ImVec2(0, 40));
-    ImGui::PopID();
-  }
+  heading("ERP averages (baseline-corrected), as arbci train --plots draws them");
+  drawErpPlots(outcome_->data->erp);
+  drawSignedR2(outcome_->data->erp);
   ImGui::InputText("##model", save_path_, sizeof save_path_);
   ImGui::SameLine();
   if (ImGui::Button("Save model")) {

@@ -1,0 +1,112 @@
+#include "erp_plots.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace arbci::ui {
+namespace {
+
+const ImU32 kTarget = IM_COL32(220, 50, 50, 255), kOther = IM_COL32(40, 110, 200, 255),
+            kTargetBand = IM_COL32(220, 50, 50, 60), kOtherBand = IM_COL32(40, 110, 200, 60),
+            kDifference = IM_COL32(235, 235, 235, 255), kAxis = IM_COL32(150, 150, 150, 255),
+            kWindow = IM_COL32(250, 240, 200, 40);
+
+ImU32 diverging(double v) {
+  v = std::clamp(v, -1.0, 1.0);
+  const int fade = static_cast<int>(255.0 * (1.0 - std::abs(v)));
+  return v < 0.0 ? IM_COL32(fade, fade, 255, 255) : IM_COL32(255, fade, fade, 255);
+}
+
+}  // namespace
+
+void drawErpPlots(const bci::ErpCurves& erp) {
+  const int channels = static_cast<int>(erp.channels.size()), samples = erp.samples();
+  if (channels == 0 || samples < 2) return;
+  const Eigen::MatrixXd difference = erp.difference();
+  const Eigen::MatrixXd band_t = 1.96 * erp.target_se, band_o = 1.96 * erp.other_se;
+  const double limit = std::ceil(std::max({1.0, (erp.target_mean.cwiseAbs() + band_t).maxCoeff(),
+                                           (erp.other_mean.cwiseAbs() + band_o).maxCoeff()}));
+  ImGui::TextColored(ImVec4(0.86f, 0.2f, 0.2f, 1.0f), "target");
+  ImGui::SameLine();
+  ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "non-target");
+  ImGui::SameLine();
+  ImGui::Text("difference (white); 95 %% bands; +/-%.0f uV, %.0f to %.0f ms", limit,
+              erp.timeS(0) * 1000.0, erp.timeS(samples - 1) * 1000.0);
+  const float width = std::max(120.0f, (ImGui::GetContentRegionAvail().x - 8.0f) / 2.0f);
+  const float height = 70.0f;
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  for (int c = 0; c < channels; ++c) {
+    if (c % 2 == 1) ImGui::SameLine();
+    const ImVec2 origin = ImGui::GetCursorScreenPos();
+    ImGui::InvisibleButton(("erp" + std::to_string(c)).c_str(), ImVec2(width, height));
+    auto at = [&](int s, double uv) {
+      return ImVec2(origin.x + width * s / (samples - 1),
+                    origin.y + height * static_cast<float>(0.5 - 0.5 * uv / limit));
+    };
+    auto atTime = [&](double t_s, double uv) {
+      return at(static_cast<int>(std::lround((t_s - erp.start_s) * erp.rate_hz)), uv);
+    };
+    draw->AddRectFilled(atTime(erp.window_start_s, limit),
+                        atTime(std::min(erp.window_end_s, erp.timeS(samples - 1)), -limit),
+                        kWindow);
+    draw->AddRect(origin, ImVec2(origin.x + width, origin.y + height), kAxis);
+    draw->AddLine(at(0, 0.0), at(samples - 1, 0.0), kAxis);
+    draw->AddLine(atTime(0.0, limit), atTime(0.0, -limit), kAxis);
+    for (int s = 0; s + 1 < samples; ++s) {
+      draw->AddQuadFilled(at(s, erp.other_mean(c, s) + band_o(c, s)),
+                          at(s + 1, erp.other_mean(c, s + 1) + band_o(c, s + 1)),
+                          at(s + 1, erp.other_mean(c, s + 1) - band_o(c, s + 1)),
+                          at(s, erp.other_mean(c, s) - band_o(c, s)), kOtherBand);
+      draw->AddQuadFilled(at(s, erp.target_mean(c, s) + band_t(c, s)),
+                          at(s + 1, erp.target_mean(c, s + 1) + band_t(c, s + 1)),
+                          at(s + 1, erp.target_mean(c, s + 1) - band_t(c, s + 1)),
+                          at(s, erp.target_mean(c, s) - band_t(c, s)), kTargetBand);
+    }
+    for (int s = 0; s + 1 < samples; ++s) {
+      draw->AddLine(at(s, erp.other_mean(c, s)), at(s + 1, erp.other_mean(c, s + 1)), kOther, 1.5f);
+      draw->AddLine(at(s, erp.target_mean(c, s)), at(s + 1, erp.target_mean(c, s + 1)), kTarget,
+                    1.5f);
+      draw->AddLine(at(s, difference(c, s)), at(s + 1, difference(c, s + 1)), kDifference, 1.0f);
+    }
+    draw->AddText(ImVec2(origin.x + 4, origin.y + 2), kDifference,
+                  erp.channels[static_cast<size_t>(c)].c_str());
+  }
+}
+
+void drawSignedR2(const bci::ErpCurves& erp) {
+  const int channels = static_cast<int>(erp.channels.size()), samples = erp.samples();
+  if (channels == 0 || samples < 2) return;
+  const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
+  ImGui::Text(
+      "signed r^2 per channel (rows) and time: red target > non-target, blue below; "
+      "|r^2| up to %.3f",
+      limit);
+  const float labels = 48.0f;
+  const float width = ImGui::GetContentRegionAvail().x - 8.0f - labels;
+  const float row = std::clamp(160.0f / channels, 3.0f, 16.0f);
+  const ImVec2 corner = ImGui::GetCursorScreenPos();
+  const ImVec2 origin(corner.x + labels, corner.y);
+  ImGui::InvisibleButton("r2", ImVec2(width + labels, row * channels));
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  const int every = std::max(1, static_cast<int>(std::ceil(14.0f / row)));
+  for (int c = 0; c < channels; c += every) {
+    draw->AddText(ImVec2(corner.x, origin.y + row * c), kDifference,
+                  erp.channels[static_cast<size_t>(c)].c_str());
+  }
+  for (int c = 0; c < channels; ++c) {
+    for (int s = 0; s < samples; ++s) {
+      const float x0 = origin.x + width * s / samples, x1 = origin.x + width * (s + 1) / samples;
+      draw->AddRectFilled(ImVec2(x0, origin.y + row * c),
+                          ImVec2(x1 + 0.5f, origin.y + row * (c + 1)),
+                          diverging(erp.signed_r2(c, s) / limit));
+    }
+  }
+  const float zero = origin.x + width * static_cast<float>(-erp.start_s * erp.rate_hz) / samples;
+  draw->AddLine(ImVec2(zero, origin.y), ImVec2(zero, origin.y + row * channels),
+                IM_COL32(0, 0, 0, 255));  // the stimulus
+}
+
+}  // namespace arbci::ui

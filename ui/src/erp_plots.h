@@ -1,0 +1,13 @@
+// The ERP figures of the Training panel, drawn as `arbci train --plots` draws its PNGs: per
+// channel the target and non-target averages overlaid on one scale with their 95 % bands, the
+// difference wave and the analysis window; and the signed r^2 per channel and time.
+#pragma once
+
+#include "arbci/bci/erp.h"
+
+namespace arbci::ui {
+
+void drawErpPlots(const bci::ErpCurves& erp);
+void drawSignedR2(const bci::ErpCurves& erp);
+
+}  // namespace arbci::ui
