@@ -5,6 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "arbci/bci/electrode_positions.h"
 
 namespace arbci::ui {
 namespace {
@@ -107,6 +112,58 @@ void drawSignedR2(const bci::ErpCurves& erp) {
   const float zero = origin.x + width * static_cast<float>(-erp.start_s * erp.rate_hz) / samples;
   draw->AddLine(ImVec2(zero, origin.y), ImVec2(zero, origin.y + row * channels),
                 IM_COL32(0, 0, 0, 255));  // the stimulus
+}
+
+void drawScalpMap(const bci::ErpCurves& erp) {
+  const int peak = erp.peakSample();
+  const Eigen::MatrixXd difference = erp.difference();
+  std::vector<std::pair<std::string, std::pair<double, double>>> known;
+  std::vector<double> values;
+  for (size_t c = 0; c < erp.channels.size(); ++c) {
+    if (const auto at = bci::electrodePosition(erp.channels[c])) {
+      known.emplace_back(erp.channels[c], *at);
+      values.push_back(difference(static_cast<Eigen::Index>(c), peak));
+    }
+  }
+  if (known.size() < 3) {
+    ImGui::TextDisabled("no scalp map: fewer than 3 channels have 10-20 names");
+    return;
+  }
+  double limit = 1e-6;
+  for (double v : values) limit = std::max(limit, std::abs(v));
+  ImGui::Text("target - non-target at %.0f ms (the difference's peak), +/-%.1f uV",
+              erp.timeS(peak) * 1000.0, limit);
+  const float size = 180.0f, head = 0.55f;
+  const ImVec2 corner = ImGui::GetCursorScreenPos();
+  ImGui::InvisibleButton("scalp", ImVec2(size, size));
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  const ImVec2 centre(corner.x + size / 2, corner.y + size / 2);
+  constexpr int kCells = 45;
+  const float cell = size / kCells;
+  for (int i = 0; i < kCells; ++i) {
+    for (int j = 0; j < kCells; ++j) {
+      const double px = ((i + 0.5) / kCells * 2.0 - 1.0) * head;
+      const double py = (1.0 - (j + 0.5) / kCells * 2.0) * head;
+      if (px * px + py * py > head * head) continue;
+      double weighted = 0.0, weights = 0.0;  // inverse-distance weighting, power 2
+      for (size_t k = 0; k < known.size(); ++k) {
+        const double dx = px - known[k].second.first, dy = py - known[k].second.second;
+        const double w = 1.0 / std::max(dx * dx + dy * dy, 1e-9);
+        weighted += w * values[k];
+        weights += w;
+      }
+      const ImVec2 a(corner.x + i * cell, corner.y + j * cell);
+      draw->AddRectFilled(a, ImVec2(a.x + cell + 0.5f, a.y + cell + 0.5f),
+                          diverging(weighted / weights / limit));
+    }
+  }
+  draw->AddCircle(centre, size / 2, kAxis, 64);
+  for (const auto& [name, at] : known) {
+    const ImVec2 p(centre.x + static_cast<float>(at.first / head) * size / 2,
+                   centre.y - static_cast<float>(at.second / head) * size / 2);
+    draw->AddCircleFilled(p, 2.5f, IM_COL32(0, 0, 0, 255));
+    draw->AddText(ImVec2(p.x + 4, p.y - 12), IM_COL32(0, 0, 0, 255), name.c_str());
+  }
 }
 
 }  // namespace arbci::ui

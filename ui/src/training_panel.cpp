@@ -124,6 +124,7 @@ void TrainingPanel::draw() {
   heading("ERP averages (baseline-corrected), as arbci train --plots draws them");
   drawErpPlots(outcome_->data->erp);
   drawSignedR2(outcome_->data->erp);
+  drawScalpMap(outcome_->data->erp);
   ImGui::InputText("##model", save_path_, sizeof save_path_);
   ImGui::SameLine();
   if (ImGui::Button("Save model")) {
