@@ -1,6 +1,7 @@
 // `arbci run`: the workstation. Windowed with the experimenter panels and the HMD mirror, or
 // headless (chosen automatically without a display) for batch work and tests.
 #include <ctime>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
@@ -17,19 +18,40 @@ namespace {
 
 struct RunOptions {
   std::string session, out;
-  bool headless = false, realtime = false, wait_for_start = false, exit_when_done = false;
+  bool headless = false, realtime = false, wait_for_start = false, exit_when_done = false,
+       overwrite = false;
   int trials = 0;
   long long seed = -1;
   double fault_wait_s = 5.0;
 };
 
+// arbci-session-<date>-<time>, with -2, -3, ... when a session of the same second exists.
 std::string defaultFolder() {
   const std::time_t now = std::time(nullptr);
   std::tm local{};
   localtime_r(&now, &local);
   char name[64];
   std::strftime(name, sizeof name, "arbci-session-%Y%m%d-%H%M%S", &local);
-  return name;
+  std::string folder = name;
+  for (int n = 2; std::filesystem::exists(folder); ++n)
+    folder = std::string(name) + "-" + std::to_string(n);
+  return folder;
+}
+
+// A session's data are never overwritten by accident: an existing, non-empty --out is refused
+// unless --overwrite, which empties it first.
+void claimFolder(const std::string& out, bool overwrite) {
+  std::error_code error;
+  if (!std::filesystem::exists(out, error) || std::filesystem::is_empty(out, error)) return;
+  if (!std::filesystem::is_directory(out))
+    throw CliError("--out " + out + ": exists and is not a folder");
+  if (!overwrite) {
+    throw CliError("--out " + out +
+                   ": the folder exists and is not empty (an earlier session?); choose another "
+                   "--out, leave it out for a new time-stamped folder, or add --overwrite");
+  }
+  std::filesystem::remove_all(out, error);
+  if (error) throw CliError("--overwrite: cannot empty " + out + ": " + error.message());
 }
 
 void printSummary(const Session& session) {
@@ -52,6 +74,7 @@ void printSummary(const Session& session) {
 int runSession(const RunOptions& o) {
   const SessionConfig config = loadSessionOption(o.session);
   SessionOptions options;
+  if (!o.out.empty()) claimFolder(o.out, o.overwrite);
   options.folder = o.out.empty() ? defaultFolder() : o.out;
   if (o.trials > 0) options.trials = o.trials;
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
@@ -99,7 +122,10 @@ void addRunCommand(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(1, 1000));
   run->add_option("--seed", o->seed, "random seed of the simulated subject and world")
       ->check(CLI::Range(0LL, 1LL << 30));
-  run->add_option("--out", o->out, "session folder (default: arbci-session-<date>-<time>)");
+  run->add_option("--out", o->out,
+                  "session folder, which must not hold a session already (default: a new "
+                  "arbci-session-<date>-<time>)");
+  run->add_flag("--overwrite", o->overwrite, "empty an existing --out folder first");
   run->add_flag("--realtime", o->realtime,
                 "headless: the EEG, the frames and the arm on the wall clock (not reproducible)\n"
                 "instead of a simulated clock as fast as the machine allows");

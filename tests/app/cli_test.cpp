@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -55,6 +57,24 @@ TEST(Cli, UnwritableOutputGivesOneLineErrorAndNonZeroExit) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_EQ(lineCount(result.err), 1) << result.err;
   EXPECT_NE(result.err.find("/nonexistent-dir/shot.png"), std::string::npos) << result.err;
+}
+
+// A session folder is never overwritten by accident: the second run into it refuses and leaves
+// the first run's data as they were.
+TEST(Cli, RunRefusesAFolderThatHoldsASession) {
+  const auto folder = std::filesystem::temp_directory_path() / "arbci_cli_test_taken_session";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  { std::ofstream(folder / "summary.json") << "{\"ended\": \"finished\"}\n"; }
+  const ProcessResult r =
+      runProcess(kArbci, {"run", "--headless", "--trials", "1", "--out", folder.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("exists and is not empty"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  std::ifstream in(folder / "summary.json");
+  std::string kept((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(kept, "{\"ended\": \"finished\"}\n");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder), {}), 1);
 }
 
 TEST(Cli, GlInfoHeadlessPrintsVendorRendererAndVersion) {
