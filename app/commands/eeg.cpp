@@ -123,7 +123,7 @@ void addEegCommand(CLI::App& root, int& exit_code) {
 
   CLI::App* conv =
       eeg->add_subcommand("convert",
-                          "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N\",\n"
+                          "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N|U\",\n"
                           "other events, parameters as \"Param name=value\").");
   conv->add_option("IN", options->in, "the recording to read")->required();
   conv->add_option("OUT", options->out, "the BDF+ file to write (*.bdf)")->required();

@@ -38,7 +38,10 @@ std::vector<bci::Recording> readAll(const std::vector<std::string>& files) {
 nlohmann::json checkChannels(std::vector<bci::Recording>& recordings, bool exclude) {
   std::set<std::string> flat, drifting;
   for (const bci::Recording& r : recordings) {
+    const auto photodiode = r.parameters.find("PhotodiodeChannel");
     for (const bci::ChannelQuality& q : bci::assessChannels(r)) {
+      // A session's photodiode channel is no EEG: the dataset leaves it out anyway.
+      if (photodiode != r.parameters.end() && q.channel == photodiode->second) continue;
       if (q.flat) flat.insert(q.channel);
       if (q.drifting) drifting.insert(q.channel);
     }
@@ -177,6 +180,14 @@ void train(TrainOptions& o) {
               << " uV peak-to-peak rejected";
   }
   if (o.pipeline.zero_phase) std::cout << "; zero-phase filters (offline only)";
+  if (data.other_code_flashes > 0) {
+    std::cout << "; " << data.other_code_flashes << " flashes with codes beyond the paradigm's "
+              << data.layout.codes() << " (a session's grid) left out";
+  }
+  if (data.unknown_flashes > 0) {
+    std::cout << "; " << data.unknown_flashes
+              << " flashes whose target is not known (labelled U) left out";
+  }
   const bci::CrossValidation& cv = result.cross_validation;
   std::cout << "\n\ncross-validation, " << cv.folds << " folds by " << cv.folds_by
             << (o.training.folds_by.empty() ? " (the default here; --folds-by to change)" : "")
@@ -191,6 +202,7 @@ void train(TrainOptions& o) {
                     {"zero_phase", o.pipeline.zero_phase},
                     {"channels", quality},
                     {"rejected_epochs", data.rejected_epochs},
+                    {"unknown_flashes", data.unknown_flashes},
                     {"reject_uv", o.reject_uv}},
                    data, cv.scores, cv.fold);
   if (!o.plots.empty()) {

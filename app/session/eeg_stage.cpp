@@ -212,6 +212,7 @@ void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,
   ++selection_;
   selection_objects_ = objects;
   target_ = target;
+  truth_ = target ? std::set<int>{*target} : attended;
   presented_ = scored_ = 0;
   acquisition_->withSource([&](bci::EegSource& s) { s.attend(attended); });
   accumulator_.reset();
@@ -219,12 +220,12 @@ void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,
 }
 
 void EegStage::flash(int code, std::int64_t sample) {
-  const bool target = target_ && *target_ == code;
+  const bool target = truth_.count(code) > 0, known = !truth_.empty();
   const int nominal_duration = static_cast<int>(settings_.flash_s * eeg_info_.rate_hz + 0.5);
-  bci::StimulusEvent event{sample, code, target, nominal_duration};
+  bci::StimulusEvent event{sample, code, target, nominal_duration, known};
   acquisition_->withSource([&](bci::EegSource& s) { s.present(event); });
   if (target_ && keep_signal_) calibration_.stimuli.push_back(event);
-  const FlashRecord record{selection_, code, target, selection_objects_};
+  const FlashRecord record{selection_, code, target, selection_objects_, known};
   flashes_[sample] = record;
   unrecorded_[sample] = record;
   epocher_->addEvent(event);
@@ -236,7 +237,7 @@ void EegStage::flashEnded(std::int64_t onset_sample, int duration_samples) {
   if (found == unrecorded_.end()) return;
   const FlashRecord& r = found->second;
   writer_->addStimulus(
-      {onset_sample, r.objects ? r.code : r.code + 100, r.target, duration_samples});
+      {onset_sample, r.objects ? r.code : r.code + 100, r.target, duration_samples, r.known});
   unrecorded_.erase(found);
 }
 
@@ -314,7 +315,7 @@ void EegStage::close() {
   if (acquisition_) acquisition_->stop();
   if (writer_) {
     for (const auto& [sample, r] : unrecorded_)
-      writer_->addStimulus({sample, r.objects ? r.code : r.code + 100, r.target, 0});
+      writer_->addStimulus({sample, r.objects ? r.code : r.code + 100, r.target, 0, r.known});
     unrecorded_.clear();
     writer_->close();
   }

@@ -74,7 +74,9 @@ class EegStage final : public Stage {
   void displayed(double host_s, bool patch_lit);
 
   // A new selection: its stimuli (objects, or grid rows and columns), what the subject attends
-  // (the simulated subject looks there), and for the calibration run the cued target.
+  // (the simulated subject looks there; online, the trial's intention, which labels the flashes
+  // T and N in the recording, or U when `attended` is empty: not known), and for the calibration
+  // run the cued target.
   void startSelection(bool objects, const bci::ParadigmLayout& layout,
                       const std::set<int>& attended, std::optional<int> target);
   // A flash first presented at `sample` (its onset); epoched and shown to the subject now.
@@ -117,6 +119,7 @@ class EegStage final : public Stage {
     int code = 0;
     bool target = false;
     bool objects = true;
+    bool known = true;
   };
   bci::Block eegOnly(const bci::Block& block) const;
 
@@ -142,6 +145,7 @@ class EegStage final : public Stage {
   int selection_ = 0;
   bool selection_objects_ = true;
   std::optional<int> target_;
+  std::set<int> truth_;  // the attended codes, empty when not known
   std::optional<bci::SelectionAccumulator> accumulator_;
   int presented_ = 0, scored_ = 0;
   std::vector<std::vector<float>> recent_;

@@ -8,6 +8,20 @@
 
 namespace arbci::app {
 
+std::string stimulusCodeMap(const WorldSettings& world, const std::vector<size_t>& slots) {
+  std::string map;
+  auto add = [&map](int code, const std::string& what) {
+    if (!map.empty()) map.push_back(';');
+    map.append(std::to_string(code)).append("=").append(what);
+  };
+  for (size_t k = 0; k < slots.size(); ++k)
+    add(static_cast<int>(k) + 1, "object " + std::to_string(world.objects[slots[k]].id));
+  for (int row = 1; row <= world.grid.rows; ++row) add(100 + row, "row " + std::to_string(row));
+  for (int column = 1; column <= world.grid.columns; ++column)
+    add(100 + world.grid.rows + column, "column " + std::to_string(column));
+  return map;
+}
+
 ParadigmStageSettings ParadigmStageSettings::of(const SessionConfig& config) {
   return {config.paradigm, config.world, config.classifier_method, intendedTrials(config),
           config.eeg.seed + 11};
@@ -129,6 +143,8 @@ void ParadigmStage::chooseSelectableObjects() {
   slots_ = slots;
   paradigm_->setObjectCount(static_cast<int>(slots.size()));
   s_.log.write("objects_in_view", now_.time_s, {{"objects", ids}});
+  // The codes now stand for other objects: the recording says so from here on.
+  s_.eeg.annotate(now_.eeg_sample, "StimulusCodeMap " + stimulusCodeMap(settings_.world, slots_));
 }
 
 std::optional<int> ParadigmStage::objectOnCell(std::pair<int, int> cell) const {

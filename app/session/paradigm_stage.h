@@ -36,6 +36,10 @@ struct ParadigmStageSettings {
   static ParadigmStageSettings of(const SessionConfig& config);
 };
 
+// What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
+// ...;104=column 1;..." (object codes k for world.objects[slots[k - 1]], grid codes 100 + code).
+std::string stimulusCodeMap(const WorldSettings& world, const std::vector<size_t>& slots);
+
 class ParadigmStage final : public Stage {
  public:
   struct Services {

@@ -1,4 +1,4 @@
-// GDF, EDF(+) and BDF(+) through BioSig. ARBCI's own annotations ("Stim <code> T|N",
+// GDF, EDF(+) and BDF(+) through BioSig. ARBCI's own annotations ("Stim <code> T|N|U",
 // "Param name=value", the end-of-signal marker) become stimuli, parameters and the true length;
 // every other event is kept as an annotation with its text.
 #include <biosig.h>
@@ -45,12 +45,14 @@ bool parseStimulus(const std::string& text, StimulusEvent& event) {
   std::istringstream in(text);
   std::string word, kind;
   int code = 0;
-  if (!(in >> word >> code >> kind) || word != "Stim" || code <= 0 || (kind != "T" && kind != "N"))
+  if (!(in >> word >> code >> kind) || word != "Stim" || code <= 0 ||
+      (kind != "T" && kind != "N" && kind != "U"))
     return false;
   std::string rest;
   if (in >> rest) return false;
   event.code = code;
   event.target = kind == "T";
+  event.known = kind != "U";
   return true;
 }
 

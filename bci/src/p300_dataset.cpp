@@ -174,6 +174,14 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
     std::int64_t previous = -1;
     int in_selection = 0;
     for (const StimulusEvent& e : r.stimuli) {
+      if (!e.known) {  // an online flash of a free choice: nothing to learn from
+        ++data.unknown_flashes;
+        continue;
+      }
+      if (e.code > layout.codes()) {  // another paradigm's (a session's grid flashes, 101 on)
+        ++data.other_code_flashes;
+        continue;
+      }
       if (previous < 0 || e.sample - previous > gap_limit) {
         data.selections.push_back(SelectionEpochs{{}, {}, static_cast<int>(f)});
         in_selection = 0;

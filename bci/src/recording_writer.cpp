@@ -218,7 +218,7 @@ void RecordingWriter::addStimulus(const StimulusEvent& event) {
   State& s = *state_;
   s.annotations.push_back(
       s.tal(event.sample / s.info.rate_hz, event.duration_samples / s.info.rate_hz,
-            "Stim " + std::to_string(event.code) + (event.target ? " T" : " N")));
+            "Stim " + std::to_string(event.code) + (!event.known ? " U" : event.target ? " T" : " N")));
 }
 
 void RecordingWriter::addAnnotation(const Annotation& annotation) {

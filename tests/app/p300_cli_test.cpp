@@ -350,6 +350,41 @@ TEST(TrainAndEvaluate, ZeroPhaseFilteringRaisesTheOfflineAucOnEeg3) {
   }
 }
 
+// Flashes of free choices are recorded as "U" (target unknown), read back as such, and left out
+// of training with a count.
+TEST(TrainAndEvaluate, FlashesWithUnknownTargetsAreLeftOutAndCounted) {
+  const auto simulated = scratch("unknown_clean.bdf"), mixed = scratch("unknown.bdf");
+  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "60", "--seed", "6", "--out",
+                                simulated.string()})
+                .exit_code,
+            0);
+  const bci::Recording clean = bci::readRecording(simulated.string());
+  int unknown = 0;
+  {
+    bci::RecordingWriter writer(mixed, clean.info);
+    bci::Block block(0, clean.info.channelCount(), static_cast<int>(clean.samples));
+    block.data = clean.data;
+    writer.write(block);
+    for (bci::StimulusEvent e : clean.stimuli) {
+      e.known = e.sample > clean.samples / 2 ? false : e.known;  // the second half: free choices
+      unknown += !e.known;
+      writer.addStimulus(e);
+    }
+  }
+  ASSERT_GT(unknown, 0);
+  const bci::Recording read = bci::readRecording(mixed.string());
+  EXPECT_EQ(std::count_if(read.stimuli.begin(), read.stimuli.end(),
+                          [](const bci::StimulusEvent& e) { return !e.known; }),
+            unknown);
+  const ProcessResult r = runProcess(
+      kArbci, {"train", "--method", "slda", mixed.string(), "--out", scratch("u.json").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("; " + std::to_string(unknown) +
+                       " flashes whose target is not known (labelled U) left out"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
   ASSERT_EQ(

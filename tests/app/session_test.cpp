@@ -7,9 +7,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -80,13 +82,45 @@ TEST(Session, CalibrationTrainingAndThreeTrialsAllRightEachObjectWithinACentimet
   ASSERT_EQ(recording.info.channelCount(), 9);  // the montage and the virtual photodiode
   EXPECT_EQ(recording.info.channels.back(), "Photodiode");
   EXPECT_NEAR(recording.seconds(), summary["duration_s"].get<double>(), 0.1);
-  int calibration_targets = 0, grid_flashes = 0;
+  // Calibration flashes are labelled by the cue; online flashes by the trial's intention: T
+  // exactly when the code stands (StimulusCodeMap) for the intended object, row or column.
+  std::int64_t online_from = -1;
+  std::vector<std::int64_t> selected_at;
+  for (const auto& a : recording.annotations) {
+    if (a.text == "Phase training the classifier") online_from = a.sample;
+    if (a.text.rfind("Selected", 0) == 0) selected_at.push_back(a.sample);
+  }
+  ASSERT_GE(online_from, 0);
+  ASSERT_EQ(selected_at.size(), 6u);
+  std::map<int, std::string> code_map;
+  std::stringstream map_text(recording.parameters.at("StimulusCodeMap"));
+  for (std::string entry; std::getline(map_text, entry, ';');)
+    code_map[std::stoi(entry.substr(0, entry.find('=')))] = entry.substr(entry.find('=') + 1);
+  int rows = 0;
+  for (const auto& [code, what] : code_map) rows += what.rfind("row ", 0) == 0;
+  int calibration_targets = 0, grid_flashes = 0, online_flashes = 0;
   for (const auto& s : recording.stimuli) {
-    calibration_targets += s.target;
+    EXPECT_TRUE(s.known);  // the session knows every trial's intention
     grid_flashes += s.code > 100;
+    if (s.sample < online_from) {
+      calibration_targets += s.target;
+      continue;
+    }
+    ++online_flashes;
+    const auto selection = static_cast<size_t>(
+        std::upper_bound(selected_at.begin(), selected_at.end(), s.sample) - selected_at.begin());
+    ASSERT_LT(selection, 6u);
+    const nlohmann::json& trial = summary["trials"][selection / 2];
+    const bool expected =
+        selection % 2 == 0
+            ? code_map.at(s.code) == "object " + std::to_string(trial["intended_object"].get<int>())
+            : s.code == 100 + trial["intended_cell"][0].get<int>() ||
+                  s.code == 100 + rows + trial["intended_cell"][1].get<int>();
+    EXPECT_EQ(s.target, expected) << "code " << s.code << " in online selection " << selection;
   }
   EXPECT_EQ(calibration_targets, 6 * 8);  // 6 cued selections of 8 sequences
   EXPECT_GT(grid_flashes, 0);
+  EXPECT_GT(online_flashes, 0);
   int selections = 0;
   for (const auto& a : recording.annotations) selections += a.text.rfind("Selected", 0) == 0;
   EXPECT_EQ(selections, 6);

@@ -57,8 +57,11 @@ inline std::vector<float> withoutChannel(const std::vector<float>& data, int cha
 struct StimulusEvent {
   std::int64_t sample = 0;  // the EEG sample at which it was presented
   int code = 0;             // which stimulus: an object, a row or a column (1-based)
-  bool target = false;      // the stimulus the subject attends (known in calibration runs)
+  bool target = false;      // the stimulus the subject attends
   int duration_samples = 0;
+  // False when nobody knows whether it was attended (a free choice): recorded as "U", and left
+  // out of training.
+  bool known = true;
 };
 
 // Other events a session records: phase changes, selections, robot commands.
