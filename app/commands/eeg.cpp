@@ -67,27 +67,50 @@ void convert(const std::string& in, const std::string& out, bool salvage) {
   try {
     std::map<std::string, std::string> parameters = r.parameters;
     parameters["SourceFile"] = std::filesystem::path(in).filename().string();
-    bci::RecordingWriter writer(target, r.info, parameters);
+    bci::RecordingWriterOptions options;
+    options.known_samples = r.samples;  // records that divide the signal: no padding
+    bci::RecordingWriter writer(target, r.info, parameters, options);
+    // Events go in with the samples they belong to, so no record waits for a backlog of them.
+    std::vector<bci::StimulusEvent> stimuli = r.stimuli;
+    std::vector<bci::Annotation> annotations = r.annotations;
+    std::stable_sort(stimuli.begin(), stimuli.end(),
+                     [](const auto& a, const auto& b) { return a.sample < b.sample; });
+    std::stable_sort(annotations.begin(), annotations.end(),
+                     [](const auto& a, const auto& b) { return a.sample < b.sample; });
+    size_t next_stimulus = 0, next_annotation = 0;
     const int step = static_cast<int>(std::max(1.0, r.info.rate_hz));
     for (std::int64_t first = 0; first < r.samples; first += step) {
       const int count = static_cast<int>(std::min<std::int64_t>(step, r.samples - first));
+      while (next_stimulus < stimuli.size() && stimuli[next_stimulus].sample < first + count)
+        writer.addStimulus(stimuli[next_stimulus++]);
+      while (next_annotation < annotations.size() &&
+             annotations[next_annotation].sample < first + count)
+        writer.addAnnotation(annotations[next_annotation++]);
       bci::Block block(first, r.info.channelCount(), count);
       for (int c = 0; c < block.channels; ++c) {
         for (int s = 0; s < count; ++s) block.at(c, s) = r.at(c, first + s);
       }
       writer.write(block);
     }
-    for (const bci::StimulusEvent& e : r.stimuli) writer.addStimulus(e);
-    for (const bci::Annotation& a : r.annotations) writer.addAnnotation(a);
+    for (; next_stimulus < stimuli.size(); ++next_stimulus)
+      writer.addStimulus(stimuli[next_stimulus]);
+    for (; next_annotation < annotations.size(); ++next_annotation)
+      writer.addAnnotation(annotations[next_annotation]);
     writer.close();
     std::cout << "wrote " << out << ": " << r.info.channelCount() << " channels, " << r.samples
               << " samples, " << r.stimuli.size() << " stimuli, " << r.annotations.size()
               << " other events";
     if (writer.clippedSamples() > 0)
       std::cout << "; " << writer.clippedSamples() << " samples clipped to +-8000 uV";
+    if (writer.paddedSamples() > 0) {
+      std::cout << "; " << writer.paddedSamples()
+                << " samples of padding end the last record (no record length divides the "
+                   "signal; ARBCI's reader drops them)";
+    }
     if (writer.shortenedAnnotations() > 0) {
       std::cout << "; " << writer.shortenedAnnotations()
-                << " long parameters or events cut to fit a record";
+                << " long parameters or events cut to fit a record:";
+      for (const std::string& text : writer.shortenedTexts()) std::cout << " \"" << text << "...\"";
     }
     std::cout << "\n";
   } catch (const bci::RecordingError& error) {
@@ -121,10 +144,10 @@ void addEegCommand(CLI::App& root, int& exit_code) {
     exit_code = 0;
   });
 
-  CLI::App* conv =
-      eeg->add_subcommand("convert",
-                          "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N|U\",\n"
-                          "other events, parameters as \"Param name=value\").");
+  CLI::App* conv = eeg->add_subcommand(
+      "convert",
+      "Convert an EEG file to BDF+ (samples, stimuli as \"Stim <code> T|N|U\",\n"
+      "other events, parameters as \"Param name=value\").");
   conv->add_option("IN", options->in, "the recording to read")->required();
   conv->add_option("OUT", options->out, "the BDF+ file to write (*.bdf)")->required();
   conv->add_flag("--salvage", options->salvage,

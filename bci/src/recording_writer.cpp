@@ -22,7 +22,20 @@ namespace {
 
 // The record duration and samples per record: 0.25 s when the rate allows a whole number of
 // samples, else the shortest of 0.5, 1, 2, 5 or 10 s that does.
-std::pair<double, int> recordLayout(double rate) {
+std::pair<double, int> recordLayout(double rate, std::int64_t known_samples) {
+  // A known length: the divisor of it nearest 0.25 s whose duration the header's 8 characters
+  // hold exactly.
+  if (known_samples > 0) {
+    std::pair<double, int> best{0.0, 0};
+    for (int d = 1; d <= static_cast<int>(10.0 * rate) && d <= known_samples; ++d) {
+      if (known_samples % d != 0) continue;
+      const double seconds = d / rate;
+      if (std::abs(std::stod(bdf::number(seconds, 8)) * rate - d) > 1e-6) continue;
+      if (best.second == 0 || std::abs(seconds - 0.25) < std::abs(best.first - 0.25))
+        best = {seconds, d};
+    }
+    if (best.second > 0) return best;
+  }
   for (double seconds : {0.25, 0.5, 1.0, 2.0, 5.0, 10.0}) {
     const double samples = rate * seconds;
     if (std::abs(samples - std::round(samples)) < 1e-9 && samples >= 1.0)
@@ -66,6 +79,8 @@ struct RecordingWriter::State {
   std::int64_t samples = 0;  // written into records or pending
   std::int64_t clipped = 0;
   std::int64_t shortened = 0;  // annotations cut to fit a record
+  std::vector<std::string> shortened_texts;
+  std::int64_t padded = 0;
   std::vector<float> pending;  // channel-major, record_samples per channel
   int pending_count = 0;
   std::deque<std::string> annotations;  // TALs waiting for a record
@@ -99,6 +114,7 @@ struct RecordingWriter::State {
   std::string tal(double onset, double duration, std::string text) {
     const size_t room = static_cast<size_t>(annotation_bytes) - 64;
     if (text.size() > room) {
+      shortened_texts.push_back(text.substr(0, 40));
       text = text.substr(0, room - 16) + " [cut: too long]";
       ++shortened;
     }
@@ -165,7 +181,7 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Signal
   State& s = *state_;
   s.info = info;
   s.options = options;
-  std::tie(s.record_seconds, s.record_samples) = recordLayout(info.rate_hz);
+  std::tie(s.record_seconds, s.record_samples) = recordLayout(info.rate_hz, options.known_samples);
   s.pending.assign(static_cast<size_t>(info.channelCount()) * s.record_samples, 0.0f);
 
   bdf::HeaderFields header;
@@ -216,9 +232,12 @@ void RecordingWriter::write(const Block& block) {
 
 void RecordingWriter::addStimulus(const StimulusEvent& event) {
   State& s = *state_;
-  s.annotations.push_back(
-      s.tal(event.sample / s.info.rate_hz, event.duration_samples / s.info.rate_hz,
-            "Stim " + std::to_string(event.code) + (!event.known ? " U" : event.target ? " T" : " N")));
+  s.annotations.push_back(s.tal(event.sample / s.info.rate_hz,
+                                event.duration_samples / s.info.rate_hz,
+                                "Stim " + std::to_string(event.code) +
+                                    (!event.known   ? " U"
+                                     : event.target ? " T"
+                                                    : " N")));
 }
 
 void RecordingWriter::addAnnotation(const Annotation& annotation) {
@@ -241,6 +260,7 @@ void RecordingWriter::close() {
     do {
       s.writeRecord();
     } while (!s.annotations.empty());
+    s.padded = s.records * s.record_samples - true_samples;
   }
   {
     std::lock_guard lock(s.sync_mutex);
@@ -256,6 +276,12 @@ std::int64_t RecordingWriter::samplesWritten() const {
 }
 std::int64_t RecordingWriter::clippedSamples() const {
   return state_->clipped;
+}
+std::int64_t RecordingWriter::paddedSamples() const {
+  return state_->padded;
+}
+const std::vector<std::string>& RecordingWriter::shortenedTexts() const {
+  return state_->shortened_texts;
 }
 std::int64_t RecordingWriter::shortenedAnnotations() const {
   return state_->shortened;

@@ -83,6 +83,18 @@ TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
   }
   EXPECT_NEAR(copy.at(5, 30000), original.at(5, 30000), 0.001);
   EXPECT_EQ(copy.parameters.at("SamplingRate"), original.parameters.at("SamplingRate"));
+  // What any EDF reader sees (MNE among them): records x record duration from the header, with
+  // no padding, 222.03 s.
+  std::ifstream header(converted, std::ios::binary);
+  std::string fixed(256, '\0');
+  header.read(fixed.data(), 256);
+  const double records = std::stod(fixed.substr(236, 8)),
+               record_s = std::stod(fixed.substr(244, 8));
+  EXPECT_NEAR(records * record_s, original.samples / original.info.rate_hz,
+              1.0 / original.info.rate_hz);
+  EXPECT_EQ(r.out.find("padding"), std::string::npos) << r.out;
+  // The one parameter too long for a record is named.
+  EXPECT_NE(r.out.find("cut to fit a record: \"Param Classifier="), std::string::npos) << r.out;
 }
 
 TEST(EegCommand, RecordingKilledMidSessionIsReadableUpToItsLastSecond) {

@@ -24,6 +24,9 @@ struct RecordingWriterOptions {
   double range_microvolts = 8000.0;
   std::string subject = "X";
   std::string recording_id = "ARBCI";
+  // The whole signal's length, when known before writing (a conversion): records are sized to
+  // divide it (about 0.25 s each), so the file ends with the signal, with no padding.
+  std::int64_t known_samples = 0;
 };
 
 class RecordingWriter {
@@ -48,6 +51,10 @@ class RecordingWriter {
 
   std::int64_t samplesWritten() const;
   std::int64_t clippedSamples() const;
+  // Samples of padding that completed the last record (0 when records divide the signal).
+  std::int64_t paddedSamples() const;
+  // The beginnings of the annotations cut to fit a record (parameters among them).
+  const std::vector<std::string>& shortenedTexts() const;
   // Annotations longer than a record's annotation area (about 450 characters), cut to fit.
   std::int64_t shortenedAnnotations() const;
   const std::filesystem::path& path() const;
