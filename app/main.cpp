@@ -5,6 +5,7 @@
 
 #include "commands/commands.h"
 #include "support/cli_error.h"
+#include "support/status_line.h"
 
 int main(int argc, char** argv) {
   CLI::App root{
@@ -38,9 +39,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& error) {
     return root.exit(error);
   } catch (const arbci::app::CliError& error) {
+    if (arbci::app::statusLineOpen()) std::cerr << "\n";  // not over a progress line
     std::cerr << "arbci: " << error.what() << "\n";
     return error.exitCode();
   } catch (const std::exception& error) {
+    if (arbci::app::statusLineOpen()) std::cerr << "\n";
     std::cerr << "arbci: " << error.what() << "\n";
     return 1;
   }

@@ -188,6 +188,11 @@ int runDetect(const DetectOptions& options) {
   const int sources = (!options.inputs.empty()) + (!options.video.empty()) + (options.device >= 0);
   if (sources != 1)
     throw CliError("give image files, or --video FILE, or --device N (exactly one)");
+  if (!options.marker_set.empty() && options.camera.empty()) {
+    throw CliError(
+        "--marker-set needs --camera: a set's pose needs the camera's intrinsics "
+        "(see arbci detect --help)");
+  }
   vision::MarkerDetector detector = [&] {
     try {
       return vision::MarkerDetector(makeConfig(options));

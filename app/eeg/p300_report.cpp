@@ -7,6 +7,7 @@
 #include <iomanip>
 
 #include "support/cli_error.h"
+#include "support/status_line.h"
 
 namespace arbci::app {
 
@@ -165,6 +166,7 @@ bci::Progress progressLine(std::ostream& err) {
     std::string line = stage.substr(0, 70);
     line.resize(70, ' ');
     err << "\r" << std::setw(3) << percent << "% " << line << std::flush;
+    setStatusLineOpen(percent < 100);
     if (percent == 100) err << "\n";
   };
 }

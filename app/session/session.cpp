@@ -12,6 +12,7 @@
 #include "session/scene_source.h"
 #include "session/session_summary.h"
 #include "support/interrupt.h"
+#include "support/status_line.h"
 
 namespace arbci::app {
 namespace {
@@ -166,8 +167,7 @@ bool Session::step() {
     stage->step(cycle_);
     timing_.mark(stage->name());
   }
-  if (options_.progress && !paradigm_->phaseChanges().empty())
-    *options_.progress << "\r" << statusLine() << "      " << std::flush;
+  if (options_.progress && !paradigm_->phaseChanges().empty()) showStatus();
   if (context_.isHeadless()) {
     context_.present();  // a window is presented by its owner, with the panels
     presented(options_.simulated_clock ? cycle_.time_s : bci::hostSeconds());
@@ -175,8 +175,7 @@ bool Session::step() {
   timing_.mark("present");
   recordCycleTime();
   endIfDone();
-  if (options_.progress && frame_ % 600 == 0)
-    *options_.progress << "\r" << statusLine() << "      " << std::flush;
+  if (options_.progress && frame_ % 600 == 0) showStatus();
   ++frame_;
   if (!options_.simulated_clock && context_.isHeadless()) {
     // --realtime without a display: pace the frames to the wall clock.
@@ -266,6 +265,12 @@ std::vector<std::string> Session::selectionLines() const {
   return lines;
 }
 
+void Session::showStatus() const {
+  if (!options_.progress) return;
+  *options_.progress << "\r" << statusLine() << "      " << std::flush;
+  setStatusLineOpen(true);
+}
+
 std::string Session::statusLine() const {
   char text[256];
   std::snprintf(text, sizeof text,
@@ -284,8 +289,10 @@ void Session::endRun(const std::string& reason) {
   for (Stage* stage : stages_) stage->stop(cycle_, reason);
   log_->write("session_ended", cycle_.time_s, {{"reason", reason}});
   std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
-  if (options_.progress)
+  if (options_.progress) {
     *options_.progress << "\r" << statusLine() << "\nsession ended: " << reason << "\n";
+    setStatusLineOpen(false);
+  }
 }
 
 nlohmann::json Session::summary() const {

@@ -125,6 +125,8 @@ class Session {
   // A run without an experimenter ends on a fault after a while; every run at its end.
   void endIfDone();
   void endRun(const std::string& reason);
+  // The status line on the progress stream, rewritten in place.
+  void showStatus() const;
 
   SessionConfig config_;
   SessionOptions options_;

@@ -59,6 +59,7 @@ bool parseStimulus(const std::string& text, StimulusEvent& event) {
 // The expected size of an EDF/BDF file from its header, to name a truncation precisely.
 struct EdfSize {
   bool known = false;
+  bool no_signals = false;  // the header says 0 signals
   std::int64_t header = 0, record = 0, records = 0;
 };
 
@@ -72,6 +73,7 @@ EdfSize edfSize(const std::filesystem::path& path) {
     size.header = std::stoll(head.substr(184, 8));
     size.records = std::stoll(head.substr(236, 8));
     const int signals = std::stoi(head.substr(252, 4));
+    size.no_signals = signals == 0;
     if (signals <= 0 || signals > 4096 || size.header != 256LL * (signals + 1)) return size;
     std::string fields(static_cast<size_t>(signals) * 256, '\0');
     if (!in.read(fields.data(), static_cast<std::streamsize>(fields.size()))) return size;
@@ -154,6 +156,8 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   const auto file_size = static_cast<std::int64_t>(std::filesystem::file_size(path, error));
   if (error) fail(path, "cannot open");
   const EdfSize expected = edfSize(path);
+  // BioSig answers a header without signals with "memory allocation failed".
+  if (expected.no_signals) fail(path, "the EDF/BDF header declares no signal channels");
   std::unique_ptr<TemporaryFile> salvaged;
   std::string truncation_note;
   if (expected.known && expected.records >= 0) {

@@ -77,6 +77,13 @@ TEST(Cli, RunRefusesAFolderThatHoldsASession) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder), {}), 1);
 }
 
+// An option that cannot act is refused, not ignored.
+TEST(Cli, DetectRefusesAMarkerSetWithoutACamera) {
+  const ProcessResult r = runProcess(kArbci, {"detect", "--marker-set", "set.cfg", "frame.png"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--marker-set needs --camera"), std::string::npos) << r.err;
+}
+
 TEST(Cli, GlInfoHeadlessPrintsVendorRendererAndVersion) {
   const ProcessResult result = runProcess(kArbci, {"gl-info", "--headless"});
   ASSERT_EQ(result.exit_code, 0) << result.err;

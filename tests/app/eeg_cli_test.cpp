@@ -146,7 +146,26 @@ TEST(EegCommand, BadFilesGiveOneLineNamingTheFileAndWhatIsWrong) {
   }
   const auto unknown = scratch("unknown.edf");
   std::ofstream(unknown) << "this is not EEG";
+  // A BDF whose header declares no signals (BioSig says "memory allocation failed").
+  const auto empty = scratch("no_signals.bdf");
+  {
+    std::string header(256, ' ');
+    header[0] = '\xff';
+    auto put = [&header](size_t at, const std::string& text) {
+      header.replace(at, text.size(), text);
+    };
+    put(1, "BIOSEMI");
+    put(168, "01.01.26");
+    put(176, "00.00.00");
+    put(184, "256");
+    put(192, "24BIT");
+    put(236, "1");
+    put(244, "1");
+    put(252, "0");
+    std::ofstream(empty, std::ios::binary) << header;
+  }
   for (const auto& [file, reason] : std::vector<std::pair<std::string, std::string>>{
+           {empty.string(), "declares no signal channels"},
            {truncated.string(), "cut short"},
            {unknown.string(), "unknown format"},
            {scratch("none.gdf").string(), "no such file"}}) {
