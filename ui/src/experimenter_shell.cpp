@@ -35,6 +35,9 @@ void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
 }
 
 void ExperimenterShell::drawMenuBar() {
+  // Ctrl+Q, as the menu says. This ImGui (1.86) indexes keys by the backend's codes; GLFW's for
+  // letters are their upper-case ASCII codes.
+  if (ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('Q', false) && on_quit_) on_quit_();
   if (!ImGui::BeginMainMenuBar()) return;
   if (ImGui::BeginMenu("File")) {
     if (ImGui::MenuItem("Quit", "Ctrl+Q") && on_quit_) on_quit_();
