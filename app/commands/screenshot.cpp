@@ -6,14 +6,11 @@
 #include <memory>
 #include <string>
 
-#include <opencv2/core/version.hpp>
-
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/gl_context.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panels.h"
-#include "arbci/ui/system_panel.h"
 #include "commands/commands.h"
 #include "session/session.h"
 #include "session/session_model.h"
@@ -62,19 +59,8 @@ void renderPanels(render::GlContext& context, render::Size size,
   writePng(out, render::readPixels(context.drawFramebuffer(), size));
 }
 
-void renderShell(const ScreenshotOptions& options, render::Size size) {
-  auto context = render::createHeadlessContext(size);
-  const render::GlInfo gl = context->info();
-  ui::SystemPanel system({{"version", std::string("arbci ") + ARBCI_VERSION},
-                          {"GL context", "headless (EGL)"},
-                          {"GL vendor", gl.vendor},
-                          {"GL renderer", gl.renderer},
-                          {"GL version", gl.version},
-                          {"OpenCV", CV_VERSION}});
-  renderPanels(*context, size, {&system}, "no session", options.out);
-}
-
-// Runs a simulated session (a still head, so it goes fast) until `ready`, then shows a panel.
+// Runs a simulated session (a still head, so it goes fast) until `ready`, then shows a panel, or
+// (no --panel) the experimenter window as `arbci run` opens it during the grid's flashing.
 void renderPanel(const ScreenshotOptions& options, render::Size size) {
   SessionConfig config = loadSessionOption(options.session);
   if (options.session.empty()) {
@@ -135,6 +121,16 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     runUntil([&] { return session.frame() % 11 == 1; });
     ensureWritable(options.out);
     session.screenshot(options.out);
+  } else if (panel.empty()) {
+    runUntil(
+        [&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    ui::SessionPanel session_panel(model);
+    ui::HmdPanel hmd_panel(session.hmdTexture(),
+                           static_cast<float>(config.hmd_width) / config.hmd_height);
+    ui::RobotPanel robot_panel(model);
+    ui::ThresholdPanel threshold_panel(model);
+    renderPanels(*context, size, {&session_panel, &hmd_panel, &robot_panel, &threshold_panel},
+                 session.statusLine(), options.out, [&] { session.step(); });
   } else {
     throw CliError("--panel must be threshold, calibration, training, robot, session or hmd");
   }
@@ -150,8 +146,8 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
   auto options = std::make_shared<ScreenshotOptions>();
   auto* command = root.add_subcommand(
       "screenshot",
-      "Render the experimenter window, or one panel on a simulated session's live data, to a PNG\n"
-      "(headless through EGL)");
+      "Render the experimenter window (its session, HMD, robot and threshold panels), or one\n"
+      "panel, on a simulated session's live data to a PNG (headless through EGL)");
   command->add_flag("--headless", options->headless,
                     "Render without a display through EGL (the only mode screenshots use)");
   command->add_option("--out", options->out, "PNG file to write")->required();
@@ -161,15 +157,11 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
                    "threshold, calibration, training, robot, session or hmd (the HMD view)")
       ->check(CLI::IsMember({"threshold", "calibration", "training", "robot", "session", "hmd"}));
   command->add_option("--session", options->session,
-                      "session file for --panel (default: the embedded simulated session)");
+                      "session file (default: the embedded simulated session, with a still head)");
   command->callback([options, &exit_code] {
     ensureWritable(options->out);
     const render::Size size = parseSize(options->size);
-    if (options->panel.empty()) {
-      renderShell(*options, size);
-    } else {
-      renderPanel(*options, size);
-    }
+    renderPanel(*options, size);
     exit_code = 0;
   });
 }
