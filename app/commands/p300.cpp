@@ -108,6 +108,16 @@ void checkOutputs(const std::string& plots, const std::vector<std::string>& file
   }
 }
 
+// What a report says of the data: the files, the channels' check, what was left out.
+nlohmann::json datasetFacts(const bci::P300Dataset& data, const nlohmann::json& channels) {
+  return {{"files", data.sources},
+          {"channels", channels},
+          {"rejected_epochs", data.rejected_epochs},
+          {"reject_uv", data.reject_uv},
+          {"unknown_flashes", data.unknown_flashes},
+          {"other_code_flashes", data.other_code_flashes}};
+}
+
 void writeReportFiles(const std::string& report_path, const std::string& scores_path,
                       const bci::EvaluationReport& report, nlohmann::json extra,
                       const bci::P300Dataset& data, const std::vector<double>& scores,
@@ -193,18 +203,13 @@ void train(TrainOptions& o) {
             << (o.training.folds_by.empty() ? " (the default here; --folds-by to change)" : "")
             << ":\n";
   printReport(std::cout, cv.report);
-  writeReportFiles(o.report, o.scores, cv.report,
-                   {{"command", "train"},
-                    {"method", o.training.method},
-                    {"files", data.sources},
-                    {"folds", cv.folds},
-                    {"folds_by", cv.folds_by},
-                    {"zero_phase", o.pipeline.zero_phase},
-                    {"channels", quality},
-                    {"rejected_epochs", data.rejected_epochs},
-                    {"unknown_flashes", data.unknown_flashes},
-                    {"reject_uv", o.reject_uv}},
-                   data, cv.scores, cv.fold);
+  nlohmann::json facts = datasetFacts(data, quality);
+  facts.update({{"command", "train"},
+                {"method", o.training.method},
+                {"folds", cv.folds},
+                {"folds_by", cv.folds_by},
+                {"zero_phase", o.pipeline.zero_phase}});
+  writeReportFiles(o.report, o.scores, cv.report, facts, data, cv.scores, cv.fold);
   if (!o.plots.empty()) {
     const auto written = writeP300Plots(o.plots, data, result.cross_validation.report,
                                         "cross-validated " + o.training.method);
@@ -277,17 +282,13 @@ void evaluate(EvaluateOptions& o) {
       std::cout << "\n";
     }
     printReport(std::cout, report);
-    writeReportFiles(o.report, o.scores, report,
-                     {{"command", "evaluate"},
-                      {"method", model.method},
-                      {"model", o.model},
-                      {"align_scores", o.align},
-                      {"zero_phase", model.pipeline.zero_phase},
-                      {"channels", quality},
-                      {"rejected_epochs", data.rejected_epochs},
-                      {"reject_uv", o.reject_uv},
-                      {"files", data.sources}},
-                     data, scores, {});
+    nlohmann::json facts = datasetFacts(data, quality);
+    facts.update({{"command", "evaluate"},
+                  {"method", model.method},
+                  {"model", o.model},
+                  {"align_scores", o.align},
+                  {"zero_phase", model.pipeline.zero_phase}});
+    writeReportFiles(o.report, o.scores, report, facts, data, scores, {});
     if (!o.plots.empty()) {
       printPlots(writeP300Plots(o.plots, data, report, "evaluated " + model.method));
     }

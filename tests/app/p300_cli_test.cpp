@@ -32,6 +32,25 @@ std::string eeg(const std::string& name) {
   return sharedData("eeg/bci2000_samplefiles/" + name);
 }
 
+// A simulated copy-task recording (arbci eeg simulate), read back.
+bci::Recording simulated(const std::string& name, int seconds, int seed) {
+  const auto path = scratch(name + "_simulated.bdf");
+  const ProcessResult r =
+      runProcess(kArbci, {"eeg", "simulate", "--seconds", std::to_string(seconds), "--seed",
+                          std::to_string(seed), "--out", path.string()});
+  if (r.exit_code != 0) throw std::runtime_error("arbci eeg simulate failed: " + r.err);
+  return bci::readRecording(path.string());
+}
+
+// `recording` (its samples and stimuli) as a BDF+ file.
+void write(const std::filesystem::path& path, const bci::Recording& recording) {
+  bci::RecordingWriter writer(path, recording.info);
+  bci::Block block(0, recording.info.channelCount(), static_cast<int>(recording.samples));
+  block.data = recording.data;
+  writer.write(block);
+  for (const bci::StimulusEvent& e : recording.stimuli) writer.addStimulus(e);
+}
+
 // The ERP figure's numbers (erp.json) against ERPs averaged here from the raw file: every epoch of
 // -100 ms (the baseline, its mean subtracted) to the window's end, averaged per class. Unfiltered,
 // so nothing of ARBCI's signal path enters the reference but the file reader.
@@ -218,22 +237,10 @@ TEST(TrainAndEvaluate, ReportAndScoresFilesHoldWhatIsPrinted) {
 // A recording whose codes are the classes (target / non-target only, as Brain Invaders or an
 // oddball): single-flash AUC over contiguous blocks, and no selection metrics.
 TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
-  const auto simulated = scratch("by_selection.bdf"), by_class = scratch("by_class.bdf");
-  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "60", "--seed", "4", "--out",
-                                simulated.string()})
-                .exit_code,
-            0);
-  {
-    const bci::Recording r = bci::readRecording(simulated.string());
-    bci::RecordingWriter writer(by_class, r.info);
-    bci::Block block(0, r.info.channelCount(), static_cast<int>(r.samples));
-    block.data = r.data;
-    writer.write(block);
-    for (bci::StimulusEvent e : r.stimuli) {
-      e.code = e.target ? 1 : 2;
-      writer.addStimulus(e);
-    }
-  }
+  const auto by_class = scratch("by_class.bdf");
+  bci::Recording recording = simulated("by_class", 60, 4);
+  for (bci::StimulusEvent& e : recording.stimuli) e.code = e.target ? 1 : 2;
+  write(by_class, recording);
   const auto report = scratch("by_class_report.json");
   const ProcessResult r =
       runProcess(kArbci, {"train", "--method", "slda", by_class.string(), "--out",
@@ -274,26 +281,16 @@ TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
 // Flat and drifting channels are reported, and left out on request; epochs over an amplitude
 // limit are rejected and counted; zero-phase filtering is recorded in the model.
 TEST(TrainAndEvaluate, BadChannelsAndLargeEpochsAreReportedAndLeftOutOnRequest) {
-  const auto simulated = scratch("artifacts_clean.bdf"), damaged = scratch("artifacts.bdf");
-  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "90", "--seed", "5", "--out",
-                                simulated.string()})
-                .exit_code,
-            0);
-  const bci::Recording clean = bci::readRecording(simulated.string());
+  const auto damaged = scratch("artifacts.bdf");
+  const bci::Recording clean = simulated("artifacts", 90, 5);
   const std::string flat = clean.info.channels[1], drifting = clean.info.channels[2];
-  {
-    bci::Recording r = clean;
-    for (std::int64_t s = 0; s < r.samples; ++s) {
-      r.data[static_cast<size_t>(1 * r.samples + s)] = 0.0f;  // a shorted electrode
-      r.data[static_cast<size_t>(2 * r.samples + s)] +=
-          static_cast<float>(1e5 * s / r.samples);  // a contact drifting by 1e5 uV
-    }
-    bci::RecordingWriter writer(damaged, r.info);
-    bci::Block block(0, r.info.channelCount(), static_cast<int>(r.samples));
-    block.data = r.data;
-    writer.write(block);
-    for (const bci::StimulusEvent& e : r.stimuli) writer.addStimulus(e);
+  bci::Recording broken = clean;
+  for (std::int64_t s = 0; s < broken.samples; ++s) {
+    broken.data[static_cast<size_t>(1 * broken.samples + s)] = 0.0f;  // a shorted electrode
+    broken.data[static_cast<size_t>(2 * broken.samples + s)] +=
+        static_cast<float>(1e5 * s / broken.samples);  // a contact drifting by 1e5 uV
   }
+  write(damaged, broken);
   const auto model = scratch("artifacts.json"), report = scratch("artifacts_report.json");
   ProcessResult r =
       runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out", model.string()});
@@ -353,24 +350,14 @@ TEST(TrainAndEvaluate, ZeroPhaseFilteringRaisesTheOfflineAucOnEeg3) {
 // Flashes of free choices are recorded as "U" (target unknown), read back as such, and left out
 // of training with a count.
 TEST(TrainAndEvaluate, FlashesWithUnknownTargetsAreLeftOutAndCounted) {
-  const auto simulated = scratch("unknown_clean.bdf"), mixed = scratch("unknown.bdf");
-  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "60", "--seed", "6", "--out",
-                                simulated.string()})
-                .exit_code,
-            0);
-  const bci::Recording clean = bci::readRecording(simulated.string());
+  const auto mixed = scratch("unknown.bdf");
+  bci::Recording recording = simulated("unknown", 60, 6);
   int unknown = 0;
-  {
-    bci::RecordingWriter writer(mixed, clean.info);
-    bci::Block block(0, clean.info.channelCount(), static_cast<int>(clean.samples));
-    block.data = clean.data;
-    writer.write(block);
-    for (bci::StimulusEvent e : clean.stimuli) {
-      e.known = e.sample > clean.samples / 2 ? false : e.known;  // the second half: free choices
-      unknown += !e.known;
-      writer.addStimulus(e);
-    }
+  for (bci::StimulusEvent& e : recording.stimuli) {
+    e.known = e.sample <= recording.samples / 2;  // the second half: free choices
+    unknown += !e.known;
   }
+  write(mixed, recording);
   ASSERT_GT(unknown, 0);
   const bci::Recording read = bci::readRecording(mixed.string());
   EXPECT_EQ(std::count_if(read.stimuli.begin(), read.stimuli.end(),
