@@ -38,10 +38,7 @@ std::vector<bci::Recording> readAll(const std::vector<std::string>& files) {
 nlohmann::json checkChannels(std::vector<bci::Recording>& recordings, bool exclude) {
   std::set<std::string> flat, drifting;
   for (const bci::Recording& r : recordings) {
-    const auto photodiode = r.parameters.find("PhotodiodeChannel");
     for (const bci::ChannelQuality& q : bci::assessChannels(r)) {
-      // A session's photodiode channel is no EEG: the dataset leaves it out anyway.
-      if (photodiode != r.parameters.end() && q.channel == photodiode->second) continue;
       if (q.flat) flat.insert(q.channel);
       if (q.drifting) drifting.insert(q.channel);
     }
@@ -158,12 +155,6 @@ void train(TrainOptions& o) {
     std::vector<bci::Recording> recordings = readAll(o.files);
     quality = checkChannels(recordings, o.exclude_bad_channels);
     data = bci::buildDataset(recordings, o.pipeline, progress, o.reject_uv);
-    if ((o.training.method == "xdawn" || o.training.method == "riemann") &&
-        o.training.xdawn.filters > data.shape.channels) {
-      throw CliError("--xdawn-filters " + std::to_string(o.training.xdawn.filters) +
-                     ": the features have " + std::to_string(data.shape.channels) +
-                     " channels (1 to " + std::to_string(data.shape.channels) + " allowed)");
-    }
     result = bci::trainModel(data, o.pipeline, o.training, progress);
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
@@ -297,6 +288,15 @@ void evaluate(EvaluateOptions& o) {
   }
 }
 
+void addRejectOption(CLI::App& command, double& reject_uv) {
+  command
+      .add_option("--reject-uv", reject_uv,
+                  "leave out epochs whose filtered peak-to-peak amplitude exceeds this (0: keep "
+                  "all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e7));
+}
+
 }  // namespace
 
 void addP300Commands(CLI::App& root, int& exit_code) {
@@ -337,12 +337,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd->add_flag("--zero-phase", t->pipeline.zero_phase,
                       "filter forward and backward (no phase lag; offline only: the model says "
                       "so, and a session filters causally)");
-  train_cmd
-      ->add_option("--reject-uv", t->reject_uv,
-                   "leave out epochs whose filtered peak-to-peak amplitude exceeds this (0: keep "
-                   "all)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e7));
+  addRejectOption(*train_cmd, t->reject_uv);
   train_cmd->add_flag("--exclude-bad-channels", t->exclude_bad_channels,
                       "leave out flat (SD < 0.5 uV) and drifting (SD > 20x the median channel's) "
                       "channels, which are always reported");
@@ -420,12 +415,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                    "(scores drift between sessions); none: as the model gives them")
       ->capture_default_str()
       ->check(CLI::IsMember({"per-file", "none"}));
-  eval_cmd
-      ->add_option("--reject-uv", e->reject_uv,
-                   "leave out epochs whose filtered peak-to-peak amplitude exceeds this (0: keep "
-                   "all)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e7));
+  addRejectOption(*eval_cmd, e->reject_uv);
   eval_cmd->add_option("--report", e->report, "also write the report as JSON (everything printed)");
   eval_cmd->add_option("--scores", e->scores,
                        "also write every flash's score as CSV (file,sample,code,label,score,fold)");

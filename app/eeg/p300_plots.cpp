@@ -7,7 +7,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "arbci/bci/electrode_positions.h"
 #include "support/cli_error.h"
 
 namespace arbci::app {
@@ -39,7 +38,7 @@ struct Panel {
   void axes(cv::Mat& image, const std::string& title, int x_decimals, int y_decimals) const {
     cv::rectangle(image, area, kGrey, 1);
     if (y0 < 0.0 && y1 > 0.0) cv::line(image, map(x0, 0.0), map(x1, 0.0), kGrey, 1);
-    text(image, title, {area.x + 4, area.y + 14}, 0.45);
+    text(image, title, {area.x, area.y - 6}, 0.45);  // above: curves reach the top
     text(image, format(y1, y_decimals), {area.x - 42, area.y + 10}, 0.35);
     text(image, format(y0, y_decimals), {area.x - 42, area.y + area.height}, 0.35);
     text(image, format(x0, x_decimals), {area.x - 4, area.y + area.height + 14}, 0.35);
@@ -109,6 +108,7 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder,
            " target, " + std::to_string(erp.others) + " non-target epochs",
        {left, 28}, 0.5);
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
+  const int label_every = (14 + row_h - 1) / row_h;
   const double t0 = erp.timeS(0) * 1000.0, t1 = erp.timeS(samples - 1) * 1000.0;
   for (int c = 0; c < channels; ++c) {
     for (int s = 0; s < samples; ++s) {
@@ -116,7 +116,7 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder,
       cv::rectangle(image, cv::Rect(x0, top + c * row_h, std::max(1, x1 - x0), row_h),
                     diverging(erp.signed_r2(c, s) / limit), cv::FILLED);
     }
-    if (row_h >= 10 || c % std::max(1, 10 / row_h) == 0)
+    if (c % label_every == 0)  // as many names as fit
       text(image, erp.channels[static_cast<size_t>(c)], {8, top + c * row_h + row_h / 2 + 4}, 0.35);
   }
   const int bottom = top + channels * row_h;
@@ -137,45 +137,19 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder,
 // The difference wave at its peak on a head map, where the channels' 10-20 positions are known.
 std::filesystem::path writeScalpMap(const std::filesystem::path& folder,
                                     const bci::ErpCurves& erp) {
-  std::vector<std::pair<std::string, std::pair<double, double>>> known;
-  std::vector<double> values;
-  const int peak = erp.peakSample();
-  const Eigen::MatrixXd difference = erp.difference();
-  for (size_t c = 0; c < erp.channels.size(); ++c) {
-    if (const auto at = bci::electrodePosition(erp.channels[c])) {
-      known.emplace_back(erp.channels[c], *at);
-      values.push_back(difference(static_cast<Eigen::Index>(c), peak));
-    }
-  }
-  if (known.size() < 3) return {};
+  const std::optional<bci::ScalpMap> map = bci::scalpMapAtPeak(erp);
+  if (!map) return {};
   const int size = 360, margin = 50;
   cv::Mat image(size + 2 * margin + 40, size + 2 * margin + 90, CV_8UC3, kWhite);
   const cv::Point centre(margin + size / 2, margin + 30 + size / 2);
   const double radius = size / 2.0, head = 0.55;  // the map's edge, in position units
-  double limit = 1e-6;
-  for (double v : values) limit = std::max(limit, std::abs(v));
-  // Inverse-distance weighting (power 2) inside the head.
   for (int y = -size / 2; y <= size / 2; ++y) {
     for (int x = -size / 2; x <= size / 2; ++x) {
       const double px = x / radius * head, py = -y / radius * head;
       if (px * px + py * py > head * head) continue;
-      double weighted = 0.0, weights = 0.0;
-      for (size_t k = 0; k < known.size(); ++k) {
-        const double dx = px - known[k].second.first, dy = py - known[k].second.second;
-        const double d2 = dx * dx + dy * dy;
-        if (d2 < 1e-9) {
-          weighted = values[k];
-          weights = 1.0;
-          break;
-        }
-        weighted += values[k] / d2;
-        weights += 1.0 / d2;
-      }
-      image.at<cv::Vec3b>(centre.y + y, centre.x + x) = [&] {
-        const cv::Scalar c = diverging(weighted / weights / limit);
-        return cv::Vec3b(static_cast<uchar>(c[0]), static_cast<uchar>(c[1]),
-                         static_cast<uchar>(c[2]));
-      }();
+      const cv::Scalar c = diverging(map->at(px, py) / map->limit_uv);
+      image.at<cv::Vec3b>(centre.y + y, centre.x + x) =
+          cv::Vec3b(static_cast<uchar>(c[0]), static_cast<uchar>(c[1]), static_cast<uchar>(c[2]));
     }
   }
   cv::circle(image, centre, static_cast<int>(radius), kBlack, 1, cv::LINE_AA);
@@ -183,18 +157,18 @@ std::filesystem::path writeScalpMap(const std::filesystem::path& folder,
                                        centre + cv::Point(0, -static_cast<int>(radius) - 16),
                                        centre + cv::Point(12, -static_cast<int>(radius) + 2)};
   cv::polylines(image, nose, false, kBlack, 1, cv::LINE_AA);
-  for (const auto& [name, at] : known) {
-    const cv::Point p =
-        centre + cv::Point(static_cast<int>(std::lround(at.first / head * radius)),
-                           static_cast<int>(-std::lround(at.second / head * radius)));
+  for (const bci::ScalpMap::Electrode& e : map->electrodes) {
+    const cv::Point p = centre + cv::Point(static_cast<int>(std::lround(e.x / head * radius)),
+                                           static_cast<int>(-std::lround(e.y / head * radius)));
     cv::circle(image, p, 3, kBlack, cv::FILLED, cv::LINE_AA);
-    text(image, name, p + cv::Point(5, -4), 0.35);
+    text(image, e.name, p + cv::Point(5, -4), 0.35);
   }
   text(image,
-       "target - non-target at " + format(erp.timeS(peak) * 1000.0, 0) +
+       "target - non-target at " + format(map->time_s * 1000.0, 0) +
            " ms (the difference's peak over channels)",
        {10, 24}, 0.45);
-  colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40, 16, size - 40), limit, "uV", 1);
+  colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40, 16, size - 40), map->limit_uv,
+            "uV", 1);
   const std::filesystem::path path = folder / "scalp.png";
   save(path, image);
   return path;
@@ -231,9 +205,7 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder,
 
   const Eigen::MatrixXd difference = erp.difference();
   const Eigen::MatrixXd band_t = 1.96 * erp.target_se, band_o = 1.96 * erp.other_se;
-  const double limit = std::ceil(std::max({1.0, (erp.target_mean.cwiseAbs() + band_t).maxCoeff(),
-                                           (erp.other_mean.cwiseAbs() + band_o).maxCoeff(),
-                                           difference.cwiseAbs().maxCoeff()}));
+  const double limit = erp.scaleUv();
   std::vector<double> ms(static_cast<size_t>(samples));
   for (int s = 0; s < samples; ++s) ms[static_cast<size_t>(s)] = erp.timeS(s) * 1000.0;
   for (int c = 0; c < channels; ++c) {

@@ -106,6 +106,7 @@ EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path
 }
 
 void EegStage::step(CycleContext& cycle) {
+  time_s_ = cycle.time_s;
   if (stepped_) advanceTo(cycle.time_s);
   poll();
   if (lostSamples() != lost_logged_) {
@@ -153,7 +154,7 @@ void EegStage::setModel(bci::P300Model model) {
     const std::string text =
         "the model was trained with zero-phase (offline) filters; the session filters causally, "
         "so its features lag the model's: train without --zero-phase for online use";
-    log_.write("model_warning", 0.0, {{"text", text}});
+    log_.write("model_warning", time_s_, {{"text", text}});
     if (progress_) *progress_ << "\nwarning: " << text << "\n";
   }
   extractor_.emplace(model.extractor(info()));

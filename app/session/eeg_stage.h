@@ -128,6 +128,7 @@ class EegStage final : public Stage {
   SessionLog& log_;
   std::ostream* progress_;
   std::int64_t lost_logged_ = 0;  // lost samples already in the log
+  double time_s_ = 0.0;           // the last cycle's session time, for the log
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;
   int photodiode_ = -1;  // the photodiode's channel in the source's blocks

@@ -22,6 +22,12 @@ std::string stimulusCodeMap(const WorldSettings& world, const std::vector<size_t
   return map;
 }
 
+std::vector<size_t> allSlots(const WorldSettings& world) {
+  std::vector<size_t> slots(world.objects.size());
+  for (size_t i = 0; i < slots.size(); ++i) slots[i] = i;
+  return slots;
+}
+
 ParadigmStageSettings ParadigmStageSettings::of(const SessionConfig& config) {
   return {config.paradigm, config.world, config.classifier_method, intendedTrials(config),
           config.eeg.seed + 11};
@@ -38,7 +44,7 @@ ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const CycleC
       paradigm_(std::make_unique<bci::Paradigm>(
           settings_.paradigm, static_cast<int>(settings_.world.objects.size()),
           settings_.world.grid.rows, settings_.world.grid.columns, settings_.seed)) {
-  for (size_t i = 0; i < settings_.world.objects.size(); ++i) slots_.push_back(i);
+  slots_ = allSlots(settings_.world);
 }
 
 void ParadigmStage::start() {

@@ -39,6 +39,8 @@ struct ParadigmStageSettings {
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
 // ...;104=column 1;..." (object codes k for world.objects[slots[k - 1]], grid codes 100 + code).
 std::string stimulusCodeMap(const WorldSettings& world, const std::vector<size_t>& slots);
+// Every object offered, in the session file's order (before the cameras say what is in view).
+std::vector<size_t> allSlots(const WorldSettings& world);
 
 class ParadigmStage final : public Stage {
  public:

@@ -15,15 +15,6 @@
 #include "support/status_line.h"
 
 namespace arbci::app {
-namespace {
-
-std::vector<size_t> allObjects(const WorldSettings& world) {
-  std::vector<size_t> slots(world.objects.size());
-  for (size_t i = 0; i < slots.size(); ++i) slots[i] = i;
-  return slots;
-}
-
-}  // namespace
 
 Session::Session(SessionConfig config, const SessionOptions& options, render::GlContext& context)
     : config_(std::move(config)), options_(options), context_(context), timing_(0.0) {
@@ -87,7 +78,7 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
       {"Classifier", config_.classifier_method},
       {"PhotodiodeChannel", config_.eeg.photodiode_channel},
       {"SoaMs", std::to_string(config_.paradigm.soaSeconds() * 1000.0)},
-      {"StimulusCodeMap", stimulusCodeMap(config_.world, allObjects(config_.world))},
+      {"StimulusCodeMap", stimulusCodeMap(config_.world, allSlots(config_.world))},
   };
   eeg_ = std::make_unique<EegStage>(eeg_settings, folder_ / "recording.bdf",
                                     options.simulated_clock, parameters, *log_, options.progress);

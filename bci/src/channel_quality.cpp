@@ -3,15 +3,23 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arbci/bci/intervals.h"
 #include "arbci/bci/signal.h"
 
 namespace arbci::bci {
 
 std::vector<ChannelQuality> assessChannels(const Recording& r) {
   std::vector<ChannelQuality> out;
-  const int channels = r.info.channelCount();
+  int channels = r.info.channelCount();
   if (r.samples < 2) return out;
-  for (int c = 0; c < channels; ++c) {
+  // A session's photodiode channel is no EEG (the dataset leaves it out too).
+  const auto photodiode = r.parameters.find("PhotodiodeChannel");
+  for (int c = 0; c < r.info.channelCount(); ++c) {
+    if (photodiode != r.parameters.end() &&
+        r.info.channels[static_cast<size_t>(c)] == photodiode->second) {
+      --channels;
+      continue;
+    }
     const float* x = r.data.data() + static_cast<std::ptrdiff_t>(c) * r.samples;
     double mean = 0.0;
     for (std::int64_t s = 0; s < r.samples; ++s) mean += x[s];
@@ -23,11 +31,10 @@ std::vector<ChannelQuality> assessChannels(const Recording& r) {
   }
   std::vector<double> sds;
   for (const ChannelQuality& q : out) sds.push_back(q.sd_uv);
-  std::nth_element(sds.begin(), sds.begin() + sds.size() / 2, sds.end());
-  const double median = sds[sds.size() / 2];
+  const double typical = median(sds);
   for (ChannelQuality& q : out) {
     q.flat = q.sd_uv < 0.5;
-    q.drifting = channels >= 3 && median > 0.0 && q.sd_uv > 20.0 * median;
+    q.drifting = channels >= 3 && typical > 0.0 && q.sd_uv > 20.0 * typical;
   }
   return out;
 }

@@ -1,5 +1,7 @@
 #include "arbci/bci/decision.h"
 
+#include "arbci/bci/intervals.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -24,9 +26,7 @@ ScoreModel ScoreModel::fit(const std::vector<double>& scores, const std::vector<
   const double within = (sum2[1] - n[1] * model.target_mean * model.target_mean) +
                         (sum2[0] - n[0] * model.other_mean * model.other_mean);
   model.sd = std::sqrt(std::max(within / (n[0] + n[1] - 2), 1e-12));
-  std::vector<double> sorted = scores;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  model.median = sorted[sorted.size() / 2];
+  model.median = bci::median(scores);
   return model;
 }
 

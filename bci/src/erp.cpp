@@ -1,5 +1,8 @@
 #include "arbci/bci/erp.h"
 
+#include "arbci/bci/electrode_positions.h"
+
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -41,6 +44,41 @@ int ErpCurves::peakSample() const {
   Eigen::Index peak = 0;
   difference().colwise().squaredNorm().maxCoeff(&peak);
   return static_cast<int>(peak);
+}
+
+double ErpCurves::scaleUv() const {
+  return std::ceil(std::max({1.0, (target_mean.cwiseAbs() + 1.96 * target_se).maxCoeff(),
+                             (other_mean.cwiseAbs() + 1.96 * other_se).maxCoeff(),
+                             difference().cwiseAbs().maxCoeff()}));
+}
+
+double ScalpMap::at(double x, double y) const {
+  double weighted = 0.0, weights = 0.0;
+  for (const Electrode& e : electrodes) {
+    const double d2 = (x - e.x) * (x - e.x) + (y - e.y) * (y - e.y);
+    if (d2 < 1e-12) return e.uv;
+    weighted += e.uv / d2;
+    weights += 1.0 / d2;
+  }
+  return weights > 0.0 ? weighted / weights : 0.0;
+}
+
+std::optional<ScalpMap> scalpMapAtPeak(const ErpCurves& erp) {
+  if (erp.samples() == 0) return std::nullopt;
+  const int peak = erp.peakSample();
+  const Eigen::MatrixXd difference = erp.difference();
+  ScalpMap map;
+  map.time_s = erp.timeS(peak);
+  map.limit_uv = 1e-6;
+  for (size_t c = 0; c < erp.channels.size(); ++c) {
+    if (const auto at = electrodePosition(erp.channels[c])) {
+      const double uv = difference(static_cast<Eigen::Index>(c), peak);
+      map.electrodes.push_back({erp.channels[c], at->first, at->second, uv});
+      map.limit_uv = std::max(map.limit_uv, std::abs(uv));
+    }
+  }
+  if (map.electrodes.size() < 3) return std::nullopt;
+  return map;
 }
 
 ErpCurves ErpAccumulator::curves() const {

@@ -1,5 +1,7 @@
 #include "arbci/bci/evaluation.h"
 
+#include "xdawn_filters.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -180,8 +182,7 @@ std::vector<double> alignScoresPerFile(const P300Dataset& data, std::vector<doub
     for (size_t i = 0; i < scores.size(); ++i)
       if (data.file[i] == static_cast<int>(f)) own.push_back(scores[i]);
     if (own.empty()) continue;
-    std::nth_element(own.begin(), own.begin() + own.size() / 2, own.end());
-    shifts[f] = model.median - own[own.size() / 2];
+    shifts[f] = model.median - median(own);
     for (size_t i = 0; i < scores.size(); ++i)
       if (data.file[i] == static_cast<int>(f)) scores[i] += shifts[f];
   }
@@ -218,6 +219,9 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
   for (size_t s = 0; s < data.selections.size(); ++s) {
     if (!data.selections[s].target_codes.empty()) labelled.push_back(static_cast<int>(s));
   }
+  // Settings the data cannot meet fail now, not in the first fold.
+  if (settings.method == "xdawn" || settings.method == "riemann")
+    checkFilterCount(settings.xdawn.filters, data.shape.channels);
   CrossValidation cv;
   cv.folds_by = foldScheme(data, settings.folds_by);
   cv.scores.assign(static_cast<size_t>(data.epochs()), 0.0);

@@ -5,6 +5,13 @@
 
 namespace arbci::bci {
 
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
 Interval aucInterval(double auc, int targets, int others) {
   if (targets < 1 || others < 1) return {0.0, 1.0};
   const double a = auc, q1 = a / (2.0 - a), q2 = 2.0 * a * a / (1.0 + a);

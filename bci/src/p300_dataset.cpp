@@ -12,6 +12,16 @@
 namespace arbci::bci {
 namespace {
 
+// `length` samples of every channel of `signal` from `first`, channel-major.
+std::vector<float> span(const Block& signal, std::int64_t first, int length) {
+  std::vector<float> out(static_cast<size_t>(signal.channels) * length);
+  for (int c = 0; c < signal.channels; ++c) {
+    std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * signal.samples + first),
+                length, out.begin() + static_cast<std::ptrdiff_t>(c) * length);
+  }
+  return out;
+}
+
 void reverseInTime(Block& block) {
   for (int c = 0; c < block.channels; ++c) {
     auto first = block.data.begin() + static_cast<std::ptrdiff_t>(c) * block.samples;
@@ -197,11 +207,7 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       epoch.event = e;
       epoch.channels = signal.channels;
       epoch.samples = length;
-      epoch.data.resize(static_cast<size_t>(signal.channels) * length);
-      for (int c = 0; c < signal.channels; ++c) {
-        std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + first),
-                    length, epoch.data.begin() + static_cast<std::ptrdiff_t>(c) * length);
-      }
+      epoch.data = span(signal, first, length);
       if (reject_uv > 0.0 && peakToPeak(epoch, extractor.channelIndices()) > reject_uv) {
         ++data.rejected_epochs;
         ++in_selection;
@@ -209,14 +215,8 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       }
       rows.push_back(extractor.features(epoch));
       const std::int64_t erp_first = e.sample - erp_baseline;
-      if (erp_first >= 0 && erp_first + erp_length <= r.samples) {
-        std::vector<float> span(static_cast<size_t>(signal.channels) * erp_length);
-        for (int c = 0; c < signal.channels; ++c) {
-          std::copy_n(signal.data.begin() + static_cast<std::ptrdiff_t>(c * r.samples + erp_first),
-                      erp_length, span.begin() + static_cast<std::ptrdiff_t>(c) * erp_length);
-        }
-        erps.add(span, e.target);
-      }
+      if (erp_first >= 0 && erp_first + erp_length <= r.samples)
+        erps.add(span(signal, erp_first, erp_length), e.target);
       data.target.push_back(e.target);
       data.code.push_back(e.code);
       data.sequence.push_back(in_selection / layout.codes());

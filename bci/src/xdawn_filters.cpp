@@ -15,14 +15,18 @@ Eigen::MatrixXd epochOf(const Eigen::Ref<const Eigen::RowVectorXd>& row,
   return e;
 }
 
-XdawnFilters xdawnFilters(const Eigen::MatrixXd& features, const FeatureShape& shape,
-                          const std::vector<bool>& in_class, int kept) {
-  const int channels = shape.channels, bins = shape.bins;
+void checkFilterCount(int kept, int channels) {
   if (kept < 1 || kept > channels) {
     throw std::invalid_argument(
         "xDAWN: " + std::to_string(kept) + " spatial filters asked for, the features have " +
         std::to_string(channels) + " channels (1 to " + std::to_string(channels) + " allowed)");
   }
+}
+
+XdawnFilters xdawnFilters(const Eigen::MatrixXd& features, const FeatureShape& shape,
+                          const std::vector<bool>& in_class, int kept) {
+  const int channels = shape.channels, bins = shape.bins;
+  checkFilterCount(kept, channels);
   const Eigen::Index n = features.rows();
   XdawnFilters out;
   out.evoked = Eigen::MatrixXd::Zero(channels, bins);

@@ -14,6 +14,9 @@ namespace arbci::bci {
 // One epoch of a feature row (channel-major: channel c's bins at c * bins) as channels x bins.
 Eigen::MatrixXd epochOf(const Eigen::Ref<const Eigen::RowVectorXd>& row, const FeatureShape& shape);
 
+// Throws std::invalid_argument unless `kept` is 1 to `channels`.
+void checkFilterCount(int kept, int channels);
+
 struct XdawnFilters {
   Eigen::MatrixXd filters;  // channels x kept, the strongest last
   Eigen::MatrixXd evoked;   // the class's mean epoch, channels x bins

@@ -9,8 +9,6 @@
 #include <utility>
 #include <vector>
 
-#include "arbci/bci/electrode_positions.h"
-
 namespace arbci::ui {
 namespace {
 
@@ -32,8 +30,7 @@ void drawErpPlots(const bci::ErpCurves& erp) {
   if (channels == 0 || samples < 2) return;
   const Eigen::MatrixXd difference = erp.difference();
   const Eigen::MatrixXd band_t = 1.96 * erp.target_se, band_o = 1.96 * erp.other_se;
-  const double limit = std::ceil(std::max({1.0, (erp.target_mean.cwiseAbs() + band_t).maxCoeff(),
-                                           (erp.other_mean.cwiseAbs() + band_o).maxCoeff()}));
+  const double limit = erp.scaleUv();
   ImGui::TextColored(ImVec4(0.86f, 0.2f, 0.2f, 1.0f), "target");
   ImGui::SameLine();
   ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "non-target");
@@ -115,24 +112,13 @@ void drawSignedR2(const bci::ErpCurves& erp) {
 }
 
 void drawScalpMap(const bci::ErpCurves& erp) {
-  const int peak = erp.peakSample();
-  const Eigen::MatrixXd difference = erp.difference();
-  std::vector<std::pair<std::string, std::pair<double, double>>> known;
-  std::vector<double> values;
-  for (size_t c = 0; c < erp.channels.size(); ++c) {
-    if (const auto at = bci::electrodePosition(erp.channels[c])) {
-      known.emplace_back(erp.channels[c], *at);
-      values.push_back(difference(static_cast<Eigen::Index>(c), peak));
-    }
-  }
-  if (known.size() < 3) {
+  const std::optional<bci::ScalpMap> map = bci::scalpMapAtPeak(erp);
+  if (!map) {
     ImGui::TextDisabled("no scalp map: fewer than 3 channels have 10-20 names");
     return;
   }
-  double limit = 1e-6;
-  for (double v : values) limit = std::max(limit, std::abs(v));
   ImGui::Text("target - non-target at %.0f ms (the difference's peak), +/-%.1f uV",
-              erp.timeS(peak) * 1000.0, limit);
+              map->time_s * 1000.0, map->limit_uv);
   const float size = 180.0f, head = 0.55f;
   const ImVec2 corner = ImGui::GetCursorScreenPos();
   ImGui::InvisibleButton("scalp", ImVec2(size, size));
@@ -145,24 +131,17 @@ void drawScalpMap(const bci::ErpCurves& erp) {
       const double px = ((i + 0.5) / kCells * 2.0 - 1.0) * head;
       const double py = (1.0 - (j + 0.5) / kCells * 2.0) * head;
       if (px * px + py * py > head * head) continue;
-      double weighted = 0.0, weights = 0.0;  // inverse-distance weighting, power 2
-      for (size_t k = 0; k < known.size(); ++k) {
-        const double dx = px - known[k].second.first, dy = py - known[k].second.second;
-        const double w = 1.0 / std::max(dx * dx + dy * dy, 1e-9);
-        weighted += w * values[k];
-        weights += w;
-      }
       const ImVec2 a(corner.x + i * cell, corner.y + j * cell);
       draw->AddRectFilled(a, ImVec2(a.x + cell + 0.5f, a.y + cell + 0.5f),
-                          diverging(weighted / weights / limit));
+                          diverging(map->at(px, py) / map->limit_uv));
     }
   }
   draw->AddCircle(centre, size / 2, kAxis, 64);
-  for (const auto& [name, at] : known) {
-    const ImVec2 p(centre.x + static_cast<float>(at.first / head) * size / 2,
-                   centre.y - static_cast<float>(at.second / head) * size / 2);
+  for (const bci::ScalpMap::Electrode& e : map->electrodes) {
+    const ImVec2 p(centre.x + static_cast<float>(e.x / head) * size / 2,
+                   centre.y - static_cast<float>(e.y / head) * size / 2);
     draw->AddCircleFilled(p, 2.5f, IM_COL32(0, 0, 0, 255));
-    draw->AddText(ImVec2(p.x + 4, p.y - 12), IM_COL32(0, 0, 0, 255), name.c_str());
+    draw->AddText(ImVec2(p.x + 4, p.y - 12), IM_COL32(0, 0, 0, 255), e.name.c_str());
   }
 }
 

@@ -19,6 +19,7 @@ struct ChannelQuality {
   bool bad() const { return flat || drifting; }
 };
 
+// The EEG channels of `recording` (not a session's photodiode channel).
 std::vector<ChannelQuality> assessChannels(const Recording& recording);
 // The recording without `channels` (by name; names it lacks are ignored).
 Recording withoutChannels(const Recording& recording, const std::vector<std::string>& channels);

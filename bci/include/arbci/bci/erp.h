@@ -4,6 +4,7 @@
 // The numbers behind the ERP figures (erp.png, erp.json, the Training panel).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,9 +30,28 @@ struct ErpCurves {
   Eigen::MatrixXd difference() const { return target_mean - other_mean; }
   // The sample where the difference's root mean square over channels peaks.
   int peakSample() const;
+  // One scale for every channel's figure: the largest |average| + 1.96 SE or |difference|,
+  // rounded up (at least 1 uV).
+  double scaleUv() const;
   // One channel's row as a vector (a row of a column-major matrix is strided).
   static std::vector<double> row(const Eigen::MatrixXd& m, int channel);
 };
+
+// The difference at its peak on the scalp: the channels whose 10-20 positions are known, and the
+// value anywhere on the head by inverse-distance weighting (power 2) between them.
+struct ScalpMap {
+  struct Electrode {
+    std::string name;
+    double x, y;  // bci::electrodePosition's plane
+    double uv;
+  };
+  double time_s = 0.0;
+  std::vector<Electrode> electrodes;
+  double limit_uv = 0.0;  // the largest |value| (>= 1e-6)
+  double at(double x, double y) const;
+};
+// None when fewer than 3 channels have known positions.
+std::optional<ScalpMap> scalpMapAtPeak(const ErpCurves& erp);
 
 // Sums epochs of `channels` x `samples` (channel-major: channel c's samples at c * samples).
 class ErpAccumulator {

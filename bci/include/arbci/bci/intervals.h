@@ -1,8 +1,13 @@
-// Intervals and chance levels for classifier reports: what a reviewer asks of an AUC or an
-// accuracy measured on a finite number of flashes and selections.
+// Intervals and chance levels for classifier reports (what a reviewer asks of an AUC or an
+// accuracy measured on a finite number of flashes and selections), and the median they share.
 #pragma once
 
+#include <vector>
+
 namespace arbci::bci {
+
+// The median of `values` (the upper one of an even count); 0 for none.
+double median(std::vector<double> values);
 
 struct Interval {
   double low = 0.0, high = 0.0;

@@ -79,7 +79,7 @@ class TrainingPanel final : public Panel {
   WorkstationModel& model_;
   char files_[1024] = "";
   char save_path_[256] = "model.json";
-  int method_ = 1;  // swlda, slda, xdawn
+  int method_ = 1;  // swlda, slda, xdawn, riemann
   float window_end_ms_ = 800.0f, decimate_hz_ = 20.0f;
   std::atomic<double> progress_{0.0};
   std::mutex stage_mutex_;
