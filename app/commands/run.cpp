@@ -17,7 +17,7 @@ namespace arbci::app {
 namespace {
 
 struct RunOptions {
-  std::string session, out;
+  std::string session, out, script;
   bool headless = false, realtime = false, wait_for_start = false, exit_when_done = false,
        overwrite = false;
   int trials = 0;
@@ -68,7 +68,7 @@ void printSummary(const Session& session) {
             << " ms (configured " << ms(timing["soa_ms"]["configured"]) << "), flash median "
             << ms(timing["flash_ms"]["median"]) << " ms; late frames " << timing["late_frames"]
             << ", lost EEG samples " << timing["lost_samples"] << "\n";
-  std::cout << "ended: " << session.endReason() << "\n";
+  std::cout << "ended: " << session.endKind() << " (" << session.endReason() << ")\n";
 }
 
 int runSession(const RunOptions& o) {
@@ -84,14 +84,16 @@ int runSession(const RunOptions& o) {
   options.progress = &std::cerr;
   const bool headless = o.headless || !render::displayAvailable();
   try {
-    if (!headless) return runWorkstation(config, options);
+    if (!o.script.empty() && headless)
+      throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
+    if (!headless) return runWorkstation(config, options, o.script);
     options.simulated_clock = !o.realtime;
     auto context = render::createHeadlessContext({64, 64});
     watchInterrupts();
     Session session(config, options, *context);
     session.run();
     printSummary(session);
-    return session.endReason() == "finished" ? 0 : 3;
+    return session.endKind() == "finished" ? 0 : 3;
   } catch (const SessionConfigError& error) {
     throw CliError(error.what());
   } catch (const render::GlError& error) {
@@ -113,8 +115,8 @@ void addRunCommand(CLI::App& root, int& exit_code) {
       "subject and arm. Writes a session folder (recording.bdf, log.jsonl, HMD\n"
       "screenshots, summary.json). Headless runs use a simulated clock that the EEG and\n"
       "the arm follow: the same session file and seed give the same recording. Ctrl+C ends\n"
-      "the session and saves its summary. Exit status: 0 finished, 3 ended by a fault,\n"
-      "an abort or an interrupt.");
+      "the session and saves its summary (its \"ended\": finished, aborted, estop or fault).\n"
+      "Exit status: 0 finished, 3 ended otherwise, 4 a --script failed.");
   run->add_option("--session", o->session,
                   "session file (JSON; see assets/sessions/simulated.json)");
   run->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
@@ -131,6 +133,11 @@ void addRunCommand(CLI::App& root, int& exit_code) {
                 "instead of a simulated clock as fast as the machine allows");
   run->add_flag("--exit-when-done", o->exit_when_done,
                 "windowed: close the window once the session has ended (scripted runs)");
+  run->add_option("--script", o->script,
+                  "windowed: a scripted experimenter replays FILE with real clicks on the\n"
+                  "panels' buttons (wait \"PHASE\", click \"LABEL\", pause S, key ctrl+q,\n"
+                  "screenshot F.png; see docs/render-ui.md). Exit status 4 when it fails")
+      ->check(CLI::ExistingFile);
   run->add_flag("--wait-for-start", o->wait_for_start,
                 "windowed: wait for the experimenter to press Start");
   run->add_option("--fault-wait", o->fault_wait_s,

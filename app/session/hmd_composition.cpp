@@ -39,6 +39,8 @@ render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdSc
       h.state = stimulus.lit.count(slot) ? render::HighlightState::Flashing
                                          : render::HighlightState::Cued;
     if (stimulus.selected_object == slot) h.state = render::HighlightState::Selected;
+    // A stale pose is shown greyed, never flashed (the paradigm's stage withholds its flashes).
+    if (!vision.fresh(o.id, scene.now_s)) h.state = render::HighlightState::Lost;
     if (scene.holding == o.id) h.state = render::HighlightState::Held;
     frame.objects.push_back(h);
   }

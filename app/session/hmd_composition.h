@@ -1,5 +1,6 @@
 // What the HMD shows on a frame, composed from the paradigm's stimulus and the tracked world:
-// each tracked object's highlight (idle, cued, flashing, selected, held), the grid with its lit
+// each tracked object's highlight (idle, cued, flashing, selected, held; greyed when its pose is
+// stale), the grid with its lit
 // rows and columns and the selected cell, and the photodiode patch. And the frame's signature:
 // an unchanged frame need not be drawn again.
 #pragma once
@@ -22,6 +23,7 @@ struct HmdScene {
   int holding = -1;  // the marker id of the object in the gripper, -1: none
   render::GridLayout grid;
   bool photodiode_patch = false;
+  double now_s = 0.0;  // the frame's time: objects with an older pose than allowed are greyed
 };
 
 // The session file's grid as the renderer draws it (on the table, in the robot frame).

@@ -29,17 +29,17 @@ HmdStage::HmdStage(const HmdSettings& settings, const std::filesystem::path& fol
   all.cued_object = 1;
   all.selected_object = 2;
   all.selected_cell = std::make_pair(1, 1);
-  draw(all);
+  draw(all, 0.0);
   all.phase = bci::Phase::ObjectFlashing;
-  draw(all);
-  draw(bci::FrameStimulus{});
+  draw(all, 0.0);
+  draw(bci::FrameStimulus{}, 0.0);
 }
 
-void HmdStage::draw(const bci::FrameStimulus& stimulus) {
+void HmdStage::draw(const bci::FrameStimulus& stimulus, double now_s) {
   const auto& status = s_.robot.status();
   const HmdScene scene{
-      settings_.objects,     s_.vision, s_.paradigm.slots(), status ? status->holding : -1, grid_,
-      s_.eeg.hasPhotodiode()};
+      settings_.objects,      s_.vision, s_.paradigm.slots(), status ? status->holding : -1, grid_,
+      s_.eeg.hasPhotodiode(), now_s};
   const render::HmdFrame frame = composeHmdFrame(stimulus, scene);
   // What this frame shows; unchanged, the framebuffer already holds it.
   const std::string signature = hmdFrameSignature(frame);
@@ -54,7 +54,7 @@ void HmdStage::step(CycleContext& cycle) {
   const bci::FrameStimulus& stimulus = s_.paradigm.stimulus();
   for (const ParadigmStage::PhaseChange& change : s_.paradigm.phaseChanges())
     screenshots_.phaseEntered(change.phase, change.trial);
-  draw(stimulus);
+  draw(stimulus, cycle.time_s);
   if (const auto path = screenshots_.take(stimulus)) screenshot(*path);
   pending_ = true;
   due_ = cycle.due_s;

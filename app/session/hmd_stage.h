@@ -72,7 +72,7 @@ class HmdStage final : public Stage {
   void screenshot(const std::filesystem::path& path);
 
  private:
-  void draw(const bci::FrameStimulus& stimulus);
+  void draw(const bci::FrameStimulus& stimulus, double now_s);
   void warnIfDisplayTooSlow(double at);
 
   HmdSettings settings_;

@@ -1,6 +1,7 @@
 #include "session/paradigm_stage.h"
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 
 #include "session/hmd_composition.h"
@@ -60,10 +61,30 @@ void ParadigmStage::emergencyStop() {
   handleEvents();
 }
 
+void ParadigmStage::retryStep() {
+  retrying_ = true;
+  paradigm_->retryStep();
+  handleEvents();  // the robot's command goes out now
+  retrying_ = false;
+}
+
+void ParadigmStage::skipTrial() {
+  paradigm_->skipTrial();
+  handleEvents();
+}
+
+std::optional<int> ParadigmStage::selectedObjectId() const {
+  const int trial = paradigm_->trial();
+  if (trial < 1 || trial > static_cast<int>(trials_.size())) return std::nullopt;
+  const int id = trials_[static_cast<size_t>(trial - 1)].selected_object;
+  return id > 0 ? std::optional<int>(id) : std::nullopt;
+}
+
 void ParadigmStage::step(CycleContext& cycle) {
   phase_changes_.clear();
   collectTraining();
   stimulus_ = paradigm_->frame(cycle.frame, cycle.due_s);
+  withholdStaleFlashes();
   first_shown_.clear();
   handleEvents();
   decideIfReady();
@@ -126,16 +147,35 @@ const WorldObjectSettings& ParadigmStage::objectOfCode(int code) const {
   return settings_.world.objects[slots_.at(static_cast<size_t>(code - 1))];
 }
 
+void ParadigmStage::withholdStaleFlashes() {
+  const bool objects = stimulus_.phase == bci::Phase::ObjectFlashing ||
+                       stimulus_.phase == bci::Phase::CalibrationFlashing;
+  std::set<int> stale;
+  for (size_t k = 0; k < slots_.size(); ++k) {
+    const int id = settings_.world.objects[slots_[k]].id;
+    if (!s_.vision.fresh(id, now_.time_s)) stale.insert(id);
+    if (objects && stale.count(id)) stimulus_.lit.erase(static_cast<int>(k) + 1);
+  }
+  // The recording says when an offered object's tracking is lost and regained (once started).
+  for (int id : stale) {
+    if (!stale_.count(id) && paradigm_->phase() != bci::Phase::Setup)
+      s_.eeg.annotate(now_.eeg_sample, "Tracking lost object " + std::to_string(id));
+  }
+  for (int id : stale_) {
+    if (!stale.count(id) && paradigm_->phase() != bci::Phase::Setup)
+      s_.eeg.annotate(now_.eeg_sample, "Tracking regained object " + std::to_string(id));
+  }
+  stale_ = std::move(stale);
+}
+
 void ParadigmStage::chooseSelectableObjects() {
-  // In view: seen in the last 2 s (an object the robot moved, since it was moved). An object
-  // hidden or gone does not flash.
-  constexpr double kRecentS = 2.0;
+  // In view: a fresh pose (an object the robot moved, seen since it was moved). An object hidden,
+  // gone or not tracked lately is not offered.
   std::vector<size_t> slots;
   std::vector<int> ids;
   for (size_t i = 0; i < settings_.world.objects.size(); ++i) {
     const int id = settings_.world.objects[i].id;
-    const auto state = s_.vision.world().object(id);
-    if (state && state->age(now_.time_s) < kRecentS) {
+    if (s_.vision.fresh(id, now_.time_s)) {
       slots.push_back(i);
       ids.push_back(id);
     }
@@ -250,6 +290,13 @@ void ParadigmStage::handleEvents() {
         break;
       }
       case Kind::Flash:
+        if (!stimulus_.lit.count(e.code)) {
+          // Its object's pose is stale: not shown, so not recorded as a flash either.
+          s_.log.write(
+              "flash_withheld", time,
+              {{"code", e.code}, {"object", objectOfCode(e.code).id}, {"why", "tracking lost"}});
+          break;
+        }
         // Stamped when the frame that shows it is presented.
         first_shown_.push_back(e.code);
         ++selection_flashes_;
@@ -266,6 +313,24 @@ void ParadigmStage::handleEvents() {
         break;
       case Kind::RobotGrasp: {
         const int id = objectOfCode(e.object).id;
+        const auto seen = s_.vision.world().object(id);
+        if (seen && !s_.vision.fresh(id, time) && s_.robot.holding() != id) {
+          // Never a grasp at a stale pose: the experimenter retries once the cameras see it.
+          char why[160];
+          std::snprintf(why, sizeof why,
+                        "object %d: tracking lost (pose %.1f s old), not grasped; Retry step "
+                        "once it is seen again",
+                        id, seen->age(time));
+          currentTrial().outcome = why;
+          paradigm_->robotFinished(false, why);
+          break;
+        }
+        if (retrying_ && s_.robot.holding() == id) {
+          // Stopped after the gripper closed: the grasp is done.
+          s_.log.write("robot_step_done", time, {{"step", "grasp"}, {"object", id}});
+          paradigm_->robotFinished(true, "");
+          break;
+        }
         const auto state = s_.vision.world().object(id);
         if (!state) {
           // Never a grasp at a stale position: a moved object is grasped once seen again.
@@ -278,6 +343,11 @@ void ParadigmStage::handleEvents() {
         break;
       }
       case Kind::RobotDrop: {
+        if (retrying_ && !s_.robot.holding()) {
+          // Stopped after the object was let go: the arm goes home, and the put-down ends.
+          s_.robot.finishPutDown(time);
+          break;
+        }
         const auto other = objectOnCell(e.cell);
         if (other) {
           // Never onto another object: it goes back where it came from, and the trial says why.
@@ -293,10 +363,15 @@ void ParadigmStage::handleEvents() {
         s_.robot.stop(time);
         break;
       case Kind::TrialDone:
-        if (e.trial >= 1 && e.trial <= static_cast<int>(trials_.size()))
-          trials_[static_cast<size_t>(e.trial - 1)].ended_s = time;
+        if (e.trial >= 1 && e.trial <= static_cast<int>(trials_.size())) {
+          TrialRecord& done = trials_[static_cast<size_t>(e.trial - 1)];
+          done.ended_s = time;
+          // Ended by the experimenter (skipped, or resumed after a stop): the record says so.
+          if (!e.text.empty())
+            done.outcome = done.outcome == "incomplete" ? e.text : done.outcome + "; " + e.text;
+        }
         last_trial_end_ = time;
-        s_.log.write("trial_done", time, {{"trial", e.trial}});
+        s_.log.write("trial_done", time, {{"trial", e.trial}, {"text", e.text}});
         break;
     }
   }

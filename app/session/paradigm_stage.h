@@ -64,6 +64,12 @@ class ParadigmStage final : public Stage {
   // The experimenter.
   void start();
   void emergencyStop();
+  // Recovery (Session checks first that it is safe): the interrupted robot step again, or the
+  // trial ended as it stands.
+  void retryStep();
+  void skipTrial();
+  // The marker id of the object selected in this trial, once selected.
+  std::optional<int> selectedObjectId() const;
 
   // What this frame shows, and the codes it shows for the first time (flash onsets, stamped when
   // the frame is presented).
@@ -97,6 +103,8 @@ class ParadigmStage final : public Stage {
   void collectTraining();
   void decideIfReady();
   void chooseSelectableObjects();
+  // Objects whose pose is stale are not lit (nor their flashes recorded) on this frame.
+  void withholdStaleFlashes();
   // The attended codes of a new online selection: the intended object's, or cell's row and column.
   std::set<int> attendedCodes(bool objects);
   void recordSelection(const bci::ParadigmEvent& e);
@@ -119,6 +127,9 @@ class ParadigmStage final : public Stage {
   int selection_flashes_ = 0;
   double last_trial_end_ = 0.0;  // where the next trial's time starts (session seconds)
   double training_since_ = 0.0;
+  bool retrying_ = false;
+  std::set<int> stale_;  // offered objects whose pose is stale (marker ids)  // the robot events
+                         // come from the experimenter's Retry step
 };
 
 }  // namespace arbci::app

@@ -19,7 +19,7 @@ void RobotChoreography::step(CycleContext& cycle) {
   const double time_s = cycle.time_s;
   // A stepped arm is moved to this frame's time while it has anything to do (idle, it does not
   // move; send() brings its clock up to date before a command).
-  const bool matters = command_ || (homed_ && !clear_view_frame_) || placement_;
+  const bool matters = busy() || (homed_ && !clear_view_frame_) || placement_;
   if (stepped_ && matters && !client_->syncClock(time_s)) {
     stepped_ = false;
     log_.write("robot_clock_lost", time_s, {{"text", "the stepped robot backend did not answer"}});
@@ -34,6 +34,7 @@ void RobotChoreography::send(robot::MessageType type, const cv::Vec3d& target, d
   if (stepped_) client_->syncClock(time_s);  // the command starts now, not at the last sync
   command_ = client_->send(type, {target[0], target[1], target[2]});
   command_type_ = type;
+  if (type != robot::MessageType::Home) at_home_ = false;
 }
 
 void RobotChoreography::grasp(int object_id, const cv::Vec3d& at, double time_s) {
@@ -64,6 +65,7 @@ void RobotChoreography::drop(std::pair<int, int> cell, bool give_back, double ti
 void RobotChoreography::stop(double time_s) {
   const auto sequence = client_->send(robot::MessageType::Stop);
   command_.reset();  // the client cancelled it; the backend refuses it
+  recovery_.reset();
   log_.write("robot_command", time_s, {{"command", "STOP"}, {"sequence", sequence}});
 }
 
@@ -73,10 +75,87 @@ void RobotChoreography::reset(double time_s) {
              {{"command", "RESET"}, {"by", "experimenter"}, {"sequence", sequence}});
 }
 
+void RobotChoreography::resetIfLatched(double time_s) {
+  const auto& status = client_->status();
+  if (status && !status->stop_reason.empty()) reset(time_s);
+}
+
+void RobotChoreography::sendRecovery(robot::MessageType type, const cv::Vec3d& target,
+                                     const char* what, double time_s) {
+  resetIfLatched(time_s);
+  if (stepped_) client_->syncClock(time_s);
+  recovery_ = client_->send(type, {target[0], target[1], target[2]});
+  recovery_type_ = type;
+  if (type != robot::MessageType::Home) at_home_ = false;
+  nlohmann::json fields = {{"command", robot::toString(type)},
+                           {"by", "experimenter"},
+                           {"what", what},
+                           {"sequence", *recovery_}};
+  if (type != robot::MessageType::Home) fields["target"] = {target[0], target[1], target[2]};
+  log_.write("robot_command", time_s, fields);
+  messages_.push_back(std::string("experimenter: ") + what);
+}
+
 void RobotChoreography::home(double time_s) {
-  const auto sequence = client_->send(robot::MessageType::Home);
+  if (!whyNotMove().empty()) return;
+  sendRecovery(robot::MessageType::Home, {}, "home", time_s);
+}
+
+void RobotChoreography::release(double time_s) {
+  if (!whyNotRelease().empty()) return;
+  cv::Vec3d at = grasped_from_;
+  at[2] = world_.table_z;
+  sendRecovery(robot::MessageType::Drop, at, "open the gripper where the object was taken from",
+               time_s);
+}
+
+void RobotChoreography::finishPutDown(double time_s) {
+  resetIfLatched(time_s);
+  send(robot::MessageType::Home, {}, time_s);
   log_.write("robot_command", time_s,
-             {{"command", "HOME"}, {"by", "experimenter"}, {"sequence", sequence}});
+             {{"command", "HOME"}, {"after", "an interrupted put-down"}, {"sequence", *command_}});
+}
+
+std::optional<int> RobotChoreography::holding() const {
+  const auto& status = client_->status();
+  if (!status || status->holding < 0) return std::nullopt;
+  return status->holding;
+}
+
+std::string RobotChoreography::whyNotMove() const {
+  if (client_->silent()) return "the robot backend does not answer";
+  if (!client_->status()) return "no status from the robot backend yet";
+  if (busy()) return "the arm is carrying out a command";
+  return "";
+}
+
+std::string RobotChoreography::whyNotRelease() const {
+  if (std::string why = whyNotMove(); !why.empty()) return why;
+  const auto held = holding();
+  if (!held) return "the gripper holds nothing";
+  if (!grasped_id_ || *grasped_id_ != *held)
+    return "object " + std::to_string(*held) +
+           " was not grasped in this session: the place it came from is unknown";
+  return "";
+}
+
+void RobotChoreography::handleRecoveryEvent(const robot::RobotEvent& e, double time_s) {
+  using Kind = robot::RobotEvent::Kind;
+  if (!recovery_ || e.sequence != *recovery_) return;
+  if (e.kind != Kind::Finished && e.kind != Kind::Rejected && e.kind != Kind::Failed) return;
+  recovery_.reset();
+  client_->requestStatus();
+  const bool success = e.kind == Kind::Finished && e.outcome == robot::Outcome::Success;
+  if (!success) return;  // the messages say why; the experimenter decides again
+  if (recovery_type_ == robot::MessageType::Home) {
+    at_home_ = true;
+    return;
+  }
+  // Released: the object stands where it was taken from; the cameras must see it anew, and the
+  // arm goes home so they can.
+  if (grasped_id_) hooks_.object_moved(*grasped_id_);
+  grasped_id_.reset();
+  sendRecovery(robot::MessageType::Home, {}, "home after opening the gripper", time_s);
 }
 
 bool RobotChoreography::measuring(double time_s) const {
@@ -99,6 +178,8 @@ void RobotChoreography::handleEvents(double time_s) {
                         : std::string(robot::toString(e.kind)) + " " + robot::toString(e.command);
     messages_.push_back(what + (e.text.empty() ? "" : ": " + e.text));
     if (messages_.size() > 200) messages_.erase(messages_.begin());
+    handleRecoveryEvent(e, time_s);
+    if (e.kind == Kind::Silent) recovery_.reset();
     if (!command_) continue;
     const bool ours = e.sequence == *command_;
     if (ours && e.kind == Kind::Finished) {
@@ -122,6 +203,7 @@ void RobotChoreography::handleEvents(double time_s) {
         hooks_.current_trial().outcome =
             std::string("robot ") + robot::toString(e.outcome) + ": " + e.text;
       if (success && command_type_ == robot::MessageType::Home) {
+        at_home_ = true;
         homed_ = e.sequence;  // the put-down ends once the cameras have looked again
         continue;
       }

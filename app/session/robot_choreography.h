@@ -47,19 +47,41 @@ class RobotChoreography final : public Stage {
   void drop(std::pair<int, int> cell, bool give_back, double time_s);
   // STOP (the paradigm's, an emergency stop among them): the client cancels what is pending.
   void stop(double time_s);
-  // The experimenter's recovery after a latched stop: RESET and HOME (outside any trial).
+  // The experimenter's recovery after a stop or a fault (outside any trial's command): RESET
+  // lifts a latched stop; HOME parks the arm; release puts what the gripper holds back where it
+  // was taken from, then parks the arm. Motions lift a latched stop first.
   void reset(double time_s);
   void home(double time_s);
+  void release(double time_s);
+  // RESET when a stop is latched (the experimenter goes on: motions must run again).
+  void resetIfLatched(double time_s);
+  // A put-down interrupted after the object was let go: the arm goes home and the put-down ends
+  // as usual (once the cameras have seen the table).
+  void finishPutDown(double time_s);
+  // Why an experimenter's motion cannot go now ("" when it can): a command running, the backend
+  // silent or not yet heard.
+  std::string whyNotMove() const;
+  // Why release cannot go now: as whyNotMove(), or the gripper empty, or the place unknown.
+  std::string whyNotRelease() const;
 
   // A placement still to be measured (at most 3 s after the drop).
   bool measuring(double time_s) const;
   std::optional<int> grasped() const { return grasped_id_; }
+  // What the backend last said the gripper holds (its marker id), if anything.
+  std::optional<int> holding() const;
+  // The arm is parked: HOME finished since the last motion (it starts home).
+  bool atHome() const { return at_home_; }
+  // A command of the trial's or the experimenter's is running.
+  bool busy() const { return command_.has_value() || recovery_.has_value(); }
   const std::optional<robot::StatusPayload>& status() const { return client_->status(); }
   bool silent() const { return client_->silent(); }
   const std::vector<std::string>& messages() const { return messages_; }
 
  private:
   void send(robot::MessageType type, const cv::Vec3d& target, double time_s);
+  void sendRecovery(robot::MessageType type, const cv::Vec3d& target, const char* what,
+                    double time_s);
+  void handleRecoveryEvent(const robot::RobotEvent& e, double time_s);
   void handleEvents(double time_s);
   void measurePlacement(double time_s);
   void endPutDownOnceInView(std::int64_t frame);
@@ -84,6 +106,10 @@ class RobotChoreography final : public Stage {
   // seen the table without it.
   std::optional<std::uint64_t> homed_;
   std::optional<std::int64_t> clear_view_frame_;
+  bool at_home_ = true;
+  // The experimenter's recovery command in flight: its sequence and what it is.
+  std::optional<std::uint64_t> recovery_;
+  robot::MessageType recovery_type_ = robot::MessageType::Home;
 };
 
 }  // namespace arbci::app

@@ -15,6 +15,18 @@
 #include "support/status_line.h"
 
 namespace arbci::app {
+namespace {
+
+// How a run ended, for the summary: a run that ends in an emergency stop or a robot fault (the
+// experimenter ends it, or a headless run stops waiting) is that; any other early end is aborted.
+std::string endKindOf(const std::string& reason, bci::Phase phase) {
+  if (reason == "finished" || reason == "timing check done") return "finished";
+  if (phase == bci::Phase::EmergencyStop) return "estop";
+  if (phase == bci::Phase::RobotFault) return "fault";
+  return "aborted";
+}
+
+}  // namespace
 
 Session::Session(SessionConfig config, const SessionOptions& options, render::GlContext& context)
     : config_(std::move(config)), options_(options), context_(context), timing_(0.0) {
@@ -118,10 +130,13 @@ void Session::start() {
   paradigm_->start();
 }
 void Session::pause() {
+  if (refuse("pause", whyNotPause())) return;
   paradigm_->paradigm().pause();
 }
 void Session::resume() {
+  if (refuse("resume", whyNotResume())) return;
   fault_since_ = -1.0;
+  if (paradigm().interrupted()) robot_->resetIfLatched(cycle_.time_s);
   paradigm_->paradigm().resume();
 }
 void Session::abort() {
@@ -134,7 +149,108 @@ void Session::resetRobot() {
   robot_->reset(cycle_.time_s);
 }
 void Session::homeRobot() {
+  if (refuse("home", whyNotHome())) return;
   robot_->home(cycle_.time_s);
+}
+void Session::releaseObject() {
+  if (refuse("open the gripper", whyNotRelease())) return;
+  robot_->release(cycle_.time_s);
+}
+void Session::retryStep() {
+  if (refuse("retry the step", whyNotRetry())) return;
+  fault_since_ = -1.0;
+  log_->write("recovery", cycle_.time_s, {{"action", "retry step"}, {"trial", paradigm().trial()}});
+  robot_->resetIfLatched(cycle_.time_s);
+  paradigm_->retryStep();
+}
+void Session::skipTrial() {
+  if (refuse("skip the trial", whyNotSkip())) return;
+  fault_since_ = -1.0;
+  log_->write("recovery", cycle_.time_s, {{"action", "skip trial"}, {"trial", paradigm().trial()}});
+  robot_->resetIfLatched(cycle_.time_s);
+  paradigm_->skipTrial();
+}
+void Session::endSession() {
+  if (ended_) return;
+  const bci::Phase phase = paradigm().phase();
+  log_->write("recovery", cycle_.time_s, {{"action", "end session"}});
+  const std::string kind = endKindOf("", phase);
+  paradigm_->paradigm().abort();
+  endRun(std::string("ended by the experimenter in: ") + bci::toString(phase), kind);
+}
+
+bool Session::refuse(const char* action, const std::string& why) {
+  if (why.empty()) return false;
+  log_->write("refused", cycle_.time_s, {{"action", action}, {"why", why}});
+  return true;
+}
+
+std::string Session::whyArmNotClear() const {
+  if (const auto held = robot_->holding())
+    return "the arm holds object " + std::to_string(*held) + ": Open gripper or Retry step first";
+  if (!robot_->atHome()) return "the arm is not home: Home first";
+  return "";
+}
+
+std::string Session::whyNotResume() const {
+  if (ended_) return "the session has ended";
+  const bci::Phase phase = paradigm().phase();
+  if (phase == bci::Phase::Paused) return "";
+  const auto was = paradigm().interrupted();
+  if (!was) return "nothing to resume: the session is not paused or stopped";
+  if (*was != bci::Phase::Grasping && *was != bci::Phase::Dropping) return "";
+  // Resume ends the interrupted trial and starts the next one: only with the arm clear.
+  if (robot_->busy()) return "the arm is carrying out a command";
+  return whyArmNotClear();
+}
+
+std::string Session::whyNotHome() const {
+  if (ended_) return "the session has ended";
+  // Outside a trial, or in a stop or fault: never in the middle of a trial's robot work.
+  const bci::Phase phase = paradigm().phase();
+  if (phase != bci::Phase::Setup && !paradigm().interrupted())
+    return "only before the session starts or after an emergency stop or a robot fault";
+  return robot_->whyNotMove();
+}
+
+std::string Session::whyNotPause() const {
+  if (ended_) return "the session has ended";
+  switch (paradigm().phase()) {
+    case bci::Phase::Setup:
+      return "the session has not started";
+    case bci::Phase::Paused:
+      return "already paused";
+    case bci::Phase::EmergencyStop:
+    case bci::Phase::RobotFault:
+      return "stopped: use the Robot panel's recovery";
+    default:
+      return "";
+  }
+}
+
+std::string Session::whyNotRelease() const {
+  if (std::string why = whyNotHome(); !why.empty()) return why;
+  return robot_->whyNotRelease();
+}
+
+std::string Session::whyNotRetry() const {
+  if (ended_) return "the session has ended";
+  const auto was = paradigm().interrupted();
+  if (!was) return "nothing to retry: no emergency stop or robot fault";
+  if (*was != bci::Phase::Grasping && *was != bci::Phase::Dropping) return "";
+  if (std::string why = robot_->whyNotMove(); !why.empty()) return why;
+  const auto held = robot_->holding();
+  const std::optional<int> selected = paradigm_->selectedObjectId();
+  if (*was == bci::Phase::Grasping && held && held != selected)
+    return "the arm holds object " + std::to_string(*held) + ": Open gripper first";
+  return "";
+}
+
+std::string Session::whyNotSkip() const {
+  if (ended_) return "the session has ended";
+  if (!paradigm().interrupted()) return "only after an emergency stop or a robot fault";
+  if (robot_->busy()) return "the arm is carrying out a command";
+  return whyArmNotClear();
 }
 
 void Session::beginCycle() {
@@ -269,14 +385,26 @@ std::string Session::statusLine() const {
                 cycle_.time_s, std::max(paradigm().trial(), 0), config_.paradigm.trials,
                 bci::toString(paradigm().phase()), timing_.totalPercentiles().p50,
                 timing_.overruns(), static_cast<long long>(lateFrames()));
-  const std::string warning = timingWarning();
-  return warning.empty() ? std::string(text) : std::string(text) + "  [" + warning + "]";
+  std::string line = text;
+  for (const std::string& warning : {timingWarning(), trackingAlarm()}) {
+    if (!warning.empty()) line.append("  [").append(warning).append("]");
+  }
+  return line;
 }
 
-void Session::endRun(const std::string& reason) {
+std::string Session::trackingAlarm() const {
+  std::vector<int> ids;
+  for (const WorldObjectSettings& o : config_.world.objects) {
+    if (robot_->holding() != o.id) ids.push_back(o.id);
+  }
+  return vision_->trackingAlarm(ids, cycle_.time_s);
+}
+
+void Session::endRun(const std::string& reason, const std::string& kind) {
   if (ended_) return;
   ended_ = true;
   end_reason_ = reason;
+  end_kind_ = kind.empty() ? endKindOf(reason, paradigm().phase()) : kind;
   for (Stage* stage : stages_) stage->stop(cycle_, reason);
   log_->write("session_ended", cycle_.time_s, {{"reason", reason}});
   std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
@@ -289,6 +417,7 @@ void Session::endRun(const std::string& reason) {
 nlohmann::json Session::summary() const {
   const SessionFacts facts{config_.source,
                            config_.eeg.seed,
+                           end_kind_,
                            end_reason_,
                            cycle_.time_s,
                            frame_,

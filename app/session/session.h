@@ -81,10 +81,26 @@ class Session {
   void resume();
   void abort();
   void emergencyStop();
-  // The experimenter's recovery after a latched stop: RESET lifts it, HOME parks the arm. Neither
-  // is part of a trial: the paradigm goes on only with Resume.
+  // The experimenter's recovery after an emergency stop or a robot fault (docs/session.md):
+  // Reset lifts the robot's latched stop; Home parks the arm; Open gripper puts what it holds
+  // back where it was taken from; Retry step asks again for the interrupted grasp or put-down (or
+  // goes on with an interrupted selection); Skip trial ends the trial; End session ends the run,
+  // which the summary records as "estop" or "fault". Each why-not says why the action cannot go
+  // now ("" when it can): the panels show it, and the action refuses and logs it.
   void resetRobot();
   void homeRobot();
+  void releaseObject();
+  void retryStep();
+  void skipTrial();
+  void endSession();
+  std::string whyNotPause() const;
+  std::string whyNotResume() const;
+  std::string whyNotHome() const;
+  std::string whyNotRelease() const;
+  std::string whyNotRetry() const;
+  std::string whyNotSkip() const;
+  // How the run ended: "finished", "aborted", "estop" or "fault" (empty while it runs).
+  const std::string& endKind() const { return end_kind_; }
 
   // For the panels and the windowed app.
   const SessionConfig& config() const { return config_; }
@@ -105,6 +121,9 @@ class Session {
   double time() const { return cycle_.time_s; }
   std::int64_t frame() const { return frame_; }
   std::string statusLine() const;
+  // "" while the reference and every object not in the gripper are tracked within the allowed
+  // pose age; else "tracking lost: ...".
+  std::string trackingAlarm() const;
   bool ended() const { return ended_; }
   std::string endReason() const { return end_reason_; }
   // Experimenter settings from the panels.
@@ -124,7 +143,11 @@ class Session {
   void recordCycleTime();
   // A run without an experimenter ends on a fault after a while; every run at its end.
   void endIfDone();
-  void endRun(const std::string& reason);
+  void endRun(const std::string& reason, const std::string& kind = "");
+  // The arm holds nothing and is home: a trial may start ("" when so, else what to do).
+  std::string whyArmNotClear() const;
+  // Logs an experimenter's action the session refused, and why.
+  bool refuse(const char* action, const std::string& why);
   // The status line on the progress stream, rewritten in place.
   void showStatus() const;
 
@@ -142,6 +165,7 @@ class Session {
   double fault_since_ = -1.0;
   bool ended_ = false;
   std::string end_reason_;
+  std::string end_kind_;
   // The stages, constructed in this order (each may use those before it).
   std::unique_ptr<RobotChoreography> robot_;
   std::unique_ptr<CameraStage> cameras_;

@@ -229,9 +229,10 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   c.mirror_monitor = hmd.integer("mirror_monitor", c.mirror_monitor, -1, 15);
   parseCameras(root.section("cameras"), c.cameras);
   const Section tracker = root.section("tracker");
-  tracker.known({"kind", "border"});
+  tracker.known({"kind", "border", "max_pose_age_s"});
   c.tracker_kind = tracker.text("kind", c.tracker_kind, {"bch", "simple"});
   c.tracker_border = tracker.number("border", c.tracker_border, 0.05, 0.4);
+  c.max_pose_age_s = tracker.number("max_pose_age_s", c.max_pose_age_s, 0.05, 10.0);
   const Section world_section = root.section("world");
   parseWorld(world_section, file, c.world);
   if (c.world.objects.size() < 2) world_section.fail("objects", "must name at least 2 objects");
@@ -303,7 +304,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   const Section cl = root.section("classifier");
   cl.known(
       {"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz", "notch_hz", "model"});
-  c.classifier_method = cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn", "riemann"});
+  c.classifier_method =
+      cl.text("method", c.classifier_method, {"swlda", "slda", "xdawn", "riemann"});
   const auto window = cl.numbers(
       "window_ms", {c.pipeline.window.start_s * 1000.0, c.pipeline.window.end_s * 1000.0}, 2, 2);
   if (!(window[1] > window[0])) cl.fail("window_ms", "must end after it starts");

@@ -96,6 +96,9 @@ struct SessionConfig {
   CameraSettings cameras;
   std::string tracker_kind = "bch";
   double tracker_border = 0.125;
+  // A pose older than this is stale: its object is not flashed, offered or grasped, and the
+  // panels say "tracking lost" (also for the reference marker).
+  double max_pose_age_s = 0.5;
   WorldSettings world;
   EegSettings eeg;
   bci::ParadigmSettings paradigm;

@@ -1,5 +1,7 @@
 #include "session/session_model.h"
 
+#include <cstdio>
+
 namespace arbci::app {
 
 void SessionModel::setThreshold(const vision::ThresholdSettings& settings) {
@@ -14,6 +16,72 @@ std::vector<ui::TrackedObject> SessionModel::trackedObjects() {
         {o.id, o.T_robot_object.translation, o.age(session_.time()), o.reprojection_rms_px});
   }
   return out;
+}
+
+std::string SessionModel::whyNot(Action action) {
+  switch (action) {
+    case Action::Pause:
+      return session_.whyNotPause();
+    case Action::Resume:
+      return session_.whyNotResume();
+    case Action::Home:
+      return session_.whyNotHome();
+    case Action::OpenGripper:
+      return session_.whyNotRelease();
+    case Action::RetryStep:
+      return session_.whyNotRetry();
+    case Action::SkipTrial:
+      return session_.whyNotSkip();
+  }
+  return "";
+}
+
+std::vector<std::pair<std::string, std::string>> SessionModel::endSummary() {
+  const nlohmann::json s = session_.summary();
+  std::vector<std::pair<std::string, std::string>> rows;
+  auto number = [](const nlohmann::json& v, const char* format, double scale = 1.0) {
+    if (!v.is_number()) return std::string("-");
+    char text[64];
+    std::snprintf(text, sizeof text, format, v.get<double>() * scale);
+    return std::string(text);
+  };
+  rows.emplace_back(
+      "ended", s["ended"].get<std::string>() + " (" + s["end_reason"].get<std::string>() + ")");
+  rows.emplace_back("duration", number(s["duration_s"], "%.1f s"));
+  for (const char* kind : {"objects", "cells"}) {
+    const nlohmann::json& r = s[kind];
+    if (r.is_null()) {
+      rows.emplace_back(kind, "no selections");
+      continue;
+    }
+    rows.emplace_back(kind, number(r["accuracy"], "accuracy %.0f %%", 100.0) + ", " +
+                                number(r["seconds_per_selection"], "%.1f s per selection") + ", " +
+                                number(r["bits_per_minute"], "%.1f bits/min"));
+  }
+  if (!s["all_inclusive"].is_null())
+    rows.emplace_back("all inclusive",
+                      number(s["all_inclusive"]["seconds_per_trial"], "%.1f s per trial") + ", " +
+                          number(s["all_inclusive"]["bits_per_minute"], "%.1f bits/min"));
+  int placed = 0;
+  for (const nlohmann::json& t : s["trials"]) {
+    const std::string outcome = t["outcome"].get<std::string>();
+    const int object = t["selected_object"].get<int>();
+    std::string line =
+        (object >= 0 ? "object " + std::to_string(object) : std::string("no object")) + ": " +
+        outcome;
+    if (t["placement_error_m"].is_number()) {
+      ++placed;
+      line += ", " + number(t["placement_error_m"], "%.1f mm off", 1000.0);
+    }
+    rows.emplace_back("trial " + std::to_string(t["trial"].get<int>()), line);
+  }
+  rows.emplace_back("placements", std::to_string(placed) + " of " +
+                                      std::to_string(s["trials"].size()) + " trials");
+  const nlohmann::json& timing = s["timing"];
+  rows.emplace_back("late frames", timing["late_frames"].dump() + ", lost EEG samples " +
+                                       timing["lost_samples"].dump());
+  rows.emplace_back("folder", session_.folder().string());
+  return rows;
 }
 
 std::string SessionModel::phase() {

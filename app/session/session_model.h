@@ -36,14 +36,26 @@ class SessionModel final : public ui::WorkstationModel {
   bool robotSilent() override { return session_.robotSilent(); }
   std::vector<std::string> robotLog() override { return session_.robotLog(); }
   void emergencyStop() override { session_.emergencyStop(); }
+  std::string whyNot(Action action) override;
   void robotReset() override { session_.resetRobot(); }
   void robotHome() override { session_.homeRobot(); }
+  void openGripper() override { session_.releaseObject(); }
+  void retryStep() override { session_.retryStep(); }
+  void skipTrial() override { session_.skipTrial(); }
+  void endSession() override { session_.endSession(); }
 
   std::string phase() override;
   int trial() override { return session_.paradigm().trial(); }
   int trials() override { return session_.config().paradigm.trials; }
   int sequence() override { return session_.paradigm().sequence(); }
   bool started() override { return session_.paradigm().phase() != bci::Phase::Setup; }
+  bool ended() override { return session_.ended(); }
+  std::vector<std::pair<std::string, std::string>> endSummary() override;
+  std::string trackingAlarm() override { return session_.trackingAlarm(); }
+  double maxPoseAgeS() override { return session_.config().max_pose_age_s; }
+  std::optional<double> referenceAgeS() override {
+    return session_.vision().world().referenceAge(session_.time());
+  }
   void start() override { session_.start(); }
   void pause() override { session_.pause(); }
   void resume() override { session_.resume(); }

@@ -10,6 +10,7 @@ nlohmann::json sessionSummary(const SessionFacts& facts, const CycleTiming& cycl
       {"session", facts.session_file},
       {"seed", facts.seed},
       {"ended", facts.ended},
+      {"end_reason", facts.end_reason},
       {"duration_s", facts.duration_s},
       {"frames", facts.frames},
       {"cycle", cycle.toJson()},

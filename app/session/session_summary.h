@@ -20,7 +20,8 @@ namespace arbci::app {
 struct SessionFacts {
   std::string session_file;
   std::uint64_t seed = 0;
-  std::string ended;
+  std::string ended;       // finished, aborted, estop or fault
+  std::string end_reason;  // in words
   double duration_s = 0.0;
   std::int64_t frames = 0;
   int object_choices = 0, cell_choices = 0;

@@ -1,5 +1,7 @@
 #include "session/vision_stage.h"
 
+#include <cstdio>
+
 #include <memory>
 
 #include "arbci/vision/undistortion.h"
@@ -33,9 +35,38 @@ TrackingSettings TrackingSettings::of(const SessionConfig& config) {
                      config.world.reference_id,
                      config.world.reference_size_m,
                      config.world.reference_position,
-                     {}};
+                     {},
+                     config.max_pose_age_s};
   for (const WorldObjectSettings& o : config.world.objects) t.marker_size[o.id] = o.marker_m;
   return t;
+}
+
+bool VisionStage::fresh(int id, double now_s) const {
+  const auto state = world_.object(id);
+  return state && state->age(now_s) <= settings_.max_pose_age_s;
+}
+
+std::string VisionStage::trackingAlarm(const std::vector<int>& ids, double now_s) const {
+  std::string lost;
+  auto add = [&lost](const std::string& what, std::optional<double> age) {
+    char text[64];
+    if (age) {
+      std::snprintf(text, sizeof text, " (%.1f s)", *age);
+    } else {
+      std::snprintf(text, sizeof text, " (never seen)");
+    }
+    lost.append(lost.empty() ? "" : ", ").append(what).append(text);
+  };
+  const auto reference = world_.referenceAge(now_s);
+  if (!reference || *reference > settings_.max_pose_age_s)
+    add("reference " + std::to_string(world_.reference().id), reference);
+  for (int id : ids) {
+    const auto state = world_.object(id);
+    if (!state || state->age(now_s) > settings_.max_pose_age_s)
+      add("object " + std::to_string(id),
+          state ? std::optional<double>(state->age(now_s)) : std::nullopt);
+  }
+  return lost.empty() ? "" : "tracking lost: " + lost;
 }
 
 VisionStage::VisionStage(const TrackingSettings& settings, CameraStage& cameras)

@@ -5,6 +5,8 @@
 
 #include <map>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/marker_poses.h"
@@ -23,6 +25,7 @@ struct TrackingSettings {
   double reference_size_m;
   cv::Vec3d reference_position;       // robot frame
   std::map<int, double> marker_size;  // the objects' marker sides (metres) by id
+  double max_pose_age_s;              // older poses are stale
   static TrackingSettings of(const SessionConfig& config);
 };
 
@@ -57,6 +60,12 @@ class VisionStage final : public Stage {
   vision::MarkerDetector& detector() { return detector_; }
   // A new reference marker (id, position in the robot frame): object poses start afresh.
   void setReference(int id, double size_m, const cv::Vec3d& position);
+  // Tracking health: the object's pose is known and no older than the allowed age.
+  bool fresh(int id, double now_s) const;
+  double maxPoseAgeS() const { return settings_.max_pose_age_s; }
+  // "" while the reference and every object in `ids` are fresh, else "tracking lost: reference
+  // 0 (2.1 s), object 40 (never seen)".
+  std::string trackingAlarm(const std::vector<int>& ids, double now_s) const;
   // Marker side by id: the reference's or the object's.
   double markerSize(int id) const;
 

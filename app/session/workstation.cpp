@@ -4,12 +4,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/window_context.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panels.h"
+#include "session/experimenter_script.h"
 #include "session/session_model.h"
 #include "support/interrupt.h"
 
@@ -31,7 +33,11 @@ std::string layoutFile() {
 
 }  // namespace
 
-int runWorkstation(const SessionConfig& config, SessionOptions options) {
+int runWorkstation(const SessionConfig& config, SessionOptions options,
+                   const std::filesystem::path& script_file) {
+  // Read before the window opens: a bad script is refused at once.
+  std::optional<ExperimenterScript> script;
+  if (!script_file.empty()) script.emplace(script_file);
   options.simulated_clock = false;
   const bool wait = !options.start_immediately;  // --wait-for-start: the experimenter presses Start
   options.start_immediately = false;
@@ -60,30 +66,49 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
   ui::RobotPanel robot_panel(model);
   ui::CalibrationPanel calibration_panel(model);
   ui::TrainingPanel training_panel(model);
+  ui::SummaryPanel summary_panel(model);
   shell.addPanel(session_panel);
   shell.addPanel(hmd_panel);
   shell.addPanel(robot_panel);
   shell.addPanel(threshold_panel);
   shell.addPanel(calibration_panel, false);
   shell.addPanel(training_panel, false);
+  shell.addPanel(summary_panel, false);
   shell.setEmergencyStop([&] { model.emergencyStop(); });
   shell.setQuitHandler([&] { main_window.requestClose(); });
   // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
   watchInterrupts();
   auto last = std::chrono::steady_clock::now();
+  bool summary_shown = false;
   while (!main_window.shouldClose()) {
-    if (interruptRequested() || (close_when_ended && session.ended())) main_window.requestClose();
+    // A script runs to its end first (its last screenshot may show the ended session).
+    const bool script_over = !script || script->done();
+    if (interruptRequested() || (close_when_ended && session.ended() && script_over))
+      main_window.requestClose();
     render::WindowContext::pollEvents();
     session.step();
+    if (session.ended() && !summary_shown) {
+      shell.show(summary_panel);  // once: the experimenter may close it
+      summary_shown = true;
+    }
     main_window.makeCurrent();
     const auto now = std::chrono::steady_clock::now();
     const float frame_ms = std::chrono::duration<float, std::milli>(now - last).count();
     last = now;
     const render::Size size = main_window.framebufferSize();
-    imgui.beginFrame(frame_ms / 1000.0f);
+    ui::SyntheticInput input;
+    if (script) input = script->beforeFrame(bci::hostSeconds(), model.phase());
+    imgui.beginFrame(frame_ms / 1000.0f, script ? &input : nullptr);
     shell.draw(size, {frame_ms, model.phase(), session.statusLine()});
     render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
     imgui.endFrame();
+    if (script) {
+      script->afterFrame(main_window, size, model.phase(), session.time());
+      if (!script->error().empty()) {
+        std::cerr << "\nerror: " << script->error() << "\n";
+        main_window.requestClose();
+      }
+    }
     main_window.present();
     session.presented(bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
     if (mirror) {
@@ -93,7 +118,8 @@ int runWorkstation(const SessionConfig& config, SessionOptions options) {
       main_window.makeCurrent();
     }
   }
-  return session.ended() && session.endReason() != "finished" ? 3 : 0;
+  if (script && !script->error().empty()) return 4;
+  return session.ended() && session.endKind() != "finished" ? 3 : 0;
 }
 
 }  // namespace arbci::app

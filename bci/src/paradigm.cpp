@@ -167,21 +167,10 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
       if (due_s >= phase_until_ - kSlack) startFlashing(nextFrame(), true);
       break;
     case Phase::ObjectSelected:
-      if (due_s >= phase_until_ - kSlack) {
-        enter(Phase::Grasping, "object " + std::to_string(*selected_object_));
-        ParadigmEvent e{ParadigmEvent::Kind::RobotGrasp};
-        e.object = *selected_object_;
-        event(e);
-      }
+      if (due_s >= phase_until_ - kSlack) askRobot(Phase::Grasping);
       break;
     case Phase::CellSelected:
-      if (due_s >= phase_until_ - kSlack) {
-        enter(Phase::Dropping, "row " + std::to_string(selected_cell_->first) + " column " +
-                                   std::to_string(selected_cell_->second));
-        ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
-        e.cell = *selected_cell_;
-        event(e);
-      }
+      if (due_s >= phase_until_ - kSlack) askRobot(Phase::Dropping);
       break;
     default:
       break;
@@ -198,6 +187,21 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping)
     out.selected_cell = selected_cell_;
   return out;
+}
+
+void Paradigm::askRobot(Phase phase) {
+  if (phase == Phase::Grasping) {
+    enter(Phase::Grasping, "object " + std::to_string(*selected_object_));
+    ParadigmEvent e{ParadigmEvent::Kind::RobotGrasp};
+    e.object = *selected_object_;
+    event(e);
+    return;
+  }
+  enter(Phase::Dropping, "row " + std::to_string(selected_cell_->first) + " column " +
+                             std::to_string(selected_cell_->second));
+  ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
+  e.cell = *selected_cell_;
+  event(e);
 }
 
 void Paradigm::requestStopFlashing() {
@@ -268,15 +272,20 @@ void Paradigm::robotFinished(bool success, const std::string& text) {
     startFlashing(nextFrame(), false);
     return;
   }
+  nextTrial(now_ + settings_.pause_s, "");
+}
+
+void Paradigm::nextTrial(double at_s, const std::string& why) {
   ParadigmEvent done{ParadigmEvent::Kind::TrialDone};
+  done.text = why;
   event(done);
   selected_object_.reset();
   selected_cell_.reset();
   if (trial_ >= settings_.trials) {
-    enter(Phase::Finished);
+    enter(Phase::Finished, why);
   } else {
     ++trial_;
-    startFlashing(now_ + settings_.pause_s, true);
+    startFlashing(at_s, true);
   }
 }
 
@@ -294,42 +303,60 @@ void Paradigm::pause() {
   enter(Phase::Paused);
 }
 
+void Paradigm::restartSequence() {
+  if (awaiting_decision_) return;
+  --sequence_;
+  scheduleSequence(nextFrame());
+}
+
+std::optional<Phase> Paradigm::interrupted() const {
+  if (phase_ != Phase::EmergencyStop && phase_ != Phase::RobotFault) return std::nullopt;
+  return paused_from_;
+}
+
 void Paradigm::resume() {
   if (phase_ == Phase::Paused) {
     const Phase back = paused_from_;
     phase_until_ += now_;
     enter(back, "resumed");
-    if ((back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing ||
-         back == Phase::CellFlashing) &&
-        !awaiting_decision_) {
-      // The interrupted sequence is shown again from its start.
-      --sequence_;
-      scheduleSequence(nextFrame());
+    if (back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing ||
+        back == Phase::CellFlashing) {
+      restartSequence();
     }
     return;
   }
-  if (phase_ == Phase::RobotFault || phase_ == Phase::EmergencyStop) {
-    const Phase was = paused_from_;
-    const bool robot_phase = was == Phase::Grasping || was == Phase::Dropping;
-    if (!robot_phase && phase_ == Phase::EmergencyStop) {
-      enter(was, "resumed after the stop");
-      if (was == Phase::CalibrationFlashing || was == Phase::ObjectFlashing ||
-          was == Phase::CellFlashing) {
-        --sequence_;
-        scheduleSequence(nextFrame());
-      }
-      return;
-    }
-    // The trial whose robot command failed is over; the next one starts.
-    selected_object_.reset();
-    selected_cell_.reset();
-    if (trial_ >= settings_.trials) {
-      enter(Phase::Finished, "after a robot fault");
-    } else {
-      ++trial_;
-      startFlashing(nextFrame(), true);
-    }
+  const auto was = interrupted();
+  if (!was) return;
+  if (*was == Phase::Grasping || *was == Phase::Dropping) {
+    // The trial whose robot step was interrupted is over; the next one starts.
+    nextTrial(nextFrame(), "after " + std::string(toString(phase_)));
+    return;
   }
+  retryStep();
+}
+
+void Paradigm::retryStep() {
+  const auto was = interrupted();
+  if (!was) return;
+  if (*was == Phase::Grasping || *was == Phase::Dropping) {
+    askRobot(*was);
+    return;
+  }
+  enter(*was, std::string("resumed after the ") +
+                  (phase_ == Phase::EmergencyStop ? "emergency stop" : "robot fault"));
+  if (*was == Phase::CalibrationFlashing || *was == Phase::ObjectFlashing ||
+      *was == Phase::CellFlashing) {
+    restartSequence();
+  }
+  // A timed phase (cue, selection shown) starts its time again.
+  if (*was == Phase::CalibrationCue) phase_until_ = now_ + settings_.cue_s;
+  if (*was == Phase::ObjectSelected || *was == Phase::CellSelected)
+    phase_until_ = now_ + settings_.result_s;
+}
+
+void Paradigm::skipTrial() {
+  if (!interrupted() || trial_ < 1) return;
+  nextTrial(nextFrame(), "trial " + std::to_string(trial_) + " skipped by the experimenter");
 }
 
 void Paradigm::abort() {

@@ -235,6 +235,9 @@ void HmdView::draw(const HmdFrame& frame, unsigned int framebuffer, Size size) {
         case HighlightState::Held:
           m.primitives.drawPolyline(polygon, true, 5.0f, colors_.held, viewport);
           break;
+        case HighlightState::Lost:
+          m.primitives.drawPolyline(polygon, true, 2.0f, colors_.lost, viewport);
+          break;
       }
     }
     glDisable(GL_BLEND);

@@ -1,5 +1,7 @@
 #include "arbci/render/window_context.h"
 
+#include <algorithm>
+
 #include <GLFW/glfw3.h>
 
 #include <cstdlib>
@@ -54,6 +56,12 @@ WindowContext::WindowContext(const WindowOptions& options) {
       const GLFWvidmode* mode = glfwGetVideoMode(monitor);
       size = {mode->width, mode->height};
     }
+  } else if (GLFWmonitor* primary = glfwGetPrimaryMonitor()) {
+    // Never larger than the screen's work area (a laptop's 1280x720 shows the whole window).
+    int x = 0, y = 0, width = 0, height = 0;
+    glfwGetMonitorWorkarea(primary, &x, &y, &width, &height);
+    if (width > 0 && height > 0)
+      size = {std::min(size.width, width), std::min(size.height, height)};
   }
   window_ =
       glfwCreateWindow(size.width, size.height, options.title.c_str(), monitor, options.share_with);

@@ -344,8 +344,9 @@ TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIn
   }
   EXPECT_TRUE(fault_phase);
   const nlohmann::json summary = readJson(folder / "summary.json");
-  EXPECT_NE(summary["ended"].get<std::string>().find("robot fault"), std::string::npos)
-      << summary["ended"];
+  EXPECT_EQ(summary["ended"], "fault");
+  EXPECT_NE(summary["end_reason"].get<std::string>().find("robot fault"), std::string::npos)
+      << summary["end_reason"];
   EXPECT_NE(summary["trials"][0]["outcome"].get<std::string>().find("silent"), std::string::npos)
       << summary["trials"][0].dump();
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");

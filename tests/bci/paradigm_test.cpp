@@ -3,6 +3,8 @@
 // abort, emergency stop and robot faults.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "arbci/bci/paradigm.h"
 
 namespace arbci::bci {
@@ -179,6 +181,48 @@ TEST(Paradigm, PauseAbortEmergencyStopAndRobotFaults) {
   EXPECT_TRUE(p.frame(frame++).lit.empty());
   p.abort();
   EXPECT_EQ(p.phase(), Phase::Aborted);
+}
+
+// After an emergency stop during a grasp: Retry step asks for the same grasp again (no new
+// trial); after a stop during the put-down, Skip trial ends the trial and the next one starts.
+TEST(Paradigm, RetryStepAsksForTheInterruptedGraspAgainAndSkipTrialEndsTheTrial) {
+  Paradigm p(fast(), 4, 3, 3, 6);
+  std::int64_t frame = 0;
+  p.start(false);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(2, {3}));
+  runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
+  p.emergencyStop();
+  p.takeEvents();
+  ASSERT_EQ(p.interrupted(), Phase::Grasping);
+  p.retryStep();
+  auto events = p.takeEvents();
+  EXPECT_EQ(p.phase(), Phase::Grasping);
+  EXPECT_EQ(p.trial(), 1);
+  const auto grasp = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) {
+    return e.kind == Kind::RobotGrasp;
+  });
+  ASSERT_NE(grasp, events.end());
+  EXPECT_EQ(grasp->object, 3);  // the object selected before the stop
+  p.robotFinished(true, "");
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(4, {2, 5}));
+  runUntil(p, frame, [&] { return p.phase() == Phase::Dropping; });
+  p.robotFinished(false, "stopped");
+  ASSERT_EQ(p.interrupted(), Phase::Dropping);
+  p.skipTrial();
+  events = p.takeEvents();
+  const auto done = std::find_if(events.begin(), events.end(),
+                                 [](const ParadigmEvent& e) { return e.kind == Kind::TrialDone; });
+  ASSERT_NE(done, events.end());
+  EXPECT_NE(done->text.find("skipped"), std::string::npos) << done->text;
+  EXPECT_EQ(p.trial(), 2);
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
+  // Neither acts outside a stop or a fault.
+  p.skipTrial();
+  p.retryStep();
+  EXPECT_EQ(p.trial(), 2);
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
 }
 
 }  // namespace

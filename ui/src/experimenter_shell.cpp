@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arbci/ui/widget_registry.h"
+#include "widgets.h"
+
 namespace arbci::ui {
 namespace {
 constexpr ImGuiWindowFlags kBarFlags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
@@ -14,6 +17,12 @@ constexpr ImGuiWindowFlags kBarFlags = ImGuiWindowFlags_NoDecoration | ImGuiWind
 
 void ExperimenterShell::addPanel(Panel& panel, bool open) {
   panels_.push_back({&panel, open});
+}
+
+void ExperimenterShell::show(Panel& panel) {
+  for (Entry& entry : panels_) {
+    if (entry.panel == &panel) entry.open = true;
+  }
 }
 
 void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
@@ -53,10 +62,7 @@ void ExperimenterShell::drawMenuBar() {
   }
   if (on_stop_) {
     ImGui::SameLine(ImGui::GetWindowWidth() - 170.0f);
-    ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
-    ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));
-    if (ImGui::SmallButton("EMERGENCY STOP")) on_stop_();
-    ImGui::PopStyleColor(2);
+    if (stopButton("EMERGENCY STOP", true)) on_stop_();
   }
   ImGui::EndMainMenuBar();
 }
@@ -78,7 +84,10 @@ void ExperimenterShell::drawPanels(render::Size display, float top, float bottom
     const float y = top + height * static_cast<float>(i / columns);
     ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_FirstUseEver);
-    if (ImGui::Begin(open[i]->panel->title(), &open[i]->open)) open[i]->panel->draw();
+    if (ImGui::Begin(open[i]->panel->title(), &open[i]->open)) {
+      detail::recordWindow(open[i]->panel->title());
+      open[i]->panel->draw();
+    }
     ImGui::End();
   }
 }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "arbci/render/window_context.h"
+#include "arbci/ui/widget_registry.h"
 
 namespace arbci::ui {
 namespace {
@@ -50,7 +51,7 @@ ImGuiLayer::~ImGuiLayer() {
   ImGui::DestroyContext();
 }
 
-void ImGuiLayer::beginFrame(float delta_seconds) {
+void ImGuiLayer::beginFrame(float delta_seconds, const SyntheticInput* input) {
   ImGui_ImplOpenGL3_NewFrame();
   if (glfw_backend_) {
     ImGui_ImplGlfw_NewFrame();
@@ -61,10 +62,24 @@ void ImGuiLayer::beginFrame(float delta_seconds) {
     io.DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
     io.DeltaTime = delta_seconds > 0.0f ? delta_seconds : 1.0f / 60.0f;
   }
+  ImGuiIO& io = ImGui::GetIO();
+  if (synthetic_key_ > 0) io.KeysDown[synthetic_key_] = false;
+  synthetic_key_ = 0;
+  if (input) {
+    // After the backend read the real devices: this frame's input is the script's.
+    io.MousePos = ImVec2(input->x, input->y);
+    io.MouseDown[0] = input->left_down;
+    io.KeyCtrl = input->ctrl;
+    if (input->key > 0 && input->key < static_cast<int>(IM_ARRAYSIZE(io.KeysDown))) {
+      io.KeysDown[input->key] = true;
+      synthetic_key_ = input->key;
+    }
+  }
   ImGui::NewFrame();
 }
 
 void ImGuiLayer::endFrame() {
+  detail::endWidgetFrame();
   ImGui::Render();
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 }

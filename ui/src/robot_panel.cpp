@@ -6,11 +6,30 @@
 namespace arbci::ui {
 
 void emergencyStopButton(WorkstationModel& model) {
-  ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
-  ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));
-  if (ImGui::Button("EMERGENCY STOP")) model.emergencyStop();
-  ImGui::PopStyleColor(2);
+  if (stopButton("EMERGENCY STOP")) model.emergencyStop();
 }
+
+namespace {
+
+// After an emergency stop or a robot fault: what the experimenter can do, each button disabled
+// with the reason while it cannot go.
+void recoveryButtons(WorkstationModel& model, bool latched) {
+  using Action = WorkstationModel::Action;
+  heading("recovery");
+  if (button("Reset", latched ? "" : "no stop is latched")) model.robotReset();
+  if (ImGui::IsItemHovered() && latched) ImGui::SetTooltip("lift the latched stop; nothing moves");
+  ImGui::SameLine();
+  if (button("Home", model.whyNot(Action::Home))) model.robotHome();
+  ImGui::SameLine();
+  if (button("Open gripper", model.whyNot(Action::OpenGripper))) model.openGripper();
+  if (button("Retry step", model.whyNot(Action::RetryStep))) model.retryStep();
+  ImGui::SameLine();
+  if (button("Skip trial", model.whyNot(Action::SkipTrial))) model.skipTrial();
+  ImGui::SameLine();
+  if (button("End session", model.ended() ? "the session has ended" : "")) model.endSession();
+}
+
+}  // namespace
 
 void RobotPanel::draw() {
   emergencyStopButton(model_);
@@ -25,19 +44,11 @@ void RobotPanel::draw() {
   if (status && !status->stop_reason.empty()) {
     ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "STOPPED: %s", status->stop_reason.c_str());
     ImGui::TextWrapped(
-        "The arm refuses every motion until Reset. Check the arm and the scene, "
-        "then Reset, Home, and Resume the session.");
+        "Check the arm and the scene. Home parks it; Open gripper puts down what it holds where "
+        "it was taken from; then Retry step, Skip trial, or End session (each lifts the stop).");
   }
+  recoveryButtons(model_, status && !status->stop_reason.empty());
   if (status) {
-    const bool latched = !status->stop_reason.empty();
-    const bool running = status->current_command != robot::MessageType::Status;
-    ImGui::BeginDisabled(!latched);
-    if (ImGui::Button("Reset")) model_.robotReset();
-    ImGui::EndDisabled();
-    ImGui::SameLine();
-    ImGui::BeginDisabled(latched || running);
-    if (ImGui::Button("Home")) model_.robotHome();
-    ImGui::EndDisabled();
     ImGui::Text("state: %s", robot::toString(status->state));
     if (status->current_command != robot::MessageType::Status) {
       ImGui::Text("command: %s #%llu", robot::toString(status->current_command),

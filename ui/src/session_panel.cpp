@@ -3,28 +3,42 @@
 #include "arbci/ui/panels.h"
 #include "widgets.h"
 
+#include <cstdio>
+#include <string>
+
 namespace arbci::ui {
+namespace {
+std::string seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f s", s);
+  return text;
+}
+}  // namespace
 
 void SessionPanel::draw() {
   ImGui::Text("%s", model_.phase().c_str());
   ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", model_.trial(), model_.trials(),
               model_.sequence(), model_.sessionTime());
+  const bool ended = model_.ended();
+  const std::string over = ended ? "the session has ended" : "";
   if (!model_.started()) {
-    if (ImGui::Button("Start")) model_.start();
+    if (button("Start", over)) model_.start();
   } else {
-    if (ImGui::Button("Pause")) model_.pause();
+    if (button("Pause", model_.whyNot(WorkstationModel::Action::Pause))) model_.pause();
     ImGui::SameLine();
-    if (ImGui::Button("Resume")) model_.resume();
+    if (button("Resume", model_.whyNot(WorkstationModel::Action::Resume))) model_.resume();
     ImGui::SameLine();
-    if (ImGui::Button("Abort")) model_.abort();
+    if (button("Abort", over)) model_.abort();
   }
   ImGui::SameLine();
   emergencyStopButton(model_);
   if (const auto robot = model_.robotStatus(); robot && !robot->stop_reason.empty()) {
-    ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1),
-                       "robot fault: %s. Robot panel: Reset, then Home; then Resume.",
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
+    ImGui::TextWrapped("robot stopped (%s): the Robot panel's recovery buttons go on from here.",
                        robot->stop_reason.c_str());
+    ImGui::PopStyleColor();
   }
+  trackingHealth();
   const auto timing = model_.timing();
   heading("cycle");
   ImGui::Text("budget %.1f ms (one EEG block); overruns: %d; late frames: %lld", model_.budgetMs(),
@@ -33,7 +47,9 @@ void SessionPanel::draw() {
     ImGui::TextUnformatted(clock.c_str());
   if (const std::string warning = model_.timingWarning(); !warning.empty())
     ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", warning.c_str());
-  if (ImGui::BeginTable("timing", 6, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {
+  if (ImGui::BeginTable(
+          "timing", 6,
+          ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
     for (const char* h : {"stage", "last ms", "p50", "p90", "p99", "max"})
       ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
@@ -60,9 +76,55 @@ void SessionPanel::draw() {
   for (const std::string& line : model_.selections()) ImGui::TextUnformatted(line.c_str());
 }
 
+void SessionPanel::trackingHealth() {
+  heading("tracking");
+  const double max_age = model_.maxPoseAgeS();
+  const ImVec4 lost(1.0f, 0.35f, 0.3f, 1.0f);
+  const auto reference = model_.referenceAgeS();
+  if (!reference || *reference > max_age) {
+    ImGui::TextColored(lost, "reference %d: tracking lost%s", model_.referenceId(),
+                       reference ? (" (" + seconds(*reference) + ")").c_str() : " (never seen)");
+  } else {
+    ImGui::Text("reference %d: seen", model_.referenceId());
+  }
+  for (const TrackedObject& o : model_.trackedObjects()) {
+    ImGui::SameLine(0.0f, 20.0f);
+    if (ImGui::GetContentRegionAvail().x < 150.0f) ImGui::NewLine();
+    if (o.age_s > max_age) {
+      ImGui::TextColored(lost, "object %d: lost (%s)", o.id, seconds(o.age_s).c_str());
+    } else {
+      ImGui::Text("object %d: seen", o.id);
+    }
+  }
+}
+
 void HmdPanel::draw() {
   const float width = ImGui::GetContentRegionAvail().x;
   ImageView::drawTexture(texture_, width, width / aspect_, true);
+}
+
+}  // namespace arbci::ui
+
+namespace arbci::ui {
+
+void SummaryPanel::draw() {
+  if (!model_.ended()) {
+    ImGui::TextDisabled("the session is running; its summary appears here when it ends");
+    return;
+  }
+  if (ImGui::BeginTable("summary", 2, ImGuiTableFlags_RowBg)) {
+    ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed,
+                            ImGui::CalcTextSize("late frames  ").x);
+    ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
+    for (const auto& [label, value] : model_.endSummary()) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextDisabled("%s", label.c_str());
+      ImGui::TableNextColumn();
+      ImGui::TextWrapped("%s", value.c_str());
+    }
+    ImGui::EndTable();
+  }
 }
 
 }  // namespace arbci::ui

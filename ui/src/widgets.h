@@ -3,6 +3,8 @@
 
 #include <imgui.h>
 
+#include <string>
+
 namespace arbci::ui {
 
 // A separator with a title under it (this ImGui has no SeparatorText).
@@ -11,5 +13,18 @@ inline void heading(const char* text) {
   ImGui::Separator();
   ImGui::TextDisabled("%s", text);
 }
+
+// A button that says why it cannot be pressed: with `why_not` non-empty it is drawn disabled and
+// hovering it shows the reason. Every press leaves visible feedback this way (it acts, or it
+// says why not). Recorded for scripted clicks (widget_registry.h). Returns true when pressed.
+bool button(const char* label, const std::string& why_not = "", bool small = false);
+
+// The same, in the emergency stop's red.
+bool stopButton(const char* label, bool small = false);
+
+// A path typed by hand, with a Browse list of the folder's files beside it (those ending in one
+// of `extensions`, e.g. ".bdf .dat .gdf"). Returns true when the path changed.
+bool pathInput(const char* label, char* path, size_t size, const char* extensions,
+               const char* tooltip);
 
 }  // namespace arbci::ui

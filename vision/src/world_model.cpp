@@ -39,6 +39,11 @@ std::vector<ObjectState> WorldModel::objects() const {
   return all;
 }
 
+std::optional<double> WorldModel::referenceAge(double now_s) const {
+  if (reference_seen_at_ < 0.0) return std::nullopt;
+  return now_s - reference_seen_at_;
+}
+
 bool WorldModel::referenceVisible(double now_s, double max_age_s) const {
   return reference_seen_at_ >= 0.0 && now_s - reference_seen_at_ <= max_age_s;
 }

@@ -113,9 +113,19 @@ class Paradigm {
   // Experimenter controls (any state).
   void start(bool calibrate);  // from Setup: with a calibration run, or straight to the trials
   void pause();
-  void resume();  // also acknowledges a robot fault or an emergency stop: the trial continues
+  // Also acknowledges a robot fault or an emergency stop: an interrupted selection starts its
+  // sequence again; a trial whose robot step was interrupted is over (the next one starts). The
+  // session checks first that the arm is home and holds nothing.
+  void resume();
   void abort();
   void emergencyStop();
+  // The experimenter's recovery after an emergency stop or a robot fault. Retry: the interrupted
+  // robot step (grasp or put-down) is asked for again, or an interrupted selection goes on.
+  // Skip: the trial ends as it stands and the next one starts (or the run finishes).
+  void retryStep();
+  void skipTrial();
+  // In an emergency stop or a robot fault: the phase it interrupted.
+  std::optional<Phase> interrupted() const;
 
   // What frame `index`, due on screen at `due_s` (seconds of the session's clock), shows; call
   // once per displayed frame in order. Without `due_s`: the nominal rate's time of the frame.
@@ -146,6 +156,9 @@ class Paradigm {
   void enter(Phase phase, const std::string& text = "");
   void startFlashing(double at_s, bool objects);
   void scheduleSequence(double first_onset_s);
+  void restartSequence();  // an interrupted selection shows its sequence again from the start
+  void nextTrial(double at_s, const std::string& why);
+  void askRobot(Phase phase);  // Grasping or Dropping, with its command
   double nextFrame() const { return now_ + 1.0 / settings_.display_hz; }
   void event(ParadigmEvent e);
 

@@ -20,7 +20,8 @@
 
 namespace arbci::render {
 
-enum class HighlightState { Idle, Cued, Flashing, Selected, Held };
+// Lost: the pose is older than the session allows (greyed, dashed in spirit: never flashed).
+enum class HighlightState { Idle, Cued, Flashing, Selected, Held, Lost };
 
 struct ObjectHighlight {
   int id = 0;
@@ -70,6 +71,7 @@ struct HmdColors {
   glm::vec4 selected{0.2f, 1.0f, 0.3f, 1.0f};
   glm::vec4 held{0.3f, 0.5f, 1.0f, 1.0f};
   glm::vec4 grid{0.9f, 0.9f, 0.9f, 0.8f};
+  glm::vec4 lost{0.45f, 0.45f, 0.45f, 0.6f};
 };
 
 class HmdView {

@@ -21,6 +21,7 @@ class ExperimenterShell {
  public:
   // Panels are shown in order; the shell does not own them.
   void addPanel(Panel& panel, bool open = true);
+  void show(Panel& panel);  // opens a panel added closed (e.g. the end-of-session summary)
   void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
   // An emergency stop button in the menu bar, shown whatever panels are open.
   void setEmergencyStop(std::function<void()> on_stop) { on_stop_ = std::move(on_stop); }

@@ -8,6 +8,16 @@
 
 namespace arbci::ui {
 
+// Input for one frame that replaces the mouse and keyboard (a scripted experimenter): the pointer
+// at (x, y) in window pixels, the left button held or not, and a key (GLFW's code, e.g. 'Q')
+// pressed with or without Ctrl.
+struct SyntheticInput {
+  float x = -1.0f, y = -1.0f;
+  bool left_down = false;
+  int key = 0;
+  bool ctrl = false;
+};
+
 class ImGuiLayer {
  public:
   // `ini_path` keeps the panel layout between runs; empty disables saving (tests, screenshots).
@@ -16,7 +26,7 @@ class ImGuiLayer {
   ImGuiLayer(const ImGuiLayer&) = delete;
   ImGuiLayer& operator=(const ImGuiLayer&) = delete;
 
-  void beginFrame(float delta_seconds);
+  void beginFrame(float delta_seconds, const SyntheticInput* input = nullptr);
   // Renders the frame's draw lists into the context's draw framebuffer.
   void endFrame();
 
@@ -24,6 +34,7 @@ class ImGuiLayer {
   render::GlContext& context_;
   std::string ini_path_;
   bool glfw_backend_ = false;
+  int synthetic_key_ = 0;  // a key the last frame's synthetic input held
 };
 
 }  // namespace arbci::ui

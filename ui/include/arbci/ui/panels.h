@@ -110,8 +110,22 @@ class SessionPanel final : public Panel {
   void draw() override;
 
  private:
+  // "tracking lost" for the reference marker and each object seen too long ago.
+  void trackingHealth();
   WorkstationModel& model_;
   std::vector<float> history_;
+};
+
+// The end-of-session summary: how it ended, accuracy, time per selection, bit rate, placements,
+// late frames (the window opens it when the session ends).
+class SummaryPanel final : public Panel {
+ public:
+  explicit SummaryPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "Session summary"; }
+  void draw() override;
+
+ private:
+  WorkstationModel& model_;
 };
 
 // The HMD view as the subject sees it (both eyes), mirrored for the experimenter.

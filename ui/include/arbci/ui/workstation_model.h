@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -59,9 +60,18 @@ class WorkstationModel {
   virtual bool robotSilent() = 0;
   virtual std::vector<std::string> robotLog() = 0;
   virtual void emergencyStop() = 0;
-  // After a latched stop (STOP or the watchdog): lift it, then send the arm home.
+  // Recovery after an emergency stop or a robot fault: Reset lifts the robot's latched stop;
+  // Home parks the arm; Open gripper puts what it holds back where it was taken from; Retry step
+  // asks again for the interrupted grasp or put-down; Skip trial ends the trial; End session
+  // ends the run. whyNot() says why an action cannot go now ("" when it can).
+  enum class Action { Pause, Resume, Home, OpenGripper, RetryStep, SkipTrial };
+  virtual std::string whyNot(Action action) = 0;
   virtual void robotReset() = 0;
   virtual void robotHome() = 0;
+  virtual void openGripper() = 0;
+  virtual void retryStep() = 0;
+  virtual void skipTrial() = 0;
+  virtual void endSession() = 0;
 
   // Session.
   virtual std::string phase() = 0;
@@ -69,6 +79,15 @@ class WorkstationModel {
   virtual int trials() = 0;
   virtual int sequence() = 0;
   virtual bool started() = 0;
+  virtual bool ended() = 0;
+  // Once ended: how (finished, aborted, estop, fault) and the summary's figures as label/value rows
+  // (accuracy, time per selection, bit rate, placements, late frames).
+  virtual std::vector<std::pair<std::string, std::string>> endSummary() = 0;
+  // Tracking health: "" while the reference marker and every object were seen within the
+  // allowed pose age, else e.g. "tracking lost: reference 0, object 40 (1.3 s)".
+  virtual std::string trackingAlarm() = 0;
+  virtual double maxPoseAgeS() = 0;
+  virtual std::optional<double> referenceAgeS() = 0;  // since the reference marker was seen
   virtual void start() = 0;
   virtual void pause() = 0;
   virtual void resume() = 0;

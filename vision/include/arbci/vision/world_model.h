@@ -46,6 +46,8 @@ class WorldModel {
   std::optional<ObjectState> object(int id) const;
   std::vector<ObjectState> objects() const;
   bool referenceVisible(double now_s, double max_age_s = 0.5) const;
+  // Seconds since the reference marker was last seen; nullopt: never.
+  std::optional<double> referenceAge(double now_s) const;
   // The camera's pose in the robot frame from the last reference sighting.
   std::optional<Pose> T_robot_cam() const { return robot_cam_; }
   // A line for the experimenter, e.g. "reference marker 0 not seen for 2.4 s: object poses are 2.4

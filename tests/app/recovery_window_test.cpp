@@ -1,0 +1,205 @@
+// A study day's recovery in the real window under Xvfb, driven by a scripted experimenter
+// (arbci run --script: real mouse clicks on the panels' buttons, found by label): an emergency
+// stop during the grasp, Home, Retry step, and the session finishes; or the experimenter ends it
+// in the stop. The screenshots of each step are kept (build/test-artefacts/recovery) and checked
+// with their sidecars: the panels drawn, each button's state and the reason it is disabled.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "support/run_process.h"
+#include "support/test_files.h"
+
+namespace arbci::test {
+namespace {
+
+const std::string kArbci = ARBCI_EXECUTABLE;
+const std::string kXvfbRun = XVFB_RUN_EXECUTABLE;
+const std::filesystem::path kArtefacts = ARBCI_TEST_ARTEFACTS_DIR;
+
+// A quick session (a short calibration run, one trial) with a slow arm, so a grasp lasts long
+// enough to be stopped.
+void writeSession(const std::filesystem::path& file) {
+  std::ofstream(file) << R"({
+    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 4, "calibration_sequences": 5, "sequences": 5,
+                 "min_sequences": 5, "certainty": 0.0, "trials": 1, "cue_s": 1.0, "pause_s": 0.5,
+                 "intended": [{"object": 40, "cell": [3, 1]}]},
+    "robot": {"speed_factor": 2}})";
+}
+
+// The window at 1280x720 (a laptop screen), its layout file in a fresh folder.
+ProcessResult runScript(const std::filesystem::path& folder, const std::string& script) {
+  std::filesystem::create_directories(folder);
+  writeSession(folder / "session.json");
+  std::ofstream(folder / "script.txt") << script;
+  return runProcess("/usr/bin/env",
+                    {"XDG_CONFIG_HOME=" + (folder / "config").string(), kXvfbRun, "-a", "-s",
+                     "-screen 0 1280x720x24", kArbci, "run", "--session",
+                     (folder / "session.json").string(), "--out", (folder / "out").string(),
+                     "--script", (folder / "script.txt").string(), "--exit-when-done"},
+                    420.0);
+}
+
+std::vector<nlohmann::json> logEvents(const std::filesystem::path& log, const std::string& event) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(log);
+  std::string line;
+  while (std::getline(in, line)) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    if (j["event"] == event) out.push_back(j);
+  }
+  return out;
+}
+
+const nlohmann::json* button(const nlohmann::json& shot, const std::string& label,
+                             const std::string& panel) {
+  for (const nlohmann::json& b : shot["buttons"]) {
+    if (b["label"] == label && b["panel"] == panel) return &b;
+  }
+  return nullptr;
+}
+
+// A screenshot that shows the window: 1280x720, not one flat colour, the panels named, and the
+// Robot panel's EMERGENCY STOP button red where the sidecar says it is.
+nlohmann::json checkScreenshot(const std::filesystem::path& png,
+                               const std::vector<std::string>& panels) {
+  const cv::Mat image = cv::imread(png.string(), cv::IMREAD_COLOR);
+  EXPECT_EQ(image.cols, 1280) << png;
+  EXPECT_EQ(image.rows, 720) << png;
+  if (image.empty()) return {};
+  cv::Scalar mean, sd;
+  cv::meanStdDev(image, mean, sd);
+  EXPECT_GT(sd[0] + sd[1] + sd[2], 30.0) << png << ": nearly one flat colour";
+  std::filesystem::path sidecar = png;
+  const nlohmann::json shot = readJson(sidecar.replace_extension(".json"));
+  for (const std::string& panel : panels) {
+    EXPECT_NE(std::find(shot["panels"].begin(), shot["panels"].end(), panel), shot["panels"].end())
+        << png << " lacks the " << panel << " panel: " << shot["panels"];
+  }
+  if (const nlohmann::json* stop = button(shot, "EMERGENCY STOP", "Robot")) {
+    const auto& r = (*stop)["rect"];
+    const cv::Point centre(static_cast<int>((r[0].get<double>() + r[2].get<double>()) / 2),
+                           static_cast<int>((r[1].get<double>() + r[3].get<double>()) / 2 - 4));
+    const cv::Vec3b bgr = image.at<cv::Vec3b>(centre);
+    EXPECT_GT(bgr[2], 150) << png << ": the stop button is not red at " << centre;
+    EXPECT_LT(bgr[1], 90) << png;
+  } else {
+    ADD_FAILURE() << png << ": no EMERGENCY STOP button in the Robot panel";
+  }
+  return shot;
+}
+
+TEST(RecoveryWindow, EmergencyStopDuringTheGraspThenHomeRetryAndTheSessionFinishes) {
+  const auto folder = kArtefacts / "recovery";
+  std::filesystem::remove_all(folder);
+  const std::string shots = (folder / "shots").string();
+  std::filesystem::create_directories(shots);
+  const ProcessResult r = runScript(folder, R"(# an emergency stop during the grasp
+wait "robot grasping" 240
+pause 1
+click "EMERGENCY STOP"
+wait "EMERGENCY STOP"
+pause 0.3
+screenshot )" + shots + R"(/1-stopped.png
+click "Home"
+pause 0.3
+screenshot )" + shots + R"(/2-homing.png
+click "Retry step" 90
+wait "phase 2" 120
+screenshot )" + shots + R"(/3-retried.png
+wait "finished" 240
+pause 0.5
+screenshot )" + shots + R"(/4-finished.png
+)");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = folder / "out";
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["ended"], "finished") << summary["end_reason"];
+  ASSERT_EQ(summary["trials"].size(), 1u);
+  EXPECT_EQ(summary["trials"][0]["outcome"], "placed");
+  EXPECT_TRUE(summary["trials"][0]["placement_error_m"].is_number());
+
+  // The log: the stop, the experimenter's HOME, the retry, and a second GRASP that succeeded.
+  const auto log = out / "log.jsonl";
+  EXPECT_EQ(logEvents(log, "emergency_stop").size(), 1u);
+  int grasps = 0, experimenter_homes = 0;
+  for (const nlohmann::json& c : logEvents(log, "robot_command")) {
+    grasps += c["command"] == "GRASP";
+    experimenter_homes += c["command"] == "HOME" && c.value("by", "") == "experimenter";
+  }
+  EXPECT_EQ(grasps, 2);
+  EXPECT_EQ(experimenter_homes, 1);
+  const auto recovery = logEvents(log, "recovery");
+  ASSERT_EQ(recovery.size(), 1u);
+  EXPECT_EQ(recovery[0]["action"], "retry step");
+  int grasps_done = 0;
+  for (const nlohmann::json& e : logEvents(log, "robot"))
+    grasps_done += e["command"] == "GRASP" && e["kind"] == "finished" && e["outcome"] == "success";
+  EXPECT_EQ(grasps_done, 1);  // the first was stopped
+
+  // The steps as the experimenter saw them.
+  const nlohmann::json stopped =
+      checkScreenshot(folder / "shots/1-stopped.png", {"Session", "Robot", "HMD view"});
+  EXPECT_EQ(stopped["phase"], "EMERGENCY STOP");
+  const nlohmann::json* retry = button(stopped, "Retry step", "Robot");
+  ASSERT_NE(retry, nullptr);
+  EXPECT_TRUE((*retry)["enabled"].get<bool>());
+  for (const char* label : {"Skip trial"}) {
+    const nlohmann::json* b = button(stopped, label, "Robot");
+    ASSERT_NE(b, nullptr) << label;
+    EXPECT_FALSE((*b)["enabled"].get<bool>()) << label;
+    EXPECT_NE((*b)["why_disabled"].get<std::string>().find("arm"), std::string::npos) << *b;
+  }
+  // Resume would start the next trial with the arm out: refused, and the button says why.
+  const nlohmann::json* resume = button(stopped, "Resume", "Session");
+  ASSERT_NE(resume, nullptr);
+  EXPECT_FALSE((*resume)["enabled"].get<bool>());
+  EXPECT_FALSE((*resume)["why_disabled"].get<std::string>().empty());
+
+  checkScreenshot(folder / "shots/2-homing.png", {"Session", "Robot"});
+  const nlohmann::json retried = checkScreenshot(folder / "shots/3-retried.png", {"Robot"});
+  EXPECT_NE(retried["phase"].get<std::string>().find("phase 2"), std::string::npos);
+  EXPECT_FALSE((*button(retried, "Retry step", "Robot"))["enabled"].get<bool>());
+  const nlohmann::json finished =
+      checkScreenshot(folder / "shots/4-finished.png", {"Session", "Robot", "Session summary"});
+  for (const char* label : {"Pause", "Abort"})
+    EXPECT_FALSE((*button(finished, label, "Session"))["enabled"].get<bool>()) << label;
+}
+
+TEST(RecoveryWindow, EndingTheSessionInAnEmergencyStopIsRecordedAsEstop) {
+  const auto folder = kArtefacts / "recovery_end";
+  std::filesystem::remove_all(folder);
+  const ProcessResult r = runScript(folder, R"(wait "robot grasping" 240
+click "EMERGENCY STOP"
+wait "EMERGENCY STOP"
+click "End session"
+wait "ended by the experimenter"
+screenshot )" + (folder / "ended.png").string() +
+                                                "\n");
+  EXPECT_EQ(r.exit_code, 3) << r.err;  // ended otherwise than finished
+  const nlohmann::json summary = readJson(folder / "out/summary.json");
+  EXPECT_EQ(summary["ended"], "estop");
+  EXPECT_NE(summary["end_reason"].get<std::string>().find("experimenter"), std::string::npos);
+  const nlohmann::json shot = checkScreenshot(folder / "ended.png", {"Session summary"});
+  EXPECT_FALSE((*button(shot, "End session", "Robot"))["enabled"].get<bool>());
+}
+
+// A script that cannot go on says which line and why, and the run exits 4.
+TEST(RecoveryWindow, AScriptClickOnADisabledButtonFailsNamingTheLineAndTheReason) {
+  const auto folder = kArtefacts / "recovery_refused";
+  std::filesystem::remove_all(folder);
+  const ProcessResult r = runScript(folder, "pause 1\nclick \"Skip trial\" 2\n");
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("script line 2: \"Skip trial\" stayed disabled: only after an emergency "
+                       "stop or a robot fault"),
+            std::string::npos)
+      << r.err;
+}
+
+}  // namespace
+}  // namespace arbci::test
