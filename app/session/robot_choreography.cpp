@@ -116,6 +116,11 @@ void RobotChoreography::finishPutDown(double time_s) {
              {{"command", "HOME"}, {"after", "an interrupted put-down"}, {"sequence", *command_}});
 }
 
+bool RobotChoreography::answersStatus(double time_s) {
+  if (stepped_) return client_->syncClock(time_s, 0.5);
+  return client_->status().has_value() && !client_->silent();
+}
+
 std::optional<int> RobotChoreography::holding() const {
   const auto& status = client_->status();
   if (!status || status->holding < 0) return std::nullopt;

@@ -75,6 +75,9 @@ class RobotChoreography final : public Stage {
   bool busy() const { return command_.has_value() || recovery_.has_value(); }
   const std::optional<robot::StatusPayload>& status() const { return client_->status(); }
   bool silent() const { return client_->silent(); }
+  // The backend answers STATUS: a stepped one is asked now, at `time_s` (reproducibly); one on
+  // the wall clock has sent a status and is not silent.
+  bool answersStatus(double time_s);
   const std::vector<std::string>& messages() const { return messages_; }
 
  private:

@@ -17,6 +17,31 @@
 namespace arbci::app {
 namespace {
 
+PreflightSettings preflightSettingsOf(const SessionConfig& c, double eeg_rate_hz) {
+  PreflightSettings p;
+  p.eeg_rate_hz = eeg_rate_hz;
+  if (c.cameras.source == "simulated") {
+    p.camera_key = "cameras.source";
+    p.camera_what = "the simulated cameras";
+  } else if (!c.cameras.left.video.empty()) {
+    p.camera_key = "cameras.left.video";
+    p.camera_what = "the video " + c.cameras.left.video;
+  } else {
+    p.camera_key = "cameras.left.device";
+    p.camera_what = "camera device " + std::to_string(c.cameras.left.device);
+  }
+  p.eeg_key = c.eeg.source == "file" ? "eeg.file" : "eeg.rate_hz";
+  p.reference_id = c.world.reference_id;
+  if (c.robot_backend == "simulated") {
+    p.robot_key = "robot.backend";
+    p.robot_what = "the simulated arm (arbci-robotd)";
+  } else {
+    p.robot_key = "robot.host, robot.port";
+    p.robot_what = "the robot backend at " + c.robot_host + ":" + std::to_string(c.robot_port);
+  }
+  return p;
+}
+
 // How a run ended, for the summary: a run that ends in an emergency stop or a robot fault (the
 // experimenter ends it, or a headless run stops waiting) is that; any other early end is aborted.
 std::string endKindOf(const std::string& reason, bci::Phase phase) {
@@ -29,7 +54,11 @@ std::string endKindOf(const std::string& reason, bci::Phase phase) {
 }  // namespace
 
 Session::Session(SessionConfig config, const SessionOptions& options, render::GlContext& context)
-    : config_(std::move(config)), options_(options), context_(context), timing_(0.0) {
+    : config_(std::move(config)),
+      options_(options),
+      context_(context),
+      timing_(0.0),
+      preflight_(PreflightSettings{}) {
   if (options.seed) config_.eeg.seed = *options.seed;
   if (options.trials) config_.paradigm.trials = *options.trials;
   // The timing check: cued flashing until flashes_only_s, when the session ends.
@@ -95,6 +124,7 @@ Session::Session(SessionConfig config, const SessionOptions& options, render::Gl
   eeg_ = std::make_unique<EegStage>(eeg_settings, folder_ / "recording.bdf",
                                     options.simulated_clock, parameters, *log_, options.progress);
   stimulus_timing_ = std::make_unique<StimulusTiming>(config_.paradigm, eeg_->info().rate_hz);
+  preflight_ = Preflight(preflightSettingsOf(config_, eeg_->info().rate_hz));
 
   paradigm_ = std::make_unique<ParadigmStage>(
       paradigm_settings, cycle_, options.simulated_clock, folder_ / "model.json",
@@ -127,7 +157,44 @@ Session::~Session() {
 }
 
 void Session::start() {
-  paradigm_->start();
+  if (ended_ || paradigm().phase() != bci::Phase::Setup || preflightRunning()) return;
+  log_->write("preflight_started", cycle_.time_s, {});
+  preflight_.begin(observe());
+}
+
+PreflightObservation Session::observe() {
+  PreflightObservation o;
+  o.time_s = cycle_.time_s;
+  o.wall_s = bci::hostSeconds();
+  o.camera_frame = !cameras_->frames().left.empty();
+  o.reference_age_s = vision_->world().referenceAge(cycle_.time_s);
+  o.max_pose_age_s = config_.max_pose_age_s;
+  o.eeg_samples = eeg_->samplesRecorded();
+  o.robot_answered = robot_->answersStatus(cycle_.time_s);
+  return o;
+}
+
+void Session::checkPreflight() {
+  const Preflight::State state = preflight_.update(observe());
+  if (state == Preflight::State::Passed) {
+    log_->write("preflight", cycle_.time_s,
+                {{"passed", true},
+                 {"camera_frames", preflight_.cameraFrames()},
+                 {"eeg_rate_hz", preflight_.eegRateHz()}});
+    paradigm_->start();
+  } else if (state == Preflight::State::Failed) {
+    log_->write("preflight", cycle_.time_s,
+                {{"passed", false}, {"failures", preflight_.failures()}});
+    if (options_.progress) {
+      *options_.progress << "\n";
+      setStatusLineOpen(false);
+      for (const std::string& f : preflight_.failures())
+        *options_.progress << "pre-flight failed: " << f << "\n";
+    }
+    // Without an experimenter nothing can be fixed: the run ends before any flash.
+    if (options_.start_immediately)
+      endRun("pre-flight failed: " + preflight_.failures().front(), "aborted");
+  }
 }
 void Session::pause() {
   if (refuse("pause", whyNotPause())) return;
@@ -274,6 +341,7 @@ bool Session::step() {
     stage->step(cycle_);
     timing_.mark(stage->name());
   }
+  if (preflightRunning()) checkPreflight();
   if (options_.progress && !paradigm_->phaseChanges().empty()) showStatus();
   if (context_.isHeadless()) {
     context_.present();  // a window is presented by its owner, with the panels

@@ -24,6 +24,7 @@
 #include "session/eeg_stage.h"
 #include "session/hmd_stage.h"
 #include "session/paradigm_stage.h"
+#include "session/preflight.h"
 #include "session/robot_choreography.h"
 #include "session/robot_process.h"
 #include "session/session_config.h"
@@ -75,8 +76,12 @@ class Session {
   // for one) aborts it. Returns the summary.
   nlohmann::json run();
 
-  // Experimenter controls.
+  // Experimenter controls. Start runs the pre-flight check (session/preflight.h) and the
+  // calibration run (or the trials) once it passes; a failed check is named in the log, on the
+  // progress stream and in the panel, and ends a headless run before any flash.
   void start();
+  std::vector<std::string> preflightLines() const { return preflight_.lines(); }
+  bool preflightRunning() const { return preflight_.state() == Preflight::State::Running; }
   void pause();
   void resume();
   void abort();
@@ -148,6 +153,8 @@ class Session {
   std::string whyArmNotClear() const;
   // Logs an experimenter's action the session refused, and why.
   bool refuse(const char* action, const std::string& why);
+  PreflightObservation observe();
+  void checkPreflight();
   // The status line on the progress stream, rewritten in place.
   void showStatus() const;
 
@@ -174,6 +181,7 @@ class Session {
   std::unique_ptr<ParadigmStage> paradigm_;
   std::unique_ptr<HmdStage> hmd_;
   std::vector<Stage*> stages_;  // in the order they run
+  Preflight preflight_;
 };
 
 }  // namespace arbci::app

@@ -50,6 +50,8 @@ class SessionModel final : public ui::WorkstationModel {
   int sequence() override { return session_.paradigm().sequence(); }
   bool started() override { return session_.paradigm().phase() != bci::Phase::Setup; }
   bool ended() override { return session_.ended(); }
+  std::vector<std::string> preflight() override { return session_.preflightLines(); }
+  bool preflightRunning() override { return session_.preflightRunning(); }
   std::vector<std::pair<std::string, std::string>> endSummary() override;
   std::string trackingAlarm() override { return session_.trackingAlarm(); }
   double maxPoseAgeS() override { return session_.config().max_pose_age_s; }

@@ -22,7 +22,9 @@ void SessionPanel::draw() {
   const bool ended = model_.ended();
   const std::string over = ended ? "the session has ended" : "";
   if (!model_.started()) {
-    if (button("Start", over)) model_.start();
+    const std::string why =
+        !over.empty() ? over : (model_.preflightRunning() ? "the pre-flight check is running" : "");
+    if (button("Start", why)) model_.start();
   } else {
     if (button("Pause", model_.whyNot(WorkstationModel::Action::Pause))) model_.pause();
     ImGui::SameLine();
@@ -37,6 +39,16 @@ void SessionPanel::draw() {
     ImGui::TextWrapped("robot stopped (%s): the Robot panel's recovery buttons go on from here.",
                        robot->stop_reason.c_str());
     ImGui::PopStyleColor();
+  }
+  for (const std::string& line : model_.preflight()) {
+    const bool bad = line.find("FAILED") != std::string::npos || line.rfind("  ", 0) == 0;
+    if (bad && !model_.preflightRunning()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.35f, 0.3f, 1));
+      ImGui::TextWrapped("%s", line.c_str());
+      ImGui::PopStyleColor();
+    } else {
+      ImGui::TextWrapped("%s", line.c_str());
+    }
   }
   trackingHealth();
   const auto timing = model_.timing();

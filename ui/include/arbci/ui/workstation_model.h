@@ -79,6 +79,10 @@ class WorkstationModel {
   virtual int trials() = 0;
   virtual int sequence() = 0;
   virtual bool started() = 0;
+  // The pre-flight check that Start runs first (cameras, reference, EEG, robot): its lines, and
+  // whether it is still checking.
+  virtual std::vector<std::string> preflight() = 0;
+  virtual bool preflightRunning() = 0;
   virtual bool ended() = 0;
   // Once ended: how (finished, aborted, estop, fault) and the summary's figures as label/value rows
   // (accuracy, time per selection, bit rate, placements, late frames).

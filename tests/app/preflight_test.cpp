@@ -1,0 +1,124 @@
+// The pre-flight check before any flash, through the real executable headless: a camera whose
+// video does not show the reference marker, and a remote robot that never answers, each end the
+// run before the calibration run starts (exit 3), naming the session file's key; the default
+// simulated session passes it.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core/persistence.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "support/run_process.h"
+#include "support/test_files.h"
+
+namespace arbci::test {
+namespace {
+
+const std::string kArbci = ARBCI_EXECUTABLE;
+
+std::vector<nlohmann::json> logOf(const std::filesystem::path& folder) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(folder / "log.jsonl");
+  std::string line;
+  while (std::getline(in, line)) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+// Nothing of the paradigm ran: no phase, no flash, no stimulus in the recording's log.
+void expectNoFlash(const std::filesystem::path& folder) {
+  for (const nlohmann::json& e : logOf(folder)) {
+    EXPECT_NE(e["event"], "phase") << e.dump();
+    EXPECT_NE(e["event"], "calibration_target") << e.dump();
+  }
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "aborted");
+  EXPECT_NE(summary["end_reason"].get<std::string>().find("pre-flight failed"), std::string::npos);
+}
+
+TEST(Preflight, AVideoWithoutTheReferenceMarkerEndsTheRunBeforeAnyFlashNamingTheKey) {
+  const auto folder = freshTempPath("preflight_test", "no_reference");
+  std::filesystem::create_directories(folder);
+  // A real ARToolKitPlus sample (marker 100, not the reference 0), as a 20 frames/s video.
+  const cv::Mat image = cv::imread(std::string(ARBCI_SHARED_DATA_DIR) +
+                                       "/vision/artoolkitplus_samples/"
+                                       "image_320_240_8_marker_id_bch_nr0100.jpg",
+                                   cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  const auto video = folder / "camera.avi";
+  {
+    cv::VideoWriter writer(video.string(), cv::CAP_OPENCV_MJPEG,
+                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 20.0, image.size());
+    ASSERT_TRUE(writer.isOpened());
+    for (int i = 0; i < 200; ++i) writer.write(image);
+  }
+  {
+    cv::FileStorage calibration((folder / "camera.yml").string(), cv::FileStorage::WRITE);
+    calibration << "image_width" << 320 << "image_height" << 240;
+    calibration << "camera_matrix" << cv::Mat(cv::Matx33d(400, 0, 160, 0, 400, 120, 0, 0, 1));
+    calibration << "distortion_coefficients" << cv::Mat(cv::Vec<double, 5>(0, 0, 0, 0, 0));
+  }
+  const auto session = folder / "session.json";
+  std::ofstream(session) << nlohmann::json{{"cameras",
+                                            {{"source", "devices"},
+                                             {"left",
+                                              {{"video", video.string()},
+                                               {"calibration",
+                                                (folder / "camera.yml").string()}}}}}}
+                                .dump();
+  const auto out = folder / "out";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 120.0);
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("pre-flight failed: world.reference.id: the reference marker 0 was not "
+                       "seen"),
+            std::string::npos)
+      << r.err;
+  expectNoFlash(out);
+}
+
+TEST(Preflight, ARemoteRobotThatNeverAnswersEndsTheRunBeforeAnyFlashNamingTheKey) {
+  const auto folder = freshTempPath("preflight_test", "silent_robot");
+  std::filesystem::create_directories(folder);
+  // A UDP port on 127.0.0.1 that takes the datagrams and never answers.
+  const int silent = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(silent, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(silent, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  socklen_t length = sizeof address;
+  ::getsockname(silent, reinterpret_cast<sockaddr*>(&address), &length);
+  const int port = ntohs(address.sin_port);
+  const auto key = folder / "robot.key";
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
+  const auto session = folder / "session.json";
+  std::ofstream(session) << nlohmann::json{{"robot",
+                                            {{"backend", "remote"},
+                                             {"host", "127.0.0.1"},
+                                             {"port", port},
+                                             {"key_file", key.string()}}}}
+                                .dump();
+  const auto out = folder / "out";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 120.0);
+  ::close(silent);
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("pre-flight failed: robot.host, robot.port: the robot backend at "
+                       "127.0.0.1:" +
+                       std::to_string(port) + " did not answer STATUS in"),
+            std::string::npos)
+      << r.err;
+  // Only the robot failed: the simulated cameras, the reference and the EEG passed.
+  EXPECT_EQ(r.err.find("pre-flight failed: world"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("pre-flight failed: eeg"), std::string::npos) << r.err;
+  expectNoFlash(out);
+}
+
+}  // namespace
+}  // namespace arbci::test
