@@ -7,6 +7,22 @@
 #include "support/cli_error.h"
 #include "support/status_line.h"
 
+namespace {
+
+// The command the user gave, as far as it was parsed: "arbci eeg convert".
+std::string commandPath(const CLI::App& root) {
+  std::string path = "arbci";
+  const CLI::App* app = &root;
+  while (app) {
+    const auto chosen = app->get_subcommands();
+    app = chosen.empty() ? nullptr : chosen.front();
+    if (app) path += " " + app->get_name();
+  }
+  return path;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App root{
       "ARBCI: augmented-reality BCI experimenter workstation.\n"
@@ -14,8 +30,9 @@ int main(int argc, char** argv) {
       "arbci"};
   root.set_version_flag("--version", std::string("arbci ") + ARBCI_VERSION);
   root.require_subcommand(0, 1);
-  root.failure_message([](const CLI::App*, const CLI::Error& error) {
-    return std::string("arbci: ") + error.what() + " (see arbci --help)\n";
+  // Every error points to the help of the command that failed.
+  root.failure_message([&root](const CLI::App*, const CLI::Error& error) {
+    return std::string("arbci: ") + error.what() + " (see " + commandPath(root) + " --help)\n";
   });
 
   int exit_code = 0;
@@ -40,11 +57,11 @@ int main(int argc, char** argv) {
     return root.exit(error);
   } catch (const arbci::app::CliError& error) {
     if (arbci::app::statusLineOpen()) std::cerr << "\n";  // not over a progress line
-    std::cerr << "arbci: " << error.what() << "\n";
+    std::cerr << "arbci: " << error.what() << " (see " << commandPath(root) << " --help)\n";
     return error.exitCode();
   } catch (const std::exception& error) {
     if (arbci::app::statusLineOpen()) std::cerr << "\n";
-    std::cerr << "arbci: " << error.what() << "\n";
+    std::cerr << "arbci: " << error.what() << " (see " << commandPath(root) << " --help)\n";
     return 1;
   }
   return exit_code;

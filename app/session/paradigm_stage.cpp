@@ -46,6 +46,13 @@ ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const CycleC
           settings_.paradigm, static_cast<int>(settings_.world.objects.size()),
           settings_.world.grid.rows, settings_.world.grid.columns, settings_.seed)) {
   slots_ = allSlots(settings_.world);
+  nameObjects();
+}
+
+void ParadigmStage::nameObjects() {
+  std::vector<int> ids;
+  for (size_t slot : slots_) ids.push_back(settings_.world.objects[slot].id);
+  paradigm_->setObjectNames(ids);
 }
 
 void ParadigmStage::start() {
@@ -188,6 +195,7 @@ void ParadigmStage::chooseSelectableObjects() {
   }
   slots_ = slots;
   paradigm_->setObjectCount(static_cast<int>(slots.size()));
+  nameObjects();
   s_.log.write("objects_in_view", now_.time_s, {{"objects", ids}});
   // The codes now stand for other objects: the recording says so from here on.
   s_.eeg.annotate(now_.eeg_sample, "StimulusCodeMap " + stimulusCodeMap(settings_.world, slots_));

@@ -103,6 +103,7 @@ class ParadigmStage final : public Stage {
   void collectTraining();
   void decideIfReady();
   void chooseSelectableObjects();
+  void nameObjects();  // the paradigm's texts name the offered objects by marker id
   // Objects whose pose is stale are not lit (nor their flashes recorded) on this frame.
   void withholdStaleFlashes();
   // The attended codes of a new online selection: the intended object's, or cell's row and column.

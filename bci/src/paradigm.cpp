@@ -82,7 +82,7 @@ void Paradigm::start(bool calibrate) {
   if (calibrating_ && settings_.calibration_selections > 0) {
     calibration_target_ = *object_layout_.drawTarget(random_).begin();
     phase_until_ = now_ + settings_.cue_s;
-    enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
+    enter(Phase::CalibrationCue, objectName(*calibration_target_));
     ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
     e.codes = {*calibration_target_};
     event(e);
@@ -191,7 +191,7 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
 
 void Paradigm::askRobot(Phase phase) {
   if (phase == Phase::Grasping) {
-    enter(Phase::Grasping, "object " + std::to_string(*selected_object_));
+    enter(Phase::Grasping, objectName(*selected_object_));
     ParadigmEvent e{ParadigmEvent::Kind::RobotGrasp};
     e.object = *selected_object_;
     event(e);
@@ -217,7 +217,7 @@ void Paradigm::decide(const Decision& decision) {
     if (settings_.flashes_only || calibration_done_ < settings_.calibration_selections) {
       calibration_target_ = *object_layout_.drawTarget(random_).begin();
       phase_until_ = now_ + settings_.pause_s + settings_.cue_s;
-      enter(Phase::CalibrationCue, "object " + std::to_string(*calibration_target_));
+      enter(Phase::CalibrationCue, objectName(*calibration_target_));
       ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
       e.codes = {*calibration_target_};
       event(e);
@@ -239,7 +239,7 @@ void Paradigm::decide(const Decision& decision) {
     made.object = *selected_object_;
     event(made);
     phase_until_ = now_ + show;
-    enter(Phase::ObjectSelected, "object " + std::to_string(*selected_object_));
+    enter(Phase::ObjectSelected, objectName(*selected_object_));
   } else if (phase_ == Phase::CellFlashing) {
     selected_cell_ = {decision.choice / grid_layout_.columns + 1,
                       decision.choice % grid_layout_.columns + 1};
@@ -291,6 +291,15 @@ void Paradigm::nextTrial(double at_s, const std::string& why) {
 
 void Paradigm::setObjectCount(int objects) {
   if (objects >= 2) object_layout_ = ParadigmLayout::single(objects, object_layout_.soa_s);
+}
+
+void Paradigm::setObjectNames(std::vector<int> ids) {
+  object_ids_ = std::move(ids);
+}
+
+std::string Paradigm::objectName(int slot) const {
+  const bool named = slot >= 1 && slot <= static_cast<int>(object_ids_.size());
+  return "object " + std::to_string(named ? object_ids_[static_cast<size_t>(slot - 1)] : slot);
 }
 
 void Paradigm::pause() {

@@ -1,5 +1,7 @@
 #include <imgui.h>
 
+#include <cfloat>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -47,19 +49,17 @@ void CalibrationPanel::draw() {
     if (ImGui::Checkbox("hold the simulated board up", &board_)) model_.holdBoard(board_);
   }
   cv::Mat image = model_.cameraImage();
-  if (ImGui::Button("Capture view")) captureView();
+  if (button("Capture view", image.empty() ? "no camera image yet" : "")) captureView();
   ImGui::SameLine();
   ImGui::Text("%zu views; coverage %.0f%%", calibrator_.viewCount(),
               100.0 * calibrator_.coverageFraction());
   if (!last_view_.empty()) ImGui::Text("last view: %s", last_view_.c_str());
-  ImGui::BeginDisabled(calibrator_.viewCount() < 3);
-  if (ImGui::Button("Calibrate")) calibrate();
-  ImGui::EndDisabled();
+  if (button("Calibrate", calibrator_.viewCount() < 3 ? "capture at least 3 views first" : ""))
+    calibrate();
   if (result_) {
-    ImGui::SameLine();
-    ImGui::InputText("##save", save_path_, sizeof save_path_);
-    ImGui::SameLine();
-    if (ImGui::Button("Save")) {
+    pathInput("calibration file (.yml, .xml)", save_path_, sizeof save_path_, ".yml .yaml .xml",
+              "where Save writes the camera's calibration (OpenCV YAML or XML)");
+    if (button("Save")) {
       try {
         result_->camera.save(save_path_);
         message_ = std::string("saved ") + save_path_;
@@ -118,9 +118,13 @@ void CalibrationPanel::draw() {
   ImGui::EndGroup();
 
   heading("reference marker (robot frame)");
-  ImGui::InputInt("id", &reference_id_);
-  ImGui::InputFloat3("position (m)", reference_position_, "%.3f");
-  if (ImGui::Button("Apply reference")) {
+  ImGui::TextUnformatted("marker id");
+  ImGui::SetNextItemWidth(-FLT_MIN);
+  ImGui::InputInt("##id", &reference_id_);
+  ImGui::TextUnformatted("position in the robot frame (m)");
+  ImGui::SetNextItemWidth(-FLT_MIN);
+  ImGui::InputFloat3("##position", reference_position_, "%.3f");
+  if (button("Apply reference")) {
     model_.setReference(reference_id_, cv::Vec3d(reference_position_[0], reference_position_[1],
                                                  reference_position_[2]));
   }

@@ -35,7 +35,7 @@ void drawErpPlots(const bci::ErpCurves& erp) {
   ImGui::SameLine();
   ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "non-target");
   ImGui::SameLine();
-  ImGui::Text("difference (white); 95 %% bands; +/-%.0f uV, %.0f to %.0f ms", limit,
+  ImGui::TextWrapped("difference (white); 95 %% bands; +/-%.0f uV, %.0f to %.0f ms", limit,
               erp.timeS(0) * 1000.0, erp.timeS(samples - 1) * 1000.0);
   const float width = std::max(120.0f, (ImGui::GetContentRegionAvail().x - 8.0f) / 2.0f);
   const float height = 70.0f;
@@ -82,7 +82,7 @@ void drawSignedR2(const bci::ErpCurves& erp) {
   const int channels = static_cast<int>(erp.channels.size()), samples = erp.samples();
   if (channels == 0 || samples < 2) return;
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
-  ImGui::Text(
+  ImGui::TextWrapped(
       "signed r^2 per channel (rows) and time: red target > non-target, blue below; "
       "|r^2| up to %.3f",
       limit);
@@ -117,7 +117,7 @@ void drawScalpMap(const bci::ErpCurves& erp) {
     ImGui::TextDisabled("no scalp map: fewer than 3 channels have 10-20 names");
     return;
   }
-  ImGui::Text("target - non-target at %.0f ms (the difference's peak), +/-%.1f uV",
+  ImGui::TextWrapped("target - non-target at %.0f ms (the difference's peak), +/-%.1f uV",
               map->time_s * 1000.0, map->limit_uv);
   const float size = 180.0f, head = 0.55f;
   const ImVec2 corner = ImGui::GetCursorScreenPos();

@@ -76,9 +76,11 @@ void RobotPanel::draw() {
     const bool bad =
         it->find("rejected") == 0 || it->find("failed") == 0 || it->find("silent") == 0;
     if (bad) {
-      ImGui::TextColored(ImVec4(1, 0.5f, 0.3f, 1), "%s", it->c_str());
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.5f, 0.3f, 1));
+      ImGui::TextWrapped("%s", it->c_str());
+      ImGui::PopStyleColor();
     } else {
-      ImGui::TextUnformatted(it->c_str());
+      ImGui::TextWrapped("%s", it->c_str());
     }
   }
   ImGui::EndChild();

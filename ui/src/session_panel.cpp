@@ -99,10 +99,14 @@ void SessionPanel::trackingHealth() {
   } else {
     ImGui::Text("reference %d: seen", model_.referenceId());
   }
+  const auto robot = model_.robotStatus();
+  const int held = robot ? robot->holding : -1;
   for (const TrackedObject& o : model_.trackedObjects()) {
     ImGui::SameLine(0.0f, 20.0f);
     if (ImGui::GetContentRegionAvail().x < 150.0f) ImGui::NewLine();
-    if (o.age_s > max_age) {
+    if (o.id == held) {
+      ImGui::Text("object %d: in the gripper", o.id);
+    } else if (o.age_s > max_age) {
       ImGui::TextColored(lost, "object %d: lost (%s)", o.id, seconds(o.age_s).c_str());
     } else {
       ImGui::Text("object %d: seen", o.id);

@@ -1,5 +1,7 @@
 #include <imgui.h>
 
+#include <cfloat>
+
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -73,18 +75,27 @@ void TrainingPanel::collect() {
 }
 
 void TrainingPanel::draw() {
-  ImGui::InputTextMultiline("recordings", files_, sizeof files_,
-                            ImVec2(-1, ImGui::GetTextLineHeight() * 3));
+  pathInput("recordings (BCI2000 .dat, GDF, EDF, BDF; several: separated by spaces)", files_,
+            sizeof files_, ".dat .gdf .edf .bdf",
+            "the recordings to train on; Browse picks one from the folder of the last");
   const char* methods[] = {"SWLDA (as BCI2000)", "shrinkage LDA", "xDAWN + LDA",
                            "Riemannian (xDAWN covariances, tangent space)"};
-  ImGui::Combo("method", &method_, methods, 4);
-  ImGui::SliderFloat("window end (ms)", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
-  ImGui::SliderFloat("decimate to (Hz)", &decimate_hz_, 10.0f, 64.0f, "%.0f");
+  ImGui::TextUnformatted("method");
+  ImGui::SetNextItemWidth(-FLT_MIN);
+  ImGui::Combo("##method", &method_, methods, 4);
+  ImGui::TextUnformatted("window end (ms)");
+  ImGui::SetNextItemWidth(-FLT_MIN);
+  ImGui::SliderFloat("##window end", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
+  ImGui::TextUnformatted("decimate to (Hz)");
+  ImGui::SetNextItemWidth(-FLT_MIN);
+  ImGui::SliderFloat("##decimate", &decimate_hz_, 10.0f, 64.0f, "%.0f");
   collect();
   const bool running = training_.valid();
-  ImGui::BeginDisabled(running);
-  if (ImGui::Button("Train")) startTraining();
-  ImGui::EndDisabled();
+  const bool named = std::string(files_).find_first_not_of(" \t\n") != std::string::npos;
+  if (button("Train", running  ? "training is running"
+                      : !named ? "name at least one recording above"
+                               : ""))
+    startTraining();
   if (running) {
     std::lock_guard lock(stage_mutex_);
     ImGui::SameLine();
@@ -96,7 +107,7 @@ void TrainingPanel::draw() {
   if (!outcome_ || !outcome_->result) {
     const auto current = model_.model();
     if (current) {
-      ImGui::Text(
+      ImGui::TextWrapped(
           "session model: %s, trained on %s", current->method.c_str(),
           current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
     } else {
@@ -106,18 +117,20 @@ void TrainingPanel::draw() {
   }
   const bci::TrainingResult& r = *outcome_->result;
   const bci::EvaluationReport& cv = r.cross_validation.report;
-  ImGui::Text("cross-validated (%d folds by %s): AUC %.3f (95 %% interval %.3f-%.3f)",
+  ImGui::TextWrapped("cross-validated (%d folds by %s): AUC %.3f (95 %% interval %.3f-%.3f)",
               r.cross_validation.folds, r.cross_validation.folds_by.c_str(), cv.auc,
               cv.auc_interval.low, cv.auc_interval.high);
   if (cv.selection_metrics) {
-    ImGui::Text("%d selections; chance %.3f, beaten at p < 0.05 from %.3f",
+    ImGui::TextWrapped("%d selections; chance %.3f, beaten at p < 0.05 from %.3f",
                 cv.selections_with_truth, cv.chance, cv.chance_95);
     std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()),
         bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
-    ImGui::PlotLines("accuracy by sequences", accuracy.data(), static_cast<int>(accuracy.size()), 0,
-                     nullptr, 0.0f, 1.0f, ImVec2(0, 70));
-    ImGui::PlotLines("bits/min by sequences", bits.data(), static_cast<int>(bits.size()), 0,
-                     nullptr, 0.0f, FLT_MAX, ImVec2(0, 70));
+    ImGui::TextUnformatted("accuracy by sequences (0 to 1)");
+    ImGui::PlotLines("##accuracy", accuracy.data(), static_cast<int>(accuracy.size()), 0, nullptr,
+                     0.0f, 1.0f, ImVec2(ImGui::GetContentRegionAvail().x, 70));
+    ImGui::TextUnformatted("bits/min by sequences");
+    ImGui::PlotLines("##bits", bits.data(), static_cast<int>(bits.size()), 0, nullptr, 0.0f,
+                     FLT_MAX, ImVec2(ImGui::GetContentRegionAvail().x, 70));
   } else {
     ImGui::TextWrapped("no selection metrics: the stimulus codes are classes, not choices");
   }
@@ -125,9 +138,9 @@ void TrainingPanel::draw() {
   drawErpPlots(outcome_->data->erp);
   drawSignedR2(outcome_->data->erp);
   drawScalpMap(outcome_->data->erp);
-  ImGui::InputText("##model", save_path_, sizeof save_path_);
-  ImGui::SameLine();
-  if (ImGui::Button("Save model")) {
+  pathInput("model file (.json)", save_path_, sizeof save_path_, ".json",
+            "where Save model writes the trained model");
+  if (button("Save model")) {
     try {
       r.model.save(save_path_);
       message_ = std::string("saved ") + save_path_;
@@ -136,7 +149,7 @@ void TrainingPanel::draw() {
     }
   }
   ImGui::SameLine();
-  if (ImGui::Button("Use in the session")) {
+  if (button("Use in the session")) {
     try {
       model_.useModel(r.model);
       message_ = "the session now uses this model";

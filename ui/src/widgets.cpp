@@ -66,7 +66,7 @@ bool pathInput(const char* label, char* path, size_t size, const char* extension
                const char* tooltip) {
   namespace fs = std::filesystem;
   ImGui::PushID(label);
-  ImGui::TextUnformatted(label);
+  ImGui::TextWrapped("%s", label);
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", tooltip);
   const float browse_width = ImGui::CalcTextSize("Browse").x + 2 * ImGui::GetStyle().FramePadding.x;
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - browse_width -

@@ -11,7 +11,9 @@ namespace arbci::ui {
 inline void heading(const char* text) {
   ImGui::Spacing();
   ImGui::Separator();
-  ImGui::TextDisabled("%s", text);
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  ImGui::TextWrapped("%s", text);  // never cut in a narrow panel
+  ImGui::PopStyleColor();
 }
 
 // A button that says why it cannot be pressed: with `why_not` non-empty it is drawn disabled and

@@ -140,6 +140,10 @@ class Paradigm {
   void robotFinished(bool success, const std::string& text);
   // The number of objects that can be selected from the next trial on (those tracked).
   void setObjectCount(int objects);
+  // What the objects are called in the phase texts (their marker ids, slot k at k - 1), so the
+  // log, the panels and the recording name an object the same way; without: the slot number.
+  void setObjectNames(std::vector<int> ids);
+  std::string objectName(int slot) const;
 
   std::vector<ParadigmEvent> takeEvents();
   Phase phase() const { return phase_; }
@@ -190,6 +194,7 @@ class Paradigm {
   std::optional<int> selected_object_;
   std::optional<std::pair<int, int>> selected_cell_;
   std::vector<ParadigmEvent> events_;
+  std::vector<int> object_ids_;
 };
 
 }  // namespace arbci::bci
