@@ -59,11 +59,16 @@ class DeviceScene final : public SceneSource {
   explicit DeviceScene(const SceneSettings& settings) {
     const CameraSettings& c = settings.cameras;
     left_camera_ = vision::CameraModel::load(c.left.calibration);
-    left_ = std::make_unique<CameraCapture>(c.left.device, c.left.video, "cameras.left");
+    // Errors name the key: the video file's, or the device's.
+    left_ = std::make_unique<CameraCapture>(
+        c.left.device, c.left.video,
+        c.left.video.empty() ? "cameras.left.device" : "cameras.left.video");
     right_camera_ = left_camera_;
     if (!c.right.calibration.empty()) {
       right_camera_ = vision::CameraModel::load(c.right.calibration);
-      right_ = std::make_unique<CameraCapture>(c.right.device, c.right.video, "cameras.right");
+      right_ = std::make_unique<CameraCapture>(
+          c.right.device, c.right.video,
+          c.right.video.empty() ? "cameras.right.device" : "cameras.right.video");
       if (!c.stereo_calibration.empty()) {
         const vision::StereoCameras stereo = vision::StereoCameras::load(c.stereo_calibration);
         T_right_left_ = {stereo.rotation, stereo.translation};

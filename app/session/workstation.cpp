@@ -119,7 +119,8 @@ int runWorkstation(const SessionConfig& config, SessionOptions options,
     }
   }
   if (script && !script->error().empty()) return 4;
-  return session.ended() && session.endKind() != "finished" ? 3 : 0;
+  // Closed before the end: the session ends now (its summary says "closed"), not finished.
+  return session.ended() && session.endKind() == "finished" ? 0 : 3;
 }
 
 }  // namespace arbci::app

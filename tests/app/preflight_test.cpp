@@ -82,6 +82,33 @@ TEST(Preflight, AVideoWithoutTheReferenceMarkerEndsTheRunBeforeAnyFlashNamingThe
   expectNoFlash(out);
 }
 
+// A file that is not a video at all is refused as the camera opens, before the session starts.
+TEST(Preflight, ACameraPointingAtANonVideoFileExitsBeforeAnyFlashNamingTheKey) {
+  const auto folder = freshTempPath("preflight_test", "not_a_video");
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "camera.mp4") << "this is not a video\n";
+  {
+    cv::FileStorage calibration((folder / "camera.yml").string(), cv::FileStorage::WRITE);
+    calibration << "image_width" << 640 << "image_height" << 480;
+    calibration << "camera_matrix" << cv::Mat(cv::Matx33d(800, 0, 320, 0, 800, 240, 0, 0, 1));
+    calibration << "distortion_coefficients" << cv::Mat(cv::Vec<double, 5>(0, 0, 0, 0, 0));
+  }
+  const auto session = folder / "session.json";
+  std::ofstream(session) << nlohmann::json{{"cameras",
+                                            {{"source", "devices"},
+                                             {"left",
+                                              {{"video", (folder / "camera.mp4").string()},
+                                               {"calibration",
+                                                (folder / "camera.yml").string()}}}}}}
+                                .dump();
+  const auto out = folder / "out";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 120.0);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("cameras.left.video: cannot open video"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out / "recording.bdf"));  // nothing recorded, no flash
+}
+
 TEST(Preflight, ARemoteRobotThatNeverAnswersEndsTheRunBeforeAnyFlashNamingTheKey) {
   const auto folder = freshTempPath("preflight_test", "silent_robot");
   std::filesystem::create_directories(folder);

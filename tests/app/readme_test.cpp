@@ -70,8 +70,9 @@ TEST(Readme, EveryCommandAndOptionInTheCommandSummaryExists) {
     const ProcessResult help = runProcess(program, arguments, 30.0);
     ASSERT_EQ(help.exit_code, 0) << s.line << "\n" << help.err;
     for (const std::string& option : s.options) {
-      EXPECT_NE(help.out.find(option), std::string::npos)
-          << "README: " << s.line << "\n" << option << " is not in its --help:\n" << help.out;
+      EXPECT_NE(help.out.find(option), std::string::npos) << "README: " << s.line << "\n"
+                                                          << option << " is not in its --help:\n"
+                                                          << help.out;
     }
   }
 }

@@ -189,6 +189,18 @@ screenshot )" + (folder / "ended.png").string() +
   EXPECT_FALSE((*button(shot, "End session", "Robot"))["enabled"].get<bool>());
 }
 
+// Ctrl+Q closes the window as the File menu says; the session ends there, its summary saved.
+TEST(RecoveryWindow, CtrlQQuitsTheWindowAndTheSummarySaysItWasClosed) {
+  const auto folder = kArtefacts / "recovery_quit";
+  std::filesystem::remove_all(folder);
+  const ProcessResult r = runScript(folder, "wait \"calibration\" 60\npause 1\nkey ctrl+q\n");
+  EXPECT_EQ(r.exit_code, 3) << r.err;  // not finished
+  const nlohmann::json summary = readJson(folder / "out/summary.json");
+  EXPECT_EQ(summary["ended"], "aborted");
+  EXPECT_EQ(summary["end_reason"], "closed");
+  EXPECT_LT(summary["duration_s"].get<double>(), 30.0);
+}
+
 // A script that cannot go on says which line and why, and the run exits 4.
 TEST(RecoveryWindow, AScriptClickOnADisabledButtonFailsNamingTheLineAndTheReason) {
   const auto folder = kArtefacts / "recovery_refused";

@@ -36,7 +36,7 @@ void drawErpPlots(const bci::ErpCurves& erp) {
   ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "non-target");
   ImGui::SameLine();
   ImGui::TextWrapped("difference (white); 95 %% bands; +/-%.0f uV, %.0f to %.0f ms", limit,
-              erp.timeS(0) * 1000.0, erp.timeS(samples - 1) * 1000.0);
+                     erp.timeS(0) * 1000.0, erp.timeS(samples - 1) * 1000.0);
   const float width = std::max(120.0f, (ImGui::GetContentRegionAvail().x - 8.0f) / 2.0f);
   const float height = 70.0f;
   ImDrawList* draw = ImGui::GetWindowDrawList();
@@ -118,7 +118,7 @@ void drawScalpMap(const bci::ErpCurves& erp) {
     return;
   }
   ImGui::TextWrapped("target - non-target at %.0f ms (the difference's peak), +/-%.1f uV",
-              map->time_s * 1000.0, map->limit_uv);
+                     map->time_s * 1000.0, map->limit_uv);
   const float size = 180.0f, head = 0.55f;
   const ImVec2 corner = ImGui::GetCursorScreenPos();
   ImGui::InvisibleButton("scalp", ImVec2(size, size));

@@ -118,11 +118,11 @@ void TrainingPanel::draw() {
   const bci::TrainingResult& r = *outcome_->result;
   const bci::EvaluationReport& cv = r.cross_validation.report;
   ImGui::TextWrapped("cross-validated (%d folds by %s): AUC %.3f (95 %% interval %.3f-%.3f)",
-              r.cross_validation.folds, r.cross_validation.folds_by.c_str(), cv.auc,
-              cv.auc_interval.low, cv.auc_interval.high);
+                     r.cross_validation.folds, r.cross_validation.folds_by.c_str(), cv.auc,
+                     cv.auc_interval.low, cv.auc_interval.high);
   if (cv.selection_metrics) {
     ImGui::TextWrapped("%d selections; chance %.3f, beaten at p < 0.05 from %.3f",
-                cv.selections_with_truth, cv.chance, cv.chance_95);
+                       cv.selections_with_truth, cv.chance, cv.chance_95);
     std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()),
         bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
     ImGui::TextUnformatted("accuracy by sequences (0 to 1)");
