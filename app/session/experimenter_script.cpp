@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cfloat>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -142,17 +143,25 @@ ui::SyntheticInput ExperimenterScript::beforeFrame(double now_s, const std::stri
       advance();
       break;
     case Kind::Click: {
-      if (click_stage_ == 0) {
-        const ui::DrawnWidget* found = nullptr;
-        for (const ui::DrawnWidget& w : ui::drawnWidgets()) {
-          if (w.label == c.text) {
-            found = &w;
-            break;
-          }
+      const ui::DrawnWidget* found = nullptr;
+      for (const ui::DrawnWidget& w : ui::drawnWidgets()) {
+        if (w.label == c.text) {
+          found = &w;
+          break;
         }
+      }
+      const float x = found ? 0.5f * (found->x0 + found->x1) : 0.0f;
+      const float y = found ? 0.5f * (found->y0 + found->y1) : 0.0f;
+      // The panel's layout can shift under the pointer (a message appears above the button):
+      // the click starts again wherever the button is now.
+      if (click_stage_ > 0 && (!found || !found->enabled || std::abs(x - click_x_) > 1.0f ||
+                               std::abs(y - click_y_) > 1.0f)) {
+        click_stage_ = 0;
+      }
+      if (click_stage_ == 0) {
         if (found && found->enabled) {
-          click_x_ = 0.5f * (found->x0 + found->x1);
-          click_y_ = 0.5f * (found->y0 + found->y1);
+          click_x_ = x;
+          click_y_ = y;
           click_stage_ = 1;
         } else if (waited > c.seconds) {
           fail(c, found ? "\"" + c.text + "\" stayed disabled: " + found->why_disabled

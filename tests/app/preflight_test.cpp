@@ -41,6 +41,26 @@ void expectNoFlash(const std::filesystem::path& folder) {
   EXPECT_NE(summary["end_reason"].get<std::string>().find("pre-flight failed"), std::string::npos);
 }
 
+// A session whose left camera is `video`, with a pinhole calibration for its frame size.
+std::filesystem::path videoSession(const std::filesystem::path& folder,
+                                   const std::filesystem::path& video, cv::Size size) {
+  const auto calibration_file = folder / "camera.yml";
+  cv::FileStorage calibration(calibration_file.string(), cv::FileStorage::WRITE);
+  calibration << "image_width" << size.width << "image_height" << size.height;
+  const double f = 1.25 * size.width;
+  calibration << "camera_matrix"
+              << cv::Mat(cv::Matx33d(f, 0, size.width / 2.0, 0, f, size.height / 2.0, 0, 0, 1));
+  calibration << "distortion_coefficients" << cv::Mat(cv::Vec<double, 5>(0, 0, 0, 0, 0));
+  const auto session = folder / "session.json";
+  std::ofstream(session) << nlohmann::json{{"cameras",
+                                            {{"source", "devices"},
+                                             {"left",
+                                              {{"video", video.string()},
+                                               {"calibration", calibration_file.string()}}}}}}
+                                .dump();
+  return session;
+}
+
 TEST(Preflight, AVideoWithoutTheReferenceMarkerEndsTheRunBeforeAnyFlashNamingTheKey) {
   const auto folder = freshTempPath("preflight_test", "no_reference");
   std::filesystem::create_directories(folder);
@@ -57,20 +77,7 @@ TEST(Preflight, AVideoWithoutTheReferenceMarkerEndsTheRunBeforeAnyFlashNamingThe
     ASSERT_TRUE(writer.isOpened());
     for (int i = 0; i < 200; ++i) writer.write(image);
   }
-  {
-    cv::FileStorage calibration((folder / "camera.yml").string(), cv::FileStorage::WRITE);
-    calibration << "image_width" << 320 << "image_height" << 240;
-    calibration << "camera_matrix" << cv::Mat(cv::Matx33d(400, 0, 160, 0, 400, 120, 0, 0, 1));
-    calibration << "distortion_coefficients" << cv::Mat(cv::Vec<double, 5>(0, 0, 0, 0, 0));
-  }
-  const auto session = folder / "session.json";
-  std::ofstream(session) << nlohmann::json{{"cameras",
-                                            {{"source", "devices"},
-                                             {"left",
-                                              {{"video", video.string()},
-                                               {"calibration",
-                                                (folder / "camera.yml").string()}}}}}}
-                                .dump();
+  const auto session = videoSession(folder, video, {320, 240});
   const auto out = folder / "out";
   const ProcessResult r = runProcess(
       kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 120.0);
@@ -87,20 +94,7 @@ TEST(Preflight, ACameraPointingAtANonVideoFileExitsBeforeAnyFlashNamingTheKey) {
   const auto folder = freshTempPath("preflight_test", "not_a_video");
   std::filesystem::create_directories(folder);
   std::ofstream(folder / "camera.mp4") << "this is not a video\n";
-  {
-    cv::FileStorage calibration((folder / "camera.yml").string(), cv::FileStorage::WRITE);
-    calibration << "image_width" << 640 << "image_height" << 480;
-    calibration << "camera_matrix" << cv::Mat(cv::Matx33d(800, 0, 320, 0, 800, 240, 0, 0, 1));
-    calibration << "distortion_coefficients" << cv::Mat(cv::Vec<double, 5>(0, 0, 0, 0, 0));
-  }
-  const auto session = folder / "session.json";
-  std::ofstream(session) << nlohmann::json{{"cameras",
-                                            {{"source", "devices"},
-                                             {"left",
-                                              {{"video", (folder / "camera.mp4").string()},
-                                               {"calibration",
-                                                (folder / "camera.yml").string()}}}}}}
-                                .dump();
+  const auto session = videoSession(folder, folder / "camera.mp4", {640, 480});
   const auto out = folder / "out";
   const ProcessResult r = runProcess(
       kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 120.0);

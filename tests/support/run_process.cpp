@@ -17,6 +17,7 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
+    setpgid(0, 0);  // its own process group: a timeout kills what it started too (Xvfb, arbci)
     dup2(out_pipe[1], STDOUT_FILENO);
     dup2(err_pipe[1], STDERR_FILENO);
     close(out_pipe[0]);
@@ -38,10 +39,14 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   int open_pipes = 2;
   bool killed = false;
   while (open_pipes > 0) {
-    if (std::chrono::steady_clock::now() > deadline && !killed) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now > deadline && !killed) {
+      kill(-pid, SIGKILL);
       kill(pid, SIGKILL);
       killed = true;
     }
+    // Whatever still holds the pipes after the kill is not waited for.
+    if (killed && now > deadline + std::chrono::seconds(5)) break;
     if (poll(fds, 2, 100) <= 0) continue;
     for (int i = 0; i < 2; ++i) {
       if (fds[i].fd < 0 || !(fds[i].revents & (POLLIN | POLLHUP))) continue;
@@ -55,6 +60,9 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
         (i == 0 ? result.out : result.err).append(buffer, static_cast<size_t>(n));
       }
     }
+  }
+  for (pollfd& f : fds) {
+    if (f.fd >= 0) close(f.fd);
   }
   int status = 0;
   waitpid(pid, &status, 0);

@@ -12,7 +12,8 @@ struct ProcessResult {
   std::string err;
 };
 
-// Runs `program` with `arguments`, killing it after `timeout_seconds`.
+// Runs `program` with `arguments` in a process group of its own, killing the group (what it
+// started too) after `timeout_seconds`; output still held open 5 s later is not waited for.
 ProcessResult runProcess(const std::string& program, const std::vector<std::string>& arguments,
                          double timeout_seconds = 120.0);
 
