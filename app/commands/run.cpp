@@ -68,7 +68,9 @@ void printSummary(const Session& session) {
             << " ms (configured " << ms(timing["soa_ms"]["configured"]) << "), flash median "
             << ms(timing["flash_ms"]["median"]) << " ms; late frames " << timing["late_frames"]
             << ", lost EEG samples " << timing["lost_samples"] << "\n";
-  std::cout << "ended: " << session.endKind() << " (" << session.endReason() << ")\n";
+  std::cout << "ended: " << session.endKind();
+  if (session.endReason() != session.endKind()) std::cout << " (" << session.endReason() << ")";
+  std::cout << "\n";
 }
 
 int runSession(const RunOptions& o) {

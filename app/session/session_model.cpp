@@ -45,8 +45,9 @@ std::vector<std::pair<std::string, std::string>> SessionModel::endSummary() {
     std::snprintf(text, sizeof text, format, v.get<double>() * scale);
     return std::string(text);
   };
-  rows.emplace_back(
-      "ended", s["ended"].get<std::string>() + " (" + s["end_reason"].get<std::string>() + ")");
+  const std::string ended = s["ended"].get<std::string>();
+  const std::string reason = s["end_reason"].get<std::string>();
+  rows.emplace_back("ended", reason == ended ? ended : ended + " (" + reason + ")");
   rows.emplace_back("duration", number(s["duration_s"], "%.1f s"));
   for (const char* kind : {"objects", "cells"}) {
     const nlohmann::json& r = s[kind];
@@ -86,7 +87,7 @@ std::vector<std::pair<std::string, std::string>> SessionModel::endSummary() {
 
 std::string SessionModel::phase() {
   std::string text = bci::toString(session_.paradigm().phase());
-  if (session_.ended()) text += " (" + session_.endReason() + ")";
+  if (session_.ended() && session_.endReason() != text) text += " (" + session_.endReason() + ")";
   return text;
 }
 
