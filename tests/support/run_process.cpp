@@ -37,7 +37,9 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::milliseconds(static_cast<long>(timeout_seconds * 1000));
   int open_pipes = 2;
-  bool killed = false;
+  bool killed = false, exited = false;
+  int status = 0;
+  auto exited_at = deadline;
   while (open_pipes > 0) {
     const auto now = std::chrono::steady_clock::now();
     if (now > deadline && !killed) {
@@ -47,6 +49,16 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
     }
     // Whatever still holds the pipes after the kill is not waited for.
     if (killed && now > deadline + std::chrono::seconds(5)) break;
+    // The program has exited, but something it started (an X server xvfb-run left behind) may
+    // hold its output open: 2 s more, then that is killed too.
+    if (!exited && waitpid(pid, &status, WNOHANG) == pid) {
+      exited = true;
+      exited_at = now;
+    }
+    if (exited && now > exited_at + std::chrono::seconds(2)) {
+      kill(-pid, SIGKILL);
+      break;
+    }
     if (poll(fds, 2, 100) <= 0) continue;
     for (int i = 0; i < 2; ++i) {
       if (fds[i].fd < 0 || !(fds[i].revents & (POLLIN | POLLHUP))) continue;
@@ -64,8 +76,7 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
   for (pollfd& f : fds) {
     if (f.fd >= 0) close(f.fd);
   }
-  int status = 0;
-  waitpid(pid, &status, 0);
+  if (!exited) waitpid(pid, &status, 0);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
 }

@@ -34,7 +34,14 @@ void recoveryButtons(WorkstationModel& model, bool latched) {
 void RobotPanel::draw() {
   emergencyStopButton(model_);
   const auto status = model_.robotStatus();
-  if (model_.robotSilent()) {
+  if (model_.ended()) {
+    // The session no longer reads the robot link: what follows is the last status it got.
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.6f, 0.2f, 1.0f));
+    ImGui::TextWrapped(
+        "session ended: the robot is no longer watched; its last status before the "
+        "end:");
+    ImGui::PopStyleColor();
+  } else if (model_.robotSilent()) {
     ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "backend silent: no answer for over a second");
   } else if (!status) {
     ImGui::TextDisabled("waiting for the backend's first status");
