@@ -37,6 +37,13 @@ std::string SessionModel::whyNot(Action action) {
 }
 
 std::vector<std::pair<std::string, std::string>> SessionModel::endSummary() {
+  // An ended session's summary no longer changes: built once, not on every frame it is shown.
+  if (!end_rows_.empty() || !session_.ended()) return end_rows_;
+  end_rows_ = summaryRows();
+  return end_rows_;
+}
+
+std::vector<std::pair<std::string, std::string>> SessionModel::summaryRows() const {
   const nlohmann::json s = session_.summary();
   std::vector<std::pair<std::string, std::string>> rows;
   auto number = [](const nlohmann::json& v, const char* format, double scale = 1.0) {

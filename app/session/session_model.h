@@ -72,7 +72,9 @@ class SessionModel final : public ui::WorkstationModel {
   std::vector<std::string> selections() override { return session_.selectionLines(); }
 
  private:
+  std::vector<std::pair<std::string, std::string>> summaryRows() const;
   Session& session_;
+  std::vector<std::pair<std::string, std::string>> end_rows_;
   vision::ThresholdSettings threshold_;
 };
 
