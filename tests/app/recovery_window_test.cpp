@@ -13,12 +13,12 @@
 
 #include "support/run_process.h"
 #include "support/test_files.h"
+#include "support/xvfb_server.h"
 
 namespace arbci::test {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
-const std::string kXvfbRun = XVFB_RUN_EXECUTABLE;
 const std::filesystem::path kArtefacts = ARBCI_TEST_ARTEFACTS_DIR;
 
 // A quick session (a short calibration run, one trial) with a slow arm, so a grasp lasts long
@@ -37,9 +37,10 @@ ProcessResult runScript(const std::filesystem::path& folder, const std::string& 
   std::filesystem::create_directories(folder);
   writeSession(folder / "session.json");
   std::ofstream(folder / "script.txt") << script;
+  const XvfbServer x("1280x720x24");
   return runProcess("/usr/bin/env",
-                    {"XDG_CONFIG_HOME=" + (folder / "config").string(), kXvfbRun, "-a", "-s",
-                     "-screen 0 1280x720x24", kArbci, "run", "--session",
+                    {"-u", "XAUTHORITY", "DISPLAY=" + x.display(),
+                     "XDG_CONFIG_HOME=" + (folder / "config").string(), kArbci, "run", "--session",
                      (folder / "session.json").string(), "--out", (folder / "out").string(),
                      "--script", (folder / "script.txt").string(), "--exit-when-done"},
                     420.0);

@@ -11,20 +11,22 @@
 #include "arbci/bci/recording.h"
 #include "support/run_process.h"
 #include "support/test_files.h"
+#include "support/xvfb_server.h"
 
 namespace arbci::test {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
-const std::string kXvfbRun = XVFB_RUN_EXECUTABLE;
 
 std::filesystem::path fresh(const std::string& name) {
   return freshTempPath("timing_test", name);
 }
 
-std::vector<std::string> inWindow(std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), {"-a", "-s", "-screen 0 1920x1080x24", kArbci});
-  return arguments;
+// Runs arbci with `arguments` in a window on an Xvfb display of its own (1920x1080).
+ProcessResult runInWindow(std::vector<std::string> arguments, double timeout_seconds) {
+  const XvfbServer x("1920x1080x24");
+  arguments.insert(arguments.begin(), {"-u", "XAUTHORITY", "DISPLAY=" + x.display(), kArbci});
+  return runProcess("/usr/bin/env", arguments, timeout_seconds);
 }
 
 void expectOnTarget(const std::filesystem::path& folder) {
@@ -51,8 +53,8 @@ TEST(TimingCheck, HeadlessOnsetsMeetThePhotodiode) {
 
 TEST(TimingCheck, InAWindowUnderXvfbOnsetsMeetThePhotodiode) {
   const auto folder = fresh("window");
-  const ProcessResult r = runProcess(
-      kXvfbRun, inWindow({"timing-check", "--seconds", "15", "--out", folder.string()}), 300.0);
+  const ProcessResult r =
+      runInWindow({"timing-check", "--seconds", "15", "--out", folder.string()}, 300.0);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   expectOnTarget(folder);
   EXPECT_EQ(readJson(folder / "timing.json")["mode"], "window");
@@ -84,9 +86,8 @@ TEST(WindowedSession, SummaryTimingAgreesWithTheRecordedOnsets) {
                  "min_sequences": 5, "certainty": 0.0, "trials": 1, "cue_s": 1.0, "pause_s": 0.5},
     "classifier": {"method": "swlda", "decimate_hz": 64, "window_ms": [0, 1000]},
     "robot": {"speed_factor": 20}})";
-  const ProcessResult r = runProcess(
-      kXvfbRun,
-      inWindow({"run", "--session", session, "--exit-when-done", "--out", folder.string()}), 400.0);
+  const ProcessResult r = runInWindow(
+      {"run", "--session", session, "--exit-when-done", "--out", folder.string()}, 400.0);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   const nlohmann::json summary = readJson(folder / "summary.json");
   const nlohmann::json& timing = summary["timing"];

@@ -1,6 +1,7 @@
-// The GLFW window back end runs the same drawing code as the headless one (run under Xvfb).
+// The GLFW window back end runs the same drawing code as the headless one (on an Xvfb display).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <glm/glm.hpp>
 #include <vector>
 
@@ -10,12 +11,21 @@
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/system_panel.h"
+#include "support/xvfb_server.h"
 
 namespace arbci::render {
 namespace {
 
+// One X server for this test program, started before the first window opens.
+void useXvfbDisplay() {
+  static const test::XvfbServer server("1280x1024x24");
+  setenv("DISPLAY", server.display().c_str(), 1);
+  unsetenv("XAUTHORITY");
+}
+
 TEST(WindowContext, DrawsThePatternIntoTheBackBuffer) {
-  ASSERT_TRUE(displayAvailable()) << "no DISPLAY: this test runs under xvfb-run";
+  useXvfbDisplay();
+  ASSERT_TRUE(displayAvailable()) << "no DISPLAY although Xvfb was started";
   WindowContext window({"test", {80, 60}, true, -1, nullptr, false});
   const Size size = window.framebufferSize();
   ASSERT_EQ(size, (Size{80, 60}));
@@ -32,6 +42,7 @@ TEST(WindowContext, DrawsThePatternIntoTheBackBuffer) {
 }
 
 TEST(WindowContext, DrawsTheExperimenterShell) {
+  useXvfbDisplay();
   WindowContext window({"shell", {800, 500}, true, -1, nullptr, false});
   ui::SystemPanel panel({{std::string("context"), std::string("window (GLFW)")}});
   ui::ImGuiLayer imgui(window, "");

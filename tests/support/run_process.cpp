@@ -49,7 +49,7 @@ ProcessResult runProcess(const std::string& program, const std::vector<std::stri
     }
     // Whatever still holds the pipes after the kill is not waited for.
     if (killed && now > deadline + std::chrono::seconds(5)) break;
-    // The program has exited, but something it started (an X server xvfb-run left behind) may
+    // The program has exited, but something it started (a server it launched and left behind) may
     // hold its output open: 2 s more, then that is killed too.
     if (!exited && waitpid(pid, &status, WNOHANG) == pid) {
       exited = true;
