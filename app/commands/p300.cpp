@@ -6,10 +6,12 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "arbci/bci/channel_quality.h"
+#include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/p300_model.h"
 #include "commands/commands.h"
 #include "eeg/p300_plots.h"
@@ -85,6 +87,10 @@ struct TrainOptions {
   bool exclude_bad_channels = false;
   bci::TrainingSettings training;
   bci::PipelineSettings pipeline;
+  // ErrP: the recordings' feedback events instead of their flashes.
+  bool errp = false;
+  std::string p300_model;  // the ErrP classifier is written inside this P300 model
+  double errp_threshold = 0.5;
 };
 
 bci::EpochWindow parseWindow(const std::string& text) {
@@ -144,6 +150,18 @@ void train(TrainOptions& o) {
         "--bci2000: a riemann model is not linear in its features, so BCI2000's "
         "LinearClassifier cannot run it (train swlda, slda or xdawn for BCI2000)");
   }
+  if (o.errp && !o.bci2000.empty())
+    throw CliError("--bci2000: BCI2000 has no ErrP classifier; leave out --bci2000 with --errp");
+  if (!o.errp && !o.p300_model.empty())
+    throw CliError("--p300-model takes the ErrP classifier: it needs --errp");
+  std::optional<bci::P300Model> p300;
+  if (!o.p300_model.empty()) {
+    try {
+      p300 = bci::P300Model::load(o.p300_model);
+    } catch (const bci::ModelError& error) {
+      throw CliError(error.what());
+    }
+  }
   checkOutputs(o.plots, {o.out, o.bci2000, o.report, o.scores});
   o.pipeline.window = parseWindow(o.window_ms);
   o.pipeline.channels = splitNameList(o.channels);
@@ -153,6 +171,17 @@ void train(TrainOptions& o) {
   nlohmann::json quality;
   try {
     std::vector<bci::Recording> recordings = readAll(o.files);
+    if (o.errp) {
+      for (bci::Recording& r : recordings) {
+        bci::FeedbackRecording feedback = bci::feedbackRecording(r);
+        std::cout << r.source << ": " << feedback.errors << " error and " << feedback.correct
+                  << " correct feedbacks";
+        if (feedback.unknown > 0)
+          std::cout << " (" << feedback.unknown << " of unknown correctness left out)";
+        std::cout << "\n";
+        r = std::move(feedback.recording);
+      }
+    }
     quality = checkChannels(recordings, o.exclude_bad_channels);
     data = bci::buildDataset(recordings, o.pipeline, progress, o.reject_uv);
     result = bci::trainModel(data, o.pipeline, o.training, progress);
@@ -162,7 +191,13 @@ void train(TrainOptions& o) {
   result.model.provenance["created"] = utcNow();
   result.model.provenance["arbci_version"] = ARBCI_VERSION;
   try {
-    result.model.save(o.out);
+    if (p300) {
+      p300->errp = std::make_shared<const bci::P300Model>(result.model);
+      p300->errp_auc = result.cross_validation.report.auc;
+      p300->save(o.out);
+    } else {
+      result.model.save(o.out);
+    }
     if (!o.bci2000.empty()) {
       std::ofstream prm(o.bci2000);
       prm << result.model.bci2000Fragment();
@@ -195,6 +230,27 @@ void train(TrainOptions& o) {
             << ":\n";
   printReport(std::cout, cv.report);
   nlohmann::json facts = datasetFacts(data, quality);
+  if (o.errp) {
+    // What the threshold does to the cross-validated feedbacks (a prior of 0.5 for an error).
+    int caught = 0, errors = 0, vetoed = 0, correct = 0;
+    for (size_t i = 0; i < cv.scores.size(); ++i) {
+      if (cv.fold[i] < 0) continue;
+      const bool veto = bci::errorPosterior(cv.score_model, cv.scores[i], 0.5) > o.errp_threshold;
+      if (data.target[i]) {
+        ++errors;
+        caught += veto;
+      } else {
+        ++correct;
+        vetoed += veto;
+      }
+    }
+    std::cout << "at threshold " << o.errp_threshold << " (prior of an error 0.5): " << caught
+              << " of " << errors << " errors caught, " << vetoed << " of " << correct
+              << " correct feedbacks vetoed\n";
+    facts["errp_confusion"] = {
+        {"threshold", o.errp_threshold}, {"prior_error", 0.5}, {"errors", errors},
+        {"errors_caught", caught},       {"correct", correct}, {"correct_vetoed", vetoed}};
+  }
   facts.update({{"command", "train"},
                 {"method", o.training.method},
                 {"folds", cv.folds},
@@ -351,6 +407,19 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                    "selection, block (contiguous flashes) or file; default: by selection, or by "
                    "block for one selection or codes that are classes (an oddball)")
       ->check(CLI::IsMember({"selection", "block", "file"}));
+  train_cmd->add_flag("--errp", t->errp,
+                      "train the error-related-potential classifier on the recordings' feedback "
+                      "events (Feedback ... correct|error; a session with errp.enabled records "
+                      "them) instead of a P300 model on their flashes");
+  train_cmd->add_option("--p300-model", t->p300_model,
+                        "with --errp: write the ErrP classifier inside this P300 model (a session "
+                        "needs both in one file) to --out");
+  train_cmd
+      ->add_option("--threshold", t->errp_threshold,
+                   "with --errp: the posterior of an error above which a selection is rejected, "
+                   "for the confusion printed")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   train_cmd->add_option("--report", t->report,
                         "also write the cross-validation report as JSON (everything printed)");
   train_cmd->add_option("--scores", t->scores,

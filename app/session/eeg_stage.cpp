@@ -38,6 +38,8 @@ std::unique_ptr<bci::EegSource> openSource(const EegSettings& eeg,
   bci::SubjectProfile profile = bci::SubjectProfile::drawn(eeg.seed);
   profile.p3_amplitude_uv *= eeg.erp_scale;
   profile.n2_amplitude_uv *= eeg.erp_scale;
+  profile.errp_ne_amplitude_uv *= eeg.errp_scale;
+  profile.errp_pe_amplitude_uv *= eeg.errp_scale;
   subject.profile = profile;
   return std::make_unique<bci::SimulatedSubject>(subject, clock);
 }
@@ -45,12 +47,17 @@ std::unique_ptr<bci::EegSource> openSource(const EegSettings& eeg,
 }  // namespace
 
 EegStageSettings EegStageSettings::of(const SessionConfig& config) {
-  return {config.eeg,
-          config.pipeline,
-          config.paradigm.flashSeconds(),
-          static_cast<int>(config.world.objects.size()),
-          config.model_file,
-          config.source};
+  EegStageSettings s;
+  s.eeg = config.eeg;
+  s.pipeline = config.pipeline;
+  s.flash_s = config.paradigm.flashSeconds();
+  s.object_stimuli = static_cast<int>(config.world.objects.size());
+  s.model_file = config.model_file;
+  s.session_file = config.source;
+  s.errp = config.paradigm.errp;
+  if (s.errp) s.errp_pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
+  s.errp_method = config.errp.method;
+  return s;
 }
 
 void EegStageSettings::validate() const {
@@ -160,6 +167,21 @@ void EegStage::setModel(bci::P300Model model) {
   extractor_.emplace(model.extractor(info()));
   // The online filter and window follow the model's pipeline.
   filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, info());
+  errp_extractor_.reset();
+  errp_epocher_.reset();
+  if (model.errp) {
+    model.errp->checkCompatible(info(), "the EEG source (for the ErrP classifier)");
+    const bci::FilterSettings &a = model.pipeline.filter, &b = model.errp->pipeline.filter;
+    if (a.highpass_hz != b.highpass_hz || a.lowpass_hz != b.lowpass_hz || a.order != b.order ||
+        a.notch_hz != b.notch_hz || a.common_average != b.common_average) {
+      throw bci::ModelError(
+          "the model's ErrP classifier was trained with other filters than its P300 one; the "
+          "session filters once for both: train them together");
+    }
+    errp_extractor_.emplace(model.errp->extractor(info()));
+    errp_epocher_ = std::make_unique<bci::Epocher>(eeg_info_.channelCount(), eeg_info_.rate_hz,
+                                                   model.errp->pipeline.window, 10.0);
+  }
   model_ = std::move(model);
   keep_signal_ = false;
   calibration_.data.clear();
@@ -194,6 +216,13 @@ void EegStage::poll() {
       auto& r = recent_[static_cast<size_t>(c)];
       for (int s = 0; s < block.samples; ++s) r.push_back(block.at(c, s));
       if (r.size() > 4096) r.erase(r.begin(), r.end() - 2048);
+    }
+    if (errp_epocher_) {
+      for (const bci::Epoch& epoch : errp_epocher_->push(block)) {
+        if (epoch.event.sample != errp_pending_) continue;
+        errp_score_ = model_->errp->classifier->score(errp_extractor_->features(epoch));
+        errp_pending_ = -1;
+      }
     }
     for (const bci::Epoch& epoch : epocher_->push(block)) {
       const auto found = flashes_.find(epoch.event.sample);
@@ -246,6 +275,32 @@ void EegStage::annotate(std::int64_t sample, const std::string& text) {
   writer_->addAnnotation({sample, text, 0});
 }
 
+void EegStage::feedback(const std::set<int>& codes, bool objects, std::optional<bool> error,
+                        std::int64_t sample) {
+  acquisition_->withSource([&](bci::EegSource& s) { s.feedback(sample, codes); });
+  std::string text = "Feedback ";
+  for (int code : codes) {
+    if (text.back() != ' ') text += '+';
+    text += std::to_string(objects ? code : code + 100);  // as the recording codes the grid
+  }
+  text += error ? (*error ? " error" : " correct") : " unknown";
+  annotate(sample, text);
+  if (target_ && keep_signal_ && error) {
+    // The calibration block: code 1 error feedback (the ErrP classifier's target), 2 correct.
+    const int duration = static_cast<int>(settings_.flash_s * eeg_info_.rate_hz + 0.5);
+    errp_stimuli_.push_back({sample, *error ? 1 : 2, *error, duration, true});
+  }
+  if (errp_epocher_) {
+    errp_score_.reset();
+    errp_pending_ = sample;
+    errp_epocher_->addEvent({sample, 1, false, 0, false});
+  }
+}
+
+std::optional<double> EegStage::takeErrpScore() {
+  return std::exchange(errp_score_, std::nullopt);
+}
+
 void EegStage::startTraining(const std::string& method) {
   // A copy, channel-major as a recording holds its samples: the cycle keeps recording meanwhile.
   bci::Recording recording = calibration_;
@@ -258,19 +313,50 @@ void EegStage::startTraining(const std::string& method) {
     }
   }
   const bci::PipelineSettings pipeline = settings_.pipeline;
-  training_ =
-      std::async(std::launch::async, [recording = std::move(recording), pipeline, method]() {
-        // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
-        // frames come first and the training takes what is left.
-        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
-        bci::TrainingSettings settings;
-        settings.method = method;
-        settings.folds = 4;
-        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
-        bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
-        result.model.provenance["training_files"] = {"this session's calibration run"};
-        return TrainingOutcome{std::move(result.model), result.cross_validation.report};
-      });
+  // The ErrP block's feedbacks on the same signal, when there are any.
+  std::optional<bci::Recording> errp_recording;
+  if (settings_.errp) {
+    errp_recording.emplace();
+    errp_recording->source = "calibration run, ErrP feedback block";
+    errp_recording->format = "memory";
+    errp_recording->info = recording.info;
+    errp_recording->samples = recording.samples;
+    errp_recording->parameters["Paradigm"] = "single stimulus, 2 stimuli";
+    errp_recording->stimuli = errp_stimuli_;
+  }
+  training_ = std::async(std::launch::async, [recording = std::move(recording),
+                                              errp_recording = std::move(errp_recording), pipeline,
+                                              method, errp_pipeline = settings_.errp_pipeline,
+                                              errp_method = settings_.errp_method]() mutable {
+    // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
+    // frames come first and the training takes what is left.
+    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+    bci::TrainingSettings settings;
+    settings.method = method;
+    settings.folds = 4;
+    const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+    bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
+    result.model.provenance["training_files"] = {"this session's calibration run"};
+    TrainingOutcome outcome{std::move(result.model), result.cross_validation.report, {}, ""};
+    if (errp_recording) {
+      try {
+        errp_recording->data = std::move(recording.data);
+        bci::TrainingSettings errp_settings;
+        errp_settings.method = errp_method;
+        errp_settings.folds = 5;
+        errp_settings.folds_by = "block";
+        const bci::P300Dataset errp_data = bci::buildDataset({*errp_recording}, errp_pipeline);
+        bci::TrainingResult errp = bci::trainModel(errp_data, errp_pipeline, errp_settings);
+        errp.model.provenance["training_files"] = {"this session's ErrP feedback block"};
+        outcome.errp_report = errp.cross_validation.report;
+        outcome.model.errp_auc = errp.cross_validation.report.auc;
+        outcome.model.errp = std::make_shared<const bci::P300Model>(std::move(errp.model));
+      } catch (const std::exception& error) {
+        outcome.errp_failure = error.what();
+      }
+    }
+    return outcome;
+  });
 }
 
 std::optional<TrainingOutcome> EegStage::trainingResult(bool wait) {

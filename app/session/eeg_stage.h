@@ -3,7 +3,9 @@
 // flashes actually presented, scores them with the model and accumulates the scores of the
 // current selection. It keeps the calibration run's signal and trains the model from it on a
 // worker thread, exactly as `arbci train` would. A photodiode channel, when there is one, is
-// recorded but kept out of the filters, epochs and classifier.
+// recorded but kept out of the filters, epochs and classifier. With ErrPs on, each selection's
+// feedback is recorded ("Feedback <codes> correct|error"), kept from the calibration run's
+// feedback block to train the ErrP classifier beside the P300 one, and scored online.
 #pragma once
 
 #include <filesystem>
@@ -29,10 +31,13 @@ namespace arbci::app {
 struct EegStageSettings {
   EegSettings eeg;
   bci::PipelineSettings pipeline;
-  double flash_s;            // a flash's nominal duration (the paradigm's, in whole frames)
-  int object_stimuli;        // stimuli of the calibration run (the objects)
+  double flash_s = 0.06;     // a flash's nominal duration (the paradigm's, in whole frames)
+  int object_stimuli = 0;    // stimuli of the calibration run (the objects)
   std::string model_file;    // a trained model (empty: none, the calibration run trains one)
   std::string session_file;  // for messages naming a key
+  bool errp = false;         // train and use an ErrP classifier
+  bci::PipelineSettings errp_pipeline;
+  std::string errp_method;
   static EegStageSettings of(const SessionConfig& config);
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.
   void validate() const;
@@ -41,6 +46,9 @@ struct EegStageSettings {
 struct TrainingOutcome {
   bci::P300Model model;
   bci::EvaluationReport report;
+  // The ErrP classifier's cross-validated report, or why it could not be trained.
+  std::optional<bci::EvaluationReport> errp_report;
+  std::string errp_failure;
 };
 
 class EegStage final : public Stage {
@@ -85,6 +93,15 @@ class EegStage final : public Stage {
   // "Stim <code> T|N" (grid codes as 100 + code) with the duration.
   void flashEnded(std::int64_t onset_sample, int duration_samples);
   void annotate(std::int64_t sample, const std::string& text);
+  // A selection's feedback first presented at `sample`: the codes shown as chosen (grid codes as
+  // the paradigm's), whether it is wrong (known: the calibration block's deliberate errors, or
+  // the trial's intention; unknown: nullopt). Shown to the subject, recorded, and epoched for the
+  // ErrP classifier (training data in the calibration run, scored online).
+  void feedback(const std::set<int>& codes, bool objects, std::optional<bool> error,
+                std::int64_t sample);
+  // The ErrP classifier's score of the latest feedback, once its epoch is complete (each once).
+  std::optional<double> takeErrpScore();
+  bool hasErrpModel() const { return model_ && model_->errp != nullptr; }
 
   bool hasModel() const { return model_.has_value(); }
   const std::optional<bci::P300Model>& model() const { return model_; }
@@ -150,6 +167,12 @@ class EegStage final : public Stage {
   std::optional<bci::SelectionAccumulator> accumulator_;
   int presented_ = 0, scored_ = 0;
   std::vector<std::vector<float>> recent_;
+  // ErrP: the calibration block's feedbacks (code 1 error, 2 correct), the online epocher.
+  std::vector<bci::StimulusEvent> errp_stimuli_;
+  std::unique_ptr<bci::Epocher> errp_epocher_;
+  std::optional<bci::FeatureExtractor> errp_extractor_;
+  std::optional<double> errp_score_;
+  std::int64_t errp_pending_ = -1;  // the onset of the feedback whose score is awaited
 };
 
 }  // namespace arbci::app

@@ -60,6 +60,7 @@ void HmdStage::step(CycleContext& cycle) {
   due_ = cycle.due_s;
   lit_ = stimulus.lit;
   first_shown_ = s_.paradigm.firstShown();
+  feedback_ = s_.paradigm.feedbackShown();
 }
 
 void HmdStage::stop(const CycleContext&, const std::string&) {
@@ -94,6 +95,7 @@ void HmdStage::presented(double host_s, double host_origin, std::int64_t frame) 
   for (const StimulusTiming::Ended& ended : shown.ended)
     s_.eeg.flashEnded(ended.onset_sample, ended.duration_samples);
   for (const StimulusTiming::Onset& onset : shown.onsets) s_.eeg.flash(onset.code, onset.sample);
+  if (feedback_) s_.eeg.feedback(feedback_->codes, feedback_->objects, feedback_->error, sample);
   if (shown.late) {
     s_.log.write("late_frame", at,
                  {{"frame", frame},

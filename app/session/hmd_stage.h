@@ -91,6 +91,7 @@ class HmdStage final : public Stage {
   double due_ = 0.0;
   std::set<int> lit_;
   std::vector<int> first_shown_;
+  std::optional<ParadigmStage::FeedbackShown> feedback_;  // a selection shown for the first time
   std::optional<double> last_presented_;
   bool patch_lit_ = false;  // as last told to the EEG source
   bool warned_slow_display_ = false;

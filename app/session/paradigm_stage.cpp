@@ -30,8 +30,8 @@ std::vector<size_t> allSlots(const WorldSettings& world) {
 }
 
 ParadigmStageSettings ParadigmStageSettings::of(const SessionConfig& config) {
-  return {config.paradigm, config.world, config.classifier_method, intendedTrials(config),
-          config.eeg.seed + 11};
+  return {config.paradigm,        config.world,         config.classifier_method,
+          intendedTrials(config), config.eeg.seed + 11, config.errp.threshold};
 }
 
 ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const CycleContext& now,
@@ -93,8 +93,10 @@ void ParadigmStage::step(CycleContext& cycle) {
   stimulus_ = paradigm_->frame(cycle.frame, cycle.due_s);
   withholdStaleFlashes();
   first_shown_.clear();
+  feedback_shown_.reset();
   handleEvents();
   decideIfReady();
+  judgeFeedback();
 }
 
 TrialRecord& ParadigmStage::currentTrial() {
@@ -141,6 +143,22 @@ void ParadigmStage::collectTraining() {
                   {"median_frame_ms", s_.timing.medianFrameIntervalMs().value_or(0.0)},
                   {"auc", calibration_report_->auc},
                   {"accuracy_by_sequences", calibration_report_->accuracy}});
+    if (settings_.paradigm.errp) {
+      if (outcome->errp_report) {
+        s_.log.write(
+            "errp_trained", time,
+            {{"auc", outcome->errp_report->auc},
+             {"auc_95",
+              {outcome->errp_report->auc_interval.low, outcome->errp_report->auc_interval.high}},
+             {"error_feedbacks", outcome->errp_report->target_flashes},
+             {"correct_feedbacks", outcome->errp_report->other_flashes}});
+      } else {
+        s_.log.write("errp_training_failed", time, {{"reason", outcome->errp_failure}});
+        if (s_.progress)
+          *s_.progress << "\nwarning: no ErrP classifier (" << outcome->errp_failure
+                       << "): selections are executed without an ErrP check\n";
+      }
+    }
     chooseSelectableObjects();
     last_trial_end_ = time;  // the first trial's time counts from here
     paradigm_->modelTrained(true, "");
@@ -210,6 +228,62 @@ std::optional<int> ParadigmStage::objectOnCell(std::pair<int, int> cell) const {
     if (std::abs(p[0] - centre[0]) < half && std::abs(p[1] - centre[1]) < half) return o.id;
   }
   return std::nullopt;
+}
+
+std::set<int> ParadigmStage::intendedCodes(bool objects) const {
+  const int number = paradigm_->trial();
+  if (number < 1 || number > static_cast<int>(trials_.size())) return {};
+  const TrialRecord& trial = trials_[static_cast<size_t>(number - 1)];
+  if (!objects)
+    return {trial.intended_cell.first, settings_.world.grid.rows + trial.intended_cell.second};
+  for (size_t k = 0; k < slots_.size(); ++k) {
+    if (settings_.world.objects[slots_[k]].id == trial.intended_object)
+      return {static_cast<int>(k) + 1};
+  }
+  return {};
+}
+
+void ParadigmStage::judgeFeedback() {
+  if (!paradigm_->awaitingErrpVerdict()) return;
+  const double time = now_.time_s;
+  const bool objects = paradigm_->phase() == bci::Phase::ObjectSelected;
+  nlohmann::json fields = {{"trial", paradigm_->trial()}, {"kind", objects ? "object" : "cell"}};
+  if (shown_error_) fields["correct"] = !*shown_error_;
+  if (!s_.eeg.hasErrpModel()) {
+    fields["veto"] = false;
+    fields["why"] = "no ErrP classifier: executed";
+    s_.log.write("errp_decision", time, fields);
+    paradigm_->errpVerdict(false);
+    return;
+  }
+  const auto score = s_.eeg.takeErrpScore();
+  if (!score) return;  // its epoch is not complete yet
+  const double prior = 1.0 - shown_certainty_;
+  const double posterior = bci::errorPosterior(s_.eeg.model()->errp->score_model, *score, prior);
+  const bool veto = posterior > settings_.errp_threshold;
+  fields["score"] = *score;
+  fields["prior_error"] = prior;
+  fields["posterior_error"] = posterior;
+  fields["threshold"] = settings_.errp_threshold;
+  fields["veto"] = veto;
+  s_.log.write("errp_decision", time, fields);
+  char text[96];
+  std::snprintf(text, sizeof text, "ErrP %s (posterior of error %.2f)",
+                veto ? "rejected the selection" : "accepted the selection", posterior);
+  s_.eeg.annotate(now_.eeg_sample, text);
+  ++errp_counts_.decisions;
+  if (shown_error_) {
+    (*shown_error_ ? errp_counts_.wrong_shown : errp_counts_.correct_shown) += 1;
+    if (veto) (*shown_error_ ? errp_counts_.wrong_caught : errp_counts_.correct_vetoed) += 1;
+  }
+  if (veto && vetoed_since_ < 0.0) vetoed_since_ = time;
+  if (!veto && vetoed_since_ >= 0.0) {
+    errp_counts_.correction_s += time - vetoed_since_;
+    vetoed_since_ = -1.0;
+  }
+  if (veto && s_.progress)
+    *s_.progress << "\n" << text << " in trial " << paradigm_->trial() << "\n";
+  paradigm_->errpVerdict(veto);
 }
 
 std::set<int> ParadigmStage::attendedCodes(bool objects) {
@@ -311,6 +385,31 @@ void ParadigmStage::handleEvents() {
         break;
       case Kind::SelectionMade:
         recordSelection(e);
+        shown_certainty_ = e.certainty;
+        break;
+      case Kind::Feedback: {
+        FeedbackShown shown{e.codes, e.objects_layout, e.error};
+        const bool online = !e.error.has_value();
+        if (online) {
+          const std::set<int> intended = intendedCodes(e.objects_layout);
+          if (!intended.empty()) shown.error = e.codes != intended;
+        }
+        shown_error_ = online ? shown.error : std::nullopt;
+        feedback_shown_ = shown;
+        break;
+      }
+      case Kind::ErrpCorrection:
+        s_.log.write("errp_correction", time,
+                     {{"trial", e.trial},
+                      {"kind", e.objects_layout ? "object" : "cell"},
+                      {"action", e.text}});
+        if (e.text == "runner-up") ++errp_counts_.runner_up;
+        if (e.text == "repeat") ++errp_counts_.repeats;
+        if (e.text == "skip") {
+          ++errp_counts_.skipped_trials;
+          if (vetoed_since_ >= 0.0) errp_counts_.correction_s += time - vetoed_since_;
+          vetoed_since_ = -1.0;
+        }
         break;
       case Kind::TrainModel:
         // On a worker thread: the cycle (and the window) goes on; collectTraining() takes it.

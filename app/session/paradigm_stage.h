@@ -33,6 +33,7 @@ struct ParadigmStageSettings {
   std::string classifier_method;
   std::vector<TrialIntent> intended;  // each trial's intention (the simulated subject's)
   std::uint64_t seed;                 // the paradigm's random flash order
+  double errp_threshold = 0.5;        // ErrP: reject a selection above this posterior of error
   static ParadigmStageSettings of(const SessionConfig& config);
 };
 
@@ -75,6 +76,22 @@ class ParadigmStage final : public Stage {
   // the frame is presented).
   const bci::FrameStimulus& stimulus() const { return stimulus_; }
   const std::vector<int>& firstShown() const { return first_shown_; }
+  // A selection's feedback this frame shows for the first time (stamped when presented).
+  struct FeedbackShown {
+    std::set<int> codes;
+    bool objects = true;
+    std::optional<bool> error;  // known: the calibration block's, or against the intention
+  };
+  const std::optional<FeedbackShown>& feedbackShown() const { return feedback_shown_; }
+  // What the ErrP classifier did in this session (summary.json's "errp").
+  struct ErrpCounts {
+    int decisions = 0;  // verdicts on selections shown
+    int wrong_shown = 0, wrong_caught = 0;
+    int correct_shown = 0, correct_vetoed = 0;
+    int runner_up = 0, repeats = 0, skipped_trials = 0;
+    double correction_s = 0.0;  // from each rejection to the next accepted selection
+  };
+  const ErrpCounts& errpCounts() const { return errp_counts_; }
   struct PhaseChange {
     bci::Phase phase;
     int trial;
@@ -102,6 +119,10 @@ class ParadigmStage final : public Stage {
   void handleEvents();
   void collectTraining();
   void decideIfReady();
+  // The ErrP verdict on the selection shown, once its feedback epoch is scored.
+  void judgeFeedback();
+  // The codes the subject means in this trial's current selection (objects or cell).
+  std::set<int> intendedCodes(bool objects) const;
   void chooseSelectableObjects();
   void nameObjects();  // the paradigm's texts name the offered objects by marker id
   // Objects whose pose is stale are not lit (nor their flashes recorded) on this frame.
@@ -129,6 +150,11 @@ class ParadigmStage final : public Stage {
   double last_trial_end_ = 0.0;  // where the next trial's time starts (session seconds)
   double training_since_ = 0.0;
   bool retrying_ = false;
+  std::optional<FeedbackShown> feedback_shown_;
+  double shown_certainty_ = 0.0;  // the P300 certainty of the selection shown
+  std::optional<bool> shown_error_;
+  ErrpCounts errp_counts_;
+  double vetoed_since_ = -1.0;  // session time of the first rejection not yet made good
   std::set<int> stale_;  // offered objects whose pose is stale (marker ids)  // the robot events
                          // come from the experimenter's Retry step
 };

@@ -1,5 +1,6 @@
 #include "session/session_config.h"
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -219,7 +220,7 @@ void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
 void parse(const Json& json, const std::string& file, SessionConfig& c, bool defaults) {
   const Section root(json, "", file, defaults);
   root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "paradigm",
-              "classifier", "robot"});
+              "classifier", "errp", "robot"});
   c.display_hz = root.number("display_hz", c.display_hz, 10.0, 500.0);
   const Section hmd = root.section("hmd");
   hmd.known({"width", "height", "undistort", "mirror_monitor"});
@@ -238,8 +239,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   if (c.world.objects.size() < 2) world_section.fail("objects", "must name at least 2 objects");
 
   const Section eeg = root.section("eeg");
-  eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale", "file",
-             "photodiode_channel", "latency_ms"});
+  eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale",
+             "errp_scale", "file", "photodiode_channel", "latency_ms"});
   c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file"});
   c.eeg.seed =
       static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
@@ -252,6 +253,7 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   c.eeg.block_size = eeg.integer("block_size", c.eeg.block_size, 1, 4096);
   c.eeg.line_hz = eeg.number("line_hz", c.eeg.line_hz, 0.0, 70.0);
   c.eeg.erp_scale = eeg.number("erp_scale", c.eeg.erp_scale, 0.0, 10.0);
+  c.eeg.errp_scale = eeg.number("errp_scale", c.eeg.errp_scale, 0.0, 10.0);
   c.eeg.file = eeg.text("file", c.eeg.file);
   c.eeg.photodiode_channel = eeg.text("photodiode_channel", c.eeg.photodiode_channel);
   c.eeg.latency_ms = eeg.number("latency_ms", c.eeg.latency_ms, 0.0, 1000.0);
@@ -317,6 +319,32 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   c.pipeline.filter.notch_hz = cl.number("notch_hz", c.pipeline.filter.notch_hz, 0.0, 500.0);
   c.model_file = cl.text("model", c.model_file);
 
+  const Section e = root.section("errp");
+  e.known({"enabled", "calibration_feedbacks", "wrong_feedback_rate", "threshold", "runner_up",
+           "repeat_sequences", "max_corrections", "channels", "window_ms", "decimate_hz",
+           "method"});
+  ps.errp = e.boolean("enabled", ps.errp);
+  ps.errp_calibration_feedbacks =
+      e.integer("calibration_feedbacks", ps.errp_calibration_feedbacks, 4, 1000);
+  ps.errp_wrong_rate = e.number("wrong_feedback_rate", ps.errp_wrong_rate, 0.05, 0.5);
+  ps.errp_runner_up = e.number("runner_up", ps.errp_runner_up, 0.0, 1.0);
+  ps.errp_repeat_sequences = e.integer("repeat_sequences", ps.errp_repeat_sequences, 0, 100);
+  ps.errp_max_corrections = e.integer("max_corrections", ps.errp_max_corrections, 0, 10);
+  c.errp.threshold = e.number("threshold", c.errp.threshold, 0.0, 1.0);
+  if (e.has("channels")) {
+    if (!e.at("channels").is_array() || e.at("channels").empty())
+      e.fail("channels", "must be a list of channel names");
+    c.errp.channels = e.at("channels").get<std::vector<std::string>>();
+  }
+  const auto errp_window =
+      e.numbers("window_ms", {c.errp.window.start_s * 1000.0, c.errp.window.end_s * 1000.0}, 2, 2);
+  if (!(errp_window[1] > errp_window[0]) || errp_window[0] < 0.0)
+    e.fail("window_ms", "must start at or after the feedback and end after it starts");
+  c.errp.window = {errp_window[0] / 1000.0, errp_window[1] / 1000.0};
+  c.errp.decimate_hz = e.number("decimate_hz", c.errp.decimate_hz, 1.0, 500.0);
+  c.errp.method = e.text("method", c.errp.method, {"swlda", "slda", "xdawn", "riemann"});
+  if (ps.errp) (void)c.errp.pipeline(c.pipeline, c.eeg.montage);  // the montage has its channels
+
   const Section r = root.section("robot");
   r.known({"backend", "speed_factor", "host", "port", "key_file"});
   c.robot_backend = r.text("backend", c.robot_backend, {"simulated", "remote"});
@@ -329,6 +357,25 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
 }
 
 }  // namespace
+
+bci::PipelineSettings ErrpSettings::pipeline(const bci::PipelineSettings& p300,
+                                             const std::vector<std::string>& montage) const {
+  bci::PipelineSettings out = p300;
+  out.window = window;
+  out.decimate_hz = decimate_hz;
+  out.channels.clear();
+  for (const std::string& channel : channels) {
+    if (std::find(montage.begin(), montage.end(), channel) != montage.end())
+      out.channels.push_back(channel);
+  }
+  if (out.channels.empty()) {
+    std::string wanted;
+    for (const std::string& channel : channels) wanted += (wanted.empty() ? "" : ", ") + channel;
+    throw SessionConfigError("errp.channels: the EEG montage has none of " + wanted +
+                             " (the ErrP is fronto-central: name the montage's channels there)");
+  }
+  return out;
+}
 
 SessionConfig SessionConfig::defaults(const std::string& json_text, const std::string& name) {
   SessionConfig config;

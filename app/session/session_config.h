@@ -74,12 +74,28 @@ struct EegSettings {
   double rate_hz = 256.0;
   int block_size = 15;
   double line_hz = 50.0;
-  double erp_scale = 1.0;  // the simulated subject's ERP amplitude factor (weak subjects < 1)
-  std::string file;        // source "file": a recording replayed in real time
+  double erp_scale = 1.0;   // the simulated subject's ERP amplitude factor (weak subjects < 1)
+  double errp_scale = 1.0;  // its error-related potentials' amplitude factor (0: none)
+  std::string file;         // source "file": a recording replayed in real time
   // The channel a photodiode on the HMD's patch feeds (simulated: a virtual channel of this name
   // is added); empty: none.
   std::string photodiode_channel;
   double latency_ms = 0.0;  // the amplifier's delivery latency, as timing-check measured it
+};
+
+// The ErrP classifier (docs/errp.md), trained on the calibration run's feedback block when
+// paradigm.errp is on: shrinkage LDA (or another method) over the decimated window after each
+// feedback, on the fronto-central channels the montage has.
+struct ErrpSettings {
+  double threshold = 0.5;  // a selection whose posterior of "error" exceeds it is rejected
+  std::vector<std::string> channels{"FCz", "Fz", "Cz", "FC1", "FC2"};
+  bci::EpochWindow window{0.0, 0.8};
+  double decimate_hz = 20.0;
+  std::string method = "slda";
+  // The ErrP pipeline: the session's filters, this window, decimation and channels (those of
+  // `channels` the montage has; throws SessionConfigError when it has none).
+  bci::PipelineSettings pipeline(const bci::PipelineSettings& p300,
+                                 const std::vector<std::string>& montage) const;
 };
 
 struct TrialIntent {
@@ -105,6 +121,7 @@ struct SessionConfig {
   std::vector<TrialIntent> intended;
   std::string classifier_method = "slda";
   bci::PipelineSettings pipeline;
+  ErrpSettings errp;
   std::string model_file;                   // a trained model: no calibration run
   std::string robot_backend = "simulated";  // "simulated" (arbci-robotd here) or "remote"
   double robot_speed_factor = 8.0;

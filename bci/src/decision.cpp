@@ -1,11 +1,12 @@
 #include "arbci/bci/decision.h"
 
-#include "arbci/bci/intervals.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <vector>
+
+#include "arbci/bci/intervals.h"
 
 namespace arbci::bci {
 
@@ -64,23 +65,52 @@ std::map<int, double> SelectionAccumulator::posterior(int first_code, int count)
   return p;
 }
 
+double errorPosterior(const ScoreModel& errp, double score, double prior_error) {
+  const double prior = std::clamp(prior_error, 0.01, 0.99);
+  const double a = score - errp.target_mean, b = score - errp.other_mean;
+  // log p(score | error) - log p(score | correct), equal variances.
+  const double log_ratio = (b * b - a * a) / (2.0 * errp.sd * errp.sd);
+  const double log_odds = std::clamp(log_ratio + std::log(prior / (1.0 - prior)), -700.0, 700.0);
+  return 1.0 / (1.0 + std::exp(-log_odds));
+}
+
 Decision SelectionAccumulator::decide() const {
   Decision decision;
-  auto best = [](const std::map<int, double>& p) {
-    return *std::max_element(p.begin(), p.end(),
-                             [](const auto& a, const auto& b) { return a.second < b.second; });
+  using Entry = std::pair<int, double>;
+  auto ranked = [](const std::map<int, double>& p) {
+    std::vector<Entry> order(p.begin(), p.end());
+    std::stable_sort(order.begin(), order.end(),
+                     [](const Entry& a, const Entry& b) { return a.second > b.second; });
+    return order;
   };
   if (layout_.kind == ParadigmLayout::Kind::RowColumn) {
-    const auto row = best(posterior(1, layout_.rows));
-    const auto column = best(posterior(layout_.rows + 1, layout_.columns));
-    decision.codes = {row.first, column.first};
-    decision.choice = (row.first - 1) * layout_.columns + (column.first - layout_.rows - 1);
-    decision.certainty = row.second * column.second;
+    const auto rows = ranked(posterior(1, layout_.rows));
+    const auto columns = ranked(posterior(layout_.rows + 1, layout_.columns));
+    auto cell = [&](const Entry& row, const Entry& column) {
+      return (row.first - 1) * layout_.columns + (column.first - layout_.rows - 1);
+    };
+    decision.codes = {rows[0].first, columns[0].first};
+    decision.choice = cell(rows[0], columns[0]);
+    decision.certainty = rows[0].second * columns[0].second;
+    const double other_row = rows.size() > 1 ? rows[1].second * columns[0].second : -1.0;
+    const double other_column = columns.size() > 1 ? rows[0].second * columns[1].second : -1.0;
+    if (other_row >= 0.0 || other_column >= 0.0) {
+      const Entry& row = other_row >= other_column ? rows[1] : rows[0];
+      const Entry& column = other_row >= other_column ? columns[0] : columns[1];
+      decision.runner_up_codes = {row.first, column.first};
+      decision.runner_up_choice = cell(row, column);
+      decision.runner_up_certainty = std::max(other_row, other_column);
+    }
   } else {
-    const auto object = best(posterior(1, layout_.stimuli));
-    decision.codes = {object.first};
-    decision.choice = object.first - 1;
-    decision.certainty = object.second;
+    const auto objects = ranked(posterior(1, layout_.stimuli));
+    decision.codes = {objects[0].first};
+    decision.choice = objects[0].first - 1;
+    decision.certainty = objects[0].second;
+    if (objects.size() > 1) {
+      decision.runner_up_codes = {objects[1].first};
+      decision.runner_up_choice = objects[1].first - 1;
+      decision.runner_up_certainty = objects[1].second;
+    }
   }
   return decision;
 }

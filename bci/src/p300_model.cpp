@@ -52,6 +52,10 @@ nlohmann::json P300Model::toJson() const {
       {"soa_s", layout.soa_s},
       {"symbols", layout.symbols}};
   json["provenance"] = provenance;
+  if (errp) {
+    json["errp"] = errp->toJson();
+    if (!std::isnan(errp_auc)) json["errp"]["cross_validated_auc"] = errp_auc;
+  }
   return json;
 }
 
@@ -99,6 +103,11 @@ P300Model P300Model::fromJson(const nlohmann::json& json, const std::string& sou
     }
     model.layout.symbols = l.value("symbols", std::vector<std::string>{});
     model.provenance = json.value("provenance", nlohmann::json::object());
+    if (json.contains("errp")) {
+      model.errp = std::make_shared<const P300Model>(fromJson(json.at("errp"), source + " (errp)"));
+      model.errp_auc =
+          json.at("errp").value("cross_validated_auc", std::numeric_limits<double>::quiet_NaN());
+    }
     return model;
   } catch (const nlohmann::json::exception& error) {
     throw ModelError(source + ": " + error.what());

@@ -27,6 +27,8 @@ const char* toString(Phase phase) {
       return "calibration: target cued";
     case Phase::CalibrationFlashing:
       return "calibration: flashing";
+    case Phase::CalibrationFeedback:
+      return "calibration: feedback";
     case Phase::Training:
       return "training the classifier";
     case Phase::ObjectFlashing:
@@ -80,17 +82,21 @@ void Paradigm::start(bool calibrate) {
   if (phase_ != Phase::Setup) return;
   calibrating_ = calibrate || settings_.flashes_only;
   if (calibrating_ && settings_.calibration_selections > 0) {
-    calibration_target_ = *object_layout_.drawTarget(random_).begin();
-    phase_until_ = now_ + settings_.cue_s;
-    enter(Phase::CalibrationCue, objectName(*calibration_target_));
-    ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
-    e.codes = {*calibration_target_};
-    event(e);
+    cueCalibrationTarget(0.0);
   } else {
     calibrating_ = false;
     trial_ = 1;
     startFlashing(nextFrame(), true);
   }
+}
+
+void Paradigm::cueCalibrationTarget(double delay_s) {
+  calibration_target_ = *object_layout_.drawTarget(random_).begin();
+  phase_until_ = now_ + delay_s + settings_.cue_s;
+  enter(Phase::CalibrationCue, objectName(*calibration_target_));
+  ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
+  e.codes = {*calibration_target_};
+  event(e);
 }
 
 void Paradigm::startFlashing(double at_s, bool objects) {
@@ -100,6 +106,9 @@ void Paradigm::startFlashing(double at_s, bool objects) {
   sequence_ = 0;
   stop_requested_ = false;
   awaiting_decision_ = false;
+  sequences_override_ = 0;
+  corrections_ = 0;
+  verdict_pending_ = false;
   if (objects) selected_cell_.reset();
   enter(calibrating_ ? Phase::CalibrationFlashing
                      : (objects ? Phase::ObjectFlashing : Phase::CellFlashing));
@@ -133,9 +142,12 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
     // end of flashing.
     if (!schedule_.empty() && next_flash_ == schedule_.size() &&
         due_s >= schedule_.back().onset_s + settings_.soaSeconds() - kSlack) {
-      const bool dynamic_stop =
-          !calibrating_ && stop_requested_ && sequence_ >= settings_.min_sequences;
-      const int most = calibrating_ ? settings_.calibration_sequences : settings_.sequences;
+      // A selection repeated after an ErrP rejection shows all its sequences.
+      const bool dynamic_stop = !calibrating_ && sequences_override_ == 0 && stop_requested_ &&
+                                sequence_ >= settings_.min_sequences;
+      const int most = calibrating_              ? settings_.calibration_sequences
+                       : sequences_override_ > 0 ? sequences_override_
+                                                 : settings_.sequences;
       if (sequence_ < most && !dynamic_stop) {
         scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
       } else {
@@ -164,13 +176,46 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   }
   switch (phase_) {
     case Phase::CalibrationCue:
-      if (due_s >= phase_until_ - kSlack) startFlashing(nextFrame(), true);
+      if (due_s < phase_until_ - kSlack) break;
+      if (!errp_block_) {
+        startFlashing(nextFrame(), true);
+        break;
+      }
+      {
+        // The ErrP block: the cued object, or deliberately another, shown as if selected.
+        int shown = *calibration_target_;
+        const bool wrong = errp_plan_[errp_done_];
+        if (wrong) {
+          std::uniform_int_distribution<int> other(1, object_layout_.stimuli - 1);
+          shown = other(random_);
+          if (shown >= *calibration_target_) ++shown;
+        }
+        shown_codes_ = {shown};
+        shown_error_ = wrong;
+        selected_object_ = shown;
+        feedback_pending_ = true;
+        phase_until_ = due_s + settings_.result_s;
+        enter(Phase::CalibrationFeedback, objectName(shown) + (wrong ? " (wrong)" : ""));
+      }
+      break;
+    case Phase::CalibrationFeedback:
+      if (due_s < phase_until_ - kSlack) break;
+      selected_object_.reset();
+      if (++errp_done_ < errp_plan_.size()) {
+        cueCalibrationTarget(settings_.pause_s);
+      } else {
+        errp_block_ = false;
+        calibration_target_.reset();
+        calibrating_ = false;
+        enter(Phase::Training);
+        event(ParadigmEvent{ParadigmEvent::Kind::TrainModel});
+      }
       break;
     case Phase::ObjectSelected:
-      if (due_s >= phase_until_ - kSlack) askRobot(Phase::Grasping);
+      if (due_s >= phase_until_ - kSlack && !verdict_pending_) askRobot(Phase::Grasping);
       break;
     case Phase::CellSelected:
-      if (due_s >= phase_until_ - kSlack) askRobot(Phase::Dropping);
+      if (due_s >= phase_until_ - kSlack && !verdict_pending_) askRobot(Phase::Dropping);
       break;
     default:
       break;
@@ -180,6 +225,17 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
                      phase_ == Phase::Dropping || phase_ == Phase::Grasping;
   if (calibrating_ && (phase_ == Phase::CalibrationCue || phase_ == Phase::CalibrationFlashing))
     out.cued_object = calibration_target_;
+  if (phase_ == Phase::CalibrationFeedback) out.selected_object = selected_object_;
+  // The first frame that shows a selection: its feedback's onset (stamped when presented).
+  if (feedback_pending_ && (phase_ == Phase::ObjectSelected || phase_ == Phase::CellSelected ||
+                            phase_ == Phase::CalibrationFeedback)) {
+    feedback_pending_ = false;
+    ParadigmEvent e{ParadigmEvent::Kind::Feedback};
+    e.codes = shown_codes_;
+    e.objects_layout = phase_ != Phase::CellSelected;
+    e.error = phase_ == Phase::CalibrationFeedback ? shown_error_ : std::nullopt;
+    event(e);
+  }
   if (phase_ == Phase::ObjectSelected || phase_ == Phase::Grasping ||
       phase_ == Phase::CellFlashing || phase_ == Phase::CellSelected || phase_ == Phase::Dropping) {
     out.selected_object = selected_object_;
@@ -215,12 +271,17 @@ void Paradigm::decide(const Decision& decision) {
   if (phase_ == Phase::CalibrationFlashing) {
     ++calibration_done_;
     if (settings_.flashes_only || calibration_done_ < settings_.calibration_selections) {
-      calibration_target_ = *object_layout_.drawTarget(random_).begin();
-      phase_until_ = now_ + settings_.pause_s + settings_.cue_s;
-      enter(Phase::CalibrationCue, objectName(*calibration_target_));
-      ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
-      e.codes = {*calibration_target_};
-      event(e);
+      cueCalibrationTarget(settings_.pause_s);
+    } else if (settings_.errp && settings_.errp_calibration_feedbacks > 0) {
+      // The ErrP block: a fixed share of wrong feedbacks, in random order.
+      const int n = settings_.errp_calibration_feedbacks;
+      const int wrong = static_cast<int>(std::lround(settings_.errp_wrong_rate * n));
+      errp_plan_.assign(static_cast<size_t>(n), false);
+      std::fill(errp_plan_.begin(), errp_plan_.begin() + wrong, true);
+      std::shuffle(errp_plan_.begin(), errp_plan_.end(), random_);
+      errp_done_ = 0;
+      errp_block_ = true;
+      cueCalibrationTarget(settings_.pause_s);
     } else {
       calibration_target_.reset();
       calibrating_ = false;
@@ -229,26 +290,78 @@ void Paradigm::decide(const Decision& decision) {
     }
     return;
   }
+  if (phase_ != Phase::ObjectFlashing && phase_ != Phase::CellFlashing) return;
+  last_decision_ = decision;
+  runner_up_taken_ = false;
+  showSelection(decision.codes, decision.choice, decision.certainty,
+                phase_ == Phase::ObjectFlashing, "");
+}
+
+void Paradigm::showSelection(const std::set<int>& codes, int choice, double certainty, bool objects,
+                             const std::string& text) {
   ParadigmEvent made{ParadigmEvent::Kind::SelectionMade};
-  made.codes = decision.codes;
-  made.certainty = decision.certainty;
-  made.objects_layout = phase_ == Phase::ObjectFlashing;
-  const double show = settings_.result_s;
-  if (phase_ == Phase::ObjectFlashing) {
-    selected_object_ = decision.choice + 1;
+  made.codes = codes;
+  made.certainty = certainty;
+  made.objects_layout = objects;
+  made.text = text;
+  shown_codes_ = codes;
+  shown_error_.reset();
+  feedback_pending_ = true;
+  verdict_pending_ = settings_.errp;
+  phase_until_ = now_ + settings_.result_s;
+  if (objects) {
+    selected_object_ = choice + 1;
     made.object = *selected_object_;
     event(made);
-    phase_until_ = now_ + show;
-    enter(Phase::ObjectSelected, objectName(*selected_object_));
-  } else if (phase_ == Phase::CellFlashing) {
-    selected_cell_ = {decision.choice / grid_layout_.columns + 1,
-                      decision.choice % grid_layout_.columns + 1};
+    enter(Phase::ObjectSelected,
+          objectName(*selected_object_) + (text.empty() ? "" : " (" + text + ")"));
+  } else {
+    selected_cell_ = {choice / grid_layout_.columns + 1, choice % grid_layout_.columns + 1};
     made.cell = *selected_cell_;
     event(made);
-    phase_until_ = now_ + show;
     enter(Phase::CellSelected, "row " + std::to_string(selected_cell_->first) + " column " +
-                                   std::to_string(selected_cell_->second));
+                                   std::to_string(selected_cell_->second) +
+                                   (text.empty() ? "" : " (" + text + ")"));
   }
+}
+
+bool Paradigm::awaitingErrpVerdict() const {
+  return verdict_pending_ && (phase_ == Phase::ObjectSelected || phase_ == Phase::CellSelected);
+}
+
+void Paradigm::errpVerdict(bool error) {
+  if (!awaitingErrpVerdict()) return;
+  verdict_pending_ = false;
+  if (!error) return;  // executed once the selection has been shown its time
+  const bool objects = phase_ == Phase::ObjectSelected;
+  ++corrections_;
+  ParadigmEvent correction{ParadigmEvent::Kind::ErrpCorrection};
+  correction.objects_layout = objects;
+  if (corrections_ > settings_.errp_max_corrections) {
+    correction.text = "skip";
+    event(correction);
+    nextTrial(nextFrame(), "skipped: the ErrP rejected " + std::to_string(corrections_) +
+                               " selections in a row");
+    return;
+  }
+  const Decision& d = last_decision_;
+  const double rest = 1.0 - d.certainty;
+  if (!runner_up_taken_ && d.runner_up_choice >= 0 && rest > 0.0 &&
+      d.runner_up_certainty / rest >= settings_.errp_runner_up) {
+    runner_up_taken_ = true;
+    correction.text = "runner-up";
+    event(correction);
+    showSelection(d.runner_up_codes, d.runner_up_choice, d.runner_up_certainty, objects,
+                  "runner-up");
+    return;
+  }
+  correction.text = "repeat";
+  event(correction);
+  const int corrections = corrections_;
+  startFlashing(nextFrame(), objects);
+  corrections_ = corrections;
+  sequences_override_ = settings_.errp_repeat_sequences > 0 ? settings_.errp_repeat_sequences
+                                                            : 2 * settings_.sequences;
 }
 
 void Paradigm::modelTrained(bool ok, const std::string& text) {

@@ -80,6 +80,11 @@ SubjectProfile SubjectProfile::drawn(std::uint64_t seed) {
   p.n2_amplitude_uv = -(1.0 + 2.0 * unit(random));
   p.n2_latency_s = 0.20 + 0.06 * unit(random);
   p.latency_jitter_s = 0.03 + 0.03 * unit(random);
+  // Drawn after the P300's, so a seed's P300 stays what it was.
+  p.errp_ne_amplitude_uv = -(6.0 + 4.0 * unit(random));
+  p.errp_ne_latency_s = 0.22 + 0.07 * unit(random);
+  p.errp_pe_amplitude_uv = 8.0 + 5.0 * unit(random);
+  p.errp_pe_latency_s = p.errp_ne_latency_s + 0.10 + 0.01 * unit(random);
   return p;
 }
 
@@ -147,6 +152,22 @@ void SimulatedSubject::present(const StimulusEvent& event) {
   responses_.push_back(response);
 }
 
+void SimulatedSubject::feedback(std::int64_t sample, const std::set<int>& codes) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  ActiveResponse response{};
+  response.onset = sample;
+  response.attended = false;
+  const bool agrees = !attended_.empty() && codes == attended_;
+
+  response.errp_scale = agrees ? profile_.errp_correct_fraction : 1.0;
+  // The shift of the whole complex, and its size this time.
+  response.p3_latency = profile_.errp_latency_jitter_s * normal(trial_random_);
+  response.p3_scale =
+      std::exp(profile_.amplitude_variability * normal(trial_random_) -
+               0.5 * profile_.amplitude_variability * profile_.amplitude_variability);
+  responses_.push_back(response);
+}
+
 void SimulatedSubject::displayed(double host_s, bool patch_lit) {
   const auto first =
       static_cast<std::int64_t>(std::ceil(clock_->sampleAtHost(host_s, config_.rate_hz) - 1e-6));
@@ -159,6 +180,15 @@ float SimulatedSubject::evoked(int channel, std::int64_t sample) const {
   for (const ActiveResponse& r : responses_) {
     const double t = (sample - r.onset) / config_.rate_hz;
     if (t < 0.0 || t > 1.0) continue;
+    if (r.errp_scale > 0.0) {
+      const double shift = r.p3_latency, size = w.errp * r.errp_scale * r.p3_scale;
+      value +=
+          size * (profile_.errp_ne_amplitude_uv *
+                      gaussian(t, profile_.errp_ne_latency_s + shift, profile_.errp_ne_width_s) +
+                  profile_.errp_pe_amplitude_uv *
+                      gaussian(t, profile_.errp_pe_latency_s + shift, profile_.errp_pe_width_s));
+      continue;
+    }
     // N1/P2 to every flash.
     value += w.vep * profile_.vep_amplitude_uv *
              (-gaussian(t, 0.15, 0.02) + 0.8 * gaussian(t, 0.21, 0.03));

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
+#include "arbci/bci/decision.h"
 #include "arbci/bci/paradigm.h"
 
 namespace arbci::bci {
@@ -288,6 +290,153 @@ TEST(Paradigm, FlashesOnlyNeverEndsTheCalibrationRun) {
   EXPECT_NE(p.phase(), Phase::Training);
   EXPECT_GE(selections, 5);
   EXPECT_GE(flashes, selections * 3 * 4);  // every decided selection had its 3 sequences of 4
+}
+
+}  // namespace
+}  // namespace arbci::bci
+
+namespace arbci::bci {
+namespace {
+
+ParadigmSettings withErrp() {
+  ParadigmSettings s = fast();
+  s.errp = true;
+  s.errp_calibration_feedbacks = 8;
+  s.errp_wrong_rate = 0.25;
+  return s;
+}
+
+// The calibration run ends with its ErrP block: each feedback shows the cued object or, for the
+// planned share, another one; the feedback is an event of its own, and training comes after.
+TEST(ParadigmErrp, TheCalibrationRunEndsWithFeedbacksAQuarterOfThemWrong) {
+  Paradigm p(withErrp(), 4, 3, 3, 7);
+  std::int64_t frame = 0;
+  p.start(true);
+  std::vector<ParadigmEvent> events;
+  for (int i = 0; i < 20000 && p.phase() != Phase::Training; ++i) {
+    const FrameStimulus shown = p.frame(frame++);
+    if (shown.phase == Phase::CalibrationFeedback) {
+      EXPECT_TRUE(shown.selected_object.has_value());
+      EXPECT_FALSE(shown.cued_object.has_value());  // the cue is gone while the feedback shows
+    }
+    for (auto& e : p.takeEvents()) events.push_back(e);
+    if (p.awaitingDecision()) p.decide(choose(0, {1}));
+  }
+  ASSERT_EQ(p.phase(), Phase::Training);
+  int feedbacks = 0, wrong = 0;
+  std::optional<int> cued;
+  for (const ParadigmEvent& e : events) {
+    if (e.kind == Kind::SelectionStarted && !e.codes.empty()) cued = *e.codes.begin();
+    if (e.kind != Kind::Feedback) continue;
+    ++feedbacks;
+    ASSERT_TRUE(e.error.has_value());
+    ASSERT_TRUE(cued.has_value());
+    EXPECT_EQ(*e.error, e.codes != std::set<int>{*cued});
+    wrong += *e.error;
+  }
+  EXPECT_EQ(feedbacks, 8);
+  EXPECT_EQ(wrong, 2);
+}
+
+// Online, the robot waits for the ErrP verdict however long the selection has been shown.
+TEST(ParadigmErrp, NoGraspBeforeTheVerdictAndARejectedSelectionTakesTheRunnerUp) {
+  Paradigm p(withErrp(), 4, 3, 3, 1);
+  std::int64_t frame = 0;
+  p.start(false);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  Decision d = choose(1, {2});
+  d.certainty = 0.5;
+  d.runner_up_codes = {3};
+  d.runner_up_choice = 2;
+  d.runner_up_certainty = 0.4;  // 0.8 of what the rejected choice leaves
+  p.decide(d);
+  auto events = runUntil(
+      p, frame, [] { return false; }, 300);  // 5 s, well past result_s
+  EXPECT_TRUE(p.awaitingErrpVerdict());
+  EXPECT_EQ(std::count_if(events.begin(), events.end(),
+                          [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; }),
+            0);
+  EXPECT_EQ(std::count_if(events.begin(), events.end(),
+                          [](const ParadigmEvent& e) { return e.kind == Kind::Feedback; }),
+            1);
+  p.errpVerdict(true);
+  events = runUntil(
+      p, frame, [] { return false; }, 2);
+  auto made = std::find_if(events.begin(), events.end(),
+                           [](const ParadigmEvent& e) { return e.kind == Kind::SelectionMade; });
+  ASSERT_NE(made, events.end());
+  EXPECT_EQ(made->object, 3);
+  EXPECT_EQ(made->text, "runner-up");
+  EXPECT_EQ(p.corrections(), 1);
+  // The runner-up is shown as feedback and judged in turn; accepted, the robot grasps it.
+  EXPECT_TRUE(p.awaitingErrpVerdict());
+  p.errpVerdict(false);
+  events = runUntil(
+      p, frame, [&] { return p.phase() == Phase::Grasping; }, 200);
+  auto grasp = std::find_if(events.begin(), events.end(),
+                            [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; });
+  ASSERT_NE(grasp, events.end());
+  EXPECT_EQ(grasp->object, 3);
+}
+
+// A runner-up without enough evidence: the selection is made again, with more sequences; after
+// the most corrections the trial is skipped and the robot never moves.
+TEST(ParadigmErrp, WithoutACloseRunnerUpTheSelectionIsRepeatedThenTheTrialSkipped) {
+  ParadigmSettings s = withErrp();
+  s.errp_max_corrections = 1;
+  Paradigm p(s, 4, 3, 3, 1);
+  std::int64_t frame = 0;
+  p.start(false);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  Decision d = choose(1, {2});
+  d.certainty = 0.6;
+  d.runner_up_codes = {3};
+  d.runner_up_choice = 2;
+  d.runner_up_certainty = 0.1;  // 0.25 of the rest: not close
+  p.decide(d);
+  runUntil(
+      p, frame, [] { return false; }, 2);
+  p.errpVerdict(true);
+  int flashes = 0;
+  auto events = runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  for (const ParadigmEvent& e : events) flashes += e.kind == Kind::Flash;
+  EXPECT_EQ(flashes, 4 * 6);  // twice the 3 sequences, all of them
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
+  p.decide(d);
+  runUntil(
+      p, frame, [] { return false; }, 2);
+  p.errpVerdict(true);
+  events = runUntil(
+      p, frame, [] { return false; }, 2);
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const ParadigmEvent& e) {
+    return e.kind == Kind::ErrpCorrection && e.text == "skip";
+  }));
+  EXPECT_TRUE(std::none_of(events.begin(), events.end(),
+                           [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; }));
+  EXPECT_EQ(p.trial(), 2);
+}
+
+// The runner-up of a row/column selection differs in the less certain of row and column; the
+// ErrP posterior follows the score model and the prior.
+TEST(ParadigmErrp, TheRunnerUpCellAndTheErrorPosterior) {
+  const ParadigmLayout grid = ParadigmLayout::matrix(3, 3, 0.18);
+  ScoreModel model{1.0, -1.0, 1.0};
+  SelectionAccumulator a(grid, model);
+  for (int code = 1; code <= 6; ++code) a.add(code, -1.0);
+  a.add(2, 3.0);  // row 2, very sure
+  a.add(6, 1.0);  // column 3, less sure than row 2
+  a.add(5, 0.6);  // column 2, close behind
+  const Decision d = a.decide();
+  EXPECT_EQ(d.codes, (std::set<int>{2, 6}));
+  EXPECT_EQ(d.runner_up_codes, (std::set<int>{2, 5}));
+  EXPECT_EQ(d.runner_up_choice, 1 * 3 + 1);
+  EXPECT_LT(d.runner_up_certainty, d.certainty);
+  // A score at the error class's mean with an even prior: the likelihood ratio decides.
+  const ScoreModel errp{2.0, 0.0, 1.0};
+  EXPECT_NEAR(errorPosterior(errp, 1.0, 0.5), 0.5, 1e-12);
+  EXPECT_NEAR(errorPosterior(errp, 2.0, 0.5), 1.0 / (1.0 + std::exp(-2.0)), 1e-12);
+  EXPECT_LT(errorPosterior(errp, 2.0, 0.05), errorPosterior(errp, 2.0, 0.5));
+  EXPECT_NEAR(errorPosterior(errp, 1.0, 0.0), 0.01, 1e-12);  // the prior is kept off 0
 }
 
 }  // namespace

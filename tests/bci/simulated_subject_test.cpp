@@ -2,6 +2,7 @@
 // flashes only, alpha at the configured frequency, blinks frontal.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -105,6 +106,83 @@ TEST(SimulatedSubject, TargetMinusNonTargetAtPzPeaksBetween250And500Ms) {
   EXPECT_GE(peak_ms, 250.0);
   EXPECT_LE(peak_ms, 500.0);
   EXPECT_GT(target[peak] / n_target - other[peak] / n_other, 1.0);  // microvolts
+}
+
+// Feedback every 1.5 s, a quarter of it wrong (the subject attends code 1): the average at Cz
+// after wrong minus right feedback has the ErrP's fronto-central negativity and later positivity,
+// at the profile's latencies; with errp amplitudes of 0 there is none.
+struct FeedbackAverages {
+  std::vector<double> difference;  // Cz, wrong minus right, 0-800 ms, 12 Hz low-passed
+  int wrong = 0, right = 0;
+};
+
+FeedbackAverages feedbackAverages(const SimulatedSubjectConfig& config) {
+  auto clock = std::make_shared<ManualClock>();
+  SimulatedSubject subject(config, clock);
+  subject.attend({1});
+  std::vector<std::pair<std::int64_t, bool>> feedbacks;  // onset, wrong
+  std::vector<std::vector<float>> channels(config.montage.size());
+  std::int64_t next = 128;
+  const auto total = static_cast<std::int64_t>(900.0 * config.rate_hz);
+  while (subject.samplesGenerated() < total) {
+    const std::int64_t end = subject.samplesGenerated() + config.block_size;
+    while (next < end) {
+      const bool wrong = feedbacks.size() % 4 == 1;
+      subject.feedback(next, {wrong ? 3 : 1});
+      feedbacks.emplace_back(next, wrong);
+      next += static_cast<std::int64_t>(1.5 * config.rate_hz);
+    }
+    clock->advanceTo(end / config.rate_hz);
+    for (const Block& b : subject.poll()) {
+      for (int c = 0; c < b.channels; ++c)
+        for (int s = 0; s < b.samples; ++s) channels[c].push_back(b.at(c, s));
+    }
+  }
+  SignalInfo info;
+  info.channels = config.montage;
+  Block all(0, static_cast<int>(channels.size()), static_cast<int>(channels[0].size()));
+  for (int c = 0; c < all.channels; ++c)
+    std::copy(channels[c].begin(), channels[c].end(), all.data.begin() + c * all.samples);
+  FilterSettings settings;
+  settings.common_average = false;  // the ErrP is everywhere: a common average would halve it
+  settings.lowpass_hz = 12.0;
+  FilterChain(settings, info).process(all);
+  const int cz = 1, length = 205;
+  FeedbackAverages out;
+  std::vector<double> wrong(length, 0.0), right(length, 0.0);
+  for (const auto& [onset, is_wrong] : feedbacks) {
+    if (onset + length > all.samples) break;
+    (is_wrong ? out.wrong : out.right)++;
+    for (int s = 0; s < length; ++s)
+      (is_wrong ? wrong : right)[s] += all.at(cz, static_cast<int>(onset) + s);
+  }
+  for (int s = 0; s < length; ++s)
+    out.difference.push_back(wrong[s] / out.wrong - right[s] / out.right);
+  return out;
+}
+
+TEST(SimulatedSubject, WrongFeedbackEvokesAFrontoCentralNegativityThenPositivity) {
+  SimulatedSubjectConfig config;
+  config.blinks_per_minute = 0.0;
+  const SubjectProfile profile = SubjectProfile::drawn(config.seed);
+  const FeedbackAverages a = feedbackAverages(config);
+  ASSERT_GT(a.wrong, 140);
+  const auto low = std::min_element(a.difference.begin(), a.difference.begin() + 103);
+  const auto high = std::max_element(a.difference.begin(), a.difference.end());
+  const double low_ms = (low - a.difference.begin()) * 1000.0 / 256.0;
+  const double high_ms = (high - a.difference.begin()) * 1000.0 / 256.0;
+  // The filters delay a little; the components overlap, so the peaks move apart a little.
+  EXPECT_NEAR(low_ms, 1000.0 * profile.errp_ne_latency_s, 60.0);
+  EXPECT_NEAR(high_ms, 1000.0 * profile.errp_pe_latency_s, 60.0);
+  EXPECT_LT(*low, -1.5);  // microvolts
+  EXPECT_GT(*high, 2.0);
+  EXPECT_LT(low_ms, high_ms);
+
+  SubjectProfile none = profile;
+  none.errp_ne_amplitude_uv = none.errp_pe_amplitude_uv = 0.0;
+  config.profile = none;
+  const FeedbackAverages b = feedbackAverages(config);
+  for (double v : b.difference) EXPECT_LT(std::abs(v), 1.5);
 }
 
 // Power at `frequency` by a Goertzel-like projection, averaged over 2 s windows.

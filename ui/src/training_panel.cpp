@@ -110,6 +110,23 @@ void TrainingPanel::draw() {
       ImGui::TextWrapped(
           "session model: %s, trained on %s", current->method.c_str(),
           current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
+      const auto threshold = model_.errpThreshold();
+      if (current->errp) {
+        std::string channels;
+        for (const auto& c : current->errp->pipeline.channels)
+          channels += (channels.empty() ? "" : ", ") + c;
+        ImGui::TextWrapped(
+            "ErrP classifier: %s on %s, %.0f-%.0f ms after the feedback; cross-validated AUC "
+            "%.3f; a selection is rejected above a posterior of error of %.2f",
+            current->errp->method.c_str(), channels.c_str(),
+            1000.0 * current->errp->pipeline.window.start_s,
+            1000.0 * current->errp->pipeline.window.end_s, current->errp_auc,
+            threshold.value_or(0.5));
+      } else if (threshold) {
+        ImGui::TextDisabled(
+            "ErrP classifier: none yet (trained after the calibration run's "
+            "feedback block); until then selections are executed unchecked");
+      }
     } else {
       ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
     }

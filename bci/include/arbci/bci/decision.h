@@ -30,7 +30,17 @@ struct Decision {
   std::set<int> codes;     // {object} or {row, rows + column}
   int choice = -1;         // 0-based object or cell (row-major)
   double certainty = 0.0;  // posterior probability of `codes`
+  // The next most probable choice (for a cell: the best row with the second column, or the
+  // second row with the best column), for a correction when the choice is rejected.
+  std::set<int> runner_up_codes;
+  int runner_up_choice = -1;
+  double runner_up_certainty = 0.0;
 };
+
+// The posterior probability that a selection was wrong, from its ErrP classifier score under the
+// Gaussian score model (target: error feedback) and the prior probability of an error (1 minus
+// the selection's certainty, kept within 0.01-0.99 so neither source alone is final).
+double errorPosterior(const ScoreModel& errp, double score, double prior_error);
 
 struct StoppingRule {
   int max_sequences = 15;

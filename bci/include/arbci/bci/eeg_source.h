@@ -21,6 +21,10 @@ class EegSource {
   // Which stimulus codes the subject attends from now on (empty: none). A row/column paradigm
   // attends the target's row and its column.
   virtual void attend(const std::set<int>&) {}
+  // A selection's feedback first shown at `sample`: the stimulus codes it shows as chosen (an
+  // object's, or a cell's row and column). The simulated subject answers with an error-related
+  // potential, large when they are not the codes it attends.
+  virtual void feedback(std::int64_t /*sample*/, const std::set<int>& /*codes*/) {}
   // What the screen showed from host instant `host_s` on: the photodiode patch lit or dark. A
   // simulated amplifier puts it on its virtual photodiode channel; a real one has a real diode.
   virtual void displayed(double /*host_s*/, bool /*patch_lit*/) {}

@@ -35,9 +35,9 @@ struct P300Dataset {
   std::vector<std::int64_t> sample;  // the stimulus onset in its file
   std::vector<SelectionEpochs> selections;
   std::vector<std::string> sources;
-  int dropped_epochs = 0;   // flashes too close to the end of a file for a whole window
-  int rejected_epochs = 0;  // over the amplitude limit (buildDataset's reject_uv)
-  int unknown_flashes = 0;  // recorded as "U" (not known whether attended): left out
+  int dropped_epochs = 0;      // flashes too close to the end of a file for a whole window
+  int rejected_epochs = 0;     // over the amplitude limit (buildDataset's reject_uv)
+  int unknown_flashes = 0;     // recorded as "U" (not known whether attended): left out
   int other_code_flashes = 0;  // codes beyond the paradigm's (a session's grid flashes): left out
   double reject_uv = 0.0;
   // Every stimulus code is always a target or never one (an oddball, or a recording coded by

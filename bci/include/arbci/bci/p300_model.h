@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,11 @@ struct P300Model {
   ScoreModel score_model;
   ParadigmLayout layout;
   nlohmann::json provenance = nlohmann::json::object();
+  // The error-related-potential classifier trained beside it (its "target": error feedback;
+  // its layout: 2 classes), when the session has one. Saved inside this model's JSON as "errp".
+  std::shared_ptr<const P300Model> errp;
+  // Its cross-validated AUC on the calibration block (NaN: unknown).
+  double errp_auc = std::numeric_limits<double>::quiet_NaN();
 
   // Throws ModelError naming the mismatch (rate, a missing channel).
   void checkCompatible(const SignalInfo& info, const std::string& what) const;

@@ -42,6 +42,19 @@ struct ParadigmSettings {
   int trials = 3;
   // The timing check: cued calibration selections without end (never training, never trials).
   bool flashes_only = false;
+  // Error-related potentials (docs/errp.md). A selection is shown for `result_s` as feedback,
+  // and the robot waits for the ErrP verdict on it; a rejected selection is replaced by the
+  // runner-up when, among the rest, it holds at least `errp_runner_up` of the probability,
+  // otherwise the selection is made again with `errp_repeat_sequences` sequences (0: twice
+  // `sequences`); after `errp_max_corrections` rejections the trial is skipped. The calibration
+  // run ends with `errp_calibration_feedbacks` cued feedbacks, `errp_wrong_rate` of them
+  // deliberately wrong (in random order).
+  bool errp = false;
+  int errp_calibration_feedbacks = 100;
+  double errp_wrong_rate = 0.25;
+  double errp_runner_up = 0.5;
+  int errp_repeat_sequences = 0;
+  int errp_max_corrections = 2;
 
   int flashFrames() const;  // frames a flash lasts (60 ms at 60 Hz: 4)
   int onsetFrames() const;  // frames from one flash onset to the next (180 ms: 11)
@@ -53,6 +66,7 @@ enum class Phase {
   Setup,
   CalibrationCue,
   CalibrationFlashing,
+  CalibrationFeedback,  // the ErrP block: a cued object shown as if selected (maybe wrongly)
   Training,
   ObjectFlashing,
   ObjectSelected,
@@ -83,7 +97,9 @@ struct ParadigmEvent {
     PhaseChanged,      // text: the phase
     SelectionStarted,  // layout, target codes (calibration) in `codes`
     Flash,             // code, onset frame
-    SelectionMade,     // codes chosen, certainty
+    SelectionMade,     // codes chosen, certainty (text "runner-up" for an ErrP correction)
+    Feedback,          // a selection first shown (codes); calibration: `error` says if wrong
+    ErrpCorrection,    // text: "runner-up", "repeat" or "skip" after a rejected selection
     TrainModel,        // the calibration run is complete: train now and call modelTrained()
     RobotGrasp,        // object slot in `object`
     RobotDrop,         // cell in `cell`
@@ -102,6 +118,7 @@ struct ParadigmEvent {
   double certainty = 0.0;
   int trial = 0;
   std::string text;
+  std::optional<bool> error;  // Feedback in the calibration run: deliberately wrong
 };
 
 class Paradigm {
@@ -136,6 +153,10 @@ class Paradigm {
   void requestStopFlashing();
   // All epochs of the selection are scored: its decision.
   void decide(const Decision& decision);
+  // The ErrP classifier's verdict on the selection shown (the robot waits for it when `errp`):
+  // `error` rejects it. Ignored unless awaitingErrpVerdict().
+  void errpVerdict(bool error);
+  bool awaitingErrpVerdict() const;
   void modelTrained(bool ok, const std::string& text);
   void robotFinished(bool success, const std::string& text);
   // The number of objects that can be selected from the next trial on (those tracked).
@@ -148,6 +169,8 @@ class Paradigm {
   std::vector<ParadigmEvent> takeEvents();
   Phase phase() const { return phase_; }
   int trial() const { return trial_; }
+  // ErrP rejections of the current selection so far.
+  int corrections() const { return corrections_; }
   int sequence() const { return sequence_; }  // the current sequence of a flashing phase (1-based)
   bool awaitingDecision() const { return awaiting_decision_; }
   const ParadigmLayout& objectLayout() const { return object_layout_; }
@@ -159,6 +182,9 @@ class Paradigm {
  private:
   void enter(Phase phase, const std::string& text = "");
   void startFlashing(double at_s, bool objects);
+  void cueCalibrationTarget(double at_s);  // the next calibration selection's (or feedback's) cue
+  void showSelection(const std::set<int>& codes, int choice, double certainty, bool objects,
+                     const std::string& text);
   void scheduleSequence(double first_onset_s);
   void restartSequence();  // an interrupted selection shows its sequence again from the start
   void nextTrial(double at_s, const std::string& why);
@@ -195,6 +221,18 @@ class Paradigm {
   std::optional<std::pair<int, int>> selected_cell_;
   std::vector<ParadigmEvent> events_;
   std::vector<int> object_ids_;
+  // ErrP.
+  bool feedback_pending_ = false;    // the next frame is the first to show the selection
+  bool verdict_pending_ = false;     // the selection shown waits for the ErrP verdict
+  std::set<int> shown_codes_;        // the selection shown as feedback
+  std::optional<bool> shown_error_;  // calibration feedback: deliberately wrong
+  Decision last_decision_;
+  bool runner_up_taken_ = false;
+  int corrections_ = 0;
+  int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
+  bool errp_block_ = false;      // the calibration run's ErrP feedback block
+  std::vector<bool> errp_plan_;  // the block's feedbacks: true = deliberately wrong
+  size_t errp_done_ = 0;
 };
 
 }  // namespace arbci::bci

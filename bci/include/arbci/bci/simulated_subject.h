@@ -1,8 +1,10 @@
 // The default EEG source: a simulated subject. Background EEG with a 1/f spectrum shared in part
 // between channels (volume conduction), alpha, line noise and eye blinks; every flash evokes a
 // small visual response, and flashes of the attended stimuli an N2/P3 complex with a parietal
-// maximum, its latency and amplitude varying from trial to trial. Deterministic for a seed and
-// the same sequence of calls.
+// maximum, its latency and amplitude varying from trial to trial. A selection's feedback evokes
+// an error-related potential at fronto-central sites (a negativity near 250 ms and a positivity
+// near 350 ms), large when the feedback disagrees with what the subject attends and small when it
+// agrees (docs/errp.md gives the sources). Deterministic for a seed and the same sequence of calls.
 #pragma once
 
 #include <cstdint>
@@ -28,8 +30,20 @@ struct SubjectProfile {
   double latency_jitter_s = 0.04;      // trial-to-trial standard deviation
   double amplitude_variability = 0.4;  // log-normal sigma of the trial's amplitude factor
   double vep_amplitude_uv = 2.0;       // N1/P2 evoked by every flash, occipital
+  // The error-related potential to a selection's feedback (at FCz; less elsewhere), when the
+  // feedback disagrees with the subject's intention; feedback that agrees evokes the same shape
+  // at `errp_correct_fraction` of the size. Jitter and variability as for the P3.
+  double errp_ne_amplitude_uv = -8.0;
+  double errp_ne_latency_s = 0.25;
+  double errp_ne_width_s = 0.035;
+  double errp_pe_amplitude_uv = 10.0;
+  double errp_pe_latency_s = 0.35;
+  double errp_pe_width_s = 0.045;
+  double errp_correct_fraction = 0.2;
+  double errp_latency_jitter_s = 0.025;
 
-  // A plausible subject drawn from `seed` (amplitude 3.5-7 uV, P3 latency 300-420 ms).
+  // A plausible subject drawn from `seed` (amplitude 3.5-7 uV, P3 latency 300-420 ms; ErrP
+  // negativity 220-290 ms, -6 to -10 uV; positivity 320-400 ms, 8-13 uV, at FCz).
   static SubjectProfile drawn(std::uint64_t seed);
 };
 
@@ -66,6 +80,7 @@ class SimulatedSubject final : public EegSource {
   std::vector<Block> poll(int max_blocks = 64) override;
   void present(const StimulusEvent& event) override;
   void attend(const std::set<int>& codes) override { attended_ = codes; }
+  void feedback(std::int64_t sample, const std::set<int>& codes) override;
   void displayed(double host_s, bool patch_lit) override;
   double knownLatencyS() const override { return clock_->deliveryLagS(); }
   const SubjectProfile& profile() const { return profile_; }
@@ -77,6 +92,8 @@ class SimulatedSubject final : public EegSource {
     std::int64_t onset;
     double p3_latency, p3_scale, n2_scale;
     bool attended;
+    // A feedback's ErrP (not a flash's response): its size relative to an error's.
+    double errp_scale = 0.0;
   };
   float evoked(int channel, std::int64_t sample) const;
 

@@ -53,6 +53,8 @@ class WorkstationModel {
 
   // Classifier.
   virtual std::optional<bci::P300Model> model() = 0;
+  // With ErrPs on: the posterior of an error above which a selection is rejected.
+  virtual std::optional<double> errpThreshold() { return std::nullopt; }
   virtual void useModel(const bci::P300Model& model) = 0;
 
   // Robot.
