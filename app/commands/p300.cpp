@@ -259,7 +259,8 @@ void train(TrainOptions& o) {
   writeReportFiles(o.report, o.scores, cv.report, facts, data, cv.scores, cv.fold);
   if (!o.plots.empty()) {
     const auto written = writeP300Plots(o.plots, data, result.cross_validation.report,
-                                        "cross-validated " + o.training.method);
+                                        "cross-validated " + o.training.method,
+                                        o.errp ? ClassNames{"error", "correct"} : ClassNames{});
     printPlots(written);
   }
   std::cout << "model: " << o.out << "\n";

@@ -97,15 +97,16 @@ void colourBar(cv::Mat& image, const cv::Rect& area, double limit, const std::st
 }
 
 // Signed r^2 per channel (rows) and time (columns).
-std::filesystem::path writeR2Figure(const std::filesystem::path& folder,
-                                    const bci::ErpCurves& erp) {
+std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const bci::ErpCurves& erp,
+                                    const ClassNames& names) {
   const int channels = static_cast<int>(erp.channels.size()), samples = erp.samples();
   if (channels == 0 || samples < 2) return {};
   const int left = 80, top = 60, row_h = std::clamp(320 / channels, 6, 28), width = 720;
   cv::Mat image(top + channels * row_h + 70, left + width + 120, CV_8UC3, kWhite);
   text(image,
-       "signed r^2 (target vs non-target) per channel and time: " + std::to_string(erp.targets) +
-           " target, " + std::to_string(erp.others) + " non-target epochs",
+       "signed r^2 (" + names.target + " vs " + names.other +
+           ") per channel and time: " + std::to_string(erp.targets) + " " + names.target + ", " +
+           std::to_string(erp.others) + " " + names.other + " epochs",
        {left, 28}, 0.5);
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
   const int label_every = (14 + row_h - 1) / row_h;
@@ -176,8 +177,8 @@ std::filesystem::path writeScalpMap(const std::filesystem::path& folder,
 
 // The ERP figure: per channel, target and non-target averages overlaid on one scale with their
 // standard-error bands, the difference wave, the baseline and the analysis window marked.
-std::filesystem::path writeErpFigure(const std::filesystem::path& folder,
-                                     const bci::ErpCurves& erp) {
+std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const bci::ErpCurves& erp,
+                                     const ClassNames& names) {
   const int channels = static_cast<int>(erp.channels.size());
   const int samples = erp.samples();
   if (channels == 0 || samples < 2) return {};
@@ -188,12 +189,12 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder,
   text(image,
        "ERP averages (mean +/- 1.96 SE over epochs, baseline " + format(erp.start_s * 1000.0, 0) +
            " to " + format((erp.start_s + erp.baseline_s) * 1000.0, 0) +
-           " ms subtracted): " + std::to_string(erp.targets) + " target, " +
-           std::to_string(erp.others) + " non-target epochs",
+           " ms subtracted): " + std::to_string(erp.targets) + " " + names.target + ", " +
+           std::to_string(erp.others) + " " + names.other + " epochs",
        {left, 26}, 0.5);
   // Legend.
-  const std::pair<const char*, cv::Scalar> legend[] = {
-      {"target", kTarget}, {"non-target", kOther}, {"difference", kBlack}};
+  const std::pair<std::string, cv::Scalar> legend[] = {
+      {names.target, kTarget}, {names.other, kOther}, {"difference", kBlack}};
   int x = left;
   for (const auto& [name, colour] : legend) {
     cv::line(image, {x, 48}, {x + 24, 48}, colour, 2, cv::LINE_AA);
@@ -272,17 +273,19 @@ nlohmann::json erpJson(const bci::ErpCurves& erp) {
 std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,
                                                   const bci::P300Dataset& data,
                                                   const bci::EvaluationReport& report,
-                                                  const std::string& title) {
+                                                  const std::string& title,
+                                                  const ClassNames& names) {
   std::error_code error;
   std::filesystem::create_directories(folder, error);
   if (error)
     throw CliError(folder.string() + ": cannot create the plot folder (" + error.message() + ")");
   std::vector<std::filesystem::path> written;
 
-  const std::filesystem::path erp_png = writeErpFigure(folder, data.erp);
+  const std::filesystem::path erp_png = writeErpFigure(folder, data.erp, names);
   if (!erp_png.empty()) {
     written.push_back(erp_png);
-    for (const auto& extra : {writeR2Figure(folder, data.erp), writeScalpMap(folder, data.erp)})
+    for (const auto& extra :
+         {writeR2Figure(folder, data.erp, names), writeScalpMap(folder, data.erp)})
       if (!extra.empty()) written.push_back(extra);
     written.push_back(folder / "erp.json");
     std::ofstream out(written.back());

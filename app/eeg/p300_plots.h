@@ -13,13 +13,19 @@
 
 namespace arbci::app {
 
+// What the two classes are called in the figures (an ErrP classifier's are error and correct).
+struct ClassNames {
+  std::string target = "target", other = "non-target";
+};
+
 // Writes erp.png, erp.json (the figure's numbers) and accuracy.png into `folder` (created if
 // missing); returns their paths.
 // Throws CliError when the folder cannot be written.
 std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,
                                                   const bci::P300Dataset& data,
                                                   const bci::EvaluationReport& report,
-                                                  const std::string& title);
+                                                  const std::string& title,
+                                                  const ClassNames& names = {});
 
 // erp.json: per channel the time axis (ms), the target and non-target averages, their difference
 // and standard errors (uV), with the baseline, the analysis window and the epoch counts.

@@ -171,13 +171,7 @@ void EegStage::setModel(bci::P300Model model) {
   errp_epocher_.reset();
   if (model.errp) {
     model.errp->checkCompatible(info(), "the EEG source (for the ErrP classifier)");
-    const bci::FilterSettings &a = model.pipeline.filter, &b = model.errp->pipeline.filter;
-    if (a.highpass_hz != b.highpass_hz || a.lowpass_hz != b.lowpass_hz || a.order != b.order ||
-        a.notch_hz != b.notch_hz || a.common_average != b.common_average) {
-      throw bci::ModelError(
-          "the model's ErrP classifier was trained with other filters than its P300 one; the "
-          "session filters once for both: train them together");
-    }
+    errp_filters_ = std::make_unique<bci::FilterChain>(model.errp->pipeline.filter, info());
     errp_extractor_.emplace(model.errp->extractor(info()));
     errp_epocher_ = std::make_unique<bci::Epocher>(eeg_info_.channelCount(), eeg_info_.rate_hz,
                                                    model.errp->pipeline.window, 10.0);
@@ -211,18 +205,21 @@ void EegStage::poll() {
       }
       calibration_.samples += block.samples;
     }
+    if (errp_epocher_) {
+      // The ErrP's own band on the raw signal.
+      bci::Block errp_block = block;
+      errp_filters_->process(errp_block);
+      for (const bci::Epoch& epoch : errp_epocher_->push(errp_block)) {
+        if (epoch.event.sample != errp_pending_) continue;
+        errp_score_ = model_->errp->classifier->score(errp_extractor_->features(epoch));
+        errp_pending_ = -1;
+      }
+    }
     filters_->process(block);
     for (int c = 0; c < block.channels; ++c) {
       auto& r = recent_[static_cast<size_t>(c)];
       for (int s = 0; s < block.samples; ++s) r.push_back(block.at(c, s));
       if (r.size() > 4096) r.erase(r.begin(), r.end() - 2048);
-    }
-    if (errp_epocher_) {
-      for (const bci::Epoch& epoch : errp_epocher_->push(block)) {
-        if (epoch.event.sample != errp_pending_) continue;
-        errp_score_ = model_->errp->classifier->score(errp_extractor_->features(epoch));
-        errp_pending_ = -1;
-      }
     }
     for (const bci::Epoch& epoch : epocher_->push(block)) {
       const auto found = flashes_.find(epoch.event.sample);

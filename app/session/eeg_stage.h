@@ -169,6 +169,7 @@ class EegStage final : public Stage {
   std::vector<std::vector<float>> recent_;
   // ErrP: the calibration block's feedbacks (code 1 error, 2 correct), the online epocher.
   std::vector<bci::StimulusEvent> errp_stimuli_;
+  std::unique_ptr<bci::FilterChain> errp_filters_;
   std::unique_ptr<bci::Epocher> errp_epocher_;
   std::optional<bci::FeatureExtractor> errp_extractor_;
   std::optional<double> errp_score_;

@@ -405,7 +405,7 @@ void ParadigmStage::handleEvents() {
                       {"action", e.text}});
         if (e.text == "runner-up") ++errp_counts_.runner_up;
         if (e.text == "repeat") ++errp_counts_.repeats;
-        if (e.text == "skip") {
+        if (e.text == "skip" || e.text == "return") {
           ++errp_counts_.skipped_trials;
           if (vetoed_since_ >= 0.0) errp_counts_.correction_s += time - vetoed_since_;
           vetoed_since_ = -1.0;
@@ -463,7 +463,11 @@ void ParadigmStage::handleEvents() {
                                    std::to_string(*other);
           std::cerr << "trial " << currentTrial().trial << ": " << currentTrial().outcome << "\n";
         }
-        s_.robot.drop(e.cell, other.has_value(), time);
+        if (e.give_back) {
+          currentTrial().outcome = "returned: the ErrP rejected every cell selected";
+          std::cerr << "trial " << currentTrial().trial << ": " << currentTrial().outcome << "\n";
+        }
+        s_.robot.drop(e.cell, other.has_value() || e.give_back, time);
         break;
       }
       case Kind::RobotStop:

@@ -322,7 +322,7 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   const Section e = root.section("errp");
   e.known({"enabled", "calibration_feedbacks", "wrong_feedback_rate", "threshold", "runner_up",
            "repeat_sequences", "max_corrections", "channels", "window_ms", "decimate_hz",
-           "method"});
+           "highpass_hz", "lowpass_hz", "method"});
   ps.errp = e.boolean("enabled", ps.errp);
   ps.errp_calibration_feedbacks =
       e.integer("calibration_feedbacks", ps.errp_calibration_feedbacks, 4, 1000);
@@ -342,6 +342,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
     e.fail("window_ms", "must start at or after the feedback and end after it starts");
   c.errp.window = {errp_window[0] / 1000.0, errp_window[1] / 1000.0};
   c.errp.decimate_hz = e.number("decimate_hz", c.errp.decimate_hz, 1.0, 500.0);
+  c.errp.highpass_hz = e.number("highpass_hz", c.errp.highpass_hz, 0.0, 100.0);
+  c.errp.lowpass_hz = e.number("lowpass_hz", c.errp.lowpass_hz, 0.0, 500.0);
   c.errp.method = e.text("method", c.errp.method, {"swlda", "slda", "xdawn", "riemann"});
   if (ps.errp) (void)c.errp.pipeline(c.pipeline, c.eeg.montage);  // the montage has its channels
 
@@ -363,6 +365,8 @@ bci::PipelineSettings ErrpSettings::pipeline(const bci::PipelineSettings& p300,
   bci::PipelineSettings out = p300;
   out.window = window;
   out.decimate_hz = decimate_hz;
+  out.filter.highpass_hz = highpass_hz;
+  out.filter.lowpass_hz = lowpass_hz;
   out.channels.clear();
   for (const std::string& channel : channels) {
     if (std::find(montage.begin(), montage.end(), channel) != montage.end())

@@ -85,15 +85,17 @@ struct EegSettings {
 
 // The ErrP classifier (docs/errp.md), trained on the calibration run's feedback block when
 // paradigm.errp is on: shrinkage LDA (or another method) over the decimated window after each
-// feedback, on the fronto-central channels the montage has.
+// feedback, on the fronto-central channels the montage has, band-passed on its own (1-10 Hz, as
+// ErrP studies filter; the P300's filters stay the P300's).
 struct ErrpSettings {
   double threshold = 0.5;  // a selection whose posterior of "error" exceeds it is rejected
   std::vector<std::string> channels{"FCz", "Fz", "Cz", "FC1", "FC2"};
   bci::EpochWindow window{0.0, 0.8};
   double decimate_hz = 20.0;
+  double highpass_hz = 1.0, lowpass_hz = 10.0;
   std::string method = "slda";
-  // The ErrP pipeline: the session's filters, this window, decimation and channels (those of
-  // `channels` the montage has; throws SessionConfigError when it has none).
+  // The ErrP pipeline: the session's notch, these band edges, window, decimation and channels
+  // (those of `channels` the montage has; throws SessionConfigError when it has none).
   bci::PipelineSettings pipeline(const bci::PipelineSettings& p300,
                                  const std::vector<std::string>& montage) const;
 };

@@ -109,6 +109,7 @@ void Paradigm::startFlashing(double at_s, bool objects) {
   sequences_override_ = 0;
   corrections_ = 0;
   verdict_pending_ = false;
+  giving_back_ = false;
   if (objects) selected_cell_.reset();
   enter(calibrating_ ? Phase::CalibrationFlashing
                      : (objects ? Phase::ObjectFlashing : Phase::CellFlashing));
@@ -257,6 +258,7 @@ void Paradigm::askRobot(Phase phase) {
                              std::to_string(selected_cell_->second));
   ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
   e.cell = *selected_cell_;
+  e.give_back = giving_back_;
   event(e);
 }
 
@@ -338,10 +340,19 @@ void Paradigm::errpVerdict(bool error) {
   ParadigmEvent correction{ParadigmEvent::Kind::ErrpCorrection};
   correction.objects_layout = objects;
   if (corrections_ > settings_.errp_max_corrections) {
-    correction.text = "skip";
-    event(correction);
-    nextTrial(nextFrame(), "skipped: the ErrP rejected " + std::to_string(corrections_) +
-                               " selections in a row");
+    const std::string why =
+        "the ErrP rejected " + std::to_string(corrections_) + " selections in a row";
+    if (objects) {
+      correction.text = "skip";
+      event(correction);
+      nextTrial(nextFrame(), "skipped: " + why);
+    } else {
+      // The arm holds the object: never left in the gripper, it goes back where it was taken.
+      correction.text = "return";
+      event(correction);
+      giving_back_ = true;
+      askRobot(Phase::Dropping);
+    }
     return;
   }
   const Decision& d = last_decision_;
@@ -351,7 +362,8 @@ void Paradigm::errpVerdict(bool error) {
     runner_up_taken_ = true;
     correction.text = "runner-up";
     event(correction);
-    showSelection(d.runner_up_codes, d.runner_up_choice, d.runner_up_certainty, objects,
+    // Its certainty now that the first choice is rejected.
+    showSelection(d.runner_up_codes, d.runner_up_choice, d.runner_up_certainty / rest, objects,
                   "runner-up");
     return;
   }

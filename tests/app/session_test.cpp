@@ -396,3 +396,87 @@ TEST(Session, ATermSignalEndsAHeadlessRunWithItsSummarySaved) {
 
 }  // namespace
 }  // namespace arbci::test
+
+namespace arbci::test {
+namespace {
+
+// ErrP study end to end: a subject without P300 (so most selections are wrong) whose ErrPs are
+// strong; the robot is only ever sent to the intended object and cell, every robot command comes
+// after an ErrP verdict that accepted its selection, and the recording trains an ErrP classifier
+// offline (arbci train --errp) into the session's model.
+TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
+  const auto folder = fresh("errp");
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"eeg": {"erp_scale": 0.0, "errp_scale": 3.0},
+    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 4, "sequences": 3, "min_sequences": 3, "certainty": 0.0,
+                 "trials": 3},
+    "errp": {"enabled": true, "calibration_feedbacks": 60, "max_corrections": 8},
+    "robot": {"speed_factor": 20}})";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session, "--seed", "4", "--out", folder.string()},
+      400.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  const nlohmann::json& errp = summary["errp"];
+  ASSERT_TRUE(errp["classifier"].get<bool>()) << errp.dump();
+  EXPECT_GE(errp["calibration_auc"].get<double>(), 0.85) << errp.dump();
+  EXPECT_GT(errp["wrong_selections"].get<int>(), 0) << errp.dump();  // the P300 guessed wrong
+  EXPECT_EQ(errp["wrong_caught"], errp["wrong_selections"]) << errp.dump();
+
+  std::map<int, nlohmann::json> intended;  // by trial
+  for (const auto& t : summary["trials"]) intended[t["trial"].get<int>()] = t;
+  int trial = 0, grasps = 0;
+  bool accepted = false;  // the last ErrP verdict accepted the selection shown
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    if (line["event"] == "phase") trial = line["trial"].get<int>();
+    if (line["event"] == "errp_decision") accepted = !line["veto"].get<bool>();
+    if (line["event"] != "robot_command") continue;
+    if (line["command"] == "GRASP") {
+      ++grasps;
+      EXPECT_TRUE(accepted) << line.dump();
+      EXPECT_EQ(line["object"], intended[trial]["intended_object"]) << line.dump();
+      accepted = false;
+    } else if (line["command"] == "DROP" && !line["returning"].get<bool>()) {
+      EXPECT_TRUE(accepted) << line.dump();
+      EXPECT_EQ(line["cell"], intended[trial]["intended_cell"]) << line.dump();
+      accepted = false;
+    }
+  }
+  EXPECT_GT(grasps, 0);
+
+  // The recording says what was shown and what the ErrP classifier decided.
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  int feedback = 0, wrong = 0, verdicts = 0;
+  for (const auto& a : recording.annotations) {
+    if (a.text.rfind("Feedback ", 0) == 0) {
+      ++feedback;
+      wrong += a.text.ends_with(" error");
+    }
+    verdicts += a.text.rfind("ErrP ", 0) == 0;
+  }
+  EXPECT_EQ(feedback, 60 + errp["decisions"].get<int>());
+  EXPECT_EQ(wrong, 15 + errp["wrong_selections"].get<int>());
+  EXPECT_EQ(verdicts, errp["decisions"].get<int>());
+
+  // Offline: the same classifier from the recording, written into the session's P300 model.
+  const ProcessResult train = runProcess(
+      kArbci, {"train", "--errp", (folder / "recording.bdf").string(), "--method", "slda",
+               "--channels", "Fz,Cz", "--p300-model", (folder / "model.json").string(), "--out",
+               (folder / "both.json").string()});
+  ASSERT_EQ(train.exit_code, 0) << train.err << train.out;
+  EXPECT_NE(train.out.find("error and"), std::string::npos) << train.out;
+  EXPECT_NE(train.out.find("errors caught"), std::string::npos) << train.out;
+  const nlohmann::json both = readJson(folder / "both.json");
+  EXPECT_EQ(both["format"], "arbci-p300-model");
+  EXPECT_EQ(both["errp"]["pipeline"]["channels"], (nlohmann::json{"Fz", "Cz"}));
+  // A recording without feedback events is refused with the reason.
+  const ProcessResult none =
+      runProcess(kArbci, {"train", "--errp", ARBCI_SHARED_DATA_DIR "/eeg/eeg3_1.dat", "--out",
+                          (folder / "none.json").string()});
+  EXPECT_NE(none.exit_code, 0);
+  EXPECT_NE(none.err.find("no feedback events"), std::string::npos) << none.err;
+}
+
+}  // namespace
+}  // namespace arbci::test

@@ -441,3 +441,38 @@ TEST(ParadigmErrp, TheRunnerUpCellAndTheErrorPosterior) {
 
 }  // namespace
 }  // namespace arbci::bci
+
+namespace arbci::bci {
+namespace {
+
+// In phase 2 the arm holds the object: when no cell is accepted it is put back, never left in
+// the gripper for the next trial.
+TEST(ParadigmErrp, WhenNoCellIsAcceptedTheObjectGoesBackWhereItWasTaken) {
+  ParadigmSettings s = withErrp();
+  s.errp_max_corrections = 0;
+  Paradigm p(s, 4, 3, 3, 1);
+  std::int64_t frame = 0;
+  p.start(false);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(0, {1}));
+  runUntil(
+      p, frame, [] { return false; }, 2);
+  p.errpVerdict(false);
+  runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
+  p.robotFinished(true, "");
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(4, {2, 5}));
+  runUntil(
+      p, frame, [] { return false; }, 2);
+  p.errpVerdict(true);
+  const auto events = runUntil(
+      p, frame, [] { return false; }, 2);
+  auto drop = std::find_if(events.begin(), events.end(),
+                           [](const ParadigmEvent& e) { return e.kind == Kind::RobotDrop; });
+  ASSERT_NE(drop, events.end());
+  EXPECT_TRUE(drop->give_back);
+  EXPECT_EQ(p.phase(), Phase::Dropping);
+}
+
+}  // namespace
+}  // namespace arbci::bci

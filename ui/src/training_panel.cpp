@@ -116,9 +116,11 @@ void TrainingPanel::draw() {
         for (const auto& c : current->errp->pipeline.channels)
           channels += (channels.empty() ? "" : ", ") + c;
         ImGui::TextWrapped(
-            "ErrP classifier: %s on %s, %.0f-%.0f ms after the feedback; cross-validated AUC "
-            "%.3f; a selection is rejected above a posterior of error of %.2f",
+            "ErrP classifier: %s on %s, %.0f-%.0f Hz, %.0f-%.0f ms after the feedback; "
+            "cross-validated AUC %.3f; a selection is rejected above a posterior of error of "
+            "%.2f",
             current->errp->method.c_str(), channels.c_str(),
+            current->errp->pipeline.filter.highpass_hz, current->errp->pipeline.filter.lowpass_hz,
             1000.0 * current->errp->pipeline.window.start_s,
             1000.0 * current->errp->pipeline.window.end_s, current->errp_auc,
             threshold.value_or(0.5));

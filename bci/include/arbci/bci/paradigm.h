@@ -46,7 +46,8 @@ struct ParadigmSettings {
   // and the robot waits for the ErrP verdict on it; a rejected selection is replaced by the
   // runner-up when, among the rest, it holds at least `errp_runner_up` of the probability,
   // otherwise the selection is made again with `errp_repeat_sequences` sequences (0: twice
-  // `sequences`); after `errp_max_corrections` rejections the trial is skipped. The calibration
+  // `sequences`); after `errp_max_corrections` rejections the trial is skipped (an object already
+  // grasped is put back where it was taken). The calibration
   // run ends with `errp_calibration_feedbacks` cued feedbacks, `errp_wrong_rate` of them
   // deliberately wrong (in random order).
   bool errp = false;
@@ -99,10 +100,12 @@ struct ParadigmEvent {
     Flash,             // code, onset frame
     SelectionMade,     // codes chosen, certainty (text "runner-up" for an ErrP correction)
     Feedback,          // a selection first shown (codes); calibration: `error` says if wrong
-    ErrpCorrection,    // text: "runner-up", "repeat" or "skip" after a rejected selection
-    TrainModel,        // the calibration run is complete: train now and call modelTrained()
-    RobotGrasp,        // object slot in `object`
-    RobotDrop,         // cell in `cell`
+    // After a rejected selection, text: "runner-up", "repeat", "skip" (no object held yet: the
+    // trial ends) or "return" (no cell accepted: the object goes back where it was taken).
+    ErrpCorrection,
+    TrainModel,  // the calibration run is complete: train now and call modelTrained()
+    RobotGrasp,  // object slot in `object`
+    RobotDrop,   // cell in `cell`; `give_back`: put the object back where it was taken
     RobotStop,
     TrialDone,
   };
@@ -115,6 +118,7 @@ struct ParadigmEvent {
   std::pair<int, int> cell{0, 0};
   std::set<int> codes;
   bool objects_layout = true;  // the selection's stimuli are objects (else grid rows/columns)
+  bool give_back = false;
   double certainty = 0.0;
   int trial = 0;
   std::string text;
@@ -228,6 +232,7 @@ class Paradigm {
   std::optional<bool> shown_error_;  // calibration feedback: deliberately wrong
   Decision last_decision_;
   bool runner_up_taken_ = false;
+  bool giving_back_ = false;  // the put-down returns the object (no cell was accepted)
   int corrections_ = 0;
   int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
   bool errp_block_ = false;      // the calibration run's ErrP feedback block
