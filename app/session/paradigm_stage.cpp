@@ -386,6 +386,7 @@ void ParadigmStage::handleEvents() {
       case Kind::SelectionMade:
         recordSelection(e);
         shown_certainty_ = e.certainty;
+        s_.eeg.takeErrpScore();  // a score still held is an earlier feedback's, not this one's
         break;
       case Kind::Feedback: {
         FeedbackShown shown{e.codes, e.objects_layout, e.error};
