@@ -21,7 +21,6 @@ endif()
 if(ARBCI_BUILD_BENCH)
   find_package(benchmark REQUIRED)
 endif()
-if(ARBCI_BUILD_TESTS OR ARBCI_BUILD_BENCH)
-  # The synthetic marker scenes draw AprilTags with libapriltag; the benchmark runs it as a peer.
-  find_package(apriltag REQUIRED)
-endif()
+# libapriltag: the tracker's AprilTag kind (vision/), the synthetic scenes' tags and the
+# benchmark's peer.
+find_package(apriltag REQUIRED)

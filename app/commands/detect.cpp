@@ -318,7 +318,8 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
       "--vignetting", options->vignetting,
       "Threshold offsets CORNERS,LEFTRIGHT,TOPBOTTOM (constant and automatic modes)");
   command->add_option("--dictionary", options->dictionary,
-                      "OpenCV dictionary for aruco/apriltag, e.g. DICT_6X6_250");
+                      "aruco: an OpenCV dictionary (default DICT_6X6_250); apriltag: a libapriltag "
+                      "family (default tag36h11; tagStandard41h12, tag25h9, ...)");
   command->add_option("--pattern", options->patterns,
                       "Template patterns for --kind template: FILE.patt or ID=FILE.patt");
   command->add_flag("--track", options->track,

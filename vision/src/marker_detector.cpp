@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "apriltag_detector.h"
 #include "code_decoder.h"
 #include "contour_trace.h"
 #include "dictionary_detector.h"
@@ -84,7 +85,8 @@ void validate(const DetectorConfig& config) {
 
 struct MarkerDetector::Impl {
   DetectorConfig config;
-  int dictionary = -1;
+  int dictionary = -1;                         // ArUco: OpenCV's dictionary
+  std::unique_ptr<AprilTagDetector> apriltag;  // AprilTag: libapriltag
   int threshold = 100;  // global threshold carried between frames (automatic modes)
   std::mt19937 random;
   // `gray` is a read-only view: of the caller's pixels for grey input, else of `converted`.
@@ -105,14 +107,15 @@ struct MarkerDetector::Impl {
 
   explicit Impl(DetectorConfig c) : config(std::move(c)) {
     validate(config);
-    if (config.kind == MarkerKind::Aruco || config.kind == MarkerKind::AprilTag) {
-      const std::string name = !config.dictionary.empty()         ? config.dictionary
-                               : config.kind == MarkerKind::Aruco ? "DICT_6X6_250"
-                                                                  : "DICT_APRILTAG_36h11";
-      dictionary = dictionaryId(name);
-    }
+    if (config.kind == MarkerKind::Aruco)
+      dictionary = dictionaryId(config.dictionary.empty() ? "DICT_6X6_250" : config.dictionary);
+    if (config.kind == MarkerKind::AprilTag)
+      apriltag = std::make_unique<AprilTagDetector>(config.dictionary);
     resetThreshold();
   }
+
+  // ArUco and AprilTag markers are found by their own libraries, not by our stages.
+  bool external() const { return dictionary >= 0 || apriltag != nullptr; }
 
   void resetThreshold() {
     threshold = config.threshold.value;
@@ -369,9 +372,10 @@ struct MarkerDetector::Impl {
     if (gray.empty() || gray.cols < 3 || gray.rows < 3) {
       result.threshold = threshold;
       result.threshold_mode = "empty image";
-    } else if (dictionary >= 0) {
+    } else if (external()) {
       const auto decode_start = Clock::now();
-      result.markers = detectDictionaryMarkers(gray, dictionary, config.kind);
+      result.markers = apriltag ? apriltag->detect(gray)
+                                : detectDictionaryMarkers(gray, dictionary, config.kind);
       for (MarkerDetection& m : result.markers) {
         for (int k = 0; k < 4; ++k) {
           m.ideal_corners[k] =
@@ -399,8 +403,8 @@ DetectionResult MarkerDetector::detect(const cv::Mat& image) {
   const auto start = Clock::now();
   if (image.type() == CV_8UC1) {
     impl_->gray = image;  // a view; never written
-  } else if (impl_->dictionary >= 0 && (image.type() == CV_8UC3 || image.type() == CV_8UC4)) {
-    // OpenCV's dictionaries are tuned on its own (BT.601) grey.
+  } else if (impl_->external() && (image.type() == CV_8UC3 || image.type() == CV_8UC4)) {
+    // OpenCV's dictionaries and libapriltag are tuned on BT.601 grey.
     cv::cvtColor(image, impl_->converted,
                  image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
     impl_->gray = impl_->converted;
@@ -444,7 +448,7 @@ const std::vector<SquareCorners>& MarkerDetector::lastIdealSquares() const {
 cv::Mat MarkerDetector::lastBinaryImage() const {
   const cv::Mat& gray = impl_->gray;
   cv::Mat binary(gray.rows, gray.cols, CV_8UC1, cv::Scalar(0));
-  if (impl_->dictionary >= 0 || gray.empty() || impl_->labels.maskStride() != gray.cols + 2)
+  if (impl_->external() || gray.empty() || impl_->labels.maskStride() != gray.cols + 2)
     return binary;
   for (int y = 0; y < gray.rows; ++y) {
     std::uint8_t* row = binary.ptr<std::uint8_t>(y);

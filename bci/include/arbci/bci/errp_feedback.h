@@ -11,7 +11,7 @@
 namespace arbci::bci {
 
 // Stimulus codes of an ErrP dataset: the classes, not choices.
-constexpr int kErrorFeedbackCode = 1;    // the ErrP classifier's target
+constexpr int kErrorFeedbackCode = 1;  // the ErrP classifier's target
 constexpr int kCorrectFeedbackCode = 2;
 
 struct FeedbackRecording {

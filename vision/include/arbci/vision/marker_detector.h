@@ -40,8 +40,9 @@ struct DetectorConfig {
   // The camera's lens (its calibration and an undistortion mode): sides are fitted straight in
   // undistorted coordinates and ideal corners are reported. Frames must match its image size.
   std::shared_ptr<const Undistorter> lens;
-  // MarkerKind::Aruco / AprilTag: an OpenCV predefined dictionary name; empty for the kind's
-  // default (DICT_6X6_250, DICT_APRILTAG_36h11).
+  // MarkerKind::Aruco: an OpenCV predefined dictionary name (empty: DICT_6X6_250).
+  // MarkerKind::AprilTag: a libapriltag family (tag36h11, tagStandard41h12, ...; OpenCV's
+  // DICT_APRILTAG_* names the same families; empty: tag36h11), found by libapriltag itself.
   std::string dictionary;
 };
 
@@ -78,7 +79,7 @@ class MarkerDetector {
   std::unique_ptr<Impl> impl_;
 };
 
-// The OpenCV predefined dictionary names accepted for the ArUco and AprilTag kinds.
+// The OpenCV predefined dictionary names accepted for the ArUco kind.
 std::vector<std::string> dictionaryNames();
 
 }  // namespace arbci::vision

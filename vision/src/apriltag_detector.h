@@ -1,0 +1,37 @@
+// Private: AprilTag markers through libapriltag itself (the families it ships), not OpenCV's
+// dictionary path, which misses many tags the library finds (22 of 47 in apriltag_test).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "arbci/vision/marker.h"
+
+namespace arbci::vision {
+
+// The families accepted by name ("tag36h11", "tagStandard41h12", ...), for messages.
+std::string aprilTagFamilies();
+
+class AprilTagDetector {
+ public:
+  // `family`: a libapriltag family name, or OpenCV's DICT_APRILTAG_16h5/25h9/36h10/36h11 for
+  // the same families; empty: tag36h11. Throws std::invalid_argument naming the accepted ones.
+  explicit AprilTagDetector(const std::string& family);
+  ~AprilTagDetector();
+  AprilTagDetector(const AprilTagDetector&) = delete;
+  AprilTagDetector& operator=(const AprilTagDetector&) = delete;
+
+  // Full-resolution quads (no decimation: small tags count), one thread, edges not refined.
+  // Corners as every detection here: top-left, top-right, bottom-right, bottom-left, OpenCV
+  // pixels.
+  std::vector<MarkerDetection> detect(const cv::Mat& gray);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace arbci::vision
