@@ -1,6 +1,7 @@
 // The simulated session end to end, headless, through the real executables: a calibration run,
 // training, then online trials with given intentions; a subject without ERP (selections fail,
-// the session says so and carries on); and the robot backend killed during a grasp.
+// the session says so and carries on); the robot backend killed during a grasp; and ErrPs
+// stopping wrong robot actions.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -358,12 +359,6 @@ TEST(Session, KillingTheRobotBackendDuringAGraspIsReportedAndTheRecordingStaysIn
   EXPECT_TRUE(ended_note);
 }
 
-}  // namespace
-}  // namespace arbci::test
-
-namespace arbci::test {
-namespace {
-
 // Ctrl+C or a TERM ends a headless run like an abort: the summary is written, the recording
 // closed, and the exit status says it did not finish.
 TEST(Session, ATermSignalEndsAHeadlessRunWithItsSummarySaved) {
@@ -394,12 +389,6 @@ TEST(Session, ATermSignalEndsAHeadlessRunWithItsSummarySaved) {
   EXPECT_EQ(summary["ended"], "aborted");
   EXPECT_GT(bci::readRecording(folder / "recording.bdf").samples, 0);
 }
-
-}  // namespace
-}  // namespace arbci::test
-
-namespace arbci::test {
-namespace {
 
 // ErrP study end to end: a subject without P300 (so most selections are wrong) whose ErrPs are
 // unmistakable (5 times the default's: the classifier is not what is tested here, the gating is;

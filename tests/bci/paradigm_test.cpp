@@ -1,6 +1,7 @@
 // The paradigm, frame by frame: flash timing in frames, every stimulus once per sequence and never
 // twice in a row, the calibration run, a whole trial with the robot, dynamic stopping, and pause,
-// abort, emergency stop and robot faults.
+// abort, emergency stop and robot faults; with ErrPs, the calibration's feedback block, the robot
+// waiting for the verdict, the runner-up, repeats, and the object put back.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -227,12 +228,6 @@ TEST(Paradigm, RetryStepAsksForTheInterruptedGraspAgainAndSkipTrialEndsTheTrial)
   EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
 }
 
-}  // namespace
-}  // namespace arbci::bci
-
-namespace arbci::bci {
-namespace {
-
 // A display that manages a frame every 28 ms, not the 16.7 ms of its nominal 60 Hz: the onsets
 // keep to the 183 ms SOA (each on the first frame due at or after it), no frame shows two flashes,
 // and every flash is shown.
@@ -265,12 +260,6 @@ TEST(Paradigm, OnASlowDisplayFlashesKeepTheirScheduleInTime) {
   EXPECT_LE(lit_frames, 36);
 }
 
-}  // namespace
-}  // namespace arbci::bci
-
-namespace arbci::bci {
-namespace {
-
 // The timing check's paradigm: cued calibration selections that go on, never to training.
 TEST(Paradigm, FlashesOnlyNeverEndsTheCalibrationRun) {
   ParadigmSettings s = fast();  // 2 calibration selections
@@ -291,12 +280,6 @@ TEST(Paradigm, FlashesOnlyNeverEndsTheCalibrationRun) {
   EXPECT_GE(selections, 5);
   EXPECT_GE(flashes, selections * 3 * 4);  // every decided selection had its 3 sequences of 4
 }
-
-}  // namespace
-}  // namespace arbci::bci
-
-namespace arbci::bci {
-namespace {
 
 ParadigmSettings withErrp() {
   ParadigmSettings s = fast();
@@ -438,12 +421,6 @@ TEST(ParadigmErrp, TheRunnerUpCellAndTheErrorPosterior) {
   EXPECT_LT(errorPosterior(errp, 2.0, 0.05), errorPosterior(errp, 2.0, 0.5));
   EXPECT_NEAR(errorPosterior(errp, 1.0, 0.0), 0.01, 1e-12);  // the prior is kept off 0
 }
-
-}  // namespace
-}  // namespace arbci::bci
-
-namespace arbci::bci {
-namespace {
 
 // In phase 2 the arm holds the object: when no cell is accepted it is put back, never left in
 // the gripper for the next trial.
