@@ -121,7 +121,8 @@ SimulatedSubject::SimulatedSubject(const SimulatedSubjectConfig& config,
     : config_(config),
       profile_(config.profile ? *config.profile : SubjectProfile::drawn(config.seed)),
       clock_(std::move(clock)),
-      trial_random_(config.seed ^ 0xA5A5A5A5ULL) {
+      trial_random_(config.seed ^ 0xA5A5A5A5ULL),
+      errp_random_(config.seed ^ 0x5EEDE44ULL) {
   if (config.montage.empty())
     throw std::invalid_argument("simulated subject: the montage has no channels");
   if (!(config.rate_hz >= 32.0 && config.rate_hz <= 20000.0)) {
@@ -161,9 +162,9 @@ void SimulatedSubject::feedback(std::int64_t sample, const std::set<int>& codes)
 
   response.errp_scale = agrees ? profile_.errp_correct_fraction : 1.0;
   // The shift of the whole complex, and its size this time.
-  response.p3_latency = profile_.errp_latency_jitter_s * normal(trial_random_);
+  response.p3_latency = profile_.errp_latency_jitter_s * normal(errp_random_);
   response.p3_scale =
-      std::exp(profile_.amplitude_variability * normal(trial_random_) -
+      std::exp(profile_.amplitude_variability * normal(errp_random_) -
                0.5 * profile_.amplitude_variability * profile_.amplitude_variability);
   responses_.push_back(response);
 }

@@ -6,6 +6,7 @@
 
 #include "arbci/vision/marker_detector.h"
 #include "support/marker_scoring.h"
+#include "support/posed_markers.h"
 #include "support/synthetic_markers.h"
 
 namespace arbci::vision {
@@ -154,6 +155,46 @@ TEST(ThresholdModes, AdaptiveFindsWhatNoSingleThresholdCan) {
   }
   MarkerDetector adaptive(DetectorConfig{});
   EXPECT_EQ(ids(adaptive.detect(frame)), (std::vector<int>{300, 400}));
+}
+
+}  // namespace
+}  // namespace arbci::vision
+
+namespace arbci::vision {
+namespace {
+
+// The case: a readable, high-contrast 71 px BCH marker tilted 55 degrees (border about 25
+// grey, surround about 212, noise sigma 12), read at every constant threshold from 100 to 170.
+cv::Mat tiltedMarker() {
+  const cv::Matx33d camera(800, 0, 320, 0, 800, 240, 0, 0, 1);
+  Pose pose;
+  pose.rotation = test::markerRotation(55.0, 30.0, 10.0);
+  pose.translation = {0.0, 0.0, 0.563};  // a 50 mm marker about 71 px across
+  cv::Mat frame(480, 640, CV_8UC1, cv::Scalar(255));
+  test::drawPosedMarker(frame, camera, pose, 0.05, test::MarkerFamily::ArbciBch, 100);
+  cv::Mat levels;
+  frame.convertTo(levels, CV_32F, (212.0 - 25.0) / 255.0, 25.0);
+  cv::Mat noise(levels.size(), CV_32F);
+  cv::RNG random(7);
+  random.fill(noise, cv::RNG::NORMAL, 0.0, 12.0);
+  levels += noise;
+  cv::Mat out;
+  levels.convertTo(out, CV_8U);
+  return out;
+}
+
+TEST(ThresholdModes, AReadableTiltedMarkerIsFoundAtEveryThresholdFrom100To170) {
+  const cv::Mat frame = tiltedMarker();
+  std::vector<int> missed;
+  for (int t = 100; t <= 170; t += 5) {
+    DetectorConfig config;
+    config.threshold = settings(ThresholdMode::Constant, t);
+    MarkerDetector detector(config);
+    if (ids(detector.detect(frame)) != std::vector<int>{100}) missed.push_back(t);
+  }
+  EXPECT_TRUE(missed.empty()) << "missed at " << ::testing::PrintToString(missed);
+  DetectorConfig adaptive;
+  EXPECT_EQ(ids(MarkerDetector(adaptive).detect(frame)), std::vector<int>{100});
 }
 
 }  // namespace

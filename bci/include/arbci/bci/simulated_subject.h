@@ -109,6 +109,8 @@ class SimulatedSubject final : public EegSource {
   std::vector<std::pair<std::int64_t, bool>> screen_;
   bool screen_lit_ = false;
   std::mt19937_64 trial_random_;
+  // The ErrPs' own draws: feedback does not change a seed's P300 trial-to-trial variation.
+  std::mt19937_64 errp_random_;
   std::int64_t generated_ = 0;
 };
 
