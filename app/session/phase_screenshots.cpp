@@ -7,6 +7,8 @@ std::string phaseSlug(bci::Phase phase) {
   switch (phase) {
     case bci::Phase::CalibrationFlashing:
       return "calibration";
+    case bci::Phase::CalibrationFeedback:
+      return "calibration_feedback";
     case bci::Phase::ObjectFlashing:
       return "1_objects_flashing";
     case bci::Phase::ObjectSelected:
@@ -33,12 +35,13 @@ std::string phaseSlug(bci::Phase phase) {
 void PhaseScreenshots::phaseEntered(bci::Phase phase, int trial) {
   const std::string slug = phaseSlug(phase);
   if (slug.empty()) return;
-  // The calibration run's flashing phase recurs with every target: the first one is kept.
-  if (phase == bci::Phase::CalibrationFlashing &&
-      std::filesystem::exists(folder_ / "hmd_calibration.png"))
-    return;
-  const bool once = phase == bci::Phase::CalibrationFlashing || phase == bci::Phase::Finished ||
+  // The calibration run's phases recur with every target: the first of each is kept.
+  const bool once = phase == bci::Phase::CalibrationFlashing ||
+                    phase == bci::Phase::CalibrationFeedback || phase == bci::Phase::Finished ||
                     phase == bci::Phase::RobotFault;
+  if ((phase == bci::Phase::CalibrationFlashing || phase == bci::Phase::CalibrationFeedback) &&
+      std::filesystem::exists(folder_ / ("hmd_" + slug + ".png")))
+    return;
   name_ = once ? "hmd_" + slug + ".png" : "hmd_trial" + std::to_string(trial) + "_" + slug + ".png";
   needs_flash_ = phase == bci::Phase::CalibrationFlashing || phase == bci::Phase::ObjectFlashing ||
                  phase == bci::Phase::CellFlashing;
