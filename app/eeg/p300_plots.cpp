@@ -136,8 +136,8 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const b
 }
 
 // The difference wave at its peak on a head map, where the channels' 10-20 positions are known.
-std::filesystem::path writeScalpMap(const std::filesystem::path& folder,
-                                    const bci::ErpCurves& erp) {
+std::filesystem::path writeScalpMap(const std::filesystem::path& folder, const bci::ErpCurves& erp,
+                                    const ClassNames& names) {
   const std::optional<bci::ScalpMap> map = bci::scalpMapAtPeak(erp);
   if (!map) return {};
   const int size = 360, margin = 50;
@@ -165,7 +165,7 @@ std::filesystem::path writeScalpMap(const std::filesystem::path& folder,
     text(image, e.name, p + cv::Point(5, -4), 0.35);
   }
   text(image,
-       "target - non-target at " + format(map->time_s * 1000.0, 0) +
+       names.target + " - " + names.other + " at " + format(map->time_s * 1000.0, 0) +
            " ms (the difference's peak over channels)",
        {10, 24}, 0.45);
   colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40, 16, size - 40), map->limit_uv,
@@ -285,7 +285,7 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
   if (!erp_png.empty()) {
     written.push_back(erp_png);
     for (const auto& extra :
-         {writeR2Figure(folder, data.erp, names), writeScalpMap(folder, data.erp)})
+         {writeR2Figure(folder, data.erp, names), writeScalpMap(folder, data.erp, names)})
       if (!extra.empty()) written.push_back(extra);
     written.push_back(folder / "erp.json");
     std::ofstream out(written.back());

@@ -8,6 +8,7 @@
 #include <ostream>
 #include <thread>
 
+#include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/file_source.h"
 #include "arbci/bci/filters.h"
 #include "arbci/bci/simulated_subject.h"
@@ -285,7 +286,8 @@ void EegStage::feedback(const std::set<int>& codes, bool objects, std::optional<
   if (target_ && keep_signal_ && error) {
     // The calibration block: code 1 error feedback (the ErrP classifier's target), 2 correct.
     const int duration = static_cast<int>(settings_.flash_s * eeg_info_.rate_hz + 0.5);
-    errp_stimuli_.push_back({sample, *error ? 1 : 2, *error, duration, true});
+    errp_stimuli_.push_back({sample, *error ? bci::kErrorFeedbackCode : bci::kCorrectFeedbackCode,
+                             *error, duration, true});
   }
   if (errp_epocher_) {
     errp_score_.reset();

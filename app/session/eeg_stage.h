@@ -167,7 +167,8 @@ class EegStage final : public Stage {
   std::optional<bci::SelectionAccumulator> accumulator_;
   int presented_ = 0, scored_ = 0;
   std::vector<std::vector<float>> recent_;
-  // ErrP: the calibration block's feedbacks (code 1 error, 2 correct), the online epocher.
+  // ErrP: the calibration block's feedbacks (bci::kErrorFeedbackCode, kCorrectFeedbackCode), the
+  // online filters and epocher.
   std::vector<bci::StimulusEvent> errp_stimuli_;
   std::unique_ptr<bci::FilterChain> errp_filters_;
   std::unique_ptr<bci::Epocher> errp_epocher_;

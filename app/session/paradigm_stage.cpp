@@ -288,12 +288,8 @@ void ParadigmStage::judgeFeedback() {
 
 std::set<int> ParadigmStage::attendedCodes(bool objects) {
   const TrialRecord& trial = currentTrial();
-  if (!objects)
-    return {trial.intended_cell.first, settings_.world.grid.rows + trial.intended_cell.second};
-  for (size_t k = 0; k < slots_.size(); ++k) {
-    if (settings_.world.objects[slots_[k]].id == trial.intended_object)
-      return {static_cast<int>(k) + 1};
-  }
+  std::set<int> codes = intendedCodes(objects);
+  if (!codes.empty()) return codes;
   std::cerr << "trial " << trial.trial << ": the intended object " << trial.intended_object
             << " is not in view, so it does not flash\n";
   s_.log.write("intended_not_in_view", now_.time_s,

@@ -493,23 +493,8 @@ nlohmann::json Session::summary() const {
                            config_.world.grid.rows * config_.world.grid.columns};
   nlohmann::json out =
       sessionSummary(facts, timing_, *stimulus_timing_, *eeg_, trials(), calibrationReport());
-  if (config_.paradigm.errp) {
-    const ParadigmStage::ErrpCounts& c = paradigm_->errpCounts();
-    nlohmann::json errp = {{"threshold", config_.errp.threshold},
-                           {"classifier", eeg_->hasErrpModel()},
-                           {"decisions", c.decisions},
-                           {"wrong_selections", c.wrong_shown},
-                           {"wrong_caught", c.wrong_caught},
-                           {"correct_selections", c.correct_shown},
-                           {"correct_vetoed", c.correct_vetoed},
-                           {"runner_up", c.runner_up},
-                           {"repeated", c.repeats},
-                           {"trials_skipped", c.skipped_trials},
-                           {"correction_s", c.correction_s}};
-    if (eeg_->hasErrpModel() && !std::isnan(eeg_->model()->errp_auc))
-      errp["calibration_auc"] = eeg_->model()->errp_auc;
-    out["errp"] = errp;
-  }
+  if (config_.paradigm.errp)
+    out["errp"] = errpSummary(paradigm_->errpCounts(), config_.errp.threshold, *eeg_);
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include "session/session_summary.h"
 
+#include <cmath>
+
 namespace arbci::app {
 
 nlohmann::json sessionSummary(const SessionFacts& facts, const CycleTiming& cycle,
@@ -29,6 +31,24 @@ nlohmann::json sessionSummary(const SessionFacts& facts, const CycleTiming& cycl
                           {"accuracy_by_sequences", calibration->accuracy}};
   }
   return out;
+}
+
+nlohmann::json errpSummary(const ParadigmStage::ErrpCounts& c, double threshold,
+                           const EegStage& eeg) {
+  nlohmann::json errp = {{"threshold", threshold},
+                         {"classifier", eeg.hasErrpModel()},
+                         {"decisions", c.decisions},
+                         {"wrong_selections", c.wrong_shown},
+                         {"wrong_caught", c.wrong_caught},
+                         {"correct_selections", c.correct_shown},
+                         {"correct_vetoed", c.correct_vetoed},
+                         {"runner_up", c.runner_up},
+                         {"repeated", c.repeats},
+                         {"trials_skipped", c.skipped_trials},
+                         {"correction_s", c.correction_s}};
+  if (eeg.hasErrpModel() && !std::isnan(eeg.model()->errp_auc))
+    errp["calibration_auc"] = eeg.model()->errp_auc;
+  return errp;
 }
 
 }  // namespace arbci::app

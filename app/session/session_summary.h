@@ -12,6 +12,7 @@
 #include "arbci/bci/evaluation.h"
 #include "session/cycle_timing.h"
 #include "session/eeg_stage.h"
+#include "session/paradigm_stage.h"
 #include "session/stimulus_timing.h"
 #include "session/trial_record.h"
 
@@ -31,5 +32,9 @@ nlohmann::json sessionSummary(const SessionFacts& facts, const CycleTiming& cycl
                               const StimulusTiming& stimuli, const EegStage& eeg,
                               const std::vector<TrialRecord>& trials,
                               const std::optional<bci::EvaluationReport>& calibration);
+
+// summary.json's "errp": what the ErrP classifier caught, vetoed and cost (docs/errp.md).
+nlohmann::json errpSummary(const ParadigmStage::ErrpCounts& counts, double threshold,
+                           const EegStage& eeg);
 
 }  // namespace arbci::app
