@@ -10,6 +10,9 @@ find_package(nlohmann_json 3 REQUIRED)
 find_package(OpenSSL REQUIRED)
 find_package(ZLIB REQUIRED)
 find_package(orocos_kdl REQUIRED)
+# LSL stream descriptions are XML and discovery queries are XPath: pugixml evaluates them as
+# liblsl does (Debian libpugixml-dev).
+find_package(pugixml REQUIRED)
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
 pkg_check_modules(BIOSIG REQUIRED IMPORTED_TARGET libbiosig)
 find_package(Threads REQUIRED)

@@ -64,9 +64,14 @@ void Acquisition::pump() {
   const double now = hostSeconds();
   for (const Block& block : blocks) {
     // Stepped: each block arrives the instant it is complete, as from a perfect amplifier.
-    deliver(block, mode_ == Mode::Stepped
-                       ? clock_->availableAtHost(block.endSample(), info_.rate_hz)
-                       : now);
+    // A source that knows when its samples were taken (LSL) gives the instant the block was
+    // complete: one sample period after its last.
+    double at = now;
+    if (mode_ == Mode::Stepped)
+      at = clock_->availableAtHost(block.endSample(), info_.rate_hz);
+    else if (!std::isnan(block.taken_host_s))
+      at = block.taken_host_s + 1.0 / info_.rate_hz;
+    deliver(block, at);
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <set>
+#include <string>
 #include <vector>
 
 #include "arbci/bci/signal.h"
@@ -30,6 +31,11 @@ class EegSource {
   virtual void displayed(double /*host_s*/, bool /*patch_lit*/) {}
   // The delivery delay the source itself knows of (a simulated transport), in seconds.
   virtual double knownLatencyS() const { return 0.0; }
+  // Why a live source delivers nothing now (its stream lost, ...), for the panel and the log;
+  // empty while it is well.
+  virtual std::string fault() const { return {}; }
+  // Where the signal comes from, in a line for the Session panel (empty: nothing to add).
+  virtual std::string describe() const { return {}; }
   // Stimuli the source itself carries (a replayed file's events) up to the samples delivered so
   // far; each is returned once.
   virtual std::vector<StimulusEvent> takeRecordedStimuli() { return {}; }

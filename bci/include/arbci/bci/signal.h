@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct Block {
   int channels = 0;
   int samples = 0;
   std::vector<float> data;
+  // When the source knows it (an LSL stream's time-corrected stamps): the host instant its last
+  // sample was taken; NaN otherwise (the acquisition then uses the block's arrival).
+  double taken_host_s = std::numeric_limits<double>::quiet_NaN();
 
   Block() = default;
   Block(std::int64_t first, int channel_count, int sample_count)
