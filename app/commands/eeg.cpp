@@ -1,5 +1,5 @@
-// `arbci eeg info|convert|simulate`: look into EEG files, convert them to BDF+, and record the
-// simulated subject.
+// `arbci eeg info|convert|simulate|stream|streams`: look into EEG files, convert them to BDF+,
+// record the simulated subject, and play or list Lab Streaming Layer streams (eeg_lsl.cpp).
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -157,6 +157,7 @@ void addEegCommand(CLI::App& root, int& exit_code) {
     exit_code = 0;
   });
 
+  addEegStreamCommands(eeg, exit_code);
   CLI::App* sim =
       eeg->add_subcommand("simulate",
                           "Record the simulated subject in a copy task to BDF+: selections of\n"

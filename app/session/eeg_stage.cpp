@@ -11,6 +11,7 @@
 #include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/file_source.h"
 #include "arbci/bci/filters.h"
+#include "arbci/bci/lsl_source.h"
 #include "arbci/bci/simulated_subject.h"
 
 namespace arbci::app {
@@ -21,8 +22,23 @@ namespace {
 // `arbci timing-check` and set as eeg.latency_ms).
 constexpr double kSimulatedTransportS = 0.020;
 
-std::unique_ptr<bci::EegSource> openSource(const EegSettings& eeg,
+std::unique_ptr<bci::EegSource> openSource(const EegStageSettings& settings,
                                            std::shared_ptr<bci::SampleClock> clock) {
+  const EegSettings& eeg = settings.eeg;
+  if (eeg.source == "lsl") {
+    bci::LslSourceSettings lsl;
+    lsl.name = eeg.lsl_name;
+    lsl.type = eeg.lsl_type;
+    lsl.resolve_timeout_s = eeg.lsl_resolve_timeout_s;
+    lsl.block_size = eeg.block_size;
+    lsl.expected_rate_hz = eeg.rate_hz;
+    lsl.config = settings.lsl;
+    try {
+      return std::make_unique<bci::LslSource>(lsl);
+    } catch (const bci::lsl::LslError& e) {
+      throw SessionConfigError(settings.session_file + ": eeg.source = \"lsl\": " + e.what());
+    }
+  }
   if (eeg.source == "file") {
     bci::Recording replay = bci::readRecording(eeg.file);
     replay.stimuli.clear();  // the session presents its own stimuli
@@ -58,6 +74,7 @@ EegStageSettings EegStageSettings::of(const SessionConfig& config) {
   s.errp = config.paradigm.errp;
   if (s.errp) s.errp_pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
   s.errp_method = config.errp.method;
+  if (config.eeg.source == "lsl") s.lsl = config.lsl.config(config.source);
   return s;
 }
 
@@ -83,7 +100,7 @@ EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path
   bci::AcquisitionSettings acquisition;
   acquisition.latency_s = eeg.latency_ms / 1000.0;
   acquisition_ = std::make_unique<bci::Acquisition>(
-      openSource(eeg, clock), clock,
+      openSource(settings_, clock), clock,
       stepped ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live, acquisition);
   const bci::SignalInfo& all = acquisition_->info();
   eeg_info_ = all;
@@ -125,7 +142,28 @@ void EegStage::step(CycleContext& cycle) {
                  << " EEG samples lost (see the recording's annotations)\n";
     lost_logged_ = lostSamples();
   }
+  // A live source's fault (an LSL stream gone), logged when it starts and when it ends.
+  std::string fault;
+  acquisition_->withSource([&](bci::EegSource& source) { fault = source.fault(); });
+  if (fault != fault_logged_) {
+    log_.write("eeg_source", cycle.time_s,
+               {{"fault", fault}, {"state", fault.empty() ? "delivering" : "fault"}});
+    if (progress_) *progress_ << "\n" << (fault.empty() ? "EEG source delivering again" : "warning: " + fault) << "\n";
+    fault_logged_ = fault;
+  }
   cycle.eeg_sample = sampleAt(cycle.host_s);
+}
+
+std::string EegStage::sourceLine() const {
+  std::string line;
+  acquisition_->withSource([&](bci::EegSource& source) { line = source.describe(); });
+  return line;
+}
+
+std::string EegStage::sourceFault() const {
+  std::string fault;
+  acquisition_->withSource([&](bci::EegSource& source) { fault = source.fault(); });
+  return fault;
 }
 
 void EegStage::stop(const CycleContext& cycle, const std::string& reason) {

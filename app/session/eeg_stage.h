@@ -38,6 +38,7 @@ struct EegStageSettings {
   bool errp = false;         // train and use an ErrP classifier
   bci::PipelineSettings errp_pipeline;
   std::string errp_method;
+  bci::lsl::LslConfig lsl;  // source "lsl": lsl_api.cfg with the session's scope and peers
   static EegStageSettings of(const SessionConfig& config);
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.
   void validate() const;
@@ -122,6 +123,9 @@ class EegStage final : public Stage {
   std::int64_t samplesRecorded() const;
   double clockDriftPpm() const { return acquisition_->driftPpm(); }
   double clockJitterMs() const { return acquisition_->jitterS() * 1000.0; }
+  // The source's own account (an LSL stream's name, host, rates, clock offset) and its fault.
+  std::string sourceLine() const;
+  std::string sourceFault() const;
   // Live: waits (at most `timeout_s`) until the samples taken up to host instant `host_s` have
   // arrived and are recorded, so the last flashes' EEG and photodiode edges are in the file.
   void drainUntil(double host_s, double timeout_s);
@@ -145,6 +149,7 @@ class EegStage final : public Stage {
   SessionLog& log_;
   std::ostream* progress_;
   std::int64_t lost_logged_ = 0;  // lost samples already in the log
+  std::string fault_logged_;      // the source's fault last logged (empty: none)
   double time_s_ = 0.0;           // the last cycle's session time, for the log
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;

@@ -404,7 +404,12 @@ std::string Session::eegClockLine() const {
   std::snprintf(text, sizeof text, "EEG: lost samples %lld, clock drift %+.1f ppm, jitter %.2f ms",
                 static_cast<long long>(eeg_->lostSamples()), eeg_->clockDriftPpm(),
                 eeg_->clockJitterMs());
-  return text;
+  const std::string source = eeg_->sourceLine();
+  return source.empty() ? std::string(text) : std::string(text) + "\n" + source;
+}
+
+std::string Session::eegSourceFault() const {
+  return eeg_->sourceFault();
 }
 
 std::int64_t Session::lateFrames() const {

@@ -72,6 +72,7 @@ class Session {
   std::string timingWarning() const;
   // "EEG: lost samples N, clock drift X ppm, jitter Y ms".
   std::string eegClockLine() const;
+  std::string eegSourceFault() const;
   // Steps until the end (headless); an interrupt (support/interrupt.h, when the caller watches
   // for one) aborts it. Returns the summary.
   nlohmann::json run();

@@ -219,8 +219,8 @@ void parseWorld(const Section& s, const std::string& file, WorldSettings& w) {
 // `defaults`: this is the embedded session file, which must set every key.
 void parse(const Json& json, const std::string& file, SessionConfig& c, bool defaults) {
   const Section root(json, "", file, defaults);
-  root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "paradigm",
-              "classifier", "errp", "robot"});
+  root.known({"description", "display_hz", "hmd", "cameras", "tracker", "world", "eeg", "lsl",
+              "paradigm", "classifier", "errp", "robot"});
   c.display_hz = root.number("display_hz", c.display_hz, 10.0, 500.0);
   const Section hmd = root.section("hmd");
   hmd.known({"width", "height", "undistort", "mirror_monitor"});
@@ -240,8 +240,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
 
   const Section eeg = root.section("eeg");
   eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale",
-             "errp_scale", "file", "photodiode_channel", "latency_ms"});
-  c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file"});
+             "errp_scale", "file", "photodiode_channel", "latency_ms", "lsl"});
+  c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file", "lsl"});
   c.eeg.seed =
       static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
   if (eeg.has("montage")) {
@@ -259,6 +259,28 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   c.eeg.latency_ms = eeg.number("latency_ms", c.eeg.latency_ms, 0.0, 1000.0);
   if (c.eeg.source == "file" && c.eeg.file.empty())
     eeg.fail("file", "is required when source is \"file\"");
+  const Section eeg_lsl = eeg.section("lsl");
+  eeg_lsl.known({"name", "type", "resolve_timeout_s"});
+  c.eeg.lsl_name = eeg_lsl.text("name", c.eeg.lsl_name);
+  c.eeg.lsl_type = eeg_lsl.text("type", c.eeg.lsl_type);
+  c.eeg.lsl_resolve_timeout_s =
+      eeg_lsl.number("resolve_timeout_s", c.eeg.lsl_resolve_timeout_s, 0.1, 600.0);
+  if (c.eeg.source == "lsl" && c.eeg.lsl_name.empty() && c.eeg.lsl_type.empty())
+    eeg_lsl.fail("name", "or type is required when eeg.source is \"lsl\"");
+
+  const Section lsl = root.section("lsl");
+  lsl.known({"scope", "known_peers", "markers", "marker_stream"});
+  c.lsl.scope = lsl.text("scope", c.lsl.scope, {"", "machine", "link", "site"});
+  if (lsl.has("known_peers")) {
+    if (!lsl.at("known_peers").is_array()) lsl.fail("known_peers", "must be a list of host names");
+    c.lsl.known_peers = lsl.at("known_peers").get<std::vector<std::string>>();
+  } else {
+    lsl.missing("known_peers");
+  }
+  c.lsl.markers = lsl.boolean("markers", c.lsl.markers);
+  c.lsl.marker_stream = lsl.text("marker_stream", c.lsl.marker_stream);
+  if (c.lsl.markers && c.lsl.marker_stream.empty())
+    lsl.fail("marker_stream", "must name the stream when markers is true");
 
   const Section p = root.section("paradigm");
   p.known({"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty",
@@ -408,6 +430,18 @@ SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& pa
   config.source = path->string();
   parse(json, path->string(), config, false);
   return config;
+}
+
+bci::lsl::LslConfig LslSettings::config(const std::string& session_file) const {
+  bci::lsl::LslConfig c;
+  try {
+    c = bci::lsl::LslConfig::load();
+  } catch (const bci::lsl::LslError& e) {
+    throw SessionConfigError(session_file + ": the LSL configuration: " + e.what());
+  }
+  if (!scope.empty()) c.resolve_scope = scope;
+  c.known_peers.insert(c.known_peers.end(), known_peers.begin(), known_peers.end());
+  return c;
 }
 
 }  // namespace arbci::app

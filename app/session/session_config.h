@@ -12,6 +12,7 @@
 
 #include <opencv2/core/matx.hpp>
 
+#include "arbci/bci/lsl/config.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/paradigm.h"
 
@@ -68,7 +69,7 @@ struct WorldSettings {
 };
 
 struct EegSettings {
-  std::string source = "simulated";  // "simulated" or "file"
+  std::string source = "simulated";  // "simulated", "file" or "lsl"
   std::uint64_t seed = 1;
   std::vector<std::string> montage{"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
   double rate_hz = 256.0;
@@ -81,6 +82,22 @@ struct EegSettings {
   // is added); empty: none.
   std::string photodiode_channel;
   double latency_ms = 0.0;  // the amplifier's delivery latency, as timing-check measured it
+  // source "lsl": the stream, by name and/or type, and how long to look for it.
+  std::string lsl_name;
+  std::string lsl_type = "EEG";
+  double lsl_resolve_timeout_s = 5.0;
+};
+
+// The Lab Streaming Layer (docs/eeg.md): where streams are looked for and what ARBCI publishes.
+// The scope and peers default to the lab's lsl_api.cfg (read as liblsl reads it).
+struct LslSettings {
+  std::string scope;                     // "" (from lsl_api.cfg), "machine", "link" or "site"
+  std::vector<std::string> known_peers;  // added to lsl_api.cfg's KnownPeers
+  bool markers = false;                  // publish every stimulus and event as a Markers stream
+  std::string marker_stream = "ARBCI-Markers";
+  // lsl_api.cfg (throws SessionConfigError for one that does not parse) with this file's scope
+  // and peers over it.
+  bci::lsl::LslConfig config(const std::string& session_file) const;
 };
 
 // The ErrP classifier (docs/errp.md), trained on the calibration run's feedback block when
@@ -119,6 +136,7 @@ struct SessionConfig {
   double max_pose_age_s = 0.5;
   WorldSettings world;
   EegSettings eeg;
+  LslSettings lsl;
   bci::ParadigmSettings paradigm;
   std::vector<TrialIntent> intended;
   std::string classifier_method = "slda";

@@ -72,6 +72,7 @@ class SessionModel final : public ui::WorkstationModel {
   long long lateFrames() override { return session_.lateFrames(); }
   std::string timingWarning() override { return session_.timingWarning(); }
   std::string eegClockLine() override { return session_.eegClockLine(); }
+  std::string eegSourceFault() override { return session_.eegSourceFault(); }
   std::vector<ui::StageTiming> timing() override;
   std::vector<std::string> selections() override { return session_.selectionLines(); }
 

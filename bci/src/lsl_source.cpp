@@ -4,7 +4,11 @@
 #include <cstdio>
 #include <limits>
 
+#include <chrono>
+#include <thread>
+
 #include "arbci/bci/lsl/inlet.h"
+#include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/lsl/resolver.h"
 
 namespace arbci::bci {
@@ -58,6 +62,18 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
                         " Hz (eeg.rate_hz). ARBCI does not resample a live stream: set eeg.rate_hz "
                         "to the amplifier's rate");
   inlet_ = std::make_unique<lsl::Inlet>(stream, settings.config);
+  if (settings.require_samples) {
+    const double deadline = lsl::localClock() + settings.resolve_timeout_s;
+    while (inlet_->status().received == 0 && lsl::localClock() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (inlet_->status().received == 0) {
+      char timeout[32];
+      std::snprintf(timeout, sizeof timeout, "%.1f", settings.resolve_timeout_s);
+      throw lsl::LslError("LSL stream \"" + stream.name + "\" on " + stream.hostname +
+                          " answered but sent no sample within " + timeout +
+                          " s: is the amplifier acquiring?");
+    }
+  }
   const lsl::StreamInfo& full = inlet_->info();
   info_.rate_hz = full.nominal_srate;
   info_.channels = full.channelLabels();

@@ -152,6 +152,21 @@ TEST(LslSource, NoStreamIsRefusedWithAMessageNamingItAndTheScope) {
   }
 }
 
+TEST(LslSource, AStreamThatSendsNothingIsRefusedBeforeTheSession) {
+  const std::string name = uniqueName("silent");
+  Outlet outlet(eegStream(name, 2, 256, ChannelFormat::Float32), machineScope());
+  LslSourceSettings settings;
+  settings.name = name;
+  settings.resolve_timeout_s = 1.0;
+  settings.config = machineScope();
+  try {
+    LslSource source(settings);
+    FAIL();
+  } catch (const LslError& e) {
+    EXPECT_NE(std::string(e.what()).find("sent no sample"), std::string::npos) << e.what();
+  }
+}
+
 TEST(LslSource, AStreamAtAnotherRateThanTheSessionsIsRefused) {
   const std::string name = uniqueName("rate");
   Outlet outlet(eegStream(name, 2, 500, ChannelFormat::Float32), machineScope());
@@ -159,6 +174,7 @@ TEST(LslSource, AStreamAtAnotherRateThanTheSessionsIsRefused) {
   settings.name = name;
   settings.expected_rate_hz = 256;
   settings.config = machineScope();
+  settings.require_samples = false;
   try {
     LslSource source(settings);
     FAIL();
@@ -177,6 +193,7 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
   settings.name = name;
   settings.block_size = 4;
   settings.config = machineScope();
+  settings.require_samples = false;  // it pushes once connected
   LslSource source(settings);
   EXPECT_EQ(source.info().channels, (std::vector<std::string>{"E1", "E2"}));
   waitForClient(outlet);

@@ -57,6 +57,8 @@ void SessionPanel::draw() {
               model_.overruns(), model_.lateFrames());
   if (const std::string clock = model_.eegClockLine(); !clock.empty())
     ImGui::TextUnformatted(clock.c_str());
+  if (const std::string fault = model_.eegSourceFault(); !fault.empty())
+    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "EEG source: %s", fault.c_str());
   if (const std::string warning = model_.timingWarning(); !warning.empty())
     ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", warning.c_str());
   if (ImGui::BeginTable(

@@ -7,9 +7,11 @@
 
 #include <chrono>
 #include <deque>
+#include <iterator>
 #include <random>
 #include <sstream>
 
+#include "lsl/discovery_responder.h"
 #include "lsl/socket.h"
 
 namespace arbci::bci::lsl {
@@ -47,26 +49,6 @@ std::string trimmed(const std::string& s) {
   return s.substr(begin, s.find_last_not_of(" \t\r\n") - begin + 1);
 }
 
-// "LSL:shortinfo\r\n<query>\r\n<return port> <query id>\r\n": the reply, or nothing when the
-// query does not match (or the request is malformed).
-std::optional<std::pair<int, std::string>> shortinfoReply(std::istream& request,
-                                                          const StreamInfo& info,
-                                                          const std::string& shortinfo) {
-  std::string query, ids;
-  std::getline(request, query);
-  std::getline(request, ids);
-  std::istringstream fields(ids);
-  int port = 0;
-  std::string id;
-  if (!(fields >> port >> id) || port <= 0 || port > 65535) return std::nullopt;
-  try {
-    if (!info.matches(trimmed(query))) return std::nullopt;
-  } catch (const LslError&) {
-    return std::nullopt;  // an invalid query matches nothing
-  }
-  return std::pair{port, id + "\r\n" + shortinfo};
-}
-
 }  // namespace
 
 double localClock() {
@@ -75,7 +57,6 @@ double localClock() {
 
 struct Outlet::Sockets {
   net::Fd listener, service;
-  std::vector<net::Fd> discovery;
 };
 
 struct Outlet::Client {
@@ -110,32 +91,13 @@ Outlet::Outlet(StreamInfo info, LslConfig config, double max_buffer_s)
   shortinfo_ = info_.toXml(false);
   fullinfo_ = info_.toXml(true);
 
-  // The discovery addresses: loopback ones on their own address, broadcast and multicast on
-  // any address (joining the group), all sharing the port with other outlets.
-  for (const auto& a : config_.queryAddresses()) {
-    try {
-      net::Fd fd = net::udpSocket();
-      const sockaddr_in group = net::endpoint(a, config_.multicast_port);
-      const bool multicast = IN_MULTICAST(ntohl(group.sin_addr.s_addr));
-      const bool loopback = a.rfind("127.", 0) == 0;
-      net::bindExact(fd, loopback ? a : "0.0.0.0", config_.multicast_port, true);
-      if (multicast) {
-        ip_mreq membership{};
-        membership.imr_multiaddr = group.sin_addr;
-        membership.imr_interface.s_addr = htonl(INADDR_ANY);
-        if (::setsockopt(fd.get(), IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof membership) != 0)
-          throw LslError("cannot join the multicast group " + a);
-      }
-      sockets_->discovery.push_back(std::move(fd));
-    } catch (const LslError& e) {
-      warnings_.push_back("discovery on " + a + ":" + std::to_string(config_.multicast_port) +
-                          ": " + e.what());
-    }
-  }
+  discovery_ = DiscoveryResponder::shared(config_, warnings_);
+  discovery_->add(this, info_, shortinfo_);
   discovery_thread_ = std::thread([this] { serveDiscovery(); });
 }
 
 Outlet::~Outlet() {
+  discovery_->remove(this);
   stop_ = true;
   {
     std::lock_guard lock(clients_mutex_);
@@ -204,7 +166,6 @@ void Outlet::serveDiscovery() {
   std::vector<pollfd> watched;
   watched.push_back({sockets_->listener.get(), POLLIN, 0});
   watched.push_back({sockets_->service.get(), POLLIN, 0});
-  for (const auto& d : sockets_->discovery) watched.push_back({d.get(), POLLIN, 0});
   while (!stop_) {
     for (auto& w : watched) w.revents = 0;
     if (::poll(watched.data(), watched.size(), 100) <= 0) continue;
@@ -233,7 +194,7 @@ void Outlet::serveDiscovery() {
     for (size_t i = 1; i < watched.size(); ++i) {
       if (!(watched[i].revents & POLLIN)) continue;
       const double received_at = localClock();
-      const net::Fd& socket = i == 1 ? sockets_->service : sockets_->discovery[i - 2];
+      const net::Fd& socket = sockets_->service;
       auto datagram = net::receiveDatagram(socket, 0.0);
       if (!datagram) continue;
       std::istringstream request(datagram->bytes);
@@ -241,12 +202,13 @@ void Outlet::serveDiscovery() {
       std::getline(request, method);
       method = trimmed(method);
       if (method == "LSL:shortinfo") {
-        if (auto reply = shortinfoReply(request, info_, shortinfo_)) {
+        std::string rest((std::istreambuf_iterator<char>(request)), std::istreambuf_iterator<char>());
+        if (auto reply = shortinfoReply(rest, info_, shortinfo_)) {
           sockaddr_in to = datagram->from;
           to.sin_port = htons(static_cast<std::uint16_t>(reply->first));
           net::sendDatagram(socket, reply->second, to);
         }
-      } else if (method == "LSL:timedata" && i == 1) {
+      } else if (method == "LSL:timedata") {
         // " <wave id> <t0> <t1> <t2>": the client's send time, our receive and reply times.
         long long wave = 0;
         double t0 = 0;

@@ -29,7 +29,7 @@ void build(const StreamInfo& s, pugi::xml_document& doc, bool full) {
   addText(info, "channel_format", formatName(s.channel_format));
   addText(info, "source_id", s.source_id);
   addText(info, "nominal_srate", number(s.nominal_srate));
-  addText(info, "version", number(s.version / 100.0));
+  addText(info, "version", std::to_string(s.version / 100) + "." + std::to_string(s.version / 10 % 10) + (s.version % 10 ? std::to_string(s.version % 10) : ""));
   addText(info, "created_at", number(s.created_at));
   addText(info, "uid", s.uid);
   addText(info, "session_id", s.session_id);

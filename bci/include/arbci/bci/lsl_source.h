@@ -28,6 +28,8 @@ struct LslSourceSettings {
   double resolve_timeout_s = 5.0;
   int block_size = 15;
   double expected_rate_hz = 0.0;  // the session's rate: a stream at another rate is refused
+  // Refuse a stream that answers but sends no sample within resolve_timeout_s (pre-flight).
+  bool require_samples = true;
   lsl::LslConfig config;
 };
 

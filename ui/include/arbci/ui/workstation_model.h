@@ -107,6 +107,8 @@ class WorkstationModel {
   virtual std::string timingWarning() { return ""; }
   // The EEG time base: samples lost (gaps, overflows), the amplifier clock's drift and jitter.
   virtual std::string eegClockLine() { return ""; }
+  // Why a live EEG source delivers nothing now (e.g. its LSL stream is gone); empty when well.
+  virtual std::string eegSourceFault() { return ""; }
   virtual std::vector<StageTiming> timing() = 0;
   virtual std::vector<std::string> selections() = 0;  // one line per selection made
 };

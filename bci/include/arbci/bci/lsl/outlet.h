@@ -24,6 +24,8 @@
 
 namespace arbci::bci::lsl {
 
+class DiscoveryResponder;
+
 // The LSL clock: seconds of the host's steady clock, as liblsl's lsl_local_clock().
 double localClock();
 
@@ -71,7 +73,8 @@ class Outlet {
   };
   std::list<Session> clients_;
   std::atomic<std::int64_t> dropped_{0};
-  std::thread discovery_thread_;
+  std::thread discovery_thread_;  // the service port (unicast queries, time) and clients
+  std::shared_ptr<DiscoveryResponder> discovery_;  // the shared discovery port
 };
 
 }  // namespace arbci::bci::lsl
