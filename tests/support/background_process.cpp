@@ -80,6 +80,10 @@ std::optional<std::string> BackgroundProcess::waitForLine(const std::string& pre
   }
 }
 
+void BackgroundProcess::signal(int signal_number) {
+  if (pid_ > 0 && !reaped_) ::kill(pid_, signal_number);
+}
+
 void BackgroundProcess::kill() {
   if (pid_ <= 0 || reaped_) return;
   ::kill(-pid_, SIGKILL);

@@ -25,6 +25,8 @@ class BackgroundProcess {
   std::optional<std::string> readLine(double timeout_s);
   // The first line starting with `prefix` within `timeout_s` (lines before it are skipped).
   std::optional<std::string> waitForLine(const std::string& prefix, double timeout_s);
+  // Sends `signal` to the process alone (SIGTERM: end as Ctrl+C would).
+  void signal(int signal_number);
   // SIGKILL to the group, then reaped; idempotent.
   void kill();
   // Waits up to `timeout_s` for it to exit by itself; its exit status, or nothing.
