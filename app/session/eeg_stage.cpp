@@ -74,7 +74,9 @@ EegStageSettings EegStageSettings::of(const SessionConfig& config) {
   s.errp = config.paradigm.errp;
   if (s.errp) s.errp_pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
   s.errp_method = config.errp.method;
-  if (config.eeg.source == "lsl") s.lsl = config.lsl.config(config.source);
+  if (config.eeg.source == "lsl" || config.lsl.markers) s.lsl = config.lsl.config(config.source);
+  s.lsl_markers = config.lsl.markers;
+  s.marker_stream = config.lsl.marker_stream;
   return s;
 }
 
@@ -127,6 +129,22 @@ EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path
       "single stimulus, " + std::to_string(settings_.object_stimuli) + " stimuli";
   recent_.assign(static_cast<size_t>(eeg_info_.channelCount()), {});
   if (!settings_.model_file.empty()) setModel(bci::P300Model::load(settings_.model_file));
+  if (settings_.lsl_markers) {
+    bci::lsl::StreamInfo info;
+    info.name = settings_.marker_stream;
+    info.type = "Markers";
+    info.channel_count = 1;
+    info.channel_format = bci::lsl::ChannelFormat::String;
+    info.source_id = "arbci-session-markers:" + settings_.marker_stream;
+    try {
+      markers_ = std::make_unique<bci::lsl::Outlet>(info, settings_.lsl);
+    } catch (const bci::lsl::LslError& e) {
+      throw SessionConfigError(settings_.session_file + ": lsl.markers: " + e.what());
+    }
+    log_.write("lsl_markers", 0.0,
+               {{"stream", info.name}, {"port", markers_->info().v4data_port},
+                {"scope", settings_.lsl.describe()}});
+  }
   acquisition_->start();
 }
 
@@ -285,7 +303,12 @@ void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,
   if (model_) accumulator_.emplace(layout, model_->score_model);
 }
 
-void EegStage::flash(int code, std::int64_t sample) {
+void EegStage::publish(const std::string& text, double host_s) {
+  if (!markers_) return;
+  markers_->pushStrings({text}, stepped_ ? bci::lsl::localClock() : host_s);
+}
+
+void EegStage::flash(int code, std::int64_t sample, double host_s) {
   const bool target = truth_.count(code) > 0, known = !truth_.empty();
   const int nominal_duration = static_cast<int>(settings_.flash_s * eeg_info_.rate_hz + 0.5);
   bci::StimulusEvent event{sample, code, target, nominal_duration, known};
@@ -296,6 +319,9 @@ void EegStage::flash(int code, std::int64_t sample) {
   unrecorded_[sample] = record;
   epocher_->addEvent(event);
   ++presented_;
+  publish("flash " + std::to_string(selection_objects_ ? code : code + 100) + " " +
+              (known ? (target ? "target" : "nontarget") : "unknown"),
+          host_s);
 }
 
 void EegStage::flashEnded(std::int64_t onset_sample, int duration_samples) {
@@ -309,6 +335,11 @@ void EegStage::flashEnded(std::int64_t onset_sample, int duration_samples) {
 
 void EegStage::annotate(std::int64_t sample, const std::string& text) {
   writer_->addAnnotation({sample, text, 0});
+  if (markers_) {
+    // When the sample was taken: its distance from the newest one, on the host clock.
+    const double now = bci::hostSeconds();
+    publish(text, now + (static_cast<double>(sample) - acquisition_->sampleAt(now)) / eeg_info_.rate_hz);
+  }
 }
 
 void EegStage::feedback(const std::set<int>& codes, bool objects, std::optional<bool> error,

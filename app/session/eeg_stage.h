@@ -16,6 +16,7 @@
 #include <set>
 
 #include "arbci/bci/acquisition.h"
+#include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/decision.h"
 #include "arbci/bci/epocher.h"
 #include "arbci/bci/p300_model.h"
@@ -38,7 +39,9 @@ struct EegStageSettings {
   bool errp = false;         // train and use an ErrP classifier
   bci::PipelineSettings errp_pipeline;
   std::string errp_method;
-  bci::lsl::LslConfig lsl;  // source "lsl": lsl_api.cfg with the session's scope and peers
+  bci::lsl::LslConfig lsl;  // source "lsl" or markers: lsl_api.cfg with the session's scope, peers
+  bool lsl_markers = false;  // publish stimuli and annotations as an LSL Markers stream
+  std::string marker_stream;
   static EegStageSettings of(const SessionConfig& config);
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.
   void validate() const;
@@ -89,7 +92,8 @@ class EegStage final : public Stage {
   void startSelection(bool objects, const bci::ParadigmLayout& layout,
                       const std::set<int>& attended, std::optional<int> target);
   // A flash first presented at `sample` (its onset); epoched and shown to the subject now.
-  void flash(int code, std::int64_t sample);
+  // A flash first shown at `host_s` (the frame's presentation), stamped `sample`.
+  void flash(int code, std::int64_t sample, double host_s);
   // Its measured duration, once the frame after its last is presented: recorded then, as
   // "Stim <code> T|N" (grid codes as 100 + code) with the duration.
   void flashEnded(std::int64_t onset_sample, int duration_samples);
@@ -150,6 +154,10 @@ class EegStage final : public Stage {
   std::ostream* progress_;
   std::int64_t lost_logged_ = 0;  // lost samples already in the log
   std::string fault_logged_;      // the source's fault last logged (empty: none)
+  std::unique_ptr<bci::lsl::Outlet> markers_;  // lsl.markers: the session's events on LSL
+  // An event at `host_s` (the host clock, which is LSL's) to the Markers stream; a run on the
+  // simulated clock stamps the instant it is sent.
+  void publish(const std::string& text, double host_s);
   double time_s_ = 0.0;           // the last cycle's session time, for the log
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;

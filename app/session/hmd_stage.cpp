@@ -94,7 +94,8 @@ void HmdStage::presented(double host_s, double host_origin, std::int64_t frame) 
   }
   for (const StimulusTiming::Ended& ended : shown.ended)
     s_.eeg.flashEnded(ended.onset_sample, ended.duration_samples);
-  for (const StimulusTiming::Onset& onset : shown.onsets) s_.eeg.flash(onset.code, onset.sample);
+  for (const StimulusTiming::Onset& onset : shown.onsets)
+    s_.eeg.flash(onset.code, onset.sample, host_s);
   if (feedback_) s_.eeg.feedback(feedback_->codes, feedback_->objects, feedback_->error, sample);
   if (shown.late) {
     s_.log.write("late_frame", at,

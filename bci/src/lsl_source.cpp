@@ -104,6 +104,9 @@ void LslSource::flush(std::vector<Block>& out) {
 
 std::vector<Block> LslSource::poll(int max_blocks) {
   std::vector<Block> out;
+  // Until the first time-correction estimate (about 0.6 s), the samples wait in the inlet: a
+  // block stamped by its arrival would bend the clock model that the exact stamps then follow.
+  if (!inlet_->status().clock_known) return out;
   std::vector<lsl::Sample> samples;
   inlet_->pull(samples, static_cast<size_t>(max_blocks) * info_.block_size);
   const lsl::SampleCodec& codec = inlet_->codec();

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <thread>
 
+#include "arbci/bci/lsl/inlet.h"
+#include "arbci/bci/lsl/resolver.h"
 #include "arbci/bci/recording.h"
 #include "support/background_process.h"
 #include "support/test_files.h"
@@ -18,7 +20,13 @@ namespace {
 const std::string kArbci = ARBCI_EXECUTABLE;
 const std::string kEeg3 = std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
 
-TEST(LslSession, TheRecordingHoldsTheStreamedFilesSamplesUnchanged) {
+bci::lsl::LslConfig machine() {
+  bci::lsl::LslConfig c;
+  c.resolve_scope = "machine";
+  return c;
+}
+
+TEST(LslSession, TheRecordingHoldsTheStreamedSamplesAndItsMarkersFallOnTheFlashSamples) {
   const auto folder = test::freshTempPath("lsl_session", "recording");
   std::filesystem::create_directories(folder);
   const std::string name = "eeg3-" + std::to_string(::getpid());
@@ -27,7 +35,7 @@ TEST(LslSession, TheRecordingHoldsTheStreamedFilesSamplesUnchanged) {
       {"description", "EEG from LSL (arbci eeg stream)"},
       {"eeg", {{"source", "lsl"}, {"rate_hz", file.info.rate_hz}, {"photodiode_channel", ""},
                {"lsl", {{"name", name}, {"type", "EEG"}, {"resolve_timeout_s", 10}}}}},
-      {"lsl", {{"scope", "machine"}}}};
+      {"lsl", {{"scope", "machine"}, {"markers", true}, {"marker_stream", name + "-session"}}}};
   const auto session_file = folder / "lsl.json";
   std::ofstream(session_file) << session.dump(2);
 
@@ -36,7 +44,14 @@ TEST(LslSession, TheRecordingHoldsTheStreamedFilesSamplesUnchanged) {
   const auto out = folder / "session";
   test::BackgroundProcess run(kArbci, {"run", "--headless", "--session", session_file.string(),
                                        "--out", out.string()});
-  ASSERT_TRUE(streamer.waitForLine("streaming t0=", 30.0)) << "the session never connected";
+  const auto streaming = streamer.waitForLine("streaming t0=", 30.0);
+  ASSERT_TRUE(streaming) << "the session never connected";
+  // The LSL time of the file's first sample, which is the recording's first.
+  const double t0 = std::stod(streaming->substr(streaming->find('=') + 1));
+  // The session's own Markers stream, as LabRecorder would take it.
+  const auto found = bci::lsl::resolveStreams(machine(), bci::lsl::buildQuery("default", name + "-session", "Markers"), 10.0);
+  ASSERT_EQ(found.size(), 1u) << "the session published no Markers stream";
+  bci::lsl::Inlet markers(found[0], machine());
   std::this_thread::sleep_for(std::chrono::seconds(12));
   run.signal(SIGTERM);  // ends the session as Ctrl+C does
   const auto status = run.wait(30.0);
@@ -54,8 +69,40 @@ TEST(LslSession, TheRecordingHoldsTheStreamedFilesSamplesUnchanged) {
       worst = std::max(worst, static_cast<double>(std::abs(recorded.at(c, s) - file.at(c, s))));
   EXPECT_LT(worst, 0.05) << "microvolts";
   EXPECT_FALSE(recorded.stimuli.empty());
+  // Every flash after the markers inlet connected is on the Markers stream, stamped with its
+  // presentation time; that time, on the amplifier's clock, is the flash's sample in the file.
+  std::vector<bci::lsl::Sample> received;
+  markers.pull(received);
+  std::vector<std::pair<double, std::string>> flashes;
+  for (const auto& m : received)
+    if (m.strings[0].rfind("flash ", 0) == 0) flashes.emplace_back(m.timestamp, m.strings[0]);
+  ASSERT_GT(flashes.size(), 20u);
+  int matched = 0, considered = 0;
+  double worst_samples = 0;
+  for (const auto& stimulus : recorded.stimuli) {
+    const double at = t0 + stimulus.sample / file.info.rate_hz;
+    if (at < flashes.front().first - 1e-3) continue;  // before the inlet connected
+    ++considered;
+    const std::string code = "flash " + std::to_string(stimulus.code) + " ";
+    for (const auto& [stamp, text] : flashes) {
+      if (text.rfind(code, 0) != 0) continue;
+      const double off = (stamp - t0) * file.info.rate_hz - static_cast<double>(stimulus.sample);
+      if (std::abs(off) <= 1.0) {
+        ++matched;
+        worst_samples = std::max(worst_samples, std::abs(off));
+        break;
+      }
+    }
+  }
+  EXPECT_GT(considered, 20);
+  EXPECT_EQ(matched, considered) << "flashes whose marker time is not their recorded sample";
+  std::printf("[ measured ] %d flashes: marker time vs recorded sample within %.2f samples\n",
+              considered, worst_samples);
   const nlohmann::json summary = test::readJson(out / "summary.json");
   EXPECT_EQ(summary["timing"]["lost_samples"], 0);
+  // The stream's stamps are exact: the clock model sees no arrival jitter and no drift.
+  EXPECT_LT(summary["timing"]["clock_jitter_ms"].get<double>(), 0.5);
+  EXPECT_LT(std::abs(summary["timing"]["clock_drift_ppm"].get<double>()), 20.0);
 }
 
 }  // namespace
