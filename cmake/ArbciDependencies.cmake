@@ -13,6 +13,10 @@ find_package(orocos_kdl REQUIRED)
 # LSL stream descriptions are XML and discovery queries are XPath: pugixml evaluates them as
 # liblsl does (Debian libpugixml-dev).
 find_package(pugixml REQUIRED)
+# Amplifiers through eegdev (Debian libeegdev-dev; its plugins in eegdev-plugins-free). Found
+# directly: its pkg-config file requires xdffileio's and libusb's development files.
+find_library(EEGDEV_LIBRARY eegdev REQUIRED)
+find_path(EEGDEV_INCLUDE_DIR eegdev.h REQUIRED)
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
 pkg_check_modules(BIOSIG REQUIRED IMPORTED_TARGET libbiosig)
 find_package(Threads REQUIRED)

@@ -89,10 +89,10 @@ int runSession(const RunOptions& o) {
     if (!o.script.empty() && headless)
       throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
     if (!headless) return runWorkstation(config, options, o.script);
-    // A live stream cannot be stepped by a simulated clock: it runs on the wall clock.
-    options.simulated_clock = !o.realtime && config.eeg.source != "lsl";
-    if (config.eeg.source == "lsl" && !o.realtime)
-      std::cerr << "eeg.source is \"lsl\" (a live stream): running in real time\n";
+    // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
+    options.simulated_clock = !o.realtime && !config.eeg.live();
+    if (config.eeg.live() && !o.realtime)
+      std::cerr << "eeg.source is \"" << config.eeg.source << "\" (a live amplifier): running in real time\n";
     auto context = render::createHeadlessContext({64, 64});
     watchInterrupts();
     Session session(config, options, *context);

@@ -8,6 +8,7 @@
 #include <ostream>
 #include <thread>
 
+#include "arbci/bci/eegdev_source.h"
 #include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/file_source.h"
 #include "arbci/bci/filters.h"
@@ -37,6 +38,17 @@ std::unique_ptr<bci::EegSource> openSource(const EegStageSettings& settings,
       return std::make_unique<bci::LslSource>(lsl);
     } catch (const bci::lsl::LslError& e) {
       throw SessionConfigError(settings.session_file + ": eeg.source = \"lsl\": " + e.what());
+    }
+  }
+  if (eeg.source == "eegdev") {
+    bci::EegdevSourceSettings device;
+    device.device = eeg.eegdev_device;
+    device.block_size = eeg.block_size;
+    device.expected_rate_hz = eeg.rate_hz;
+    try {
+      return std::make_unique<bci::EegdevSource>(device);
+    } catch (const bci::EegdevError& e) {
+      throw SessionConfigError(settings.session_file + ": eeg.source = \"eegdev\": " + e.what());
     }
   }
   if (eeg.source == "file") {

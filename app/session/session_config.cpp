@@ -240,8 +240,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
 
   const Section eeg = root.section("eeg");
   eeg.known({"source", "seed", "montage", "rate_hz", "block_size", "line_hz", "erp_scale",
-             "errp_scale", "file", "photodiode_channel", "latency_ms", "lsl"});
-  c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file", "lsl"});
+             "errp_scale", "file", "photodiode_channel", "latency_ms", "lsl", "eegdev"});
+  c.eeg.source = eeg.text("source", c.eeg.source, {"simulated", "file", "lsl", "eegdev"});
   c.eeg.seed =
       static_cast<std::uint64_t>(eeg.integer("seed", static_cast<int>(c.eeg.seed), 0, 1 << 30));
   if (eeg.has("montage")) {
@@ -267,6 +267,13 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
       eeg_lsl.number("resolve_timeout_s", c.eeg.lsl_resolve_timeout_s, 0.1, 600.0);
   if (c.eeg.source == "lsl" && c.eeg.lsl_name.empty() && c.eeg.lsl_type.empty())
     eeg_lsl.fail("name", "or type is required when eeg.source is \"lsl\"");
+
+  const Section eeg_eegdev = eeg.section("eegdev");
+  eeg_eegdev.known({"device"});
+  c.eeg.eegdev_device = eeg_eegdev.text("device", c.eeg.eegdev_device);
+  if (c.eeg.source == "eegdev" && c.eeg.eegdev_device.empty())
+    eeg_eegdev.fail("device", "is required when eeg.source is \"eegdev\" (e.g. \"biosemi\", "
+                              "\"datafile|path|/data/s01.bdf\")");
 
   const Section lsl = root.section("lsl");
   lsl.known({"scope", "known_peers", "markers", "marker_stream"});

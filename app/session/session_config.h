@@ -69,7 +69,7 @@ struct WorldSettings {
 };
 
 struct EegSettings {
-  std::string source = "simulated";  // "simulated", "file" or "lsl"
+  std::string source = "simulated";  // "simulated", "file", "lsl" or "eegdev"
   std::uint64_t seed = 1;
   std::vector<std::string> montage{"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
   double rate_hz = 256.0;
@@ -86,6 +86,11 @@ struct EegSettings {
   std::string lsl_name;
   std::string lsl_type = "EEG";
   double lsl_resolve_timeout_s = 5.0;
+  // source "eegdev": eegdev's device string (device|option|value..., e.g. "biosemi",
+  // "datafile|path|/data/s01.bdf").
+  std::string eegdev_device;
+  // A source that runs on its own clock in real time (an amplifier): the session cannot step it.
+  bool live() const { return source == "lsl" || source == "eegdev"; }
 };
 
 // The Lab Streaming Layer (docs/eeg.md): where streams are looked for and what ARBCI publishes.

@@ -95,7 +95,7 @@ TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
   EXPECT_NE(unknown.find("flash_ms"), std::string::npos) << unknown;
   const std::string latency = errorOf(R"({"eeg": {"latency_ms": -3}})");
   EXPECT_NE(latency.find("eeg.latency_ms = -3"), std::string::npos) << latency;
-  const std::string source = errorOf(R"({"eeg": {"source": "eegdev"}})");  // not built yet
+  const std::string source = errorOf(R"({"eeg": {"source": "amplifier"}})");
   EXPECT_NE(source.find("eeg.source"), std::string::npos) << source;
   EXPECT_NE(source.find("simulated"), std::string::npos) << source;
 }

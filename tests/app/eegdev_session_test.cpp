@@ -1,0 +1,120 @@
+// A headless session whose EEG comes through eegdev's `datafile` device, which plays a BDF file
+// as if it were an amplifier, in real time.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+
+#include "arbci/bci/eegdev_source.h"
+#include "arbci/bci/recording.h"
+#include "support/background_process.h"
+#include "support/test_files.h"
+
+namespace arbci {
+namespace {
+
+const std::string kArbci = ARBCI_EXECUTABLE;
+const std::string kEeg3 = std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
+constexpr double kRangeUv = 8000.0;
+
+std::string field(const std::string& text, size_t width) {
+  std::string f = text.substr(0, width);
+  f.resize(width, ' ');
+  return f;
+}
+
+// A BDF as BioSemi's ActiView writes it: 1-second records, 24-bit samples, a Status channel
+// last (the layout eegdev's datafile device reads; it cannot read BDF+ annotation channels).
+void writeBiosemiBdf(const bci::Recording& r, const std::filesystem::path& path) {
+  const int rate = static_cast<int>(r.info.rate_hz);
+  const int channels = r.info.channelCount() + 1;
+  const std::int64_t records = r.samples / rate;
+  std::string h = "\xff" "BIOSEMI" + field("X", 80) + field("eeg3_1 for eegdev", 80) +
+                  "01.01.26" "00.00.00" + field(std::to_string(256 * (channels + 1)), 8) +
+                  field("24BIT", 44) + field(std::to_string(records), 8) + field("1", 8) +
+                  field(std::to_string(channels), 4);
+  const auto each = [&](auto value, size_t width) {
+    for (int c = 0; c < channels; ++c) h += field(value(c), width);
+  };
+  const int eeg = r.info.channelCount();
+  each([&](int c) { return c < eeg ? r.info.channels[c] : std::string("Status"); }, 16);
+  each([&](int c) { return std::string(c < eeg ? "Active Electrode" : "Triggers and Status"); }, 80);
+  each([&](int c) { return std::string(c < eeg ? "uV" : "Boolean"); }, 8);
+  each([&](int c) { return c < eeg ? std::string("-8000") : std::string("-8388608"); }, 8);
+  each([&](int c) { return c < eeg ? std::string("8000") : std::string("8388607"); }, 8);
+  each([&](int) { return std::string("-8388608"); }, 8);
+  each([&](int) { return std::string("8388607"); }, 8);
+  each([&](int) { return std::string(""); }, 80);
+  each([&](int) { return std::to_string(rate); }, 8);
+  each([&](int) { return std::string(""); }, 32);
+  std::ofstream out(path, std::ios::binary);
+  out << h;
+  for (std::int64_t record = 0; record < records; ++record)
+    for (int c = 0; c < channels; ++c)
+      for (int s = 0; s < rate; ++s) {
+        std::int32_t digital = 0;
+        if (c < eeg) {
+          const double uv = r.at(c, record * rate + s);
+          digital = static_cast<std::int32_t>(std::lround((uv + kRangeUv) / (2 * kRangeUv) * 16777215.0 - 8388608.0));
+        }
+        const char bytes[3] = {static_cast<char>(digital & 0xff), static_cast<char>((digital >> 8) & 0xff),
+                               static_cast<char>((digital >> 16) & 0xff)};
+        out.write(bytes, 3);
+      }
+}
+
+TEST(EegdevSession, TheDatafileDeviceDeliversTheBdfIntoTheRecordingUnchanged) {
+  const auto folder = test::freshTempPath("eegdev_session", "datafile");
+  std::filesystem::create_directories(folder);
+  const bci::Recording source = bci::readRecording(kEeg3);
+  const auto bdf = folder / "eeg3_biosemi.bdf";
+  writeBiosemiBdf(source, bdf);
+  const bci::Recording file = bci::readRecording(bdf);  // what the file holds, quantised
+  ASSERT_EQ(file.info.channels, source.info.channels);  // the reader keeps Status as events
+
+  nlohmann::json session = {
+      {"description", "EEG through eegdev's datafile device"},
+      {"eeg", {{"source", "eegdev"}, {"rate_hz", source.info.rate_hz}, {"photodiode_channel", ""},
+               {"eegdev", {{"device", "datafile|path|" + bdf.string()}}}}}};
+  const auto session_file = folder / "eegdev.json";
+  std::ofstream(session_file) << session.dump(2);
+  const auto out = folder / "session";
+  test::BackgroundProcess run(kArbci, {"run", "--headless", "--session", session_file.string(),
+                                       "--out", out.string()});
+  std::this_thread::sleep_for(std::chrono::seconds(12));
+  run.signal(SIGTERM);
+  ASSERT_TRUE(run.wait(30.0)) << "the session did not end";
+
+  const bci::Recording recorded = bci::readRecording(out / "recording.bdf");
+  // The EEG channels (the Status channel is a trigger, not EEG), sample for sample from the
+  // file's first, within the two files' 24-bit steps.
+  ASSERT_EQ(recorded.info.channels, source.info.channels);
+  ASSERT_GT(recorded.samples, static_cast<std::int64_t>(8 * source.info.rate_hz));
+  double worst = 0;
+  for (int c = 0; c < recorded.info.channelCount(); ++c)
+    for (std::int64_t s = 0; s < recorded.samples; ++s)
+      worst = std::max(worst, static_cast<double>(std::abs(recorded.at(c, s) - file.at(c, s))));
+  EXPECT_LT(worst, 0.005) << "microvolts";
+  const nlohmann::json summary = test::readJson(out / "summary.json");
+  EXPECT_EQ(summary["timing"]["lost_samples"], 0);
+  std::printf("[ measured ] %lld samples x %d channels from eegdev datafile; worst difference %.4f uV\n",
+              static_cast<long long>(recorded.samples), recorded.info.channelCount(), worst);
+}
+
+TEST(EegdevSource, AnUnreadableDeviceIsRefusedWithTheReasonAndTheSyntax) {
+  bci::EegdevSourceSettings settings;
+  settings.device = "nosuchdevice";
+  try {
+    bci::EegdevSource source(settings);
+    FAIL();
+  } catch (const bci::EegdevError& e) {
+    EXPECT_NE(std::string(e.what()).find("no installed eegdev plugin"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("datafile|path|"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace arbci
