@@ -135,7 +135,7 @@ void addEegCommand(CLI::App& root, int& exit_code) {
   CLI::App* info =
       eeg->add_subcommand("info",
                           "Channels, rate, duration and event counts by code of an EEG file\n"
-                          "(BCI2000 .dat, GDF, EDF(+), BDF(+)).");
+                          "(BCI2000 .dat, GDF, EDF(+), BDF(+), XDF).");
   info->add_option("FILE", options->file, "the recording")->required();
   info->add_flag("--salvage", options->salvage,
                  "read a file cut short up to its last complete record");

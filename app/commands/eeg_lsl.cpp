@@ -172,7 +172,7 @@ void addEegStreamCommands(CLI::App* eeg, int& exit_code) {
   });
   CLI::App* stream = eeg->add_subcommand(
       "stream",
-      "Play a recording (BCI2000 .dat, GDF, EDF, BDF) as an LSL outlet in real time, with its\n"
+      "Play a recording (BCI2000 .dat, GDF, EDF, BDF, XDF) as an LSL outlet in real time, with its\n"
       "stimuli as strings (\"flash <code> target|nontarget|unknown\") on a Markers outlet\n"
       "NAME-Markers: a stand-in amplifier for demos and tests. Stops at the file's end.");
   stream->add_option("file", options->file, "the recording")->required()->check(CLI::ExistingFile);

@@ -312,7 +312,8 @@ Recording readRecording(const std::filesystem::path& path, const ReadOptions& op
   const bool bdf = head.size() >= 8 && head.substr(0, 8) == std::string("\xff") + "BIOSEMI";
   const bool gdf = head.rfind("GDF", 0) == 0;
   if (edf || bdf || gdf) return readWithBiosig(path, options);
-  fail(path, "unknown format (not BCI2000 .dat, GDF, EDF or BDF)");
+  if (head.rfind("XDF:", 0) == 0) return readXdf(path, options);
+  fail(path, "unknown format (not BCI2000 .dat, GDF, EDF, BDF or XDF)");
 }
 
 }  // namespace arbci::bci

@@ -52,6 +52,10 @@ struct ReadOptions {
 Recording readRecording(const std::filesystem::path& path, const ReadOptions& options = {});
 Recording readBci2000(const std::filesystem::path& path, const ReadOptions& options = {});
 Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& options = {});
+// XDF (LabRecorder) through libxdf: the first regular stream of type EEG (else the regular one
+// with most channels), with the string streams' markers as stimuli ("flash <code> target",
+// "<code> nontarget", a bare code) or annotations, each at the first sample at or after it.
+Recording readXdf(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // A BCI2000 parameter's numeric value with its unit: "256Hz" -> 256, "800ms" -> 0.8 (seconds),
 // "0.019muV" -> 0.019. Throws RecordingError naming the parameter when it is missing or not a
