@@ -32,7 +32,7 @@ std::string trimmed(const std::string& s) {
 void sleepUnless(const std::atomic<bool>& stop, double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!stop && std::chrono::steady_clock::now() < until)
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
 }
 
 // The query that finds the same stream again after its outlet restarted (with a new uid).
@@ -260,7 +260,7 @@ void Inlet::timeLoop() {
           ++sent;
           next_probe += config_.time_probe_interval_s;
         }
-        auto reply = net::receiveDatagram(socket, 0.005);
+        auto reply = net::receiveDatagram(socket, std::min(0.02, config_.time_probe_interval_s / 2));
         if (!reply) continue;
         const double t3 = localClock();
         std::istringstream fields(reply->bytes);
