@@ -2,6 +2,7 @@
 // shell, or one panel (or the HMD view) on the live data of a simulated session.
 #include <unistd.h>
 #include <filesystem>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -75,8 +76,12 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
   session_options.trials = 1;
   Session session(config, session_options, *context);
   SessionModel model(session);
+  // A live amplifier runs in real time: the picture is taken after 10 s at most, whatever the
+  // session has reached by then.
+  const auto live_limit = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   auto runUntil = [&](const std::function<bool()>& ready) {
     for (int i = 0; i < 60 * 600 && !ready() && session.step(); ++i) {
+      if (config.eeg.live() && std::chrono::steady_clock::now() > live_limit) break;
     }
   };
   auto phase = [&] { return session.paradigm().phase(); };

@@ -263,6 +263,7 @@ void EegStage::poll() {
     writer_->addAnnotation({loss.first_sample,
                             "Lost " + std::to_string(loss.samples) + " samples: " + loss.reason,
                             static_cast<int>(loss.samples)});
+    lost_spans_.emplace_back(loss.first_sample, loss.first_sample + loss.samples);
   }
   for (const bci::Block& recorded : acquisition_->take()) {
     writer_->write(recorded);
@@ -297,10 +298,28 @@ void EegStage::poll() {
       flashes_.erase(found);
       if (record.selection != selection_) continue;
       ++scored_;
+      if (touchesLoss(epoch.event.sample)) {
+        // Zeros in place of lost samples (or the filters' ringing after them): no evidence.
+        ++discarded_;
+        log_.write("epoch_discarded", time_s_,
+                   {{"sample", epoch.event.sample}, {"code", record.code},
+                    {"reason", "it overlaps lost EEG samples"}});
+        continue;
+      }
       if (accumulator_ && extractor_)
         accumulator_->add(record.code, model_->classifier->score(extractor_->features(epoch)));
     }
   }
+}
+
+bool EegStage::touchesLoss(std::int64_t onset) const {
+  // The epoch's window, and a second before it for the filters to settle after a gap.
+  const double rate = eeg_info_.rate_hz;
+  const auto from = onset + static_cast<std::int64_t>(std::floor((settings_.pipeline.window.start_s - 1.0) * rate));
+  const auto to = onset + static_cast<std::int64_t>(std::ceil(settings_.pipeline.window.end_s * rate));
+  for (const auto& [first, end] : lost_spans_)
+    if (first < to && end > from) return true;
+  return false;
 }
 
 void EegStage::startSelection(bool objects, const bci::ParadigmLayout& layout,

@@ -130,6 +130,8 @@ class EegStage final : public Stage {
   // The source's own account (an LSL stream's name, host, rates, clock offset) and its fault.
   std::string sourceLine() const;
   std::string sourceFault() const;
+  // Epochs left out because they overlapped lost samples.
+  std::int64_t discardedEpochs() const { return discarded_; }
   // Live: waits (at most `timeout_s`) until the samples taken up to host instant `host_s` have
   // arrived and are recorded, so the last flashes' EEG and photodiode edges are in the file.
   void drainUntil(double host_s, double timeout_s);
@@ -154,6 +156,10 @@ class EegStage final : public Stage {
   std::ostream* progress_;
   std::int64_t lost_logged_ = 0;  // lost samples already in the log
   std::string fault_logged_;      // the source's fault last logged (empty: none)
+  // Stretches of lost samples [first, end): epochs touching them are discarded, not scored.
+  std::vector<std::pair<std::int64_t, std::int64_t>> lost_spans_;
+  std::int64_t discarded_ = 0;
+  bool touchesLoss(std::int64_t onset) const;
   std::unique_ptr<bci::lsl::Outlet> markers_;  // lsl.markers: the session's events on LSL
   // An event at `host_s` (the host clock, which is LSL's) to the Markers stream; a run on the
   // simulated clock stamps the instant it is sent.

@@ -53,12 +53,24 @@ std::string endKindOf(const std::string& reason, bci::Phase phase) {
 
 }  // namespace
 
-Session::Session(SessionConfig config, const SessionOptions& options, render::GlContext& context)
+namespace {
+
+// A live amplifier (LSL, eegdev) runs on its own clock: a session on it cannot be stepped by a
+// simulated clock, whoever asked for one (a headless run, a screenshot).
+SessionOptions forSource(SessionOptions options, const SessionConfig& config) {
+  if (config.eeg.live()) options.simulated_clock = false;
+  return options;
+}
+
+}  // namespace
+
+Session::Session(SessionConfig config, const SessionOptions& requested, render::GlContext& context)
     : config_(std::move(config)),
-      options_(options),
+      options_(forSource(requested, config_)),
       context_(context),
       timing_(0.0),
       preflight_(PreflightSettings{}) {
+  const SessionOptions& options = options_;
   if (options.seed) config_.eeg.seed = *options.seed;
   if (options.trials) config_.paradigm.trials = *options.trials;
   // The timing check: cued flashing until flashes_only_s, when the session ends.
@@ -342,6 +354,7 @@ bool Session::step() {
     timing_.mark(stage->name());
   }
   if (preflightRunning()) checkPreflight();
+  watchEegSource();
   if (options_.progress && !paradigm_->phaseChanges().empty()) showStatus();
   if (context_.isHeadless()) {
     context_.present();  // a window is presented by its owner, with the panels
@@ -358,6 +371,44 @@ bool Session::step() {
     if (wait > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
   }
   return !ended_;
+}
+
+void Session::watchEegSource() {
+  using bci::Phase;
+  const Phase phase = paradigm().phase();
+  const std::string fault = eeg_->sourceFault();
+  const double time = cycle_.time_s;
+  if (!fault.empty()) {
+    eeg_ok_since_ = -1.0;
+    // Flashing (or cueing, or showing feedback) without EEG would decide on nothing: the
+    // paradigm waits. The robot's own steps need no EEG and go on.
+    const bool needs_eeg = phase == Phase::CalibrationCue || phase == Phase::CalibrationFlashing ||
+                           phase == Phase::CalibrationFeedback || phase == Phase::ObjectFlashing ||
+                           phase == Phase::CellFlashing || phase == Phase::ObjectSelected ||
+                           phase == Phase::CellSelected;
+    if (!paused_for_eeg_ && needs_eeg) {
+      paradigm_->paradigm().pause();
+      paused_for_eeg_ = true;
+      log_->write("paused", time, {{"reason", "EEG source fault"}, {"fault", fault}});
+      if (options_.progress)
+        *options_.progress << "\npaused: " << fault << " (resumes 2 s after the EEG is back)\n";
+    }
+    return;
+  }
+  if (!paused_for_eeg_) return;
+  if (phase != Phase::Paused) {
+    paused_for_eeg_ = false;  // the experimenter resumed or ended it
+    return;
+  }
+  if (eeg_ok_since_ < 0.0) eeg_ok_since_ = time;
+  // Two seconds of signal again, then the sequence starts over (epochs touching the gap, and a
+  // second before their window, are discarded).
+  if (time - eeg_ok_since_ >= 2.0) {
+    paradigm_->paradigm().resume();
+    paused_for_eeg_ = false;
+    log_->write("resumed", time, {{"reason", "EEG source delivering again"}});
+    if (options_.progress) *options_.progress << "\nresumed: the EEG source delivers again\n";
+  }
 }
 
 void Session::recordCycleTime() {

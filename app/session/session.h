@@ -171,6 +171,10 @@ class Session {
   double host_origin_ = 0.0;  // session second 0 on the host clock (0 for a simulated clock)
   std::int64_t frame_ = 0;    // the next frame
   double fault_since_ = -1.0;
+  // An EEG source fault pauses the paradigm; it resumes once the source has delivered 2 s again.
+  void watchEegSource();
+  bool paused_for_eeg_ = false;
+  double eeg_ok_since_ = -1.0;
   bool ended_ = false;
   std::string end_reason_;
   std::string end_kind_;

@@ -22,7 +22,9 @@ nlohmann::json sessionSummary(const SessionFacts& facts, const CycleTiming& cycl
        {{"recording", "recording.bdf"},
         {"samples", eeg.samplesRecorded()},
         {"lost_samples", eeg.lostSamples()},
-        {"missed_epochs", eeg.missedEpochs()}}},
+        {"missed_epochs", eeg.missedEpochs()},
+        {"discarded_epochs", eeg.discardedEpochs()},
+        {"source", eeg.sourceLine()}}},
   };
   out.update(trialsSummary(trials, facts.object_choices, facts.cell_choices));
   if (calibration) {
