@@ -89,11 +89,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   const std::vector<Config> configs{{8, 256, 1}, {8, 256, 15}, {64, 2048, 16}, {64, 2048, 1}};
   std::printf("ARBCI LSL, outlet and inlet in two processes on loopback, %.0f s each\n\n", seconds);
-  std::printf("| channels | rate (Hz) | samples per push | latency p50 ms | p99 ms | max ms | inlet CPU per 15-sample block | share of a 58.6 ms cycle |\n");
+  std::printf(
+      "| channels | rate (Hz) | samples per push | latency p50 ms | p99 ms | max ms | inlet CPU "
+      "per 15-sample block | share of a 58.6 ms cycle |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const Config& c : configs) {
-    const std::string name = "lsl-bench-" + std::to_string(getpid()) + "-" + std::to_string(c.channels) +
-                             "-" + std::to_string(c.chunk);
+    const std::string name = "lsl-bench-" + std::to_string(getpid()) + "-" +
+                             std::to_string(c.channels) + "-" + std::to_string(c.chunk);
     const pid_t child = fork();
     if (child == 0) runOutlet(name, c, seconds);
     LslSourceSettings settings;
@@ -107,7 +109,8 @@ int main(int argc, char** argv) {
     const auto started = std::chrono::steady_clock::now();
     long blocks = 0;
     const long expected = static_cast<long>(seconds * c.rate) / 15;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds + 10);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds + 10);
     while (blocks < expected - 2 && std::chrono::steady_clock::now() < deadline) {
       const double before = threadCpuSeconds();
       const std::vector<Block> polled = source.poll(256);

@@ -40,7 +40,8 @@ void addScopeOptions(CLI::App* command, LslOptions& o) {
   command
       ->add_option("--scope", o.scope,
                    "where to look and serve: machine (127.0.0.1 only), link or site; default: "
-                   "lsl_api.cfg's ResolveScope ($LSLAPICFG, ./lsl_api.cfg, ~/lsl_api/, /etc/lsl_api/), else site")
+                   "lsl_api.cfg's ResolveScope ($LSLAPICFG, ./lsl_api.cfg, ~/lsl_api/, "
+                   "/etc/lsl_api/), else site")
       ->check(CLI::IsMember({"machine", "link", "site"}));
   command->add_option("--peer", o.peers, "a host to ask directly (repeatable; adds to KnownPeers)");
 }
@@ -48,8 +49,8 @@ void addScopeOptions(CLI::App* command, LslOptions& o) {
 void listStreams(const LslOptions& o) {
   const bci::lsl::LslConfig config = configOf(o);
   std::cerr << "looking for LSL streams for " << o.timeout_s << " s: " << config.describe() << "\n";
-  const auto streams = bci::lsl::resolveStreams(config, "session_id='" + config.session_id + "'",
-                                                o.timeout_s, 0);
+  const auto streams =
+      bci::lsl::resolveStreams(config, "session_id='" + config.session_id + "'", o.timeout_s, 0);
   if (streams.empty()) {
     std::cout << "no LSL streams seen\n";
     return;
@@ -77,8 +78,7 @@ void streamFile(const LslOptions& o) {
     throw CliError(e.what());
   }
   const bci::lsl::LslConfig config = configOf(o);
-  const std::string name =
-      o.name.empty() ? std::filesystem::path(o.file).stem().string() : o.name;
+  const std::string name = o.name.empty() ? std::filesystem::path(o.file).stem().string() : o.name;
   bci::lsl::StreamInfo eeg;
   eeg.name = name;
   eeg.type = o.type;
@@ -102,9 +102,8 @@ void streamFile(const LslOptions& o) {
   }
   for (const auto& w : eeg_outlet->warnings()) std::cerr << "warning: " << w << "\n";
   std::cerr << "streaming \"" << name << "\" (" << eeg.channel_count << " channels at "
-            << eeg.nominal_srate << " Hz, " << r.seconds() << " s) and \"" << markers.name
-            << "\" (" << r.stimuli.size() << " stimuli) from " << o.file << "; "
-            << config.describe() << "\n";
+            << eeg.nominal_srate << " Hz, " << r.seconds() << " s) and \"" << markers.name << "\" ("
+            << r.stimuli.size() << " stimuli) from " << o.file << "; " << config.describe() << "\n";
   watchInterrupts();
   if (o.wait) {
     std::cerr << "waiting for a consumer (up to 60 s)...\n";
@@ -133,10 +132,11 @@ void streamFile(const LslOptions& o) {
         for (int c = 0; c < eeg.channel_count; ++c)
           chunk[static_cast<size_t>(s) * eeg.channel_count + c] = r.at(c, first + s);
       eeg_outlet->pushRaw(chunk.data(), n, stamp);
-      for (; next_stimulus < r.stimuli.size() && r.stimuli[next_stimulus].sample < first + n; ++next_stimulus) {
+      for (; next_stimulus < r.stimuli.size() && r.stimuli[next_stimulus].sample < first + n;
+           ++next_stimulus) {
         const auto& e = r.stimuli[next_stimulus];
-        marker_outlet->pushStrings({markerText(e)},
-                                   t0 + static_cast<double>(sent_total + e.sample) / r.info.rate_hz);
+        marker_outlet->pushStrings(
+            {markerText(e)}, t0 + static_cast<double>(sent_total + e.sample) / r.info.rate_hz);
       }
       const double at = static_cast<double>(first + n) / r.info.rate_hz;
       if (at >= next_report) {
@@ -159,9 +159,10 @@ void streamFile(const LslOptions& o) {
 
 void addEegStreamCommands(CLI::App* eeg, int& exit_code) {
   auto options = std::make_shared<LslOptions>();
-  CLI::App* list = eeg->add_subcommand(
-      "streams", "List the Lab Streaming Layer streams this machine can see (name, type,\n"
-                 "channels, rate, host).");
+  CLI::App* list =
+      eeg->add_subcommand("streams",
+                          "List the Lab Streaming Layer streams this machine can see (name, type,\n"
+                          "channels, rate, host).");
   addScopeOptions(list, *options);
   list->add_option("--timeout", options->timeout_s, "seconds to wait for answers")
       ->capture_default_str()
@@ -172,7 +173,8 @@ void addEegStreamCommands(CLI::App* eeg, int& exit_code) {
   });
   CLI::App* stream = eeg->add_subcommand(
       "stream",
-      "Play a recording (BCI2000 .dat, GDF, EDF, BDF, XDF) as an LSL outlet in real time, with its\n"
+      "Play a recording (BCI2000 .dat, GDF, EDF, BDF, XDF) as an LSL outlet in real time, with "
+      "its\n"
       "stimuli as strings (\"flash <code> target|nontarget|unknown\") on a Markers outlet\n"
       "NAME-Markers: a stand-in amplifier for demos and tests. Stops at the file's end.");
   stream->add_option("file", options->file, "the recording")->required()->check(CLI::ExistingFile);

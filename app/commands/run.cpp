@@ -92,7 +92,8 @@ int runSession(const RunOptions& o) {
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.simulated_clock = !o.realtime && !config.eeg.live();
     if (config.eeg.live() && !o.realtime)
-      std::cerr << "eeg.source is \"" << config.eeg.source << "\" (a live amplifier): running in real time\n";
+      std::cerr << "eeg.source is \"" << config.eeg.source
+                << "\" (a live amplifier): running in real time\n";
     auto context = render::createHeadlessContext({64, 64});
     watchInterrupts();
     Session session(config, options, *context);

@@ -1,8 +1,8 @@
 // `arbci screenshot`: renders the experimenter window headless (EGL) and writes it as a PNG: the
 // shell, or one panel (or the HMD view) on the live data of a simulated session.
 #include <unistd.h>
-#include <filesystem>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>

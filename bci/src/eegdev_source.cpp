@@ -46,9 +46,10 @@ EegdevSource::EegdevSource(const EegdevSourceSettings& settings) : settings_(set
                       "). The datafile device reads BDF/EDF/GDF through xdffileio, which needs "
                       "1-second records and no annotation channel");
   if (settings.expected_rate_hz > 0 && std::abs(rate - settings.expected_rate_hz) > 1e-6)
-    throw EegdevError(where + " samples at " + std::to_string(rate) + " Hz but the session expects " +
-                      std::to_string(settings.expected_rate_hz) +
-                      " Hz (eeg.rate_hz); ARBCI does not resample: set eeg.rate_hz to the device's rate");
+    throw EegdevError(
+        where + " samples at " + std::to_string(rate) + " Hz but the session expects " +
+        std::to_string(settings.expected_rate_hz) +
+        " Hz (eeg.rate_hz); ARBCI does not resample: set eeg.rate_hz to the device's rate");
   const int eeg = egd_sensor_type("eeg");
   const int channels = egd_get_numch(device_.get(), eeg);
   if (channels <= 0) throw EegdevError(where + ": has no EEG channels");
@@ -81,8 +82,8 @@ std::vector<Block> EegdevSource::poll(int max_blocks) {
   if (available < 0) {
     const int error = errno;
     fault_ = "eegdev device \"" + settings_.device + "\" stopped: " +
-             (error == EAGAIN ? std::string("connection lost (a cable, or the power)")
-              : error == EIO  ? std::string("synchronisation lost")
+             (error == EAGAIN   ? std::string("connection lost (a cable, or the power)")
+              : error == EIO    ? std::string("synchronisation lost")
               : error == ENOMEM ? std::string("its buffer overflowed, or the file ended")
                                 : std::string(std::strerror(error)));
     return out;
@@ -101,7 +102,8 @@ std::vector<Block> EegdevSource::poll(int max_blocks) {
     Block block(next_sample_, channels, info_.block_size);
     for (int s = 0; s < info_.block_size; ++s)
       for (int c = 0; c < channels; ++c)
-        block.at(c, s) = static_cast<float>(pending_[used + static_cast<size_t>(s) * channels + c] * scale_[c]);
+        block.at(c, s) =
+            static_cast<float>(pending_[used + static_cast<size_t>(s) * channels + c] * scale_[c]);
     used += per_block;
     next_sample_ += info_.block_size;
     out.push_back(std::move(block));
@@ -111,7 +113,8 @@ std::vector<Block> EegdevSource::poll(int max_blocks) {
 }
 
 std::string EegdevSource::describe() const {
-  return "eegdev \"" + settings_.device + "\" (" + (device_type_.empty() ? "device" : device_type_) +
+  return "eegdev \"" + settings_.device + "\" (" +
+         (device_type_.empty() ? "device" : device_type_) +
          "): " + std::to_string(info_.channelCount()) + " EEG channels at " +
          std::to_string(static_cast<int>(info_.rate_hz)) + " Hz";
 }

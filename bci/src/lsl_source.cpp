@@ -43,7 +43,8 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
     char timeout[32];
     std::snprintf(timeout, sizeof timeout, "%.1f", settings.resolve_timeout_s);
     throw lsl::LslError("no LSL stream with " + wanted + " answered within " + timeout + " s (" +
-                        settings.config.describe() + "). Is the amplifier's LSL app streaming? "
+                        settings.config.describe() +
+                        "). Is the amplifier's LSL app streaming? "
                         "`arbci eeg streams` lists the streams this machine can see");
   }
   if (found.size() > 1)
@@ -55,7 +56,8 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
   if (stream.nominal_srate <= 0)
     throw lsl::LslError("LSL stream \"" + stream.name +
                         "\" has no regular sampling rate; EEG needs one");
-  if (settings.expected_rate_hz > 0 && std::abs(stream.nominal_srate - settings.expected_rate_hz) > 1e-6)
+  if (settings.expected_rate_hz > 0 &&
+      std::abs(stream.nominal_srate - settings.expected_rate_hz) > 1e-6)
     throw lsl::LslError("LSL stream \"" + stream.name + "\" runs at " +
                         std::to_string(stream.nominal_srate) + " Hz but the session expects " +
                         std::to_string(settings.expected_rate_hz) +
@@ -79,7 +81,8 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
   info_.channels = full.channelLabels();
   info_.block_size = std::max(1, settings.block_size);
   for (int c = 0; c < full.channel_count; ++c)
-    scale_.push_back(c < static_cast<int>(full.channels.size()) ? microvoltsPer(full.channels[c].unit) : 1.0);
+    scale_.push_back(
+        c < static_cast<int>(full.channels.size()) ? microvoltsPer(full.channels[c].unit) : 1.0);
   name_ = full.name;
   host_ = full.hostname;
   pending_ = Block(0, info_.channelCount(), 0);
@@ -95,8 +98,7 @@ void LslSource::flush(std::vector<Block>& out) {
     for (int c = 0; c < pending_.channels; ++c)
       block.at(c, s) = pending_.data[static_cast<size_t>(s) * pending_.channels + c];
   const lsl::InletStatus status = inlet_->status();
-  if (status.clock_known)
-    block.taken_host_s = last_timestamp_ + status.clock_offset_s;
+  if (status.clock_known) block.taken_host_s = last_timestamp_ + status.clock_offset_s;
   out.push_back(std::move(block));
   pending_ = Block(next_index_, info_.channelCount(), 0);
   pending_.data.reserve(static_cast<size_t>(info_.block_size) * info_.channelCount());
@@ -161,7 +163,8 @@ std::string LslSource::describe() const {
                 name_.c_str(), inlet_->endpoint().c_str(), info_.rate_hz, measured,
                 status.clock_known ? status.clock_offset_s * 1e3 : 0.0,
                 status.clock_known ? status.clock_rtt_s * 1e3 : 0.0,
-                static_cast<long long>(gap_samples_), status.clock_known ? "" : " (clock not yet estimated)");
+                static_cast<long long>(gap_samples_),
+                status.clock_known ? "" : " (clock not yet estimated)");
   return text;
 }
 

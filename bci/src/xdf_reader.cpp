@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <map>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -184,7 +184,8 @@ std::uintmax_t checkChunks(const std::filesystem::path& path, bool& cut_short) {
       corrupt("data for stream " + std::to_string(stream) + ", which has no header before it");
     if (tag == 3 && !samplesFit(body, layout->second.channels, layout->second.value_bytes))
       corrupt("samples of stream " + std::to_string(stream) + " that do not fill their chunk");
-    if (tag == 4 && body.size() != 16) corrupt("a clock offset of " + std::to_string(body.size()) + " bytes");
+    if (tag == 4 && body.size() != 16)
+      corrupt("a clock offset of " + std::to_string(body.size()) + " bytes");
     if (tag == 6) {
       pugi::xml_document doc;
       if (!doc.load_buffer(body.data(), body.size())) corrupt("a stream footer that is not XML");
@@ -255,7 +256,8 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
     if (c < static_cast<int>(eeg.info.channels.size())) {
       const auto& meta = eeg.info.channels[static_cast<size_t>(c)];
       if (auto l = meta.find("label"); l != meta.end()) label = l->second;
-      if (auto u = meta.find("unit"); u != meta.end()) scale[static_cast<size_t>(c)] = microvoltsPer(u->second);
+      if (auto u = meta.find("unit"); u != meta.end())
+        scale[static_cast<size_t>(c)] = microvoltsPer(u->second);
     }
     r.info.channels.push_back(label.empty() ? "Ch" + std::to_string(c + 1) : label);
   }
@@ -275,7 +277,8 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
   r.parameters["XdfStream"] = eeg.info.name;
   if (cut_short) {
     r.truncated = true;
-    r.truncation_note = "cut short at byte " + std::to_string(whole) + "; read up to its last whole chunk";
+    r.truncation_note =
+        "cut short at byte " + std::to_string(whole) + "; read up to its last whole chunk";
   }
   r.parameters["XdfStreamType"] = eeg.info.type;
   // Markers: each at the first EEG sample taken at or after it (as ARBCI stamps a flash).
@@ -292,8 +295,9 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
     else
       r.annotations.push_back({sample, event.first, 0});
   }
-  std::stable_sort(r.stimuli.begin(), r.stimuli.end(),
-                   [](const StimulusEvent& a, const StimulusEvent& b) { return a.sample < b.sample; });
+  std::stable_sort(
+      r.stimuli.begin(), r.stimuli.end(),
+      [](const StimulusEvent& a, const StimulusEvent& b) { return a.sample < b.sample; });
   std::stable_sort(r.annotations.begin(), r.annotations.end(),
                    [](const Annotation& a, const Annotation& b) { return a.sample < b.sample; });
   return r;

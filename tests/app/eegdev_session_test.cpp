@@ -17,7 +17,8 @@ namespace arbci {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
-const std::string kEeg3 = std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
+const std::string kEeg3 =
+    std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
 constexpr double kRangeUv = 8000.0;
 
 std::string field(const std::string& text, size_t width) {
@@ -32,16 +33,21 @@ void writeBiosemiBdf(const bci::Recording& r, const std::filesystem::path& path)
   const int rate = static_cast<int>(r.info.rate_hz);
   const int channels = r.info.channelCount() + 1;
   const std::int64_t records = r.samples / rate;
-  std::string h = "\xff" "BIOSEMI" + field("X", 80) + field("eeg3_1 for eegdev", 80) +
-                  "01.01.26" "00.00.00" + field(std::to_string(256 * (channels + 1)), 8) +
-                  field("24BIT", 44) + field(std::to_string(records), 8) + field("1", 8) +
-                  field(std::to_string(channels), 4);
+  std::string h =
+      "\xff"
+      "BIOSEMI" +
+      field("X", 80) + field("eeg3_1 for eegdev", 80) +
+      "01.01.26"
+      "00.00.00" +
+      field(std::to_string(256 * (channels + 1)), 8) + field("24BIT", 44) +
+      field(std::to_string(records), 8) + field("1", 8) + field(std::to_string(channels), 4);
   const auto each = [&](auto value, size_t width) {
     for (int c = 0; c < channels; ++c) h += field(value(c), width);
   };
   const int eeg = r.info.channelCount();
   each([&](int c) { return c < eeg ? r.info.channels[c] : std::string("Status"); }, 16);
-  each([&](int c) { return std::string(c < eeg ? "Active Electrode" : "Triggers and Status"); }, 80);
+  each([&](int c) { return std::string(c < eeg ? "Active Electrode" : "Triggers and Status"); },
+       80);
   each([&](int c) { return std::string(c < eeg ? "uV" : "Boolean"); }, 8);
   each([&](int c) { return c < eeg ? std::string("-8000") : std::string("-8388608"); }, 8);
   each([&](int c) { return c < eeg ? std::string("8000") : std::string("8388607"); }, 8);
@@ -58,9 +64,11 @@ void writeBiosemiBdf(const bci::Recording& r, const std::filesystem::path& path)
         std::int32_t digital = 0;
         if (c < eeg) {
           const double uv = r.at(c, record * rate + s);
-          digital = static_cast<std::int32_t>(std::lround((uv + kRangeUv) / (2 * kRangeUv) * 16777215.0 - 8388608.0));
+          digital = static_cast<std::int32_t>(
+              std::lround((uv + kRangeUv) / (2 * kRangeUv) * 16777215.0 - 8388608.0));
         }
-        const char bytes[3] = {static_cast<char>(digital & 0xff), static_cast<char>((digital >> 8) & 0xff),
+        const char bytes[3] = {static_cast<char>(digital & 0xff),
+                               static_cast<char>((digital >> 8) & 0xff),
                                static_cast<char>((digital >> 16) & 0xff)};
         out.write(bytes, 3);
       }
@@ -75,15 +83,17 @@ TEST(EegdevSession, TheDatafileDeviceDeliversTheBdfIntoTheRecordingUnchanged) {
   const bci::Recording file = bci::readRecording(bdf);  // what the file holds, quantised
   ASSERT_EQ(file.info.channels, source.info.channels);  // the reader keeps Status as events
 
-  nlohmann::json session = {
-      {"description", "EEG through eegdev's datafile device"},
-      {"eeg", {{"source", "eegdev"}, {"rate_hz", source.info.rate_hz}, {"photodiode_channel", ""},
-               {"eegdev", {{"device", "datafile|path|" + bdf.string()}}}}}};
+  nlohmann::json session = {{"description", "EEG through eegdev's datafile device"},
+                            {"eeg",
+                             {{"source", "eegdev"},
+                              {"rate_hz", source.info.rate_hz},
+                              {"photodiode_channel", ""},
+                              {"eegdev", {{"device", "datafile|path|" + bdf.string()}}}}}};
   const auto session_file = folder / "eegdev.json";
   std::ofstream(session_file) << session.dump(2);
   const auto out = folder / "session";
-  test::BackgroundProcess run(kArbci, {"run", "--headless", "--session", session_file.string(),
-                                       "--out", out.string()});
+  test::BackgroundProcess run(
+      kArbci, {"run", "--headless", "--session", session_file.string(), "--out", out.string()});
   std::this_thread::sleep_for(std::chrono::seconds(12));
   run.signal(SIGTERM);
   ASSERT_TRUE(run.wait(30.0)) << "the session did not end";
@@ -100,8 +110,9 @@ TEST(EegdevSession, TheDatafileDeviceDeliversTheBdfIntoTheRecordingUnchanged) {
   EXPECT_LT(worst, 0.005) << "microvolts";
   const nlohmann::json summary = test::readJson(out / "summary.json");
   EXPECT_EQ(summary["timing"]["lost_samples"], 0);
-  std::printf("[ measured ] %lld samples x %d channels from eegdev datafile; worst difference %.4f uV\n",
-              static_cast<long long>(recorded.samples), recorded.info.channelCount(), worst);
+  std::printf(
+      "[ measured ] %lld samples x %d channels from eegdev datafile; worst difference %.4f uV\n",
+      static_cast<long long>(recorded.samples), recorded.info.channelCount(), worst);
 }
 
 TEST(EegdevSource, AnUnreadableDeviceIsRefusedWithTheReasonAndTheSyntax) {
@@ -111,7 +122,8 @@ TEST(EegdevSource, AnUnreadableDeviceIsRefusedWithTheReasonAndTheSyntax) {
     bci::EegdevSource source(settings);
     FAIL();
   } catch (const bci::EegdevError& e) {
-    EXPECT_NE(std::string(e.what()).find("no installed eegdev plugin"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no installed eegdev plugin"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("datafile|path|"), std::string::npos) << e.what();
   }
 }

@@ -18,7 +18,8 @@ namespace arbci {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
-const std::string kEeg3 = std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
+const std::string kEeg3 =
+    std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
 
 bci::lsl::LslConfig machine() {
   bci::lsl::LslConfig c;
@@ -33,23 +34,27 @@ TEST(LslSession, TheRecordingHoldsTheStreamedSamplesAndItsMarkersFallOnTheFlashS
   const bci::Recording file = bci::readRecording(kEeg3);
   nlohmann::json session = {
       {"description", "EEG from LSL (arbci eeg stream)"},
-      {"eeg", {{"source", "lsl"}, {"rate_hz", file.info.rate_hz}, {"photodiode_channel", ""},
-               {"lsl", {{"name", name}, {"type", "EEG"}, {"resolve_timeout_s", 10}}}}},
+      {"eeg",
+       {{"source", "lsl"},
+        {"rate_hz", file.info.rate_hz},
+        {"photodiode_channel", ""},
+        {"lsl", {{"name", name}, {"type", "EEG"}, {"resolve_timeout_s", 10}}}}},
       {"lsl", {{"scope", "machine"}, {"markers", true}, {"marker_stream", name + "-session"}}}};
   const auto session_file = folder / "lsl.json";
   std::ofstream(session_file) << session.dump(2);
 
-  test::BackgroundProcess streamer(kArbci, {"eeg", "stream", kEeg3, "--name", name, "--wait",
-                                            "--scope", "machine"});
+  test::BackgroundProcess streamer(
+      kArbci, {"eeg", "stream", kEeg3, "--name", name, "--wait", "--scope", "machine"});
   const auto out = folder / "session";
-  test::BackgroundProcess run(kArbci, {"run", "--headless", "--session", session_file.string(),
-                                       "--out", out.string()});
+  test::BackgroundProcess run(
+      kArbci, {"run", "--headless", "--session", session_file.string(), "--out", out.string()});
   const auto streaming = streamer.waitForLine("streaming t0=", 30.0);
   ASSERT_TRUE(streaming) << "the session never connected";
   // The LSL time of the file's first sample, which is the recording's first.
   const double t0 = std::stod(streaming->substr(streaming->find('=') + 1));
   // The session's own Markers stream, as LabRecorder would take it.
-  const auto found = bci::lsl::resolveStreams(machine(), bci::lsl::buildQuery("default", name + "-session", "Markers"), 10.0);
+  const auto found = bci::lsl::resolveStreams(
+      machine(), bci::lsl::buildQuery("default", name + "-session", "Markers"), 10.0);
   ASSERT_EQ(found.size(), 1u) << "the session published no Markers stream";
   bci::lsl::Inlet markers(found[0], machine());
   std::this_thread::sleep_for(std::chrono::seconds(12));
@@ -120,16 +125,20 @@ TEST(LslSession, AStreamLostMidSessionPausesItAndItGoesOnWhenTheStreamIsBack) {
   const std::string name = "eeg3r-" + std::to_string(::getpid());
   nlohmann::json session = {
       {"description", "EEG from LSL, the stream restarted"},
-      {"eeg", {{"source", "lsl"}, {"rate_hz", 256}, {"photodiode_channel", ""},
-               {"lsl", {{"name", name}, {"type", "EEG"}, {"resolve_timeout_s", 10}}}}},
+      {"eeg",
+       {{"source", "lsl"},
+        {"rate_hz", 256},
+        {"photodiode_channel", ""},
+        {"lsl", {{"name", name}, {"type", "EEG"}, {"resolve_timeout_s", 10}}}}},
       {"lsl", {{"scope", "machine"}}}};
   const auto session_file = folder / "lsl.json";
   std::ofstream(session_file) << session.dump(2);
-  const std::vector<std::string> stream_args{"eeg", "stream", kEeg3, "--name", name, "--scope", "machine"};
+  const std::vector<std::string> stream_args{"eeg", "stream",  kEeg3,    "--name",
+                                             name,  "--scope", "machine"};
   auto first = std::make_unique<test::BackgroundProcess>(kArbci, stream_args);
   const auto out = folder / "session";
-  test::BackgroundProcess run(kArbci, {"run", "--headless", "--session", session_file.string(),
-                                       "--out", out.string()});
+  test::BackgroundProcess run(
+      kArbci, {"run", "--headless", "--session", session_file.string(), "--out", out.string()});
   std::this_thread::sleep_for(std::chrono::seconds(7));
   first->kill();  // the amplifier's app dies
   std::this_thread::sleep_for(std::chrono::seconds(2));
@@ -161,7 +170,8 @@ TEST(LslSession, AStreamLostMidSessionPausesItAndItGoesOnWhenTheStreamIsBack) {
   for (const auto& a : recorded.annotations) annotated |= a.text.rfind("Lost ", 0) == 0;
   EXPECT_TRUE(annotated);
   std::printf("[ measured ] %lld samples lost while the stream was away; %lld epochs discarded\n",
-              static_cast<long long>(lost), static_cast<long long>(summary["eeg"]["discarded_epochs"].get<std::int64_t>()));
+              static_cast<long long>(lost),
+              static_cast<long long>(summary["eeg"]["discarded_epochs"].get<std::int64_t>()));
 }
 
 }  // namespace

@@ -36,7 +36,8 @@ StreamInfo eegStream(const std::string& name, int channels, double rate, Channel
   s.nominal_srate = rate;
   s.channel_format = format;
   s.source_id = name + "-source";
-  for (int c = 0; c < channels; ++c) s.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG"});
+  for (int c = 0; c < channels; ++c)
+    s.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG"});
   return s;
 }
 
@@ -45,7 +46,8 @@ std::vector<Sample> pullSamples(Inlet& inlet, size_t count, double timeout_s) {
   std::vector<Sample> got;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
-    if (inlet.pull(got, count - got.size()) == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    if (inlet.pull(got, count - got.size()) == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   return got;
 }
@@ -72,8 +74,8 @@ TEST(LslLoopback, AnOutletIsFoundByNameAndTypeOnLoopbackOnly) {
 }
 
 TEST(LslLoopback, EveryFormatArrivesBitIdenticalWithItsTimestamps) {
-  for (ChannelFormat format : {ChannelFormat::Float32, ChannelFormat::Double64, ChannelFormat::Int32,
-                               ChannelFormat::Int16}) {
+  for (ChannelFormat format : {ChannelFormat::Float32, ChannelFormat::Double64,
+                               ChannelFormat::Int32, ChannelFormat::Int16}) {
     SCOPED_TRACE(formatName(format));
     const std::string name = uniqueName(formatName(format));
     Outlet outlet(eegStream(name, 7, 500, format), machineScope());
@@ -94,7 +96,8 @@ TEST(LslLoopback, EveryFormatArrivesBitIdenticalWithItsTimestamps) {
     const auto got = pullSamples(inlet, 100, 5.0);
     ASSERT_EQ(got.size(), 100u);
     for (int s = 0; s < 100; ++s) {
-      EXPECT_EQ(std::vector<char>(chunk.begin() + s * codec.rawBytes(), chunk.begin() + (s + 1) * codec.rawBytes()),
+      EXPECT_EQ(std::vector<char>(chunk.begin() + s * codec.rawBytes(),
+                                  chunk.begin() + (s + 1) * codec.rawBytes()),
                 got[s].raw);
       EXPECT_NEAR(got[s].timestamp, 1000.0 + s / 500.0, 1e-9);
     }
@@ -266,10 +269,12 @@ TEST(LslTwoProcesses, AnOutletKilledAndRestartedIsReconnectedAndTheGapCountedExa
   constexpr std::int64_t kStopAt = 5000, kResumeAt = 7340, kEnd = 10000;  // whole blocks of 10
   const std::string rate = "1000";
   arbci::test::BackgroundProcess first(
-      LSL_OUTLET_HELPER, {name, name + "-src", "8", rate, "20", "0", std::to_string(kStopAt), "-1", "60"});
+      LSL_OUTLET_HELPER,
+      {name, name + "-src", "8", rate, "20", "0", std::to_string(kStopAt), "-1", "60"});
   const auto ready = first.waitForLine("ready", 10.0);
   ASSERT_TRUE(ready);
-  const std::string t0 = ready->substr(ready->find("t0=") + 3, ready->find(' ', ready->find("t0=")) - ready->find("t0=") - 3);
+  const std::string t0 = ready->substr(
+      ready->find("t0=") + 3, ready->find(' ', ready->find("t0=")) - ready->find("t0=") - 3);
   LslSourceSettings settings;
   settings.name = name;
   settings.block_size = 10;
@@ -277,8 +282,10 @@ TEST(LslTwoProcesses, AnOutletKilledAndRestartedIsReconnectedAndTheGapCountedExa
   LslSource source(settings);
   std::vector<Block> blocks;
   const auto collect = [&](std::int64_t until, double timeout_s) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while ((blocks.empty() || blocks.back().endSample() < until) && std::chrono::steady_clock::now() < deadline) {
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while ((blocks.empty() || blocks.back().endSample() < until) &&
+           std::chrono::steady_clock::now() < deadline) {
       for (auto& b : source.poll(256)) blocks.push_back(std::move(b));
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
@@ -293,7 +300,8 @@ TEST(LslTwoProcesses, AnOutletKilledAndRestartedIsReconnectedAndTheGapCountedExa
   EXPECT_NE(fault.find(name), std::string::npos) << "the lost stream was not reported";
   // The same amplifier (source id) comes back, its clock having run on.
   arbci::test::BackgroundProcess second(
-      LSL_OUTLET_HELPER, {name, name + "-src", "8", rate, "20", std::to_string(kResumeAt), std::to_string(kEnd), t0, "60"});
+      LSL_OUTLET_HELPER, {name, name + "-src", "8", rate, "20", std::to_string(kResumeAt),
+                          std::to_string(kEnd), t0, "60"});
   ASSERT_TRUE(second.waitForLine("ready", 10.0));
   collect(kEnd, 20.0);
   ASSERT_FALSE(blocks.empty());
@@ -304,7 +312,8 @@ TEST(LslTwoProcesses, AnOutletKilledAndRestartedIsReconnectedAndTheGapCountedExa
   std::int64_t wrong = 0, checked = 0;
   for (const Block& b : blocks)
     for (int s = 0; s < b.samples; ++s, ++checked)
-      for (int c = 0; c < 8; ++c) wrong += b.at(c, s) != arbci::test::lslTestValue(b.first_sample + s, c);
+      for (int c = 0; c < 8; ++c)
+        wrong += b.at(c, s) != arbci::test::lslTestValue(b.first_sample + s, c);
   EXPECT_EQ(wrong, 0);
   EXPECT_EQ(checked, kStopAt + (kEnd - kResumeAt));
 }

@@ -129,16 +129,17 @@ TEST(LslSampleCodec, TestPatternsAreLiblsls) {
 }
 
 TEST(LslSampleCodec, EverySampleFormatRoundTripsThroughTheWireBitForBit) {
-  for (ChannelFormat format : {ChannelFormat::Float32, ChannelFormat::Double64, ChannelFormat::Int32,
-                               ChannelFormat::Int16, ChannelFormat::Int8, ChannelFormat::Int64,
-                               ChannelFormat::String}) {
+  for (ChannelFormat format :
+       {ChannelFormat::Float32, ChannelFormat::Double64, ChannelFormat::Int32, ChannelFormat::Int16,
+        ChannelFormat::Int8, ChannelFormat::Int64, ChannelFormat::String}) {
     SCOPED_TRACE(formatName(format));
     const SampleCodec codec(format, 5);
     Sample sample = codec.testPattern(4);
     sample.timestamp = 42.125;
     Sample deduced = codec.testPattern(2);
     deduced.deduced = true;
-    if (format == ChannelFormat::String) deduced.strings[1] = std::string(300, 'x');  // 4-byte length
+    if (format == ChannelFormat::String)
+      deduced.strings[1] = std::string(300, 'x');  // 4-byte length
     std::string wire;
     codec.encode(wire, sample);
     codec.encode(wire, deduced);
@@ -167,7 +168,12 @@ TEST(LslSampleCodec, ValuesSentInTheOtherByteOrderAreTurnedAround) {
   const unsigned char wire[] = {2, 0x3f, 0xf0, 0, 0, 0, 0, 0, 0, 1, 2, 3, 4};
   size_t at = 0;
   Sample s;
-  codec.decode([&](void* into, size_t n) { std::memcpy(into, wire + at, n); at += n; }, true, s);
+  codec.decode(
+      [&](void* into, size_t n) {
+        std::memcpy(into, wire + at, n);
+        at += n;
+      },
+      true, s);
   EXPECT_DOUBLE_EQ(s.timestamp, 1.0);
   EXPECT_EQ(codec.value(s, 0), 0x01020304);
 }
@@ -177,8 +183,12 @@ TEST(LslSampleCodec, ACorruptTagIsRefused) {
   const char wire[] = {7, 0, 0, 0, 0};
   size_t at = 0;
   Sample s;
-  EXPECT_THROW(codec.decode([&](void* into, size_t n) { std::memcpy(into, wire + at, n); at += n; },
-                            false, s),
+  EXPECT_THROW(codec.decode(
+                   [&](void* into, size_t n) {
+                     std::memcpy(into, wire + at, n);
+                     at += n;
+                   },
+                   false, s),
                LslError);
 }
 

@@ -237,7 +237,8 @@ TEST(P300Dataset, ASessionsPhotodiodeChannelIsNeverClassified) {
   with_diode.parameters["PhotodiodeChannel"] = "Photodiode";
   std::vector<float> diode(static_cast<size_t>(eeg.samples), 0.0f);
   for (const StimulusEvent& e : eeg.stimuli) {
-    for (std::int64_t s = e.sample; s < std::min<std::int64_t>(e.sample + e.duration_samples, eeg.samples); ++s)
+    for (std::int64_t s = e.sample;
+         s < std::min<std::int64_t>(e.sample + e.duration_samples, eeg.samples); ++s)
       diode[static_cast<size_t>(s)] = 1000.0f;
   }
   with_diode.data.insert(with_diode.data.end(), diode.begin(), diode.end());
@@ -245,9 +246,9 @@ TEST(P300Dataset, ASessionsPhotodiodeChannelIsNeverClassified) {
   const P300Dataset session = buildDataset({with_diode}, PipelineSettings{});
   EXPECT_EQ(session.info.channels, eeg.info.channels);
   EXPECT_EQ(session.feature_channels, plain.feature_channels);
-  EXPECT_EQ(std::count(session.feature_channels.begin(), session.feature_channels.end(),
-                       "Photodiode"),
-            0);
+  EXPECT_EQ(
+      std::count(session.feature_channels.begin(), session.feature_channels.end(), "Photodiode"),
+      0);
   ASSERT_EQ(session.features.rows(), plain.features.rows());
   ASSERT_EQ(session.features.cols(), plain.features.cols());
   EXPECT_EQ((session.features - plain.features).cwiseAbs().maxCoeff(), 0.0);

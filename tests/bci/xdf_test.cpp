@@ -18,7 +18,8 @@ test::XdfNumericStream eegStream(int samples) {
   s.labels = {"Fz", "Cz", "Pz", "Oz"};
   for (int i = 0; i < samples; ++i) {
     std::vector<float> v;
-    for (int c = 0; c < 4; ++c) v.push_back(static_cast<float>(std::sin(i * 0.01 * (c + 1)) * 40.0 + c));
+    for (int c = 0; c < 4; ++c)
+      v.push_back(static_cast<float>(std::sin(i * 0.01 * (c + 1)) * 40.0 + c));
     s.samples.push_back(v);
   }
   return s;
@@ -121,7 +122,8 @@ TEST(Xdf, DamagedFilesAreRefusedOrReadNeverACrash) {
     std::string copy = bytes;
     state = state * 1664525u + 1013904223u;
     // Most damage in the headers, where the layout is declared.
-    const size_t where = (state >> 8) % (trial % 2 ? copy.size() : std::min<size_t>(copy.size(), 1200));
+    const size_t where =
+        (state >> 8) % (trial % 2 ? copy.size() : std::min<size_t>(copy.size(), 1200));
     copy[where] = static_cast<char>(state >> 24);
     std::ofstream(damaged, std::ios::binary | std::ios::trunc) << copy;
     try {

@@ -12,8 +12,8 @@
 #include <iostream>
 #include <limits>
 
-#include "support/robot_test_support.h"
 #include "support/halt_recording_arm.h"
+#include "support/robot_test_support.h"
 #include "support/udp_relay.h"
 
 namespace arbci::robot {

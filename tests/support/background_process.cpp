@@ -41,8 +41,7 @@ BackgroundProcess::~BackgroundProcess() {
 }
 
 std::optional<std::string> BackgroundProcess::readLine(double timeout_s) {
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     const auto newline = buffer_.find('\n');
     if (newline != std::string::npos) {
@@ -68,8 +67,7 @@ std::optional<std::string> BackgroundProcess::readLine(double timeout_s) {
 
 std::optional<std::string> BackgroundProcess::waitForLine(const std::string& prefix,
                                                           double timeout_s) {
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     const double left =
         std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
@@ -95,8 +93,7 @@ void BackgroundProcess::kill() {
 
 std::optional<int> BackgroundProcess::wait(double timeout_s) {
   if (reaped_) return std::nullopt;
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (std::chrono::steady_clock::now() < deadline) {
     int status = 0;
     if (waitpid(pid_, &status, WNOHANG) == pid_) {

@@ -18,7 +18,9 @@ using namespace arbci::bci::lsl;
 
 int main(int argc, char** argv) {
   if (argc < 9) {
-    std::fprintf(stderr, "usage: %s NAME SOURCE_ID CHANNELS RATE SPEED START STOP_AT T0 [LINGER_S]\n", argv[0]);
+    std::fprintf(stderr,
+                 "usage: %s NAME SOURCE_ID CHANNELS RATE SPEED START STOP_AT T0 [LINGER_S]\n",
+                 argv[0]);
     return 2;
   }
   const std::string name = argv[1], source_id = argv[2];
@@ -36,7 +38,8 @@ int main(int argc, char** argv) {
   info.nominal_srate = rate;
   info.channel_format = ChannelFormat::Float32;
   info.source_id = source_id;
-  for (int c = 0; c < channels; ++c) info.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG"});
+  for (int c = 0; c < channels; ++c)
+    info.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG"});
   Outlet outlet(info, config);
   if (t0 < 0) t0 = localClock();
   std::printf("ready t0=%.9f port=%d\n", t0, outlet.info().v4data_port);

@@ -47,21 +47,23 @@ void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
   chunk(file, 1, "<?xml version=\"1.0\"?><info><version>1.0</version></info>");
   std::string channels;
   for (const auto& l : eeg.labels)
-    channels += "<channel><label>" + l + "</label><unit>" + eeg.unit + "</unit><type>EEG</type></channel>";
+    channels +=
+        "<channel><label>" + l + "</label><unit>" + eeg.unit + "</unit><type>EEG</type></channel>";
   char rate[32];
   std::snprintf(rate, sizeof rate, "%.17g", eeg.rate);
   chunk(file, 2,
-        withStream(1, "<?xml version=\"1.0\"?><info><name>" + eeg.name + "</name><type>" + eeg.type +
-                          "</type><channel_count>" + std::to_string(eeg.labels.size()) +
+        withStream(1, "<?xml version=\"1.0\"?><info><name>" + eeg.name + "</name><type>" +
+                          eeg.type + "</type><channel_count>" + std::to_string(eeg.labels.size()) +
                           "</channel_count><nominal_srate>" + rate +
                           "</nominal_srate><channel_format>float32</channel_format>"
-                          "<created_at>50.0</created_at><desc><channels>" + channels +
-                          "</channels></desc></info>"));
+                          "<created_at>50.0</created_at><desc><channels>" +
+                          channels + "</channels></desc></info>"));
   chunk(file, 2,
-        withStream(2, "<?xml version=\"1.0\"?><info><name>" + eeg.name + "-Markers</name>"
-                      "<type>Markers</type><channel_count>1</channel_count><nominal_srate>0"
-                      "</nominal_srate><channel_format>string</channel_format>"
-                      "<created_at>50.0</created_at><desc/></info>"));
+        withStream(2, "<?xml version=\"1.0\"?><info><name>" + eeg.name +
+                          "-Markers</name>"
+                          "<type>Markers</type><channel_count>1</channel_count><nominal_srate>0"
+                          "</nominal_srate><channel_format>string</channel_format>"
+                          "<created_at>50.0</created_at><desc/></info>"));
   const size_t n = eeg.samples.size();
   for (size_t first = 0; first < n; first += 100) {
     const size_t count = std::min<size_t>(100, n - first);
@@ -90,13 +92,17 @@ void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
     chunk(file, 4, withStream(id, content));
   }
   char last[32];
-  std::snprintf(last, sizeof last, "%.17g", eeg.first_timestamp + static_cast<double>(n - 1) / eeg.rate);
-  chunk(file, 6, withStream(1, "<?xml version=\"1.0\"?><info><first_timestamp>" +
-                                   std::to_string(eeg.first_timestamp) + "</first_timestamp><last_timestamp>" +
-                                   last + "</last_timestamp><sample_count>" + std::to_string(n) +
-                                   "</sample_count></info>"));
-  chunk(file, 6, withStream(2, "<?xml version=\"1.0\"?><info><sample_count>" +
-                                   std::to_string(markers.size()) + "</sample_count></info>"));
+  std::snprintf(last, sizeof last, "%.17g",
+                eeg.first_timestamp + static_cast<double>(n - 1) / eeg.rate);
+  chunk(
+      file, 6,
+      withStream(1, "<?xml version=\"1.0\"?><info><first_timestamp>" +
+                        std::to_string(eeg.first_timestamp) + "</first_timestamp><last_timestamp>" +
+                        last + "</last_timestamp><sample_count>" + std::to_string(n) +
+                        "</sample_count></info>"));
+  chunk(file, 6,
+        withStream(2, "<?xml version=\"1.0\"?><info><sample_count>" +
+                          std::to_string(markers.size()) + "</sample_count></info>"));
 }
 
 }  // namespace arbci::test

@@ -385,7 +385,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
               next = (vertex[(k + 2) % 4] - vertex[k] + n) % n;
     if (step == 0 || next <= step) return result;
   }
-  const float max_deviation = std::max(kMinSideDeviation, params.max_side_deviation * side_estimate);
+  const float max_deviation =
+      std::max(kMinSideDeviation, params.max_side_deviation * side_estimate);
   for (int k = 0; k < 4; ++k) {
     float deviation = 0.0f;
     farthestFromChord(contour, vertex[k], vertex[(k + 1) % 4], deviation);

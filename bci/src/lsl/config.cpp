@@ -118,8 +118,8 @@ LslConfig LslConfig::parse(const std::string& text, const std::string& origin) {
   if (auto v = take("ports.PortRange")) c.port_range = parseInt(*v, at + "PortRange", 1, 65535);
   if (auto v = take("ports.AllowRandomPorts")) c.allow_random_ports = (*v == "1" || *v == "true");
   if (auto v = take("ports.IPv6")) {
-    static const std::vector<std::string> known{"allow",   "allowed", "disable",
-                                                "disabled", "force",  "forced"};
+    static const std::vector<std::string> known{"allow",    "allowed", "disable",
+                                                "disabled", "force",   "forced"};
     if (std::find(known.begin(), known.end(), *v) == known.end())
       throw LslError(at + "IPv6 = \"" + *v + "\": use allow, disable or force");
     c.ipv6 = *v;
@@ -134,8 +134,10 @@ LslConfig LslConfig::parse(const std::string& text, const std::string& origin) {
   }
   if (auto v = take("multicast.MachineAddresses"))
     c.machine_addresses = parseSet(*v, at + "MachineAddresses");
-  if (auto v = take("multicast.LinkAddresses")) c.link_addresses = parseSet(*v, at + "LinkAddresses");
-  if (auto v = take("multicast.SiteAddresses")) c.site_addresses = parseSet(*v, at + "SiteAddresses");
+  if (auto v = take("multicast.LinkAddresses"))
+    c.link_addresses = parseSet(*v, at + "LinkAddresses");
+  if (auto v = take("multicast.SiteAddresses"))
+    c.site_addresses = parseSet(*v, at + "SiteAddresses");
   if (auto v = take("multicast.AddressesOverride"))
     c.addresses_override = parseSet(*v, at + "AddressesOverride");
   if (auto v = take("multicast.TTLOverride"))

@@ -49,7 +49,8 @@ std::shared_ptr<DiscoveryResponder> DiscoveryResponder::shared(const LslConfig& 
   return made;
 }
 
-DiscoveryResponder::DiscoveryResponder(const LslConfig& config, std::vector<std::string>& warnings) {
+DiscoveryResponder::DiscoveryResponder(const LslConfig& config,
+                                       std::vector<std::string>& warnings) {
   // Loopback addresses are bound as themselves; broadcast and multicast on any address (joining
   // the group). All share the port with other processes' outlets.
   for (const auto& a : config.queryAddresses()) {
@@ -63,7 +64,8 @@ DiscoveryResponder::DiscoveryResponder(const LslConfig& config, std::vector<std:
         ip_mreq membership{};
         membership.imr_multiaddr = group.sin_addr;
         membership.imr_interface.s_addr = htonl(INADDR_ANY);
-        if (::setsockopt(fd.get(), IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof membership) != 0)
+        if (::setsockopt(fd.get(), IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof membership) !=
+            0)
           throw LslError("cannot join the multicast group " + a);
       }
       sockets_.push_back(std::move(fd));
@@ -80,7 +82,8 @@ DiscoveryResponder::~DiscoveryResponder() {
   if (thread_.joinable()) thread_.join();
 }
 
-void DiscoveryResponder::add(const void* owner, const StreamInfo& info, const std::string& shortinfo) {
+void DiscoveryResponder::add(const void* owner, const StreamInfo& info,
+                             const std::string& shortinfo) {
   std::lock_guard lock(mutex_);
   outlets_[owner] = {info, shortinfo};
 }
@@ -104,7 +107,8 @@ void DiscoveryResponder::serve() {
       auto datagram = net::receiveDatagram(sockets_[i], 0.0);
       if (!datagram) continue;
       const auto newline = datagram->bytes.find('\n');
-      if (newline == std::string::npos || trimmed(datagram->bytes.substr(0, newline)) != "LSL:shortinfo")
+      if (newline == std::string::npos ||
+          trimmed(datagram->bytes.substr(0, newline)) != "LSL:shortinfo")
         continue;
       const std::string rest = datagram->bytes.substr(newline + 1);
       std::lock_guard lock(mutex_);

@@ -91,7 +91,8 @@ InletStatus Inlet::status() const {
 
 std::string Inlet::endpoint() const {
   std::lock_guard lock(mutex_);
-  return current_.hostname + " (" + current_.v4address + ":" + std::to_string(current_.v4data_port) + ")";
+  return current_.hostname + " (" + current_.v4address + ":" +
+         std::to_string(current_.v4data_port) + ")";
 }
 
 void Inlet::receiveLoop() {
@@ -186,9 +187,7 @@ void Inlet::streamOnce() {
     if (key == "data-protocol-version" && value != std::to_string(kProtocolVersion))
       throw LslError("the outlet wants data protocol " + value + "; ARBCI speaks 110");
   }
-  const auto read = [&](void* into, size_t bytes) {
-    stream.read(into, bytes, watchdog_s_);
-  };
+  const auto read = [&](void* into, size_t bytes) { stream.read(into, bytes, watchdog_s_); };
   for (int pattern : {4, 2}) {
     Sample received;
     codec_.decode(read, reverse, received);
@@ -260,7 +259,8 @@ void Inlet::timeLoop() {
           ++sent;
           next_probe += config_.time_probe_interval_s;
         }
-        auto reply = net::receiveDatagram(socket, std::min(0.02, config_.time_probe_interval_s / 2));
+        auto reply =
+            net::receiveDatagram(socket, std::min(0.02, config_.time_probe_interval_s / 2));
         if (!reply) continue;
         const double t3 = localClock();
         std::istringstream fields(reply->bytes);

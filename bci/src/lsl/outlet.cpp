@@ -202,7 +202,8 @@ void Outlet::serveDiscovery() {
       std::getline(request, method);
       method = trimmed(method);
       if (method == "LSL:shortinfo") {
-        std::string rest((std::istreambuf_iterator<char>(request)), std::istreambuf_iterator<char>());
+        std::string rest((std::istreambuf_iterator<char>(request)),
+                         std::istreambuf_iterator<char>());
         if (auto reply = shortinfoReply(rest, info_, shortinfo_)) {
           sockaddr_in to = datagram->from;
           to.sin_port = htons(static_cast<std::uint16_t>(reply->first));
@@ -258,12 +259,14 @@ void Outlet::serveClient(std::shared_ptr<Client> client, int raw_fd) {
         stream.writeAll(status + " 505 Version not supported\r\n", kSendTimeoutS);
       } else if (!uid.empty() && uid != info_.uid) {
         stream.writeAll(status + " 404 Not found\r\n", kSendTimeoutS);
-      } else if (version < 110 || (codec_.format() != ChannelFormat::String && !value_size_text.empty() &&
-                                   value_size_text != std::to_string(formatSize(codec_.format())))) {
+      } else if (version < 110 ||
+                 (codec_.format() != ChannelFormat::String && !value_size_text.empty() &&
+                  value_size_text != std::to_string(formatSize(codec_.format())))) {
         // Protocol 100 (Boost serialization) is not spoken; a client asks for it only when
         // told to, or when its value sizes differ.
-        stream.writeAll(status + " 505 Version not supported (ARBCI serves data protocol 110 only)\r\n",
-                        kSendTimeoutS);
+        stream.writeAll(
+            status + " 505 Version not supported (ARBCI serves data protocol 110 only)\r\n",
+            kSendTimeoutS);
       } else {
         std::string header = status + " 200 OK\r\nUID: " + info_.uid +
                              "\r\nByte-Order: 1234\r\nSuppress-Subnormals: 0\r\n"

@@ -39,8 +39,8 @@ std::vector<StreamInfo> resolveStreams(const LslConfig& config, const std::strin
 
   const bool machine = config.machineOnly();
   net::Fd receiver = net::udpSocket();
-  net::bindInRange(receiver, machine ? "127.0.0.1" : "0.0.0.0", config.base_port,
-                   config.port_range, true);
+  net::bindInRange(receiver, machine ? "127.0.0.1" : "0.0.0.0", config.base_port, config.port_range,
+                   true);
   sockaddr_in bound{};
   socklen_t length = sizeof bound;
   ::getsockname(receiver.get(), reinterpret_cast<sockaddr*>(&bound), &length);

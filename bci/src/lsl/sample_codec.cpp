@@ -21,7 +21,8 @@ void reverseEach(char* data, size_t count, int width) {
 template <typename T>
 void fillPattern(char* raw, int channels, long long offset) {
   for (int k = 0; k < channels; ++k) {
-    unsigned long long v = static_cast<unsigned long long>(k) + static_cast<unsigned long long>(offset);
+    unsigned long long v =
+        static_cast<unsigned long long>(k) + static_cast<unsigned long long>(offset);
     if (std::is_integral_v<T>) v %= static_cast<unsigned long long>(std::numeric_limits<T>::max());
     const T value = (k % 2 == 0) ? static_cast<T>(v) : static_cast<T>(-static_cast<T>(v));
     std::memcpy(raw + static_cast<size_t>(k) * sizeof(T), &value, sizeof(T));
@@ -47,7 +48,8 @@ void storeRounded(char* raw, int channel, double v) {
 
 }  // namespace
 
-SampleCodec::SampleCodec(ChannelFormat format, int channels) : format_(format), channels_(channels) {
+SampleCodec::SampleCodec(ChannelFormat format, int channels)
+    : format_(format), channels_(channels) {
   if (channels <= 0) throw LslError("an LSL stream needs at least one channel");
 }
 
@@ -63,7 +65,8 @@ void SampleCodec::encodeRaw(std::string& out, const void* values, double timesta
 
 void SampleCodec::encode(std::string& out, const Sample& sample) const {
   if (format_ != ChannelFormat::String) {
-    if (sample.raw.size() != rawBytes()) throw LslError("a sample of the wrong size for its stream");
+    if (sample.raw.size() != rawBytes())
+      throw LslError("a sample of the wrong size for its stream");
     encodeRaw(out, sample.raw.data(), sample.deduced ? -1.0 : sample.timestamp);
     return;
   }
@@ -126,7 +129,8 @@ void SampleCodec::decode(const std::function<void(void*, size_t)>& read, bool re
     } else {
       throw LslError("corrupt LSL data: string length of " + std::to_string(width) + " bytes");
     }
-    if (length > (1u << 24)) throw LslError("corrupt LSL data: a string of " + std::to_string(length) + " bytes");
+    if (length > (1u << 24))
+      throw LslError("corrupt LSL data: a string of " + std::to_string(length) + " bytes");
     s.resize(static_cast<size_t>(length));
     if (length > 0) read(s.data(), s.size());
   }
@@ -137,11 +141,21 @@ Sample SampleCodec::testPattern(int offset) const {
   s.timestamp = 123456.789;
   s.raw.assign(rawBytes(), 0);
   switch (format_) {
-    case ChannelFormat::Float32: fillPattern<float>(s.raw.data(), channels_, offset); break;
-    case ChannelFormat::Double64: fillPattern<double>(s.raw.data(), channels_, offset + 16777217LL); break;
-    case ChannelFormat::Int32: fillPattern<std::int32_t>(s.raw.data(), channels_, offset + 65537LL); break;
-    case ChannelFormat::Int16: fillPattern<std::int16_t>(s.raw.data(), channels_, offset + 257LL); break;
-    case ChannelFormat::Int8: fillPattern<std::int8_t>(s.raw.data(), channels_, offset + 1LL); break;
+    case ChannelFormat::Float32:
+      fillPattern<float>(s.raw.data(), channels_, offset);
+      break;
+    case ChannelFormat::Double64:
+      fillPattern<double>(s.raw.data(), channels_, offset + 16777217LL);
+      break;
+    case ChannelFormat::Int32:
+      fillPattern<std::int32_t>(s.raw.data(), channels_, offset + 65537LL);
+      break;
+    case ChannelFormat::Int16:
+      fillPattern<std::int16_t>(s.raw.data(), channels_, offset + 257LL);
+      break;
+    case ChannelFormat::Int8:
+      fillPattern<std::int8_t>(s.raw.data(), channels_, offset + 1LL);
+      break;
     case ChannelFormat::Int64:
       for (int k = 0; k < channels_; ++k) {
         std::int64_t v = k + 2147483649LL + offset;
@@ -165,13 +179,20 @@ bool SampleCodec::same(const Sample& a, const Sample& b) const {
 double SampleCodec::value(const Sample& sample, int channel) const {
   const char* raw = sample.raw.data();
   switch (format_) {
-    case ChannelFormat::Float32: return load<float>(raw, channel);
-    case ChannelFormat::Double64: return load<double>(raw, channel);
-    case ChannelFormat::Int32: return load<std::int32_t>(raw, channel);
-    case ChannelFormat::Int16: return load<std::int16_t>(raw, channel);
-    case ChannelFormat::Int8: return load<std::int8_t>(raw, channel);
-    case ChannelFormat::Int64: return static_cast<double>(load<std::int64_t>(raw, channel));
-    case ChannelFormat::String: break;
+    case ChannelFormat::Float32:
+      return load<float>(raw, channel);
+    case ChannelFormat::Double64:
+      return load<double>(raw, channel);
+    case ChannelFormat::Int32:
+      return load<std::int32_t>(raw, channel);
+    case ChannelFormat::Int16:
+      return load<std::int16_t>(raw, channel);
+    case ChannelFormat::Int8:
+      return load<std::int8_t>(raw, channel);
+    case ChannelFormat::Int64:
+      return static_cast<double>(load<std::int64_t>(raw, channel));
+    case ChannelFormat::String:
+      break;
   }
   throw LslError("a string stream has no numeric values");
 }
@@ -180,13 +201,26 @@ void SampleCodec::setValue(Sample& sample, int channel, double v) const {
   sample.raw.resize(rawBytes());
   char* raw = sample.raw.data();
   switch (format_) {
-    case ChannelFormat::Float32: storeRounded<float>(raw, channel, v); return;
-    case ChannelFormat::Double64: storeRounded<double>(raw, channel, v); return;
-    case ChannelFormat::Int32: storeRounded<std::int32_t>(raw, channel, v); return;
-    case ChannelFormat::Int16: storeRounded<std::int16_t>(raw, channel, v); return;
-    case ChannelFormat::Int8: storeRounded<std::int8_t>(raw, channel, v); return;
-    case ChannelFormat::Int64: storeRounded<std::int64_t>(raw, channel, v); return;
-    case ChannelFormat::String: break;
+    case ChannelFormat::Float32:
+      storeRounded<float>(raw, channel, v);
+      return;
+    case ChannelFormat::Double64:
+      storeRounded<double>(raw, channel, v);
+      return;
+    case ChannelFormat::Int32:
+      storeRounded<std::int32_t>(raw, channel, v);
+      return;
+    case ChannelFormat::Int16:
+      storeRounded<std::int16_t>(raw, channel, v);
+      return;
+    case ChannelFormat::Int8:
+      storeRounded<std::int8_t>(raw, channel, v);
+      return;
+    case ChannelFormat::Int64:
+      storeRounded<std::int64_t>(raw, channel, v);
+      return;
+    case ChannelFormat::String:
+      break;
   }
   throw LslError("a string stream has no numeric values");
 }

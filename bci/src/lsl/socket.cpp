@@ -87,9 +87,9 @@ int bindInRange(const Fd& fd, const std::string& address, int base, int range, b
       return ntohs(a.sin_port);
     }
   }
-  throw LslError("no free port in " + std::to_string(base) + "-" +
-                 std::to_string(base + range - 1) + " on " + address +
-                 " (more LSL streams than the configured PortRange, or another program holds them)");
+  throw LslError(
+      "no free port in " + std::to_string(base) + "-" + std::to_string(base + range - 1) + " on " +
+      address + " (more LSL streams than the configured PortRange, or another program holds them)");
 }
 
 void bindExact(const Fd& fd, const std::string& address, int port, bool reuse) {
@@ -204,7 +204,8 @@ std::string TcpStream::readLine(double timeout_s, size_t max_bytes) {
     const char c = static_cast<char>(readByte(timeout_s));
     if (c == '\n') break;
     line += c;
-    if (line.size() > max_bytes) throw LslError("a protocol line longer than " + std::to_string(max_bytes) + " bytes");
+    if (line.size() > max_bytes)
+      throw LslError("a protocol line longer than " + std::to_string(max_bytes) + " bytes");
   }
   if (!line.empty() && line.back() == '\r') line.pop_back();
   return line;

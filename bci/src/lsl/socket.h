@@ -66,7 +66,9 @@ class TcpStream {
   // Everything until the peer closes (at most `max_bytes`).
   std::string readAll(double timeout_s, size_t max_bytes = 1 << 24);
   void writeAll(const void* data, size_t bytes, double timeout_s);
-  void writeAll(const std::string& text, double timeout_s) { writeAll(text.data(), text.size(), timeout_s); }
+  void writeAll(const std::string& text, double timeout_s) {
+    writeAll(text.data(), text.size(), timeout_s);
+  }
   const Fd& fd() const { return fd_; }
   // Bytes received and not yet read.
   size_t buffered() const { return end_ - begin_; }

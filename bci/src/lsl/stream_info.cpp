@@ -29,7 +29,9 @@ void build(const StreamInfo& s, pugi::xml_document& doc, bool full) {
   addText(info, "channel_format", formatName(s.channel_format));
   addText(info, "source_id", s.source_id);
   addText(info, "nominal_srate", number(s.nominal_srate));
-  addText(info, "version", std::to_string(s.version / 100) + "." + std::to_string(s.version / 10 % 10) + (s.version % 10 ? std::to_string(s.version % 10) : ""));
+  addText(info, "version",
+          std::to_string(s.version / 100) + "." + std::to_string(s.version / 10 % 10) +
+              (s.version % 10 ? std::to_string(s.version % 10) : ""));
   addText(info, "created_at", number(s.created_at));
   addText(info, "uid", s.uid);
   addText(info, "session_id", s.session_id);
@@ -79,21 +81,28 @@ double realNumber(const pugi::xml_node& info, const char* field) {
 
 const char* formatName(ChannelFormat format) {
   switch (format) {
-    case ChannelFormat::Float32: return "float32";
-    case ChannelFormat::Double64: return "double64";
-    case ChannelFormat::String: return "string";
-    case ChannelFormat::Int32: return "int32";
-    case ChannelFormat::Int16: return "int16";
-    case ChannelFormat::Int8: return "int8";
-    case ChannelFormat::Int64: return "int64";
+    case ChannelFormat::Float32:
+      return "float32";
+    case ChannelFormat::Double64:
+      return "double64";
+    case ChannelFormat::String:
+      return "string";
+    case ChannelFormat::Int32:
+      return "int32";
+    case ChannelFormat::Int16:
+      return "int16";
+    case ChannelFormat::Int8:
+      return "int8";
+    case ChannelFormat::Int64:
+      return "int64";
   }
   return "undefined";
 }
 
 ChannelFormat formatFromName(const std::string& name) {
-  for (ChannelFormat f : {ChannelFormat::Float32, ChannelFormat::Double64, ChannelFormat::String,
-                          ChannelFormat::Int32, ChannelFormat::Int16, ChannelFormat::Int8,
-                          ChannelFormat::Int64})
+  for (ChannelFormat f :
+       {ChannelFormat::Float32, ChannelFormat::Double64, ChannelFormat::String,
+        ChannelFormat::Int32, ChannelFormat::Int16, ChannelFormat::Int8, ChannelFormat::Int64})
     if (name == formatName(f)) return f;
   throw LslError("stream info: channel format \"" + name +
                  "\" is not one of float32, double64, string, int32, int16, int8, int64");
@@ -101,13 +110,20 @@ ChannelFormat formatFromName(const std::string& name) {
 
 int formatSize(ChannelFormat format) {
   switch (format) {
-    case ChannelFormat::Float32: return 4;
-    case ChannelFormat::Double64: return 8;
-    case ChannelFormat::String: return 0;
-    case ChannelFormat::Int32: return 4;
-    case ChannelFormat::Int16: return 2;
-    case ChannelFormat::Int8: return 1;
-    case ChannelFormat::Int64: return 8;
+    case ChannelFormat::Float32:
+      return 4;
+    case ChannelFormat::Double64:
+      return 8;
+    case ChannelFormat::String:
+      return 0;
+    case ChannelFormat::Int32:
+      return 4;
+    case ChannelFormat::Int16:
+      return 2;
+    case ChannelFormat::Int8:
+      return 1;
+    case ChannelFormat::Int64:
+      return 8;
   }
   return 0;
 }
@@ -181,7 +197,8 @@ std::string buildQuery(const std::string& session_id, const std::string& name,
                                      {"type", type}}) {
     if (value.empty()) continue;
     if (value.find('\'') != std::string::npos)
-      throw LslError("LSL " + field + " \"" + value + "\" contains a single quote, which a query "
+      throw LslError("LSL " + field + " \"" + value +
+                     "\" contains a single quote, which a query "
                      "cannot express");
     if (!query.empty()) query += " and ";
     query += field;

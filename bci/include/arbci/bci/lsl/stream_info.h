@@ -11,7 +11,15 @@
 namespace arbci::bci::lsl {
 
 // liblsl's channel_format codes (their numbers travel nowhere; the names do).
-enum class ChannelFormat { Float32 = 1, Double64 = 2, String = 3, Int32 = 4, Int16 = 5, Int8 = 6, Int64 = 7 };
+enum class ChannelFormat {
+  Float32 = 1,
+  Double64 = 2,
+  String = 3,
+  Int32 = 4,
+  Int16 = 5,
+  Int8 = 6,
+  Int64 = 7
+};
 const char* formatName(ChannelFormat format);
 // Throws LslError for a name liblsl does not define.
 ChannelFormat formatFromName(const std::string& name);
