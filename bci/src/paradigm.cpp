@@ -213,10 +213,17 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
       }
       break;
     case Phase::ObjectSelected:
-      if (due_s >= phase_until_ - kSlack && !verdict_pending_) askRobot(Phase::Grasping);
-      break;
     case Phase::CellSelected:
-      if (due_s >= phase_until_ - kSlack && !verdict_pending_) askRobot(Phase::Dropping);
+      if (due_s < phase_until_ - kSlack) break;
+      if (runner_up_waiting_) {
+        runner_up_waiting_ = false;
+        const Decision& d = last_decision_;
+        showSelection(d.runner_up_codes, d.runner_up_choice,
+                      d.runner_up_certainty / (1.0 - d.certainty), phase_ == Phase::ObjectSelected,
+                      "runner-up");
+      } else if (!verdict_pending_) {
+        askRobot(phase_ == Phase::ObjectSelected ? Phase::Grasping : Phase::Dropping);
+      }
       break;
     default:
       break;
@@ -295,6 +302,7 @@ void Paradigm::decide(const Decision& decision) {
   if (phase_ != Phase::ObjectFlashing && phase_ != Phase::CellFlashing) return;
   last_decision_ = decision;
   runner_up_taken_ = false;
+  runner_up_waiting_ = false;
   showSelection(decision.codes, decision.choice, decision.certainty,
                 phase_ == Phase::ObjectFlashing, "");
 }
@@ -362,9 +370,15 @@ void Paradigm::errpVerdict(bool error) {
     runner_up_taken_ = true;
     correction.text = "runner-up";
     event(correction);
-    // Its certainty now that the first choice is rejected.
-    showSelection(d.runner_up_codes, d.runner_up_choice, d.runner_up_certainty / rest, objects,
-                  "runner-up");
+    // The rejected choice is cleared at once; the runner-up (with its certainty now that the
+    // first choice is out) is shown after a pause, its feedback clear of the last one's ErrP.
+    runner_up_waiting_ = true;
+    if (objects) {
+      selected_object_.reset();
+    } else {
+      selected_cell_.reset();
+    }
+    phase_until_ = now_ + settings_.pause_s;
     return;
   }
   correction.text = "repeat";

@@ -343,10 +343,22 @@ TEST(ParadigmErrp, NoGraspBeforeTheVerdictAndARejectedSelectionTakesTheRunnerUp)
                           [](const ParadigmEvent& e) { return e.kind == Kind::Feedback; }),
             1);
   p.errpVerdict(true);
+  // The rejected choice is cleared at once, and for pause_s nothing is shown as selected (so the
+  // runner-up's ErrP epoch starts clear of the rejected one's response).
+  const std::int64_t rejected_at = frame;
+  EXPECT_FALSE(p.frame(frame++).selected_object.has_value());
+  const auto is_made = [](const ParadigmEvent& e) { return e.kind == Kind::SelectionMade; };
+  events = p.takeEvents();
+  EXPECT_EQ(std::count_if(events.begin(), events.end(), is_made), 0);
+  const int pause_frames =
+      static_cast<int>(std::lround(p.settings().pause_s * p.settings().display_hz));
   events = runUntil(
-      p, frame, [] { return false; }, 2);
-  auto made = std::find_if(events.begin(), events.end(),
-                           [](const ParadigmEvent& e) { return e.kind == Kind::SelectionMade; });
+      p, frame, [&] { return frame - rejected_at >= pause_frames - 2; }, 200);
+  EXPECT_EQ(std::count_if(events.begin(), events.end(), is_made), 0);
+  EXPECT_FALSE(p.awaitingErrpVerdict());  // nothing to judge while nothing is shown
+  events = runUntil(
+      p, frame, [] { return false; }, 4);
+  auto made = std::find_if(events.begin(), events.end(), is_made);
   ASSERT_NE(made, events.end());
   EXPECT_EQ(made->object, 3);
   EXPECT_EQ(made->text, "runner-up");

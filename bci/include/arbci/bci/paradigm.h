@@ -44,12 +44,13 @@ struct ParadigmSettings {
   bool flashes_only = false;
   // Error-related potentials (docs/errp.md). A selection is shown for `result_s` as feedback,
   // and the robot waits for the ErrP verdict on it; a rejected selection is replaced by the
-  // runner-up when, among the rest, it holds at least `errp_runner_up` of the probability,
-  // otherwise the selection is made again with `errp_repeat_sequences` sequences (0: twice
-  // `sequences`); after `errp_max_corrections` rejections the trial is skipped (an object already
-  // grasped is put back where it was taken). The calibration
-  // run ends with `errp_calibration_feedbacks` cued feedbacks, `errp_wrong_rate` of them
-  // deliberately wrong (in random order).
+  // runner-up when, among the rest, it holds at least `errp_runner_up` of the probability (shown
+  // after `pause_s` with nothing selected, so that its ErrP epoch does not start in the tail of
+  // the rejected one's response, as the calibration block's feedbacks never do), otherwise the
+  // selection is made again with `errp_repeat_sequences` sequences (0: twice `sequences`); after
+  // `errp_max_corrections` rejections the trial is skipped (an object already grasped is put back
+  // where it was taken). The calibration run ends with `errp_calibration_feedbacks` cued feedbacks,
+  // `errp_wrong_rate` of them deliberately wrong (in random order).
   bool errp = false;
   int errp_calibration_feedbacks = 100;
   double errp_wrong_rate = 0.25;
@@ -232,7 +233,8 @@ class Paradigm {
   std::optional<bool> shown_error_;  // calibration feedback: deliberately wrong
   Decision last_decision_;
   bool runner_up_taken_ = false;
-  bool giving_back_ = false;  // the put-down returns the object (no cell was accepted)
+  bool runner_up_waiting_ = false;  // the rejected selection is cleared; the runner-up comes next
+  bool giving_back_ = false;        // the put-down returns the object (no cell was accepted)
   int corrections_ = 0;
   int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
   bool errp_block_ = false;      // the calibration run's ErrP feedback block
