@@ -16,6 +16,7 @@
 #include "commands/commands.h"
 #include "eeg/p300_plots.h"
 #include "eeg/p300_report.h"
+#include "session/session_config.h"
 #include "support/cli_error.h"
 #include "support/name_list.h"
 #include "support/output_path.h"
@@ -136,6 +137,49 @@ void writeReportFiles(const std::string& report_path, const std::string& scores_
     writeScoresCsv(scores_path, data, scores, fold);
     std::cout << "scores: " << scores_path << "\n";
   }
+}
+
+// With --errp, what was not given on the command line is what a session's ErrP classifier uses
+// (ErrpSettings), so an offline ErrP model compares with the session's own calibration.
+void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
+  const ErrpSettings session;
+  std::ostringstream taken;
+  const auto given = [&cmd](const char* name) { return cmd.count(name) > 0; };
+  if (!given("--method")) {
+    o.training.method = session.method;
+    taken << " --method " << session.method;
+  }
+  if (!given("--xdawn-filters")) {
+    o.training.xdawn.filters = session.xdawn_filters;
+    taken << " --xdawn-filters " << session.xdawn_filters;
+  }
+  if (!given("--window-ms")) {
+    o.window_ms = std::to_string(static_cast<int>(std::lround(session.window.start_s * 1000))) +
+                  "," + std::to_string(static_cast<int>(std::lround(session.window.end_s * 1000)));
+    taken << " --window-ms " << o.window_ms;
+  }
+  if (!given("--decimate-hz")) {
+    o.pipeline.decimate_hz = session.decimate_hz;
+    taken << " --decimate-hz " << session.decimate_hz;
+  }
+  if (!given("--highpass-hz")) {
+    o.pipeline.filter.highpass_hz = session.highpass_hz;
+    taken << " --highpass-hz " << session.highpass_hz;
+  }
+  if (!given("--lowpass-hz")) {
+    o.pipeline.filter.lowpass_hz = session.lowpass_hz;
+    taken << " --lowpass-hz " << session.lowpass_hz;
+  }
+  if (!given("--folds")) {
+    o.training.folds = 5;
+    taken << " --folds 5";
+  }
+  if (!given("--folds-by")) {
+    o.training.folds_by = "block";
+    taken << " --folds-by block";
+  }
+  if (!taken.str().empty())
+    std::cout << "--errp: as a session's ErrP classifier where not given:" << taken.str() << "\n";
 }
 
 void train(TrainOptions& o) {
@@ -411,7 +455,9 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd->add_flag("--errp", t->errp,
                       "train the error-related-potential classifier on the recordings' feedback "
                       "events (Feedback ... correct|error; a session with errp.enabled records "
-                      "them) instead of a P300 model on their flashes");
+                      "them) instead of a P300 model on their flashes; options not given take "
+                      "the session's ErrP defaults (riemann, 1 filter per class, 0-800 ms, "
+                      "1-10 Hz, 20 Hz, 5 contiguous folds)");
   train_cmd->add_option("--p300-model", t->p300_model,
                         "with --errp: write the ErrP classifier inside this P300 model (a session "
                         "needs both in one file) to --out");
@@ -452,7 +498,8 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                         "also write the model as a BCI2000 parameter fragment (.prm)");
   train_cmd->add_option("--plots", t->plots,
                         "folder for PNG plots (ERPs; accuracy and bit rate by sequences)");
-  train_cmd->callback([t, &exit_code] {
+  train_cmd->callback([t, train_cmd, &exit_code] {
+    if (t->errp) applyErrpDefaults(*t, *train_cmd);
     train(*t);
     exit_code = 0;
   });

@@ -86,6 +86,7 @@ EegStageSettings EegStageSettings::of(const SessionConfig& config) {
   s.errp = config.paradigm.errp;
   if (s.errp) s.errp_pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
   s.errp_method = config.errp.method;
+  s.errp_xdawn_filters = config.errp.xdawn_filters;
   if (config.eeg.source == "lsl" || config.lsl.markers) s.lsl = config.lsl.config(config.source);
   s.lsl_markers = config.lsl.markers;
   s.marker_stream = config.lsl.marker_stream;
@@ -154,7 +155,8 @@ EegStage::EegStage(const EegStageSettings& settings, const std::filesystem::path
       throw SessionConfigError(settings_.session_file + ": lsl.markers: " + e.what());
     }
     log_.write("lsl_markers", 0.0,
-               {{"stream", info.name}, {"port", markers_->info().v4data_port},
+               {{"stream", info.name},
+                {"port", markers_->info().v4data_port},
                 {"scope", settings_.lsl.describe()}});
   }
   acquisition_->start();
@@ -178,7 +180,9 @@ void EegStage::step(CycleContext& cycle) {
   if (fault != fault_logged_) {
     log_.write("eeg_source", cycle.time_s,
                {{"fault", fault}, {"state", fault.empty() ? "delivering" : "fault"}});
-    if (progress_) *progress_ << "\n" << (fault.empty() ? "EEG source delivering again" : "warning: " + fault) << "\n";
+    if (progress_)
+      *progress_ << "\n"
+                 << (fault.empty() ? "EEG source delivering again" : "warning: " + fault) << "\n";
     fault_logged_ = fault;
   }
   cycle.eeg_sample = sampleAt(cycle.host_s);
@@ -302,7 +306,8 @@ void EegStage::poll() {
         // Zeros in place of lost samples (or the filters' ringing after them): no evidence.
         ++discarded_;
         log_.write("epoch_discarded", time_s_,
-                   {{"sample", epoch.event.sample}, {"code", record.code},
+                   {{"sample", epoch.event.sample},
+                    {"code", record.code},
                     {"reason", "it overlaps lost EEG samples"}});
         continue;
       }
@@ -315,8 +320,10 @@ void EegStage::poll() {
 bool EegStage::touchesLoss(std::int64_t onset) const {
   // The epoch's window, and a second before it for the filters to settle after a gap.
   const double rate = eeg_info_.rate_hz;
-  const auto from = onset + static_cast<std::int64_t>(std::floor((settings_.pipeline.window.start_s - 1.0) * rate));
-  const auto to = onset + static_cast<std::int64_t>(std::ceil(settings_.pipeline.window.end_s * rate));
+  const auto from = onset + static_cast<std::int64_t>(
+                                std::floor((settings_.pipeline.window.start_s - 1.0) * rate));
+  const auto to =
+      onset + static_cast<std::int64_t>(std::ceil(settings_.pipeline.window.end_s * rate));
   for (const auto& [first, end] : lost_spans_)
     if (first < to && end > from) return true;
   return false;
@@ -369,7 +376,8 @@ void EegStage::annotate(std::int64_t sample, const std::string& text) {
   if (markers_) {
     // When the sample was taken: its distance from the newest one, on the host clock.
     const double now = bci::hostSeconds();
-    publish(text, now + (static_cast<double>(sample) - acquisition_->sampleAt(now)) / eeg_info_.rate_hz);
+    publish(text,
+            now + (static_cast<double>(sample) - acquisition_->sampleAt(now)) / eeg_info_.rate_hz);
   }
 }
 
@@ -423,39 +431,41 @@ void EegStage::startTraining(const std::string& method) {
     errp_recording->parameters["Paradigm"] = "single stimulus, 2 stimuli";
     errp_recording->stimuli = errp_stimuli_;
   }
-  training_ = std::async(std::launch::async, [recording = std::move(recording),
-                                              errp_recording = std::move(errp_recording), pipeline,
-                                              method, errp_pipeline = settings_.errp_pipeline,
-                                              errp_method = settings_.errp_method]() mutable {
-    // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
-    // frames come first and the training takes what is left.
-    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
-    bci::TrainingSettings settings;
-    settings.method = method;
-    settings.folds = 4;
-    const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
-    bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
-    result.model.provenance["training_files"] = {"this session's calibration run"};
-    TrainingOutcome outcome{std::move(result.model), result.cross_validation.report, {}, ""};
-    if (errp_recording) {
-      try {
-        errp_recording->data = std::move(recording.data);
-        bci::TrainingSettings errp_settings;
-        errp_settings.method = errp_method;
-        errp_settings.folds = 5;
-        errp_settings.folds_by = "block";
-        const bci::P300Dataset errp_data = bci::buildDataset({*errp_recording}, errp_pipeline);
-        bci::TrainingResult errp = bci::trainModel(errp_data, errp_pipeline, errp_settings);
-        errp.model.provenance["training_files"] = {"this session's ErrP feedback block"};
-        outcome.errp_report = errp.cross_validation.report;
-        outcome.model.errp_auc = errp.cross_validation.report.auc;
-        outcome.model.errp = std::make_shared<const bci::P300Model>(std::move(errp.model));
-      } catch (const std::exception& error) {
-        outcome.errp_failure = error.what();
-      }
-    }
-    return outcome;
-  });
+  training_ = std::async(
+      std::launch::async,
+      [recording = std::move(recording), errp_recording = std::move(errp_recording), pipeline,
+       method, errp_pipeline = settings_.errp_pipeline, errp_method = settings_.errp_method,
+       errp_filters = settings_.errp_xdawn_filters]() mutable {
+        // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
+        // frames come first and the training takes what is left.
+        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+        bci::TrainingSettings settings;
+        settings.method = method;
+        settings.folds = 4;
+        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+        bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
+        result.model.provenance["training_files"] = {"this session's calibration run"};
+        TrainingOutcome outcome{std::move(result.model), result.cross_validation.report, {}, ""};
+        if (errp_recording) {
+          try {
+            errp_recording->data = std::move(recording.data);
+            bci::TrainingSettings errp_settings;
+            errp_settings.method = errp_method;
+            errp_settings.xdawn.filters = errp_filters;
+            errp_settings.folds = 5;
+            errp_settings.folds_by = "block";
+            const bci::P300Dataset errp_data = bci::buildDataset({*errp_recording}, errp_pipeline);
+            bci::TrainingResult errp = bci::trainModel(errp_data, errp_pipeline, errp_settings);
+            errp.model.provenance["training_files"] = {"this session's ErrP feedback block"};
+            outcome.errp_report = errp.cross_validation.report;
+            outcome.model.errp_auc = errp.cross_validation.report.auc;
+            outcome.model.errp = std::make_shared<const bci::P300Model>(std::move(errp.model));
+          } catch (const std::exception& error) {
+            outcome.errp_failure = error.what();
+          }
+        }
+        return outcome;
+      });
 }
 
 std::optional<TrainingOutcome> EegStage::trainingResult(bool wait) {

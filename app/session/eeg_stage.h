@@ -16,9 +16,9 @@
 #include <set>
 
 #include "arbci/bci/acquisition.h"
-#include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/decision.h"
 #include "arbci/bci/epocher.h"
+#include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
@@ -39,7 +39,8 @@ struct EegStageSettings {
   bool errp = false;         // train and use an ErrP classifier
   bci::PipelineSettings errp_pipeline;
   std::string errp_method;
-  bci::lsl::LslConfig lsl;  // source "lsl" or markers: lsl_api.cfg with the session's scope, peers
+  int errp_xdawn_filters = 1;
+  bci::lsl::LslConfig lsl;   // source "lsl" or markers: lsl_api.cfg with the session's scope, peers
   bool lsl_markers = false;  // publish stimuli and annotations as an LSL Markers stream
   std::string marker_stream;
   static EegStageSettings of(const SessionConfig& config);
@@ -164,7 +165,7 @@ class EegStage final : public Stage {
   // An event at `host_s` (the host clock, which is LSL's) to the Markers stream; a run on the
   // simulated clock stamps the instant it is sent.
   void publish(const std::string& text, double host_s);
-  double time_s_ = 0.0;           // the last cycle's session time, for the log
+  double time_s_ = 0.0;  // the last cycle's session time, for the log
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;
   int photodiode_ = -1;  // the photodiode's channel in the source's blocks

@@ -272,8 +272,9 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   eeg_eegdev.known({"device"});
   c.eeg.eegdev_device = eeg_eegdev.text("device", c.eeg.eegdev_device);
   if (c.eeg.source == "eegdev" && c.eeg.eegdev_device.empty())
-    eeg_eegdev.fail("device", "is required when eeg.source is \"eegdev\" (e.g. \"biosemi\", "
-                              "\"datafile|path|/data/s01.bdf\")");
+    eeg_eegdev.fail("device",
+                    "is required when eeg.source is \"eegdev\" (e.g. \"biosemi\", "
+                    "\"datafile|path|/data/s01.bdf\")");
 
   const Section lsl = root.section("lsl");
   lsl.known({"scope", "known_peers", "markers", "marker_stream"});
@@ -351,7 +352,7 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   const Section e = root.section("errp");
   e.known({"enabled", "calibration_feedbacks", "wrong_feedback_rate", "threshold", "runner_up",
            "repeat_sequences", "max_corrections", "channels", "window_ms", "decimate_hz",
-           "highpass_hz", "lowpass_hz", "method"});
+           "highpass_hz", "lowpass_hz", "method", "xdawn_filters"});
   ps.errp = e.boolean("enabled", ps.errp);
   ps.errp_calibration_feedbacks =
       e.integer("calibration_feedbacks", ps.errp_calibration_feedbacks, 4, 1000);
@@ -361,8 +362,8 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   ps.errp_max_corrections = e.integer("max_corrections", ps.errp_max_corrections, 0, 10);
   c.errp.threshold = e.number("threshold", c.errp.threshold, 0.0, 1.0);
   if (e.has("channels")) {
-    if (!e.at("channels").is_array() || e.at("channels").empty())
-      e.fail("channels", "must be a list of channel names");
+    if (!e.at("channels").is_array())
+      e.fail("channels", "must be a list of channel names ([]: all of the montage's)");
     c.errp.channels = e.at("channels").get<std::vector<std::string>>();
   }
   const auto errp_window =
@@ -374,6 +375,7 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   c.errp.highpass_hz = e.number("highpass_hz", c.errp.highpass_hz, 0.0, 100.0);
   c.errp.lowpass_hz = e.number("lowpass_hz", c.errp.lowpass_hz, 0.0, 500.0);
   c.errp.method = e.text("method", c.errp.method, {"swlda", "slda", "xdawn", "riemann"});
+  c.errp.xdawn_filters = e.integer("xdawn_filters", c.errp.xdawn_filters, 1, 64);
   if (ps.errp) (void)c.errp.pipeline(c.pipeline, c.eeg.montage);  // the montage has its channels
 
   const Section r = root.section("robot");
@@ -397,6 +399,10 @@ bci::PipelineSettings ErrpSettings::pipeline(const bci::PipelineSettings& p300,
   out.filter.highpass_hz = highpass_hz;
   out.filter.lowpass_hz = lowpass_hz;
   out.channels.clear();
+  if (channels.empty()) {
+    out.channels = montage;  // the EEG channels only, never the photodiode
+    return out;
+  }
   for (const std::string& channel : channels) {
     if (std::find(montage.begin(), montage.end(), channel) != montage.end())
       out.channels.push_back(channel);

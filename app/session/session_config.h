@@ -12,8 +12,8 @@
 
 #include <opencv2/core/matx.hpp>
 
-#include "arbci/bci/lsl/config.h"
 #include "arbci/bci/features.h"
+#include "arbci/bci/lsl/config.h"
 #include "arbci/bci/paradigm.h"
 
 namespace arbci::app {
@@ -106,18 +106,22 @@ struct LslSettings {
 };
 
 // The ErrP classifier (docs/errp.md), trained on the calibration run's feedback block when
-// paradigm.errp is on: shrinkage LDA (or another method) over the decimated window after each
-// feedback, on the fronto-central channels the montage has, band-passed on its own (1-10 Hz, as
-// ErrP studies filter; the P300's filters stay the P300's).
+// paradigm.errp is on: by default the Riemannian method with one xDAWN filter per class over all
+// the montage's channels (the filter finds the fronto-central response and cancels what the
+// channels share), 0-800 ms after each feedback, band-passed on its own (1-10 Hz, as ErrP studies
+// filter; the P300's filters stay the P300's). Shrinkage LDA on the fronto-central channels is
+// the literature's baseline: {"method": "slda", "channels": ["FCz", "Fz", "Cz", "FC1", "FC2"]}.
 struct ErrpSettings {
   double threshold = 0.5;  // a selection whose posterior of "error" exceeds it is rejected
-  std::vector<std::string> channels{"FCz", "Fz", "Cz", "FC1", "FC2"};
+  std::vector<std::string> channels;  // empty: all of the montage's
   bci::EpochWindow window{0.0, 0.8};
   double decimate_hz = 20.0;
   double highpass_hz = 1.0, lowpass_hz = 10.0;
-  std::string method = "slda";
+  std::string method = "riemann";
+  int xdawn_filters = 1;  // xDAWN: filters kept; riemann: per class
   // The ErrP pipeline: the session's notch, these band edges, window, decimation and channels
-  // (those of `channels` the montage has; throws SessionConfigError when it has none).
+  // (those of `channels` the montage has, or the whole montage; throws SessionConfigError when it
+  // has none of them).
   bci::PipelineSettings pipeline(const bci::PipelineSettings& p300,
                                  const std::vector<std::string>& montage) const;
 };

@@ -100,6 +100,25 @@ TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
   EXPECT_NE(source.find("simulated"), std::string::npos) << source;
 }
 
+// The ErrP classifier takes the whole montage by default (its xDAWN filter finds the response),
+// a list of channels picks those the montage has, and a list with none of them is refused.
+TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
+  const SessionConfig embedded = SessionConfig::load(std::nullopt);
+  EXPECT_EQ(embedded.errp.method, "riemann");
+  EXPECT_EQ(embedded.errp.xdawn_filters, 1);
+  EXPECT_EQ(embedded.errp.pipeline(embedded.pipeline, embedded.eeg.montage).channels,
+            embedded.eeg.montage);
+  const SessionConfig listed = SessionConfig::load(sessionFile(
+      "errp_channels", R"({"errp": {"channels": ["FCz", "Fz", "Cz"], "method": "slda"}})"));
+  EXPECT_EQ(listed.errp.pipeline(listed.pipeline, listed.eeg.montage).channels,
+            (std::vector<std::string>{"Fz", "Cz"}));
+  const std::string none = errorOf(R"({"errp": {"enabled": true, "channels": ["FC5", "FC6"]}})");
+  EXPECT_NE(none.find("errp.channels: the EEG montage has none of FC5, FC6"), std::string::npos)
+      << none;
+  const std::string filters = errorOf(R"({"errp": {"xdawn_filters": 0}})");
+  EXPECT_NE(filters.find("errp.xdawn_filters = 0"), std::string::npos) << filters;
+}
+
 // Before the run each stage checks what its settings name can be used, and says which key.
 std::string validationErrorOf(const std::string& json) {
   const SessionConfig config = SessionConfig::load(sessionFile("resources", json));

@@ -414,6 +414,11 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
   ASSERT_TRUE(errp["classifier"].get<bool>()) << errp.dump();
   EXPECT_GE(errp["calibration_auc"].get<double>(), 0.85) << errp.dump();
   EXPECT_GT(errp["wrong_selections"].get<int>(), 0) << errp.dump();  // the P300 guessed wrong
+  // The default ErrP classifier: the Riemannian method, one xDAWN filter per class, the montage.
+  const nlohmann::json model = readJson(folder / "model.json");
+  EXPECT_EQ(model["errp"]["method"], "riemann");
+  EXPECT_EQ(model["errp"]["classifier"]["filters_per_class"], 1);
+  EXPECT_EQ(model["errp"]["pipeline"]["channels"].size(), 8u) << model["errp"]["pipeline"].dump();
   EXPECT_EQ(errp["wrong_caught"], errp["wrong_selections"]) << errp.dump();
 
   std::map<int, nlohmann::json> intended;  // by trial
@@ -462,6 +467,15 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
   const nlohmann::json both = readJson(folder / "both.json");
   EXPECT_EQ(both["format"], "arbci-p300-model");
   EXPECT_EQ(both["errp"]["pipeline"]["channels"], (nlohmann::json{"Fz", "Cz"}));
+  // Options not given take the session's ErrP defaults, and say so.
+  const ProcessResult defaults =
+      runProcess(kArbci, {"train", "--errp", (folder / "recording.bdf").string(), "--out",
+                          (folder / "errp_defaults.json").string()});
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err << defaults.out;
+  EXPECT_NE(defaults.out.find("--method riemann --xdawn-filters 1 --window-ms 0,800"),
+            std::string::npos)
+      << defaults.out;
+  EXPECT_EQ(readJson(folder / "errp_defaults.json")["method"], "riemann");
   // A recording without feedback events is refused with the reason.
   const ProcessResult none =
       runProcess(kArbci, {"train", "--errp", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"),
