@@ -140,9 +140,9 @@ void writeReportFiles(const std::string& report_path, const std::string& scores_
 }
 
 // With --errp, what was not given on the command line is what a session's ErrP classifier uses
-// (ErrpSettings), so an offline ErrP model compares with the session's own calibration.
+// (the embedded session's "errp"), so an offline ErrP model compares with a session's own.
 void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
-  const ErrpSettings session;
+  const ErrpSettings session = SessionConfig::load(std::nullopt).errp;
   std::ostringstream taken;
   const auto given = [&cmd](const char* name) { return cmd.count(name) > 0; };
   if (!given("--method")) {
