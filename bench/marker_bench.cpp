@@ -1,6 +1,7 @@
 // Marker detection: recall, wrong IDs, false positives, corner error and time per frame of the
 // ARBCI tracker beside AprilTag 3 and OpenCV ArUco, on the same synthetic scenes (each drawn with
-// the detector's own markers) under five conditions, at 640x480 and 1280x720.
+// the detector's own markers) under seven conditions (five photometric, two motion blurs), at
+// 640x480 and 1280x720.
 //   marker_bench [--frames N] [--sizes 640x480,1280x720]   (--help explains)
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -52,8 +53,9 @@ int main(int argc, char** argv) {
   detectors.push_back(bench::makeAprilTag(1.0f));
   detectors.push_back(bench::makeAruco());
   const std::vector<test::Condition> conditions{
-      test::Condition::Clean, test::Condition::Blur, test::Condition::Noise,
-      test::Condition::UnevenLight, test::Condition::Combined};
+      test::Condition::Clean,         test::Condition::Blur,     test::Condition::Noise,
+      test::Condition::UnevenLight,   test::Condition::Combined, test::Condition::MotionBlur,
+      test::Condition::MotionBlurJpeg};
   std::printf(
       "Marker detection, %d frames per condition, 3 markers (20-110 px, tilt <= 60 deg) and 2 "
       "decoys "
@@ -101,8 +103,8 @@ int main(int argc, char** argv) {
                     cell.marker_free_false_positives);
       }
     }
-    std::printf("\nmean time per frame over the five conditions, %dx%d:\n", size.width,
-                size.height);
+    std::printf("\nmean time per frame over the %zu conditions, %dx%d:\n", conditions.size(),
+                size.width, size.height);
     const double fastest_peer = *std::min_element(mean_ms.begin() + 1, mean_ms.end());
     for (size_t d = 0; d < detectors.size(); ++d) {
       std::printf("  %-30s %8.3f ms  (%.2fx the fastest peer)\n", detectors[d]->name().c_str(),

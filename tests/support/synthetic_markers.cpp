@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/aruco.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -170,7 +171,29 @@ cv::Mat gainField(cv::Size size, std::mt19937& random) {
   return gain;
 }
 
+// Smears the frame along a line of `length` px at `angle` (a box kernel on that line).
+void motionBlur(cv::Mat& frame, float length, float angle) {
+  const int size = static_cast<int>(std::ceil(length)) | 1;
+  cv::Mat kernel = cv::Mat::zeros(size * 4, size * 4, CV_32F);  // drawn at 4x, then reduced
+  const cv::Point2f centre(size * 2.0f, size * 2.0f);
+  const cv::Point2f half(std::cos(angle) * length * 2.0f, std::sin(angle) * length * 2.0f);
+  cv::line(kernel, centre - half, centre + half, cv::Scalar(1.0), 1, cv::LINE_AA);
+  cv::resize(kernel, kernel, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+  kernel /= cv::sum(kernel)[0];
+  cv::filter2D(frame, frame, -1, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+}
+
 void applyCondition(cv::Mat& frame, Condition condition, std::mt19937& random) {
+  if (condition == Condition::MotionBlur || condition == Condition::MotionBlurJpeg) {
+    std::uniform_real_distribution<float> length(5.0f, 15.0f), angle(0.0f, 3.14159265f);
+    motionBlur(frame, length(random), angle(random));
+    if (condition == Condition::MotionBlurJpeg) {
+      std::vector<std::uint8_t> jpeg;
+      cv::imencode(".jpg", frame, jpeg, {cv::IMWRITE_JPEG_QUALITY, 50});
+      frame = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
+    }
+    return;
+  }
   if (condition == Condition::UnevenLight || condition == Condition::Combined) {
     cv::Mat f;
     frame.convertTo(f, CV_32F);
@@ -223,6 +246,10 @@ std::string toString(Condition condition) {
       return "uneven light";
     case Condition::Combined:
       return "combined";
+    case Condition::MotionBlur:
+      return "motion blur";
+    case Condition::MotionBlurJpeg:
+      return "motion+JPEG";
   }
   return "?";
 }

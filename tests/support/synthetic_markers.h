@@ -15,7 +15,9 @@
 namespace arbci::test {
 
 enum class MarkerFamily { ArbciBch, Aruco6x6, AprilTag36h11 };
-enum class Condition { Clean, Blur, Noise, UnevenLight, Combined };
+// MotionBlur: a linear kernel 5-15 px long at a random angle (a head-mounted camera turning
+// during the exposure); MotionBlurJpeg: the same, then JPEG at quality 50 (a compressing camera).
+enum class Condition { Clean, Blur, Noise, UnevenLight, Combined, MotionBlur, MotionBlurJpeg };
 
 std::string toString(MarkerFamily family);
 std::string toString(Condition condition);
