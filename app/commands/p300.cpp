@@ -4,6 +4,7 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <optional>
@@ -143,43 +144,30 @@ void writeReportFiles(const std::string& report_path, const std::string& scores_
 // (the embedded session's "errp"), so an offline ErrP model compares with a session's own.
 void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
   const ErrpSettings session = SessionConfig::load(std::nullopt).errp;
-  std::ostringstream taken;
-  const auto given = [&cmd](const char* name) { return cmd.count(name) > 0; };
-  if (!given("--method")) {
-    o.training.method = session.method;
-    taken << " --method " << session.method;
+  const bci::TrainingSettings training = session.training();
+  const auto ms = [](double s) { return std::to_string(std::lround(s * 1000.0)); };
+  const auto text = [](double v) {  // 20, not 20.000000
+    std::ostringstream out;
+    out << v;
+    return out.str();
+  };
+  const std::vector<std::pair<const char*, std::function<std::string()>>> defaults{
+      {"--method", [&] { return o.training.method = training.method; }},
+      {"--xdawn-filters",
+       [&] { return std::to_string(o.training.xdawn.filters = training.xdawn.filters); }},
+      {"--window-ms",
+       [&] { return o.window_ms = ms(session.window.start_s) + "," + ms(session.window.end_s); }},
+      {"--decimate-hz", [&] { return text(o.pipeline.decimate_hz = session.decimate_hz); }},
+      {"--highpass-hz", [&] { return text(o.pipeline.filter.highpass_hz = session.highpass_hz); }},
+      {"--lowpass-hz", [&] { return text(o.pipeline.filter.lowpass_hz = session.lowpass_hz); }},
+      {"--folds", [&] { return std::to_string(o.training.folds = training.folds); }},
+      {"--folds-by", [&] { return o.training.folds_by = training.folds_by; }}};
+  std::string taken;
+  for (const auto& [option, apply] : defaults) {
+    if (cmd.count(option) == 0) taken += std::string(" ") + option + " " + apply();
   }
-  if (!given("--xdawn-filters")) {
-    o.training.xdawn.filters = session.xdawn_filters;
-    taken << " --xdawn-filters " << session.xdawn_filters;
-  }
-  if (!given("--window-ms")) {
-    o.window_ms = std::to_string(static_cast<int>(std::lround(session.window.start_s * 1000))) +
-                  "," + std::to_string(static_cast<int>(std::lround(session.window.end_s * 1000)));
-    taken << " --window-ms " << o.window_ms;
-  }
-  if (!given("--decimate-hz")) {
-    o.pipeline.decimate_hz = session.decimate_hz;
-    taken << " --decimate-hz " << session.decimate_hz;
-  }
-  if (!given("--highpass-hz")) {
-    o.pipeline.filter.highpass_hz = session.highpass_hz;
-    taken << " --highpass-hz " << session.highpass_hz;
-  }
-  if (!given("--lowpass-hz")) {
-    o.pipeline.filter.lowpass_hz = session.lowpass_hz;
-    taken << " --lowpass-hz " << session.lowpass_hz;
-  }
-  if (!given("--folds")) {
-    o.training.folds = 5;
-    taken << " --folds 5";
-  }
-  if (!given("--folds-by")) {
-    o.training.folds_by = "block";
-    taken << " --folds-by block";
-  }
-  if (!taken.str().empty())
-    std::cout << "--errp: as a session's ErrP classifier where not given:" << taken.str() << "\n";
+  if (!taken.empty())
+    std::cout << "--errp: as a session's ErrP classifier where not given:" << taken << "\n";
 }
 
 void train(TrainOptions& o) {
@@ -456,8 +444,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                       "train the error-related-potential classifier on the recordings' feedback "
                       "events (Feedback ... correct|error; a session with errp.enabled records "
                       "them) instead of a P300 model on their flashes; options not given take "
-                      "the session's ErrP defaults (riemann, 1 filter per class, 0-800 ms, "
-                      "1-10 Hz, 20 Hz, 5 contiguous folds)");
+                      "the embedded session's ErrP defaults (it prints which)");
   train_cmd->add_option("--p300-model", t->p300_model,
                         "with --errp: write the ErrP classifier inside this P300 model (a session "
                         "needs both in one file) to --out");

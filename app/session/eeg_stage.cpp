@@ -85,8 +85,7 @@ EegStageSettings EegStageSettings::of(const SessionConfig& config) {
   s.session_file = config.source;
   s.errp = config.paradigm.errp;
   if (s.errp) s.errp_pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
-  s.errp_method = config.errp.method;
-  s.errp_xdawn_filters = config.errp.xdawn_filters;
+  s.errp_training = config.errp.training();
   if (config.eeg.source == "lsl" || config.lsl.markers) s.lsl = config.lsl.config(config.source);
   s.lsl_markers = config.lsl.markers;
   s.marker_stream = config.lsl.marker_stream;
@@ -431,41 +430,35 @@ void EegStage::startTraining(const std::string& method) {
     errp_recording->parameters["Paradigm"] = "single stimulus, 2 stimuli";
     errp_recording->stimuli = errp_stimuli_;
   }
-  training_ = std::async(
-      std::launch::async,
-      [recording = std::move(recording), errp_recording = std::move(errp_recording), pipeline,
-       method, errp_pipeline = settings_.errp_pipeline, errp_method = settings_.errp_method,
-       errp_filters = settings_.errp_xdawn_filters]() mutable {
-        // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
-        // frames come first and the training takes what is left.
-        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
-        bci::TrainingSettings settings;
-        settings.method = method;
-        settings.folds = 4;
-        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
-        bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
-        result.model.provenance["training_files"] = {"this session's calibration run"};
-        TrainingOutcome outcome{std::move(result.model), result.cross_validation.report, {}, ""};
-        if (errp_recording) {
-          try {
-            errp_recording->data = std::move(recording.data);
-            bci::TrainingSettings errp_settings;
-            errp_settings.method = errp_method;
-            errp_settings.xdawn.filters = errp_filters;
-            errp_settings.folds = 5;
-            errp_settings.folds_by = "block";
-            const bci::P300Dataset errp_data = bci::buildDataset({*errp_recording}, errp_pipeline);
-            bci::TrainingResult errp = bci::trainModel(errp_data, errp_pipeline, errp_settings);
-            errp.model.provenance["training_files"] = {"this session's ErrP feedback block"};
-            outcome.errp_report = errp.cross_validation.report;
-            outcome.model.errp_auc = errp.cross_validation.report.auc;
-            outcome.model.errp = std::make_shared<const bci::P300Model>(std::move(errp.model));
-          } catch (const std::exception& error) {
-            outcome.errp_failure = error.what();
-          }
-        }
-        return outcome;
-      });
+  training_ = std::async(std::launch::async, [recording = std::move(recording),
+                                              errp_recording = std::move(errp_recording), pipeline,
+                                              method, errp_pipeline = settings_.errp_pipeline,
+                                              errp_settings = settings_.errp_training]() mutable {
+    // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
+    // frames come first and the training takes what is left.
+    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+    bci::TrainingSettings settings;
+    settings.method = method;
+    settings.folds = 4;
+    const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+    bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
+    result.model.provenance["training_files"] = {"this session's calibration run"};
+    TrainingOutcome outcome{std::move(result.model), result.cross_validation.report, {}, ""};
+    if (errp_recording) {
+      try {
+        errp_recording->data = std::move(recording.data);
+        const bci::P300Dataset errp_data = bci::buildDataset({*errp_recording}, errp_pipeline);
+        bci::TrainingResult errp = bci::trainModel(errp_data, errp_pipeline, errp_settings);
+        errp.model.provenance["training_files"] = {"this session's ErrP feedback block"};
+        outcome.errp_report = errp.cross_validation.report;
+        outcome.model.errp_auc = errp.cross_validation.report.auc;
+        outcome.model.errp = std::make_shared<const bci::P300Model>(std::move(errp.model));
+      } catch (const std::exception& error) {
+        outcome.errp_failure = error.what();
+      }
+    }
+    return outcome;
+  });
 }
 
 std::optional<TrainingOutcome> EegStage::trainingResult(bool wait) {

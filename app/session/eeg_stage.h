@@ -38,8 +38,7 @@ struct EegStageSettings {
   std::string session_file;  // for messages naming a key
   bool errp = false;         // train and use an ErrP classifier
   bci::PipelineSettings errp_pipeline;
-  std::string errp_method;
-  int errp_xdawn_filters = 1;
+  bci::TrainingSettings errp_training;
   bci::lsl::LslConfig lsl;   // source "lsl" or markers: lsl_api.cfg with the session's scope, peers
   bool lsl_markers = false;  // publish stimuli and annotations as an LSL Markers stream
   std::string marker_stream;

@@ -416,6 +416,15 @@ bci::PipelineSettings ErrpSettings::pipeline(const bci::PipelineSettings& p300,
   return out;
 }
 
+bci::TrainingSettings ErrpSettings::training() const {
+  bci::TrainingSettings t;
+  t.method = method;
+  t.xdawn.filters = xdawn_filters;
+  t.folds = 5;
+  t.folds_by = "block";
+  return t;
+}
+
 SessionConfig SessionConfig::defaults(const std::string& json_text, const std::string& name) {
   SessionConfig config;
   Json json;

@@ -12,6 +12,7 @@
 
 #include <opencv2/core/matx.hpp>
 
+#include "arbci/bci/evaluation.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/lsl/config.h"
 #include "arbci/bci/paradigm.h"
@@ -124,6 +125,9 @@ struct ErrpSettings {
   // has none of them).
   bci::PipelineSettings pipeline(const bci::PipelineSettings& p300,
                                  const std::vector<std::string>& montage) const;
+  // How it is trained and cross-validated: the method, its filters, 5 contiguous blocks (the
+  // feedbacks are two classes, not selections). The session and `arbci train --errp` both use it.
+  bci::TrainingSettings training() const;
 };
 
 struct TrialIntent {

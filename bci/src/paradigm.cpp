@@ -8,6 +8,13 @@ namespace arbci::bci {
 namespace {
 // Frame times are exact multiples of the frame period only on paper: a microsecond of slack.
 constexpr double kSlack = 1e-6;
+
+// The runner-up's probability once the first choice is rejected: its share of what that choice
+// left (0 when it left nothing).
+double runnerUpCertainty(const Decision& d) {
+  const double rest = 1.0 - d.certainty;
+  return rest > 0.0 ? d.runner_up_certainty / rest : 0.0;
+}
 }  // namespace
 
 int ParadigmSettings::flashFrames() const {
@@ -218,9 +225,8 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
       if (runner_up_waiting_) {
         runner_up_waiting_ = false;
         const Decision& d = last_decision_;
-        showSelection(d.runner_up_codes, d.runner_up_choice,
-                      d.runner_up_certainty / (1.0 - d.certainty), phase_ == Phase::ObjectSelected,
-                      "runner-up");
+        showSelection(d.runner_up_codes, d.runner_up_choice, runnerUpCertainty(d),
+                      phase_ == Phase::ObjectSelected, "runner-up");
       } else if (!verdict_pending_) {
         askRobot(phase_ == Phase::ObjectSelected ? Phase::Grasping : Phase::Dropping);
       }
@@ -364,14 +370,13 @@ void Paradigm::errpVerdict(bool error) {
     return;
   }
   const Decision& d = last_decision_;
-  const double rest = 1.0 - d.certainty;
-  if (!runner_up_taken_ && d.runner_up_choice >= 0 && rest > 0.0 &&
-      d.runner_up_certainty / rest >= settings_.errp_runner_up) {
+  if (!runner_up_taken_ && d.runner_up_choice >= 0 &&
+      runnerUpCertainty(d) >= settings_.errp_runner_up) {
     runner_up_taken_ = true;
     correction.text = "runner-up";
     event(correction);
-    // The rejected choice is cleared at once; the runner-up (with its certainty now that the
-    // first choice is out) is shown after a pause, its feedback clear of the last one's ErrP.
+    // The rejected choice is cleared at once; the runner-up is shown after a pause (frame()),
+    // its feedback clear of the last one's ErrP.
     runner_up_waiting_ = true;
     if (objects) {
       selected_object_.reset();
