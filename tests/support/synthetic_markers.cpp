@@ -15,8 +15,7 @@
 namespace arbci::test {
 namespace {
 
-constexpr float kCellsPerSide = 10.0f;  // quiet zone + border + 6 code + border + quiet zone
-constexpr float kBlackCells = 8.0f;
+constexpr float kBlackCells = 8.0f;  // border + 6 code + border
 
 struct Camera {
   float f, cx, cy;
@@ -55,12 +54,13 @@ float radius(const Corners& q) {
   return r;
 }
 
-// The quiet-zone square around a marker's black square (same plane, 10/8 the size).
-Corners outerSquare(const Corners& black) {
-  const std::vector<cv::Point2f> from{{1, 1}, {9, 1}, {9, 9}, {1, 9}};
+// The quiet-zone square `quiet` cells around a marker's black square (same plane).
+Corners outerSquare(const Corners& black, int quiet) {
+  const float q = static_cast<float>(quiet), far = q + kBlackCells, all = far + q;
+  const std::vector<cv::Point2f> from{{q, q}, {far, q}, {far, far}, {q, far}};
   const cv::Matx33d h =
       cv::getPerspectiveTransform(from, std::vector<cv::Point2f>(black.begin(), black.end()));
-  const cv::Point2f unit[4] = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const cv::Point2f unit[4] = {{0, 0}, {all, 0}, {all, all}, {0, all}};
   Corners out;
   for (int k = 0; k < 4; ++k) {
     const cv::Vec3d p = h * cv::Vec3d(unit[k].x, unit[k].y, 1.0);
@@ -184,10 +184,12 @@ void motionBlur(cv::Mat& frame, float length, float angle) {
 }
 
 void applyCondition(cv::Mat& frame, Condition condition, std::mt19937& random) {
-  if (condition == Condition::MotionBlur || condition == Condition::MotionBlurJpeg) {
-    std::uniform_real_distribution<float> length(5.0f, 15.0f), angle(0.0f, 3.14159265f);
+  if (condition == Condition::MotionBlur || condition == Condition::MotionBlurJpeg ||
+      condition == Condition::FastMotionJpeg) {
+    const float shortest = condition == Condition::FastMotionJpeg ? 9.0f : 5.0f;
+    std::uniform_real_distribution<float> length(shortest, 15.0f), angle(0.0f, 3.14159265f);
     motionBlur(frame, length(random), angle(random));
-    if (condition == Condition::MotionBlurJpeg) {
+    if (condition != Condition::MotionBlur) {
       std::vector<std::uint8_t> jpeg;
       cv::imencode(".jpg", frame, jpeg, {cv::IMWRITE_JPEG_QUALITY, 50});
       frame = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
@@ -216,7 +218,7 @@ void applyCondition(cv::Mat& frame, Condition condition, std::mt19937& random) {
 
 void drawDecoys(cv::Mat& frame, const SceneLayout& layout) {
   for (size_t i = 0; i < layout.decoys.size(); ++i) {
-    drawWarped(frame, decoyImage(layout.decoy_styles[i], 8), outerSquare(layout.decoys[i]));
+    drawWarped(frame, decoyImage(layout.decoy_styles[i], 8), outerSquare(layout.decoys[i], 1));
   }
 }
 
@@ -250,6 +252,8 @@ std::string toString(Condition condition) {
       return "motion blur";
     case Condition::MotionBlurJpeg:
       return "motion+JPEG";
+    case Condition::FastMotionJpeg:
+      return "fast motion+J";
   }
   return "?";
 }
@@ -282,7 +286,7 @@ const std::vector<int>& usableIds(MarkerFamily family) {
   }
 }
 
-cv::Mat markerImage(MarkerFamily family, int id, int cell_px) {
+cv::Mat markerImage(MarkerFamily family, int id, int cell_px, int quiet_cells) {
   std::vector<std::uint8_t> cells(100, 255);
   if (family == MarkerFamily::ArbciBch) {
     const vision::CodeGrid grid = vision::wordToGrid(vision::BchCode::encode(id));
@@ -308,7 +312,13 @@ cv::Mat markerImage(MarkerFamily family, int id, int cell_px) {
     image_u8_destroy(drawn);
     tag36h11_destroy(tags);
   }
-  return cellsToImage(cells, 10, cell_px);
+  cv::Mat image = cellsToImage(cells, 10, cell_px);
+  const int extra = std::max(0, quiet_cells - 1) * cell_px;
+  if (extra > 0) {
+    cv::copyMakeBorder(image, image, extra, extra, extra, extra, cv::BORDER_CONSTANT,
+                       cv::Scalar(255));
+  }
+  return image;
 }
 
 void drawWarped(cv::Mat& frame, const cv::Mat& patch, const Corners& quad) {
@@ -364,6 +374,8 @@ SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed) {
   SceneLayout layout;
   layout.size = options.size;
   layout.seed = seed;
+  layout.quiet_cells = std::max(1, static_cast<int>(std::lround(options.quiet_cells)));
+  const float outer_ratio = (kBlackCells + 2.0f * layout.quiet_cells) / kBlackCells;
   std::vector<Corners> placed;  // quiet zones of everything placed so far
   const int total = options.markers + options.decoys;
   for (int object = 0; object < total; ++object) {
@@ -381,7 +393,7 @@ SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed) {
       const cv::Point3f centre((at.x - camera.cx) * depth / camera.f,
                                (at.y - camera.cy) * depth / camera.f, depth);
       const Corners black = projectSquare(camera, r, centre, half);
-      const Corners outer = projectSquare(camera, r, centre, half * kCellsPerSide / kBlackCells);
+      const Corners outer = projectSquare(camera, r, centre, half * outer_ratio);
       bool fits = true;
       for (const cv::Point2f& p : outer) {
         fits = fits && p.x > 3 && p.y > 3 && p.x < options.size.width - 4 &&
@@ -415,7 +427,8 @@ RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condit
   std::mt19937 id_random(layout.seed * 7919u + static_cast<std::uint32_t>(family));
   for (const Corners& marker : layout.markers) {
     const int id = ids[id_random() % ids.size()];
-    drawWarped(scene.image, markerImage(family, id, 8), outerSquare(marker));
+    drawWarped(scene.image, markerImage(family, id, 8, layout.quiet_cells),
+               outerSquare(marker, layout.quiet_cells));
     scene.ids.push_back(id);
     scene.markers.push_back(marker);
   }

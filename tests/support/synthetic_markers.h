@@ -1,8 +1,8 @@
 // Synthetic camera frames of square markers with exact ground truth, for tests and benchmarks.
 // A layout (marker and decoy poses, background, lighting) is drawn once and rendered with each
 // marker family, so every detector sees the same scene with its own markers. Every family is drawn
-// as 10 x 10 cells: an 8-cell black square (1-cell black border, 6 x 6 code) inside a 1-cell white
-// quiet zone; a marker's size is the side of its black square.
+// as an 8-cell black square (1-cell black border, 6 x 6 code) inside a white quiet zone, 1 cell
+// wide unless the layout asks for more; a marker's size is the side of its black square.
 #pragma once
 
 #include <array>
@@ -16,8 +16,18 @@ namespace arbci::test {
 
 enum class MarkerFamily { ArbciBch, Aruco6x6, AprilTag36h11 };
 // MotionBlur: a linear kernel 5-15 px long at a random angle (a head-mounted camera turning
-// during the exposure); MotionBlurJpeg: the same, then JPEG at quality 50 (a compressing camera).
-enum class Condition { Clean, Blur, Noise, UnevenLight, Combined, MotionBlur, MotionBlurJpeg };
+// during the exposure); MotionBlurJpeg: the same, then JPEG at quality 50 (a compressing camera);
+// FastMotionJpeg: a 9-15 px kernel (a faster head turn), then JPEG at quality 50.
+enum class Condition {
+  Clean,
+  Blur,
+  Noise,
+  UnevenLight,
+  Combined,
+  MotionBlur,
+  MotionBlurJpeg,
+  FastMotionJpeg
+};
 
 std::string toString(MarkerFamily family);
 std::string toString(Condition condition);
@@ -31,6 +41,7 @@ struct LayoutOptions {
   float min_side_px = 20.0f;  // face-on size of the smallest marker
   float max_side_px = 110.0f;
   float max_tilt_deg = 60.0f;
+  float quiet_cells = 1.0f;  // white margin around each marker, in code cells (whole cells)
 };
 
 struct SceneLayout {
@@ -38,6 +49,7 @@ struct SceneLayout {
   std::vector<Corners> markers;  // poses of the markers (black square corners)
   std::vector<Corners> decoys;
   std::vector<int> decoy_styles;
+  int quiet_cells = 1;     // printed white margin around each marker, cells
   std::uint32_t seed = 0;  // background and lighting
 };
 
@@ -56,9 +68,9 @@ RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condit
 // A frame of `size` with background and decoys only (no markers), under `condition`.
 cv::Mat renderMarkerFree(const SceneLayout& layout, Condition condition);
 
-// The printed marker image of `family` and `id`, 10 x 10 cells of `cell_px` pixels each
-// (quiet zone included).
-cv::Mat markerImage(MarkerFamily family, int id, int cell_px);
+// The printed marker image of `family` and `id`, (8 + 2 quiet_cells)^2 cells of `cell_px` pixels
+// each (quiet zone included).
+cv::Mat markerImage(MarkerFamily family, int id, int cell_px, int quiet_cells = 1);
 
 // Ids a family offers for the benchmark: BCH ids whose rotations stay at least 5 bits from any
 // other codeword (the ARToolKitPlus notes list the hazardous ones), ArUco 6x6_250's 250 and
