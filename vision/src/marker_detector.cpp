@@ -25,9 +25,20 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kSmoothAboveNoise = 2.5;  // grey levels of estimated noise
 constexpr size_t kMaxRetries = 12;         // near-miss components re-binarised per frame
+constexpr size_t kMaxFragmentRetries = 6;  // and groups of fragments
 constexpr int kMaxRetrySide = 160;         // px; larger borders are not thinned by blur
 constexpr int kRetryMargin = 14;           // px around a near miss
-constexpr int kRetrySplit = 9;             // sixteenths: a darker split than the usual 7
+constexpr int kFragmentGap = 4;            // px: failed components this close are one region
+// Sixteenths of a tile's range, lighter than the usual 7 so that more of a blurred border counts
+// as dark: 9 closes a border that blur thinned; 11 joins the fragments of one that motion blur
+// washed to mid-grey across its direction.
+constexpr int kThinnedSplit = 9;
+constexpr int kFragmentedSplit = 11;
+
+struct RetryRegion {
+  cv::Rect box;
+  bool fragmented;  // several failed components, rather than one square-hulled outline
+};
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
@@ -100,7 +111,10 @@ struct MarkerDetector::Impl {
   RunLabeler labels;
   std::vector<cv::Point> contour;
   std::vector<Quad> quads;
-  std::vector<cv::Rect> near_misses;  // marker-sized components that did not fit a quad
+  // Components that did not fit a quad, then grouped into marker-sized regions to retry.
+  std::vector<cv::Rect> failed;
+  std::vector<RetryRegion> retries;  // square-hulled near misses first, then fragment groups
+  std::vector<int> group, group_size;
   RunLabeler roi_labels;
   cv::Mat roi_limits;
   std::vector<SquareCorners> squares, ideal_squares;
@@ -161,7 +175,8 @@ struct MarkerDetector::Impl {
     QuadFitParams params;
     params.min_side = min_side;
     params.lens = config.lens.get();
-    near_misses.clear();
+    failed.clear();
+    retries.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
     for (const DarkComponent& c : labels.components()) {
       if (c.area < min_area || c.touchesBorder(width, height)) continue;
@@ -172,34 +187,97 @@ struct MarkerDetector::Impl {
       const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *binarised, params);
       if (fit.quad) {
         quads.push_back(*fit.quad);
-      } else if (adaptive_mode && std::min(w, h) >= min_side * 0.5f &&
-                 std::max(w, h) <= kMaxRetrySide) {
-        if (fit.hull_is_quadrilateral) near_misses.emplace_back(c.min_x, c.min_y, w, h);
+      } else if (adaptive_mode && std::max(w, h) <= kMaxRetrySide) {
+        failed.emplace_back(c.min_x, c.min_y, w, h);
+        if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f)
+          retries.push_back({failed.back(), false});
       }
     }
-    if (near_misses.size() > kMaxRetries) {
-      // The largest first: noise leaves many small near misses, markers are seldom the smallest.
-      std::partial_sort(near_misses.begin(), near_misses.begin() + kMaxRetries, near_misses.end(),
-                        [](const cv::Rect& a, const cv::Rect& b) { return a.area() > b.area(); });
-      near_misses.resize(kMaxRetries);
+    if (adaptive_mode) {
+      keepLargest(retries, kMaxRetries);
+      const size_t near_miss_count = retries.size();
+      groupFragments(min_side);
+      keepLargest(retries, near_miss_count + kMaxFragmentRetries);
+      retryNearMisses(params);
     }
-    if (adaptive_mode) retryNearMisses(params);
     time.quads += microseconds(start, Clock::now());
   }
 
-  // A small marker whose thin border blur has broken at the usual threshold often closes when
-  // its neighbourhood is binarised again with a darker split; a thin, steeply tilted one that
-  // smoothing has erased survives in the unsmoothed image.
+  // Keeps the `count` largest regions from the first one not yet capped on: noise leaves many
+  // small near misses, and markers are seldom the smallest.
+  static void keepLargest(std::vector<RetryRegion>& regions, size_t count) {
+    if (regions.size() <= count) return;
+    const size_t from =
+        regions.empty() || !regions.back().fragmented
+            ? 0
+            : static_cast<size_t>(std::find_if(regions.begin(), regions.end(),
+                                               [](const RetryRegion& r) { return r.fragmented; }) -
+                                  regions.begin());
+    std::partial_sort(
+        regions.begin() + from, regions.begin() + count, regions.end(),
+        [](const RetryRegion& a, const RetryRegion& b) { return a.box.area() > b.box.area(); });
+    regions.resize(count);
+  }
+
+  // Motion blur washes out the border sides across its direction, leaving a marker as several
+  // dark fragments: failed components within kFragmentGap of each other become one region
+  // (union-find over their boxes). Regions of several fragments and of a marker's size, not
+  // inside a marker already found (its code cells), are added to the retries.
+  void groupFragments(float min_side) {
+    const size_t n = failed.size();
+    group.resize(n);
+    for (size_t i = 0; i < n; ++i) group[i] = static_cast<int>(i);
+    auto root = [&](int i) {
+      while (group[i] != i) i = group[i] = group[group[i]];
+      return i;
+    };
+    for (size_t i = 0; i < n; ++i) {
+      const cv::Rect& a = failed[i];
+      const cv::Rect grown(a.x - kFragmentGap, a.y - kFragmentGap, a.width + 2 * kFragmentGap,
+                           a.height + 2 * kFragmentGap);
+      for (size_t j = i + 1; j < n; ++j) {
+        if ((grown & failed[j]).empty()) continue;
+        const int ri = root(static_cast<int>(i)), rj = root(static_cast<int>(j));
+        if (ri != rj) group[std::max(ri, rj)] = std::min(ri, rj);
+      }
+    }
+    group_size.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+      const int r = root(static_cast<int>(i));
+      ++group_size[r];
+      if (r != static_cast<int>(i)) failed[r] |= failed[i];
+    }
+    for (size_t i = 0; i < n; ++i) {
+      if (root(static_cast<int>(i)) != static_cast<int>(i) || group_size[i] < 2) continue;
+      const cv::Rect& box = failed[i];
+      const int longer = std::max(box.width, box.height), shorter = std::min(box.width, box.height);
+      // A marker tilted up to ~70 degrees.
+      if (longer > kMaxRetrySide || shorter < min_side * 0.5f || longer > 3 * shorter) continue;
+      const cv::Point2f middle(box.x + 0.5f * box.width, box.y + 0.5f * box.height);
+      bool inside_found = false;
+      for (size_t q = 0; q < quads.size() && !inside_found; ++q)
+        inside_found = insideConvex(quads[q].corners, middle);
+      if (!inside_found) retries.push_back({box, true});
+    }
+  }
+
+  // A marker whose border blur has thinned or broken at the usual threshold often closes when
+  // its neighbourhood is binarised again with a lighter split; a thin, steeply tilted one that
+  // smoothing has erased survives in the unsmoothed image (not tried for fragment groups: in
+  // noisy frames that costs more than it finds).
   void retryNearMisses(const QuadFitParams& params) {
     const cv::Rect image(0, 0, gray.cols, gray.rows);
-    for (cv::Rect roi : near_misses) {
+    for (const RetryRegion& region : retries) {
+      cv::Rect roi = region.box;
       roi.x -= kRetryMargin;
       roi.y -= kRetryMargin;
       roi.width += 2 * kRetryMargin;
       roi.height += 2 * kRetryMargin;
       roi &= image;
-      if (retryRegion(roi, *binarised, kRetrySplit, params)) continue;
-      if (binarised != &gray) retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
+      const int split = region.fragmented ? kFragmentedSplit : kThinnedSplit;
+      if (retryRegion(roi, *binarised, split, params)) continue;
+      if (!region.fragmented && binarised != &gray)
+        retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
     }
   }
 
