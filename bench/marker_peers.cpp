@@ -17,11 +17,13 @@ class ArbciTracker final : public MarkerDetectorUnderTest {
   test::MarkerFamily family() const override { return test::MarkerFamily::ArbciBch; }
   bool orderedCorners() const override { return true; }
   std::vector<test::FoundMarker> detect(const cv::Mat& gray) override {
+    const vision::DetectionResult result = detector_.detect(gray);
+    stages_ = result.timing;
     std::vector<test::FoundMarker> found;
-    for (const vision::MarkerDetection& m : detector_.detect(gray).markers)
-      found.push_back({m.id, m.corners});
+    for (const vision::MarkerDetection& m : result.markers) found.push_back({m.id, m.corners});
     return found;
   }
+  std::optional<vision::StageTimes> lastStageTimes() const override { return stages_; }
 
  private:
   static vision::DetectorConfig config() {
@@ -32,6 +34,7 @@ class ArbciTracker final : public MarkerDetectorUnderTest {
     return c;
   }
   vision::MarkerDetector detector_;
+  vision::StageTimes stages_;
 };
 
 class AprilTag final : public MarkerDetectorUnderTest {

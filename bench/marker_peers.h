@@ -3,11 +3,13 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
 
+#include "arbci/vision/marker.h"
 #include "support/marker_scoring.h"
 
 namespace arbci::bench {
@@ -19,6 +21,8 @@ class MarkerDetectorUnderTest {
   virtual test::MarkerFamily family() const = 0;
   virtual bool orderedCorners() const = 0;
   virtual std::vector<test::FoundMarker> detect(const cv::Mat& gray) = 0;
+  // The last frame's time per stage, for detectors that measure it (ARBCI's own).
+  virtual std::optional<vision::StageTimes> lastStageTimes() const { return std::nullopt; }
 };
 
 std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker();
