@@ -3,10 +3,12 @@
 // around the table), each frame integrated over its exposure so that the marker smears exactly as
 // it moves. Per marker tilt, the tracker's poses without and with One-Euro corner smoothing are
 // compared with the truth: error, frame-to-frame jitter, flips to the other planar solution, and
-// the latency the smoothing adds.
+// the latency the smoothing adds. Then the same sequence drawn with each peer's markers: the
+// fraction of frames each detector reads the marker in, and its time per frame.
 //   pose_sequence_bench [--seconds S] [--fps F] [--exposure-ms E] [--head-deg A]   (--help)
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -20,6 +22,7 @@
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/marker_poses.h"
 #include "arbci/vision/marker_tracker.h"
+#include "marker_peers.h"
 #include "support/posed_markers.h"
 
 using namespace arbci;
@@ -31,7 +34,8 @@ constexpr double kSideM = 0.06;      // the marker's black square
 constexpr double kDistanceM = 0.55;  // from the camera, straight ahead at rest
 constexpr double kFlipDeg = 15.0;    // a rotation error this large is the other planar solution
 constexpr int kSubFrames = 8;        // renders averaged over one exposure
-constexpr int kMarkerId = 1234;
+constexpr int kMarkerId = 1234;      // ARBCI's BCH marker; the peers' is kPeerId of their family
+constexpr int kPeerId = 123;
 
 struct HeadMotion {
   double amplitude_deg;
@@ -191,10 +195,32 @@ int main(int argc, char** argv) {
               "lag ms");
 
   std::mt19937 random(7);
-  for (const double tilt : tilts) {
+  // One frame: the marker integrated over the exposure centred on t, then sensor noise.
+  auto render = [&](test::MarkerFamily family, int id, const vision::Pose& at_rest, double t) {
+    cv::Mat sum(size, CV_32F, cv::Scalar(0));
+    for (int s = 0; s < kSubFrames; ++s) {
+      const double ts = t + exposure_ms / 1000.0 * ((s + 0.5) / kSubFrames - 0.5);
+      cv::Mat frame(size, CV_8UC1, cv::Scalar(150));
+      test::drawPosedMarker(frame, k, markerInCamera(head, at_rest, ts), kSideM, family, id);
+      cv::Mat as_float;
+      frame.convertTo(as_float, CV_32F);
+      sum += as_float;
+    }
+    cv::Mat noisy(size, CV_32F);
+    cv::theRNG().state = random();
+    cv::randn(noisy, 0.0, noise);
+    cv::Mat image;
+    cv::Mat(sum / kSubFrames + noisy).convertTo(image, CV_8U);
+    return image;
+  };
+  auto restingPose = [](double tilt) {
     vision::Pose at_rest;
     at_rest.rotation = test::markerRotation(tilt, 20.0, 35.0);
     at_rest.translation = cv::Vec3d(0.0, 0.0, kDistanceM);
+    return at_rest;
+  };
+  for (const double tilt : tilts) {
+    const vision::Pose at_rest = restingPose(tilt);
     vision::MarkerDetector detector(vision::DetectorConfig{});
     vision::MarkerTracker raw_tracker, smooth_tracker(smoothing);
     vision::MarkerPoses raw_poses(k), smooth_poses(k);
@@ -203,21 +229,7 @@ int main(int argc, char** argv) {
     std::vector<std::optional<cv::Vec3d>> raw_positions, smooth_positions;
     for (int f = 0; f < frames; ++f) {
       const double t = f / fps;  // the middle of the exposure
-      cv::Mat sum(size, CV_32F, cv::Scalar(0));
-      for (int s = 0; s < kSubFrames; ++s) {
-        const double ts = t + exposure_ms / 1000.0 * ((s + 0.5) / kSubFrames - 0.5);
-        cv::Mat frame(size, CV_8UC1, cv::Scalar(150));
-        test::drawPosedMarker(frame, k, markerInCamera(head, at_rest, ts), kSideM,
-                              test::MarkerFamily::ArbciBch, kMarkerId);
-        cv::Mat as_float;
-        frame.convertTo(as_float, CV_32F);
-        sum += as_float;
-      }
-      cv::Mat noisy(size, CV_32F);
-      cv::theRNG().state = random();
-      cv::randn(noisy, 0.0, noise);
-      cv::Mat image;
-      cv::Mat(sum / kSubFrames + noisy).convertTo(image, CV_8U);
+      const cv::Mat image = render(test::MarkerFamily::ArbciBch, kMarkerId, at_rest, t);
 
       const vision::DetectionResult result = detector.detect(image);
       const vision::Pose truth = markerInCamera(head, at_rest, t);
@@ -253,5 +265,45 @@ int main(int argc, char** argv) {
   std::printf(
       "\nlag ms: the delay at which the estimated positions best match the true ones (1 ms "
       "steps); the smoothing's added latency is the One-Euro row's lag minus the raw row's.\n");
+
+  // Detection only, every detector on the same sequence drawn with its own marker.
+  std::vector<std::unique_ptr<bench::MarkerDetectorUnderTest>> detectors;
+  detectors.push_back(bench::makeArbciTracker());
+  detectors.push_back(bench::makeAprilTag(2.0f));
+  detectors.push_back(bench::makeAprilTag(1.0f));
+  detectors.push_back(bench::makeAruco());
+  std::printf(
+      "\nframes in which the marker is read (its id, centre inside the true outline), and "
+      "ms per frame, one core:\n%-30s",
+      "detector");
+  for (const double tilt : tilts) std::printf("  tilt %2.0f        ", tilt);
+  std::printf("\n");
+  for (auto& detector : detectors) {
+    const int id = detector->family() == test::MarkerFamily::ArbciBch ? kMarkerId : kPeerId;
+    std::printf("%-30s", detector->name().c_str());
+    for (const double tilt : tilts) {
+      const vision::Pose at_rest = restingPose(tilt);
+      int read = 0;
+      double seconds_spent = 0.0;
+      for (int f = 0; f < frames; ++f) {
+        const double t = f / fps;
+        const cv::Mat image = render(detector->family(), id, at_rest, t);
+        test::Corners truth;
+        const auto corners = vision::markerCorners(kSideM);
+        for (int c = 0; c < 4; ++c) {
+          const cv::Point2d p = vision::project(markerInCamera(head, at_rest, t), k, corners[c]);
+          truth[c] = cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y));
+        }
+        const auto start = std::chrono::steady_clock::now();
+        const std::vector<test::FoundMarker> found = detector->detect(image);
+        seconds_spent +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        read += test::scoreFrame({id}, {truth}, found, detector->orderedCorners()).found;
+      }
+      std::printf("  %5.3f %6.3f ms", static_cast<double>(read) / frames,
+                  1000.0 * seconds_spent / frames);
+    }
+    std::printf("\n");
+  }
   return 0;
 }
