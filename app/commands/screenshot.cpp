@@ -107,6 +107,12 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     p.setRecordings((session.folder() / "recording.bdf").string());
     p.train(true);
     renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+  } else if (panel == "session-model") {
+    // The Training panel on the model the session trained after its calibration run (with
+    // ErrPs on, the ErrP classifier's averages beside the P300 one's).
+    runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
+    ui::TrainingPanel p(model);
+    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
   } else if (panel == "robot") {
     runUntil([&] {
       return phase() == bci::Phase::Grasping && session.robotStatus() &&
@@ -137,7 +143,8 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     renderPanels(*context, size, {&session_panel, &hmd_panel, &robot_panel, &threshold_panel},
                  session.statusLine(), options.out, [&] { session.step(); });
   } else {
-    throw CliError("--panel must be threshold, calibration, training, robot, session or hmd");
+    throw CliError(
+        "--panel must be threshold, calibration, training, session-model, robot, session or hmd");
   }
   session.abort();
   session.step();
@@ -159,8 +166,11 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
   command->add_option("--size", options->size, "Image size WIDTHxHEIGHT")->capture_default_str();
   command
       ->add_option("--panel", options->panel,
-                   "threshold, calibration, training, robot, session or hmd (the HMD view)")
-      ->check(CLI::IsMember({"threshold", "calibration", "training", "robot", "session", "hmd"}));
+                   "threshold, calibration, training (trained on the session's recording), "
+                   "session-model (the Training panel on the model the session trained), robot, "
+                   "session or hmd (the HMD view)")
+      ->check(CLI::IsMember(
+          {"threshold", "calibration", "training", "session-model", "robot", "session", "hmd"}));
   command->add_option("--session", options->session,
                       "session file (default: the embedded simulated session, with a still head)");
   command->callback([options, &exit_code] {

@@ -228,6 +228,8 @@ void EegStage::displayed(double host_s, bool patch_lit) {
 
 void EegStage::setModel(bci::P300Model model) {
   model.checkCompatible(info(), "the EEG source");
+  trained_erp_.reset();  // the averages belong to the model this session trained, not this one
+  trained_errp_erp_.reset();
   if (model.pipeline.zero_phase) {
     // Online filtering must be causal: the features lag where the model's did not.
     const std::string text =
@@ -443,7 +445,8 @@ void EegStage::startTraining(const std::string& method) {
     const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
     bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
     result.model.provenance["training_files"] = {"this session's calibration run"};
-    TrainingOutcome outcome{std::move(result.model), result.cross_validation.report, {}, ""};
+    TrainingOutcome outcome{
+        std::move(result.model), result.cross_validation.report, {}, "", data.erp, std::nullopt};
     if (errp_recording) {
       try {
         errp_recording->data = std::move(recording.data);
@@ -451,6 +454,7 @@ void EegStage::startTraining(const std::string& method) {
         bci::TrainingResult errp = bci::trainModel(errp_data, errp_pipeline, errp_settings);
         errp.model.provenance["training_files"] = {"this session's ErrP feedback block"};
         outcome.errp_report = errp.cross_validation.report;
+        outcome.errp_erp = errp_data.erp;
         outcome.model.errp_auc = errp.cross_validation.report.auc;
         outcome.model.errp = std::make_shared<const bci::P300Model>(std::move(errp.model));
       } catch (const std::exception& error) {
@@ -467,6 +471,8 @@ std::optional<TrainingOutcome> EegStage::trainingResult(bool wait) {
     return std::nullopt;
   TrainingOutcome outcome = training_.get();  // rethrows the worker's error
   setModel(outcome.model);
+  trained_erp_ = outcome.erp;
+  trained_errp_erp_ = outcome.errp_erp;
   return outcome;
 }
 

@@ -18,6 +18,7 @@
 #include "arbci/bci/acquisition.h"
 #include "arbci/bci/decision.h"
 #include "arbci/bci/epocher.h"
+#include "arbci/bci/erp.h"
 #include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
@@ -53,6 +54,10 @@ struct TrainingOutcome {
   // The ErrP classifier's cross-validated report, or why it could not be trained.
   std::optional<bci::EvaluationReport> errp_report;
   std::string errp_failure;
+  // The averages the classifiers were trained on: target and non-target flashes of the
+  // calibration run; error (the ErrP classifier's target) and correct feedback of its block.
+  bci::ErpCurves erp;
+  std::optional<bci::ErpCurves> errp_erp;
 };
 
 class EegStage final : public Stage {
@@ -110,6 +115,9 @@ class EegStage final : public Stage {
 
   bool hasModel() const { return model_.has_value(); }
   const std::optional<bci::P300Model>& model() const { return model_; }
+  // The ERP averages behind the session's own training (none for a model loaded from a file).
+  const std::optional<bci::ErpCurves>& trainedErp() const { return trained_erp_; }
+  const std::optional<bci::ErpCurves>& trainedErrpErp() const { return trained_errp_erp_; }
   void setModel(bci::P300Model model);
   // Trains on the calibration run on a worker thread; trainingResult() returns it once done
   // (rethrowing a training error), waiting for it when `wait`.
@@ -172,6 +180,7 @@ class EegStage final : public Stage {
   std::unique_ptr<bci::FilterChain> filters_;
   std::unique_ptr<bci::Epocher> epocher_;
   std::optional<bci::P300Model> model_;
+  std::optional<bci::ErpCurves> trained_erp_, trained_errp_erp_;
   std::optional<bci::FeatureExtractor> extractor_;
   // Calibration data, for training.
   bci::Recording calibration_;

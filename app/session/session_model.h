@@ -31,6 +31,10 @@ class SessionModel final : public ui::WorkstationModel {
 
   std::optional<bci::P300Model> model() override { return session_.eeg().model(); }
   void useModel(const bci::P300Model& model) override { session_.useModel(model); }
+  std::optional<bci::ErpCurves> sessionErp() override { return session_.eeg().trainedErp(); }
+  std::optional<bci::ErpCurves> sessionErrpErp() override {
+    return session_.eeg().trainedErrpErp();
+  }
   std::optional<double> errpThreshold() override {
     if (!session_.config().paradigm.errp) return std::nullopt;
     return session_.config().errp.threshold;

@@ -36,8 +36,8 @@ TEST_P(PanelScreenshot, RendersThePanelOnLiveData) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Panels, PanelScreenshot,
-                         ::testing::Values("threshold", "calibration", "training", "robot",
-                                           "session", "hmd"));
+                         ::testing::Values("threshold", "calibration", "training", "session-model",
+                                           "robot", "session", "hmd"));
 
 TEST(PanelScreenshotErrors, AnUnknownPanelIsRefused) {
   const ProcessResult r =

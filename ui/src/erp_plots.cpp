@@ -25,15 +25,15 @@ ImU32 diverging(double v) {
 
 }  // namespace
 
-void drawErpPlots(const bci::ErpCurves& erp) {
+void drawErpPlots(const bci::ErpCurves& erp, const char* target, const char* other) {
   const int channels = static_cast<int>(erp.channels.size()), samples = erp.samples();
   if (channels == 0 || samples < 2) return;
   const Eigen::MatrixXd difference = erp.difference();
   const Eigen::MatrixXd band_t = 1.96 * erp.target_se, band_o = 1.96 * erp.other_se;
   const double limit = erp.scaleUv();
-  ImGui::TextColored(ImVec4(0.86f, 0.2f, 0.2f, 1.0f), "target");
+  ImGui::TextColored(ImVec4(0.86f, 0.2f, 0.2f, 1.0f), "%s (%d)", target, erp.targets);
   ImGui::SameLine();
-  ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "non-target");
+  ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "%s (%d)", other, erp.others);
   ImGui::SameLine();
   ImGui::TextWrapped("difference (white); 95 %% bands; +/-%.0f uV, %.0f to %.0f ms", limit,
                      erp.timeS(0) * 1000.0, erp.timeS(samples - 1) * 1000.0);

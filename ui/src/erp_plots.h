@@ -7,7 +7,9 @@
 
 namespace arbci::ui {
 
-void drawErpPlots(const bci::ErpCurves& erp);
+// `target` and `other` name the two classes in the legend (an ErrP figure: error, correct).
+void drawErpPlots(const bci::ErpCurves& erp, const char* target = "target",
+                  const char* other = "non-target");
 void drawSignedR2(const bci::ErpCurves& erp);
 // The difference at its peak on a head map, where 3 or more channels have 10-20 names.
 void drawScalpMap(const bci::ErpCurves& erp);

@@ -74,6 +74,30 @@ void TrainingPanel::collect() {
   }
 }
 
+// The averages the session's own classifiers were trained on, the ErrP one beside the P300 one.
+void TrainingPanel::drawSessionErps() {
+  const auto p300 = model_.sessionErp();
+  const auto errp = model_.sessionErrpErp();
+  if (!p300 && !errp) return;
+  const int columns = p300 && errp ? 2 : 1;
+  if (!ImGui::BeginTable("session erps", columns, ImGuiTableFlags_SizingStretchSame)) return;
+  if (p300) {
+    ImGui::TableNextColumn();
+    ImGui::PushID("p300");
+    heading("P300: the calibration run's flashes (baseline-corrected)");
+    drawErpPlots(*p300);
+    ImGui::PopID();
+  }
+  if (errp) {
+    ImGui::TableNextColumn();
+    ImGui::PushID("errp");
+    heading("ErrP: the feedback block, error against correct feedback");
+    drawErpPlots(*errp, "error", "correct");
+    ImGui::PopID();
+  }
+  ImGui::EndTable();
+}
+
 void TrainingPanel::draw() {
   pathInput("recordings (BCI2000 .dat, GDF, EDF, BDF; several: separated by spaces)", files_,
             sizeof files_, ".dat .gdf .edf .bdf",
@@ -132,6 +156,7 @@ void TrainingPanel::draw() {
     } else {
       ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
     }
+    drawSessionErps();
     return;
   }
   const bci::TrainingResult& r = *outcome_->result;

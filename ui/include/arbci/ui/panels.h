@@ -76,6 +76,7 @@ class TrainingPanel final : public Panel {
   };
   void startTraining();
   void collect();
+  void drawSessionErps();
   WorkstationModel& model_;
   char files_[1024] = "";
   char save_path_[256] = "model.json";

@@ -9,6 +9,7 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "arbci/bci/erp.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/vision/camera_model.h"
@@ -55,6 +56,10 @@ class WorkstationModel {
   virtual std::optional<bci::P300Model> model() = 0;
   // With ErrPs on: the posterior of an error above which a selection is rejected.
   virtual std::optional<double> errpThreshold() { return std::nullopt; }
+  // The averages the session's own training used: flashes of the calibration run (target and
+  // non-target), and the ErrP block's feedback (error and correct). None before it trains.
+  virtual std::optional<bci::ErpCurves> sessionErp() { return std::nullopt; }
+  virtual std::optional<bci::ErpCurves> sessionErrpErp() { return std::nullopt; }
   virtual void useModel(const bci::P300Model& model) = 0;
 
   // Robot.
