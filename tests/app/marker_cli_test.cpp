@@ -2,6 +2,7 @@
 // stderr without stopping, printable markers that detect as their ids.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -108,6 +109,54 @@ TEST(MarkerCommand, WritesPrintScaleMarkersThatDetectAsTheirIds) {
   const auto markers = jsonLines(detect.out)[0]["markers"];
   ASSERT_EQ(markers.size(), 1u);
   EXPECT_EQ(markers[0]["id"], 42);
+}
+
+// A still marker under sensor noise: its corners wander from frame to frame by the noise alone.
+// --smooth (One-Euro) must cut that wander, and the average corner must stay where it was.
+TEST(DetectCommand, SmoothingStillsTheCornersOfAStillMarker) {
+  const auto base = scratch("bch_0007");
+  ASSERT_EQ(runProcess(kArbci, {"marker", "make", "--kind", "bch", "--id", "7", "--size-mm", "8",
+                                "--dpi", "150", "--out", base.string()})
+                .exit_code,
+            0);
+  cv::Mat marker = cv::imread(base.string() + ".png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(marker.empty());
+  cv::Mat frame(240, 320, CV_8UC1, cv::Scalar(150));
+  marker.copyTo(frame(cv::Rect(100, 60, marker.cols, marker.rows)));
+  std::vector<std::string> files;
+  cv::RNG random(3);
+  for (int f = 0; f < 40; ++f) {
+    cv::Mat noise(frame.size(), CV_16SC1), noisy;
+    random.fill(noise, cv::RNG::NORMAL, 0, 20);
+    frame.convertTo(noisy, CV_16SC1);
+    noisy += noise;
+    noisy.convertTo(noisy, CV_8UC1);
+    files.push_back(scratch("still_" + std::to_string(100 + f) + ".png").string());
+    cv::imwrite(files.back(), noisy);
+  }
+  // The spread of corner 0's x over the last 30 frames, and its mean.
+  auto spread = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"detect"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.insert(args.end(), files.begin(), files.end());
+    const ProcessResult r = runProcess(kArbci, args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::vector<double> x;
+    for (const auto& line : jsonLines(r.out)) {
+      if (line["markers"].size() == 1) x.push_back(line["markers"][0]["corners"][0][0]);
+    }
+    EXPECT_EQ(x.size(), files.size());
+    double mean = 0.0, square = 0.0;
+    for (size_t i = 10; i < x.size(); ++i) mean += x[i] / (x.size() - 10);
+    for (size_t i = 10; i < x.size(); ++i)
+      square += (x[i] - mean) * (x[i] - mean) / (x.size() - 10);
+    return std::pair{std::sqrt(square), mean};
+  };
+  const auto [raw_sd, raw_mean] = spread({"--track"});
+  const auto [smooth_sd, smooth_mean] = spread({"--smooth"});
+  EXPECT_GT(raw_sd, 0.01);  // the noise moves the corners: 0.019 px (SD)
+  EXPECT_LT(smooth_sd, 0.5 * raw_sd) << raw_sd << " px raw";  // measured 0.005 px
+  EXPECT_NEAR(smooth_mean, raw_mean, 0.1);
 }
 
 TEST(MarkerCommand, ASheetHoldsEveryIdAndHazardousIdsAreWarnedAbout) {
