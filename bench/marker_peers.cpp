@@ -12,8 +12,11 @@ namespace {
 
 class ArbciTracker final : public MarkerDetectorUnderTest {
  public:
-  ArbciTracker() : detector_(config()) {}
-  std::string name() const override { return "ARBCI (BCH, adaptive)"; }
+  explicit ArbciTracker(int decimate) : decimate_(decimate), detector_(config(decimate)) {}
+  std::string name() const override {
+    return decimate_ == 1 ? "ARBCI (BCH, adaptive)"
+                          : "ARBCI (BCH, decimate " + std::to_string(decimate_) + ")";
+  }
   test::MarkerFamily family() const override { return test::MarkerFamily::ArbciBch; }
   bool orderedCorners() const override { return true; }
   std::vector<test::FoundMarker> detect(const cv::Mat& gray) override {
@@ -26,13 +29,15 @@ class ArbciTracker final : public MarkerDetectorUnderTest {
   std::optional<vision::StageTimes> lastStageTimes() const override { return stages_; }
 
  private:
-  static vision::DetectorConfig config() {
+  static vision::DetectorConfig config(int decimate) {
     vision::DetectorConfig c;
+    c.search_decimate = decimate;
     c.kind = vision::MarkerKind::Bch;
     c.border = 0.125;
     c.threshold.mode = vision::ThresholdMode::Adaptive;
     return c;
   }
+  int decimate_;
   vision::MarkerDetector detector_;
   vision::StageTimes stages_;
 };
@@ -109,8 +114,8 @@ class Aruco final : public MarkerDetectorUnderTest {
 
 }  // namespace
 
-std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker() {
-  return std::make_unique<ArbciTracker>();
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate) {
+  return std::make_unique<ArbciTracker>(decimate);
 }
 std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate) {
   return std::make_unique<AprilTag>(decimate);

@@ -25,7 +25,8 @@ class MarkerDetectorUnderTest {
   virtual std::optional<vision::StageTimes> lastStageTimes() const { return std::nullopt; }
 };
 
-std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker();
+// decimate: the tracker's search_decimate (1: full resolution).
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate);
 std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate);
 std::unique_ptr<MarkerDetectorUnderTest> makeAruco();
 

@@ -268,7 +268,8 @@ int main(int argc, char** argv) {
 
   // Detection only, every detector on the same sequence drawn with its own marker.
   std::vector<std::unique_ptr<bench::MarkerDetectorUnderTest>> detectors;
-  detectors.push_back(bench::makeArbciTracker());
+  detectors.push_back(bench::makeArbciTracker(1));
+  detectors.push_back(bench::makeArbciTracker(2));
   detectors.push_back(bench::makeAprilTag(2.0f));
   detectors.push_back(bench::makeAprilTag(1.0f));
   detectors.push_back(bench::makeAruco());

@@ -39,6 +39,7 @@ struct DetectOptions {
   double min_cutoff_hz = vision::TrackerOptions{}.min_cutoff_hz;
   double beta = vision::TrackerOptions{}.beta;
   int repeat = 1;
+  int decimate = 1;
   std::string annotate;
   std::string camera;
   double marker_size_mm = 50.0;
@@ -111,6 +112,7 @@ vision::DetectorConfig makeConfig(const DetectOptions& options) {
                   : config.kind == vision::MarkerKind::Bch ? 0.125
                                                            : 0.25;
   config.threshold = parseThreshold(options);
+  config.search_decimate = options.decimate;
   config.dictionary = options.dictionary;
   for (size_t i = 0; i < options.patterns.size(); ++i) {
     // ID=FILE or FILE (ids count from 0 in the order given).
@@ -349,6 +351,14 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
       ->add_option("--repeat", options->repeat,
                    "Detect each frame N times, report median stage times")
       ->check(CLI::Range(1, 100000));
+  command
+      ->add_option(
+          "--decimate", options->decimate,
+          "Square kinds: 1 searches candidates at full resolution; 2 on the frame averaged "
+          "over 2x2 pixels, corners then refined at full resolution (about twice as fast; "
+          "markers need about 24 px per side; docs/tracker.md)")
+      ->check(CLI::IsMember({1, 2}))
+      ->capture_default_str();
   command->add_option("--annotate", options->annotate,
                       "Write each frame with its markers drawn into this folder");
   command->add_option("--camera", options->camera,

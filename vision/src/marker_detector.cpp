@@ -3,10 +3,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "apriltag_detector.h"
 #include "code_decoder.h"
@@ -90,6 +96,42 @@ void validate(const DetectorConfig& config) {
     throw std::invalid_argument("threshold retries per frame must be 0..10");
   }
   if (config.min_side_px < 4) throw std::invalid_argument("min_side_px must be at least 4");
+  if (config.search_decimate != 1 && config.search_decimate != 2) {
+    throw std::invalid_argument("search_decimate must be 1 (full resolution) or 2, got " +
+                                std::to_string(config.search_decimate));
+  }
+}
+
+// Each 2x2 block of `full` averaged into one pixel of `half` (the rows' rounded average, then the
+// columns'); an odd last row or column is left out.
+void halve(const cv::Mat& full, cv::Mat& half) {
+  half.create(full.rows / 2, full.cols / 2, CV_8UC1);
+  for (int y = 0; y < half.rows; ++y) {
+    const std::uint8_t* __restrict a = full.ptr<std::uint8_t>(2 * y);
+    const std::uint8_t* __restrict b = full.ptr<std::uint8_t>(2 * y + 1);
+    std::uint8_t* __restrict out = half.ptr<std::uint8_t>(y);
+    int x = 0;
+#ifdef __SSE2__
+    const __m128i low_bytes = _mm_set1_epi16(0x00FF), one = _mm_set1_epi16(1);
+    for (; x + 16 <= half.cols; x += 16) {
+      __m128i sums[2];
+      for (int part = 0; part < 2; ++part) {
+        const __m128i rows =
+            _mm_avg_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + 2 * x + 16 * part)),
+                         _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + 2 * x + 16 * part)));
+        const __m128i pairs =
+            _mm_add_epi16(_mm_and_si128(rows, low_bytes), _mm_srli_epi16(rows, 8));
+        sums[part] = _mm_srli_epi16(_mm_add_epi16(pairs, one), 1);
+      }
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x), _mm_packus_epi16(sums[0], sums[1]));
+    }
+#endif
+    for (; x < half.cols; ++x) {
+      const int left = (a[2 * x] + b[2 * x] + 1) >> 1,
+                right = (a[2 * x + 1] + b[2 * x + 1] + 1) >> 1;
+      out[x] = static_cast<std::uint8_t>((left + right + 1) >> 1);
+    }
+  }
 }
 
 }  // namespace
@@ -103,8 +145,12 @@ struct MarkerDetector::Impl {
   // `gray` is a read-only view: of the caller's pixels for grey input, else of `converted`.
   // `converted` and `smoothed` are written only by this detector and never shared with callers,
   // so reusing their buffers can never write into a caller's image.
-  cv::Mat gray, converted, smoothed;
+  cv::Mat gray, converted, smoothed, half;
   const cv::Mat* binarised = nullptr;  // `gray` or `smoothed`
+  // The image candidates are searched in: `binarised`, or `half` (search_decimate 2), whose
+  // pixels are `scale` of the frame's.
+  const cv::Mat* searched = nullptr;
+  int scale = 1;
   TileThresholds tiles;
   AdaptiveThresholder adaptive;
   cv::Mat limits;
@@ -118,6 +164,12 @@ struct MarkerDetector::Impl {
   RunLabeler roi_labels;
   cv::Mat roi_limits;
   std::vector<SquareCorners> squares, ideal_squares;
+  // decode(): quads by decreasing area, the markers decoded (by quad index), their samples'
+  // medians, and the quads in frame pixels.
+  std::vector<size_t> order;
+  std::vector<std::pair<size_t, MarkerDetection>> decoded;
+  std::vector<std::pair<size_t, float>> medians;
+  std::vector<Quad> frame_quads;
 
   explicit Impl(DetectorConfig c) : config(std::move(c)) {
     validate(config);
@@ -144,23 +196,25 @@ struct MarkerDetector::Impl {
       int contrast = config.threshold.min_contrast;
       if (contrast <= 0) {
         // Ask for 6 sigma of the noise left in the binarised image (0.375 of it after smoothing).
-        const double sigma = noise_sigma * (binarised == &smoothed ? 0.375 : 1.0);
+        const double sigma =
+            noise_sigma * (binarised == &smoothed ? 0.375 : 1.0) / static_cast<double>(scale);
         contrast = std::max(8, static_cast<int>(std::lround(6.0 * sigma)));
       }
-      adaptive.fill(*binarised, contrast, tiles);
+      adaptive.fill(*searched, contrast, tiles, TileThresholds::kTile / scale);
       result.threshold = tiles.median();
       result.threshold_mode = "adaptive (contrast >= " + std::to_string(contrast) + ")";
     } else {
       const auto& vignetting = config.threshold.mode == ThresholdMode::Adaptive
                                    ? std::nullopt
                                    : config.threshold.vignetting;
-      fillGlobalThresholds(gray.size(), global, vignetting, tiles);
+      fillGlobalThresholds(searched->size(), global, vignetting, tiles,
+                           TileThresholds::kTile / scale);
       result.threshold = global;
       result.threshold_mode = toString(config.threshold.mode) + (vignetting ? " + vignetting" : "");
     }
-    interpolateLimits(tiles, gray.size(), limits);
+    interpolateLimits(tiles, searched->size(), limits);
     const auto mid = Clock::now();
-    labels.label(*binarised, limits);
+    labels.label(*searched, limits);
     const auto end = Clock::now();
     time.threshold += microseconds(start, mid);
     time.label += microseconds(mid, end);
@@ -169,12 +223,15 @@ struct MarkerDetector::Impl {
   void findQuads(StageTimes& time) {
     const auto start = Clock::now();
     quads.clear();
-    const int width = gray.cols, height = gray.rows;
-    const float min_side = config.min_side_px;
+    const int width = searched->cols, height = searched->rows;
+    const float min_side = std::max(4.0f, config.min_side_px / static_cast<float>(scale));
     const int min_area = std::max(12, static_cast<int>(0.2f * min_side * min_side));
+    const int max_retry_side = kMaxRetrySide / scale;
     QuadFitParams params;
     params.min_side = min_side;
-    params.lens = config.lens.get();
+    // A reduced image's quads are refined on the frame, through the lens, when decoded.
+    params.lens = scale == 1 ? config.lens.get() : nullptr;
+    params.refine_edges = scale == 1;
     failed.clear();
     retries.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
@@ -184,10 +241,10 @@ struct MarkerDetector::Impl {
       if (std::max(w, h) < min_side || std::min(w, h) < 3) continue;
       const int max_length = 4 * (w + h) + 64;
       if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
-      const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *binarised, params);
+      const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *searched, params);
       if (fit.quad) {
         quads.push_back(*fit.quad);
-      } else if (adaptive_mode && std::max(w, h) <= kMaxRetrySide) {
+      } else if (adaptive_mode && std::max(w, h) <= max_retry_side) {
         failed.emplace_back(c.min_x, c.min_y, w, h);
         if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f)
           retries.push_back({failed.back(), false});
@@ -231,10 +288,10 @@ struct MarkerDetector::Impl {
       while (group[i] != i) i = group[i] = group[group[i]];
       return i;
     };
+    const int gap = std::max(2, kFragmentGap / scale);
     for (size_t i = 0; i < n; ++i) {
       const cv::Rect& a = failed[i];
-      const cv::Rect grown(a.x - kFragmentGap, a.y - kFragmentGap, a.width + 2 * kFragmentGap,
-                           a.height + 2 * kFragmentGap);
+      const cv::Rect grown(a.x - gap, a.y - gap, a.width + 2 * gap, a.height + 2 * gap);
       for (size_t j = i + 1; j < n; ++j) {
         if ((grown & failed[j]).empty()) continue;
         const int ri = root(static_cast<int>(i)), rj = root(static_cast<int>(j));
@@ -252,7 +309,8 @@ struct MarkerDetector::Impl {
       const cv::Rect& box = failed[i];
       const int longer = std::max(box.width, box.height), shorter = std::min(box.width, box.height);
       // A marker tilted up to ~70 degrees.
-      if (longer > kMaxRetrySide || shorter < min_side * 0.5f || longer > 3 * shorter) continue;
+      if (longer > kMaxRetrySide / scale || shorter < min_side * 0.5f || longer > 3 * shorter)
+        continue;
       const cv::Point2f middle(box.x + 0.5f * box.width, box.y + 0.5f * box.height);
       bool inside_found = false;
       for (size_t q = 0; q < quads.size() && !inside_found; ++q)
@@ -266,17 +324,18 @@ struct MarkerDetector::Impl {
   // smoothing has erased survives in the unsmoothed image (not tried for fragment groups: in
   // noisy frames that costs more than it finds).
   void retryNearMisses(const QuadFitParams& params) {
-    const cv::Rect image(0, 0, gray.cols, gray.rows);
+    const cv::Rect image(0, 0, searched->cols, searched->rows);
+    const int margin = kRetryMargin / scale;
     for (const RetryRegion& region : retries) {
       cv::Rect roi = region.box;
-      roi.x -= kRetryMargin;
-      roi.y -= kRetryMargin;
-      roi.width += 2 * kRetryMargin;
-      roi.height += 2 * kRetryMargin;
+      roi.x -= margin;
+      roi.y -= margin;
+      roi.width += 2 * margin;
+      roi.height += 2 * margin;
       roi &= image;
       const int split = region.fragmented ? kFragmentedSplit : kThinnedSplit;
-      if (retryRegion(roi, *binarised, split, params)) continue;
-      if (!region.fragmented && binarised != &gray)
+      if (retryRegion(roi, *searched, split, params)) continue;
+      if (!region.fragmented && scale == 1 && binarised != &gray)
         retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
     }
   }
@@ -302,10 +361,12 @@ struct MarkerDetector::Impl {
       if (!quad) continue;
       const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
       for (cv::Point2f& p : quad->corners) p += offset;
-      // The region's ideal corners were computed as if it were the whole image: redo them.
+      // The region's ideal corners were computed as if it were the whole image: redo them (a
+      // reduced image's are, when its quads are refined on the frame).
       for (int k = 0; k < 4; ++k) {
-        quad->ideal_corners[k] =
-            config.lens ? toFloat(config.lens->undistort(quad->corners[k])) : quad->corners[k];
+        quad->ideal_corners[k] = config.lens && scale == 1
+                                     ? toFloat(config.lens->undistort(quad->corners[k]))
+                                     : quad->corners[k];
       }
       bool known = false;  // already found, from the frame or an earlier retry
       for (size_t q = 0; q < quads.size() && !known; ++q) {
@@ -319,12 +380,53 @@ struct MarkerDetector::Impl {
     return added;
   }
 
-  // Decodes every quad; returns the samples' extremes and the first marker's median for the
-  // automatic thresholds.
+  // A reduced image's quad in frame pixels (a reduced pixel's centre is the middle of the frame
+  // pixels it averages), its sides moved onto the frame's edges, through the lens.
+  std::optional<Quad> onFrame(const Quad& coarse) const {
+    QuadFitParams params;
+    params.min_side = config.min_side_px;
+    params.lens = config.lens.get();
+    const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
+    std::array<cv::Point2f, 4> corners;
+    for (int k = 0; k < 4; ++k) corners[k] = coarse.corners[k] * s + cv::Point2f(shift, shift);
+    return refineQuad(corners, *binarised, params);
+  }
+
+  // Decodes every quad, largest first (a reduced image's refined on the frame first); returns
+  // the samples' extremes and the first marker's median (in the frame's order) for the automatic
+  // thresholds. Leaves `quads` the frame's quads that were looked at.
   void decode(StageTimes& time, std::vector<MarkerDetection>& markers, float& lowest,
               float& highest, float& marker_median) {
     const auto start = Clock::now();
-    for (const Quad& quad : quads) {
+    double refining = 0.0;
+    // A quad inside a marker already decoded would be dropped as nested (code cells): it is not
+    // refined or decoded, except where every candidate's samples set the next threshold.
+    const bool skip_nested = config.threshold.mode != ThresholdMode::AutoMidrange;
+    order.resize(quads.size());
+    for (size_t i = 0; i < quads.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return quadArea(quads[a].corners) > quadArea(quads[b].corners);
+    });
+    decoded.clear();
+    frame_quads.clear();
+    for (const size_t index : order) {
+      Quad quad = quads[index];
+      if (skip_nested) {
+        const cv::Point2f middle = centre(quad.corners) * static_cast<float>(scale) +
+                                   cv::Point2f(0.5f, 0.5f) * (scale - 1);
+        bool nested = false;
+        for (size_t m = 0; m < decoded.size() && !nested; ++m)
+          nested = insideConvex(decoded[m].second.corners, middle);
+        if (nested) continue;
+      }
+      if (scale > 1) {
+        const auto refine_start = Clock::now();
+        const auto refined = onFrame(quad);
+        refining += microseconds(refine_start, Clock::now());
+        if (!refined) continue;
+        quad = *refined;
+      }
+      frame_quads.push_back(quad);
       const MarkerSamples samples = sampleMarker(gray, quad, config.border);
       lowest = std::min(lowest, samples.lowest);
       highest = std::max(highest, samples.highest);
@@ -352,10 +454,20 @@ struct MarkerDetector::Impl {
         marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
         marker.ideal_corners[k] = quad.ideal_corners[(k + 4 - marker.orientation) % 4];
       }
-      if (markers.empty()) marker_median = samples.median;
-      markers.push_back(marker);
+      decoded.emplace_back(index, marker);
+      medians.emplace_back(index, samples.median);
     }
-    time.decode += microseconds(start, Clock::now());
+    // The frame's (raster) order, as found.
+    std::sort(decoded.begin(), decoded.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [index, marker] : decoded) markers.push_back(marker);
+    if (!medians.empty()) {
+      marker_median = std::min_element(medians.begin(), medians.end())->second;
+      medians.clear();
+    }
+    quads.swap(frame_quads);
+    time.decode += microseconds(start, Clock::now()) - refining;
+    time.quads += refining;
   }
 
   // A square inside a larger decoded marker (e.g. a block of code cells) is not a marker.
@@ -383,8 +495,15 @@ struct MarkerDetector::Impl {
     const double noise_sigma = estimateNoiseSigma(gray);
     const bool smooth = config.smoothing == Smoothing::Always ||
                         (config.smoothing == Smoothing::Auto && noise_sigma >= kSmoothAboveNoise);
-    if (smooth) smoothBinomial3(gray, smoothed);
-    binarised = smooth ? &smoothed : &gray;
+    scale = config.search_decimate;
+    // A 2x2 average is itself a smoothing (noise halved): the frame is not smoothed then.
+    if (smooth && scale == 1) smoothBinomial3(gray, smoothed);
+    binarised = smooth && scale == 1 ? &smoothed : &gray;
+    searched = binarised;
+    if (scale == 2) {
+      halve(gray, half);
+      searched = &half;
+    }
     time.smooth = microseconds(start, Clock::now());
 
     const ThresholdMode mode = config.threshold.mode;
@@ -526,11 +645,12 @@ const std::vector<SquareCorners>& MarkerDetector::lastIdealSquares() const {
 cv::Mat MarkerDetector::lastBinaryImage() const {
   const cv::Mat& gray = impl_->gray;
   cv::Mat binary(gray.rows, gray.cols, CV_8UC1, cv::Scalar(0));
-  if (impl_->external() || gray.empty() || impl_->labels.maskStride() != gray.cols + 2)
+  const int s = impl_->scale;  // the labels are of the image searched, `s` times smaller
+  if (impl_->external() || gray.empty() || impl_->labels.maskStride() != gray.cols / s + 2)
     return binary;
-  for (int y = 0; y < gray.rows; ++y) {
+  for (int y = 0; y < gray.rows / s * s; ++y) {
     std::uint8_t* row = binary.ptr<std::uint8_t>(y);
-    for (int x = 0; x < gray.cols; ++x) row[x] = impl_->labels.dark(x, y) ? 255 : 0;
+    for (int x = 0; x < gray.cols / s * s; ++x) row[x] = impl_->labels.dark(x / s, y / s) ? 255 : 0;
   }
   return binary;
 }

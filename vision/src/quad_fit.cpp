@@ -253,6 +253,62 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
   return fitLine(points, weights, count);
 }
 
+// The corners where consecutive lines meet (corner k between side k - 1 and side k).
+bool intersectLines(const std::array<Line, 4>& lines, std::array<cv::Point2f, 4>& corners) {
+  for (int k = 0; k < 4; ++k) {
+    const auto corner = intersect(lines[(k + 3) % 4], lines[k]);
+    if (!corner) return false;
+    corners[k] = *corner;
+  }
+  return true;
+}
+
+// Moves the sides onto the image's edges, twice (the second time with a reach of at most 2 px),
+// and intersects them again; `corners` are ideal coordinates. False when sides no longer meet.
+bool refineToEdges(const cv::Mat& image, const LensMap& lens, std::array<Line, 4>& lines,
+                   std::array<cv::Point2f, 4>& corners) {
+  // The search reaches at most a tenth of the smallest side across the edge (1..3 px).
+  float shortest = length(corners[1] - corners[0]);
+  for (int k = 1; k < 4; ++k)
+    shortest = std::min(shortest, length(corners[(k + 1) % 4] - corners[k]));
+  const int reach = std::clamp(static_cast<int>(std::lround(0.1f * shortest)), 1, 3);
+  for (int radius : {reach, std::min(reach, 2)}) {
+    // Samples lie within radius + 1 px of the current sides (as the lens bends them).
+    std::array<cv::Point2f, 20> outline;
+    for (int k = 0; k < 4; ++k) {
+      for (int j = 0; j < 5; ++j)
+        outline[5 * k + j] =
+            lens.toImage(corners[k] + (corners[(k + 1) % 4] - corners[k]) * (j / 5.0f));
+    }
+    const BilinearSampler sample(image, boundsOf(outline, static_cast<float>(radius + 2)));
+    std::array<Line, 4> refined = lines;
+    for (int k = 0; k < 4; ++k) {
+      const auto line = refineSide(sample, lens, corners[k], corners[(k + 1) % 4], radius);
+      if (line) refined[k] = *line;
+    }
+    lines = refined;
+    if (!intersectLines(lines, corners)) return false;
+  }
+  return true;
+}
+
+// A marker is a convex quadrilateral with sides of a usable length: then `quad`'s ideal corners
+// are its corners, which become image coordinates.
+bool finishQuad(const QuadFitParams& params, const LensMap& lens, Quad& quad) {
+  float sign = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f e1 = quad.corners[(k + 1) % 4] - quad.corners[k];
+    const cv::Point2f e2 = quad.corners[(k + 2) % 4] - quad.corners[(k + 1) % 4];
+    if (length(e1) < params.min_side) return false;
+    const float cross = e1.x * e2.y - e1.y * e2.x;
+    if (sign == 0.0f) sign = cross;
+    if (cross * sign <= 0.0f) return false;
+  }
+  quad.ideal_corners = quad.corners;
+  for (int k = 0; k < 4; ++k) quad.corners[k] = lens.toImage(quad.ideal_corners[k]);
+  return true;
+}
+
 // Indices into `outline` (a closed polygon, clockwise) of the corners of the quadrilateral it
 // outlines. Candidate vertices come from recursive splitting at the point farthest from the chord
 // (ARToolKit's method, with a fine tolerance so that rounded or chamfered corners still yield a
@@ -415,15 +471,7 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
 
   // From here on, corners are ideal coordinates.
   Quad quad;
-  auto intersectAll = [&]() {
-    for (int k = 0; k < 4; ++k) {
-      const auto corner = intersect(lines[(k + 3) % 4], lines[k]);
-      if (!corner) return false;
-      quad.corners[k] = *corner;
-    }
-    return true;
-  };
-  if (!intersectAll()) return result;
+  if (!intersectLines(lines, quad.corners)) return result;
   // Corners far from their contour vertices mean the sides were not straight lines.
   for (int k = 0; k < 4; ++k) {
     const cv::Point2f d = quad.corners[k] - lens.toIdeal(cv::Point2f(contour[vertex[k]]));
@@ -431,47 +479,28 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     if (length(d) > 2.0f + 0.25f * side) return result;
   }
 
-  if (params.refine_edges) {
-    // The search reaches at most a tenth of the smallest side across the edge (1..3 px).
-    float shortest = length(quad.corners[1] - quad.corners[0]);
-    for (int k = 1; k < 4; ++k)
-      shortest = std::min(shortest, length(quad.corners[(k + 1) % 4] - quad.corners[k]));
-    const int reach = std::clamp(static_cast<int>(std::lround(0.1f * shortest)), 1, 3);
-    for (int radius : {reach, std::min(reach, 2)}) {
-      // Samples lie within radius + 1 px of the current sides (as the lens bends them).
-      std::array<cv::Point2f, 20> outline;
-      for (int k = 0; k < 4; ++k) {
-        for (int j = 0; j < 5; ++j) {
-          outline[5 * k + j] = lens.toImage(
-              quad.corners[k] + (quad.corners[(k + 1) % 4] - quad.corners[k]) * (j / 5.0f));
-        }
-      }
-      const BilinearSampler sample(image, boundsOf(outline, static_cast<float>(radius + 2)));
-      std::array<Line, 4> refined = lines;
-      for (int k = 0; k < 4; ++k) {
-        const auto line =
-            refineSide(sample, lens, quad.corners[k], quad.corners[(k + 1) % 4], radius);
-        if (line) refined[k] = *line;
-      }
-      lines = refined;
-      if (!intersectAll()) return result;
-    }
-  }
+  if (params.refine_edges && !refineToEdges(image, lens, lines, quad.corners)) return result;
 
-  // A marker is a convex quadrilateral with sides of a usable length.
-  float sign = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    const cv::Point2f e1 = quad.corners[(k + 1) % 4] - quad.corners[k];
-    const cv::Point2f e2 = quad.corners[(k + 2) % 4] - quad.corners[(k + 1) % 4];
-    if (length(e1) < params.min_side) return result;
-    const float cross = e1.x * e2.y - e1.y * e2.x;
-    if (sign == 0.0f) sign = cross;
-    if (cross * sign <= 0.0f) return result;
-  }
-  quad.ideal_corners = quad.corners;
-  for (int k = 0; k < 4; ++k) quad.corners[k] = lens.toImage(quad.ideal_corners[k]);
+  if (!finishQuad(params, lens, quad)) return result;
   result.quad = quad;
   return result;
+}
+
+std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const cv::Mat& image,
+                               const QuadFitParams& params) {
+  const LensMap lens{params.lens};
+  Quad quad;
+  for (int k = 0; k < 4; ++k) quad.corners[k] = lens.toIdeal(corners[k]);
+  std::array<Line, 4> lines;
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f d = quad.corners[(k + 1) % 4] - quad.corners[k];
+    const float n = length(d);
+    if (n <= 0.0f) return std::nullopt;
+    lines[k] = {quad.corners[k], d / n};
+  }
+  if (params.refine_edges && !refineToEdges(image, lens, lines, quad.corners)) return std::nullopt;
+  if (!finishQuad(params, lens, quad)) return std::nullopt;
+  return quad;
 }
 
 }  // namespace arbci::vision

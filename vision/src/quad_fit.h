@@ -43,4 +43,10 @@ struct QuadFit {
 QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, const cv::Mat& image,
                 const QuadFitParams& params);
 
+// A quadrilateral found elsewhere (e.g. on a reduced image, corners scaled to `image`'s pixels,
+// clockwise) with its sides moved onto `image`'s edges as fitQuad() does; nullopt when the
+// refined sides no longer make a convex quadrilateral with sides of at least `min_side`.
+std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const cv::Mat& image,
+                               const QuadFitParams& params);
+
 }  // namespace arbci::vision

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -47,10 +49,12 @@ int TileThresholds::median() const {
 
 namespace {
 
-// Pixel 4t + k lies between tile centres (4t + 1.5 is tile t's): k = 0, 1 towards tile t - 1,
-// k = 2, 3 towards tile t + 1, with these weights in eighths for the nearer and farther tile.
-constexpr int kNear[4] = {5, 7, 7, 5};
-constexpr int kFar[4] = {3, 1, 1, 3};
+// Pixel k of a tile of `tile` px lies between its centre and the next tile's: k below the middle
+// towards tile t - 1, above it towards tile t + 1; the farther tile's weight in eighths (the
+// nearer one's is 8 minus it). 4 px tiles: 3, 1, 1, 3; 2 px tiles: 2, 2.
+constexpr int farWeight(int k, int tile) {
+  return std::abs(2 * k + 1 - tile) * 4 / tile;
+}
 
 // out = (w_near * near + w_far * far + 4) / 8, with w_near + w_far = 8.
 void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restrict far, int w_near,
@@ -82,8 +86,24 @@ void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restri
 
 }  // namespace
 
+namespace {
+
+// Each tile row expanded along x: out[tile * t + k] between tile t and its neighbour.
+template <int kTileSize>
+void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restrict out) {
+  for (int t = 0; t < cols; ++t) {
+    const int left = v[t > 0 ? t - 1 : 0], here = v[t], right = v[t + 1 < cols ? t + 1 : t];
+    for (int k = 0; k < kTileSize; ++k) {
+      const int far = farWeight(k, kTileSize), other = 2 * k < kTileSize ? left : right;
+      out[kTileSize * t + k] = static_cast<std::uint8_t>(((8 - far) * here + far * other + 4) >> 3);
+    }
+  }
+}
+
+}  // namespace
+
 void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits) {
-  const int tile = TileThresholds::kTile, cols = tiles.cols, rows = tiles.rows;
+  const int tile = tiles.tile, cols = tiles.cols, rows = tiles.rows;
   const int wide = cols * tile;
   // Each tile row expanded along x first, then rows blended along y (own code rather than
   // cv::resize, which would hand this small job to OpenCV's thread pool).
@@ -92,27 +112,26 @@ void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& lim
   for (int ty = 0; ty < rows; ++ty) {
     const std::uint8_t* v = &tiles.limit[static_cast<size_t>(ty) * cols];
     std::uint8_t* out = &expanded[static_cast<size_t>(ty) * wide];
-    for (int t = 0; t < cols; ++t) {
-      const int left = v[std::max(0, t - 1)], here = v[t], right = v[std::min(cols - 1, t + 1)];
-      out[4 * t + 0] = static_cast<std::uint8_t>((kNear[0] * here + kFar[0] * left + 4) >> 3);
-      out[4 * t + 1] = static_cast<std::uint8_t>((kNear[1] * here + kFar[1] * left + 4) >> 3);
-      out[4 * t + 2] = static_cast<std::uint8_t>((kNear[2] * here + kFar[2] * right + 4) >> 3);
-      out[4 * t + 3] = static_cast<std::uint8_t>((kNear[3] * here + kFar[3] * right + 4) >> 3);
+    if (tile == 2) {
+      expandRow<2>(v, cols, out);
+    } else {
+      expandRow<TileThresholds::kTile>(v, cols, out);
     }
   }
   limits.create(image, CV_8UC1);
   for (int y = 0; y < image.height; ++y) {
-    const int t = y / tile, k = y % tile;
-    const int other = k < 2 ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
+    const int t = y / tile, k = y % tile, far = farWeight(k, tile);
+    const int other = 2 * k < tile ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
     blendRows(&expanded[static_cast<size_t>(t) * wide],
-              &expanded[static_cast<size_t>(other) * wide], kNear[k], kFar[k],
+              &expanded[static_cast<size_t>(other) * wide], 8 - far, far,
               limits.ptr<std::uint8_t>(y), image.width);
   }
 }
 
 void fillGlobalThresholds(cv::Size image, int threshold,
-                          const std::optional<Vignetting>& vignetting, TileThresholds& out) {
-  const int tile = TileThresholds::kTile;
+                          const std::optional<Vignetting>& vignetting, TileThresholds& out,
+                          int tile) {
+  out.tile = tile;
   out.cols = (image.width + tile - 1) / tile;
   out.rows = (image.height + tile - 1) / tile;
   out.limit.assign(static_cast<size_t>(out.cols) * out.rows, limitOf(threshold));
@@ -172,6 +191,15 @@ void reduce4(const std::uint8_t* __restrict in, std::uint8_t* __restrict out, in
   }
 }
 
+// out[t] = op over in[2t .. 2t + 1].
+template <bool kMax>
+void reduce2(const std::uint8_t* __restrict in, std::uint8_t* __restrict out, int n) {
+  for (int t = 0; t < n; ++t) {
+    const std::uint8_t* p = in + 2 * t;
+    out[t] = kMax ? maximum(p[0], p[1]) : minimum(p[0], p[1]);
+  }
+}
+
 template <bool kMax>
 void accumulate(const std::uint8_t* __restrict row, std::uint8_t* __restrict into, int n) {
   for (int x = 0; x < n; ++x) into[x] = kMax ? maximum(into[x], row[x]) : minimum(into[x], row[x]);
@@ -179,8 +207,13 @@ void accumulate(const std::uint8_t* __restrict row, std::uint8_t* __restrict int
 
 }  // namespace
 
-void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out) {
-  const int width = smoothed.cols, height = smoothed.rows, tile = TileThresholds::kTile;
+void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out,
+                               int tile) {
+  const int width = smoothed.cols, height = smoothed.rows;
+  if (tile != 2 && tile != TileThresholds::kTile)
+    throw std::invalid_argument("adaptive threshold: tiles of 2 or 4 px, not " +
+                                std::to_string(tile));
+  tile_ = tile;
   // Level 0: minimum and maximum of each 4x4 tile.
   MinMaxGrid& base = raw_[0];
   base.resize((width + tile - 1) / tile, (height + tile - 1) / tile);
@@ -200,8 +233,13 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
       lo[x] = lo[width - 1];
       hi[x] = hi[width - 1];
     }
-    reduce4<false>(lo, &base.lo[static_cast<size_t>(ty) * base.cols], base.cols);
-    reduce4<true>(hi, &base.hi[static_cast<size_t>(ty) * base.cols], base.cols);
+    if (tile == 2) {
+      reduce2<false>(lo, &base.lo[static_cast<size_t>(ty) * base.cols], base.cols);
+      reduce2<true>(hi, &base.hi[static_cast<size_t>(ty) * base.cols], base.cols);
+    } else {
+      reduce4<false>(lo, &base.lo[static_cast<size_t>(ty) * base.cols], base.cols);
+      reduce4<true>(hi, &base.hi[static_cast<size_t>(ty) * base.cols], base.cols);
+    }
   }
   // Coarser levels: 2x2 reductions.
   for (int level = 1; level < kLevels; ++level) {
@@ -271,6 +309,7 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
     }
   }
   contrast_ = contrast;
+  out.tile = tile;
   out.cols = base.cols;
   out.rows = base.rows;
   out.limit.assign(static_cast<size_t>(out.cols) * out.rows, 0);
@@ -314,7 +353,7 @@ std::uint8_t AdaptiveThresholder::tileLimit(int tx, int ty, int split) const {
 }
 
 void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) const {
-  const int tile = TileThresholds::kTile, cols = dilated_[0].cols, rows = dilated_[0].rows;
+  const int tile = tile_, cols = dilated_[0].cols, rows = dilated_[0].rows;
   // Tiles around the region (one more on each side for interpolation), resized exactly as the
   // whole grid would be, then cropped.
   const int tx0 = std::max(0, roi.x / tile - 1), ty0 = std::max(0, roi.y / tile - 1);
@@ -326,6 +365,7 @@ void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) co
       grid.at<std::uint8_t>(ty - ty0, tx - tx0) = tileLimit(tx, ty, split);
   }
   TileThresholds part;
+  part.tile = tile;
   part.cols = grid.cols;
   part.rows = grid.rows;
   part.limit.assign(grid.datastart, grid.dataend);

@@ -1,4 +1,5 @@
-// Private: a threshold per 4x4-pixel tile. Global modes fill it with one value (plus the
+// Private: a threshold per 4x4-pixel tile (2x2 on a frame averaged over 2x2 pixels, so that a
+// tile always covers 4x4 of the frame's pixels). Global modes fill it with one value (plus the
 // vignetting offsets); the adaptive mode takes the midrange of the tile's 12 px neighbourhood
 // where it has contrast above the noise, and makes flat tiles wholly dark or light against the
 // nearest coarser neighbourhood (up to 192 px) that has contrast.
@@ -16,7 +17,8 @@
 namespace arbci::vision {
 
 struct TileThresholds {
-  static constexpr int kTile = 4;
+  static constexpr int kTile = 4;  // at full resolution
+  int tile = kTile;                // px of the image thresholded: kTile, or 2 on a halved frame
   int cols = 0;
   int rows = 0;
   // A pixel is dark when its value is below the tile's limit (threshold + 1; 0 = never dark).
@@ -31,14 +33,19 @@ struct TileThresholds {
 // tile centres, so that the threshold surface has no steps at tile borders.
 void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits);
 
+// `tile`: TileThresholds::kTile, or 2 on a frame averaged over 2x2 pixels.
 void fillGlobalThresholds(cv::Size image, int threshold,
-                          const std::optional<Vignetting>& vignetting, TileThresholds& out);
+                          const std::optional<Vignetting>& vignetting, TileThresholds& out,
+                          int tile = TileThresholds::kTile);
 
 // Computes adaptive tile thresholds; keeps its pyramids between frames to avoid allocation.
 class AdaptiveThresholder {
  public:
-  // `min_contrast` in grey levels of `smoothed`.
-  void fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out);
+  // `min_contrast` in grey levels of `smoothed`; `tile`: TileThresholds::kTile, or 2 when
+  // `smoothed` is a frame averaged over 2x2 pixels (the neighbourhoods keep their size in the
+  // frame's pixels: with 4 px tiles there, a marker's quiet zone would be as narrow as one).
+  void fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out,
+            int tile = TileThresholds::kTile);
   // After fill(): the per-pixel limits of `roi` with edge tiles split at `split` sixteenths of
   // their range instead of the usual kSplit (a darker split closes borders thinned by blur).
   void roiLimits(cv::Rect roi, int split, cv::Mat& limits) const;
@@ -55,8 +62,9 @@ class AdaptiveThresholder {
   };
   std::uint8_t tileLimit(int tx, int ty, int split) const;
 
-  static constexpr int kLevels = 5;  // tiles of 4, 8, 16, 32 and 64 px
+  static constexpr int kLevels = 5;  // tiles of 4, 8, 16, 32 and 64 px of the frame
   int contrast_ = 8;
+  int tile_ = TileThresholds::kTile;
   std::array<MinMaxGrid, kLevels> raw_, dilated_;
   MinMaxGrid scratch_;
   std::vector<std::uint8_t> column_lo_, column_hi_;

@@ -32,6 +32,11 @@ struct DetectorConfig {
   // grey levels (sensor noise), and leaves clean frames sharp.
   Smoothing smoothing = Smoothing::Auto;
   float min_side_px = 8;  // smaller squares are ignored
+  // Square kinds: 1 looks for candidates at full resolution; 2 thresholds, labels and fits quads
+  // on the frame averaged over 2x2 pixels (a quarter of the pixels), then moves every side onto
+  // the full-resolution edge, as AprilTag's quad_decimate. About twice as fast; markers need about
+  // 24 px per side (a border of 3 px) to be found.
+  int search_decimate = 1;
   // BCH only: when ARToolKitPlus's hard decoding (at most 2 corrected bits) fails, try Chase
   // decoding on the least reliable cells (recovers blurred markers; see code_decoder.h).
   bool soft_decoding = true;
@@ -65,8 +70,8 @@ class MarkerDetector {
   void setThreshold(const ThresholdSettings& settings);
   // The global threshold the next frame starts from (automatic and constant modes).
   int currentThreshold() const;
-  // Every square outline of the last frame, decoded or not (clockwise on screen), in image and
-  // in ideal coordinates (by index).
+  // The last frame's square outlines, decoded or not (clockwise on screen), in image and in ideal
+  // coordinates (by index); squares inside a decoded marker (its code cells) are left out.
   const std::vector<SquareCorners>& lastSquares() const;
   const std::vector<SquareCorners>& lastIdealSquares() const;
   // The last frame's binary image: 255 where a pixel counted as dark.
