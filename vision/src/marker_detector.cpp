@@ -196,8 +196,7 @@ struct MarkerDetector::Impl {
       int contrast = config.threshold.min_contrast;
       if (contrast <= 0) {
         // Ask for 6 sigma of the noise left in the binarised image (0.375 of it after smoothing).
-        const double sigma =
-            noise_sigma * (binarised == &smoothed ? 0.375 : 1.0) / static_cast<double>(scale);
+        const double sigma = noise_sigma * (searched == &smoothed ? 0.375 : 1.0);
         contrast = std::max(8, static_cast<int>(std::lround(6.0 * sigma)));
       }
       adaptive.fill(*searched, contrast, tiles, TileThresholds::kTile / scale);
@@ -490,19 +489,23 @@ struct MarkerDetector::Impl {
   DetectionResult detectSquares(StageTimes& time) {
     DetectionResult result;
     auto start = Clock::now();
-    // Smoothing suppresses sensor noise but softens small markers further: by default only a
-    // visibly noisy frame is smoothed.
-    const double noise_sigma = estimateNoiseSigma(gray);
-    const bool smooth = config.smoothing == Smoothing::Always ||
-                        (config.smoothing == Smoothing::Auto && noise_sigma >= kSmoothAboveNoise);
     scale = config.search_decimate;
-    // A 2x2 average is itself a smoothing (noise halved): the frame is not smoothed then.
-    if (smooth && scale == 1) smoothBinomial3(gray, smoothed);
-    binarised = smooth && scale == 1 ? &smoothed : &gray;
-    searched = binarised;
+    double noise_sigma = 0.0;  // of the image searched, before any smoothing
     if (scale == 2) {
+      // A 2x2 average is itself a smoothing (white noise halved): the frame is not smoothed.
       halve(gray, half);
+      noise_sigma = estimateNoiseSigma(half);
+      binarised = &gray;
       searched = &half;
+    } else {
+      // Smoothing suppresses sensor noise but softens small markers further: by default only a
+      // visibly noisy frame is smoothed.
+      noise_sigma = estimateNoiseSigma(gray);
+      const bool smooth = config.smoothing == Smoothing::Always ||
+                          (config.smoothing == Smoothing::Auto && noise_sigma >= kSmoothAboveNoise);
+      if (smooth) smoothBinomial3(gray, smoothed);
+      binarised = smooth ? &smoothed : &gray;
+      searched = binarised;
     }
     time.smooth = microseconds(start, Clock::now());
 

@@ -91,7 +91,36 @@ namespace {
 // Each tile row expanded along x: out[tile * t + k] between tile t and its neighbour.
 template <int kTileSize>
 void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restrict out) {
-  for (int t = 0; t < cols; ++t) {
+  int t = 0;
+#ifdef __SSE2__
+  if constexpr (kTileSize == 2) {
+    // out[2t] = (6 v[t] + 2 v[t - 1] + 4) / 8, out[2t + 1] the same towards v[t + 1]; tiles 1 to
+    // cols - 2 here (their neighbours exist), the ends below.
+    const __m128i zero = _mm_setzero_si128(), four = _mm_set1_epi16(4), six = _mm_set1_epi16(6);
+    auto blend = [&](__m128i here, __m128i other) {  // 16-bit lanes
+      return _mm_srli_epi16(
+          _mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(here, six), _mm_slli_epi16(other, 1)), four),
+          3);
+    };
+    out[0] = static_cast<std::uint8_t>((8 * v[0] + 4) >> 3);
+    out[1] = static_cast<std::uint8_t>((6 * v[0] + 2 * v[cols > 1 ? 1 : 0] + 4) >> 3);
+    t = 1;
+    for (; t + 17 <= cols; t += 16) {
+      const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t));
+      const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t - 1));
+      const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t + 1));
+      const __m128i even =
+          _mm_packus_epi16(blend(_mm_unpacklo_epi8(h, zero), _mm_unpacklo_epi8(l, zero)),
+                           blend(_mm_unpackhi_epi8(h, zero), _mm_unpackhi_epi8(l, zero)));
+      const __m128i odd =
+          _mm_packus_epi16(blend(_mm_unpacklo_epi8(h, zero), _mm_unpacklo_epi8(r, zero)),
+                           blend(_mm_unpackhi_epi8(h, zero), _mm_unpackhi_epi8(r, zero)));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * t), _mm_unpacklo_epi8(even, odd));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * t + 16), _mm_unpackhi_epi8(even, odd));
+    }
+  }
+#endif
+  for (; t < cols; ++t) {
     const int left = v[t > 0 ? t - 1 : 0], here = v[t], right = v[t + 1 < cols ? t + 1 : t];
     for (int k = 0; k < kTileSize; ++k) {
       const int far = farWeight(k, kTileSize), other = 2 * k < kTileSize ? left : right;
@@ -194,7 +223,21 @@ void reduce4(const std::uint8_t* __restrict in, std::uint8_t* __restrict out, in
 // out[t] = op over in[2t .. 2t + 1].
 template <bool kMax>
 void reduce2(const std::uint8_t* __restrict in, std::uint8_t* __restrict out, int n) {
-  for (int t = 0; t < n; ++t) {
+  int t = 0;
+#ifdef __SSE2__
+  // In 16-bit lanes: the low byte against the high one, the result in the low byte.
+  const __m128i low_bytes = _mm_set1_epi16(0x00FF);
+  auto pairs = [&](__m128i v) {
+    const __m128i shifted = _mm_srli_epi16(v, 8);
+    return _mm_and_si128(kMax ? _mm_max_epu8(v, shifted) : _mm_min_epu8(v, shifted), low_bytes);
+  };
+  for (; t + 16 <= n; t += 16) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 2 * t));
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 2 * t + 16));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + t), _mm_packus_epi16(pairs(a), pairs(b)));
+  }
+#endif
+  for (; t < n; ++t) {
     const std::uint8_t* p = in + 2 * t;
     out[t] = kMax ? maximum(p[0], p[1]) : minimum(p[0], p[1]);
   }
@@ -203,6 +246,87 @@ void reduce2(const std::uint8_t* __restrict in, std::uint8_t* __restrict out, in
 template <bool kMax>
 void accumulate(const std::uint8_t* __restrict row, std::uint8_t* __restrict into, int n) {
   for (int x = 0; x < n; ++x) into[x] = kMax ? maximum(into[x], row[x]) : minimum(into[x], row[x]);
+}
+
+}  // namespace
+
+namespace {
+
+// One row of tiles' neighbourhoods, and their parents' (a parent per two tiles).
+struct TileRow {
+  const std::uint8_t* lo;      // the 12 px neighbourhood's minimum
+  const std::uint8_t* hi;      // and maximum
+  const std::uint8_t* own_lo;  // the tile's own
+  const std::uint8_t* own_hi;
+  const std::uint8_t* parent;  // the parent's "dark below" level + 1, or 0
+  const std::uint8_t* parent_lo;
+  const std::uint8_t* parent_hi;
+};
+
+// AdaptiveThresholder::tileLimit() at the usual split for a row of tiles, branch-free, through
+// restrict-qualified copies of the row pointers (this loop runs over every tile).
+void limitsOfRow(const TileRow& row, int contrast, int cols, std::uint8_t* __restrict limit) {
+  const std::uint8_t* __restrict lo0 = row.lo;
+  const std::uint8_t* __restrict hi0 = row.hi;
+  const std::uint8_t* __restrict own_lo = row.own_lo;
+  const std::uint8_t* __restrict own_hi = row.own_hi;
+  const std::uint8_t* __restrict parent = row.parent;
+  const std::uint8_t* __restrict lo1 = row.parent_lo;
+  const std::uint8_t* __restrict hi1 = row.parent_hi;
+  int tx = 0;
+#ifdef __SSE2__
+  // Sixteen tiles at a time, in 16-bit lanes; each parent byte serves two tiles.
+  const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi16(1), byte = _mm_set1_epi16(255);
+  const __m128i floor = _mm_set1_epi16(static_cast<short>(contrast - 1));
+  auto load16 = [](const std::uint8_t* p) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+  };
+  auto twice8 = [](const std::uint8_t* p) {  // p[0], p[0], p[1], p[1], ... p[7], p[7]
+    const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
+    return _mm_unpacklo_epi8(v, v);
+  };
+  auto limits8 = [&](__m128i lo, __m128i hi, __m128i own_sum, __m128i above, __m128i above_range) {
+    const __m128i range = _mm_sub_epi16(hi, lo);
+    const __m128i weak =
+        _mm_cmpgt_epi16(above_range, _mm_add_epi16(range, _mm_slli_epi16(range, 1)));
+    const __m128i has_parent = _mm_cmpgt_epi16(above, zero);
+    const __m128i edge =
+        _mm_andnot_si128(_mm_and_si128(weak, has_parent), _mm_cmpgt_epi16(range, floor));
+    const __m128i split = _mm_srli_epi16(_mm_sub_epi16(_mm_slli_epi16(range, 3), range),
+                                         4);  // range * 7 / 16 (kSplit)
+    const __m128i edge_limit = _mm_min_epi16(_mm_add_epi16(_mm_add_epi16(lo, split), one), byte);
+    const __m128i flat = _mm_and_si128(
+        _mm_and_si128(has_parent, _mm_cmpgt_epi16(above, _mm_srli_epi16(own_sum, 1))), byte);
+    return _mm_or_si128(_mm_and_si128(edge, edge_limit), _mm_andnot_si128(edge, flat));
+  };
+  static_assert(AdaptiveThresholder::kSplit == 7, "the SIMD split computes range * 7 / 16");
+  for (; tx + 16 <= cols; tx += 16) {
+    const __m128i lo = load16(lo0 + tx), hi = load16(hi0 + tx);
+    const __m128i a = load16(own_lo + tx), b = load16(own_hi + tx);
+    const __m128i above = twice8(parent + tx / 2);
+    const __m128i above_lo = twice8(lo1 + tx / 2), above_hi = twice8(hi1 + tx / 2);
+    const __m128i low = limits8(
+        _mm_unpacklo_epi8(lo, zero), _mm_unpacklo_epi8(hi, zero),
+        _mm_add_epi16(_mm_unpacklo_epi8(a, zero), _mm_unpacklo_epi8(b, zero)),
+        _mm_unpacklo_epi8(above, zero),
+        _mm_sub_epi16(_mm_unpacklo_epi8(above_hi, zero), _mm_unpacklo_epi8(above_lo, zero)));
+    const __m128i high = limits8(
+        _mm_unpackhi_epi8(lo, zero), _mm_unpackhi_epi8(hi, zero),
+        _mm_add_epi16(_mm_unpackhi_epi8(a, zero), _mm_unpackhi_epi8(b, zero)),
+        _mm_unpackhi_epi8(above, zero),
+        _mm_sub_epi16(_mm_unpackhi_epi8(above_hi, zero), _mm_unpackhi_epi8(above_lo, zero)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(limit + tx), _mm_packus_epi16(low, high));
+  }
+#endif
+  for (; tx < cols; ++tx) {
+    const int p = tx >> 1;
+    const int lo = lo0[tx], range = hi0[tx] - lo, above = parent[p];
+    const bool weak = 3 * range < hi1[p] - lo1[p];
+    const bool edge = range >= contrast && !(weak && above > 0);
+    const int edge_limit = std::min(255, lo + range * AdaptiveThresholder::kSplit / 16 + 1);
+    const int flat_limit = above > 0 && (own_lo[tx] + own_hi[tx]) / 2 < above ? 255 : 0;
+    limit[tx] = static_cast<std::uint8_t>(edge ? edge_limit : flat_limit);
+  }
 }
 
 }  // namespace
@@ -246,18 +370,24 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
     const MinMaxGrid& fine = raw_[level - 1];
     MinMaxGrid& coarse = raw_[level];
     coarse.resize((fine.cols + 1) / 2, (fine.rows + 1) / 2);
+    // Two fine rows into one (an odd last column repeated), then pairs of columns.
+    column_lo_.resize(static_cast<size_t>(2 * coarse.cols));
+    column_hi_.resize(column_lo_.size());
     for (int y = 0; y < coarse.rows; ++y) {
       const size_t r0 = static_cast<size_t>(2 * y) * fine.cols;
       const size_t r1 = static_cast<size_t>(std::min(2 * y + 1, fine.rows - 1)) * fine.cols;
-      std::uint8_t* clo = &coarse.lo[static_cast<size_t>(y) * coarse.cols];
-      std::uint8_t* chi = &coarse.hi[static_cast<size_t>(y) * coarse.cols];
-      for (int x = 0; x < coarse.cols; ++x) {
-        const int x0 = 2 * x, x1 = std::min(2 * x + 1, fine.cols - 1);
-        clo[x] = minimum(minimum(fine.lo[r0 + x0], fine.lo[r0 + x1]),
-                         minimum(fine.lo[r1 + x0], fine.lo[r1 + x1]));
-        chi[x] = maximum(maximum(fine.hi[r0 + x0], fine.hi[r0 + x1]),
-                         maximum(fine.hi[r1 + x0], fine.hi[r1 + x1]));
+      std::copy_n(&fine.lo[r0], fine.cols, column_lo_.begin());
+      std::copy_n(&fine.hi[r0], fine.cols, column_hi_.begin());
+      accumulate<false>(&fine.lo[r1], column_lo_.data(), fine.cols);
+      accumulate<true>(&fine.hi[r1], column_hi_.data(), fine.cols);
+      if (fine.cols % 2) {
+        column_lo_[fine.cols] = column_lo_[fine.cols - 1];
+        column_hi_[fine.cols] = column_hi_[fine.cols - 1];
       }
+      reduce2<false>(column_lo_.data(), &coarse.lo[static_cast<size_t>(y) * coarse.cols],
+                     coarse.cols);
+      reduce2<true>(column_hi_.data(), &coarse.hi[static_cast<size_t>(y) * coarse.cols],
+                    coarse.cols);
     }
   }
   // 3x3 neighbourhoods, separably: along rows into scratch, then down columns.
@@ -312,27 +442,15 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
   out.tile = tile;
   out.cols = base.cols;
   out.rows = base.rows;
-  out.limit.assign(static_cast<size_t>(out.cols) * out.rows, 0);
-  // tileLimit() for every tile, row by row (kept inline: this loop runs over every tile).
+  out.limit.resize(static_cast<size_t>(out.cols) * out.rows);
+  // tileLimit() for every tile, row by row.
   const int parent_cols = dilated_[1].cols;
   for (int ty = 0; ty < out.rows; ++ty) {
-    const std::uint8_t* coarse = &coarse_[1][static_cast<size_t>(ty / 2) * parent_cols];
-    const std::uint8_t* lo1 = &dilated_[1].lo[static_cast<size_t>(ty / 2) * parent_cols];
-    const std::uint8_t* hi1 = &dilated_[1].hi[static_cast<size_t>(ty / 2) * parent_cols];
-    const std::uint8_t* lo0 = &dilated_[0].lo[static_cast<size_t>(ty) * out.cols];
-    const std::uint8_t* hi0 = &dilated_[0].hi[static_cast<size_t>(ty) * out.cols];
-    const std::uint8_t* own_lo = &base.lo[static_cast<size_t>(ty) * out.cols];
-    const std::uint8_t* own_hi = &base.hi[static_cast<size_t>(ty) * out.cols];
-    std::uint8_t* limit = &out.limit[static_cast<size_t>(ty) * out.cols];
-    for (int tx = 0; tx < out.cols; ++tx) {
-      const int lo = lo0[tx], hi = hi0[tx], parent = coarse[tx / 2];
-      const bool weak = 3 * (hi - lo) < hi1[tx / 2] - lo1[tx / 2];
-      if (hi - lo >= contrast && !(weak && parent > 0)) {
-        limit[tx] = limitOf(lo + (hi - lo) * kSplit / 16);
-      } else if (parent > 0) {
-        limit[tx] = (own_lo[tx] + own_hi[tx]) / 2 < parent ? 255 : 0;
-      }
-    }
+    const size_t row = static_cast<size_t>(ty) * out.cols;
+    const size_t parent_row = static_cast<size_t>(ty / 2) * parent_cols;
+    limitsOfRow({&dilated_[0].lo[row], &dilated_[0].hi[row], &base.lo[row], &base.hi[row],
+                 &coarse_[1][parent_row], &dilated_[1].lo[parent_row], &dilated_[1].hi[parent_row]},
+                contrast, out.cols, &out.limit[row]);
   }
 }
 
