@@ -47,6 +47,8 @@ void addStages(vision::StageTimes& sum, const vision::StageTimes& t) {
   sum.threshold += t.threshold;
   sum.label += t.label;
   sum.quads += t.quads;
+  sum.retry += t.retry;
+  sum.refine += t.refine;
   sum.decode += t.decode;
   sum.total += t.total;
 }
@@ -173,17 +175,21 @@ int main(int argc, char** argv) {
       }
     }
     for (size_t d = 0; d < ours; ++d) {
-      std::printf("\n%s: time per stage, %dx%d (us per frame)\n%-13s %7s %7s %9s %7s %7s %7s %7s\n",
-                  detectors[d]->name().c_str(), size.width, size.height, "condition", "smooth",
-                  "thresh", "label", "quads", "decode", "other", "total");
+      std::printf(
+          "\n%s: time per stage, %dx%d (us per frame)\n%-13s %7s %7s %7s %7s %7s %7s %7s %7s "
+          "%7s\n",
+          detectors[d]->name().c_str(), size.width, size.height, "condition", "smooth", "thresh",
+          "label", "quads", "retry", "refine", "decode", "other", "total");
       for (size_t c = 0; c < conditions.size(); ++c) {
         const Cell& cell = cells[{static_cast<int>(d), static_cast<int>(c)}];
         const vision::StageTimes& t = cell.stages;
         const double n = cell.frames;
-        const double other = t.total - t.smooth - t.threshold - t.label - t.quads - t.decode;
-        std::printf("%-13s %7.0f %7.0f %9.0f %7.0f %7.0f %7.0f %7.0f\n",
+        const double other =
+            t.total - t.smooth - t.threshold - t.label - t.quads - t.retry - t.refine - t.decode;
+        std::printf("%-13s %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f\n",
                     test::toString(conditions[c]).c_str(), t.smooth / n, t.threshold / n,
-                    t.label / n, t.quads / n, t.decode / n, other / n, t.total / n);
+                    t.label / n, t.quads / n, t.retry / n, t.refine / n, t.decode / n, other / n,
+                    t.total / n);
       }
     }
     if (by_side) {

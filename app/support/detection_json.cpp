@@ -28,7 +28,7 @@ nlohmann::json stageTimesJson(const vision::StageTimes& t) {
   auto us = [](double value) { return rounded(value, 10); };
   return {{"total", us(t.total)},         {"convert", us(t.convert)}, {"smooth", us(t.smooth)},
           {"threshold", us(t.threshold)}, {"label", us(t.label)},     {"quads", us(t.quads)},
-          {"decode", us(t.decode)}};
+          {"retry", us(t.retry)},         {"refine", us(t.refine)},   {"decode", us(t.decode)}};
 }
 
 }  // namespace arbci::app

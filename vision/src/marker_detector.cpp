@@ -254,9 +254,11 @@ struct MarkerDetector::Impl {
       const size_t near_miss_count = retries.size();
       groupFragments(min_side);
       keepLargest(retries, near_miss_count + kMaxFragmentRetries);
+      const auto retry_start = Clock::now();
       retryNearMisses(params);
+      time.retry += microseconds(retry_start, Clock::now());
     }
-    time.quads += microseconds(start, Clock::now());
+    time.quads += microseconds(start, Clock::now()) - time.retry;
   }
 
   // Keeps the `count` largest regions from the first one not yet capped on: noise leaves many
@@ -381,6 +383,8 @@ struct MarkerDetector::Impl {
 
   // A reduced image's quad in frame pixels (a reduced pixel's centre is the middle of the frame
   // pixels it averages), its sides moved onto the frame's edges, through the lens.
+  // A reduced image's quad in frame pixels (a reduced pixel's centre is the middle of the frame
+  // pixels it averages), its sides moved onto the frame's edges, through the lens.
   std::optional<Quad> onFrame(const Quad& coarse) const {
     QuadFitParams params;
     params.min_side = config.min_side_px;
@@ -466,7 +470,7 @@ struct MarkerDetector::Impl {
     }
     quads.swap(frame_quads);
     time.decode += microseconds(start, Clock::now()) - refining;
-    time.quads += refining;
+    time.refine += refining;
   }
 
   // A square inside a larger decoded marker (e.g. a block of code cells) is not a marker.

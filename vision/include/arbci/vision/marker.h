@@ -34,8 +34,11 @@ struct MarkerDetection {
 };
 
 // Microseconds spent in each stage of one frame.
+// Microseconds per stage: quads is the quad search on the image searched, retry the re-binarised
+// near misses and fragments, refine the decimated search's quads moved onto the frame's edges.
 struct StageTimes {
-  double convert = 0, smooth = 0, threshold = 0, label = 0, quads = 0, decode = 0, total = 0;
+  double convert = 0, smooth = 0, threshold = 0, label = 0, quads = 0, retry = 0, refine = 0,
+         decode = 0, total = 0;
 };
 
 struct DetectionResult {
