@@ -167,6 +167,12 @@ int main(int argc, char** argv) {
   cli.add_option("--beta", smoothing.beta, "One-Euro cutoff increase per px/s")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
+  int decimate = 1;
+  cli.add_option("--decimate", decimate,
+                 "the tracker's search_decimate for the pose table: 1 full resolution, 2 the "
+                 "frame averaged over 2x2 pixels")
+      ->check(CLI::IsMember({1, 2}))
+      ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
 
   const cv::Size size(640, 480);
@@ -186,10 +192,12 @@ int main(int argc, char** argv) {
       "Head-motion sequence: %.0f s at %.0f fps, exposure %.0f ms, head yaw +-%.1f deg (pitch "
       "0.6 of it), peak image speed %.0f px/s (%.1f px of blur per exposure); %.0f mm marker at "
       "%.2f m, 640x480, f = 560 px, noise sigma %.1f.\n"
-      "Smoothing: One-Euro, min cutoff %.2f Hz, beta %.2f. Errors exclude flips (rotation error "
-      "> %.0f deg), which are counted; jitter is the RMS frame-to-frame change of the error.\n\n",
+      "Tracker search_decimate %d. Smoothing: One-Euro, min cutoff %.2f Hz, beta %.2f. Errors "
+      "exclude flips (rotation error > %.0f deg), which are counted; jitter is the RMS "
+      "frame-to-frame change of the error.\n\n",
       seconds, fps, exposure_ms, head_deg, peak_px_per_s, peak_px_per_s * exposure_ms / 1000.0,
-      kSideM * 1000, kDistanceM, noise, smoothing.min_cutoff_hz, smoothing.beta, kFlipDeg);
+      kSideM * 1000, kDistanceM, noise, decimate, smoothing.min_cutoff_hz, smoothing.beta,
+      kFlipDeg);
   std::printf("%5s %-9s %6s %7s %8s %7s %8s %9s %9s %6s %8s\n", "tilt", "corners", "found",
               "pos mm", "pos p95", "rot deg", "rot p95", "jitter mm", "jitter deg", "flips",
               "lag ms");
@@ -221,7 +229,9 @@ int main(int argc, char** argv) {
   };
   for (const double tilt : tilts) {
     const vision::Pose at_rest = restingPose(tilt);
-    vision::MarkerDetector detector(vision::DetectorConfig{});
+    vision::DetectorConfig config;
+    config.search_decimate = decimate;
+    vision::MarkerDetector detector(config);
     vision::MarkerTracker raw_tracker, smooth_tracker(smoothing);
     vision::MarkerPoses raw_poses(k), smooth_poses(k);
     Stats raw, smooth;

@@ -230,9 +230,10 @@ void parse(const Json& json, const std::string& file, SessionConfig& c, bool def
   c.mirror_monitor = hmd.integer("mirror_monitor", c.mirror_monitor, -1, 15);
   parseCameras(root.section("cameras"), c.cameras);
   const Section tracker = root.section("tracker");
-  tracker.known({"kind", "border", "max_pose_age_s"});
+  tracker.known({"kind", "border", "search_decimate", "max_pose_age_s"});
   c.tracker_kind = tracker.text("kind", c.tracker_kind, {"bch", "simple"});
   c.tracker_border = tracker.number("border", c.tracker_border, 0.05, 0.4);
+  c.tracker_search_decimate = tracker.integer("search_decimate", c.tracker_search_decimate, 1, 2);
   c.max_pose_age_s = tracker.number("max_pose_age_s", c.max_pose_age_s, 0.05, 10.0);
   const Section world_section = root.section("world");
   parseWorld(world_section, file, c.world);

@@ -144,6 +144,9 @@ struct SessionConfig {
   CameraSettings cameras;
   std::string tracker_kind = "bch";
   double tracker_border = 0.125;
+  // 1: markers are searched at full resolution; 2: on the frame averaged over 2x2 pixels, corners
+  // refined at full resolution (faster; markers need about 24 px per side; docs/tracker.md).
+  int tracker_search_decimate = 1;
   // A pose older than this is stale: its object is not flashed, offered or grasped, and the
   // panels say "tracking lost" (also for the reference marker).
   double max_pose_age_s = 0.5;

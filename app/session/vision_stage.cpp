@@ -14,6 +14,7 @@ vision::DetectorConfig detectorFor(const TrackingSettings& settings,
   vision::DetectorConfig d;
   d.kind = settings.kind;
   d.border = settings.border;
+  d.search_decimate = settings.search_decimate;
   if (!camera.distortion.empty())
     d.lens = std::make_shared<vision::Undistorter>(camera, vision::UndistortMode::LookupTable);
   return d;
@@ -32,6 +33,7 @@ vision::ReferenceMarker referenceOf(const TrackingSettings& settings) {
 TrackingSettings TrackingSettings::of(const SessionConfig& config) {
   TrackingSettings t{vision::markerKindFromString(config.tracker_kind),
                      config.tracker_border,
+                     config.tracker_search_decimate,
                      config.world.reference_id,
                      config.world.reference_size_m,
                      config.world.reference_position,

@@ -20,7 +20,8 @@ namespace arbci::app {
 // What tracking needs of the session file, and nothing else.
 struct TrackingSettings {
   vision::MarkerKind kind;
-  double border;  // of the markers' black square, as a fraction of its side
+  double border;        // of the markers' black square, as a fraction of its side
+  int search_decimate;  // vision::DetectorConfig::search_decimate
   int reference_id;
   double reference_size_m;
   cv::Vec3d reference_position;       // robot frame

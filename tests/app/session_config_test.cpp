@@ -100,6 +100,15 @@ TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
   EXPECT_NE(source.find("simulated"), std::string::npos) << source;
 }
 
+TEST(SessionConfig, TheTrackerSearchesAtFullOrHalfResolution) {
+  EXPECT_EQ(SessionConfig::load(sessionFile("decimate", R"({"tracker": {"search_decimate": 2}})"))
+                .tracker_search_decimate,
+            2);
+  const std::string refused = errorOf(R"({"tracker": {"search_decimate": 4}})");
+  EXPECT_NE(refused.find("tracker.search_decimate = 4"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("[1, 2]"), std::string::npos) << refused;
+}
+
 // The ErrP classifier takes the whole montage by default (its xDAWN filter finds the response),
 // a list of channels picks those the montage has, and a list with none of them is refused.
 TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
