@@ -5,6 +5,7 @@
 
 #include <numbers>
 #include <random>
+#include <tuple>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -52,7 +53,7 @@ struct Lens {
 };
 
 std::optional<Errors> measure(const CameraModel& camera, const Pose& truth, PoseMethod method,
-                              const std::optional<Lens>& lens = std::nullopt) {
+                              const std::optional<Lens>& lens = std::nullopt, int decimate = 1) {
   cv::Mat frame(camera.image_size, CV_8UC1, cv::Scalar(190));
   test::drawPosedMarker(frame, camera.camera_matrix, truth, 0.05, test::MarkerFamily::ArbciBch,
                         321);
@@ -61,6 +62,7 @@ std::optional<Errors> measure(const CameraModel& camera, const Pose& truth, Pose
     frame = (*lens->camera)(frame);
     config.lens = lens->undistorter;
   }
+  config.search_decimate = decimate;
   MarkerDetector detector(config);
   const auto markers = detector.detect(frame).markers;
   if (markers.size() != 1 || markers[0].id != 321) return std::nullopt;
@@ -83,10 +85,15 @@ Pose randomPose(std::mt19937& random, double min_tilt, double max_tilt) {
   return {r, direction / cv::norm(direction) * distance};
 }
 
-class PoseAccuracy : public testing::TestWithParam<bool> {};
+// (distorting lens, the tracker's search_decimate): the decimated search finds its quads without
+// the lens and refines them through it on the frame. Its corners on the thinnest marker here
+// (52 x 10 px at 0.83 m, pinhole) are up to 0.42 px off, and its position 0.79 % (the full
+// search: 0.44 px, 0.43 %; 3 px and a flipped pose before thin quads were refined on the halved
+// frame first), so it is held to 1 %.
+class PoseAccuracy : public testing::TestWithParam<std::tuple<bool, int>> {};
 
 TEST_P(PoseAccuracy, RppWithinHalfAPercentAndHalfADegreeAt30To60DegreesTilt) {
-  const bool distorting = GetParam();
+  const auto [distorting, decimate] = GetParam();
   const CameraModel camera = hmdCamera(
       distorting ? std::vector<double>{-0.12, 0.04, 0.0005, -0.0004, 0.0} : std::vector<double>{});
   std::optional<Lens> lens;
@@ -98,18 +105,22 @@ TEST_P(PoseAccuracy, RppWithinHalfAPercentAndHalfADegreeAt30To60DegreesTilt) {
   int measured = 0;
   for (int trial = 0; trial < 25; ++trial) {
     const Pose truth = randomPose(random, 30.0, 60.0);
-    const auto errors = measure(camera, truth, PoseMethod::Rpp, lens);
+    const auto errors = measure(camera, truth, PoseMethod::Rpp, lens, decimate);
     ASSERT_TRUE(errors.has_value()) << "marker not found at " << truth.translation;
-    EXPECT_LT(errors->position_fraction, 0.005) << "at " << truth.translation;
+    EXPECT_LT(errors->position_fraction, decimate == 1 ? 0.005 : 0.01)
+        << "at " << truth.translation;
     EXPECT_LT(errors->rotation_deg, 0.5) << "at " << truth.translation;
     ++measured;
   }
   EXPECT_EQ(measured, 25);
 }
 
-INSTANTIATE_TEST_SUITE_P(Lens, PoseAccuracy, testing::Values(false, true), [](const auto& info) {
-  return info.param ? std::string("distorting") : std::string("pinhole");
-});
+INSTANTIATE_TEST_SUITE_P(Lens, PoseAccuracy,
+                         testing::Combine(testing::Values(false, true), testing::Values(1, 2)),
+                         [](const auto& info) {
+                           return std::string(std::get<0>(info.param) ? "distorting" : "pinhole") +
+                                  (std::get<1>(info.param) == 2 ? "_decimated" : "");
+                         });
 
 TEST(PoseAccuracy, PositionWithinHalfAPercentAtAnyTiltForEveryMethod) {
   const CameraModel camera = hmdCamera();

@@ -40,6 +40,9 @@ constexpr int kFragmentGap = 4;            // px: failed components this close a
 // washed to mid-grey across its direction.
 constexpr int kThinnedSplit = 9;
 constexpr int kFragmentedSplit = 11;
+// Reduced-image px: a quad narrower than this (its area over its longest side) is refined on the
+// reduced image before the frame.
+constexpr float kThinQuadWidth = 8.0f;
 
 struct RetryRegion {
   cv::Rect box;
@@ -382,16 +385,26 @@ struct MarkerDetector::Impl {
   }
 
   // A reduced image's quad in frame pixels (a reduced pixel's centre is the middle of the frame
-  // pixels it averages), its sides moved onto the frame's edges, through the lens.
-  // A reduced image's quad in frame pixels (a reduced pixel's centre is the middle of the frame
-  // pixels it averages), its sides moved onto the frame's edges, through the lens.
+  // pixels it averages), its sides moved onto the frame's edges, through the lens. A thin quad
+  // (a steeply tilted marker) is first moved onto the reduced image's edges: from its contour's
+  // lines alone the frame's edges can be out of reach (one such marker's corner came out 3 px
+  // off and its pose flipped).
   std::optional<Quad> onFrame(const Quad& coarse) const {
     QuadFitParams params;
+    Quad start = coarse;
+    float longest = 0.0f;
+    for (int k = 0; k < 4; ++k)
+      longest = std::max(
+          longest, static_cast<float>(cv::norm(coarse.corners[(k + 1) % 4] - coarse.corners[k])));
+    if (quadArea(coarse.corners) < kThinQuadWidth * longest) {
+      params.min_side = 1.0f;
+      if (const auto refined = refineQuad(coarse.corners, *searched, params)) start = *refined;
+    }
     params.min_side = config.min_side_px;
     params.lens = config.lens.get();
     const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
     std::array<cv::Point2f, 4> corners;
-    for (int k = 0; k < 4; ++k) corners[k] = coarse.corners[k] * s + cv::Point2f(shift, shift);
+    for (int k = 0; k < 4; ++k) corners[k] = start.corners[k] * s + cv::Point2f(shift, shift);
     return refineQuad(corners, *binarised, params);
   }
 
