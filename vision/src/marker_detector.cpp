@@ -248,7 +248,8 @@ struct MarkerDetector::Impl {
         quads.push_back(*fit.quad);
       } else if (adaptive_mode && std::max(w, h) <= max_retry_side) {
         failed.emplace_back(c.min_x, c.min_y, w, h);
-        if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f)
+        if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f &&
+            everySideHasDark(fit.hull_corners))
           retries.push_back({failed.back(), false});
       }
     }
@@ -262,6 +263,27 @@ struct MarkerDetector::Impl {
       time.retry += microseconds(retry_start, Clock::now());
     }
     time.quads += microseconds(start, Clock::now()) - time.retry;
+  }
+
+  // A broken or dented marker border still runs along every side of its hull; a letter or an
+  // open shape (an A's foot line, a C's mouth) leaves a side with no dark pixel at all. Looked
+  // for a pixel inside each side's chord, at ten points.
+  bool everySideHasDark(const std::array<cv::Point, 4>& hull) const {
+    const cv::Point2f middle = (cv::Point2f(hull[0]) + cv::Point2f(hull[1]) + cv::Point2f(hull[2]) +
+                                cv::Point2f(hull[3])) *
+                               0.25f;
+    for (int k = 0; k < 4; ++k) {
+      const cv::Point2f a(hull[k]), b(hull[(k + 1) % 4]);
+      bool dark = false;
+      for (int j = 1; j <= 10 && !dark; ++j) {
+        const cv::Point2f p = a + (b - a) * (static_cast<float>(j) / 11.0f);
+        const cv::Point2f inward = middle - p;
+        const cv::Point2f q = p + inward / std::max(1.0f, std::sqrt(inward.dot(inward)));
+        dark = labels.dark(static_cast<int>(std::lround(q.x)), static_cast<int>(std::lround(q.y)));
+      }
+      if (!dark) return false;
+    }
+    return true;
   }
 
   // Keeps the `count` largest regions from the first one not yet capped on: noise leaves many
@@ -389,6 +411,13 @@ struct MarkerDetector::Impl {
   // (a steeply tilted marker) is first moved onto the reduced image's edges: from its contour's
   // lines alone the frame's edges can be out of reach (one such marker's corner came out 3 px
   // off and its pose flipped).
+  std::array<cv::Point2f, 4> onFrameCoarse(const Quad& coarse) const {
+    const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
+    std::array<cv::Point2f, 4> corners;
+    for (int k = 0; k < 4; ++k) corners[k] = coarse.corners[k] * s + cv::Point2f(shift, shift);
+    return corners;
+  }
+
   std::optional<Quad> onFrame(const Quad& coarse) const {
     QuadFitParams params;
     Quad start = coarse;
@@ -436,6 +465,9 @@ struct MarkerDetector::Impl {
         if (nested) continue;
       }
       if (scale > 1) {
+        if (config.kind == MarkerKind::Bch &&
+            hasFlatCodeArea(gray, onFrameCoarse(quad), config.border))
+          continue;
         const auto refine_start = Clock::now();
         const auto refined = onFrame(quad);
         refining += microseconds(refine_start, Clock::now());

@@ -19,6 +19,8 @@ class SquareToQuad {
  public:
   explicit SquareToQuad(const std::array<cv::Point2f, 4>& corners);
   cv::Point2f operator()(double u, double v) const;
+  // The image point of (u, v) and the map's partial derivatives there (px per unit).
+  void withDerivatives(double u, double v, cv::Point2f& at, cv::Point2f& du, cv::Point2f& dv) const;
   // True when the square [low, high]^2 lies wholly on the finite side of the vanishing line.
   bool finiteOn(double low, double high) const;
 
@@ -39,6 +41,13 @@ struct MarkerSamples {
 
 // `border` is the border width as a fraction of the side (0.125 thin, 0.25 standard).
 MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border);
+
+// True when the code area of the quad with `corners` is one flat level although the quad is
+// clearly darker than its surround: a solid dark shape. No BCH marker is: every BCH codeword has
+// at least 7 cells of each colour. Single samples, cheap enough to run before a quad is refined
+// (a pixel's error in the corners does not make a marker's cells flat).
+bool hasFlatCodeArea(const cv::Mat& image, const std::array<cv::Point2f, 4>& corners,
+                     double border);
 
 // An n x n grid of mean intensities over the code area [border, 1 - border]^2 (template patterns).
 std::vector<float> sampleCodeArea(const cv::Mat& image, const Quad& quad, double border, int n);

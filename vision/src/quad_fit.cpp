@@ -442,7 +442,10 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   if (!corners) return result;
   result.hull_is_quadrilateral = true;
   std::array<int, 4> vertex;
-  for (int k = 0; k < 4; ++k) vertex[k] = hull_index[(*corners)[k]];
+  for (int k = 0; k < 4; ++k) {
+    vertex[k] = hull_index[(*corners)[k]];
+    result.hull_corners[k] = contour[vertex[k]];
+  }
   // The contour must follow the hull's sides: the vertices in contour order, and no dent deeper
   // than the tolerance (a broken border or a notch is not a square, though its hull is).
   for (int k = 0; k < 4; ++k) {

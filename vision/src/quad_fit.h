@@ -38,6 +38,8 @@ struct QuadFit {
   // The contour's convex hull is a quadrilateral even if the contour is not: the outline of a
   // square whose border is broken or dented (worth binarising again), rather than of clutter.
   bool hull_is_quadrilateral = false;
+  // Then the hull's four corners (contour pixels, in contour order).
+  std::array<cv::Point, 4> hull_corners{};
 };
 
 QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, const cv::Mat& image,
