@@ -14,12 +14,39 @@ std::optional<DecodedId> decodeWord(MarkerKind kind, CodeWord word) {
   return kind == MarkerKind::Simple ? SimpleIdCode::decode(word) : BchCode::decode(word);
 }
 
+// Where each cell of the sampled grid lands after `turns` clockwise quarter turns (the cell at
+// (r, c) moves to (c, 5 - r) per turn), as a bit of the turned grid's word.
+struct Rotations {
+  std::array<std::array<CodeWord, 36>, 4> bit_of_cell{};
+  std::array<std::array<int, 36>, 4> cell_of_bit{};  // bit k of the turned word: the sampled cell
+  Rotations() {
+    for (int p = 0; p < 36; ++p) {
+      int cell = p;
+      for (int turns = 0; turns < 4; ++turns) {
+        bit_of_cell[turns][p] = CodeWord{1} << (35 - cell);
+        cell_of_bit[turns][35 - cell] = p;
+        cell = (cell % 6) * 6 + (5 - cell / 6);
+      }
+    }
+  }
+  CodeWord turned(const CodeGrid& grid, int turns) const {
+    CodeWord word = 0;
+    for (int p = 0; p < 36; ++p) word |= grid[p] ? bit_of_cell[turns][p] : 0;
+    return word;
+  }
+};
+
+const Rotations& rotations() {
+  static const Rotations table;
+  return table;
+}
+
 // ARToolKitPlus's rule: the rotation with the fewest corrected bits; a tie is ambiguous.
 std::optional<CodeDecode> hardDecode(MarkerKind kind, const CodeGrid& sampled, bool& ambiguous) {
   std::optional<CodeDecode> best;
   ambiguous = false;
   for (int turns = 0; turns < 4; ++turns) {
-    const auto decoded = decodeWord(kind, gridToWord(rotateClockwise(sampled, turns)));
+    const auto decoded = decodeWord(kind, rotations().turned(sampled, turns));
     if (!decoded) continue;
     if (!best || decoded->corrected_bits < best->corrected_bits) {
       best = CodeDecode{decoded->id, turns, decoded->corrected_bits, decoded->confidence};
@@ -33,7 +60,8 @@ std::optional<CodeDecode> hardDecode(MarkerKind kind, const CodeGrid& sampled, b
 
 // Chase decoding of a BCH word (see the header). Accepts a codeword that disagrees with at most
 // kMaxDisagreements cells whose summed reliability is at most kMaxWeight, and that beats every
-// other candidate (another id or orientation) by kMinMargin.
+// other candidate (another id or orientation) by kMinMargin. Trials are built in each turned
+// word directly (the flipped cells' bits), not as turned grids: up to 64 trials x 4 turns.
 std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
                                       const std::array<float, 36>& reliability) {
   constexpr int kFlipped = 6;
@@ -51,26 +79,34 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
     float weight;
   };
   Candidate best{-1, 0, 0, 1e9f}, second{-1, 0, 0, 1e9f};
-  const CodeWord received = gridToWord(sampled);
-  for (int pattern = 0; pattern < (1 << flippable); ++pattern) {
-    CodeGrid trial = sampled;
-    for (int b = 0; b < flippable; ++b) {
-      if (pattern & (1 << b)) trial[order[b]] = !trial[order[b]];
-    }
-    for (int turns = 0; turns < 4; ++turns) {
-      const auto decoded = BchCode::decode(gridToWord(rotateClockwise(trial, turns)));
-      if (!decoded) continue;
-      // The codeword as it appears in the sampled orientation, against the cells as read.
-      const CodeWord codeword =
-          gridToWord(rotateClockwise(wordToGrid(BchCode::encode(decoded->id)), 4 - turns));
-      const CodeWord differ = codeword ^ received;
-      float weight = 0.0f;
-      for (int p = 0; p < 36; ++p) {
-        if ((differ >> (35 - p)) & 1U) weight += reliability[p];
+  const Rotations& rotation = rotations();
+  for (int turns = 0; turns < 4; ++turns) {
+    const CodeWord received = rotation.turned(sampled, turns);
+    std::array<CodeWord, kFlipped> flip{};
+    for (int b = 0; b < flippable; ++b) flip[b] = rotation.bit_of_cell[turns][order[b]];
+    for (int pattern = 0; pattern < (1 << flippable); ++pattern) {
+      CodeWord trial = received;
+      for (int b = 0; b < flippable; ++b) {
+        if (pattern & (1 << b)) trial ^= flip[b];
       }
-      const Candidate candidate{decoded->id, turns, __builtin_popcountll(differ), weight};
-      if (candidate.id == best.id && candidate.turns == best.turns) continue;
-      if (candidate.id == second.id && candidate.turns == second.turns) continue;
+      const auto decoded = BchCode::decode(trial);
+      if (!decoded) continue;
+      if (decoded->id == best.id && turns == best.turns) continue;
+      if (decoded->id == second.id && turns == second.turns) continue;
+      // The codeword against the cells as read, both in the turned orientation; the weight in
+      // the sampled cells' order.
+      const CodeWord differ = BchCode::encode(decoded->id) ^ received;
+      std::array<bool, 36> disagrees{};
+      for (CodeWord bits = differ; bits != 0; bits &= bits - 1)
+        disagrees[rotation.cell_of_bit[turns][__builtin_ctzll(bits)]] = true;
+      float weight = 0.0f;
+      int disagreements = 0;
+      for (int p = 0; p < 36; ++p) {
+        if (!disagrees[p]) continue;
+        weight += reliability[p];
+        ++disagreements;
+      }
+      const Candidate candidate{decoded->id, turns, disagreements, weight};
       if (weight < best.weight) {
         second = best;
         best = candidate;

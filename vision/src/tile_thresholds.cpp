@@ -470,26 +470,28 @@ std::uint8_t AdaptiveThresholder::tileLimit(int tx, int ty, int split) const {
   return own_level < parent ? 255 : 0;  // all dark : all light
 }
 
-void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) const {
+void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) {
   const int tile = tile_, cols = dilated_[0].cols, rows = dilated_[0].rows;
   // Tiles around the region (one more on each side for interpolation), resized exactly as the
-  // whole grid would be, then cropped.
+  // whole grid would be, then cropped; into buffers kept between calls (a frame retries up to
+  // 18 regions, most of them small, where allocation cost as much as the work).
   const int tx0 = std::max(0, roi.x / tile - 1), ty0 = std::max(0, roi.y / tile - 1);
   const int tx1 = std::min(cols - 1, (roi.x + roi.width - 1) / tile + 1);
   const int ty1 = std::min(rows - 1, (roi.y + roi.height - 1) / tile + 1);
-  cv::Mat grid(ty1 - ty0 + 1, tx1 - tx0 + 1, CV_8UC1);
+  roi_tiles_.tile = tile;
+  roi_tiles_.cols = tx1 - tx0 + 1;
+  roi_tiles_.rows = ty1 - ty0 + 1;
+  roi_tiles_.limit.resize(static_cast<size_t>(roi_tiles_.cols) * roi_tiles_.rows);
   for (int ty = ty0; ty <= ty1; ++ty) {
     for (int tx = tx0; tx <= tx1; ++tx)
-      grid.at<std::uint8_t>(ty - ty0, tx - tx0) = tileLimit(tx, ty, split);
+      roi_tiles_.limit[static_cast<size_t>(ty - ty0) * roi_tiles_.cols + tx - tx0] =
+          tileLimit(tx, ty, split);
   }
-  TileThresholds part;
-  part.tile = tile;
-  part.cols = grid.cols;
-  part.rows = grid.rows;
-  part.limit.assign(grid.datastart, grid.dataend);
-  cv::Mat expanded;
-  interpolateLimits(part, cv::Size(grid.cols * tile, grid.rows * tile), expanded);
-  expanded(cv::Rect(roi.x - tx0 * tile, roi.y - ty0 * tile, roi.width, roi.height)).copyTo(limits);
+  const cv::Size size(roi_tiles_.cols * tile, roi_tiles_.rows * tile);
+  roi_pixels_.resize(static_cast<size_t>(size.area()));
+  cv::Mat expanded(size, CV_8UC1, roi_pixels_.data());
+  interpolateLimits(roi_tiles_, size, expanded);
+  limits = expanded(cv::Rect(roi.x - tx0 * tile, roi.y - ty0 * tile, roi.width, roi.height));
 }
 
 double estimateNoiseSigma(const cv::Mat& gray) {

@@ -48,7 +48,8 @@ class AdaptiveThresholder {
             int tile = TileThresholds::kTile);
   // After fill(): the per-pixel limits of `roi` with edge tiles split at `split` sixteenths of
   // their range instead of the usual kSplit (a darker split closes borders thinned by blur).
-  void roiLimits(cv::Rect roi, int split, cv::Mat& limits) const;
+  // `limits` becomes a view of this thresholder's buffer, valid until the next call.
+  void roiLimits(cv::Rect roi, int split, cv::Mat& limits);
 
   // Where an edge tile's threshold sits between its minimum and maximum, in sixteenths: a little
   // below the midrange, which keeps marker borders apart from their surroundings.
@@ -69,6 +70,8 @@ class AdaptiveThresholder {
   MinMaxGrid scratch_;
   std::vector<std::uint8_t> column_lo_, column_hi_;
   std::array<std::vector<std::uint8_t>, kLevels> coarse_;  // per coarse cell: threshold + 1, or 0
+  TileThresholds roi_tiles_;                               // roiLimits()' scratch
+  std::vector<std::uint8_t> roi_pixels_;
 };
 
 // Standard deviation of the image noise (grey levels), from the median response of a Laplacian
