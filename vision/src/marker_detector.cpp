@@ -156,7 +156,7 @@ struct MarkerDetector::Impl {
   int scale = 1;
   TileThresholds tiles;
   AdaptiveThresholder adaptive;
-  cv::Mat limits;
+  LimitRows limit_rows;
   RunLabeler labels;
   std::vector<cv::Point> contour;
   std::vector<Quad> quads;
@@ -214,9 +214,9 @@ struct MarkerDetector::Impl {
       result.threshold = global;
       result.threshold_mode = toString(config.threshold.mode) + (vignetting ? " + vignetting" : "");
     }
-    interpolateLimits(tiles, searched->size(), limits);
+    limit_rows.reset(tiles, searched->size());
     const auto mid = Clock::now();
-    labels.label(*searched, limits);
+    labels.label(*searched, limit_rows);
     const auto end = Clock::now();
     time.threshold += microseconds(start, mid);
     time.label += microseconds(mid, end);

@@ -172,11 +172,14 @@ std::optional<Line> fitLine(const cv::Point2f* points, const float* weights, int
     cxy += weights[i] * dx * dy;
     cyy += weights[i] * dy * dy;
   }
-  // Principal axis of the 2x2 scatter matrix.
-  const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
-  return Line{
-      cv::Point2f(static_cast<float>(mx), static_cast<float>(my)),
-      cv::Point2f(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)))};
+  // Principal axis of the 2x2 scatter matrix, at angle a = atan2(2 cxy, cxx - cyy) / 2 (in
+  // (-90, 90] degrees), from cos 2a and sin 2a by the half-angle formulas.
+  const double diagonal = cxx - cyy, r = std::sqrt(diagonal * diagonal + 4.0 * cxy * cxy);
+  const double cos2 = r > 0.0 ? diagonal / r : 1.0;
+  const double c = std::sqrt(std::max(0.0, 0.5 * (1.0 + cos2)));
+  const double s = std::copysign(std::sqrt(std::max(0.0, 0.5 * (1.0 - cos2))), cxy);
+  return Line{cv::Point2f(static_cast<float>(mx), static_cast<float>(my)),
+              cv::Point2f(static_cast<float>(c), static_cast<float>(s))};
 }
 
 std::optional<cv::Point2f> intersect(const Line& a, const Line& b) {

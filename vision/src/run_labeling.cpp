@@ -9,13 +9,20 @@
 
 namespace arbci::vision {
 void RunLabeler::label(const cv::Mat& image, const cv::Mat& limits) {
-  binarise(image, limits);
+  CV_Assert(limits.type() == CV_8UC1 && limits.size() == image.size());
+  binarise(image, [&](int y) { return limits.ptr<std::uint8_t>(y); });
   connect();
   collect();
 }
 
-void RunLabeler::binarise(const cv::Mat& image, const cv::Mat& limits) {
-  CV_Assert(limits.type() == CV_8UC1 && limits.size() == image.size());
+void RunLabeler::label(const cv::Mat& image, LimitRows& limits) {
+  binarise(image, [&](int y) { return limits.row(y); });
+  connect();
+  collect();
+}
+
+template <typename LimitOfRow>
+void RunLabeler::binarise(const cv::Mat& image, LimitOfRow limit_of_row) {
   width_ = image.cols;
   height_ = image.rows;
   stride_ = width_ + 2;
@@ -34,7 +41,7 @@ void RunLabeler::binarise(const cv::Mat& image, const cv::Mat& limits) {
   for (int y = 0; y < height_; ++y) {
     const std::uint8_t* pixels = image.ptr<std::uint8_t>(y);
     std::uint8_t* mask = mask_.data() + static_cast<size_t>(y + 1) * stride_ + 1;
-    markDark(pixels, limits.ptr<std::uint8_t>(y), width_, mask, bits_.data());
+    markDark(pixels, limit_of_row(y), width_, mask, bits_.data());
     row_begin_[y] = static_cast<int>(runs_.size());
     appendRuns(bits_.data(), words, y);
   }

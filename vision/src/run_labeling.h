@@ -31,6 +31,8 @@ class RunLabeler {
  public:
   // `limits`: per pixel, a pixel is dark when its value is below its limit (see tile_thresholds.h).
   void label(const cv::Mat& image, const cv::Mat& limits);
+  // The same with the limits made row by row.
+  void label(const cv::Mat& image, LimitRows& limits);
 
   const std::vector<DarkComponent>& components() const { return components_; }
   // 1 where the pixel is dark; (x, y) may be one pixel outside the image (never dark there).
@@ -40,7 +42,9 @@ class RunLabeler {
   size_t runCount() const { return runs_.size(); }
 
  private:
-  void binarise(const cv::Mat& image, const cv::Mat& limits);
+  // `limit_of_row(y)`: row y's limits.
+  template <typename LimitOfRow>
+  void binarise(const cv::Mat& image, LimitOfRow limit_of_row);
   static void markDark(const std::uint8_t* pixels, const std::uint8_t* limit, int width,
                        std::uint8_t* mask, std::uint64_t* bits);
   void appendRuns(const std::uint64_t* bits, int words, int y);

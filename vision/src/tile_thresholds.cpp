@@ -29,10 +29,11 @@ void AdaptiveThresholder::MinMaxGrid::resize(int c, int r) {
 }
 
 int TileThresholds::median() const {
-  // Over every 7th tile: a report, not a computation the detector depends on.
+  // Over every 31st tile (several hundred of them): a report, not a computation the detector
+  // depends on.
   std::array<int, 256> histogram{};
   int count = 0;
-  for (size_t i = 0; i < limit.size(); i += 7) {
+  for (size_t i = 0; i < limit.size(); i += 31) {
     const std::uint8_t v = limit[i];
     if (v > 0 && v < 255) {
       ++histogram[v - 1];
@@ -131,30 +132,44 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
 
 }  // namespace
 
-void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits) {
+void LimitRows::reset(const TileThresholds& tiles, cv::Size image) {
+  tiles_ = &tiles;
+  width_ = image.width;
   const int tile = tiles.tile, cols = tiles.cols, rows = tiles.rows;
-  const int wide = cols * tile;
-  // Each tile row expanded along x first, then rows blended along y (own code rather than
-  // cv::resize, which would hand this small job to OpenCV's thread pool).
-  thread_local std::vector<std::uint8_t> expanded;
-  expanded.resize(static_cast<size_t>(rows) * wide);
+  wide_ = cols * tile;
+  // Each tile row expanded along x first; rows are blended along y when asked for (own code
+  // rather than cv::resize, which would hand this small job to OpenCV's thread pool).
+  expanded_.resize(static_cast<size_t>(rows) * wide_);
   for (int ty = 0; ty < rows; ++ty) {
     const std::uint8_t* v = &tiles.limit[static_cast<size_t>(ty) * cols];
-    std::uint8_t* out = &expanded[static_cast<size_t>(ty) * wide];
+    std::uint8_t* out = &expanded_[static_cast<size_t>(ty) * wide_];
     if (tile == 2) {
       expandRow<2>(v, cols, out);
     } else {
       expandRow<TileThresholds::kTile>(v, cols, out);
     }
   }
+  row_.resize(static_cast<size_t>(width_));
+}
+
+void LimitRows::blend(int y, std::uint8_t* out) const {
+  const int tile = tiles_->tile, rows = tiles_->rows;
+  const int t = y / tile, k = y % tile, far = farWeight(k, tile);
+  const int other = 2 * k < tile ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
+  blendRows(&expanded_[static_cast<size_t>(t) * wide_],
+            &expanded_[static_cast<size_t>(other) * wide_], 8 - far, far, out, width_);
+}
+
+const std::uint8_t* LimitRows::row(int y) {
+  blend(y, row_.data());
+  return row_.data();
+}
+
+void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits) {
+  thread_local LimitRows rows;
+  rows.reset(tiles, image);
   limits.create(image, CV_8UC1);
-  for (int y = 0; y < image.height; ++y) {
-    const int t = y / tile, k = y % tile, far = farWeight(k, tile);
-    const int other = 2 * k < tile ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
-    blendRows(&expanded[static_cast<size_t>(t) * wide],
-              &expanded[static_cast<size_t>(other) * wide], 8 - far, far,
-              limits.ptr<std::uint8_t>(y), image.width);
-  }
+  for (int y = 0; y < image.height; ++y) rows.blend(y, limits.ptr<std::uint8_t>(y));
 }
 
 void fillGlobalThresholds(cv::Size image, int threshold,

@@ -33,6 +33,23 @@ struct TileThresholds {
 // tile centres, so that the threshold surface has no steps at tile borders.
 void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& limits);
 
+// The same limits one row at a time, for a labeller that compares each row as it is made: the
+// frame's limit image is never written out (a frame's worth of memory traffic saved).
+class LimitRows {
+ public:
+  // Expands `tiles` (kept by reference until the next reset) along x for an image of `image`.
+  void reset(const TileThresholds& tiles, cv::Size image);
+  // Row y's limits, in a buffer valid until the next call.
+  const std::uint8_t* row(int y);
+  // Row y's limits into `out` (the image's width).
+  void blend(int y, std::uint8_t* out) const;
+
+ private:
+  const TileThresholds* tiles_ = nullptr;
+  int width_ = 0, wide_ = 0;
+  std::vector<std::uint8_t> expanded_, row_;
+};
+
 // `tile`: TileThresholds::kTile, or 2 on a frame averaged over 2x2 pixels.
 void fillGlobalThresholds(cv::Size image, int threshold,
                           const std::optional<Vignetting>& vignetting, TileThresholds& out,
