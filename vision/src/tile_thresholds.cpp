@@ -278,9 +278,13 @@ struct TileRow {
   const std::uint8_t* parent_hi;
 };
 
-// AdaptiveThresholder::tileLimit() at the usual split for a row of tiles, branch-free, through
-// restrict-qualified copies of the row pointers (this loop runs over every tile).
-void limitsOfRow(const TileRow& row, int contrast, int cols, std::uint8_t* __restrict limit) {
+// The limit of each tile of a row (the first one even, so that tiles pair with their parents),
+// its edge tiles split at `split_sixteenths` of their range; branch-free, through
+// restrict-qualified copies of the row pointers (this loop runs over every tile). The scalar tail
+// says it plainly. A weak edge beside a strong one (grey table against a marker's white quiet
+// zone) is not one to split at: such a tile is classified whole, like a flat one.
+void limitsOfRow(const TileRow& row, int contrast, int split_sixteenths, int cols,
+                 std::uint8_t* __restrict limit) {
   const std::uint8_t* __restrict lo0 = row.lo;
   const std::uint8_t* __restrict hi0 = row.hi;
   const std::uint8_t* __restrict own_lo = row.own_lo;
@@ -293,6 +297,7 @@ void limitsOfRow(const TileRow& row, int contrast, int cols, std::uint8_t* __res
   // Sixteen tiles at a time, in 16-bit lanes; each parent byte serves two tiles.
   const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi16(1), byte = _mm_set1_epi16(255);
   const __m128i floor = _mm_set1_epi16(static_cast<short>(contrast - 1));
+  const __m128i split_factor = _mm_set1_epi16(static_cast<short>(split_sixteenths));
   auto load16 = [](const std::uint8_t* p) {
     return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
   };
@@ -307,14 +312,12 @@ void limitsOfRow(const TileRow& row, int contrast, int cols, std::uint8_t* __res
     const __m128i has_parent = _mm_cmpgt_epi16(above, zero);
     const __m128i edge =
         _mm_andnot_si128(_mm_and_si128(weak, has_parent), _mm_cmpgt_epi16(range, floor));
-    const __m128i split = _mm_srli_epi16(_mm_sub_epi16(_mm_slli_epi16(range, 3), range),
-                                         4);  // range * 7 / 16 (kSplit)
+    const __m128i split = _mm_srli_epi16(_mm_mullo_epi16(range, split_factor), 4);
     const __m128i edge_limit = _mm_min_epi16(_mm_add_epi16(_mm_add_epi16(lo, split), one), byte);
     const __m128i flat = _mm_and_si128(
         _mm_and_si128(has_parent, _mm_cmpgt_epi16(above, _mm_srli_epi16(own_sum, 1))), byte);
     return _mm_or_si128(_mm_and_si128(edge, edge_limit), _mm_andnot_si128(edge, flat));
   };
-  static_assert(AdaptiveThresholder::kSplit == 7, "the SIMD split computes range * 7 / 16");
   for (; tx + 16 <= cols; tx += 16) {
     const __m128i lo = load16(lo0 + tx), hi = load16(hi0 + tx);
     const __m128i a = load16(own_lo + tx), b = load16(own_hi + tx);
@@ -338,7 +341,7 @@ void limitsOfRow(const TileRow& row, int contrast, int cols, std::uint8_t* __res
     const int lo = lo0[tx], range = hi0[tx] - lo, above = parent[p];
     const bool weak = 3 * range < hi1[p] - lo1[p];
     const bool edge = range >= contrast && !(weak && above > 0);
-    const int edge_limit = std::min(255, lo + range * AdaptiveThresholder::kSplit / 16 + 1);
+    const int edge_limit = std::min(255, lo + range * split_sixteenths / 16 + 1);
     const int flat_limit = above > 0 && (own_lo[tx] + own_hi[tx]) / 2 < above ? 255 : 0;
     limit[tx] = static_cast<std::uint8_t>(edge ? edge_limit : flat_limit);
   }
@@ -458,49 +461,37 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
   out.cols = base.cols;
   out.rows = base.rows;
   out.limit.resize(static_cast<size_t>(out.cols) * out.rows);
-  // tileLimit() for every tile, row by row.
+  // Every tile's limit, row by row.
   const int parent_cols = dilated_[1].cols;
   for (int ty = 0; ty < out.rows; ++ty) {
     const size_t row = static_cast<size_t>(ty) * out.cols;
     const size_t parent_row = static_cast<size_t>(ty / 2) * parent_cols;
     limitsOfRow({&dilated_[0].lo[row], &dilated_[0].hi[row], &base.lo[row], &base.hi[row],
                  &coarse_[1][parent_row], &dilated_[1].lo[parent_row], &dilated_[1].hi[parent_row]},
-                contrast, out.cols, &out.limit[row]);
+                contrast, kSplit, out.cols, &out.limit[row]);
   }
-}
-
-std::uint8_t AdaptiveThresholder::tileLimit(int tx, int ty, int split) const {
-  const MinMaxGrid& fine = dilated_[0];
-  const MinMaxGrid& middle = dilated_[1];
-  const size_t i = static_cast<size_t>(ty) * fine.cols + tx;
-  const size_t p = static_cast<size_t>(ty / 2) * middle.cols + tx / 2;
-  const int lo = fine.lo[i], hi = fine.hi[i];
-  const int parent = coarse_[1][p];
-  // A weak edge beside a strong one (grey table against a marker's white quiet zone) is not one
-  // to split at: such a tile is classified whole, like a flat one.
-  const bool weak = 3 * (hi - lo) < middle.hi[p] - middle.lo[p];
-  if (hi - lo >= contrast_ && !(weak && parent > 0)) return limitOf(lo + (hi - lo) * split / 16);
-  if (parent == 0) return 0;
-  const int own_level = (raw_[0].lo[i] + raw_[0].hi[i]) / 2;
-  return own_level < parent ? 255 : 0;  // all dark : all light
 }
 
 void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) {
   const int tile = tile_, cols = dilated_[0].cols, rows = dilated_[0].rows;
-  // Tiles around the region (one more on each side for interpolation), resized exactly as the
-  // whole grid would be, then cropped; into buffers kept between calls (a frame retries up to
-  // 18 regions, most of them small, where allocation cost as much as the work).
-  const int tx0 = std::max(0, roi.x / tile - 1), ty0 = std::max(0, roi.y / tile - 1);
+  // Tiles around the region (one more on each side for interpolation, the first one even),
+  // resized exactly as the whole grid would be, then cropped; into buffers kept between calls (a
+  // frame retries up to 18 regions, most of them small).
+  const int tx0 = std::max(0, roi.x / tile - 1) & ~1, ty0 = std::max(0, roi.y / tile - 1);
   const int tx1 = std::min(cols - 1, (roi.x + roi.width - 1) / tile + 1);
   const int ty1 = std::min(rows - 1, (roi.y + roi.height - 1) / tile + 1);
   roi_tiles_.tile = tile;
   roi_tiles_.cols = tx1 - tx0 + 1;
   roi_tiles_.rows = ty1 - ty0 + 1;
   roi_tiles_.limit.resize(static_cast<size_t>(roi_tiles_.cols) * roi_tiles_.rows);
+  const int parent_cols = dilated_[1].cols;
   for (int ty = ty0; ty <= ty1; ++ty) {
-    for (int tx = tx0; tx <= tx1; ++tx)
-      roi_tiles_.limit[static_cast<size_t>(ty - ty0) * roi_tiles_.cols + tx - tx0] =
-          tileLimit(tx, ty, split);
+    const size_t row = static_cast<size_t>(ty) * cols + tx0;
+    const size_t parent_row = static_cast<size_t>(ty / 2) * parent_cols + tx0 / 2;
+    limitsOfRow({&dilated_[0].lo[row], &dilated_[0].hi[row], &raw_[0].lo[row], &raw_[0].hi[row],
+                 &coarse_[1][parent_row], &dilated_[1].lo[parent_row], &dilated_[1].hi[parent_row]},
+                contrast_, split, roi_tiles_.cols,
+                &roi_tiles_.limit[static_cast<size_t>(ty - ty0) * roi_tiles_.cols]);
   }
   const cv::Size size(roi_tiles_.cols * tile, roi_tiles_.rows * tile);
   roi_pixels_.resize(static_cast<size_t>(size.area()));

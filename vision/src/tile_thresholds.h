@@ -78,7 +78,6 @@ class AdaptiveThresholder {
     std::vector<std::uint8_t> lo, hi;
     void resize(int c, int r);
   };
-  std::uint8_t tileLimit(int tx, int ty, int split) const;
 
   static constexpr int kLevels = 5;  // tiles of 4, 8, 16, 32 and 64 px of the frame
   int contrast_ = 8;
