@@ -161,6 +161,7 @@ struct MarkerDetector::Impl {
   std::vector<cv::Point> contour;
   std::vector<Quad> quads;
   // Components that did not fit a quad, then grouped into marker-sized regions to retry.
+  std::vector<DarkComponent> traced;  // the frame's components whose outline was fitted
   std::vector<cv::Rect> failed;
   std::vector<RetryRegion> retries;  // square-hulled near misses first, then fragment groups
   std::vector<int> group, group_size;
@@ -236,12 +237,14 @@ struct MarkerDetector::Impl {
     params.refine_edges = scale == 1;
     failed.clear();
     retries.clear();
+    traced.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
     for (const DarkComponent& c : labels.components()) {
       if (c.area < min_area || c.touchesBorder(width, height)) continue;
       const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
       if (std::max(w, h) < min_side || std::min(w, h) < 3) continue;
       const int max_length = 4 * (w + h) + 64;
+      traced.push_back(c);
       if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
       const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *searched, params);
       if (fit.quad) {
@@ -366,6 +369,17 @@ struct MarkerDetector::Impl {
     }
   }
 
+  // True when the frame's labelling had this component (of a region at `origin`) and fitted it
+  // already: the same box and area are the same pixels here, whose fit would only repeat.
+  bool wasTraced(const DarkComponent& c, cv::Point origin) const {
+    for (const DarkComponent& t : traced) {
+      if (t.area == c.area && t.min_x == c.min_x + origin.x && t.min_y == c.min_y + origin.y &&
+          t.max_x == c.max_x + origin.x && t.max_y == c.max_y + origin.y)
+        return true;
+    }
+    return false;
+  }
+
   // Binarises `roi` of `source` with edge tiles split at `split` sixteenths; adds the new quads.
   bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split,
                    const QuadFitParams& frame_params) {
@@ -378,7 +392,7 @@ struct MarkerDetector::Impl {
     for (const DarkComponent& c : roi_labels.components()) {
       const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
       if (c.touchesBorder(roi.width, roi.height) || std::max(w, h) < params.min_side ||
-          std::min(w, h) < params.min_side * 0.5f) {
+          std::min(w, h) < params.min_side * 0.5f || wasTraced(c, roi.tl())) {
         continue;
       }
       if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour))

@@ -211,7 +211,7 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
   cv::Point2f points[kMaxSamples];
   float weights[kMaxSamples];
   int count = 0;
-  float profile[2 * kMaxRadius + 3], rise[2 * kMaxRadius + 1];
+  float profile[2 * kMaxRadius + 4], rise[2 * kMaxRadius + 1];
   for (int s = 0; s < samples; ++s) {
     // Stay clear of the corners, where the profile would cross the neighbouring side.
     const float t =
@@ -224,10 +224,8 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
                 lens.toImage(ideal_base - 0.5f * ideal_outward);
       outward /= std::max(1e-6f, std::sqrt(outward.dot(outward)));
     }
-    for (int k = -radius - 1; k <= radius + 1; ++k) {
-      const cv::Point2f p = base + static_cast<float>(k) * outward;
-      profile[k + radius + 1] = sample(p.x, p.y);
-    }
+    const cv::Point2f from = base - static_cast<float>(radius + 1) * outward;
+    sample.line(from.x, from.y, outward.x, outward.y, 2 * radius + 3, profile);
     int best = 0;
     float best_rise = 0.0f;
     for (int k = -radius; k <= radius; ++k) {
