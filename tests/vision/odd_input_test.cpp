@@ -32,6 +32,29 @@ TEST(OddInput, EmptyTinyAndDegenerateImagesGiveNoMarkers) {
   EXPECT_TRUE(detector.detect(cv::Mat(480, 640, CV_8UC1, cv::Scalar(128))).markers.empty());
 }
 
+// A BCH marker's outline encloses its light code cells; a solid dark quadrilateral encloses none
+// and is dropped before it is refined or decoded, in both searches, while a hollow one of the
+// same size (a dark dot inside, as a code has dark cells) stays a candidate.
+TEST(OddInput, SolidDarkSquaresAreNotCandidates) {
+  cv::Mat frame(480, 640, CV_8UC1, cv::Scalar(200));
+  cv::rectangle(frame, cv::Rect(100, 150, 120, 120), cv::Scalar(20), cv::FILLED);
+  cv::rectangle(frame, cv::Rect(400, 150, 120, 120), cv::Scalar(20), cv::FILLED);
+  cv::rectangle(frame, cv::Rect(420, 170, 80, 80), cv::Scalar(200), cv::FILLED);
+  cv::rectangle(frame, cv::Rect(450, 200, 20, 20), cv::Scalar(20), cv::FILLED);  // a "code" dot
+  for (int decimate : {1, 2}) {
+    DetectorConfig config;
+    config.search_decimate = decimate;
+    MarkerDetector detector(config);
+    EXPECT_TRUE(detector.detect(frame).markers.empty());
+    const std::vector<SquareCorners>& squares = detector.lastSquares();
+    ASSERT_EQ(squares.size(), 1u) << "decimate " << decimate;
+    for (const cv::Point2f& corner : squares[0]) {
+      EXPECT_GT(corner.x, 390.0f) << "decimate " << decimate;
+      EXPECT_LT(corner.x, 530.0f) << "decimate " << decimate;
+    }
+  }
+}
+
 TEST(OddInput, AHugeFrameIsProcessed) {
   cv::Mat huge(4000, 6000, CV_8UC1, cv::Scalar(200));
   cv::rectangle(huge, cv::Rect(100, 100, 300, 300), cv::Scalar(10), cv::FILLED);

@@ -246,9 +246,15 @@ struct MarkerDetector::Impl {
       const int max_length = 4 * (w + h) + 64;
       traced.push_back(c);
       if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
-      const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *searched, params);
+      // A BCH marker's outline encloses its light code cells (7 or more); a quadrilateral
+      // enclosing none is a solid shape and is dropped unrefined. One that does not fit may still
+      // be a marker whose border broke open.
+      const bool solid = c.holes == 0 && config.kind == MarkerKind::Bch;
+      QuadFitParams component_params = params;
+      if (solid) component_params.refine_edges = false;
+      const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *searched, component_params);
       if (fit.quad) {
-        quads.push_back(*fit.quad);
+        if (!solid) quads.push_back(*fit.quad);
       } else if (adaptive_mode && std::max(w, h) <= max_retry_side) {
         failed.emplace_back(c.min_x, c.min_y, w, h);
         if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f &&

@@ -119,6 +119,7 @@ void RunLabeler::connect() {
       const PixelRun& here = runs_[j];
       // 8-connected when the runs overlap or touch diagonally.
       if (above.x0 <= here.x1 && here.x0 <= above.x1) {
+        ++runs_[j].links;
         const int a = find(i), b = find(j);
         // The smaller index becomes the root, so a root is its component's first run.
         if (a < b) {
@@ -144,10 +145,11 @@ void RunLabeler::collect() {
     const PixelRun& run = runs_[i];
     if (root == i) {
       component_of_root_[i] = static_cast<int>(components_.size());
-      components_.push_back({0, run.x0, run.x1 - 1, run.y, run.y, run.x0, run.y});
+      components_.push_back({0, run.x0, run.x1 - 1, run.y, run.y, run.x0, run.y, 1});
     }
     DarkComponent& component = components_[component_of_root_[root]];
     component.area += run.x1 - run.x0;
+    component.holes += run.links - 1;
     component.min_x = std::min(component.min_x, run.x0);
     component.max_x = std::max(component.max_x, run.x1 - 1);
     component.max_y = run.y;  // rows arrive in order

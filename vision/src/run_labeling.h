@@ -16,12 +16,16 @@ struct PixelRun {
   int x0 = 0, x1 = 0;  // dark pixels [x0, x1) of row y
   int y = 0;
   int parent = 0;
+  int links = 0;  // runs of the row above it touches
 };
 
 struct DarkComponent {
   int area = 0;
   int min_x = 0, max_x = 0, min_y = 0, max_y = 0;
   int first_x = 0, first_y = 0;  // the top-most, then left-most pixel
+  // Light regions it encloses: by Euler's formula over its runs (as a graph whose edges are the
+  // touching runs of consecutive rows, each cycle encloses one hole), links - runs + 1.
+  int holes = 0;
   bool touchesBorder(int width, int height) const {
     return min_x <= 0 || min_y <= 0 || max_x >= width - 1 || max_y >= height - 1;
   }
