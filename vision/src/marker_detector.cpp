@@ -426,18 +426,19 @@ struct MarkerDetector::Impl {
     return added;
   }
 
-  // A reduced image's quad in frame pixels (a reduced pixel's centre is the middle of the frame
-  // pixels it averages), its sides moved onto the frame's edges, through the lens. A thin quad
-  // (a steeply tilted marker) is first moved onto the reduced image's edges: from its contour's
-  // lines alone the frame's edges can be out of reach (one such marker's corner came out 3 px
-  // off and its pose flipped).
-  std::array<cv::Point2f, 4> onFrameCoarse(const Quad& coarse) const {
+  // A reduced image's corners in frame pixels: a reduced pixel's centre is the middle of the
+  // frame pixels it averages.
+  std::array<cv::Point2f, 4> onFrameCoarse(const std::array<cv::Point2f, 4>& coarse) const {
     const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
     std::array<cv::Point2f, 4> corners;
-    for (int k = 0; k < 4; ++k) corners[k] = coarse.corners[k] * s + cv::Point2f(shift, shift);
+    for (int k = 0; k < 4; ++k) corners[k] = coarse[k] * s + cv::Point2f(shift, shift);
     return corners;
   }
 
+  // A reduced image's quad in frame pixels, its sides moved onto the frame's edges, through the
+  // lens. A thin quad (a steeply tilted marker) is first moved onto the reduced image's edges:
+  // from its contour's lines alone the frame's edges can be out of reach (one such marker's
+  // corner came out 3 px off and its pose flipped).
   std::optional<Quad> onFrame(const Quad& coarse) const {
     QuadFitParams params;
     Quad start = coarse;
@@ -451,10 +452,7 @@ struct MarkerDetector::Impl {
     }
     params.min_side = config.min_side_px;
     params.lens = config.lens.get();
-    const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
-    std::array<cv::Point2f, 4> corners;
-    for (int k = 0; k < 4; ++k) corners[k] = start.corners[k] * s + cv::Point2f(shift, shift);
-    return refineQuad(corners, *binarised, params);
+    return refineQuad(onFrameCoarse(start.corners), *binarised, params);
   }
 
   // Decodes every quad, largest first (a reduced image's refined on the frame first); returns
@@ -485,8 +483,9 @@ struct MarkerDetector::Impl {
         if (nested) continue;
       }
       if (scale > 1) {
+        // A flat code area is no BCH marker whoever refines it: not worth refining.
         if (config.kind == MarkerKind::Bch &&
-            hasFlatCodeArea(gray, onFrameCoarse(quad), config.border))
+            hasFlatCodeArea(gray, onFrameCoarse(quad.corners), config.border))
           continue;
         const auto refine_start = Clock::now();
         const auto refined = onFrame(quad);

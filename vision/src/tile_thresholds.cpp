@@ -24,8 +24,9 @@ std::uint8_t limitOf(int threshold) {
 void AdaptiveThresholder::MinMaxGrid::resize(int c, int r) {
   cols = c;
   rows = r;
-  lo.assign(static_cast<size_t>(c) * r, 255);
-  hi.assign(static_cast<size_t>(c) * r, 0);
+  // Every cell is written by fill() before it is read.
+  lo.resize(static_cast<size_t>(c) * r);
+  hi.resize(static_cast<size_t>(c) * r);
 }
 
 int TileThresholds::median() const {
@@ -135,29 +136,35 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
 void LimitRows::reset(const TileThresholds& tiles, cv::Size image) {
   tiles_ = &tiles;
   width_ = image.width;
-  const int tile = tiles.tile, cols = tiles.cols, rows = tiles.rows;
-  wide_ = cols * tile;
-  // Each tile row expanded along x first; rows are blended along y when asked for (own code
-  // rather than cv::resize, which would hand this small job to OpenCV's thread pool).
-  expanded_.resize(static_cast<size_t>(rows) * wide_);
-  for (int ty = 0; ty < rows; ++ty) {
-    const std::uint8_t* v = &tiles.limit[static_cast<size_t>(ty) * cols];
-    std::uint8_t* out = &expanded_[static_cast<size_t>(ty) * wide_];
-    if (tile == 2) {
-      expandRow<2>(v, cols, out);
-    } else {
-      expandRow<TileThresholds::kTile>(v, cols, out);
-    }
-  }
+  wide_ = tiles.cols * tiles.tile;
+  // Tile rows are expanded along x when first needed, into three slots (a row blends its tile
+  // row with the one above or below; rows come in order), then blended along y (own code rather
+  // than cv::resize, which would hand this small job to OpenCV's thread pool).
+  expanded_.resize(3 * static_cast<size_t>(wide_));
+  slot_row_ = {-1, -1, -1};
   row_.resize(static_cast<size_t>(width_));
+}
+
+const std::uint8_t* LimitRows::expandedRow(int ty) const {
+  const int slot = ty % 3;
+  std::uint8_t* out = &expanded_[static_cast<size_t>(slot) * wide_];
+  if (slot_row_[slot] != ty) {
+    const std::uint8_t* v = &tiles_->limit[static_cast<size_t>(ty) * tiles_->cols];
+    if (tiles_->tile == 2) {
+      expandRow<2>(v, tiles_->cols, out);
+    } else {
+      expandRow<TileThresholds::kTile>(v, tiles_->cols, out);
+    }
+    slot_row_[slot] = ty;
+  }
+  return out;
 }
 
 void LimitRows::blend(int y, std::uint8_t* out) const {
   const int tile = tiles_->tile, rows = tiles_->rows;
   const int t = y / tile, k = y % tile, far = farWeight(k, tile);
   const int other = 2 * k < tile ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
-  blendRows(&expanded_[static_cast<size_t>(t) * wide_],
-            &expanded_[static_cast<size_t>(other) * wide_], 8 - far, far, out, width_);
+  blendRows(expandedRow(t), expandedRow(other), 8 - far, far, out, width_);
 }
 
 const std::uint8_t* LimitRows::row(int y) {
@@ -408,24 +415,22 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
                     coarse.cols);
     }
   }
-  // 3x3 neighbourhoods, separably: along rows into scratch, then down columns.
+  // 3x3 neighbourhoods, separably: down columns into a row, then along it (a row of scratch
+  // rather than a grid's: less memory to pass through).
   for (int level = 0; level < kLevels; ++level) {
     const MinMaxGrid& grid = raw_[level];
     MinMaxGrid& dilated = dilated_[level];
-    scratch_.resize(grid.cols, grid.rows);
     dilated.resize(grid.cols, grid.rows);
+    column_lo_.resize(static_cast<size_t>(grid.cols));
+    column_hi_.resize(column_lo_.size());
     const size_t c = static_cast<size_t>(grid.cols);
-    for (int y = 0; y < grid.rows; ++y) {
-      neighbourhood3<false>(&grid.lo[y * c], &scratch_.lo[y * c], grid.cols);
-      neighbourhood3<true>(&grid.hi[y * c], &scratch_.hi[y * c], grid.cols);
-    }
     for (int y = 0; y < grid.rows; ++y) {
       const size_t up = static_cast<size_t>(std::max(0, y - 1)) * c, here = y * c;
       const size_t down = static_cast<size_t>(std::min(grid.rows - 1, y + 1)) * c;
-      combine3<false>(&scratch_.lo[up], &scratch_.lo[here], &scratch_.lo[down], &dilated.lo[here],
-                      grid.cols);
-      combine3<true>(&scratch_.hi[up], &scratch_.hi[here], &scratch_.hi[down], &dilated.hi[here],
-                     grid.cols);
+      combine3<false>(&grid.lo[up], &grid.lo[here], &grid.lo[down], column_lo_.data(), grid.cols);
+      combine3<true>(&grid.hi[up], &grid.hi[here], &grid.hi[down], column_hi_.data(), grid.cols);
+      neighbourhood3<false>(column_lo_.data(), &dilated.lo[here], grid.cols);
+      neighbourhood3<true>(column_hi_.data(), &dilated.hi[here], grid.cols);
     }
   }
   // A tile with contrast in its own 12 px neighbourhood -- at least the noise floor and a third of

@@ -37,17 +37,23 @@ void interpolateLimits(const TileThresholds& tiles, cv::Size image, cv::Mat& lim
 // frame's limit image is never written out (a frame's worth of memory traffic saved).
 class LimitRows {
  public:
-  // Expands `tiles` (kept by reference until the next reset) along x for an image of `image`.
+  // For an image of `image` with `tiles` (kept by reference until the next reset).
   void reset(const TileThresholds& tiles, cv::Size image);
   // Row y's limits, in a buffer valid until the next call.
   const std::uint8_t* row(int y);
-  // Row y's limits into `out` (the image's width).
+  // Row y's limits into `out` (the image's width). Rows asked for in any order are right;
+  // in order, each tile row is expanded once.
   void blend(int y, std::uint8_t* out) const;
 
  private:
+  const std::uint8_t* expandedRow(int tile_row) const;  // tile row expanded along x
+
   const TileThresholds* tiles_ = nullptr;
   int width_ = 0, wide_ = 0;
-  std::vector<std::uint8_t> expanded_, row_;
+  // Three expanded tile rows (a cache, refilled as rows are asked for) and their tile rows.
+  mutable std::vector<std::uint8_t> expanded_;
+  mutable std::array<int, 3> slot_row_{-1, -1, -1};
+  std::vector<std::uint8_t> row_;
 };
 
 // `tile`: TileThresholds::kTile, or 2 on a frame averaged over 2x2 pixels.
@@ -83,7 +89,6 @@ class AdaptiveThresholder {
   int contrast_ = 8;
   int tile_ = TileThresholds::kTile;
   std::array<MinMaxGrid, kLevels> raw_, dilated_;
-  MinMaxGrid scratch_;
   std::vector<std::uint8_t> column_lo_, column_hi_;
   std::array<std::vector<std::uint8_t>, kLevels> coarse_;  // per coarse cell: threshold + 1, or 0
   TileThresholds roi_tiles_;                               // roiLimits()' scratch
