@@ -1,0 +1,149 @@
+// How well the simulated subject's error-related potentials can be told apart at all: the ErrP
+// classifier's cross-validated AUC (5 contiguous blocks, as a session's calibration) on
+// calibration blocks of growing size, per seed and method. The subject and the ErrP pipeline are
+// the embedded session's (its montage, rate, notch, band, window, decimation, channels); feedbacks
+// come every 3.5 s as in the calibration block (cue 1.5 s, result 1 s, pause 1 s), a quarter of
+// them wrong in random order. An AUC that stops rising with thousands of feedbacks is the
+// subject's, not the classifier's.
+//   errp_ceiling_bench [--feedbacks 100,400,1600,6400] [--seeds 1] [--methods riemann,slda]
+//                      [--errp-scale F]
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "arbci/bci/errp_feedback.h"
+#include "arbci/bci/evaluation.h"
+#include "arbci/bci/p300_dataset.h"
+#include "arbci/bci/sample_clock.h"
+#include "arbci/bci/simulated_subject.h"
+#include "session/session_config.h"
+
+using namespace arbci;
+
+namespace {
+
+constexpr double kFeedbackPeriodS = 3.5;  // cue 1.5 s + result 1 s + pause 1 s
+
+// A calibration block of `feedbacks` feedbacks (a quarter wrong) by the simulated subject of
+// `eeg` with `seed`, as a recording whose stimuli are the feedbacks coded by class.
+bci::Recording calibrationBlock(const app::EegSettings& eeg, std::uint64_t seed, int feedbacks) {
+  bci::SimulatedSubjectConfig config;
+  config.montage = eeg.montage;
+  config.rate_hz = eeg.rate_hz;
+  config.block_size = eeg.block_size;
+  config.seed = seed;
+  config.line_hz = eeg.line_hz;
+  bci::SubjectProfile profile = bci::SubjectProfile::drawn(seed);
+  profile.p3_amplitude_uv *= eeg.erp_scale;
+  profile.n2_amplitude_uv *= eeg.erp_scale;
+  profile.errp_ne_amplitude_uv *= eeg.errp_scale;
+  profile.errp_pe_amplitude_uv *= eeg.errp_scale;
+  config.profile = profile;
+  bci::SimulatedSubject subject(config, std::make_shared<bci::UnboundedClock>());
+
+  std::mt19937 random(static_cast<std::uint32_t>(seed * 7919 + 17));
+  std::vector<bool> wrong(static_cast<size_t>(feedbacks), false);
+  std::fill_n(wrong.begin(), feedbacks / 4, true);
+  std::shuffle(wrong.begin(), wrong.end(), random);
+
+  const int channels = static_cast<int>(config.montage.size());
+  const auto period = static_cast<std::int64_t>(kFeedbackPeriodS * config.rate_hz);
+  const std::int64_t total = (feedbacks + 1) * period;
+  bci::Recording recording;
+  recording.source = "simulated subject, seed " + std::to_string(seed);
+  recording.format = "memory";
+  recording.info = subject.info();
+  recording.info.channels.resize(static_cast<size_t>(channels));
+  std::vector<std::vector<float>> samples(static_cast<size_t>(channels));
+  std::int64_t onset = period;  // the first feedback's presentation
+  int done = 0;
+  while (subject.samplesGenerated() < total) {
+    if (done < feedbacks && subject.samplesGenerated() + config.block_size > onset) {
+      const int target = 1 + static_cast<int>(random() % 4);
+      int shown = target;
+      if (wrong[static_cast<size_t>(done)]) {
+        while (shown == target) shown = 1 + static_cast<int>(random() % 4);
+      }
+      subject.attend({target});
+      subject.feedback(onset, {shown});
+      bci::StimulusEvent event;
+      event.sample = onset;
+      event.code =
+          wrong[static_cast<size_t>(done)] ? bci::kErrorFeedbackCode : bci::kCorrectFeedbackCode;
+      event.target = wrong[static_cast<size_t>(done)];
+      recording.stimuli.push_back(event);
+      ++done;
+      onset += period;
+    }
+    for (const bci::Block& block : subject.poll(1)) {
+      for (int c = 0; c < channels; ++c) {
+        for (int s = 0; s < block.samples; ++s)
+          samples[static_cast<size_t>(c)].push_back(block.at(c, s));
+      }
+    }
+  }
+  recording.samples = static_cast<std::int64_t>(samples[0].size());
+  for (const std::vector<float>& channel : samples)
+    recording.data.insert(recording.data.end(), channel.begin(), channel.end());
+  recording.parameters["Paradigm"] = "single stimulus, 2 stimuli";
+  return recording;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{
+      "Cross-validated AUC of the ErrP classifier on simulated calibration blocks of growing "
+      "size: how separable the simulated subject's error-related potentials are"};
+  std::vector<int> sizes{100, 400, 1600, 6400};
+  std::vector<int> seeds{1};
+  std::vector<std::string> methods{"riemann", "slda"};
+  cli.add_option("--feedbacks", sizes, "calibration block sizes (a quarter of them wrong)")
+      ->delimiter(',')
+      ->check(CLI::Range(20, 100000))
+      ->capture_default_str();
+  cli.add_option("--seeds", seeds, "simulated subjects (the embedded session's is 1)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
+  double errp_scale = -1.0;
+  cli.add_option("--errp-scale", errp_scale,
+                 "the simulated ErrP's size against the subject's drawn one (default: the "
+                 "embedded session's eeg.errp_scale)")
+      ->check(CLI::Range(0.0, 100.0));
+  cli.add_option("--methods", methods, "ErrP classifiers (swlda, slda, xdawn, riemann)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"swlda", "slda", "xdawn", "riemann"}))
+      ->capture_default_str();
+  CLI11_PARSE(cli, argc, argv);
+
+  app::SessionConfig config = app::SessionConfig::load(std::nullopt);
+  if (errp_scale >= 0.0) config.eeg.errp_scale = errp_scale;
+  const bci::PipelineSettings pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
+  std::printf(
+      "ErrP classifier, cross-validated AUC [95 %%] (5 contiguous blocks); the embedded session's "
+      "subject (errp_scale %.2f) and ErrP pipeline (%.1f-%.1f Hz, %.0f-%.0f ms, %.0f Hz "
+      "features, %zu channels); xDAWN filters per class %d\n%6s %9s %-8s %s\n",
+      config.eeg.errp_scale, pipeline.filter.highpass_hz, pipeline.filter.lowpass_hz,
+      pipeline.window.start_s * 1000.0, pipeline.window.end_s * 1000.0, pipeline.decimate_hz,
+      pipeline.channels.size(), config.errp.xdawn_filters, "seed", "feedbacks", "method", "AUC");
+  for (const int seed : seeds) {
+    for (const int size : sizes) {
+      const bci::Recording block =
+          calibrationBlock(config.eeg, static_cast<std::uint64_t>(seed), size);
+      const bci::P300Dataset data = bci::buildDataset({block}, pipeline);
+      for (const std::string& method : methods) {
+        bci::TrainingSettings training = config.errp.training();
+        training.method = method;
+        const bci::CrossValidation cv = bci::crossValidate(data, training);
+        std::printf("%6d %9d %-8s %.3f [%.3f, %.3f]\n", seed, size, method.c_str(), cv.report.auc,
+                    cv.report.auc_interval.low, cv.report.auc_interval.high);
+        std::fflush(stdout);
+      }
+    }
+  }
+  return 0;
+}
