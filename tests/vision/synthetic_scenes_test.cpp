@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_printer.h"
 #include "support/marker_scoring.h"
 #include "support/synthetic_markers.h"
 
@@ -76,6 +79,48 @@ TEST(SyntheticScenes, ReadsMotionBlurredMarkers) {
     EXPECT_GE(score.recall(), floor)
         << test::toString(condition) << ": " << score.found << " of " << score.truth;
   }
+}
+
+// A marker smeared along one line (a head turning fast): 6 ids, 44-60 px, a 15 or 17 px line at
+// 6 angles, 216 frames. Sharpening the cells against their two neighbours along each of the
+// grid's directions reads 62 of them; with the four-neighbour sharpening alone, 49. No wrong id.
+TEST(SyntheticScenes, ReadsMarkersSmearedAlongOneLine) {
+  int found = 0, frames = 0, wrong = 0;
+  for (int id : {17, 300, 1234, 2047, 3001, 4000}) {
+    const cv::Mat cells = markerCells(MarkerKind::Bch, id, 0.125);
+    for (int side : {44, 52, 60}) {
+      for (double degrees : {0.0, 30.0, 60.0, 90.0, 120.0, 150.0}) {
+        for (int length : {15, 17}) {
+          cv::Mat frame(240, 320, CV_8UC1, cv::Scalar(150));
+          const int margin = 12;  // white, as printed
+          frame(cv::Rect(160 - side / 2 - margin, 120 - side / 2 - margin, side + 2 * margin,
+                         side + 2 * margin))
+              .setTo(230);
+          cv::Mat marker;
+          cv::resize(cells, marker, cv::Size(side, side), 0, 0, cv::INTER_NEAREST);
+          marker.convertTo(frame(cv::Rect(160 - side / 2, 120 - side / 2, side, side)), CV_8U,
+                           200.0 / 255.0, 20.0);
+          // A line kernel `length` px long at `degrees`, drawn at 4x and reduced.
+          const int size = length | 1;
+          cv::Mat kernel = cv::Mat::zeros(4 * size, 4 * size, CV_32F);
+          const double angle = degrees * CV_PI / 180.0;
+          const cv::Point2f middle(2.0f * size, 2.0f * size);
+          const cv::Point2f half(static_cast<float>(2.0 * length * std::cos(angle)),
+                                 static_cast<float>(2.0 * length * std::sin(angle)));
+          cv::line(kernel, middle - half, middle + half, cv::Scalar(1.0), 1, cv::LINE_AA);
+          cv::resize(kernel, kernel, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+          kernel /= cv::sum(kernel)[0];
+          cv::filter2D(frame, frame, -1, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+          MarkerDetector detector(DetectorConfig{});
+          for (const MarkerDetection& m : detector.detect(frame).markers)
+            (m.id == id ? found : wrong)++;
+          ++frames;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GE(found, 56) << found << " of " << frames;
 }
 
 // The search on the frame averaged over 2x2 pixels, corners refined on the frame. Its adaptive

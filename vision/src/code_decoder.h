@@ -3,7 +3,9 @@
 // rather than guessed). For BCH IDs, when that hard decoding fails, a Chase decoder may try
 // again: the least reliable cells (closest to their threshold) are flipped in every combination,
 // each trial is hard-decoded, and the codeword whose disagreements with the cells weigh least
-// (summed reliability) wins if it is clearly better than any other.
+// (summed reliability) wins if it is clearly better than any other. It reads the cells as sampled,
+// sharpened against their four neighbours (blur), and sharpened along each of the grid's four
+// directions in turn (motion blur).
 #pragma once
 
 #include <optional>
