@@ -1,5 +1,6 @@
 #include "session/experimenter_script.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cfloat>
 #include <cmath>
@@ -154,8 +155,9 @@ ui::SyntheticInput ExperimenterScript::beforeFrame(double now_s, const std::stri
       const float y = found ? 0.5f * (found->y0 + found->y1) : 0.0f;
       // The panel's layout can shift under the pointer (a message appears above the button):
       // the click starts again wherever the button is now.
-      if (click_stage_ > 0 && (!found || !found->enabled || std::abs(x - click_x_) > 1.0f ||
-                               std::abs(y - click_y_) > 1.0f)) {
+      if (click_stage_ > 0 && click_stage_ < 3 &&
+          (!found || !found->enabled || std::abs(x - click_x_) > 1.0f ||
+           std::abs(y - click_y_) > 1.0f)) {
         click_stage_ = 0;
       }
       if (click_stage_ == 0) {
@@ -172,13 +174,25 @@ ui::SyntheticInput ExperimenterScript::beforeFrame(double now_s, const std::stri
         input.y = click_y_;
         break;
       }
-      // Pointer there (one frame), pressed (one frame), released: ImGui's click.
+      // Pointer there (one frame), pressed (one frame), released (one frame): ImGui's click.
+      // Then the frame that took the release says whether it landed: the layout can shift in
+      // that very frame (a message appears above the button as the arm reports), and the release
+      // then falls beside the button and nothing happens; the click is made again.
       input.x = click_x_;
       input.y = click_y_;
       input.left_down = click_stage_ == 1;
-      if (click_stage_ == 2) {
-        std::cerr << "\nscript: clicked \"" << c.text << "\"\n";
-        advance();
+      if (click_stage_ == 3) {
+        const bool landed =
+            std::any_of(ui::drawnWidgets().begin(), ui::drawnWidgets().end(),
+                        [&](const ui::DrawnWidget& w) { return w.label == c.text && w.clicked; });
+        if (landed) {
+          std::cerr << "\nscript: clicked \"" << c.text << "\"\n";
+          advance();
+        } else {
+          std::cerr << "\nscript: the click on \"" << c.text
+                    << "\" fell beside it (the panel moved); clicking again\n";
+          click_stage_ = 0;
+        }
       } else {
         ++click_stage_;
       }

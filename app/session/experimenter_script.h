@@ -52,7 +52,7 @@ class ExperimenterScript {
   std::vector<Command> commands_;
   size_t next_ = 0;
   double started_s_ = -1.0;  // when the current command began
-  int click_stage_ = 0;      // 0: find, 1: press, 2: release
+  int click_stage_ = 0;      // 0: find, 1: press, 2: release, 3: confirm
   float click_x_ = 0, click_y_ = 0;
   std::string error_;
 };

@@ -24,10 +24,10 @@ std::string currentWindowTitle() {
   return window ? shownLabel(window->Name) : std::string();
 }
 
-void record(const char* label, bool enabled, const std::string& why_not) {
+void record(const char* label, bool enabled, const std::string& why_not, bool clicked) {
   const ImVec2 min = ImGui::GetItemRectMin(), max = ImGui::GetItemRectMax();
-  detail::recordWidget(
-      {shownLabel(label), currentWindowTitle(), min.x, min.y, max.x, max.y, enabled, why_not});
+  detail::recordWidget({shownLabel(label), currentWindowTitle(), min.x, min.y, max.x, max.y,
+                        enabled, why_not, clicked});
 }
 
 bool hasExtension(const std::filesystem::path& path, const char* extensions) {
@@ -50,7 +50,7 @@ bool button(const char* label, const std::string& why_not, bool small) {
   ImGui::EndDisabled();
   if (!enabled && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip("%s", why_not.c_str());
-  record(label, enabled, why_not);
+  record(label, enabled, why_not, pressed && enabled);
   return pressed && enabled;
 }
 

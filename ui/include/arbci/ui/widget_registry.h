@@ -14,6 +14,7 @@ struct DrawnWidget {
   float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   bool enabled = true;
   std::string why_disabled;
+  bool clicked = false;  // a click landed on it in this frame (the UI acted on it)
 };
 
 // The widgets of the last frame that ended (ImGuiLayer::endFrame).
