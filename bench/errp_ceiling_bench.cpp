@@ -19,6 +19,7 @@
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/sample_clock.h"
 #include "arbci/bci/simulated_subject.h"
+#include "session/eeg_stage.h"
 #include "session/session_config.h"
 
 using namespace arbci;
@@ -29,19 +30,10 @@ constexpr double kFeedbackPeriodS = 3.5;  // cue 1.5 s + result 1 s + pause 1 s
 
 // A calibration block of `feedbacks` feedbacks (a quarter wrong) by the simulated subject of
 // `eeg` with `seed`, as a recording whose stimuli are the feedbacks coded by class.
-bci::Recording calibrationBlock(const app::EegSettings& eeg, std::uint64_t seed, int feedbacks) {
-  bci::SimulatedSubjectConfig config;
-  config.montage = eeg.montage;
-  config.rate_hz = eeg.rate_hz;
-  config.block_size = eeg.block_size;
-  config.seed = seed;
-  config.line_hz = eeg.line_hz;
-  bci::SubjectProfile profile = bci::SubjectProfile::drawn(seed);
-  profile.p3_amplitude_uv *= eeg.erp_scale;
-  profile.n2_amplitude_uv *= eeg.erp_scale;
-  profile.errp_ne_amplitude_uv *= eeg.errp_scale;
-  profile.errp_pe_amplitude_uv *= eeg.errp_scale;
-  config.profile = profile;
+bci::Recording calibrationBlock(app::EegSettings eeg, std::uint64_t seed, int feedbacks) {
+  eeg.seed = seed;
+  eeg.photodiode_channel.clear();  // the ErrP pipeline's channels only
+  const bci::SimulatedSubjectConfig config = app::simulatedSubjectOf(eeg);
   bci::SimulatedSubject subject(config, std::make_shared<bci::UnboundedClock>());
 
   std::mt19937 random(static_cast<std::uint32_t>(seed * 7919 + 17));

@@ -56,6 +56,12 @@ std::unique_ptr<bci::EegSource> openSource(const EegStageSettings& settings,
     replay.stimuli.clear();  // the session presents its own stimuli
     return std::make_unique<bci::FileSource>(std::move(replay), clock, eeg.block_size);
   }
+  return std::make_unique<bci::SimulatedSubject>(simulatedSubjectOf(eeg), clock);
+}
+
+}  // namespace
+
+bci::SimulatedSubjectConfig simulatedSubjectOf(const EegSettings& eeg) {
   bci::SimulatedSubjectConfig subject;
   subject.montage = eeg.montage;
   subject.rate_hz = eeg.rate_hz;
@@ -70,10 +76,8 @@ std::unique_ptr<bci::EegSource> openSource(const EegStageSettings& settings,
   profile.errp_ne_amplitude_uv *= eeg.errp_scale;
   profile.errp_pe_amplitude_uv *= eeg.errp_scale;
   subject.profile = profile;
-  return std::make_unique<bci::SimulatedSubject>(subject, clock);
+  return subject;
 }
-
-}  // namespace
 
 EegStageSettings EegStageSettings::of(const SessionConfig& config) {
   EegStageSettings s;

@@ -23,6 +23,7 @@
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
+#include "arbci/bci/simulated_subject.h"
 #include "session/session_config.h"
 #include "session/session_log.h"
 #include "session/stage.h"
@@ -47,6 +48,11 @@ struct EegStageSettings {
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.
   void validate() const;
 };
+
+// The simulated subject a session with `eeg` (source "simulated") acquires from: its montage,
+// rate, seed and line noise, the seed's drawn profile with eeg.erp_scale and eeg.errp_scale
+// applied, and a virtual photodiode channel when one is named.
+bci::SimulatedSubjectConfig simulatedSubjectOf(const EegSettings& eeg);
 
 struct TrainingOutcome {
   bci::P300Model model;

@@ -171,18 +171,6 @@ cv::Mat gainField(cv::Size size, std::mt19937& random) {
   return gain;
 }
 
-// Smears the frame along a line of `length` px at `angle` (a box kernel on that line).
-void motionBlur(cv::Mat& frame, float length, float angle) {
-  const int size = static_cast<int>(std::ceil(length)) | 1;
-  cv::Mat kernel = cv::Mat::zeros(size * 4, size * 4, CV_32F);  // drawn at 4x, then reduced
-  const cv::Point2f centre(size * 2.0f, size * 2.0f);
-  const cv::Point2f half(std::cos(angle) * length * 2.0f, std::sin(angle) * length * 2.0f);
-  cv::line(kernel, centre - half, centre + half, cv::Scalar(1.0), 1, cv::LINE_AA);
-  cv::resize(kernel, kernel, cv::Size(size, size), 0, 0, cv::INTER_AREA);
-  kernel /= cv::sum(kernel)[0];
-  cv::filter2D(frame, frame, -1, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
-}
-
 void applyCondition(cv::Mat& frame, Condition condition, std::mt19937& random) {
   if (condition == Condition::MotionBlur || condition == Condition::MotionBlurJpeg ||
       condition == Condition::FastMotionJpeg) {
@@ -223,6 +211,18 @@ void drawDecoys(cv::Mat& frame, const SceneLayout& layout) {
 }
 
 }  // namespace
+
+// Smears the frame along a line of `length` px at `angle` (a box kernel on that line).
+void motionBlur(cv::Mat& frame, float length, float angle) {
+  const int size = static_cast<int>(std::ceil(length)) | 1;
+  cv::Mat kernel = cv::Mat::zeros(size * 4, size * 4, CV_32F);  // drawn at 4x, then reduced
+  const cv::Point2f centre(size * 2.0f, size * 2.0f);
+  const cv::Point2f half(std::cos(angle) * length * 2.0f, std::sin(angle) * length * 2.0f);
+  cv::line(kernel, centre - half, centre + half, cv::Scalar(1.0), 1, cv::LINE_AA);
+  cv::resize(kernel, kernel, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+  kernel /= cv::sum(kernel)[0];
+  cv::filter2D(frame, frame, -1, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+}
 
 std::string toString(MarkerFamily family) {
   switch (family) {

@@ -65,6 +65,10 @@ SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed);
 // Draws the layout with `family`'s markers (ids drawn from the seed) under `condition`.
 RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condition condition);
 
+// Smears `frame` along a line `length` px long at `angle` radians (a box kernel on that line, drawn
+// at 4x and reduced): a camera moving during its exposure.
+void motionBlur(cv::Mat& frame, float length, float angle);
+
 // A frame of `size` with background and decoys only (no markers), under `condition`.
 cv::Mat renderMarkerFree(const SceneLayout& layout, Condition condition);
 

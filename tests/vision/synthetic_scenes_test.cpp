@@ -100,17 +100,8 @@ TEST(SyntheticScenes, ReadsMarkersSmearedAlongOneLine) {
           cv::resize(cells, marker, cv::Size(side, side), 0, 0, cv::INTER_NEAREST);
           marker.convertTo(frame(cv::Rect(160 - side / 2, 120 - side / 2, side, side)), CV_8U,
                            200.0 / 255.0, 20.0);
-          // A line kernel `length` px long at `degrees`, drawn at 4x and reduced.
-          const int size = length | 1;
-          cv::Mat kernel = cv::Mat::zeros(4 * size, 4 * size, CV_32F);
-          const double angle = degrees * CV_PI / 180.0;
-          const cv::Point2f middle(2.0f * size, 2.0f * size);
-          const cv::Point2f half(static_cast<float>(2.0 * length * std::cos(angle)),
-                                 static_cast<float>(2.0 * length * std::sin(angle)));
-          cv::line(kernel, middle - half, middle + half, cv::Scalar(1.0), 1, cv::LINE_AA);
-          cv::resize(kernel, kernel, cv::Size(size, size), 0, 0, cv::INTER_AREA);
-          kernel /= cv::sum(kernel)[0];
-          cv::filter2D(frame, frame, -1, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+          test::motionBlur(frame, static_cast<float>(length),
+                           static_cast<float>(degrees * CV_PI / 180.0));
           MarkerDetector detector(DetectorConfig{});
           for (const MarkerDetection& m : detector.detect(frame).markers)
             (m.id == id ? found : wrong)++;
