@@ -73,18 +73,18 @@ void RunLabeler::markDark(const std::uint8_t* pixels, const std::uint8_t* limit,
 }
 
 void RunLabeler::appendRuns(const std::uint64_t* bits, int words, int y) {
+  // Bit x of `edges` is set where pixel x differs from pixel x - 1 (the one left of the row is
+  // light): runs start and end at alternate edges.
   bool inside = false;
   int start = 0;
+  std::uint64_t previous = 0;  // the last pixel of the word before
   for (int w = 0; w < words; ++w) {
     const std::uint64_t word = bits[w];
-    if (word == (inside ? ~std::uint64_t{0} : std::uint64_t{0})) continue;
-    int position = 0;
-    while (position < 64) {
-      // Next change of state at or after `position`.
-      const std::uint64_t pending = (inside ? ~word : word) & (~std::uint64_t{0} << position);
-      if (pending == 0) break;
-      position = __builtin_ctzll(pending);
-      const int x = w * 64 + position;
+    std::uint64_t edges = word ^ ((word << 1) | previous);
+    previous = word >> 63;
+    while (edges != 0) {
+      const int x = w * 64 + __builtin_ctzll(edges);
+      edges &= edges - 1;
       if (inside) {
         const int index = static_cast<int>(runs_.size());
         runs_.push_back({start, x, y, index});
@@ -119,13 +119,18 @@ void RunLabeler::connect() {
       const PixelRun& here = runs_[j];
       // 8-connected when the runs overlap or touch diagonally.
       if (above.x0 <= here.x1 && here.x0 <= above.x1) {
-        ++runs_[j].links;
-        const int a = find(i), b = find(j);
-        // The smaller index becomes the root, so a root is its component's first run.
-        if (a < b) {
-          runs_[b].parent = a;
-        } else if (b < a) {
-          runs_[a].parent = b;
+        const int a = find(i);
+        // The smaller index becomes the root, so a root is its component's first run (and every
+        // run's parent comes before it). A run's first link finds it still its own root.
+        if (runs_[j].links++ == 0) {
+          runs_[j].parent = a;
+        } else {
+          const int b = find(j);
+          if (a < b) {
+            runs_[b].parent = a;
+          } else if (b < a) {
+            runs_[a].parent = b;
+          }
         }
       }
       if (above.x1 < here.x1) {
@@ -141,8 +146,10 @@ void RunLabeler::collect() {
   components_.clear();
   component_of_root_.assign(runs_.size(), -1);
   for (int i = 0; i < static_cast<int>(runs_.size()); ++i) {
-    const int root = find(i);
-    const PixelRun& run = runs_[i];
+    // Parents come before their runs: in this order a run's parent already points at its root.
+    PixelRun& run = runs_[i];
+    run.parent = runs_[run.parent].parent;
+    const int root = run.parent;
     if (root == i) {
       component_of_root_[i] = static_cast<int>(components_.size());
       components_.push_back({0, run.x0, run.x1 - 1, run.y, run.y, run.x0, run.y, 1});

@@ -58,6 +58,16 @@ constexpr int farWeight(int k, int tile) {
   return std::abs(2 * k + 1 - tile) * 4 / tile;
 }
 
+#ifdef __SSE2__
+// (6 a + 2 b + 4) / 8 exactly, in bytes: the rounded mean of a and the truncated mean of a and b
+// (for an odd a + b the truncation's half is lost where the sum's last bit could not carry).
+inline __m128i threeQuartersTowards(__m128i a, __m128i b) {
+  const __m128i truncated =
+      _mm_sub_epi8(_mm_avg_epu8(a, b), _mm_and_si128(_mm_xor_si128(a, b), _mm_set1_epi8(1)));
+  return _mm_avg_epu8(a, truncated);
+}
+#endif
+
 // out = (w_near * near + w_far * far + 4) / 8, with w_near + w_far = 8.
 void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restrict far, int w_near,
                int w_far, std::uint8_t* __restrict out, int n) {
@@ -66,6 +76,14 @@ void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restri
   const __m128i zero = _mm_setzero_si128(), four = _mm_set1_epi16(4);
   const __m128i wn = _mm_set1_epi16(static_cast<short>(w_near)),
                 wf = _mm_set1_epi16(static_cast<short>(w_far));
+  if (w_near == 6) {  // every row of 2 px tiles
+    for (; x + 16 <= n; x += 16) {
+      _mm_storeu_si128(
+          reinterpret_cast<__m128i*>(out + x),
+          threeQuartersTowards(_mm_loadu_si128(reinterpret_cast<const __m128i*>(near + x)),
+                               _mm_loadu_si128(reinterpret_cast<const __m128i*>(far + x))));
+    }
+  }
   for (; x + 16 <= n; x += 16) {
     const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(near + x));
     const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(far + x));
@@ -98,12 +116,6 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
   if constexpr (kTileSize == 2) {
     // out[2t] = (6 v[t] + 2 v[t - 1] + 4) / 8, out[2t + 1] the same towards v[t + 1]; tiles 1 to
     // cols - 2 here (their neighbours exist), the ends below.
-    const __m128i zero = _mm_setzero_si128(), four = _mm_set1_epi16(4), six = _mm_set1_epi16(6);
-    auto blend = [&](__m128i here, __m128i other) {  // 16-bit lanes
-      return _mm_srli_epi16(
-          _mm_add_epi16(_mm_add_epi16(_mm_mullo_epi16(here, six), _mm_slli_epi16(other, 1)), four),
-          3);
-    };
     out[0] = static_cast<std::uint8_t>((8 * v[0] + 4) >> 3);
     out[1] = static_cast<std::uint8_t>((6 * v[0] + 2 * v[cols > 1 ? 1 : 0] + 4) >> 3);
     t = 1;
@@ -111,12 +123,7 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
       const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t));
       const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t - 1));
       const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t + 1));
-      const __m128i even =
-          _mm_packus_epi16(blend(_mm_unpacklo_epi8(h, zero), _mm_unpacklo_epi8(l, zero)),
-                           blend(_mm_unpackhi_epi8(h, zero), _mm_unpackhi_epi8(l, zero)));
-      const __m128i odd =
-          _mm_packus_epi16(blend(_mm_unpacklo_epi8(h, zero), _mm_unpacklo_epi8(r, zero)),
-                           blend(_mm_unpackhi_epi8(h, zero), _mm_unpackhi_epi8(r, zero)));
+      const __m128i even = threeQuartersTowards(h, l), odd = threeQuartersTowards(h, r);
       _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * t), _mm_unpacklo_epi8(even, odd));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * t + 16), _mm_unpackhi_epi8(even, odd));
     }
@@ -354,6 +361,42 @@ void limitsOfRow(const TileRow& row, int contrast, int split_sixteenths, int col
   }
 }
 
+// One row of a coarse level's "dark below" levels + 1: the lower quarter of a cell's range where
+// that has contrast, else its parent's (`parent`: the row of the next coarser level, a cell per
+// two; nullptr at the coarsest level, whose cells without contrast get 0).
+void darkBelowOfRow(const std::uint8_t* __restrict lo, const std::uint8_t* __restrict hi,
+                    const std::uint8_t* __restrict parent, int contrast, int cols,
+                    std::uint8_t* __restrict out) {
+  int x = 0;
+#ifdef __SSE2__
+  // In bytes: the range cannot wrap (hi >= lo), and the quarter level is at most 255 wherever it
+  // is used (a range of at least 1 keeps lo below 255).
+  const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi8(1);
+  const __m128i floor = _mm_set1_epi8(static_cast<char>(contrast - 1));
+  const __m128i six_bits = _mm_set1_epi8(0x3F);
+  for (; x + 16 <= cols; x += 16) {
+    const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(lo + x));
+    const __m128i range =
+        _mm_sub_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(hi + x)), l);
+    const __m128i quarter = _mm_and_si128(_mm_srli_epi16(range, 2), six_bits);
+    const __m128i own = _mm_add_epi8(_mm_add_epi8(l, quarter), one);
+    const __m128i flat = _mm_cmpeq_epi8(_mm_subs_epu8(range, floor), zero);  // range < contrast
+    __m128i above = zero;
+    if (parent) {
+      const __m128i p = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(parent + x / 2));
+      above = _mm_unpacklo_epi8(p, p);
+    }
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x),
+                     _mm_or_si128(_mm_andnot_si128(flat, own), _mm_and_si128(flat, above)));
+  }
+#endif
+  for (; x < cols; ++x) {
+    const int range = hi[x] - lo[x];
+    out[x] = range >= contrast ? static_cast<std::uint8_t>(lo[x] + range / 4 + 1)
+                               : (parent ? parent[x / 2] : std::uint8_t{0});
+  }
+}
+
 }  // namespace
 
 void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileThresholds& out,
@@ -447,18 +490,14 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
   for (int level = kLevels - 1; level >= 1; --level) {
     const MinMaxGrid& grid = dilated_[level];
     std::vector<std::uint8_t>& coarse = coarse_[level];
-    coarse.assign(grid.lo.size(), 0);
+    coarse.resize(grid.lo.size());  // every cell is written below
     for (int y = 0; y < grid.rows; ++y) {
-      for (int x = 0; x < grid.cols; ++x) {
-        const size_t i = static_cast<size_t>(y) * grid.cols + x;
-        const int lo = grid.lo[i], hi = grid.hi[i];
-        if (hi - lo >= contrast) {
-          coarse[i] = static_cast<std::uint8_t>(lo + (hi - lo) / 4 + 1);
-        } else if (level + 1 < kLevels) {
-          coarse[i] =
-              coarse_[level + 1][static_cast<size_t>(y / 2) * dilated_[level + 1].cols + x / 2];
-        }
-      }
+      const size_t row = static_cast<size_t>(y) * grid.cols;
+      const std::uint8_t* parent =
+          level + 1 < kLevels
+              ? &coarse_[level + 1][static_cast<size_t>(y / 2) * dilated_[level + 1].cols]
+              : nullptr;
+      darkBelowOfRow(&grid.lo[row], &grid.hi[row], parent, contrast, grid.cols, &coarse[row]);
     }
   }
   contrast_ = contrast;
