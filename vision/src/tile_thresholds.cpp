@@ -308,9 +308,11 @@ void limitsOfRow(const TileRow& row, int contrast, int split_sixteenths, int col
   const std::uint8_t* __restrict hi1 = row.parent_hi;
   int tx = 0;
 #ifdef __SSE2__
-  // Sixteen tiles at a time, in 16-bit lanes; each parent byte serves two tiles.
-  const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi16(1), byte = _mm_set1_epi16(255);
-  const __m128i floor = _mm_set1_epi16(static_cast<short>(contrast - 1));
+  // Sixteen tiles at a time, in bytes (only the split's product needs 16-bit lanes); each parent
+  // byte serves two tiles. Saturating adds stand for the scalar code's clamps: three times a
+  // range of 85 or more is never exceeded by a parent's range, and lo + split <= hi.
+  const __m128i zero = _mm_setzero_si128(), ones = _mm_set1_epi8(1);
+  const __m128i floor = _mm_set1_epi8(static_cast<char>(contrast - 1));
   const __m128i split_factor = _mm_set1_epi16(static_cast<short>(split_sixteenths));
   auto load16 = [](const std::uint8_t* p) {
     return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
@@ -319,35 +321,27 @@ void limitsOfRow(const TileRow& row, int contrast, int split_sixteenths, int col
     const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
     return _mm_unpacklo_epi8(v, v);
   };
-  auto limits8 = [&](__m128i lo, __m128i hi, __m128i own_sum, __m128i above, __m128i above_range) {
-    const __m128i range = _mm_sub_epi16(hi, lo);
-    const __m128i weak =
-        _mm_cmpgt_epi16(above_range, _mm_add_epi16(range, _mm_slli_epi16(range, 1)));
-    const __m128i has_parent = _mm_cmpgt_epi16(above, zero);
-    const __m128i edge =
-        _mm_andnot_si128(_mm_and_si128(weak, has_parent), _mm_cmpgt_epi16(range, floor));
-    const __m128i split = _mm_srli_epi16(_mm_mullo_epi16(range, split_factor), 4);
-    const __m128i edge_limit = _mm_min_epi16(_mm_add_epi16(_mm_add_epi16(lo, split), one), byte);
-    const __m128i flat = _mm_and_si128(
-        _mm_and_si128(has_parent, _mm_cmpgt_epi16(above, _mm_srli_epi16(own_sum, 1))), byte);
-    return _mm_or_si128(_mm_and_si128(edge, edge_limit), _mm_andnot_si128(edge, flat));
+  auto above = [&](__m128i a, __m128i b) {  // a > b, unsigned bytes
+    return _mm_xor_si128(_mm_cmpeq_epi8(_mm_subs_epu8(a, b), zero), _mm_set1_epi8(-1));
   };
   for (; tx + 16 <= cols; tx += 16) {
-    const __m128i lo = load16(lo0 + tx), hi = load16(hi0 + tx);
+    const __m128i lo = load16(lo0 + tx), range = _mm_sub_epi8(load16(hi0 + tx), lo);
     const __m128i a = load16(own_lo + tx), b = load16(own_hi + tx);
-    const __m128i above = twice8(parent + tx / 2);
-    const __m128i above_lo = twice8(lo1 + tx / 2), above_hi = twice8(hi1 + tx / 2);
-    const __m128i low = limits8(
-        _mm_unpacklo_epi8(lo, zero), _mm_unpacklo_epi8(hi, zero),
-        _mm_add_epi16(_mm_unpacklo_epi8(a, zero), _mm_unpacklo_epi8(b, zero)),
-        _mm_unpacklo_epi8(above, zero),
-        _mm_sub_epi16(_mm_unpacklo_epi8(above_hi, zero), _mm_unpacklo_epi8(above_lo, zero)));
-    const __m128i high = limits8(
-        _mm_unpackhi_epi8(lo, zero), _mm_unpackhi_epi8(hi, zero),
-        _mm_add_epi16(_mm_unpackhi_epi8(a, zero), _mm_unpackhi_epi8(b, zero)),
-        _mm_unpackhi_epi8(above, zero),
-        _mm_sub_epi16(_mm_unpackhi_epi8(above_hi, zero), _mm_unpackhi_epi8(above_lo, zero)));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(limit + tx), _mm_packus_epi16(low, high));
+    const __m128i level = twice8(parent + tx / 2);
+    const __m128i above_range = _mm_sub_epi8(twice8(hi1 + tx / 2), twice8(lo1 + tx / 2));
+    const __m128i weak = above(above_range, _mm_adds_epu8(_mm_adds_epu8(range, range), range));
+    const __m128i has_parent = above(level, zero);
+    const __m128i edge = _mm_andnot_si128(_mm_and_si128(weak, has_parent), above(range, floor));
+    const __m128i split = _mm_packus_epi16(
+        _mm_srli_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(range, zero), split_factor), 4),
+        _mm_srli_epi16(_mm_mullo_epi16(_mm_unpackhi_epi8(range, zero), split_factor), 4));
+    const __m128i edge_limit = _mm_adds_epu8(_mm_adds_epu8(lo, split), ones);
+    // The tile's own midrange, truncated: the rounded byte average less the lost half.
+    const __m128i middle =
+        _mm_sub_epi8(_mm_avg_epu8(a, b), _mm_and_si128(_mm_xor_si128(a, b), ones));
+    const __m128i flat = _mm_and_si128(has_parent, above(level, middle));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(limit + tx),
+                     _mm_or_si128(_mm_and_si128(edge, edge_limit), _mm_andnot_si128(edge, flat)));
   }
 #endif
   for (; tx < cols; ++tx) {
