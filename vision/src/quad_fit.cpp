@@ -371,7 +371,7 @@ void convexHullOfContour(const std::vector<cv::Point>& contour, std::vector<int>
     y1 = std::max(y1, p.y);
   }
   const int rows = y1 - y0 + 1;
-  thread_local std::vector<int> left, right, order;
+  thread_local std::vector<int> left, right, down, up;
   left.assign(static_cast<size_t>(rows), -1);
   right.assign(static_cast<size_t>(rows), -1);
   for (int i = 0; i < static_cast<int>(contour.size()); ++i) {
@@ -379,26 +379,30 @@ void convexHullOfContour(const std::vector<cv::Point>& contour, std::vector<int>
     if (left[r] < 0 || contour[i].x < contour[left[r]].x) left[r] = i;
     if (right[r] < 0 || contour[i].x > contour[right[r]].x) right[r] = i;
   }
-  order.clear();  // sorted by (y, x)
-  for (int r = 0; r < rows; ++r) {
-    if (left[r] < 0) continue;
-    order.push_back(left[r]);
-    if (contour[right[r]].x != contour[left[r]].x) order.push_back(right[r]);
-  }
+  // Andrew's monotone chain over the points sorted by (y, x): the right side going down, then
+  // the left side going up, keeping only turns to the right on screen (clockwise with y pointing
+  // down). A row's leftmost point lies left of the right side and its rightmost right of the left
+  // side (but in the top and bottom rows, where the sides meet), so each side is chained from the
+  // points that can lie on it: the same hull from half the points.
+  down.clear();  // the first point, then each row's rightmost
+  up.clear();    // each row's leftmost but the last point, from the bottom up
+  auto wide = [&](int r) { return contour[right[r]].x != contour[left[r]].x; };
+  down.push_back(left[0]);
+  if (wide(0)) down.push_back(right[0]);
+  for (int r = 1; r < rows; ++r) down.push_back(right[r]);
+  if (wide(rows - 1)) up.push_back(left[rows - 1]);
+  for (int r = rows - 2; r >= 0; --r) up.push_back(left[r]);
   auto cross = [&](int o, int a, int b) {
     const cv::Point oa = contour[a] - contour[o], ob = contour[b] - contour[o];
     return static_cast<std::int64_t>(oa.x) * ob.y - static_cast<std::int64_t>(oa.y) * ob.x;
   };
-  // Monotone chain over points sorted by y: the right side going down, then the left going up,
-  // keeping only turns to the right on screen (clockwise with y pointing down).
   hull.clear();
-  for (int i : order) {
+  for (int i : down) {
     while (hull.size() >= 2 && cross(hull[hull.size() - 2], hull.back(), i) <= 0) hull.pop_back();
     hull.push_back(i);
   }
   const size_t right_side = hull.size() + 1;
-  for (int k = static_cast<int>(order.size()) - 2; k >= 0; --k) {
-    const int i = order[k];
+  for (int i : up) {
     while (hull.size() >= right_side && cross(hull[hull.size() - 2], hull.back(), i) <= 0)
       hull.pop_back();
     hull.push_back(i);
