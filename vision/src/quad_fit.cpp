@@ -379,11 +379,11 @@ void convexHullOfContour(const std::vector<cv::Point>& contour, std::vector<int>
     if (left[r] < 0 || contour[i].x < contour[left[r]].x) left[r] = i;
     if (right[r] < 0 || contour[i].x > contour[right[r]].x) right[r] = i;
   }
-  // Andrew's monotone chain over the points sorted by (y, x): the right side going down, then
-  // the left side going up, keeping only turns to the right on screen (clockwise with y pointing
-  // down). A row's leftmost point lies left of the right side and its rightmost right of the left
-  // side (but in the top and bottom rows, where the sides meet), so each side is chained from the
-  // points that can lie on it: the same hull from half the points.
+  // Andrew's monotone chain, its points taken row by row (so already in (y, x) order): the right
+  // side going down, then the left side going up, keeping only turns to the right on screen
+  // (clockwise with y pointing down). A row's leftmost point lies left of the right side and its
+  // rightmost right of the left side (but in the top and bottom rows, where the sides meet), so
+  // each side is chained from the points that can lie on it: the same hull from half the points.
   down.clear();  // the first point, then each row's rightmost
   up.clear();    // each row's leftmost but the last point, from the bottom up
   auto wide = [&](int r) { return contour[right[r]].x != contour[left[r]].x; };
