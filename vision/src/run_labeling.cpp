@@ -55,14 +55,23 @@ void RunLabeler::markDark(const std::uint8_t* pixels, const std::uint8_t* limit,
   int x = 0;
 #ifdef __SSE2__
   const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi8(1);
-  for (; x + 16 <= width; x += 16) {
-    const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pixels + x));
-    const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(limit + x));
+  auto sixteen = [&](int at) {
+    const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pixels + at));
+    const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(limit + at));
     // limit - value saturates to 0 exactly when the pixel is not dark.
     const __m128i light = _mm_cmpeq_epi8(_mm_subs_epu8(l, p), zero);
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(mask + x), _mm_andnot_si128(light, one));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(mask + at), _mm_andnot_si128(light, one));
     const std::uint64_t dark = ~static_cast<unsigned>(_mm_movemask_epi8(light)) & 0xFFFFu;
-    bits[x >> 6] |= dark << (x & 63);
+    bits[at >> 6] |= dark << (at & 63);
+    // Sixteen pixels from `at` may cross into the next word.
+    if ((at & 63) > 48) bits[(at >> 6) + 1] |= dark >> (64 - (at & 63));
+  };
+  for (; x + 16 <= width; x += 16) sixteen(x);
+  // The last pixels (a region narrower than a multiple of 16) as the last sixteen, again
+  // writing the pixels before them with the same values.
+  if (x < width && width >= 16) {
+    sixteen(width - 16);
+    x = width;
   }
 #endif
   for (; x < width; ++x) {
