@@ -30,7 +30,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kSmoothAboveNoise = 2.5;  // grey levels of estimated noise
-constexpr size_t kMaxRetries = 12;         // near-miss components re-binarised per frame
+constexpr size_t kMaxRetries = 8;          // near-miss components re-binarised per frame
 constexpr size_t kMaxFragmentRetries = 6;  // and groups of fragments
 constexpr int kMaxRetrySide = 160;         // px; larger borders are not thinned by blur
 constexpr int kRetryMargin = 14;           // px around a near miss
@@ -43,10 +43,17 @@ constexpr int kFragmentedSplit = 11;
 // Reduced-image px: a quad narrower than this (its area over its longest side) is refined on the
 // reduced image before the frame.
 constexpr float kThinQuadWidth = 8.0f;
+// Reduced-image px: a ringed near miss narrower than this and at least this long (a marker seen
+// nearly edge-on, its code cells 1 px or less) is labelled again on the frame. Shorter ones are
+// too small to read edge-on, and retrying them (text, clutter) would cost more than they find.
+constexpr float kThinOnFrameWidth = 10.0f;
+constexpr float kThinOnFrameMinLength = 20.0f;
 
 struct RetryRegion {
   cv::Rect box;
-  bool fragmented;  // several failed components, rather than one square-hulled outline
+  bool fragmented;      // several failed components, rather than one square-hulled outline
+  bool thin = false;    // also labelled again on the frame (kThinOnFrameWidth)
+  bool ringed = false;  // encloses a hole, as a marker's border does
 };
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
@@ -163,10 +170,12 @@ struct MarkerDetector::Impl {
   // Components that did not fit a quad, then grouped into marker-sized regions to retry.
   std::vector<DarkComponent> traced;  // the frame's components whose outline was fitted
   std::vector<cv::Rect> failed;
+  std::vector<int> failed_rings;     // per failed component (then group): how many enclose a hole
   std::vector<RetryRegion> retries;  // square-hulled near misses first, then fragment groups
   std::vector<int> group, group_size;
   RunLabeler roi_labels;
-  cv::Mat roi_limits;
+  cv::Mat roi_limits, frame_limits;
+  std::vector<Quad> on_frame_quads;  // found on the frame by retryOnFrame(), decoded as they are
   std::vector<SquareCorners> squares, ideal_squares;
   // decode(): quads by decreasing area, the markers decoded (by quad index), their samples'
   // medians, and the quads in frame pixels.
@@ -236,7 +245,9 @@ struct MarkerDetector::Impl {
     params.lens = scale == 1 ? config.lens.get() : nullptr;
     params.refine_edges = scale == 1;
     failed.clear();
+    failed_rings.clear();
     retries.clear();
+    on_frame_quads.clear();
     traced.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
     for (const DarkComponent& c : labels.components()) {
@@ -257,9 +268,11 @@ struct MarkerDetector::Impl {
         if (!solid) quads.push_back(*fit.quad);
       } else if (adaptive_mode && std::max(w, h) <= max_retry_side) {
         failed.emplace_back(c.min_x, c.min_y, w, h);
+        failed_rings.push_back(c.holes > 0);
         if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f &&
             everySideHasDark(fit.hull_corners))
-          retries.push_back({failed.back(), false});
+          retries.push_back({failed.back(), false,
+                             scale > 1 && c.holes > 0 && isThin(fit.hull_corners), c.holes > 0});
       }
     }
     if (adaptive_mode) {
@@ -295,8 +308,23 @@ struct MarkerDetector::Impl {
     return true;
   }
 
-  // Keeps the `count` largest regions from the first one not yet capped on: noise leaves many
-  // small near misses, and markers are seldom the smallest.
+  // A hull narrower than kThinOnFrameWidth (its area over its longest side) and as long as
+  // kThinOnFrameMinLength.
+  static bool isThin(const std::array<cv::Point, 4>& hull) {
+    std::array<cv::Point2f, 4> q;
+    float longest = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      q[k] = hull[k];
+      longest = std::max(longest, static_cast<float>(cv::norm(hull[(k + 1) % 4] - hull[k])));
+    }
+    const float width = quadArea(q) / std::max(1.0f, longest);
+    return width < kThinOnFrameWidth && longest >= kThinOnFrameMinLength;
+  }
+
+  // Keeps `count` regions from the first one not yet capped on: near misses enclosing a hole
+  // first (a marker's border does; a blurred line seldom), then the largest. Noise leaves many
+  // small near misses, and markers are seldom the smallest. (Fragment groups are kept by size
+  // alone: ranked by their pieces' holes, two fewer markers were read under motion blur.)
   static void keepLargest(std::vector<RetryRegion>& regions, size_t count) {
     if (regions.size() <= count) return;
     const size_t from =
@@ -305,9 +333,10 @@ struct MarkerDetector::Impl {
             : static_cast<size_t>(std::find_if(regions.begin(), regions.end(),
                                                [](const RetryRegion& r) { return r.fragmented; }) -
                                   regions.begin());
-    std::partial_sort(
-        regions.begin() + from, regions.begin() + count, regions.end(),
-        [](const RetryRegion& a, const RetryRegion& b) { return a.box.area() > b.box.area(); });
+    std::partial_sort(regions.begin() + from, regions.begin() + count, regions.end(),
+                      [](const RetryRegion& a, const RetryRegion& b) {
+                        return a.ringed != b.ringed ? a.ringed : a.box.area() > b.box.area();
+                      });
     regions.resize(count);
   }
 
@@ -337,7 +366,10 @@ struct MarkerDetector::Impl {
     for (size_t i = 0; i < n; ++i) {
       const int r = root(static_cast<int>(i));
       ++group_size[r];
-      if (r != static_cast<int>(i)) failed[r] |= failed[i];
+      if (r != static_cast<int>(i)) {
+        failed[r] |= failed[i];
+        failed_rings[r] += failed_rings[i];
+      }
     }
     for (size_t i = 0; i < n; ++i) {
       if (root(static_cast<int>(i)) != static_cast<int>(i) || group_size[i] < 2) continue;
@@ -350,7 +382,11 @@ struct MarkerDetector::Impl {
       bool inside_found = false;
       for (size_t q = 0; q < quads.size() && !inside_found; ++q)
         inside_found = insideConvex(quads[q].corners, middle);
-      if (!inside_found) retries.push_back({box, true});
+      // A thin marker broken into pieces: some of them ringed, the group's box narrow (a
+      // diagonal one's box is not, and stays on the reduced image).
+      const bool thin = scale > 1 && failed_rings[i] > 0 && shorter < 2 * kThinOnFrameWidth &&
+                        longer >= kThinOnFrameMinLength;
+      if (!inside_found) retries.push_back({box, true, thin});
     }
   }
 
@@ -372,6 +408,7 @@ struct MarkerDetector::Impl {
       if (retryRegion(roi, *searched, split, params)) continue;
       if (!region.fragmented && scale == 1 && binarised != &gray)
         retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
+      if (region.thin) retryOnFrame(roi);
     }
   }
 
@@ -426,6 +463,41 @@ struct MarkerDetector::Impl {
     return added;
   }
 
+  // A thin near miss of the reduced image, labelled again on the frame (its thresholds
+  // interpolated from the reduced image's), where its code cells are wide enough to show.
+  void retryOnFrame(const cv::Rect& reduced_roi) {
+    adaptive.roiLimits(reduced_roi, AdaptiveThresholder::kSplit, roi_limits);
+    const cv::Rect roi(reduced_roi.x * scale, reduced_roi.y * scale, reduced_roi.width * scale,
+                       reduced_roi.height * scale);
+    cv::resize(roi_limits, frame_limits, roi.size(), 0, 0, cv::INTER_LINEAR);
+    const cv::Mat patch = gray(roi);
+    roi_labels.label(patch, frame_limits);
+    QuadFitParams params;
+    params.min_side = config.min_side_px;
+    for (const DarkComponent& c : roi_labels.components()) {
+      const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
+      if (c.holes == 0 || c.touchesBorder(roi.width, roi.height) ||
+          std::max(w, h) < params.min_side || std::min(w, h) < params.min_side * 0.5f)
+        continue;
+      if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour))
+        continue;
+      auto quad = fitQuad(contour, {c.first_x, c.first_y}, patch, params).quad;
+      if (!quad) continue;
+      const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      for (int k = 0; k < 4; ++k) {
+        quad->corners[k] += offset;
+        quad->ideal_corners[k] =
+            config.lens ? toFloat(config.lens->undistort(quad->corners[k])) : quad->corners[k];
+      }
+      const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
+      const cv::Point2f reduced_centre = (centre(quad->corners) - cv::Point2f(shift, shift)) / s;
+      bool known = false;
+      for (size_t q = 0; q < quads.size() && !known; ++q)
+        known = insideConvex(quads[q].corners, reduced_centre);
+      if (!known) on_frame_quads.push_back(*quad);
+    }
+  }
+
   // A reduced image's corners in frame pixels: a reduced pixel's centre is the middle of the
   // frame pixels it averages.
   std::array<cv::Point2f, 4> onFrameCoarse(const std::array<cv::Point2f, 4>& coarse) const {
@@ -465,24 +537,32 @@ struct MarkerDetector::Impl {
     // A quad inside a marker already decoded would be dropped as nested (code cells): it is not
     // refined or decoded, except where every candidate's samples set the next threshold.
     const bool skip_nested = config.threshold.mode != ThresholdMode::AutoMidrange;
-    order.resize(quads.size());
-    for (size_t i = 0; i < quads.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      return quadArea(quads[a].corners) > quadArea(quads[b].corners);
-    });
+    // Quads of the searched image, then those already on the frame (retryOnFrame()).
+    const size_t searched_count = quads.size();
+    const float frame_area_per_searched = static_cast<float>(scale * scale);
+    auto frameArea = [&](size_t i) {
+      return i < searched_count ? quadArea(quads[i].corners) * frame_area_per_searched
+                                : quadArea(on_frame_quads[i - searched_count].corners);
+    };
+    order.resize(searched_count + on_frame_quads.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return frameArea(a) > frameArea(b); });
     decoded.clear();
     frame_quads.clear();
     for (const size_t index : order) {
-      Quad quad = quads[index];
+      const bool on_frame = index >= searched_count;
+      Quad quad = on_frame ? on_frame_quads[index - searched_count] : quads[index];
       if (skip_nested) {
-        const cv::Point2f middle = centre(quad.corners) * static_cast<float>(scale) +
-                                   cv::Point2f(0.5f, 0.5f) * (scale - 1);
+        const cv::Point2f middle = on_frame ? centre(quad.corners)
+                                            : centre(quad.corners) * static_cast<float>(scale) +
+                                                  cv::Point2f(0.5f, 0.5f) * (scale - 1);
         bool nested = false;
         for (size_t m = 0; m < decoded.size() && !nested; ++m)
           nested = insideConvex(decoded[m].second.corners, middle);
         if (nested) continue;
       }
-      if (scale > 1) {
+      if (scale > 1 && !on_frame) {
         // A flat code area is no BCH marker whoever refines it: not worth refining.
         if (config.kind == MarkerKind::Bch &&
             hasFlatCodeArea(gray, onFrameCoarse(quad.corners), config.border))
@@ -567,10 +647,11 @@ struct MarkerDetector::Impl {
       searched = &half;
     } else {
       // Smoothing suppresses sensor noise but softens small markers further: by default only a
-      // visibly noisy frame is smoothed.
+      // visibly noisy or a JPEG-compressed frame is smoothed.
       noise_sigma = estimateNoiseSigma(gray);
       const bool smooth = config.smoothing == Smoothing::Always ||
-                          (config.smoothing == Smoothing::Auto && noise_sigma >= kSmoothAboveNoise);
+                          (config.smoothing == Smoothing::Auto &&
+                           (noise_sigma >= kSmoothAboveNoise || looksBlockCompressed(gray)));
       if (smooth) smoothBinomial3(gray, smoothed);
       binarised = smooth ? &smoothed : &gray;
       searched = binarised;
@@ -605,6 +686,7 @@ struct MarkerDetector::Impl {
       if (attempt + 1 < attempts) result.threshold_mode += ", retry";
     }
     dropNested(result.markers);
+    if (binarised == &smoothed) result.threshold_mode += ", smoothed frame";
     squares.clear();
     ideal_squares.clear();
     for (const Quad& quad : quads) {

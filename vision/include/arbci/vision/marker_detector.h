@@ -29,7 +29,8 @@ struct DetectorConfig {
   double border = 0.125;
   ThresholdSettings threshold;
   // 3x3 binomial blur before binarising: Auto smooths frames whose estimated noise exceeds 2.5
-  // grey levels (sensor noise), and leaves clean frames sharp.
+  // grey levels (sensor noise) or that show JPEG's 8 px block edges (an MJPEG camera), and leaves
+  // other frames sharp. A frame searched at half resolution (search_decimate 2) is not smoothed.
   Smoothing smoothing = Smoothing::Auto;
   float min_side_px = 8;  // smaller squares are ignored
   // Square kinds: 1 looks for candidates at full resolution; 2 thresholds, labels and fits quads
