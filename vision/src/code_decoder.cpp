@@ -63,8 +63,9 @@ std::optional<CodeDecode> hardDecode(MarkerKind kind, const CodeGrid& sampled, b
 // kMaxDisagreements cells whose summed reliability is at most kMaxWeight, and that beats every
 // other candidate (another id or orientation) by kMinMargin. Trials are built in each turned
 // word directly (the flipped cells' bits), not as turned grids: up to 64 trials x 4 turns.
+// `nearest`: how many cells at least any codeword (in any turn) disagrees with.
 std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
-                                      const std::array<float, 36>& reliability) {
+                                      const std::array<float, 36>& reliability, int nearest) {
   constexpr int kFlipped = 6;
   constexpr float kMaxReliabilityToFlip = 0.5f, kMaxWeight = 1.2f, kMinMargin = 0.6f;
   constexpr int kMaxDisagreements = 5;
@@ -72,6 +73,11 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
   std::iota(order.begin(), order.end(), 0);
   std::partial_sort(order.begin(), order.begin() + kFlipped, order.end(),
                     [&](int a, int b) { return reliability[a] < reliability[b]; });
+  // Every codeword disagrees with at least `nearest` cells, weighing at least the least reliable
+  // ones: when even they weigh too much, no trial can be accepted (a clearly read decoy).
+  float least_weight = 0.0f;
+  for (int k = 0; k < std::min(nearest, kFlipped); ++k) least_weight += reliability[order[k]];
+  if (least_weight > kMaxWeight) return std::nullopt;
   int flippable = 0;
   while (flippable < kFlipped && reliability[order[flippable]] < kMaxReliabilityToFlip) ++flippable;
 
@@ -178,17 +184,24 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   const std::optional<CodeDecode> hard = hardDecode(kind, sampled, ambiguous);
   if (hard && !ambiguous) return hard;
   if (ambiguous || kind != MarkerKind::Bch || !soft_decoding) return std::nullopt;
+  // Hard decoding corrects up to 2 cells in every turn: when it found no codeword, each one
+  // disagrees with 3 cells or more; when it found two equally near, nothing is known.
+  constexpr int kBeyondHard = 3;
+  auto nearest = [](const std::optional<CodeDecode>& decoded) { return decoded ? 0 : kBeyondHard; };
   // Blur: read the sharpened cells, then Chase-decode the plain and the sharpened reading.
   constexpr std::array<CellOffset, 4> kFourNeighbours{{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};
   const Reading sharpened = readingOf(sharpenedLevels(samples, kFourNeighbours, 1.0f));
+  int sharpened_nearest = kBeyondHard;
   if (sharpened.cells != sampled) {
     const std::optional<CodeDecode> again = hardDecode(kind, sharpened.cells, ambiguous);
     if (again && !ambiguous)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.9f};
+    sharpened_nearest = nearest(again);
   }
-  if (auto chase = chaseDecode(sampled, reliability)) return chase;
-  if (auto chase = chaseDecode(sharpened.cells, sharpened.reliability)) return chase;
+  if (auto chase = chaseDecode(sampled, reliability, kBeyondHard)) return chase;
+  if (auto chase = chaseDecode(sharpened.cells, sharpened.reliability, sharpened_nearest))
+    return chase;
   // Motion blur smears each cell into its neighbours along one direction: sharpened against
   // those two alone, along the grid's rows, columns and diagonals (within 22.5 degrees of any
   // direction). The amount was chosen on the bench's seeds 1000-1099; on its motion-blurred
@@ -203,7 +216,8 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
     if (again && !ambiguous)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.8f};
-    if (auto chase = chaseDecode(directional.cells, directional.reliability)) return chase;
+    if (auto chase = chaseDecode(directional.cells, directional.reliability, nearest(again)))
+      return chase;
   }
   return std::nullopt;
 }
