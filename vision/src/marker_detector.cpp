@@ -277,8 +277,9 @@ struct MarkerDetector::Impl {
           // Ringed around light cells as a marker's border, but blur cut a thin corner off its
           // hull. Retried in the full search only: on seeds 7000-7099 it read 2 more blurred
           // markers of 300 there; the decimated search found 1 more under motion blur for 2 % of
-          // its time.
-          retries.push_back({failed.back(), false, false, true});
+          // its time. Kept by size, not first: first, it crowded out near misses of small
+          // markers in noise (2 of 300 fewer on the 16-110 px scenes).
+          retries.push_back({failed.back(), false, false, false});
         }
       }
     }
@@ -330,8 +331,9 @@ struct MarkerDetector::Impl {
 
   // Keeps `count` regions from the first one not yet capped on: near misses enclosing a hole
   // first (a marker's border does; a blurred line seldom), then the largest. Noise leaves many
-  // small near misses, and markers are seldom the smallest. (Fragment groups are kept by size
-  // alone: ranked by their pieces' holes, two fewer markers were read under motion blur.)
+  // small near misses, and markers are seldom the smallest. (Fragment groups and the full
+  // search's rings with a corner cut off are kept by size alone: ranked first by their holes,
+  // they read 1-2 fewer markers of 300 under motion blur or noise.)
   static void keepLargest(std::vector<RetryRegion>& regions, size_t count) {
     if (regions.size() <= count) return;
     const size_t from =
