@@ -30,11 +30,16 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kSmoothAboveNoise = 2.5;  // grey levels of estimated noise
-constexpr size_t kMaxRetries = 8;          // near-miss components re-binarised per frame
-constexpr size_t kMaxFragmentRetries = 6;  // and groups of fragments
-constexpr int kMaxRetrySide = 160;         // px; larger borders are not thinned by blur
-constexpr int kRetryMargin = 14;           // px around a near miss
-constexpr int kFragmentGap = 4;            // px: failed components this close are one region
+// Near-miss components re-binarised per frame: the decimated search takes 8, those enclosing a
+// hole first (by size alone, 8 lost a small marker); the full search 12 by size (hole-first, it
+// read 5 fewer of the 300 frames of the head-motion sequence at 70 degrees).
+constexpr size_t kMaxRetriesDecimated = 8;
+constexpr size_t kMaxRetries = 12;
+constexpr size_t kMaxCornerCutRetries = 2;  // the full search's rings with a corner cut off
+constexpr size_t kMaxFragmentRetries = 6;   // and groups of fragments
+constexpr int kMaxRetrySide = 160;          // px; larger borders are not thinned by blur
+constexpr int kRetryMargin = 14;            // px around a near miss
+constexpr int kFragmentGap = 4;             // px: failed components this close are one region
 // Sixteenths of a tile's range, lighter than the usual 7 so that more of a blurred border counts
 // as dark: 9 closes a border that blur thinned; 11 joins the fragments of one that motion blur
 // washed to mid-grey across its direction.
@@ -53,7 +58,7 @@ struct RetryRegion {
   cv::Rect box;
   bool fragmented;      // several failed components, rather than one square-hulled outline
   bool thin = false;    // also labelled again on the frame (kThinOnFrameWidth)
-  bool ringed = false;  // encloses a hole, as a marker's border does
+  bool ringed = false;  // encloses a hole, as a marker's border does (decimated search only)
 };
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
@@ -172,6 +177,7 @@ struct MarkerDetector::Impl {
   std::vector<cv::Rect> failed;
   std::vector<int> failed_rings;     // per failed component (then group): how many enclose a hole
   std::vector<RetryRegion> retries;  // square-hulled near misses first, then fragment groups
+  std::vector<RetryRegion> corner_cut;  // rings whose hull is not square (full search)
   std::vector<int> group, group_size;
   RunLabeler roi_labels;
   cv::Mat roi_limits, frame_limits;
@@ -247,6 +253,7 @@ struct MarkerDetector::Impl {
     failed.clear();
     failed_rings.clear();
     retries.clear();
+    corner_cut.clear();
     on_frame_quads.clear();
     traced.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
@@ -271,20 +278,23 @@ struct MarkerDetector::Impl {
         failed_rings.push_back(c.holes > 0);
         if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f &&
             everySideHasDark(fit.hull_corners)) {
-          retries.push_back({failed.back(), false,
-                             scale > 1 && c.holes > 0 && isThin(fit.hull_corners), c.holes > 0});
+          const bool decimated = scale > 1, ringed = c.holes > 0;
+          retries.push_back({failed.back(), false, decimated && ringed && isThin(fit.hull_corners),
+                             decimated && ringed});
         } else if (scale == 1 && c.holes >= 2 && std::min(w, h) >= min_side) {
           // Ringed around light cells as a marker's border, but blur cut a thin corner off its
-          // hull. Retried in the full search only: on seeds 7000-7099 it read 2 more blurred
-          // markers of 300 there; the decimated search found 1 more under motion blur for 2 % of
-          // its time. Kept by size, not first: first, it crowded out near misses of small
-          // markers in noise (2 of 300 fewer on the 16-110 px scenes).
-          retries.push_back({failed.back(), false, false, false});
+          // hull. Retried in the full search only, the largest two beside the other near misses
+          // (among them, they crowded out small markers' in noise): on seeds 7000-7099 they read
+          // 2 more blurred markers of 300; in the decimated search 1 more under motion blur for
+          // 2 % of its time.
+          corner_cut.push_back({failed.back(), false});
         }
       }
     }
     if (adaptive_mode) {
-      keepLargest(retries, kMaxRetries);
+      keepLargest(retries, scale > 1 ? kMaxRetriesDecimated : kMaxRetries);
+      keepLargest(corner_cut, kMaxCornerCutRetries);
+      retries.insert(retries.end(), corner_cut.begin(), corner_cut.end());
       const size_t near_miss_count = retries.size();
       groupFragments(min_side);
       keepLargest(retries, near_miss_count + kMaxFragmentRetries);
@@ -329,11 +339,11 @@ struct MarkerDetector::Impl {
     return width < kThinOnFrameWidth && longest >= kThinOnFrameMinLength;
   }
 
-  // Keeps `count` regions from the first one not yet capped on: near misses enclosing a hole
-  // first (a marker's border does; a blurred line seldom), then the largest. Noise leaves many
-  // small near misses, and markers are seldom the smallest. (Fragment groups and the full
-  // search's rings with a corner cut off are kept by size alone: ranked first by their holes,
-  // they read 1-2 fewer markers of 300 under motion blur or noise.)
+  // Keeps `count` regions from the first one not yet capped on: those marked `ringed` first (a
+  // marker's border encloses a hole; a blurred line seldom does), then the largest. Noise leaves
+  // many small near misses, and markers are seldom the smallest. (Fragment groups are kept by
+  // size alone: ranked by their pieces' holes, they read 2 fewer markers of 300 under motion
+  // blur.)
   static void keepLargest(std::vector<RetryRegion>& regions, size_t count) {
     if (regions.size() <= count) return;
     const size_t from =
