@@ -65,8 +65,9 @@ INSTANTIATE_TEST_SUITE_P(Conditions, SyntheticScenes,
 
 // Motion blur washes a marker's border out across its direction, leaving dark fragments; they
 // are grouped and binarised again. On the benchmark's fair scenes (markers from 48 px, a 2-cell
-// margin) these 40 frames give 105/120 (5-15 px blur + JPEG) and 97/120 (9-15 px + JPEG);
-// without the fragment retry 97/120 and 88/120. The floors sit between.
+// margin) these 40 frames give 105/120 (5-15 px blur + JPEG) and 100/120 (9-15 px + JPEG; 97
+// before JPEG frames were smoothed); without the fragment retry 97/120 and 88/120. The floors sit
+// between.
 TEST(SyntheticScenes, ReadsMotionBlurredMarkers) {
   test::LayoutOptions fair;
   fair.min_side_px = 48.0f;
