@@ -451,35 +451,48 @@ struct MarkerDetector::Impl {
     adaptive.roiLimits(roi, split, roi_limits);
     roi_labels.label(patch, roi_limits);
     bool added = false;
+    fitComponents(
+        patch, roi.tl(), params, [&](const DarkComponent& c) { return !wasTraced(c, roi.tl()); },
+        [&](Quad& quad) {
+          // The region's ideal corners were computed as if it were the whole image: redo them
+          // (a reduced image's are, when its quads are refined on the frame).
+          for (int k = 0; k < 4; ++k) {
+            quad.ideal_corners[k] = config.lens && scale == 1
+                                        ? toFloat(config.lens->undistort(quad.corners[k]))
+                                        : quad.corners[k];
+          }
+          bool known = false;  // already found, from the frame or an earlier retry
+          for (size_t q = 0; q < quads.size() && !known; ++q) {
+            known = insideConvex(quads[q].corners, centre(quad.corners));
+          }
+          if (!known) {
+            quads.push_back(quad);
+            added = true;
+          }
+        });
+    return added;
+  }
+
+  // The quads of `roi_labels`' components in `patch` (at `origin` of its image) that are
+  // marker-sized, do not touch the patch's border and `wanted` accepts, their corners moved by
+  // `origin`, each given to `found`.
+  template <typename Wanted, typename Found>
+  void fitComponents(const cv::Mat& patch, cv::Point origin, const QuadFitParams& params,
+                     Wanted wanted, Found found) {
     for (const DarkComponent& c : roi_labels.components()) {
       const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
-      if (c.touchesBorder(roi.width, roi.height) || std::max(w, h) < params.min_side ||
-          std::min(w, h) < params.min_side * 0.5f || wasTraced(c, roi.tl())) {
+      if (c.touchesBorder(patch.cols, patch.rows) || std::max(w, h) < params.min_side ||
+          std::min(w, h) < params.min_side * 0.5f || !wanted(c)) {
         continue;
       }
       if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour))
         continue;
       auto quad = fitQuad(contour, {c.first_x, c.first_y}, patch, params).quad;
       if (!quad) continue;
-      const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      const cv::Point2f offset(static_cast<float>(origin.x), static_cast<float>(origin.y));
       for (cv::Point2f& p : quad->corners) p += offset;
-      // The region's ideal corners were computed as if it were the whole image: redo them (a
-      // reduced image's are, when its quads are refined on the frame).
-      for (int k = 0; k < 4; ++k) {
-        quad->ideal_corners[k] = config.lens && scale == 1
-                                     ? toFloat(config.lens->undistort(quad->corners[k]))
-                                     : quad->corners[k];
-      }
-      bool known = false;  // already found, from the frame or an earlier retry
-      for (size_t q = 0; q < quads.size() && !known; ++q) {
-        known = insideConvex(quads[q].corners, centre(quad->corners));
-      }
-      if (!known) {
-        quads.push_back(*quad);
-        added = true;
-      }
+      found(*quad);
     }
-    return added;
   }
 
   // A thin near miss of the reduced image, labelled again on the frame (its thresholds
@@ -493,28 +506,20 @@ struct MarkerDetector::Impl {
     roi_labels.label(patch, frame_limits);
     QuadFitParams params;
     params.min_side = config.min_side_px;
-    for (const DarkComponent& c : roi_labels.components()) {
-      const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
-      if (c.holes == 0 || c.touchesBorder(roi.width, roi.height) ||
-          std::max(w, h) < params.min_side || std::min(w, h) < params.min_side * 0.5f)
-        continue;
-      if (!traceOuterContour(roi_labels, {c.first_x, c.first_y}, 4 * (w + h) + 64, contour))
-        continue;
-      auto quad = fitQuad(contour, {c.first_x, c.first_y}, patch, params).quad;
-      if (!quad) continue;
-      const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
-      for (int k = 0; k < 4; ++k) {
-        quad->corners[k] += offset;
-        quad->ideal_corners[k] =
-            config.lens ? toFloat(config.lens->undistort(quad->corners[k])) : quad->corners[k];
-      }
-      const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
-      const cv::Point2f reduced_centre = (centre(quad->corners) - cv::Point2f(shift, shift)) / s;
-      bool known = false;
-      for (size_t q = 0; q < quads.size() && !known; ++q)
-        known = insideConvex(quads[q].corners, reduced_centre);
-      if (!known) on_frame_quads.push_back(*quad);
-    }
+    fitComponents(
+        patch, roi.tl(), params, [](const DarkComponent& c) { return c.holes > 0; },
+        [&](Quad& quad) {
+          for (int k = 0; k < 4; ++k) {
+            quad.ideal_corners[k] =
+                config.lens ? toFloat(config.lens->undistort(quad.corners[k])) : quad.corners[k];
+          }
+          const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
+          const cv::Point2f reduced_centre = (centre(quad.corners) - cv::Point2f(shift, shift)) / s;
+          bool known = false;
+          for (size_t q = 0; q < quads.size() && !known; ++q)
+            known = insideConvex(quads[q].corners, reduced_centre);
+          if (!known) on_frame_quads.push_back(quad);
+        });
   }
 
   // A reduced image's corners in frame pixels: a reduced pixel's centre is the middle of the
