@@ -87,6 +87,13 @@ float quadArea(const SquareCorners& q) {
   return std::abs(area) * 0.5f;
 }
 
+float longestSide(const SquareCorners& q) {
+  float longest = 0.0f;
+  for (int k = 0; k < 4; ++k)
+    longest = std::max(longest, static_cast<float>(cv::norm(q[(k + 1) % 4] - q[k])));
+  return longest;
+}
+
 cv::Point2f centre(const SquareCorners& q) {
   return (q[0] + q[1] + q[2] + q[3]) * 0.25f;
 }
@@ -329,14 +336,11 @@ struct MarkerDetector::Impl {
   // A hull narrower than kThinOnFrameWidth (its area over its longest side) and as long as
   // kThinOnFrameMinLength.
   static bool isThin(const std::array<cv::Point, 4>& hull) {
-    std::array<cv::Point2f, 4> q;
-    float longest = 0.0f;
-    for (int k = 0; k < 4; ++k) {
-      q[k] = hull[k];
-      longest = std::max(longest, static_cast<float>(cv::norm(hull[(k + 1) % 4] - hull[k])));
-    }
-    const float width = quadArea(q) / std::max(1.0f, longest);
-    return width < kThinOnFrameWidth && longest >= kThinOnFrameMinLength;
+    const SquareCorners q{cv::Point2f(hull[0]), cv::Point2f(hull[1]), cv::Point2f(hull[2]),
+                          cv::Point2f(hull[3])};
+    const float longest = longestSide(q);
+    return quadArea(q) < kThinOnFrameWidth * std::max(1.0f, longest) &&
+           longest >= kThinOnFrameMinLength;
   }
 
   // Keeps `count` regions from the first one not yet capped on: those marked `ringed` first (a
@@ -538,11 +542,7 @@ struct MarkerDetector::Impl {
   std::optional<Quad> onFrame(const Quad& coarse) const {
     QuadFitParams params;
     Quad start = coarse;
-    float longest = 0.0f;
-    for (int k = 0; k < 4; ++k)
-      longest = std::max(
-          longest, static_cast<float>(cv::norm(coarse.corners[(k + 1) % 4] - coarse.corners[k])));
-    if (quadArea(coarse.corners) < kThinQuadWidth * longest) {
+    if (quadArea(coarse.corners) < kThinQuadWidth * longestSide(coarse.corners)) {
       params.min_side = 1.0f;
       if (const auto refined = refineQuad(coarse.corners, *searched, params)) start = *refined;
     }
