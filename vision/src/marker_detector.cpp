@@ -333,6 +333,14 @@ struct MarkerDetector::Impl {
     return true;
   }
 
+  // True when `p` (in the searched image's pixels) lies inside a quad found so far.
+  bool insideAnyQuad(cv::Point2f p) const {
+    for (const Quad& quad : quads) {
+      if (insideConvex(quad.corners, p)) return true;
+    }
+    return false;
+  }
+
   // A hull narrower than kThinOnFrameWidth (its area over its longest side) and as long as
   // kThinOnFrameMinLength.
   static bool isThin(const std::array<cv::Point, 4>& hull) {
@@ -402,9 +410,7 @@ struct MarkerDetector::Impl {
       if (longer > kMaxRetrySide / scale || shorter < min_side * 0.5f || longer > 3 * shorter)
         continue;
       const cv::Point2f middle(box.x + 0.5f * box.width, box.y + 0.5f * box.height);
-      bool inside_found = false;
-      for (size_t q = 0; q < quads.size() && !inside_found; ++q)
-        inside_found = insideConvex(quads[q].corners, middle);
+      const bool inside_found = insideAnyQuad(middle);
       // A thin marker broken into pieces: some of them ringed, the group's box narrow (a
       // diagonal one's box is not, and stays on the reduced image).
       const bool thin = scale > 1 && failed_rings[i] > 0 && shorter < 2 * kThinOnFrameWidth &&
@@ -465,11 +471,8 @@ struct MarkerDetector::Impl {
                                         ? toFloat(config.lens->undistort(quad.corners[k]))
                                         : quad.corners[k];
           }
-          bool known = false;  // already found, from the frame or an earlier retry
-          for (size_t q = 0; q < quads.size() && !known; ++q) {
-            known = insideConvex(quads[q].corners, centre(quad.corners));
-          }
-          if (!known) {
+          // Unless already found, from the frame or an earlier retry.
+          if (!insideAnyQuad(centre(quad.corners))) {
             quads.push_back(quad);
             added = true;
           }
@@ -519,10 +522,7 @@ struct MarkerDetector::Impl {
           }
           const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
           const cv::Point2f reduced_centre = (centre(quad.corners) - cv::Point2f(shift, shift)) / s;
-          bool known = false;
-          for (size_t q = 0; q < quads.size() && !known; ++q)
-            known = insideConvex(quads[q].corners, reduced_centre);
-          if (!known) on_frame_quads.push_back(quad);
+          if (!insideAnyQuad(reduced_centre)) on_frame_quads.push_back(quad);
         });
   }
 
