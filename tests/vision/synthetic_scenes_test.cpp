@@ -82,6 +82,28 @@ TEST(SyntheticScenes, ReadsMotionBlurredMarkers) {
   }
 }
 
+// Seed 9009's motion-blurred 51 x 44 px marker (id 3575): sharpened hard along a diagonal, its
+// cells read in another turn as id 3201 with 2 corrections, one of them overruling a cell read at
+// 4.6 times full contrast. Both searches read it as 3201 before such decodes were left to Chase.
+TEST(SyntheticScenes, OverSharpenedMotionBlurIsNotReadAsAnotherId) {
+  test::LayoutOptions fair;
+  fair.min_side_px = 48.0f;
+  fair.quiet_cells = 2.0f;
+  const test::RenderedScene scene = test::renderScene(
+      test::makeLayout(fair, 9009u), test::MarkerFamily::ArbciBch, Condition::MotionBlurJpeg);
+  for (int decimate : {1, 2}) {
+    DetectorConfig config;
+    config.search_decimate = decimate;
+    std::vector<test::FoundMarker> found;
+    for (const MarkerDetection& m : MarkerDetector(config).detect(scene.image).markers)
+      found.push_back({m.id, m.corners});
+    const test::Score score = test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true);
+    EXPECT_EQ(score.wrong_id, 0) << "search_decimate " << decimate;
+    EXPECT_EQ(score.false_positive, 0) << "search_decimate " << decimate;
+    EXPECT_EQ(score.found, 2) << "search_decimate " << decimate;  // the other two markers
+  }
+}
+
 // A marker smeared along one line (a head turning fast): 6 ids, 44-60 px, a 15 or 17 px line at
 // 6 angles, 216 frames. Sharpening the cells against their two neighbours along each of the
 // grid's directions reads 62 of them; with the four-neighbour sharpening alone, 49. No wrong id.
