@@ -528,19 +528,25 @@ struct MarkerDetector::Impl {
             quad.ideal_corners[k] =
                 config.lens ? toFloat(config.lens->undistort(quad.corners[k])) : quad.corners[k];
           }
-          const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
-          const cv::Point2f reduced_centre = (centre(quad.corners) - cv::Point2f(shift, shift)) / s;
-          if (!insideAnyQuad(reduced_centre)) on_frame_quads.push_back(quad);
+          if (!insideAnyQuad(toReduced(centre(quad.corners)))) on_frame_quads.push_back(quad);
         });
     return on_frame_quads.size() > before;
   }
 
-  // A reduced image's corners in frame pixels: a reduced pixel's centre is the middle of the
-  // frame pixels it averages.
-  std::array<cv::Point2f, 4> onFrameCoarse(const std::array<cv::Point2f, 4>& coarse) const {
+  // A reduced image's point in frame pixels, and back: a reduced pixel's centre is the middle of
+  // the frame pixels it averages.
+  cv::Point2f toFrame(cv::Point2f reduced) const {
     const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
+    return reduced * s + cv::Point2f(shift, shift);
+  }
+  cv::Point2f toReduced(cv::Point2f frame) const {
+    const float s = static_cast<float>(scale), shift = 0.5f * (s - 1.0f);
+    return (frame - cv::Point2f(shift, shift)) / s;
+  }
+
+  std::array<cv::Point2f, 4> onFrameCoarse(const std::array<cv::Point2f, 4>& coarse) const {
     std::array<cv::Point2f, 4> corners;
-    for (int k = 0; k < 4; ++k) corners[k] = coarse[k] * s + cv::Point2f(shift, shift);
+    for (int k = 0; k < 4; ++k) corners[k] = toFrame(coarse[k]);
     return corners;
   }
 
@@ -587,9 +593,7 @@ struct MarkerDetector::Impl {
       const bool on_frame = index >= searched_count;
       Quad quad = on_frame ? on_frame_quads[index - searched_count] : quads[index];
       if (skip_nested) {
-        const cv::Point2f middle = on_frame ? centre(quad.corners)
-                                            : centre(quad.corners) * static_cast<float>(scale) +
-                                                  cv::Point2f(0.5f, 0.5f) * (scale - 1);
+        const cv::Point2f middle = on_frame ? centre(quad.corners) : toFrame(centre(quad.corners));
         bool nested = false;
         for (size_t m = 0; m < decoded.size() && !nested; ++m)
           nested = insideConvex(decoded[m].second.corners, middle);
