@@ -48,17 +48,18 @@ constexpr int kFragmentedSplit = 11;
 // Reduced-image px: a quad narrower than this (its area over its longest side) is refined on the
 // reduced image before the frame.
 constexpr float kThinQuadWidth = 8.0f;
-// Reduced-image px: a ringed near miss narrower than this and at least this long (a marker seen
-// nearly edge-on, its code cells 1 px or less) is labelled again on the frame. Shorter ones are
-// too small to read edge-on, and retrying them (text, clutter) would cost more than they find, as
-// would retrying those without a hole (10 times as many: 4-9 % of the time for one marker of 300).
+// Reduced-image px: a near miss narrower than this and at least this long (a marker seen nearly
+// edge-on, its code cells 1 px or less) is labelled again on the frame. Shorter ones are too
+// small to read edge-on, and retrying them (text, clutter) would cost more than they find. Those
+// without a hole are 10 times as many: labelling each on the frame cost 4-9 % of the time, so
+// they are labelled there only when the reduced image gave them a quad (2-21 per 100 frames).
 constexpr float kThinOnFrameWidth = 10.0f;
 constexpr float kThinOnFrameMinLength = 20.0f;
 
 struct RetryRegion {
   cv::Rect box;
   bool fragmented;      // several failed components, rather than one square-hulled outline
-  bool thin = false;    // labelled again on the frame first (kThinOnFrameWidth)
+  bool thin = false;    // labelled again on the frame (kThinOnFrameWidth)
   bool ringed = false;  // encloses a hole, as a marker's border does (decimated search only)
 };
 
@@ -190,6 +191,7 @@ struct MarkerDetector::Impl {
   RunLabeler roi_labels;
   cv::Mat roi_limits, frame_limits;
   std::vector<Quad> on_frame_quads;  // found on the frame by retryOnFrame(), decoded as they are
+  std::vector<Quad> reduced_found;   // a thin near miss's quads of the reduced image, kept aside
   std::vector<SquareCorners> squares, ideal_squares;
   // decode(): quads by decreasing area, the markers decoded (by quad index), their samples'
   // medians, and the quads in frame pixels.
@@ -287,8 +289,8 @@ struct MarkerDetector::Impl {
         if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f &&
             everySideHasDark(fit.hull_corners)) {
           const bool decimated = scale > 1, ringed = c.holes > 0;
-          retries.push_back({failed.back(), false, decimated && ringed && isThin(fit.hull_corners),
-                             decimated && ringed});
+          retries.push_back(
+              {failed.back(), false, decimated && isThin(fit.hull_corners), decimated && ringed});
         } else if (scale == 1 && c.holes >= 2 && std::min(w, h) >= min_side) {
           // Ringed around light cells as a marker's border, but blur cut a thin corner off its
           // hull. Retried in the full search only, the largest two beside the other near misses
@@ -437,11 +439,23 @@ struct MarkerDetector::Impl {
       roi.width += 2 * margin;
       roi.height += 2 * margin;
       roi &= image;
-      // A thin one on the frame first: on the reduced image its code cells may have merged, and
-      // a quad found there would fail to decode.
-      if (region.thin && retryOnFrame(roi)) continue;
+      // A thin ringed one on the frame first: on the reduced image its code cells may have
+      // merged, and a quad found there would fail to decode. A thin one without a hole (mostly
+      // letters and strokes, 10 times as many) only when the reduced image gives it a quad, which
+      // the frame's, if any, replaces.
+      const bool frame_first = region.thin && (region.ringed || region.fragmented);
+      if (frame_first && retryOnFrame(roi)) continue;
       const int split = region.fragmented ? kFragmentedSplit : kThinnedSplit;
-      if (retryRegion(roi, *searched, split, params)) continue;
+      const size_t before = quads.size();
+      if (retryRegion(roi, *searched, split, params)) {
+        if (region.thin && !frame_first) {
+          reduced_found.assign(quads.begin() + static_cast<std::ptrdiff_t>(before), quads.end());
+          quads.resize(before);
+          if (!retryOnFrame(roi))
+            quads.insert(quads.end(), reduced_found.begin(), reduced_found.end());
+        }
+        continue;
+      }
       if (!region.fragmented && scale == 1 && binarised != &gray)
         retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
     }
