@@ -162,6 +162,26 @@ TEST(SyntheticScenes, DecimatedSearchReadsFairScenesAsTheFullOne) {
   }
 }
 
+// Seed 9044's marker (id 1071) is skewed into a rhombus 15 x 71 px: on the halved frame its
+// code cells merge with the border into an outline 7 px across with no hole, whose retry there
+// gives a quad that does not decode. Labelled again on the frame, it is read.
+TEST(SyntheticScenes, DecimatedSearchReadsAMarkerSkewedIntoARhombus) {
+  test::LayoutOptions fair;
+  fair.min_side_px = 48.0f;
+  fair.quiet_cells = 2.0f;
+  const test::RenderedScene scene = test::renderScene(
+      test::makeLayout(fair, 9044u), test::MarkerFamily::ArbciBch, Condition::Clean);
+  DetectorConfig decimated;
+  decimated.search_decimate = 2;
+  std::vector<test::FoundMarker> found;
+  for (const MarkerDetection& m : MarkerDetector(decimated).detect(scene.image).markers)
+    found.push_back({m.id, m.corners});
+  const test::Score score = test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true);
+  EXPECT_EQ(score.found, 3);
+  EXPECT_EQ(score.wrong_id, 0);
+  EXPECT_EQ(score.false_positive, 0);
+}
+
 TEST(SyntheticScenes, MarkerFreeFramesGiveNoDetections) {
   MarkerDetector detector(DetectorConfig{});
   for (Condition condition : {Condition::Clean, Condition::Blur, Condition::Noise,
