@@ -1,5 +1,6 @@
 // The tracker on synthetic frames with exact ground truth (the benchmark's scenes): markers 20 px
 // and up, tilted up to 60 degrees, with decoys and clutter, under the five conditions.
+#include <cstdint>
 #include <cstdio>
 
 #include <gtest/gtest.h>
@@ -30,6 +31,19 @@ test::Score run(Condition condition, int frames, const test::LayoutOptions& opti
     total.add(test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true));
   }
   return total;
+}
+
+// One frame of the benchmark's fair scenes (markers from 48 px, a 2-cell margin), scored.
+test::Score scoreFairFrame(std::uint32_t seed, Condition condition, const DetectorConfig& config) {
+  test::LayoutOptions fair;
+  fair.min_side_px = 48.0f;
+  fair.quiet_cells = 2.0f;
+  const test::RenderedScene scene =
+      test::renderScene(test::makeLayout(fair, seed), test::MarkerFamily::ArbciBch, condition);
+  std::vector<test::FoundMarker> found;
+  for (const MarkerDetection& m : MarkerDetector(config).detect(scene.image).markers)
+    found.push_back({m.id, m.corners});
+  return test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true);
 }
 
 struct Expectation {
@@ -86,18 +100,10 @@ TEST(SyntheticScenes, ReadsMotionBlurredMarkers) {
 // cells read in another turn as id 3201 with 2 corrections, one of them overruling a cell read at
 // 4.6 times full contrast. Both searches read it as 3201 before such decodes were left to Chase.
 TEST(SyntheticScenes, OverSharpenedMotionBlurIsNotReadAsAnotherId) {
-  test::LayoutOptions fair;
-  fair.min_side_px = 48.0f;
-  fair.quiet_cells = 2.0f;
-  const test::RenderedScene scene = test::renderScene(
-      test::makeLayout(fair, 9009u), test::MarkerFamily::ArbciBch, Condition::MotionBlurJpeg);
   for (int decimate : {1, 2}) {
     DetectorConfig config;
     config.search_decimate = decimate;
-    std::vector<test::FoundMarker> found;
-    for (const MarkerDetection& m : MarkerDetector(config).detect(scene.image).markers)
-      found.push_back({m.id, m.corners});
-    const test::Score score = test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true);
+    const test::Score score = scoreFairFrame(9009u, Condition::MotionBlurJpeg, config);
     EXPECT_EQ(score.wrong_id, 0) << "search_decimate " << decimate;
     EXPECT_EQ(score.false_positive, 0) << "search_decimate " << decimate;
     EXPECT_EQ(score.found, 2) << "search_decimate " << decimate;  // the other two markers
@@ -166,17 +172,9 @@ TEST(SyntheticScenes, DecimatedSearchReadsFairScenesAsTheFullOne) {
 // code cells merge with the border into an outline 7 px across with no hole, whose retry there
 // gives a quad that does not decode. Labelled again on the frame, it is read.
 TEST(SyntheticScenes, DecimatedSearchReadsAMarkerSkewedIntoARhombus) {
-  test::LayoutOptions fair;
-  fair.min_side_px = 48.0f;
-  fair.quiet_cells = 2.0f;
-  const test::RenderedScene scene = test::renderScene(
-      test::makeLayout(fair, 9044u), test::MarkerFamily::ArbciBch, Condition::Clean);
   DetectorConfig decimated;
   decimated.search_decimate = 2;
-  std::vector<test::FoundMarker> found;
-  for (const MarkerDetection& m : MarkerDetector(decimated).detect(scene.image).markers)
-    found.push_back({m.id, m.corners});
-  const test::Score score = test::scoreFrame(scene.ids, scene.markers, found, /*ordered=*/true);
+  const test::Score score = scoreFairFrame(9044u, Condition::Clean, decimated);
   EXPECT_EQ(score.found, 3);
   EXPECT_EQ(score.wrong_id, 0);
   EXPECT_EQ(score.false_positive, 0);
