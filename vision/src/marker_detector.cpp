@@ -439,23 +439,20 @@ struct MarkerDetector::Impl {
       roi.width += 2 * margin;
       roi.height += 2 * margin;
       roi &= image;
-      // A thin ringed one on the frame first: on the reduced image its code cells may have
-      // merged, and a quad found there would fail to decode. A thin one without a hole (mostly
-      // letters and strokes, 10 times as many) only when the reduced image gives it a quad, which
-      // the frame's, if any, replaces.
-      const bool frame_first = region.thin && (region.ringed || region.fragmented);
-      if (frame_first && retryOnFrame(roi)) continue;
       const int split = region.fragmented ? kFragmentedSplit : kThinnedSplit;
       const size_t before = quads.size();
-      if (retryRegion(roi, *searched, split, params)) {
-        if (region.thin && !frame_first) {
-          reduced_found.assign(quads.begin() + static_cast<std::ptrdiff_t>(before), quads.end());
-          quads.resize(before);
-          if (!retryOnFrame(roi))
-            quads.insert(quads.end(), reduced_found.begin(), reduced_found.end());
-        }
-        continue;
+      const bool found = retryRegion(roi, *searched, split, params);
+      // A thin region is labelled on the frame too, and its quads there replace the reduced
+      // image's, whose code cells may have merged (a quad that fails to decode). One without a
+      // hole (mostly letters and strokes, 10 times as many) only when the reduced image gave it
+      // a quad.
+      if (region.thin && (found || region.ringed || region.fragmented)) {
+        reduced_found.assign(quads.begin() + static_cast<std::ptrdiff_t>(before), quads.end());
+        quads.resize(before);
+        if (retryOnFrame(roi)) continue;
+        quads.insert(quads.end(), reduced_found.begin(), reduced_found.end());
       }
+      if (found) continue;
       if (!region.fragmented && scale == 1 && binarised != &gray)
         retryRegion(roi, gray, AdaptiveThresholder::kSplit, params);
     }
