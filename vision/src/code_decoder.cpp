@@ -169,6 +169,15 @@ Reading readingOf(const std::array<float, 36>& levels) {
   return reading;
 }
 
+// Sharpening overshoots, so a sharpened cell may read beyond full contrast (reliability over 1),
+// and a hard decode of a sharpened reading may overrule such a cell. Beyond twice full contrast
+// it is not trusted, and Chase judges the reading instead: on seeds 9000-9099 a motion-blurred
+// marker read as another id in another turn by overruling a cell at 4.6 (directional reading);
+// the right ids overruled cells at 2.65 at most (1.4 but once) on the motion-blurred scenes of
+// five seed sets, and under 2 in all 358 four-neighbour readings so decoded (blur and motion
+// rows of three seed sets), where the bound has refused none.
+constexpr float kMaxOverruled = 2.0f;
+
 // The most decisively read cell a BCH decode overrules (0 when it corrected none).
 float strongestCorrection(const CodeDecode& decoded, const Reading& reading) {
   const Rotations& rotation = rotations();
@@ -207,7 +216,7 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   int sharpened_nearest = kBeyondHard;
   if (sharpened.cells != sampled) {
     const std::optional<CodeDecode> again = hardDecode(kind, sharpened.cells, ambiguous);
-    if (again && !ambiguous)
+    if (again && !ambiguous && strongestCorrection(*again, sharpened) <= kMaxOverruled)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.9f};
     sharpened_nearest = nearest(again);
@@ -221,12 +230,6 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   // scenes nothing was tuned on (seeds 7000-7099) this read 4-6 more markers of 300 per
   // condition with the decimated search, and no wrong id.
   constexpr float kDirectionalAmount = 1.5f;
-  // Sharpening this hard overshoots, so a cell may read beyond full contrast (reliability over 1),
-  // and a hard decode may overrule such a cell. Beyond twice full contrast it is not trusted and
-  // Chase judges the reading instead: on seeds 9000-9099 a motion-blurred marker read as another
-  // id in another turn by overruling a cell at 4.6, while the right ids overruled cells at 2.65
-  // at most (1.4 but once) on the motion-blurred scenes of five seed sets.
-  constexpr float kMaxOverruled = 2.0f;
   constexpr std::array<CellOffset, 4> kDirections{{{0, 1}, {1, 0}, {1, 1}, {1, -1}}};
   for (const CellOffset& along : kDirections) {
     const std::array<CellOffset, 2> ends{along, CellOffset{-along[0], -along[1]}};
