@@ -83,6 +83,48 @@ int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, f
   return best;
 }
 
+// True when the outline's forward arc (from, to) stays within `tolerance` of the chord from-to,
+// leaving out its ends up to the first point farther than `end_radius` from their corner.
+bool followsChord(const std::vector<cv::Point>& outline, int from, int to, float end_radius,
+                  float tolerance) {
+  const int n = static_cast<int>(outline.size());
+  const cv::Point a = outline[from], b = outline[to];
+  auto squared = [](cv::Point v) {
+    return static_cast<std::int64_t>(v.x) * v.x + static_cast<std::int64_t>(v.y) * v.y;
+  };
+  const auto radius_squared = static_cast<std::int64_t>(end_radius * end_radius);
+  // The arc's points left: `count` of them from index `start` on.
+  int first = 1, last = (to - from + n) % n - 1;
+  int start = from + 1 == n ? 0 : from + 1, end = to == 0 ? n - 1 : to - 1;
+  for (; first <= last && squared(outline[start] - a) <= radius_squared; ++first)
+    start = start + 1 == n ? 0 : start + 1;
+  for (; last >= first && squared(outline[end] - b) <= radius_squared; --last)
+    end = end == 0 ? n - 1 : end - 1;
+  const int count = last - first + 1;
+  const cv::Point chord = b - a;
+  const std::int64_t chord_squared = squared(chord);
+  // |chord x p| is the distance times the chord's length (exact in integers); for a chord of one
+  // point, the squared distance is compared.
+  const double limit = chord_squared == 0
+                           ? tolerance * tolerance
+                           : tolerance * std::sqrt(static_cast<double>(chord_squared));
+  const auto most = static_cast<std::int64_t>(std::floor(limit));
+  auto within = [&](int begin, int stop) {
+    for (int i = begin; i < stop; ++i) {
+      const cv::Point p = outline[i] - a;
+      const std::int64_t measure = chord_squared == 0
+                                       ? squared(p)
+                                       : std::abs(static_cast<std::int64_t>(chord.x) * p.y -
+                                                  static_cast<std::int64_t>(chord.y) * p.x);
+      if (measure > most) return false;
+    }
+    return true;
+  };
+  if (count <= 0) return true;
+  const int head = std::min(count, n - start);
+  return within(start, start + head) && within(0, count - head);
+}
+
 std::vector<int>& scratchIndices() {
   thread_local std::vector<int> indices;
   return indices;
@@ -325,7 +367,8 @@ bool finishQuad(const QuadFitParams& params, const LensMap& lens, Quad& quad) {
 // vertex), starting from `first` and the point farthest from it; the corners are the four
 // candidates spanning the largest area, and every outline point must lie close to its side.
 std::optional<std::array<int, 4>> quadVertices(const std::vector<cv::Point>& outline, int first,
-                                               float side_estimate, float max_side_deviation) {
+                                               float side_estimate, float max_side_deviation,
+                                               float corner_allowance) {
   const int n = static_cast<int>(outline.size());
   if (n < 4) return std::nullopt;
   int second = first;
@@ -354,9 +397,9 @@ std::optional<std::array<int, 4>> quadVertices(const std::vector<cv::Point>& out
   const std::array<int, 4> vertex = largestQuadrilateral(outline, candidates);
   const float max_deviation = std::max(kMinSideDeviation, max_side_deviation * side_estimate);
   for (int k = 0; k < 4; ++k) {
-    float deviation = 0.0f;
-    farthestFromChord(outline, vertex[k], vertex[(k + 1) % 4], deviation);
-    if (deviation > max_deviation) return std::nullopt;
+    if (!followsChord(outline, vertex[k], vertex[(k + 1) % 4], corner_allowance * side_estimate,
+                      max_deviation))
+      return std::nullopt;
   }
   return vertex;
 }
@@ -443,7 +486,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     }
   }
   const float side_estimate = perimeterOf(hull) / 4.0f;
-  const auto corners = quadVertices(hull, first, side_estimate, params.max_side_deviation);
+  const auto corners =
+      quadVertices(hull, first, side_estimate, params.max_side_deviation, params.corner_allowance);
   if (!corners) return result;
   result.hull_is_quadrilateral = true;
   std::array<int, 4> vertex;
@@ -452,7 +496,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     result.hull_corners[k] = contour[vertex[k]];
   }
   // The contour must follow the hull's sides: the vertices in contour order, and no dent deeper
-  // than the tolerance (a broken border or a notch is not a square, though its hull is).
+  // than the tolerance away from the corners (a broken border or a notch is not a square, though
+  // its hull is; a rounded corner is).
   for (int k = 0; k < 4; ++k) {
     const int step = (vertex[(k + 1) % 4] - vertex[k] + n) % n,
               next = (vertex[(k + 2) % 4] - vertex[k] + n) % n;
@@ -461,9 +506,9 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   const float max_deviation =
       std::max(kMinSideDeviation, params.max_side_deviation * side_estimate);
   for (int k = 0; k < 4; ++k) {
-    float deviation = 0.0f;
-    farthestFromChord(contour, vertex[k], vertex[(k + 1) % 4], deviation);
-    if (deviation > max_deviation) return result;
+    if (!followsChord(contour, vertex[k], vertex[(k + 1) % 4],
+                      params.corner_allowance * side_estimate, max_deviation))
+      return result;
   }
 
   // A line through each side's contour arc, its ends trimmed.
