@@ -181,8 +181,8 @@ TEST(SyntheticScenes, DecimatedSearchReadsAMarkerSkewedIntoARhombus) {
 }
 
 // Seed 9268's clean marker (id 1030, 39 x 75 px, tilted) has an acute corner that the halved
-// frame's binarisation chamfers: its outline runs 4.5 px off the chord of the side beside it,
-// within a sixth of the side of the corner. Held to the chord there, the outline was no quad.
+// frame's binarisation chamfers: its hull runs 3 px off the chord of the side beside it (2.5
+// allowed) 4.5 px from the corner. Held to the chord there, the outline was no quad.
 TEST(SyntheticScenes, DecimatedSearchReadsAMarkerWithAChamferedCorner) {
   DetectorConfig decimated;
   decimated.search_decimate = 2;
