@@ -206,6 +206,43 @@ TEST(SyntheticScenes, MarkerFreeFramesGiveNoDetections) {
   }
 }
 
+// A corner cut off (a chamfer, a dog-eared print) within 0.3 of a side of the corner leaves the
+// outline a quad, its corner where the sides meet; a notch in the middle of a side does not.
+TEST(SyntheticScenes, AMarkerWithACornerCutOffIsReadWhereItsSidesMeet) {
+  MarkerDetector detector(DetectorConfig{});
+  cv::Mat frame(240, 320, CV_8UC1, cv::Scalar(160));
+  const int id = 1234;
+  const test::Corners quad{{{100.0f, 60.0f}, {200.0f, 60.0f}, {200.0f, 160.0f}, {100.0f, 160.0f}}};
+  const test::Corners outer{{{87.5f, 47.5f}, {212.5f, 47.5f}, {212.5f, 172.5f}, {87.5f, 172.5f}}};
+  test::drawWarped(frame, test::markerImage(test::MarkerFamily::ArbciBch, id, 8), outer);
+  // Legs of 10 px, inside the border's corner cell (12.5 px). A corner is taken at one end of
+  // the cut, so the side that skips the cut strays from its chord by up to 9 px, more than the
+  // 8 px a 100 px side may, but by less farther than 30 px from that corner.
+  const std::vector<cv::Point> cut{{100, 60}, {110, 60}, {100, 70}};
+  cv::fillConvexPoly(frame, cut, cv::Scalar(255));
+  const auto markers = detector.detect(frame).markers;
+  ASSERT_EQ(markers.size(), 1u);
+  EXPECT_EQ(markers[0].id, id);
+  for (int k = 0; k < 4; ++k)
+    EXPECT_LT(cv::norm(markers[0].corners[k] - quad[k]), 1.0) << "corner " << k;
+}
+
+TEST(SyntheticScenes, ASquareRingNotchedMidSideIsNoSquare) {
+  MarkerDetector detector(DetectorConfig{});
+  cv::Mat frame(240, 320, CV_8UC1, cv::Scalar(160));
+  cv::rectangle(frame, cv::Rect(80, 50, 140, 140), cv::Scalar(255), cv::FILLED);  // surround
+  cv::rectangle(frame, cv::Rect(100, 70, 100, 100), cv::Scalar(0), cv::FILLED);
+  cv::rectangle(frame, cv::Rect(115, 85, 70, 70), cv::Scalar(255), cv::FILLED);
+  // 10 px deep and 12 wide in the middle of the top side, 44 px from either corner.
+  cv::rectangle(frame, cv::Rect(144, 70, 12, 10), cv::Scalar(255), cv::FILLED);
+  detector.detect(frame);
+  EXPECT_TRUE(detector.lastSquares().empty());
+  // Without the notch the ring is a square.
+  cv::rectangle(frame, cv::Rect(144, 70, 12, 10), cv::Scalar(0), cv::FILLED);
+  detector.detect(frame);
+  EXPECT_EQ(detector.lastSquares().size(), 1u);
+}
+
 TEST(SyntheticScenes, CornersComeInThePrintedOrder) {
   // A marker rotated in the image still reports its printed top-left first.
   MarkerDetector detector(DetectorConfig{});
