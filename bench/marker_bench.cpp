@@ -39,6 +39,8 @@ struct Cell {
   int frames = 0;
   int marker_free_false_positives = 0;
   vision::StageTimes stages;  // summed over the frames (detectors that measure them)
+  // Misses, for the detectors that explain them (ARBCI's own).
+  int missed = 0, missed_with_square = 0, missed_readable = 0;
 };
 
 void addStages(vision::StageTimes& sum, const vision::StageTimes& t) {
@@ -147,9 +149,17 @@ int main(int argc, char** argv) {
           for (size_t m = 0; m < scene.markers.size(); ++m) {
             const int bin = sideBin(scene.markers[m]);
             ++cell.truth_by_side[bin];
-            cell.found_by_side[bin] += test::scoreFrame({scene.ids[m]}, {scene.markers[m]}, found,
-                                                        detectors[d]->orderedCorners())
-                                           .found;
+            const int hit = test::scoreFrame({scene.ids[m]}, {scene.markers[m]}, found,
+                                             detectors[d]->orderedCorners())
+                                .found;
+            cell.found_by_side[bin] += hit;
+            if (hit) continue;
+            if (const auto miss =
+                    detectors[d]->explainMiss(scene.image, scene.markers[m], scene.ids[m])) {
+              ++cell.missed;
+              cell.missed_with_square += miss->square_on_it;
+              cell.missed_readable += miss->readable_at_truth;
+            }
           }
           cell.seconds += seconds;
           if (const auto stages = detectors[d]->lastStageTimes()) addStages(cell.stages, *stages);
@@ -190,6 +200,18 @@ int main(int argc, char** argv) {
                     test::toString(conditions[c]).c_str(), t.smooth / n, t.threshold / n,
                     t.label / n, t.quads / n, t.retry / n, t.refine / n, t.decode / n, other / n,
                     t.total / n);
+      }
+    }
+    for (size_t d = 0; d < ours; ++d) {
+      std::printf(
+          "\n%s: its misses, %dx%d (a square on the marker: the search found its outline; read at "
+          "the true corners: its code is readable there)\n%-13s %7s %16s %22s\n",
+          detectors[d]->name().c_str(), size.width, size.height, "condition", "missed",
+          "square on it", "read at true corners");
+      for (size_t c = 0; c < conditions.size(); ++c) {
+        const Cell& cell = cells[{static_cast<int>(d), static_cast<int>(c)}];
+        std::printf("%-13s %7d %16d %22d\n", test::toString(conditions[c]).c_str(), cell.missed,
+                    cell.missed_with_square, cell.missed_readable);
       }
     }
     if (by_side) {

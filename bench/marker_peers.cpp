@@ -4,6 +4,7 @@
 #include <tag36h11.h>
 
 #include <opencv2/aruco.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "arbci/vision/marker_detector.h"
 
@@ -27,6 +28,23 @@ class ArbciTracker final : public MarkerDetectorUnderTest {
     return found;
   }
   std::optional<vision::StageTimes> lastStageTimes() const override { return stages_; }
+  std::optional<Miss> explainMiss(const cv::Mat& gray, const test::Corners& truth,
+                                  int id) override {
+    Miss miss;
+    const std::vector<cv::Point2f> outline(truth.begin(), truth.end());
+    const double area = cv::contourArea(outline);
+    for (const vision::SquareCorners& square : detector_.lastSquares()) {
+      const std::vector<cv::Point2f> corners(square.begin(), square.end());
+      const cv::Point2f centre = (square[0] + square[1] + square[2] + square[3]) * 0.25f;
+      const double square_area = cv::contourArea(corners);
+      if (cv::pointPolygonTest(outline, centre, false) > 0 && square_area > 0.5 * area &&
+          square_area < 2.0 * area)
+        miss.square_on_it = true;
+    }
+    const auto read = detector_.readAt(gray, truth);
+    miss.readable_at_truth = read && read->id == id;
+    return miss;
+  }
 
  private:
   static vision::DetectorConfig config(int decimate) {

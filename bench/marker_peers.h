@@ -23,6 +23,17 @@ class MarkerDetectorUnderTest {
   virtual std::vector<test::FoundMarker> detect(const cv::Mat& gray) = 0;
   // The last frame's time per stage, for detectors that measure it (ARBCI's own).
   virtual std::optional<vision::StageTimes> lastStageTimes() const { return std::nullopt; }
+  // A marker the last frame's detection missed, as the detectors that can tell (ARBCI's own) see
+  // it: whether that frame gave a square on it (its centre inside the true outline, half to
+  // twice its area), and whether it reads as its id at its true corners.
+  struct Miss {
+    bool square_on_it = false;
+    bool readable_at_truth = false;
+  };
+  virtual std::optional<Miss> explainMiss(const cv::Mat& /*gray*/, const test::Corners& /*truth*/,
+                                          int /*id*/) {
+    return std::nullopt;
+  }
 };
 
 // decimate: the tracker's search_decimate (1: full resolution).

@@ -1,7 +1,9 @@
 // The tracker on synthetic frames with exact ground truth (the benchmark's scenes): markers 20 px
 // and up, tilted up to 60 degrees, with decoys and clutter, under the five conditions.
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -241,6 +243,39 @@ TEST(SyntheticScenes, ASquareRingNotchedMidSideIsNoSquare) {
   cv::rectangle(frame, cv::Rect(144, 70, 12, 10), cv::Scalar(0), cv::FILLED);
   detector.detect(frame);
   EXPECT_EQ(detector.lastSquares().size(), 1u);
+}
+
+TEST(SyntheticScenes, AMarkerIsReadAtGivenCornersInEitherTurnAndABlankSquareIsNot) {
+  MarkerDetector detector(DetectorConfig{});
+  cv::Mat frame(240, 320, CV_8UC1, cv::Scalar(160));
+  const int id = 2345;
+  // An 80 px square turned 20 degrees; its white margin a cell (a tenth of the drawn image) wide.
+  const cv::Point2f centre(160.0f, 110.0f);
+  const float c = 40.0f * std::cos(0.35f), d = 40.0f * std::sin(0.35f);
+  const test::Corners quad{{centre + cv::Point2f(-c + d, -d - c),
+                            centre + cv::Point2f(c + d, d - c), centre + cv::Point2f(c - d, d + c),
+                            centre + cv::Point2f(-c - d, -d + c)}};
+  test::Corners outer;
+  for (int k = 0; k < 4; ++k) outer[k] = centre + 1.25f * (quad[k] - centre);
+  test::drawWarped(frame, test::markerImage(test::MarkerFamily::ArbciBch, id, 8), outer);
+  const auto read = detector.readAt(frame, quad);
+  ASSERT_TRUE(read.has_value());
+  EXPECT_EQ(read->id, id);
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(read->corners[k], quad[k]) << "corner " << k;
+  // Counter-clockwise, starting elsewhere: the same marker, its corners in the printed order.
+  const auto turned = detector.readAt(frame, {quad[1], quad[0], quad[3], quad[2]});
+  ASSERT_TRUE(turned.has_value());
+  EXPECT_EQ(turned->id, id);
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(turned->corners[k], quad[k]) << "corner " << k;
+  // Where there is no marker, nothing.
+  EXPECT_FALSE(
+      detector
+          .readAt(frame, {{{230.0f, 150.0f}, {300.0f, 150.0f}, {300.0f, 220.0f}, {230.0f, 220.0f}}})
+          .has_value());
+  DetectorConfig aruco;
+  aruco.kind = MarkerKind::Aruco;
+  MarkerDetector dictionary(aruco);
+  EXPECT_THROW(dictionary.readAt(frame, quad), std::invalid_argument);
 }
 
 TEST(SyntheticScenes, CornersComeInThePrintedOrder) {

@@ -582,6 +582,36 @@ struct MarkerDetector::Impl {
     return refineQuad(onFrameCoarse(start.corners), *binarised, params);
   }
 
+  // The marker that `quad`'s samples (of `gray`) read as, its corners in the printed order.
+  std::optional<MarkerDetection> read(const Quad& quad, const MarkerSamples& samples) const {
+    if (samples.contrast < 8.0f || samples.border_light * 10 > samples.border_samples)
+      return std::nullopt;
+    MarkerDetection marker;
+    marker.kind = config.kind;
+    if (config.kind == MarkerKind::Template) {
+      const auto match =
+          matchTemplate(sampleCodeArea(gray, quad, config.border, TemplatePattern::kSize),
+                        config.templates, config.template_limits);
+      if (!match) return std::nullopt;
+      marker.id = match->id;
+      marker.orientation = match->orientation;
+      marker.confidence = match->confidence;
+    } else {
+      const auto code = decodeCode(config.kind, samples, config.soft_decoding);
+      if (!code) return std::nullopt;
+      marker.id = code->id;
+      marker.orientation = code->orientation;
+      marker.confidence = code->confidence;
+      marker.corrected_bits = code->corrected_bits;
+    }
+    // Printed corner k (TL, TR, BR, BL) is quad corner (k + 4 - orientation) mod 4.
+    for (int k = 0; k < 4; ++k) {
+      marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
+      marker.ideal_corners[k] = quad.ideal_corners[(k + 4 - marker.orientation) % 4];
+    }
+    return marker;
+  }
+
   // Decodes every quad, largest first (a reduced image's refined on the frame first); returns
   // the samples' extremes and the first marker's median (in the frame's order) for the automatic
   // thresholds. Leaves `quads` the frame's quads that were looked at.
@@ -630,31 +660,9 @@ struct MarkerDetector::Impl {
       const MarkerSamples samples = sampleMarker(gray, quad, config.border);
       lowest = std::min(lowest, samples.lowest);
       highest = std::max(highest, samples.highest);
-      if (samples.contrast < 8.0f || samples.border_light * 10 > samples.border_samples) continue;
-      MarkerDetection marker;
-      marker.kind = config.kind;
-      if (config.kind == MarkerKind::Template) {
-        const auto match =
-            matchTemplate(sampleCodeArea(gray, quad, config.border, TemplatePattern::kSize),
-                          config.templates, config.template_limits);
-        if (!match) continue;
-        marker.id = match->id;
-        marker.orientation = match->orientation;
-        marker.confidence = match->confidence;
-      } else {
-        const auto code = decodeCode(config.kind, samples, config.soft_decoding);
-        if (!code) continue;
-        marker.id = code->id;
-        marker.orientation = code->orientation;
-        marker.confidence = code->confidence;
-        marker.corrected_bits = code->corrected_bits;
-      }
-      // Printed corner k (TL, TR, BR, BL) is quad corner (k + 4 - orientation) mod 4.
-      for (int k = 0; k < 4; ++k) {
-        marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
-        marker.ideal_corners[k] = quad.ideal_corners[(k + 4 - marker.orientation) % 4];
-      }
-      decoded.emplace_back(index, marker);
+      const auto marker = read(quad, samples);
+      if (!marker) continue;
+      decoded.emplace_back(index, *marker);
       medians.emplace_back(index, samples.median);
     }
     // The frame's (raster) order, as found.
@@ -823,6 +831,38 @@ DetectionResult MarkerDetector::detect(const ImageView& image) {
   toLuminance(image, impl_->converted);
   impl_->gray = impl_->converted;
   return impl_->runAfterConversion(start);
+}
+
+std::optional<MarkerDetection> MarkerDetector::readAt(const cv::Mat& image,
+                                                      const SquareCorners& corners) {
+  Impl& impl = *impl_;
+  if (!isSquareKind(impl.config.kind)) {
+    throw std::invalid_argument(
+        "MarkerDetector::readAt reads ARToolKitPlus-style markers (BCH, simple, template); this "
+        "detector finds ArUco or AprilTag markers through their own libraries");
+  }
+  if (image.empty()) return std::nullopt;
+  if (image.type() == CV_8UC1) {
+    impl.gray = image;
+  } else {
+    toLuminance(image, impl.converted);
+    impl.gray = impl.converted;
+  }
+  Quad quad;
+  quad.corners = corners;
+  // Clockwise on screen (y down), as the search gives them: a mirrored grid would read another
+  // code.
+  float twice_area = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f a = corners[k], b = corners[(k + 1) % 4];
+    twice_area += a.x * b.y - b.x * a.y;
+  }
+  if (twice_area < 0.0f) std::swap(quad.corners[1], quad.corners[3]);
+  for (int k = 0; k < 4; ++k) {
+    quad.ideal_corners[k] =
+        impl.config.lens ? toFloat(impl.config.lens->undistort(quad.corners[k])) : quad.corners[k];
+  }
+  return impl.read(quad, sampleMarker(impl.gray, quad, impl.config.border));
 }
 
 const DetectorConfig& MarkerDetector::config() const {

@@ -67,6 +67,13 @@ class MarkerDetector {
   // A frame in any supported pixel format.
   DetectionResult detect(const ImageView& image);
 
+  // Reads a marker of the configured ARToolKitPlus-style kind (BCH, simple, template) at
+  // `corners`, the outline of its black square in image pixels, as given: no search and no
+  // refinement (either turn; counter-clockwise corners are reordered). Tells a marker the search
+  // missed from one that cannot be read (marker_bench's miss analysis). Throws
+  // std::invalid_argument for the ArUco and AprilTag kinds.
+  std::optional<MarkerDetection> readAt(const cv::Mat& image, const SquareCorners& corners);
+
   const DetectorConfig& config() const;
   void setThreshold(const ThresholdSettings& settings);
   // The global threshold the next frame starts from (automatic and constant modes).
