@@ -83,10 +83,15 @@ bool insideConvex(const SquareCorners& quad, cv::Point2f p) {
   return true;
 }
 
-float quadArea(const SquareCorners& q) {
+// Positive when the corners run clockwise on screen (y down).
+float signedQuadArea(const SquareCorners& q) {
   float area = 0.0f;
   for (int k = 0; k < 4; ++k) area += q[k].x * q[(k + 1) % 4].y - q[(k + 1) % 4].x * q[k].y;
-  return std::abs(area) * 0.5f;
+  return area * 0.5f;
+}
+
+float quadArea(const SquareCorners& q) {
+  return std::abs(signedQuadArea(q));
 }
 
 float longestSide(const SquareCorners& q) {
@@ -280,8 +285,9 @@ struct MarkerDetector::Impl {
       const bool solid = c.holes == 0 && config.kind == MarkerKind::Bch;
       QuadFitParams component_params = params;
       if (solid) {
-        // Dropped whether it fits or not, so held to sharp corners: fewer go on to the line fit,
-        // and the markers found are the same within 3 of 14,400 (seeds 1000, 7000, 9000).
+        // Dropped whether it fits or not, so held to sharp corners: fewer go on to the line fit
+        // (about 1 % of the time in A/B runs), and the markers found are the same within 3 of
+        // 14,400 (seeds 1000, 7000, 9000).
         component_params.refine_edges = false;
         component_params.corner_allowance = 0.0f;
       }
@@ -582,15 +588,30 @@ struct MarkerDetector::Impl {
     return refineQuad(onFrameCoarse(start.corners), *binarised, params);
   }
 
-  // The marker that `quad`'s samples (of `gray`) read as, its corners in the printed order.
-  std::optional<MarkerDetection> read(const Quad& quad, const MarkerSamples& samples) const {
+  // `image` as 8-bit luminance: itself when gray (a view; never written), else converted into
+  // `converted`.
+  cv::Mat luminanceOf(const cv::Mat& image, cv::Mat& converted) const {
+    if (image.type() == CV_8UC1) return image;
+    if (external() && (image.type() == CV_8UC3 || image.type() == CV_8UC4)) {
+      // OpenCV's dictionaries and libapriltag are tuned on BT.601 grey.
+      cv::cvtColor(image, converted,
+                   image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+    } else {
+      toLuminance(image, converted);
+    }
+    return converted;
+  }
+
+  // The marker that `quad`'s samples of `image` read as, its corners in the printed order.
+  std::optional<MarkerDetection> read(const cv::Mat& image, const Quad& quad,
+                                      const MarkerSamples& samples) const {
     if (samples.contrast < 8.0f || samples.border_light * 10 > samples.border_samples)
       return std::nullopt;
     MarkerDetection marker;
     marker.kind = config.kind;
     if (config.kind == MarkerKind::Template) {
       const auto match =
-          matchTemplate(sampleCodeArea(gray, quad, config.border, TemplatePattern::kSize),
+          matchTemplate(sampleCodeArea(image, quad, config.border, TemplatePattern::kSize),
                         config.templates, config.template_limits);
       if (!match) return std::nullopt;
       marker.id = match->id;
@@ -660,7 +681,7 @@ struct MarkerDetector::Impl {
       const MarkerSamples samples = sampleMarker(gray, quad, config.border);
       lowest = std::min(lowest, samples.lowest);
       highest = std::max(highest, samples.highest);
-      const auto marker = read(quad, samples);
+      const auto marker = read(gray, quad, samples);
       if (!marker) continue;
       decoded.emplace_back(index, *marker);
       medians.emplace_back(index, samples.median);
@@ -812,17 +833,7 @@ MarkerDetector& MarkerDetector::operator=(MarkerDetector&&) noexcept = default;
 
 DetectionResult MarkerDetector::detect(const cv::Mat& image) {
   const auto start = Clock::now();
-  if (image.type() == CV_8UC1) {
-    impl_->gray = image;  // a view; never written
-  } else if (impl_->external() && (image.type() == CV_8UC3 || image.type() == CV_8UC4)) {
-    // OpenCV's dictionaries and libapriltag are tuned on BT.601 grey.
-    cv::cvtColor(image, impl_->converted,
-                 image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
-    impl_->gray = impl_->converted;
-  } else {
-    toLuminance(image, impl_->converted);
-    impl_->gray = impl_->converted;
-  }
+  impl_->gray = impl_->luminanceOf(image, impl_->converted);
   return impl_->runAfterConversion(start);
 }
 
@@ -834,35 +845,26 @@ DetectionResult MarkerDetector::detect(const ImageView& image) {
 }
 
 std::optional<MarkerDetection> MarkerDetector::readAt(const cv::Mat& image,
-                                                      const SquareCorners& corners) {
-  Impl& impl = *impl_;
+                                                      const SquareCorners& corners) const {
+  const Impl& impl = *impl_;
   if (!isSquareKind(impl.config.kind)) {
     throw std::invalid_argument(
         "MarkerDetector::readAt reads ARToolKitPlus-style markers (BCH, simple, template); this "
         "detector finds ArUco or AprilTag markers through their own libraries");
   }
   if (image.empty()) return std::nullopt;
-  if (image.type() == CV_8UC1) {
-    impl.gray = image;
-  } else {
-    toLuminance(image, impl.converted);
-    impl.gray = impl.converted;
-  }
+  // Its own conversion: the last frame's images (lastGrayImage() and the rest) stay as they were.
+  cv::Mat converted;
+  const cv::Mat gray = impl.luminanceOf(image, converted);
   Quad quad;
   quad.corners = corners;
-  // Clockwise on screen (y down), as the search gives them: a mirrored grid would read another
-  // code.
-  float twice_area = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    const cv::Point2f a = corners[k], b = corners[(k + 1) % 4];
-    twice_area += a.x * b.y - b.x * a.y;
-  }
-  if (twice_area < 0.0f) std::swap(quad.corners[1], quad.corners[3]);
+  // Clockwise on screen, as the search gives them: a mirrored grid would read another code.
+  if (signedQuadArea(corners) < 0.0f) std::swap(quad.corners[1], quad.corners[3]);
   for (int k = 0; k < 4; ++k) {
     quad.ideal_corners[k] =
         impl.config.lens ? toFloat(impl.config.lens->undistort(quad.corners[k])) : quad.corners[k];
   }
-  return impl.read(quad, sampleMarker(impl.gray, quad, impl.config.border));
+  return impl.read(gray, quad, sampleMarker(gray, quad, impl.config.border));
 }
 
 const DetectorConfig& MarkerDetector::config() const {

@@ -46,32 +46,47 @@ float length(cv::Point2f v) {
   return std::sqrt(v.dot(v));
 }
 
-// Index of the contour point in the forward arc (from, to) farthest from the chord from-to.
-int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, float& distance) {
+// Index of the contour point in the forward arc (from, to) farthest from the chord from-to, and
+// its distance; the arc's ends up to the first point farther than `end_radius` from their corner
+// are left out (-1 and 0 when no point is left).
+int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, float& distance,
+                      float end_radius = 0.0f) {
   const int n = static_cast<int>(contour.size());
-  const cv::Point a = contour[from];
-  const cv::Point chord = contour[to] - a;
+  const cv::Point a = contour[from], b = contour[to];
+  auto squared = [](cv::Point v) {
+    return static_cast<std::int64_t>(v.x) * v.x + static_cast<std::int64_t>(v.y) * v.y;
+  };
+  const auto radius_squared = static_cast<std::int64_t>(end_radius * end_radius);
+  // The arc's points left: offsets first..last from `from`, the first of them at index `start`.
+  int first = 1, last = (to - from + n) % n - 1;
+  int start = from + 1 == n ? 0 : from + 1, end = to == 0 ? n - 1 : to - 1;
+  for (; first <= last && squared(contour[start] - a) <= radius_squared; ++first)
+    start = start + 1 == n ? 0 : start + 1;
+  for (; last >= first && squared(contour[end] - b) <= radius_squared; --last)
+    end = end == 0 ? n - 1 : end - 1;
+  const cv::Point chord = b - a;
   const bool point_chord = chord.x == 0 && chord.y == 0;
   int best = -1;
   std::int64_t best_measure = -1;
   // |chord x p| is the distance times the chord's length (exact in integers); for a chord of one
   // point, the squared distance.
-  auto visit = [&](int i) {
-    const cv::Point p = contour[i] - a;
-    const std::int64_t measure =
-        point_chord ? static_cast<std::int64_t>(p.x) * p.x + static_cast<std::int64_t>(p.y) * p.y
-                    : std::abs(static_cast<std::int64_t>(chord.x) * p.y -
-                               static_cast<std::int64_t>(chord.y) * p.x);
-    if (measure > best_measure) {
-      best_measure = measure;
-      best = i;
+  auto scan = [&](int begin, int stop) {
+    for (int i = begin; i < stop; ++i) {
+      const cv::Point p = contour[i] - a;
+      const std::int64_t measure = point_chord ? squared(p)
+                                               : std::abs(static_cast<std::int64_t>(chord.x) * p.y -
+                                                          static_cast<std::int64_t>(chord.y) * p.x);
+      if (measure > best_measure) {
+        best_measure = measure;
+        best = i;
+      }
     }
   };
-  if (from < to) {
-    for (int i = from + 1; i < to; ++i) visit(i);
-  } else {
-    for (int i = from + 1; i < n; ++i) visit(i);
-    for (int i = 0; i < to; ++i) visit(i);
+  const int count = last - first + 1;
+  if (count > 0) {
+    const int head = std::min(count, n - start);
+    scan(start, start + head);
+    scan(0, count - head);
   }
   if (best < 0) {
     distance = 0.0f;
@@ -83,46 +98,16 @@ int farthestFromChord(const std::vector<cv::Point>& contour, int from, int to, f
   return best;
 }
 
-// True when the outline's forward arc (from, to) stays within `tolerance` of the chord from-to,
-// leaving out its ends up to the first point farther than `end_radius` from their corner.
-bool followsChord(const std::vector<cv::Point>& outline, int from, int to, float end_radius,
-                  float tolerance) {
-  const int n = static_cast<int>(outline.size());
-  const cv::Point a = outline[from], b = outline[to];
-  auto squared = [](cv::Point v) {
-    return static_cast<std::int64_t>(v.x) * v.x + static_cast<std::int64_t>(v.y) * v.y;
-  };
-  const auto radius_squared = static_cast<std::int64_t>(end_radius * end_radius);
-  // The arc's points left: `count` of them from index `start` on.
-  int first = 1, last = (to - from + n) % n - 1;
-  int start = from + 1 == n ? 0 : from + 1, end = to == 0 ? n - 1 : to - 1;
-  for (; first <= last && squared(outline[start] - a) <= radius_squared; ++first)
-    start = start + 1 == n ? 0 : start + 1;
-  for (; last >= first && squared(outline[end] - b) <= radius_squared; --last)
-    end = end == 0 ? n - 1 : end - 1;
-  const int count = last - first + 1;
-  const cv::Point chord = b - a;
-  const std::int64_t chord_squared = squared(chord);
-  // |chord x p| is the distance times the chord's length (exact in integers); for a chord of one
-  // point, the squared distance is compared.
-  const double limit = chord_squared == 0
-                           ? tolerance * tolerance
-                           : tolerance * std::sqrt(static_cast<double>(chord_squared));
-  const auto most = static_cast<std::int64_t>(std::floor(limit));
-  auto within = [&](int begin, int stop) {
-    for (int i = begin; i < stop; ++i) {
-      const cv::Point p = outline[i] - a;
-      const std::int64_t measure = chord_squared == 0
-                                       ? squared(p)
-                                       : std::abs(static_cast<std::int64_t>(chord.x) * p.y -
-                                                  static_cast<std::int64_t>(chord.y) * p.x);
-      if (measure > most) return false;
-    }
-    return true;
-  };
-  if (count <= 0) return true;
-  const int head = std::min(count, n - start);
-  return within(start, start + head) && within(0, count - head);
+// True when the outline's sides from each corner to the next stay within `tolerance` of their
+// chords, but within `corner_radius` of a corner.
+bool sidesFollowChords(const std::vector<cv::Point>& outline, const std::array<int, 4>& corners,
+                       float corner_radius, float tolerance) {
+  for (int k = 0; k < 4; ++k) {
+    float deviation = 0.0f;
+    farthestFromChord(outline, corners[k], corners[(k + 1) % 4], deviation, corner_radius);
+    if (deviation > tolerance) return false;
+  }
+  return true;
 }
 
 std::vector<int>& scratchIndices() {
@@ -396,11 +381,8 @@ std::optional<std::array<int, 4>> quadVertices(const std::vector<cv::Point>& out
   if (candidates.size() < 4) return std::nullopt;
   const std::array<int, 4> vertex = largestQuadrilateral(outline, candidates);
   const float max_deviation = std::max(kMinSideDeviation, max_side_deviation * side_estimate);
-  for (int k = 0; k < 4; ++k) {
-    if (!followsChord(outline, vertex[k], vertex[(k + 1) % 4], corner_allowance * side_estimate,
-                      max_deviation))
-      return std::nullopt;
-  }
+  if (!sidesFollowChords(outline, vertex, corner_allowance * side_estimate, max_deviation))
+    return std::nullopt;
   return vertex;
 }
 
@@ -505,11 +487,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
   }
   const float max_deviation =
       std::max(kMinSideDeviation, params.max_side_deviation * side_estimate);
-  for (int k = 0; k < 4; ++k) {
-    if (!followsChord(contour, vertex[k], vertex[(k + 1) % 4],
-                      params.corner_allowance * side_estimate, max_deviation))
-      return result;
-  }
+  if (!sidesFollowChords(contour, vertex, params.corner_allowance * side_estimate, max_deviation))
+    return result;
 
   // A line through each side's contour arc, its ends trimmed.
   const LensMap lens{params.lens};

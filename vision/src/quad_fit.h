@@ -25,7 +25,7 @@ struct Quad {
 
 struct QuadFitParams {
   float min_side = 6.0f;  // px
-  // Contour points may stray this fraction of a side's length (at least 2 px) from the chord,
+  // Contour points may stray this fraction of a side's length (at least 2.5 px) from the chord,
   float max_side_deviation = 0.08f;
   // except those within this fraction of the outline's mean side of a corner: binarisation and
   // blur round and chamfer corners (an acute corner of a tilted marker in the halved frame by

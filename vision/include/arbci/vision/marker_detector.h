@@ -70,9 +70,9 @@ class MarkerDetector {
   // Reads a marker of the configured ARToolKitPlus-style kind (BCH, simple, template) at
   // `corners`, the outline of its black square in image pixels, as given: no search and no
   // refinement (either turn; counter-clockwise corners are reordered). Tells a marker the search
-  // missed from one that cannot be read (marker_bench's miss analysis). Throws
-  // std::invalid_argument for the ArUco and AprilTag kinds.
-  std::optional<MarkerDetection> readAt(const cv::Mat& image, const SquareCorners& corners);
+  // missed from one that cannot be read (marker_bench's miss analysis); the last frame's results
+  // are left as they were. Throws std::invalid_argument for the ArUco and AprilTag kinds.
+  std::optional<MarkerDetection> readAt(const cv::Mat& image, const SquareCorners& corners) const;
 
   const DetectorConfig& config() const;
   void setThreshold(const ThresholdSettings& settings);
