@@ -194,7 +194,7 @@ float strongestCorrection(const CodeDecode& decoded, const Reading& reading) {
 }  // namespace
 
 std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& samples,
-                                     bool soft_decoding) {
+                                     CodeReadings readings) {
   CodeGrid sampled{};
   std::array<float, 36> reliability{};
   const float half_contrast = std::max(1.0f, samples.contrast * 0.5f);
@@ -205,7 +205,8 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   bool ambiguous = false;
   const std::optional<CodeDecode> hard = hardDecode(kind, sampled, ambiguous);
   if (hard && !ambiguous) return hard;
-  if (ambiguous || kind != MarkerKind::Bch || !soft_decoding) return std::nullopt;
+  if (ambiguous || kind != MarkerKind::Bch || readings == CodeReadings::Plain) return std::nullopt;
+  const bool chase = readings == CodeReadings::SharpenedAndChase;
   // Hard decoding corrects up to 2 cells in every turn: when it found no codeword, each one
   // disagrees with 3 cells or more; when it found two equally near, nothing is known.
   constexpr int kBeyondHard = 3;
@@ -221,9 +222,11 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
                         again->confidence * 0.9f};
     sharpened_nearest = nearest(again);
   }
-  if (auto chase = chaseDecode(sampled, reliability, kBeyondHard)) return chase;
-  if (auto chase = chaseDecode(sharpened.cells, sharpened.reliability, sharpened_nearest))
-    return chase;
+  if (chase) {
+    if (auto soft = chaseDecode(sampled, reliability, kBeyondHard)) return soft;
+    if (auto soft = chaseDecode(sharpened.cells, sharpened.reliability, sharpened_nearest))
+      return soft;
+  }
   // Motion blur smears each cell into its neighbours along one direction: sharpened against
   // those two alone, along the grid's rows, columns and diagonals (within 22.5 degrees of any
   // direction). The amount was chosen on the bench's seeds 1000-1099; on its motion-blurred
@@ -238,8 +241,9 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
     if (again && !ambiguous && strongestCorrection(*again, directional) <= kMaxOverruled)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.8f};
-    if (auto chase = chaseDecode(directional.cells, directional.reliability, nearest(again)))
-      return chase;
+    if (!chase) continue;
+    if (auto soft = chaseDecode(directional.cells, directional.reliability, nearest(again)))
+      return soft;
   }
   return std::nullopt;
 }

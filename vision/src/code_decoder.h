@@ -22,7 +22,11 @@ struct CodeDecode {
   float confidence = 0.0f;
 };
 
+// How hard decodeCode() tries once the plain hard decoding fails (BCH only): not at all, hard
+// decoding of the sharpened readings, or those and Chase decoding.
+enum class CodeReadings { Plain, Sharpened, SharpenedAndChase };
+
 std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& samples,
-                                     bool soft_decoding);
+                                     CodeReadings readings);
 
 }  // namespace arbci::vision

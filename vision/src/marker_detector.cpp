@@ -611,9 +611,10 @@ struct MarkerDetector::Impl {
     return samples.contrast >= 8.0f && samples.border_light * 10 <= samples.border_samples;
   }
 
-  // The marker that `quad`'s samples of `image` read as, its corners in the printed order.
+  // The marker that `quad`'s samples of `image` read as, its corners in the printed order;
+  // without `chase`, BCH codes are not Chase-decoded.
   std::optional<MarkerDetection> read(const cv::Mat& image, const Quad& quad,
-                                      const MarkerSamples& samples) const {
+                                      const MarkerSamples& samples, bool chase = true) const {
     if (!hasMarkerBorder(samples)) return std::nullopt;
     MarkerDetection marker;
     marker.kind = config.kind;
@@ -626,7 +627,10 @@ struct MarkerDetector::Impl {
       marker.orientation = match->orientation;
       marker.confidence = match->confidence;
     } else {
-      const auto code = decodeCode(config.kind, samples, config.soft_decoding);
+      const CodeReadings readings = !config.soft_decoding ? CodeReadings::Plain
+                                    : chase               ? CodeReadings::SharpenedAndChase
+                                                          : CodeReadings::Sharpened;
+      const auto code = decodeCode(config.kind, samples, readings);
       if (!code) return std::nullopt;
       marker.id = code->id;
       marker.orientation = code->orientation;
@@ -642,9 +646,11 @@ struct MarkerDetector::Impl {
   }
 
   // A quad with a marker's border whose code does not decode, its sides moved onto
-  // motion-blurred edges (placeOnBlurredEdges()) and read again; then `quad` and `samples` are the
-  // moved quad's. (On the bench's motion-blurred frames no quad that failed for want of contrast
-  // or a dark border read after the move.)
+  // motion-blurred edges (placeOnBlurredEdges()) and read again, without Chase decoding; then
+  // `quad` and `samples` are the moved quad's. (On the bench's motion-blurred frames no quad that
+  // failed for want of contrast or a dark border read after the move. Chase decoding there read
+  // a quarter more markers, but also two decoys of marker-free frames as markers: a second
+  // reading of every failing decoy doubles its chances.)
   std::optional<MarkerDetection> readOnBlurredEdges(Quad& quad, MarkerSamples& samples) const {
     if (!hasMarkerBorder(samples)) return std::nullopt;
     QuadFitParams params;
@@ -660,7 +666,13 @@ struct MarkerDetector::Impl {
     }
     if (moved < kLeastBlurredEdgeMove * kLeastBlurredEdgeMove) return std::nullopt;
     MarkerSamples placed_samples = sampleMarker(gray, *placed, config.border);
-    auto marker = read(gray, *placed, placed_samples);
+    auto marker = read(gray, *placed, placed_samples, /*chase=*/false);
+#ifdef ABCOUNT
+    if (marker)
+      fprintf(stderr, "BLURREAD id %d bits %d conf %.3f at %.0f,%.0f\n", marker->id,
+              marker->corrected_bits, marker->confidence, marker->corners[0].x,
+              marker->corners[0].y);
+#endif
     if (marker) {
       quad = *placed;
       samples = placed_samples;
