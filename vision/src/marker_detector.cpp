@@ -15,6 +15,7 @@
 #endif
 
 #include "apriltag_detector.h"
+#include "blurred_edges.h"
 #include "code_decoder.h"
 #include "contour_trace.h"
 #include "dictionary_detector.h"

@@ -6,10 +6,13 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "arbci/vision/undistortion.h"
 #include "image_sampling.h"
+#include "side_geometry.h"
 
 namespace arbci::vision {
+
+using namespace side_geometry;
+
 namespace {
 
 // The least a side may stray from its chord, px. Blur rounds a small square's corners, bending the
@@ -21,30 +24,6 @@ constexpr float kMinSideDeviation = 2.5f;
 // time per 640x480 frame by 0.04 ms, but gave one pose flip in 600 random poses at 30-60 degrees
 // (tests/vision/pose_test.cpp's, run 600 times; 20 and 14 gave none in 1,200).
 constexpr int kFirstPassSamples = 14, kSecondPassSamples = 20;
-
-// Image <-> ideal coordinates through the lens; the identity without one.
-struct LensMap {
-  const Undistorter* lens = nullptr;
-  cv::Point2f toIdeal(cv::Point2f p) const {
-    if (!lens) return p;
-    const cv::Point2d q = lens->undistort(p);
-    return {static_cast<float>(q.x), static_cast<float>(q.y)};
-  }
-  cv::Point2f toImage(cv::Point2f p) const {
-    if (!lens) return p;
-    const cv::Point2d q = lens->distort(p);
-    return {static_cast<float>(q.x), static_cast<float>(q.y)};
-  }
-};
-
-struct Line {
-  cv::Point2f point;      // a point on the line
-  cv::Point2f direction;  // unit length
-};
-
-float length(cv::Point2f v) {
-  return std::sqrt(v.dot(v));
-}
 
 // Index of the contour point in the forward arc (from, to) farthest from the chord from-to, and
 // its distance; the arc's ends up to the first point farther than `end_radius` from their corner
@@ -182,50 +161,6 @@ bool splitArc(const std::vector<cv::Point>& contour, int from, int to, float tol
   return splitArc(contour, split, to, tolerance, limit, vertices);
 }
 
-// Weighted total-least-squares line through `count` points.
-std::optional<Line> fitLine(const cv::Point2f* points, const float* weights, int count) {
-  double sw = 0, sx = 0, sy = 0;
-  for (int i = 0; i < count; ++i) {
-    sw += weights[i];
-    sx += weights[i] * points[i].x;
-    sy += weights[i] * points[i].y;
-  }
-  if (count < 2 || sw <= 0) return std::nullopt;
-  const double mx = sx / sw, my = sy / sw;
-  double cxx = 0, cxy = 0, cyy = 0;
-  for (int i = 0; i < count; ++i) {
-    const double dx = points[i].x - mx, dy = points[i].y - my;
-    cxx += weights[i] * dx * dx;
-    cxy += weights[i] * dx * dy;
-    cyy += weights[i] * dy * dy;
-  }
-  // Principal axis of the 2x2 scatter matrix, at angle a = atan2(2 cxy, cxx - cyy) / 2 (in
-  // (-90, 90] degrees), from cos 2a and sin 2a by the half-angle formulas.
-  const double diagonal = cxx - cyy, r = std::sqrt(diagonal * diagonal + 4.0 * cxy * cxy);
-  const double cos2 = r > 0.0 ? diagonal / r : 1.0;
-  const double c = std::sqrt(std::max(0.0, 0.5 * (1.0 + cos2)));
-  const double s = std::copysign(std::sqrt(std::max(0.0, 0.5 * (1.0 - cos2))), cxy);
-  return Line{cv::Point2f(static_cast<float>(mx), static_cast<float>(my)),
-              cv::Point2f(static_cast<float>(c), static_cast<float>(s))};
-}
-
-std::optional<cv::Point2f> intersect(const Line& a, const Line& b) {
-  const float det = a.direction.x * b.direction.y - a.direction.y * b.direction.x;
-  if (std::abs(det) < 1e-6f) return std::nullopt;
-  const cv::Point2f d = b.point - a.point;
-  const float t = (d.x * b.direction.y - d.y * b.direction.x) / det;
-  return a.point + t * a.direction;
-}
-
-// The unit vector in the image that `ideal_outward` (a unit vector at `ideal_base`, ideal
-// coordinates) becomes as the lens bends it.
-cv::Point2f outwardInImage(const LensMap& lens, cv::Point2f ideal_base, cv::Point2f ideal_outward) {
-  if (!lens.lens) return ideal_outward;
-  cv::Point2f outward = lens.toImage(ideal_base + 0.5f * ideal_outward) -
-                        lens.toImage(ideal_base - 0.5f * ideal_outward);
-  return outward / std::max(1e-6f, std::sqrt(outward.dot(outward)));
-}
-
 // Moves the side from `a` to `b` onto the image edge: at points along the side, the offset across
 // it (within +-radius px) where the intensity rises fastest (dark inside, light outside) is found
 // to sub-pixel precision by a parabola, and a line is fitted to those edge points weighted by the
@@ -292,16 +227,6 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
   return fitLine(points, weights, count);
 }
 
-// The corners where consecutive lines meet (corner k between side k - 1 and side k).
-bool intersectLines(const std::array<Line, 4>& lines, std::array<cv::Point2f, 4>& corners) {
-  for (int k = 0; k < 4; ++k) {
-    const auto corner = intersect(lines[(k + 3) % 4], lines[k]);
-    if (!corner) return false;
-    corners[k] = *corner;
-  }
-  return true;
-}
-
 // Moves the sides onto the image's edges, twice (the second time with a reach of at most 2 px),
 // and intersects them again; `corners` are ideal coordinates. False when sides no longer meet.
 bool refineToEdges(const cv::Mat& image, const LensMap& lens, std::array<Line, 4>& lines,
@@ -314,13 +239,7 @@ bool refineToEdges(const cv::Mat& image, const LensMap& lens, std::array<Line, 4
   for (int pass = 0; pass < 2; ++pass) {
     const int radius = pass == 0 ? reach : std::min(reach, 2);
     // Samples lie within radius + 1 px of the current sides (as the lens bends them).
-    std::array<cv::Point2f, 20> outline;
-    for (int k = 0; k < 4; ++k) {
-      for (int j = 0; j < 5; ++j)
-        outline[5 * k + j] =
-            lens.toImage(corners[k] + (corners[(k + 1) % 4] - corners[k]) * (j / 5.0f));
-    }
-    const BilinearSampler sample(image, boundsOf(outline, static_cast<float>(radius + 2)));
+    const BilinearSampler sample(image, sidesRegion(lens, corners, static_cast<float>(radius + 2)));
     std::array<Line, 4> refined = lines;
     for (int k = 0; k < 4; ++k) {
       const auto line = refineSide(sample, lens, corners[k], corners[(k + 1) % 4], radius,
@@ -330,104 +249,6 @@ bool refineToEdges(const cv::Mat& image, const LensMap& lens, std::array<Line, 4
     lines = refined;
     if (!intersectLines(lines, corners)) return false;
   }
-  return true;
-}
-
-// Motion blur smears the border across the sides it crosses: such a side's edge is a ramp as wide
-// as the smear (9-15 px), wider than refineSide()'s reach, and the binarised outline ends partway
-// down it, outside the printed edge (the bench's smeared markers came out 2-7 px too large along
-// the motion). Where the box kernel passes the edge it covers light surround and black border
-// only, so the ramp falls linearly from the surround's level and reaches the middle of the
-// surround and the black at the printed edge: found where the profile crosses 15 % and 35 % of
-// the way down, extended to 50 %. A sharp edge gives the mid-level crossing, as refineSide().
-constexpr int kRampOutside = 12, kRampInside = 8;  // profile reach across the side, px
-constexpr float kRampStep = 1.0f;                  // px between profile samples
-constexpr int kRampSamples = static_cast<int>((kRampOutside + kRampInside) / kRampStep) + 1;
-constexpr int kRampProfiles = 8;           // per side, spread over its middle 70 %
-constexpr float kMinRampContrast = 16.0f;  // grey levels between surround and black
-constexpr float kLeastSmearRamp = 1.3f;    // px from 15 % to 35 % of the way down, on some side
-using RampProfiles = float[kRampProfiles][kRampSamples];  // outside to inside
-
-float rampProfileAt(int s) {
-  return 0.15f + 0.7f * (static_cast<float>(s) + 0.5f) / static_cast<float>(kRampProfiles);
-}
-
-constexpr float kNearLevel = 0.15f, kFarLevel = 0.35f;  // of the way from surround to black
-
-// Where a profile (samples from outside in) first falls 15 % and 35 % of the way from its
-// surround (the lightest sample at least 2 px outside the side) to `black`, as sample indices;
-// nullopt when it shows no such ramp.
-struct RampCrossings {
-  float near_at, far_at;
-  float edge() const {  // the printed edge, 50 % of the way down a linear ramp
-    return near_at + (0.5f - kNearLevel) / (kFarLevel - kNearLevel) * (far_at - near_at);
-  }
-};
-std::optional<RampCrossings> rampCrossings(const float* profile, float black) {
-  constexpr int kLast = static_cast<int>((kRampOutside - 2) / kRampStep);
-  int light = 0;
-  for (int i = 1; i <= kLast; ++i)
-    if (profile[i] >= profile[light]) light = i;
-  const float surround = profile[light], contrast = surround - black;
-  if (contrast < kMinRampContrast) return std::nullopt;
-  const float near_level = surround - kNearLevel * contrast;
-  const float far_level = surround - kFarLevel * contrast;
-  float near_at = -1.0f;
-  for (int i = light; i + 1 < kRampSamples; ++i) {
-    const float p = profile[i], q = profile[i + 1];
-    if (near_at < 0.0f && p >= near_level && q < near_level)
-      near_at = static_cast<float>(i) + (p - near_level) / (p - q);
-    if (near_at >= 0.0f && p >= far_level && q < far_level)
-      return RampCrossings{near_at, static_cast<float>(i) + (p - far_level) / (p - q)};
-  }
-  return std::nullopt;
-}
-
-// A line through the side's ramp edges; profiles that met a neighbouring shape instead are
-// dropped (over 1.5 px off a first fit) and the line fitted again.
-std::optional<Line> lineOnRamps(const LensMap& lens, cv::Point2f a, cv::Point2f b,
-                                const RampProfiles& profiles, float black) {
-  const cv::Point2f d = b - a;
-  const cv::Point2f along = d / length(d), ideal_outward(along.y, -along.x);
-  cv::Point2f points[kRampProfiles];
-  float weights[kRampProfiles];
-  int count = 0;
-  for (int s = 0; s < kRampProfiles; ++s) {
-    const auto ramp = rampCrossings(profiles[s], black);
-    if (!ramp) continue;
-    const cv::Point2f ideal_base = a + rampProfileAt(s) * d;
-    const float outward_px = static_cast<float>(kRampOutside) - ramp->edge() * kRampStep;
-    points[count] = lens.toIdeal(lens.toImage(ideal_base) +
-                                 outward_px * outwardInImage(lens, ideal_base, ideal_outward));
-    weights[count++] = 1.0f;
-  }
-  if (count < 4) return std::nullopt;
-  const auto first = fitLine(points, weights, count);
-  if (!first) return std::nullopt;
-  int kept = 0;
-  for (int i = 0; i < count; ++i) {
-    const cv::Point2f r = points[i] - first->point;
-    if (std::abs(r.x * first->direction.y - r.y * first->direction.x) <= 1.5f)
-      points[kept++] = points[i];
-  }
-  if (kept < 4) return std::nullopt;
-  return fitLine(points, weights, kept);
-}
-
-// A marker is a convex quadrilateral with sides of a usable length: then `quad`'s ideal corners
-// are its corners, which become image coordinates.
-bool finishQuad(const QuadFitParams& params, const LensMap& lens, Quad& quad) {
-  float sign = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    const cv::Point2f e1 = quad.corners[(k + 1) % 4] - quad.corners[k];
-    const cv::Point2f e2 = quad.corners[(k + 2) % 4] - quad.corners[(k + 1) % 4];
-    if (length(e1) < params.min_side) return false;
-    const float cross = e1.x * e2.y - e1.y * e2.x;
-    if (sign == 0.0f) sign = cross;
-    if (cross * sign <= 0.0f) return false;
-  }
-  quad.ideal_corners = quad.corners;
-  for (int k = 0; k < 4; ++k) quad.corners[k] = lens.toImage(quad.ideal_corners[k]);
   return true;
 }
 
@@ -627,67 +448,6 @@ std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const 
   if (params.refine_edges && !refineToEdges(image, lens, lines, quad.corners)) return std::nullopt;
   if (!finishQuad(params, lens, quad)) return std::nullopt;
   return quad;
-}
-
-std::optional<Quad> placeOnBlurredEdges(const Quad& quad, const cv::Mat& image,
-                                        const QuadFitParams& params) {
-  const LensMap lens{params.lens};
-  const std::array<cv::Point2f, 4>& ideal = quad.ideal_corners;
-  std::array<cv::Point2f, 20> outline;
-  for (int k = 0; k < 4; ++k) {
-    for (int j = 0; j < 5; ++j)
-      outline[5 * k + j] = lens.toImage(ideal[k] + (ideal[(k + 1) % 4] - ideal[k]) * (j / 5.0f));
-  }
-  const BilinearSampler sample(image, boundsOf(outline, static_cast<float>(kRampOutside + 2)));
-  RampProfiles profiles[4];
-  constexpr int kFirstInside = static_cast<int>(kRampOutside / kRampStep) + 1;
-  // Samples profile s of side k; returns its darkest sample inside the quad.
-  auto sampleProfile = [&](int k, int s) {
-    const cv::Point2f a = ideal[k], d = ideal[(k + 1) % 4] - a;
-    const cv::Point2f along = d / length(d), ideal_outward(along.y, -along.x);
-    const cv::Point2f ideal_base = a + rampProfileAt(s) * d;
-    const cv::Point2f inward = -outwardInImage(lens, ideal_base, ideal_outward);
-    const cv::Point2f from = lens.toImage(ideal_base) - static_cast<float>(kRampOutside) * inward;
-    float* profile = profiles[k][s];
-    sample.line(from.x, from.y, kRampStep * inward.x, kRampStep * inward.y, kRampSamples, profile);
-    return *std::min_element(profile + kFirstInside, profile + kRampSamples);
-  };
-  for (int k = 0; k < 4; ++k) {
-    if (length(ideal[(k + 1) % 4] - ideal[k]) < params.min_side) return std::nullopt;
-  }
-  // First the two middle profiles of each side: unless some side's edge is a ramp (a sharp edge
-  // falls from 15 % to 35 % within 0.5 px, Gaussian blur of sigma 1.5 px within 1; a 9 px smear
-  // across it in 1.8 px, at 45 degrees in 1.3), the quad stays where it is.
-  constexpr int kMiddle = kRampProfiles / 2 - 1;
-  float black = 255.0f;
-  for (int k = 0; k < 4; ++k) {
-    black = std::min({black, sampleProfile(k, kMiddle), sampleProfile(k, kMiddle + 1)});
-  }
-  float widest = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    float mean[kRampSamples];  // of the two: half the noise
-    for (int i = 0; i < kRampSamples; ++i)
-      mean[i] = 0.5f * (profiles[k][kMiddle][i] + profiles[k][kMiddle + 1][i]);
-    if (const auto ramp = rampCrossings(mean, black))
-      widest = std::max(widest, (ramp->far_at - ramp->near_at) * kRampStep);
-  }
-  if (widest < kLeastSmearRamp) return std::nullopt;
-  // Then the rest: the black level is the darkest sample inside the quad.
-  for (int k = 0; k < 4; ++k) {
-    for (int s = 0; s < kRampProfiles; ++s) {
-      if (s != kMiddle && s != kMiddle + 1) black = std::min(black, sampleProfile(k, s));
-    }
-  }
-  std::array<Line, 4> lines;
-  for (int k = 0; k < 4; ++k) {
-    const auto line = lineOnRamps(lens, ideal[k], ideal[(k + 1) % 4], profiles[k], black);
-    if (!line) return std::nullopt;
-    lines[k] = *line;
-  }
-  Quad placed;
-  if (!intersectLines(lines, placed.corners) || !finishQuad(params, lens, placed))
-    return std::nullopt;
-  return placed;
 }
 
 }  // namespace arbci::vision

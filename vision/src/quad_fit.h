@@ -57,10 +57,4 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
 std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const cv::Mat& image,
                                const QuadFitParams& params);
 
-// `quad` with its sides moved onto motion-blurred edges (the printed edge in the middle of a ramp
-// up to 15 px wide, see quad_fit.cpp); for a marker that refineQuad()'s short reach left on the
-// smear's outer part. nullopt where a side shows no ramp or the sides no longer make a quad.
-std::optional<Quad> placeOnBlurredEdges(const Quad& quad, const cv::Mat& image,
-                                        const QuadFitParams& params);
-
 }  // namespace arbci::vision
