@@ -1,11 +1,16 @@
 #include "support/test_files.h"
 
+#include <unistd.h>
+
 #include <fstream>
 
 namespace arbci::test {
 
 std::filesystem::path freshTempPath(const std::string& suite, const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / ("arbci_" + suite + "_" + name);
+  // The process id keeps apart the tests that ctest runs side by side (each test case its own
+  // process): two cases naming the same file raced, one reading the other's.
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("arbci_" + suite + "_" + std::to_string(::getpid()) + "_" + name);
   std::filesystem::remove_all(path);
   return path;
 }
