@@ -86,6 +86,19 @@ int main(int argc, char** argv) {
                  "seed of the first frame's layout (frame f uses first-seed + f); other seeds give "
                  "scenes nothing was tuned on")
       ->capture_default_str();
+  float max_tilt_deg = 60.0f;
+  cli.add_option("--max-tilt", max_tilt_deg, "largest tilt of a marker off face-on, degrees")
+      ->check(CLI::Range(0.0f, 85.0f))
+      ->capture_default_str();
+  std::string tilt_from = "sight";
+  cli.add_option("--tilt-from", tilt_from,
+                 "what the tilt is measured from: 'sight', the line of sight to the marker (no "
+                 "marker is seen more obliquely than --max-tilt), or 'axis', the camera's optical "
+                 "axis (markers near the frame's sides are then seen up to about 30 deg more "
+                 "obliquely, nearly edge-on at the largest tilts; the scenes of this bench "
+                 "before 2026-11-26)")
+      ->check(CLI::IsMember({"sight", "axis"}))
+      ->capture_default_str();
   bool by_side = false;
   cli.add_flag("--by-side", by_side,
                "also print recall by apparent marker side (<30, 30-45, 45-60, 60-80, >=80 px)");
@@ -119,11 +132,11 @@ int main(int argc, char** argv) {
       test::Condition::MotionBlurJpeg, test::Condition::FastMotionJpeg};
   std::printf(
       "Marker detection, %d frames per condition (layout seeds %u-%u), 3 markers (%g-%g px at "
-      "640x480, scaled with the width; tilt <= 60 deg; %d-cell white margin) and 2 decoys per "
-      "frame;\nthe same layouts drawn with each detector's markers. Time: mean per frame, one "
-      "core.\n",
+      "640x480, scaled with the width; tilt <= %g deg from the %s; %d-cell white margin) and 2 "
+      "decoys per frame;\nthe same layouts drawn with each detector's markers. Time: mean per "
+      "frame, one core.\n",
       frames, first_seed, first_seed + static_cast<unsigned>(frames) - 1, min_side_px, max_side_px,
-      quiet_cells);
+      max_tilt_deg, tilt_from == "sight" ? "line of sight" : "optical axis", quiet_cells);
   for (const cv::Size size : sizes) {
     std::map<std::pair<int, int>, Cell> cells;  // (detector, condition)
     for (int f = 0; f < frames; ++f) {
@@ -132,6 +145,9 @@ int main(int argc, char** argv) {
       options.max_side_px = max_side_px * size.width / 640.0f;
       options.quiet_cells = static_cast<float>(quiet_cells);
       options.min_side_px = min_side_px * size.width / 640.0f;
+      options.max_tilt_deg = max_tilt_deg;
+      options.tilt_from = tilt_from == "sight" ? test::LayoutOptions::TiltFrom::LineOfSight
+                                               : test::LayoutOptions::TiltFrom::OpticalAxis;
       const test::SceneLayout layout =
           test::makeLayout(options, first_seed + static_cast<unsigned>(f));
       for (size_t c = 0; c < conditions.size(); ++c) {

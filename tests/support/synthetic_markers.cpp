@@ -30,6 +30,15 @@ cv::Matx33f rotation(cv::Vec3f axis, float angle) {
   return cv::Matx33f(r);
 }
 
+// The rotation that turns the optical axis (0, 0, 1) onto the ray through `centre`.
+cv::Matx33f towardsRay(const cv::Point3f& centre) {
+  const cv::Vec3f ray = cv::normalize(cv::Vec3f(centre.x, centre.y, centre.z));
+  const cv::Vec3f axis = cv::Vec3f(0, 0, 1).cross(ray);
+  const float sine = static_cast<float>(cv::norm(axis));
+  if (sine < 1e-6f) return cv::Matx33f::eye();
+  return rotation(axis / sine, std::atan2(sine, ray[2]));
+}
+
 // The corners of a square of half-side `half` in the marker plane, posed and projected.
 Corners projectSquare(const Camera& camera, const cv::Matx33f& r, const cv::Point3f& centre,
                       float half) {
@@ -387,11 +396,12 @@ SceneLayout makeLayout(const LayoutOptions& options, std::uint32_t seed) {
       const float tilt = options.max_tilt_deg * unit(random) * static_cast<float>(CV_PI) / 180.0f;
       const float axis_angle = unit(random) * 2.0f * static_cast<float>(CV_PI);
       const float spin = unit(random) * 2.0f * static_cast<float>(CV_PI);
-      const cv::Matx33f r = rotation({std::cos(axis_angle), std::sin(axis_angle), 0.0f}, tilt) *
-                            rotation({0, 0, 1}, spin);
+      cv::Matx33f r = rotation({std::cos(axis_angle), std::sin(axis_angle), 0.0f}, tilt) *
+                      rotation({0, 0, 1}, spin);
       const cv::Point2f at(unit(random) * options.size.width, unit(random) * options.size.height);
       const cv::Point3f centre((at.x - camera.cx) * depth / camera.f,
                                (at.y - camera.cy) * depth / camera.f, depth);
+      if (options.tilt_from == LayoutOptions::TiltFrom::LineOfSight) r = towardsRay(centre) * r;
       const Corners black = projectSquare(camera, r, centre, half);
       const Corners outer = projectSquare(camera, r, centre, half * outer_ratio);
       bool fits = true;

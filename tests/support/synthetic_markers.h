@@ -41,6 +41,12 @@ struct LayoutOptions {
   float min_side_px = 20.0f;  // face-on size of the smallest marker
   float max_side_px = 110.0f;
   float max_tilt_deg = 60.0f;
+  // What the tilt is measured from. The optical axis: a marker near the frame's edge is then seen
+  // up to the tilt plus the ray's own angle (about 29 degrees at 640x480's side edges) off face-on,
+  // nearly edge-on at the largest tilts. The line of sight: no marker is seen more obliquely than
+  // max_tilt_deg.
+  enum class TiltFrom { OpticalAxis, LineOfSight };
+  TiltFrom tilt_from = TiltFrom::OpticalAxis;
   float quiet_cells = 1.0f;  // white margin around each marker, in code cells (whole cells)
 };
 
