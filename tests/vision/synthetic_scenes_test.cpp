@@ -1,5 +1,7 @@
 // The tracker on synthetic frames with exact ground truth (the benchmark's scenes): markers 20 px
-// and up, tilted up to 60 degrees, with decoys and clutter, under the five conditions.
+// and up, tilted up to 60 degrees, with decoys and clutter, under the five conditions. The tilt is
+// from the optical axis here (LayoutOptions' default): the benchmark's steep scenes
+// (`--tilt-from axis`), whose markers near the frame's sides are seen nearly edge-on.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -38,7 +40,8 @@ test::Score run(Condition condition, int frames, const test::LayoutOptions& opti
   return total;
 }
 
-// One frame of the benchmark's fair scenes (markers from 48 px, a 2-cell margin), scored.
+// One frame of the benchmark's steep scenes (markers from 48 px, a 2-cell margin, tilted from the
+// optical axis), scored.
 test::Score scoreFairFrame(std::uint32_t seed, Condition condition, const DetectorConfig& config) {
   test::LayoutOptions fair;
   fair.min_side_px = 48.0f;
@@ -83,7 +86,7 @@ INSTANTIATE_TEST_SUITE_P(Conditions, SyntheticScenes,
                          });
 
 // Motion blur washes a marker's border out across its direction, leaving dark fragments; they
-// are grouped and binarised again. On the benchmark's fair scenes (markers from 48 px, a 2-cell
+// are grouped and binarised again. On the benchmark's steep scenes (markers from 48 px, a 2-cell
 // margin) these 40 frames give 105/120 (5-15 px blur + JPEG) and 100/120 (9-15 px + JPEG; 97
 // before JPEG frames were smoothed); without the fragment retry 97/120 and 88/120. The floors sit
 // between.
