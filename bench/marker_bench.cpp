@@ -279,7 +279,8 @@ int main(int argc, char** argv) {
         }
         const Cell& cell = cells[{static_cast<int>(d), static_cast<int>(c)}];
         const double ours_ms = 1000.0 * cell.seconds / cell.frames;
-        std::printf("  %-13s %6.3f %9.3f %9.3f %9.3f %6.2fx %s%s\n",
+        // Three decimals: at two, a row just over the line printed "0.20x time over 0.2x".
+        std::printf("  %-13s %6.3f %9.3f %9.3f %9.3f %6.3fx %s%s\n",
                     test::toString(conditions[c]).c_str(), cell.score.recall(), best_peer, ours_ms,
                     fastest_ms, ours_ms / fastest_ms,
                     cell.score.recall() >= best_peer ? "" : "recall BELOW ",
