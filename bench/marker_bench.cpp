@@ -90,8 +90,8 @@ int main(int argc, char** argv) {
   cli.add_option("--max-tilt", max_tilt_deg, "largest tilt of a marker off face-on, degrees")
       ->check(CLI::Range(0.0f, 85.0f))
       ->capture_default_str();
-  std::string tilt_from = "sight";
-  cli.add_option("--tilt-from", tilt_from,
+  std::string tilt_from_name = "sight";
+  cli.add_option("--tilt-from", tilt_from_name,
                  "what the tilt is measured from: 'sight', the line of sight to the marker (no "
                  "marker is seen more obliquely than --max-tilt), or 'axis', the camera's optical "
                  "axis (markers near the frame's sides are then seen up to about 30 deg more "
@@ -103,6 +103,8 @@ int main(int argc, char** argv) {
   cli.add_flag("--by-side", by_side,
                "also print recall by apparent marker side (<30, 30-45, 45-60, 60-80, >=80 px)");
   CLI11_PARSE(cli, argc, argv);
+  const auto tilt_from = tilt_from_name == "sight" ? test::LayoutOptions::TiltFrom::LineOfSight
+                                                   : test::LayoutOptions::TiltFrom::OpticalAxis;
   if (max_side_px < min_side_px) {
     std::fprintf(stderr, "marker_bench: --max-side (%g) is below --min-side (%g)\n", max_side_px,
                  min_side_px);
@@ -136,7 +138,9 @@ int main(int argc, char** argv) {
       "decoys per frame;\nthe same layouts drawn with each detector's markers. Time: mean per "
       "frame, one core.\n",
       frames, first_seed, first_seed + static_cast<unsigned>(frames) - 1, min_side_px, max_side_px,
-      max_tilt_deg, tilt_from == "sight" ? "line of sight" : "optical axis", quiet_cells);
+      max_tilt_deg,
+      tilt_from == test::LayoutOptions::TiltFrom::LineOfSight ? "line of sight" : "optical axis",
+      quiet_cells);
   for (const cv::Size size : sizes) {
     std::map<std::pair<int, int>, Cell> cells;  // (detector, condition)
     for (int f = 0; f < frames; ++f) {
@@ -146,8 +150,7 @@ int main(int argc, char** argv) {
       options.quiet_cells = static_cast<float>(quiet_cells);
       options.min_side_px = min_side_px * size.width / 640.0f;
       options.max_tilt_deg = max_tilt_deg;
-      options.tilt_from = tilt_from == "sight" ? test::LayoutOptions::TiltFrom::LineOfSight
-                                               : test::LayoutOptions::TiltFrom::OpticalAxis;
+      options.tilt_from = tilt_from;
       const test::SceneLayout layout =
           test::makeLayout(options, first_seed + static_cast<unsigned>(f));
       for (size_t c = 0; c < conditions.size(); ++c) {

@@ -110,6 +110,11 @@ cv::Point2f centre(const SquareCorners& q) {
   return (q[0] + q[1] + q[2] + q[3]) * 0.25f;
 }
 
+// `box` grown by `margin` px on every side.
+cv::Rect grown(const cv::Rect& box, int margin) {
+  return {box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin};
+}
+
 cv::Point2f toFloat(cv::Point2d p) {
   return {static_cast<float>(p.x), static_cast<float>(p.y)};
 }
@@ -452,11 +457,7 @@ struct MarkerDetector::Impl {
       if (!(other & box).empty()) joined |= other;
     }
     if (joined.area() > 3 * box.area()) joined = box;  // clutter around it, rather than its pieces
-    joined.x -= margin;
-    joined.y -= margin;
-    joined.width += 2 * margin;
-    joined.height += 2 * margin;
-    return joined;
+    return grown(joined, margin);
   }
 
   // A marker whose border blur has thinned or broken at the usual threshold often closes when
@@ -467,12 +468,7 @@ struct MarkerDetector::Impl {
     const cv::Rect image(0, 0, searched->cols, searched->rows);
     const int margin = kRetryMargin / scale;
     for (const RetryRegion& region : retries) {
-      cv::Rect roi = region.box;
-      roi.x -= margin;
-      roi.y -= margin;
-      roi.width += 2 * margin;
-      roi.height += 2 * margin;
-      roi &= image;
+      const cv::Rect roi = grown(region.box, margin) & image;
       const int split = region.fragmented ? kFragmentedSplit : kThinnedSplit;
       const size_t before = quads.size();
       const bool found = retryRegion(roi, *searched, split, params);
