@@ -91,11 +91,12 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
     const CodeWord received = rotation.turned(sampled, turns);
     std::array<CodeWord, kFlipped> flip{};
     for (int b = 0; b < flippable; ++b) flip[b] = rotation.bit_of_cell[turns][order[b]];
-    for (int pattern = 0; pattern < (1 << flippable); ++pattern) {
-      CodeWord trial = received;
-      for (int b = 0; b < flippable; ++b) {
-        if (pattern & (1 << b)) trial ^= flip[b];
-      }
+    // The patterns in Gray-code order, each one cell away from the last (the outcome does not
+    // depend on the order: only the two lightest candidates count, and a tie between them
+    // refuses).
+    CodeWord trial = received;
+    for (int step = 0; step < (1 << flippable); ++step) {
+      if (step > 0) trial ^= flip[__builtin_ctz(static_cast<unsigned>(step))];
       const auto decoded = BchCode::decode(trial);
       if (!decoded) continue;
       if (decoded->id == best.id && turns == best.turns) continue;

@@ -58,37 +58,22 @@ class BilinearSampler {
     return inside_ ? sampleBilinearInside(image_, x, y) : sampleBilinear(image_, x, y);
   }
   // n samples at (x, y) + k (dx, dy), k = 0 .. n - 1 (an edge profile), four at a time where
-  // the region lies inside the image.
+  // the region lies inside the image (each as operator() computes it, to the bit).
   void line(float x, float y, float dx, float dy, int n, float* out) const {
     int k = 0;
 #ifdef __SSE2__
     if (inside_) {
       const __m128 steps = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
-      const std::uint8_t* data = image_.data;
-      const size_t step = image_.step[0];
-      for (; k + 4 <= n; k += 4) {
-        const __m128 ks = _mm_add_ps(_mm_set1_ps(static_cast<float>(k)), steps);
-        const __m128 xs = _mm_add_ps(_mm_set1_ps(x), _mm_mul_ps(ks, _mm_set1_ps(dx)));
-        const __m128 ys = _mm_add_ps(_mm_set1_ps(y), _mm_mul_ps(ks, _mm_set1_ps(dy)));
-        const __m128i xi = _mm_cvttps_epi32(xs), yi = _mm_cvttps_epi32(ys);  // >= 0 inside
-        const __m128 fx = _mm_sub_ps(xs, _mm_cvtepi32_ps(xi)),
-                     fy = _mm_sub_ps(ys, _mm_cvtepi32_ps(yi));
-        alignas(16) int xa[4], ya[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(xa), xi);
-        _mm_store_si128(reinterpret_cast<__m128i*>(ya), yi);
-        alignas(16) float p00[4], p01[4], p10[4], p11[4];
-        for (int j = 0; j < 4; ++j) {
-          const std::uint8_t* r0 = data + static_cast<size_t>(ya[j]) * step + xa[j];
-          p00[j] = r0[0];
-          p01[j] = r0[1];
-          p10[j] = r0[step];
-          p11[j] = r0[step + 1];
-        }
-        const __m128 a = _mm_load_ps(p00), b = _mm_load_ps(p01), c = _mm_load_ps(p10),
-                     d = _mm_load_ps(p11);
-        const __m128 top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
-        const __m128 bottom = _mm_add_ps(c, _mm_mul_ps(fx, _mm_sub_ps(d, c)));
-        _mm_storeu_ps(out + k, _mm_add_ps(top, _mm_mul_ps(fy, _mm_sub_ps(bottom, top))));
+      auto fourFrom = [&](int first) {
+        const __m128 ks = _mm_add_ps(_mm_set1_ps(static_cast<float>(first)), steps);
+        gather4(_mm_add_ps(_mm_set1_ps(x), _mm_mul_ps(ks, _mm_set1_ps(dx))),
+                _mm_add_ps(_mm_set1_ps(y), _mm_mul_ps(ks, _mm_set1_ps(dy))), out + first);
+      };
+      for (; k + 4 <= n; k += 4) fourFrom(k);
+      // The last samples (a profile of 7 or 9) as the last four, some of them again.
+      if (k < n && n >= 4) {
+        fourFrom(n - 4);
+        k = n;
       }
     }
 #endif
@@ -96,7 +81,50 @@ class BilinearSampler {
       out[k] = (*this)(x + static_cast<float>(k) * dx, y + static_cast<float>(k) * dy);
   }
 
+  // The sum of five samples, (x, y) and (x, y) +- a and +- b, added in that order (an area
+  // sample); the four around it at once where the region lies inside the image, with the
+  // arithmetic of operator() lane by lane, so the sum is the same to the bit.
+  float cross(float x, float y, cv::Point2f a, cv::Point2f b) const {
+#ifdef __SSE2__
+    if (inside_) {
+      const __m128 xs = _mm_add_ps(_mm_set1_ps(x), _mm_set_ps(-b.x, b.x, -a.x, a.x));
+      const __m128 ys = _mm_add_ps(_mm_set1_ps(y), _mm_set_ps(-b.y, b.y, -a.y, a.y));
+      alignas(16) float around[4];
+      gather4(xs, ys, around);
+      return (*this)(x, y) + around[0] + around[1] + around[2] + around[3];
+    }
+#endif
+    return (*this)(x, y) + (*this)(x + a.x, y + a.y) + (*this)(x - a.x, y - a.y) +
+           (*this)(x + b.x, y + b.y) + (*this)(x - b.x, y - b.y);
+  }
+
  private:
+#ifdef __SSE2__
+  // Bilinear samples at four points inside the image, as sampleBilinearInside() computes them.
+  void gather4(__m128 xs, __m128 ys, float* out) const {
+    const std::uint8_t* data = image_.data;
+    const size_t step = image_.step[0];
+    const __m128i xi = _mm_cvttps_epi32(xs), yi = _mm_cvttps_epi32(ys);  // >= 0 inside
+    const __m128 fx = _mm_sub_ps(xs, _mm_cvtepi32_ps(xi)), fy = _mm_sub_ps(ys, _mm_cvtepi32_ps(yi));
+    alignas(16) int xa[4], ya[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(xa), xi);
+    _mm_store_si128(reinterpret_cast<__m128i*>(ya), yi);
+    alignas(16) float p00[4], p01[4], p10[4], p11[4];
+    for (int j = 0; j < 4; ++j) {
+      const std::uint8_t* r0 = data + static_cast<size_t>(ya[j]) * step + xa[j];
+      p00[j] = r0[0];
+      p01[j] = r0[1];
+      p10[j] = r0[step];
+      p11[j] = r0[step + 1];
+    }
+    const __m128 a = _mm_load_ps(p00), b = _mm_load_ps(p01), c = _mm_load_ps(p10),
+                 d = _mm_load_ps(p11);
+    const __m128 top = _mm_add_ps(a, _mm_mul_ps(fx, _mm_sub_ps(b, a)));
+    const __m128 bottom = _mm_add_ps(c, _mm_mul_ps(fx, _mm_sub_ps(d, c)));
+    _mm_storeu_ps(out, _mm_add_ps(top, _mm_mul_ps(fy, _mm_sub_ps(bottom, top))));
+  }
+#endif
+
   const cv::Mat& image_;
   bool inside_;
 };

@@ -57,10 +57,7 @@ float sampleArea(const BilinearSampler& sample, const SquareToQuad& map, double 
   map.withDerivatives(u, v, centre, du, dv);
   const float s = static_cast<float>(spread);
   const cv::Point2f a = s * (du + dv), b = s * (du - dv);  // towards (+1, +1) and (+1, -1)
-  return (sample(centre.x, centre.y) + sample(centre.x + a.x, centre.y + a.y) +
-          sample(centre.x - a.x, centre.y - a.y) + sample(centre.x + b.x, centre.y + b.y) +
-          sample(centre.x - b.x, centre.y - b.y)) /
-         5.0f;
+  return sample.cross(centre.x, centre.y, a, b) / 5.0f;
 }
 
 // Where the square [low, high]^2 of marker coordinates lands in the image (a convex region when

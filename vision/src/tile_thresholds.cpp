@@ -115,6 +115,12 @@ void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restri
                        3);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x), _mm_packus_epi16(lo, hi));
   }
+  // The last pixels of a row narrower than a multiple of 16 (most of a small region's) as the
+  // last sixteen, writing the ones before them again with the same values.
+  if (x < n && n >= 16) {
+    blendRows(near + n - 16, far + n - 16, w_near, w_far, out + n - 16, 16);
+    x = n;
+  }
 #endif
   for (; x < n; ++x)
     out[x] = static_cast<std::uint8_t>((w_near * near[x] + w_far * far[x] + 4) >> 3);
@@ -134,14 +140,21 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
     // cols - 2 here (their neighbours exist), the ends below.
     out[0] = static_cast<std::uint8_t>((8 * v[0] + 4) >> 3);
     out[1] = static_cast<std::uint8_t>((6 * v[0] + 2 * v[cols > 1 ? 1 : 0] + 4) >> 3);
-    t = 1;
-    for (; t + 17 <= cols; t += 16) {
-      const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t));
-      const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t - 1));
-      const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + t + 1));
+    auto sixteenFrom = [&](int first) {  // tiles first .. first + 15
+      const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + first));
+      const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + first - 1));
+      const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + first + 1));
       const __m128i even = threeQuartersTowards(h, l), odd = threeQuartersTowards(h, r);
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * t), _mm_unpacklo_epi8(even, odd));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * t + 16), _mm_unpackhi_epi8(even, odd));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * first), _mm_unpacklo_epi8(even, odd));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * first + 16),
+                       _mm_unpackhi_epi8(even, odd));
+    };
+    t = 1;
+    for (; t + 17 <= cols; t += 16) sixteenFrom(t);
+    // The tiles left but the last as the sixteen before it (writing some again, alike).
+    if (t + 1 < cols && cols >= 18) {
+      sixteenFrom(cols - 17);
+      t = cols - 1;
     }
   }
 #endif
@@ -185,7 +198,9 @@ const std::uint8_t* LimitRows::expandedRow(int ty) const {
 
 void LimitRows::blend(int y, std::uint8_t* out) const {
   const int tile = tiles_->tile, rows = tiles_->rows;
-  const int t = y / tile, k = y % tile, far = farWeight(k, tile);
+  // Tiles of 2 or 4 px: shifts, not divisions (a small region's rows are only a few dozen px).
+  const int shift = tile == 2 ? 1 : 2;
+  const int t = y >> shift, k = y & (tile - 1), far = std::abs(2 * k + 1 - tile) << (2 - shift);
   const int other = 2 * k < tile ? std::max(0, t - 1) : std::min(rows - 1, t + 1);
   blendRows(expandedRow(t), expandedRow(other), 8 - far, far, out, width_);
 }
@@ -337,7 +352,7 @@ void limitsOfRow(const TileRow& row, int contrast, int split_sixteenths, int col
     const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
     return _mm_unpacklo_epi8(v, v);
   };
-  for (; tx + 16 <= cols; tx += 16) {
+  auto sixteenFrom = [&](int tx) {  // tiles tx .. tx + 15, tx even
     const __m128i lo = load16(lo0 + tx), range = _mm_sub_epi8(load16(hi0 + tx), lo);
     const __m128i a = load16(own_lo + tx), b = load16(own_hi + tx);
     const __m128i level = twice8(parent + tx / 2);
@@ -354,6 +369,13 @@ void limitsOfRow(const TileRow& row, int contrast, int split_sixteenths, int col
     const __m128i flat = _mm_and_si128(has_parent, greaterThan(level, truncatedMean(a, b)));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(limit + tx),
                      _mm_or_si128(_mm_and_si128(edge, edge_limit), _mm_andnot_si128(edge, flat)));
+  };
+  for (; tx + 16 <= cols; tx += 16) sixteenFrom(tx);
+  // The tiles left (a region's row is seldom a multiple of 16) as the sixteen before them, from
+  // an even tile, writing some again with the same values.
+  if (tx < cols && cols >= 17) {
+    sixteenFrom((cols - 16) & ~1);
+    tx = (cols - 16) % 2 == 0 ? cols : cols - 1;
   }
 #endif
   for (; tx < cols; ++tx) {
