@@ -204,7 +204,7 @@ struct MarkerDetector::Impl {
   std::vector<RetryRegion> corner_cut;  // rings whose hull is not square (full search)
   std::vector<int> group, group_size;
   RunLabeler roi_labels;
-  cv::Mat roi_limits, frame_limits;
+  cv::Mat roi_limits;
   std::vector<Quad> on_frame_quads;  // found on the frame by retryOnFrame(), decoded as they are
   std::vector<Quad> reduced_found;   // a thin near miss's quads of the reduced image, kept aside
   std::vector<SquareCorners> squares, ideal_squares;
@@ -553,12 +553,11 @@ struct MarkerDetector::Impl {
   // interpolated from the reduced image's), where its code cells are wide enough to show. True
   // when it found a quad.
   bool retryOnFrame(const cv::Rect& reduced_roi) {
-    adaptive.roiLimits(reduced_roi, AdaptiveThresholder::kSplit, roi_limits);
+    adaptive.roiLimits(reduced_roi, AdaptiveThresholder::kSplit, roi_limits, scale);
     const cv::Rect roi(reduced_roi.x * scale, reduced_roi.y * scale, reduced_roi.width * scale,
                        reduced_roi.height * scale);
-    cv::resize(roi_limits, frame_limits, roi.size(), 0, 0, cv::INTER_LINEAR);
     const cv::Mat patch = gray(roi);
-    roi_labels.label(patch, frame_limits);
+    roi_labels.label(patch, roi_limits);
     QuadFitParams params;
     params.min_side = config.min_side_px;
     const size_t before = on_frame_quads.size();

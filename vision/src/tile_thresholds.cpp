@@ -544,7 +544,7 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
   }
 }
 
-void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) {
+void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits, int upscale) {
   const int tile = tile_, cols = dilated_[0].cols, rows = dilated_[0].rows;
   // Tiles around the region (one more on each side for interpolation, the first one even),
   // resized exactly as the whole grid would be, then cropped; into buffers kept between calls (a
@@ -552,7 +552,6 @@ void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) {
   const int tx0 = std::max(0, roi.x / tile - 1) & ~1, ty0 = std::max(0, roi.y / tile - 1);
   const int tx1 = std::min(cols - 1, (roi.x + roi.width - 1) / tile + 1);
   const int ty1 = std::min(rows - 1, (roi.y + roi.height - 1) / tile + 1);
-  roi_tiles_.tile = tile;
   roi_tiles_.cols = tx1 - tx0 + 1;
   roi_tiles_.rows = ty1 - ty0 + 1;
   roi_tiles_.limit.resize(static_cast<size_t>(roi_tiles_.cols) * roi_tiles_.rows);
@@ -565,11 +564,16 @@ void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits) {
                 contrast_, split, roi_tiles_.cols,
                 &roi_tiles_.limit[static_cast<size_t>(ty - ty0) * roi_tiles_.cols]);
   }
-  const cv::Size size(roi_tiles_.cols * tile, roi_tiles_.rows * tile);
+  // Interpolated between the tiles' centres at `upscale` times the resolution (a tile's pixels
+  // are the middle of the frame pixels they average).
+  const int pixels = tile * upscale;
+  roi_tiles_.tile = pixels;
+  const cv::Size size(roi_tiles_.cols * pixels, roi_tiles_.rows * pixels);
   roi_pixels_.resize(static_cast<size_t>(size.area()));
   cv::Mat expanded(size, CV_8UC1, roi_pixels_.data());
   interpolateLimits(roi_tiles_, size, expanded);
-  limits = expanded(cv::Rect(roi.x - tx0 * tile, roi.y - ty0 * tile, roi.width, roi.height));
+  limits = expanded(cv::Rect((roi.x - tx0 * tile) * upscale, (roi.y - ty0 * tile) * upscale,
+                             roi.width * upscale, roi.height * upscale));
 }
 
 double estimateNoiseSigma(const cv::Mat& gray) {

@@ -71,8 +71,10 @@ class AdaptiveThresholder {
             int tile = TileThresholds::kTile);
   // After fill(): the per-pixel limits of `roi` with edge tiles split at `split` sixteenths of
   // their range instead of the usual kSplit (a darker split closes borders thinned by blur).
-  // `limits` becomes a view of this thresholder's buffer, valid until the next call.
-  void roiLimits(cv::Rect roi, int split, cv::Mat& limits);
+  // `limits` becomes a view of this thresholder's buffer, valid until the next call. With
+  // `upscale` 2 (tiles of 2 px on a frame averaged over 2x2 pixels), the limits are those of
+  // `roi`'s pixels in the frame, `roi` scaled by 2, interpolated there between the tiles' centres.
+  void roiLimits(cv::Rect roi, int split, cv::Mat& limits, int upscale = 1);
 
   // Where an edge tile's threshold sits between its minimum and maximum, in sixteenths: a little
   // below the midrange, which keeps marker borders apart from their surroundings.
