@@ -58,22 +58,16 @@ class BilinearSampler {
     return inside_ ? sampleBilinearInside(image_, x, y) : sampleBilinear(image_, x, y);
   }
   // n samples at (x, y) + k (dx, dy), k = 0 .. n - 1 (an edge profile), four at a time where
-  // the region lies inside the image (each as operator() computes it, to the bit).
+  // the region lies inside the image.
   void line(float x, float y, float dx, float dy, int n, float* out) const {
     int k = 0;
 #ifdef __SSE2__
     if (inside_) {
       const __m128 steps = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
-      auto fourFrom = [&](int first) {
-        const __m128 ks = _mm_add_ps(_mm_set1_ps(static_cast<float>(first)), steps);
+      for (; k + 4 <= n; k += 4) {
+        const __m128 ks = _mm_add_ps(_mm_set1_ps(static_cast<float>(k)), steps);
         gather4(_mm_add_ps(_mm_set1_ps(x), _mm_mul_ps(ks, _mm_set1_ps(dx))),
-                _mm_add_ps(_mm_set1_ps(y), _mm_mul_ps(ks, _mm_set1_ps(dy))), out + first);
-      };
-      for (; k + 4 <= n; k += 4) fourFrom(k);
-      // The last samples (a profile of 7 or 9) as the last four, some of them again.
-      if (k < n && n >= 4) {
-        fourFrom(n - 4);
-        k = n;
+                _mm_add_ps(_mm_set1_ps(y), _mm_mul_ps(ks, _mm_set1_ps(dy))), out + k);
       }
     }
 #endif
