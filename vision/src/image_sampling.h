@@ -75,6 +75,42 @@ class BilinearSampler {
       out[k] = (*this)(x + static_cast<float>(k) * dx, y + static_cast<float>(k) * dy);
   }
 
+  // Four samples: out[i] = operator()(x[i], y[i]).
+  void four(const float* x, const float* y, float* out) const {
+#ifdef __SSE2__
+    if (inside_) {
+      gather4(_mm_loadu_ps(x), _mm_loadu_ps(y), out);
+      return;
+    }
+#endif
+    for (int i = 0; i < 4; ++i) out[i] = (*this)(x[i], y[i]);
+  }
+
+  // cross() at four points: out[i] = cross(x[i], y[i], a[i], b[i]), a and b given by components.
+  void cross4(const float* x, const float* y, const float* ax, const float* ay, const float* bx,
+              const float* by, float* out) const {
+#ifdef __SSE2__
+    if (inside_) {
+      const __m128 xs = _mm_loadu_ps(x), ys = _mm_loadu_ps(y);
+      const __m128 axs = _mm_loadu_ps(ax), ays = _mm_loadu_ps(ay);
+      const __m128 bxs = _mm_loadu_ps(bx), bys = _mm_loadu_ps(by);
+      alignas(16) float centre[4], plus_a[4], minus_a[4], plus_b[4], minus_b[4];
+      gather4(xs, ys, centre);
+      gather4(_mm_add_ps(xs, axs), _mm_add_ps(ys, ays), plus_a);
+      gather4(_mm_sub_ps(xs, axs), _mm_sub_ps(ys, ays), minus_a);
+      gather4(_mm_add_ps(xs, bxs), _mm_add_ps(ys, bys), plus_b);
+      gather4(_mm_sub_ps(xs, bxs), _mm_sub_ps(ys, bys), minus_b);
+      __m128 sum = _mm_add_ps(_mm_load_ps(centre), _mm_load_ps(plus_a));
+      sum = _mm_add_ps(sum, _mm_load_ps(minus_a));
+      sum = _mm_add_ps(sum, _mm_load_ps(plus_b));
+      _mm_storeu_ps(out, _mm_add_ps(sum, _mm_load_ps(minus_b)));
+      return;
+    }
+#endif
+    for (int i = 0; i < 4; ++i)
+      out[i] = cross(x[i], y[i], cv::Point2f(ax[i], ay[i]), cv::Point2f(bx[i], by[i]));
+  }
+
   // The sum of five samples, (x, y) and (x, y) +- a and +- b, added in that order (an area
   // sample); the four around it at once where the region lies inside the image, with the
   // arithmetic of operator() lane by lane, so the sum is the same to the bit.

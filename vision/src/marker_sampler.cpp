@@ -60,6 +60,35 @@ float sampleArea(const BilinearSampler& sample, const SquareToQuad& map, double 
   return sample.cross(centre.x, centre.y, a, b) / 5.0f;
 }
 
+// sampleArea() at four points at once, each to the bit as it computes it.
+void sampleAreas(const BilinearSampler& sample, const SquareToQuad& map, const double (&u)[4],
+                 const double (&v)[4], double spread, float* out) {
+  SquareToQuad::Four at;
+  map.withDerivatives(u, v, at);
+  const float s = static_cast<float>(spread);
+  float ax[4], ay[4], bx[4], by[4];
+  for (int i = 0; i < 4; ++i) {
+    ax[i] = s * (at.du_x[i] + at.dv_x[i]);
+    ay[i] = s * (at.du_y[i] + at.dv_y[i]);
+    bx[i] = s * (at.du_x[i] - at.dv_x[i]);
+    by[i] = s * (at.du_y[i] - at.dv_y[i]);
+  }
+  sample.cross4(at.x, at.y, ax, ay, bx, by, out);
+  for (int i = 0; i < 4; ++i) out[i] /= 5.0f;
+}
+
+// Single samples at four points of the marker (u[i], v[i]).
+void samplesAt(const BilinearSampler& sample, const SquareToQuad& map, const double (&u)[4],
+               const double (&v)[4], float* out) {
+  float x[4], y[4];
+  for (int i = 0; i < 4; ++i) {
+    const cv::Point2f p = map(u[i], v[i]);
+    x[i] = p.x;
+    y[i] = p.y;
+  }
+  sample.four(x, y, out);
+}
+
 // Where the square [low, high]^2 of marker coordinates lands in the image (a convex region when
 // the map's vanishing line stays outside it), plus a pixel for interpolation; an empty rectangle
 // (so every sample is clamped) when the map degenerates there.
@@ -114,6 +143,19 @@ void SquareToQuad::withDerivatives(double u, double v, cv::Point2f& at, cv::Poin
   dv = {static_cast<float>((b_ - x * h_) * w), static_cast<float>((e_ - y * h_) * w)};
 }
 
+void SquareToQuad::withDerivatives(const double (&u)[4], const double (&v)[4], Four& out) const {
+  for (int i = 0; i < 4; ++i) {
+    const double w = 1.0 / (g_ * u[i] + h_ * v[i] + 1.0);
+    const double x = (a_ * u[i] + b_ * v[i] + c_) * w, y = (d_ * u[i] + e_ * v[i] + f_) * w;
+    out.x[i] = static_cast<float>(x);
+    out.y[i] = static_cast<float>(y);
+    out.du_x[i] = static_cast<float>((a_ - x * g_) * w);
+    out.du_y[i] = static_cast<float>((d_ - y * g_) * w);
+    out.dv_x[i] = static_cast<float>((b_ - x * h_) * w);
+    out.dv_y[i] = static_cast<float>((e_ - y * h_) * w);
+  }
+}
+
 cv::Point2f SquareToQuad::operator()(double u, double v) const {
   const double w = g_ * u + h_ * v + 1.0;
   return {static_cast<float>((a_ * u + b_ * v + c_) / w),
@@ -140,18 +182,18 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
     const double t = k == 0 ? band : border + cell * (k - 0.5);
     for (int depth = 0; depth < 2; ++depth) {
       const double d = border * (depth == 0 ? 0.3 : 0.7);
-      const double along[4][2] = {{t, d}, {1.0 - d, t}, {1.0 - t, 1.0 - d}, {d, 1.0 - t}};
-      for (int s = 0; s < 4; ++s) {
-        const float b = sampleArea(sample, map, along[s][0], along[s][1], spread * 0.5);
-        black[2 * (4 * k + s) + depth] = {along[s][0], along[s][1], b};
-      }
+      const double us[4] = {t, 1.0 - d, 1.0 - t, d}, vs[4] = {d, t, 1.0 - d, 1.0 - t};
+      float b[4];
+      sampleAreas(sample, map, us, vs, spread * 0.5, b);
+      for (int s = 0; s < 4; ++s) black[2 * (4 * k + s) + depth] = {us[s], vs[s], b[s]};
     }
-    const double out[4][2] = {
-        {t, outside}, {1.0 - outside, t}, {1.0 - t, 1.0 - outside}, {outside, 1.0 - t}};
+    const double us[4] = {t, 1.0 - outside, 1.0 - t, outside};
+    const double vs[4] = {outside, t, 1.0 - outside, 1.0 - t};
+    float w[4];
+    samplesAt(sample, map, us, vs, w);
     for (int s = 0; s < 4; ++s) {
       ring_samples[ring] = 0.5f * static_cast<float>(black[2 * ring].z + black[2 * ring + 1].z);
-      const cv::Point2f w = map(out[s][0], out[s][1]);
-      white[ring] = {out[s][0], out[s][1], sample(w.x, w.y)};
+      white[ring] = {us[s], vs[s], w[s]};
       ring_samples[kRing + ring] = static_cast<float>(white[ring].z);
       ++ring;
     }
@@ -161,15 +203,21 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
 
   out.lowest = 255.0f;
   out.highest = 0.0f;
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) {
-      const double u = border + cell * (c + 0.5), v = border + cell * (r + 0.5);
-      const float value = sampleArea(sample, map, u, v, spread);
-      out.cells[r * 6 + c] = value;
-      out.thresholds[r * 6 + c] =
-          static_cast<float>(0.5 * (black_level.at(u, v) + white_level.at(u, v)));
-      out.lowest = std::min(out.lowest, value);
-      out.highest = std::max(out.highest, value);
+  // The cells four at a time, in row-major order.
+  for (int first = 0; first < 36; first += 4) {
+    double us[4], vs[4];
+    for (int i = 0; i < 4; ++i) {
+      us[i] = border + cell * ((first + i) % 6 + 0.5);
+      vs[i] = border + cell * ((first + i) / 6 + 0.5);
+    }
+    float values[4];
+    sampleAreas(sample, map, us, vs, spread, values);
+    for (int i = 0; i < 4; ++i) {
+      out.cells[first + i] = values[i];
+      out.thresholds[first + i] =
+          static_cast<float>(0.5 * (black_level.at(us[i], vs[i]) + white_level.at(us[i], vs[i])));
+      out.lowest = std::min(out.lowest, values[i]);
+      out.highest = std::max(out.highest, values[i]);
     }
   }
   for (const cv::Point3d& b : black) {
@@ -191,14 +239,16 @@ bool hasFlatCodeArea(const cv::Mat& image, const std::array<cv::Point2f, 4>& cor
   const SquareToQuad map(corners);
   const double cell = (1.0 - 2.0 * border) / 6.0;
   const BilinearSampler sample(image, regionOf(map, -cell, 1.0 + cell));
-  auto at = [&](double u, double v) {
-    const cv::Point2f p = map(u, v);
-    return sample(p.x, p.y);
-  };
   float lowest = 255.0f, highest = 0.0f;
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) {
-      const float value = at(border + cell * (c + 0.5), border + cell * (r + 0.5));
+  for (int first = 0; first < 36; first += 4) {  // the cells, row-major
+    double us[4], vs[4];
+    for (int i = 0; i < 4; ++i) {
+      us[i] = border + cell * ((first + i) % 6 + 0.5);
+      vs[i] = border + cell * ((first + i) / 6 + 0.5);
+    }
+    float values[4];
+    samplesAt(sample, map, us, vs, values);
+    for (const float value : values) {
       lowest = std::min(lowest, value);
       highest = std::max(highest, value);
     }
@@ -207,9 +257,12 @@ bool hasFlatCodeArea(const cv::Mat& image, const std::array<cv::Point2f, 4>& cor
   float black = 0.0f, white = 0.0f;
   const double depth = 0.5 * border, outside = -0.5 * cell;
   for (const double t : {0.3, 0.7}) {
-    black += at(t, depth) + at(1.0 - depth, t) + at(1.0 - t, 1.0 - depth) + at(depth, 1.0 - t);
-    white +=
-        at(t, outside) + at(1.0 - outside, t) + at(1.0 - t, 1.0 - outside) + at(outside, 1.0 - t);
+    float b[4], w[4];
+    samplesAt(sample, map, {t, 1.0 - depth, 1.0 - t, depth}, {depth, t, 1.0 - depth, 1.0 - t}, b);
+    samplesAt(sample, map, {t, 1.0 - outside, 1.0 - t, outside},
+              {outside, t, 1.0 - outside, 1.0 - t}, w);
+    black += b[0] + b[1] + b[2] + b[3];
+    white += w[0] + w[1] + w[2] + w[3];
   }
   const float contrast = (white - black) / 8.0f;
   return contrast >= 16.0f && highest - lowest < 0.25f * contrast;

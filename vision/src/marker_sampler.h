@@ -21,6 +21,11 @@ class SquareToQuad {
   cv::Point2f operator()(double u, double v) const;
   // The image point of (u, v) and the map's partial derivatives there (px per unit).
   void withDerivatives(double u, double v, cv::Point2f& at, cv::Point2f& du, cv::Point2f& dv) const;
+  // The same at four points, as arrays of their coordinates (each to the bit as above).
+  struct Four {
+    float x[4], y[4], du_x[4], du_y[4], dv_x[4], dv_y[4];
+  };
+  void withDerivatives(const double (&u)[4], const double (&v)[4], Four& out) const;
   // True when the square [low, high]^2 lies wholly on the finite side of the vanishing line.
   bool finiteOn(double low, double high) const;
 
