@@ -75,6 +75,26 @@ class BilinearSampler {
       out[k] = (*this)(x + static_cast<float>(k) * dx, y + static_cast<float>(k) * dy);
   }
 
+  // line() for four profiles at once: profile i's samples (x[i], y[i]) + k (dx[i], dy[i]) into
+  // out[i * stride + k], each as line() computes it.
+  void lines4(const float* x, const float* y, const float* dx, const float* dy, int n, float* out,
+              int stride) const {
+#ifdef __SSE2__
+    if (inside_) {
+      const __m128 xs = _mm_loadu_ps(x), ys = _mm_loadu_ps(y);
+      const __m128 dxs = _mm_loadu_ps(dx), dys = _mm_loadu_ps(dy);
+      for (int k = 0; k < n; ++k) {
+        const __m128 ks = _mm_set1_ps(static_cast<float>(k));
+        alignas(16) float values[4];
+        gather4(_mm_add_ps(xs, _mm_mul_ps(ks, dxs)), _mm_add_ps(ys, _mm_mul_ps(ks, dys)), values);
+        for (int i = 0; i < 4; ++i) out[i * stride + k] = values[i];
+      }
+      return;
+    }
+#endif
+    for (int i = 0; i < 4; ++i) line(x[i], y[i], dx[i], dy[i], n, out + i * stride);
+  }
+
   // Four samples: out[i] = operator()(x[i], y[i]).
   void four(const float* x, const float* y, float* out) const {
 #ifdef __SSE2__

@@ -179,19 +179,42 @@ std::optional<Line> refineSide(const BilinearSampler& sample, const LensMap& len
   const int samples =
       std::clamp(static_cast<int>(length / 2.5f), 5, std::min(most_samples, kMaxSamples));
   const float end = std::min(0.3f, std::max(0.05f, (static_cast<float>(radius) + 1.0f) / length));
-  cv::Point2f points[kMaxSamples];
-  float weights[kMaxSamples];
-  int count = 0;
-  float profile[2 * kMaxRadius + 4], rise[2 * kMaxRadius + 1];
+  // Where each profile starts and runs, then every profile sampled, four at a time (the last
+  // group padded with copies of the last profile).
+  constexpr int kPadded = kMaxSamples + 3, kProfileLength = 2 * kMaxRadius + 4;
+  cv::Point2f bases[kPadded], outwards[kPadded];
+  float from_x[kPadded], from_y[kPadded], out_x[kPadded], out_y[kPadded];
   for (int s = 0; s < samples; ++s) {
     // Stay clear of the corners, where the profile would cross the neighbouring side.
     const float t =
         end + (1.0f - 2.0f * end) * (static_cast<float>(s) + 0.5f) / static_cast<float>(samples);
     const cv::Point2f ideal_base = a + t * d;
-    const cv::Point2f base = lens.toImage(ideal_base);
-    const cv::Point2f outward = outwardInImage(lens, ideal_base, ideal_outward);
-    const cv::Point2f from = base - static_cast<float>(radius + 1) * outward;
-    sample.line(from.x, from.y, outward.x, outward.y, 2 * radius + 3, profile);
+    bases[s] = lens.toImage(ideal_base);
+    outwards[s] = outwardInImage(lens, ideal_base, ideal_outward);
+    const cv::Point2f from = bases[s] - static_cast<float>(radius + 1) * outwards[s];
+    from_x[s] = from.x;
+    from_y[s] = from.y;
+    out_x[s] = outwards[s].x;
+    out_y[s] = outwards[s].y;
+  }
+  for (int s = samples; s % 4 != 0; ++s) {
+    from_x[s] = from_x[samples - 1];
+    from_y[s] = from_y[samples - 1];
+    out_x[s] = out_x[samples - 1];
+    out_y[s] = out_y[samples - 1];
+  }
+  float profiles[kPadded][kProfileLength];
+  for (int s = 0; s < samples; s += 4) {
+    sample.lines4(&from_x[s], &from_y[s], &out_x[s], &out_y[s], 2 * radius + 3, profiles[s],
+                  kProfileLength);
+  }
+  cv::Point2f points[kMaxSamples];
+  float weights[kMaxSamples];
+  int count = 0;
+  float rise[2 * kMaxRadius + 1];
+  for (int s = 0; s < samples; ++s) {
+    const float* profile = profiles[s];
+    const cv::Point2f base = bases[s], outward = outwards[s];
     int best = 0;
     float best_rise = 0.0f;
     for (int k = -radius; k <= radius; ++k) {
