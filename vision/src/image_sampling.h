@@ -106,7 +106,8 @@ class BilinearSampler {
     for (int i = 0; i < 4; ++i) out[i] = (*this)(x[i], y[i]);
   }
 
-  // cross() at four points: out[i] = cross(x[i], y[i], a[i], b[i]), a and b given by components.
+  // Four area samples: out[i] the sum of five samples, (x[i], y[i]) and that +- (ax[i], ay[i]) and
+  // +- (bx[i], by[i]), added in that order.
   void cross4(const float* x, const float* y, const float* ax, const float* ay, const float* bx,
               const float* by, float* out) const {
 #ifdef __SSE2__
@@ -127,25 +128,11 @@ class BilinearSampler {
       return;
     }
 #endif
-    for (int i = 0; i < 4; ++i)
-      out[i] = cross(x[i], y[i], cv::Point2f(ax[i], ay[i]), cv::Point2f(bx[i], by[i]));
-  }
-
-  // The sum of five samples, (x, y) and (x, y) +- a and +- b, added in that order (an area
-  // sample); the four around it at once where the region lies inside the image, with the
-  // arithmetic of operator() lane by lane, so the sum is the same to the bit.
-  float cross(float x, float y, cv::Point2f a, cv::Point2f b) const {
-#ifdef __SSE2__
-    if (inside_) {
-      const __m128 xs = _mm_add_ps(_mm_set1_ps(x), _mm_set_ps(-b.x, b.x, -a.x, a.x));
-      const __m128 ys = _mm_add_ps(_mm_set1_ps(y), _mm_set_ps(-b.y, b.y, -a.y, a.y));
-      alignas(16) float around[4];
-      gather4(xs, ys, around);
-      return (*this)(x, y) + around[0] + around[1] + around[2] + around[3];
+    for (int i = 0; i < 4; ++i) {
+      const BilinearSampler& at = *this;
+      out[i] = at(x[i], y[i]) + at(x[i] + ax[i], y[i] + ay[i]) + at(x[i] - ax[i], y[i] - ay[i]) +
+               at(x[i] + bx[i], y[i] + by[i]) + at(x[i] - bx[i], y[i] - by[i]);
     }
-#endif
-    return (*this)(x, y) + (*this)(x + a.x, y + a.y) + (*this)(x - a.x, y - a.y) +
-           (*this)(x + b.x, y + b.y) + (*this)(x - b.x, y - b.y);
   }
 
  private:

@@ -412,10 +412,9 @@ struct MarkerDetector::Impl {
     };
     const int gap = std::max(2, kFragmentGap / scale);
     for (size_t i = 0; i < n; ++i) {
-      const cv::Rect& a = failed[i];
-      const cv::Rect grown(a.x - gap, a.y - gap, a.width + 2 * gap, a.height + 2 * gap);
+      const cv::Rect near = grown(failed[i], gap);
       for (size_t j = i + 1; j < n; ++j) {
-        if ((grown & failed[j]).empty()) continue;
+        if ((near & failed[j]).empty()) continue;
         const int ri = root(static_cast<int>(i)), rj = root(static_cast<int>(j));
         if (ri != rj) group[std::max(ri, rj)] = std::min(ri, rj);
       }

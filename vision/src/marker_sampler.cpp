@@ -47,26 +47,16 @@ Plane fitPlane(const cv::Point3d* samples, int count) {
   return {solution[0], solution[1], solution[2]};
 }
 
-// Mean of five samples: (u, v) and the corners of a square +-`spread` (unit-square units) around.
-// The four corners are placed through the map's derivative at (u, v): a quarter cell is small
-// enough for the projective map to be linear across it (well under 0.01 px off), and one map
-// evaluation instead of five is most of the sampling's cost.
-float sampleArea(const BilinearSampler& sample, const SquareToQuad& map, double u, double v,
-                 double spread) {
-  cv::Point2f centre, du, dv;
-  map.withDerivatives(u, v, centre, du, dv);
-  const float s = static_cast<float>(spread);
-  const cv::Point2f a = s * (du + dv), b = s * (du - dv);  // towards (+1, +1) and (+1, -1)
-  return sample.cross(centre.x, centre.y, a, b) / 5.0f;
-}
-
-// sampleArea() at four points at once, each to the bit as it computes it.
+// Means of five samples at four points (u[i], v[i]): each point and the corners of a square
+// +-`spread` (unit-square units) around it. The corners are placed through the map's derivative
+// at the point: a quarter cell is small enough for the projective map to be linear across it
+// (well under 0.01 px off), and one map evaluation instead of five is most of the sampling's cost.
 void sampleAreas(const BilinearSampler& sample, const SquareToQuad& map, const double (&u)[4],
                  const double (&v)[4], double spread, float* out) {
   SquareToQuad::Four at;
   map.withDerivatives(u, v, at);
   const float s = static_cast<float>(spread);
-  float ax[4], ay[4], bx[4], by[4];
+  float ax[4], ay[4], bx[4], by[4];  // towards (+1, +1) and (+1, -1)
   for (int i = 0; i < 4; ++i) {
     ax[i] = s * (at.du_x[i] + at.dv_x[i]);
     ay[i] = s * (at.du_y[i] + at.dv_y[i]);
@@ -75,6 +65,17 @@ void sampleAreas(const BilinearSampler& sample, const SquareToQuad& map, const d
   }
   sample.cross4(at.x, at.y, ax, ay, bx, by, out);
   for (int i = 0; i < 4; ++i) out[i] /= 5.0f;
+}
+
+// The centres of cells first .. first + 3 (row-major) of an n x n grid over [border, 1 -
+// border]^2; past the grid's last cell, copies of it.
+void gridCentres(int first, int n, double border, double (&u)[4], double (&v)[4]) {
+  const double cell = (1.0 - 2.0 * border) / n;
+  for (int i = 0; i < 4; ++i) {
+    const int index = std::min(first + i, n * n - 1);
+    u[i] = border + cell * (index % n + 0.5);
+    v[i] = border + cell * (index / n + 0.5);
+  }
 }
 
 // Single samples at four points of the marker (u[i], v[i]).
@@ -132,15 +133,6 @@ bool SquareToQuad::finiteOn(double low, double high) const {
     }
   }
   return true;
-}
-
-void SquareToQuad::withDerivatives(double u, double v, cv::Point2f& at, cv::Point2f& du,
-                                   cv::Point2f& dv) const {
-  const double w = 1.0 / (g_ * u + h_ * v + 1.0);
-  const double x = (a_ * u + b_ * v + c_) * w, y = (d_ * u + e_ * v + f_) * w;
-  at = {static_cast<float>(x), static_cast<float>(y)};
-  du = {static_cast<float>((a_ - x * g_) * w), static_cast<float>((d_ - y * g_) * w)};
-  dv = {static_cast<float>((b_ - x * h_) * w), static_cast<float>((e_ - y * h_) * w)};
 }
 
 void SquareToQuad::withDerivatives(const double (&u)[4], const double (&v)[4], Four& out) const {
@@ -206,10 +198,7 @@ MarkerSamples sampleMarker(const cv::Mat& image, const Quad& quad, double border
   // The cells four at a time, in row-major order.
   for (int first = 0; first < 36; first += 4) {
     double us[4], vs[4];
-    for (int i = 0; i < 4; ++i) {
-      us[i] = border + cell * ((first + i) % 6 + 0.5);
-      vs[i] = border + cell * ((first + i) / 6 + 0.5);
-    }
+    gridCentres(first, 6, border, us, vs);
     float values[4];
     sampleAreas(sample, map, us, vs, spread, values);
     for (int i = 0; i < 4; ++i) {
@@ -242,10 +231,7 @@ bool hasFlatCodeArea(const cv::Mat& image, const std::array<cv::Point2f, 4>& cor
   float lowest = 255.0f, highest = 0.0f;
   for (int first = 0; first < 36; first += 4) {  // the cells, row-major
     double us[4], vs[4];
-    for (int i = 0; i < 4; ++i) {
-      us[i] = border + cell * ((first + i) % 6 + 0.5);
-      vs[i] = border + cell * ((first + i) / 6 + 0.5);
-    }
+    gridCentres(first, 6, border, us, vs);
     float values[4];
     samplesAt(sample, map, us, vs, values);
     for (const float value : values) {
@@ -273,11 +259,12 @@ std::vector<float> sampleCodeArea(const cv::Mat& image, const Quad& quad, double
   const BilinearSampler sample(image, regionOf(map, 0.0, 1.0));
   const double cell = (1.0 - 2.0 * border) / n;
   std::vector<float> values(static_cast<size_t>(n) * n);
-  for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) {
-      values[r * n + c] = sampleArea(sample, map, border + cell * (c + 0.5),
-                                     border + cell * (r + 0.5), cell * 0.25);
-    }
+  for (int first = 0; first < n * n; first += 4) {
+    double us[4], vs[4];
+    gridCentres(first, n, border, us, vs);
+    float four[4];
+    sampleAreas(sample, map, us, vs, cell * 0.25, four);
+    std::copy_n(four, std::min(4, n * n - first), values.begin() + first);
   }
   return values;
 }

@@ -19,9 +19,7 @@ class SquareToQuad {
  public:
   explicit SquareToQuad(const std::array<cv::Point2f, 4>& corners);
   cv::Point2f operator()(double u, double v) const;
-  // The image point of (u, v) and the map's partial derivatives there (px per unit).
-  void withDerivatives(double u, double v, cv::Point2f& at, cv::Point2f& du, cv::Point2f& dv) const;
-  // The same at four points, as arrays of their coordinates (each to the bit as above).
+  // The image points of four (u[i], v[i]) and the map's partial derivatives there (px per unit).
   struct Four {
     float x[4], y[4], du_x[4], du_y[4], dv_x[4], dv_y[4];
   };

@@ -406,8 +406,8 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
     vertex[k] = hull_index[(*corners)[k]];
     result.hull_corners[k] = contour[vertex[k]];
   }
-  // Every side as long as a marker's (checked first: it is cheap, and a third of the solid
-  // components that fail, fail here).
+  // Every side as long as a marker's (checked first: it is cheap, and a third to a half of the
+  // solid components that fail, fail here).
   for (int k = 0; k < 4; ++k) {
     if (length(cv::Point2f(result.hull_corners[(k + 1) % 4] - result.hull_corners[k])) <
         params.min_side)
