@@ -11,8 +11,8 @@
 namespace arbci::vision {
 
 // `quad` with its sides moved onto motion-blurred edges (the printed edge in the middle of a ramp
-// up to 15 px wide, see blurred_edges.cpp); for a marker that refineQuad()'s short reach left on the
-// smear's outer part. nullopt where a side shows no ramp or the sides no longer make a quad.
+// up to 15 px wide, see blurred_edges.cpp); for a marker that refineQuad()'s short reach left on
+// the smear's outer part. nullopt where a side shows no ramp or the sides no longer make a quad.
 std::optional<Quad> placeOnBlurredEdges(const Quad& quad, const cv::Mat& image,
                                         const QuadFitParams& params);
 
