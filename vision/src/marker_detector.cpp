@@ -38,6 +38,7 @@ constexpr size_t kMaxRetriesDecimated = 8;
 constexpr size_t kMaxRetries = 12;
 constexpr size_t kMaxCornerCutRetries = 2;  // the full search's rings with a corner cut off
 constexpr size_t kMaxFragmentRetries = 6;   // and groups of fragments
+constexpr size_t kMaxJoinedGroups = 2;      // and pairs of groups tried as one
 constexpr int kMaxRetrySide = 160;          // px; larger borders are not thinned by blur
 constexpr int kRetryMargin = 14;            // px around a near miss
 constexpr int kFragmentGap = 4;             // px: failed components this close are one region
@@ -66,6 +67,7 @@ struct RetryRegion {
   bool fragmented;      // several failed components, rather than one square-hulled outline
   bool thin = false;    // labelled again on the frame (kThinOnFrameWidth)
   bool ringed = false;  // encloses a hole, as a marker's border does (decimated search only)
+  bool joined = false;  // two fragment groups whose boxes overlap, tried when neither gave a marker
 };
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
@@ -329,6 +331,7 @@ struct MarkerDetector::Impl {
       const size_t near_miss_count = retries.size();
       groupFragments(min_side);
       keepLargest(retries, near_miss_count + kMaxFragmentRetries);
+      joinOverlappingGroups(near_miss_count);
       const auto retry_start = Clock::now();
       retryNearMisses(params);
       time.retry += microseconds(retry_start, Clock::now());
@@ -445,6 +448,37 @@ struct MarkerDetector::Impl {
     }
   }
 
+  // A smear across a marker can leave its two ends as fragment groups of their own, whose boxes
+  // overlap but whose pieces are too far apart to be grouped (seed 9928's 1280x720 marker: its
+  // top and bottom border greyed out, its code's light cells between the two dark ends). Such a
+  // pair is also tried as one region, after the groups themselves.
+  void joinOverlappingGroups(size_t first_group) {
+    const size_t groups_end = retries.size();
+    size_t added = 0;
+    for (size_t i = first_group; i < groups_end && added < kMaxJoinedGroups; ++i) {
+      for (size_t j = i + 1; j < groups_end && added < kMaxJoinedGroups; ++j) {
+        const cv::Rect& a = retries[i].box;
+        const cv::Rect& b = retries[j].box;
+        if ((a & b).empty()) continue;
+        const cv::Rect box = a | b;
+        const int longer = std::max(box.width, box.height);
+        if (longer > kMaxRetrySide / scale || longer > 3 * std::min(box.width, box.height))
+          continue;
+        retries.push_back({box, true, false, false, true});
+        ++added;
+      }
+    }
+  }
+
+  // True when a quad found so far has its centre inside `box` (of the searched image).
+  bool foundInside(const cv::Rect& box) const {
+    const cv::Rect2f area(box);
+    for (const Quad& quad : quads) {
+      if (area.contains(centre(quad.corners))) return true;
+    }
+    return false;
+  }
+
   // `box` joined with the failed outlines and fragment groups it overlaps, grown by `margin`: a
   // thin marker that the reduced image broke into pieces (seed 9723's 14 x 78 px rhombus: a
   // ringed piece and an open one) is labelled on the frame whole, not cut off at the ringed
@@ -467,6 +501,7 @@ struct MarkerDetector::Impl {
     const cv::Rect image(0, 0, searched->cols, searched->rows);
     const int margin = kRetryMargin / scale;
     for (const RetryRegion& region : retries) {
+      if (region.joined && foundInside(region.box)) continue;
       const cv::Rect roi = grown(region.box, margin) & image;
       const int split = region.fragmented ? kFragmentedSplit : kThinnedSplit;
       const size_t before = quads.size();
