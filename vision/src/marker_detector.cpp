@@ -67,7 +67,7 @@ struct RetryRegion {
   bool fragmented;      // several failed components, rather than one square-hulled outline
   bool thin = false;    // labelled again on the frame (kThinOnFrameWidth)
   bool ringed = false;  // encloses a hole, as a marker's border does (decimated search only)
-  bool joined = false;  // two fragment groups whose boxes overlap, tried when neither gave a marker
+  bool joined = false;  // two fragment groups whose boxes overlap, tried when neither gave a quad
 };
 
 double microseconds(Clock::time_point from, Clock::time_point to) {
@@ -466,7 +466,8 @@ struct MarkerDetector::Impl {
   // A smear across a marker can leave its two ends as fragment groups of their own, whose boxes
   // overlap but whose pieces are too far apart to be grouped (seed 9928's 1280x720 marker: its
   // top and bottom border greyed out, its code's light cells between the two dark ends). Such a
-  // pair is also tried as one region, after the groups themselves.
+  // pair is also tried as one region, after the groups themselves and only where they gave no
+  // quad.
   void joinOverlappingGroups(size_t first_group) {
     const size_t groups_end = retries.size();
     size_t added = 0;
@@ -479,7 +480,7 @@ struct MarkerDetector::Impl {
         const int longer = std::max(box.width, box.height);
         if (longer > kMaxRetrySide / scale || longer > 3 * std::min(box.width, box.height))
           continue;
-        retries.push_back({box, true, false, false, true});
+        retries.push_back({.box = box, .fragmented = true, .joined = true});
         ++added;
       }
     }
