@@ -42,6 +42,9 @@ constexpr size_t kMaxJoinedGroups = 2;      // and pairs of groups tried as one
 constexpr int kMaxRetrySide = 160;          // px; larger borders are not thinned by blur
 constexpr int kRetryMargin = 14;            // px around a near miss
 constexpr int kFragmentGap = 4;             // px: failed components this close are one region
+// A retry region joined with the pieces around it is kept to this many times its area: beyond
+// that the pieces were clutter, not a marker's (joining them cost 3.8 % of noisy frames' time).
+constexpr int kMaxJoinGrowth = 3;
 // Sixteenths of a tile's range, lighter than the usual 7 so that more of a blurred border counts
 // as dark: 9 closes a border that blur thinned; 11 joins the fragments of one that motion blur
 // washed to mid-grey across its direction.
@@ -117,7 +120,8 @@ cv::Rect grown(const cv::Rect& box, int margin) {
   return {box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin};
 }
 
-// The whole pixels `q` covers.
+// The whole pixels `q` covers: cv::boundingRect's result, without its InputArray set-up (42 ns a
+// call against 12; called for every quad at every near miss, it cost 0.5 % of a frame).
 cv::Rect pixelBox(const SquareCorners& q) {
   float min_x = q[0].x, max_x = q[0].x, min_y = q[0].y, max_y = q[0].y;
   for (const cv::Point2f& p : q) {
@@ -346,7 +350,7 @@ struct MarkerDetector::Impl {
       const size_t near_miss_count = retries.size();
       groupFragments(min_side);
       keepLargest(retries, near_miss_count + kMaxFragmentRetries);
-      joinOverlappingGroups(near_miss_count);
+      joinOverlappingGroups(near_miss_count, min_side);
       const auto retry_start = Clock::now();
       retryNearMisses(params);
       time.retry += microseconds(retry_start, Clock::now());
@@ -416,6 +420,13 @@ struct MarkerDetector::Impl {
     regions.resize(count);
   }
 
+  // A box a marker tilted up to ~70 degrees could fill: its longer side within kMaxRetrySide (of
+  // the frame) and at most three times the shorter, the shorter at least half `min_side`.
+  bool markerSized(const cv::Rect& box, float min_side) const {
+    const int longer = std::max(box.width, box.height), shorter = std::min(box.width, box.height);
+    return longer <= kMaxRetrySide / scale && shorter >= min_side * 0.5f && longer <= 3 * shorter;
+  }
+
   // Motion blur washes out the border sides across its direction, leaving a marker as several
   // dark fragments: failed components within kFragmentGap of each other become one region
   // (union-find over their boxes). Regions of several fragments and of a marker's size, not
@@ -449,10 +460,8 @@ struct MarkerDetector::Impl {
     for (size_t i = 0; i < n; ++i) {
       if (root(static_cast<int>(i)) != static_cast<int>(i) || group_size[i] < 2) continue;
       const cv::Rect& box = failed[i];
+      if (!markerSized(box, min_side)) continue;
       const int longer = std::max(box.width, box.height), shorter = std::min(box.width, box.height);
-      // A marker tilted up to ~70 degrees.
-      if (longer > kMaxRetrySide / scale || shorter < min_side * 0.5f || longer > 3 * shorter)
-        continue;
       const cv::Point2f middle(box.x + 0.5f * box.width, box.y + 0.5f * box.height);
       const bool inside_found = insideAnyQuad(middle);
       // A thin marker broken into pieces: some of them ringed, the group's box narrow (a
@@ -468,7 +477,7 @@ struct MarkerDetector::Impl {
   // top and bottom border greyed out, its code's light cells between the two dark ends). Such a
   // pair is also tried as one region, after the groups themselves and only where they gave no
   // quad.
-  void joinOverlappingGroups(size_t first_group) {
+  void joinOverlappingGroups(size_t first_group, float min_side) {
     const size_t groups_end = retries.size();
     size_t added = 0;
     for (size_t i = first_group; i < groups_end && added < kMaxJoinedGroups; ++i) {
@@ -477,9 +486,7 @@ struct MarkerDetector::Impl {
         const cv::Rect& b = retries[j].box;
         if ((a & b).empty()) continue;
         const cv::Rect box = a | b;
-        const int longer = std::max(box.width, box.height);
-        if (longer > kMaxRetrySide / scale || longer > 3 * std::min(box.width, box.height))
-          continue;
+        if (!markerSized(box, min_side)) continue;
         retries.push_back({.box = box, .fragmented = true, .joined = true});
         ++added;
       }
@@ -499,8 +506,8 @@ struct MarkerDetector::Impl {
   // border can cut the marker in two: one end fitted as a quad of its own (which does not decode)
   // and the other a near miss (seed 9000's 1280x720 marker under motion+JPEG). Binarised again
   // around the near miss alone, the marker was cut off at the region's edge. Only quads no larger
-  // than the box (a larger one was mostly a marker found beside clutter), and not when that
-  // triples the box. Not for fragment groups: those beside a quad were mostly a found marker's
+  // than the box (a larger one was mostly a marker found beside clutter), within kMaxJoinGrowth.
+  // Not for fragment groups: those beside a quad were mostly a found marker's
   // smeared surround, and joining them grew the retried area 5-7 % for nothing.
   cv::Rect joinedWithOverlappingQuads(const cv::Rect& box) const {
     cv::Rect joined = box;
@@ -508,20 +515,19 @@ struct MarkerDetector::Impl {
       const cv::Rect outline = pixelBox(quad.corners);
       if (outline.area() <= box.area() && !(outline & box).empty()) joined |= outline;
     }
-    return joined.area() > 3 * box.area() ? box : joined;
+    return joined.area() > kMaxJoinGrowth * box.area() ? box : joined;
   }
 
   // `box` joined with the failed outlines and fragment groups it overlaps, grown by `margin`: a
   // thin marker that the reduced image broke into pieces (seed 9723's 14 x 78 px rhombus: a
   // ringed piece and an open one) is labelled on the frame whole, not cut off at the ringed
-  // piece's end. Not when that triples the box: in noisy frames the pieces joined were clutter
-  // (and cost 3.8 % of the time there).
+  // piece's end. Within kMaxJoinGrowth.
   cv::Rect joinedWithTouchingFailures(const cv::Rect& box, int margin) const {
     cv::Rect joined = box;
     for (const cv::Rect& other : failed) {
       if (!(other & box).empty()) joined |= other;
     }
-    if (joined.area() > 3 * box.area()) joined = box;  // clutter around it, rather than its pieces
+    if (joined.area() > kMaxJoinGrowth * box.area()) joined = box;
     return grown(joined, margin);
   }
 
