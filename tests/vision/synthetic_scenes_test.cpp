@@ -259,28 +259,32 @@ TEST(SyntheticScenes, DecimatedSearchReadsEveryMarkerOfFramesItOnceMissedOneOf) 
 }
 
 // A marker read from one frame of the benchmark's default scenes (tilted from the line of sight)
-// by the decimated search, with no wrong id and no false positive in that frame.
+// or of its small-marker scenes, by the decimated or the full search, with no wrong id and no
+// false positive in that frame.
 struct ReadCase {
   std::uint32_t seed;
   Condition condition;
   cv::Size size;
   int id;
+  int search_decimate = 2;
+  bool small_markers = false;  // marker_bench --min-side 16 --quiet-cells 1
 };
 
-void expectDecimatedSearchReads(const ReadCase& c) {
-  DetectorConfig decimated;
-  decimated.search_decimate = 2;
+void expectSearchReads(const ReadCase& c) {
+  DetectorConfig config;
+  config.search_decimate = c.search_decimate;
   test::LayoutOptions options;
+  const float scale = static_cast<float>(c.size.width) / 640.0f;
   options.size = c.size;
-  options.min_side_px = 48.0f * static_cast<float>(c.size.width) / 640.0f;
-  options.max_side_px = 110.0f * static_cast<float>(c.size.width) / 640.0f;
-  options.quiet_cells = 2.0f;
+  options.min_side_px = (c.small_markers ? 16.0f : 48.0f) * scale;
+  options.max_side_px = 110.0f * scale;
+  options.quiet_cells = c.small_markers ? 1.0f : 2.0f;
   options.tilt_from = test::LayoutOptions::TiltFrom::LineOfSight;
   const test::RenderedScene scene = test::renderScene(test::makeLayout(options, c.seed),
                                                       test::MarkerFamily::ArbciBch, c.condition);
   std::vector<test::FoundMarker> found;
   bool read = false;
-  for (const MarkerDetection& m : MarkerDetector(decimated).detect(scene.image).markers) {
+  for (const MarkerDetection& m : MarkerDetector(config).detect(scene.image).markers) {
     found.push_back({m.id, m.corners});
     read = read || m.id == c.id;
   }
@@ -300,7 +304,7 @@ TEST(SyntheticScenes, DecimatedSearchTriesOverlappingFragmentGroupsAsOneRegion) 
                             ReadCase{9064u, Condition::MotionBlurJpeg, {640, 480}, 1391},
                             ReadCase{9086u, Condition::FastMotionJpeg, {640, 480}, 3154},
                             ReadCase{10084u, Condition::MotionBlur, {640, 480}, 3054}})
-    expectDecimatedSearchReads(c);
+    expectSearchReads(c);
 }
 
 // A smear across a marker's border can cut the marker in two: one end a quad of its own that
@@ -312,7 +316,21 @@ TEST(SyntheticScenes, DecimatedSearchRetriesANearMissWithTheQuadsItOverlaps) {
   for (const ReadCase& c : {ReadCase{9000u, Condition::MotionBlurJpeg, {1280, 720}, 3182},
                             ReadCase{9055u, Condition::MotionBlur, {640, 480}, 3178},
                             ReadCase{10094u, Condition::MotionBlur, {640, 480}, 3737}})
-    expectDecimatedSearchReads(c);
+    expectSearchReads(c);
+}
+
+// The full search tries a region that gave no quad once more at one threshold, halfway between
+// its darkest and lightest grey, when these span nearly the frame's range. Smeared by 5-15 px,
+// these markers of the small-marker scenes (a 1-cell quiet zone) were missed before that: the
+// edge tiles' thresholds followed the grey background and joined the greyed border to it.
+TEST(SyntheticScenes, FullSearchReadsSmearedMarkersAtTheirRegionsMidGrey) {
+  const cv::Size vga{640, 480};
+  for (const ReadCase& c : {ReadCase{1025u, Condition::MotionBlur, vga, 2074, 1, true},
+                            ReadCase{1053u, Condition::MotionBlur, vga, 3866, 1, true},
+                            ReadCase{1050u, Condition::MotionBlur, vga, 9, 1, true},
+                            ReadCase{1007u, Condition::MotionBlurJpeg, vga, 1576, 1, true},
+                            ReadCase{1014u, Condition::FastMotionJpeg, vga, 1867, 1, true}})
+    expectSearchReads(c);
 }
 
 // The angle between a posed square's normal and the line of sight to its centre, degrees, from

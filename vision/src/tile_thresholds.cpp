@@ -544,6 +544,14 @@ void AdaptiveThresholder::fill(const cv::Mat& smoothed, int min_contrast, TileTh
   }
 }
 
+std::pair<int, int> AdaptiveThresholder::imageRange() const {
+  // The coarsest grid's cells cover the image: a few dozen to compare.
+  const MinMaxGrid& coarsest = raw_[kLevels - 1];
+  if (coarsest.lo.empty()) return {0, 0};
+  return {*std::min_element(coarsest.lo.begin(), coarsest.lo.end()),
+          *std::max_element(coarsest.hi.begin(), coarsest.hi.end())};
+}
+
 void AdaptiveThresholder::roiLimits(cv::Rect roi, int split, cv::Mat& limits, int upscale) {
   const int tile = tile_, cols = dilated_[0].cols, rows = dilated_[0].rows;
   // Tiles around the region (one more on each side for interpolation, the first one even),

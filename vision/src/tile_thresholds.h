@@ -76,6 +76,9 @@ class AdaptiveThresholder {
   // `roi`'s pixels in the frame, `roi` scaled by 2, interpolated there between the tiles' centres.
   void roiLimits(cv::Rect roi, int split, cv::Mat& limits, int upscale = 1);
 
+  // After fill(): the darkest and the lightest grey level of the image filled from.
+  std::pair<int, int> imageRange() const;
+
   // Where an edge tile's threshold sits between its minimum and maximum, in sixteenths: a little
   // below the midrange, which keeps marker borders apart from their surroundings.
   static constexpr int kSplit = 7;
