@@ -155,7 +155,10 @@ TEST(AprilTags, EveryReferenceTagOfTheLibrarysTestImagesAtItsCorners) {
       reference.push_back(corners);
     }
     reference_tags += static_cast<int>(reference.size());
-    const auto markers = detector.detect(cv::imread(base + ".jpg")).markers;
+    const DetectionResult result = detector.detect(cv::imread(base + ".jpg"));
+    // The frame is thresholded by libapriltag, not by OpenCV's dictionary path.
+    EXPECT_EQ(result.threshold_mode, "libapriltag's own") << name;
+    const auto& markers = result.markers;
     EXPECT_EQ(markers.size(), reference.size()) << name;
     for (const auto& m : markers) {
       EXPECT_EQ(m.id, 0) << name;

@@ -976,7 +976,9 @@ struct MarkerDetector::Impl {
         }
       }
       time.decode = microseconds(decode_start, Clock::now());
-      result.threshold_mode = "opencv adaptive";
+      // Each library thresholds the frame itself: AprilTag by its own adaptive threshold, ArUco
+      // by OpenCV's adaptive one.
+      result.threshold_mode = apriltag ? "libapriltag's own" : "opencv adaptive";
     } else {
       result = detectSquares(time);
     }
