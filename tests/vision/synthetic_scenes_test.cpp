@@ -324,12 +324,19 @@ TEST(SyntheticScenes, DecimatedSearchRetriesANearMissWithTheQuadsItOverlaps) {
 // these markers of the small-marker scenes (a 1-cell quiet zone) were missed before that: the
 // edge tiles' thresholds followed the grey background and joined the greyed border to it.
 TEST(SyntheticScenes, FullSearchReadsSmearedMarkersAtTheirRegionsMidGrey) {
-  const cv::Size vga{640, 480};
-  for (const ReadCase& c : {ReadCase{1025u, Condition::MotionBlur, vga, 2074, 1, true},
-                            ReadCase{1053u, Condition::MotionBlur, vga, 3866, 1, true},
-                            ReadCase{1050u, Condition::MotionBlur, vga, 9, 1, true},
-                            ReadCase{1007u, Condition::MotionBlurJpeg, vga, 1576, 1, true},
-                            ReadCase{1014u, Condition::FastMotionJpeg, vga, 1867, 1, true}})
+  const auto smallMarker = [](std::uint32_t seed, Condition condition, int id) {
+    return ReadCase{.seed = seed,
+                    .condition = condition,
+                    .size = {640, 480},
+                    .id = id,
+                    .search_decimate = 1,
+                    .small_markers = true};
+  };
+  for (const ReadCase& c : {smallMarker(1025u, Condition::MotionBlur, 2074),
+                            smallMarker(1053u, Condition::MotionBlur, 3866),
+                            smallMarker(1050u, Condition::MotionBlur, 9),
+                            smallMarker(1007u, Condition::MotionBlurJpeg, 1576),
+                            smallMarker(1014u, Condition::FastMotionJpeg, 1867)})
     expectSearchReads(c);
 }
 

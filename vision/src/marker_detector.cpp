@@ -64,9 +64,10 @@ constexpr float kThinOnFrameMinLength = 20.0f;
 // far onto them. The bench's smeared markers were 2-7 px off; from 1 px, a third more quads were
 // read again (mostly noisy decoys) for no more markers.
 constexpr float kLeastBlurredEdgeMove = 1.5f;
-// A region's grey range, as a fraction of the frame's, from which it is tried at its mid-grey:
-// every marker this read on the bench's scenes came from regions at 0.8 or more; from 0.85, a
-// quarter of the regions are tried, for 46 of the 49 markers read from any region.
+// A region's grey range, as a fraction of the frame's, from which it is tried at its mid-grey.
+// Counted over the regions of 600 frames each of the small-marker scenes (seeds 1000-1099) and
+// the default ones (10200-10299): every marker this read came from a region at 0.8 or more; from
+// 0.85, a quarter of the regions are tried, for 46 of the 49 markers read from any region.
 constexpr double kMidGreyMinRange = 0.85;
 
 struct RetryRegion {
@@ -542,6 +543,8 @@ struct MarkerDetector::Impl {
   void retryNearMisses(const QuadFitParams& params) {
     const cv::Rect image(0, 0, searched->cols, searched->rows);
     const int margin = kRetryMargin / scale;
+    const auto [frame_darkest, frame_lightest] = adaptive.imageRange();
+    const double mid_grey_min_range = kMidGreyMinRange * (frame_lightest - frame_darkest);
     for (const RetryRegion& region : retries) {
       if (region.joined && foundInside(region.box)) continue;
       const cv::Rect box = region.fragmented ? region.box : joinedWithOverlappingQuads(region.box);
@@ -563,32 +566,28 @@ struct MarkerDetector::Impl {
       if (!region.fragmented && binarised != &gray &&
           retryRegion(roi, gray, AdaptiveThresholder::kSplit, params))
         continue;
-      retryAtMidGrey(roi, params);
+      retryAtMidGrey(roi, mid_grey_min_range, params);
     }
   }
 
   // The full search's last try of a region: one threshold, halfway between its darkest and
-  // lightest grey, where these are nearly the frame's own (a black border and a white quiet zone
-  // both there). A smear that greys a border where the frame is mid-grey leaves the edge tiles'
-  // thresholds following the background, which breaks the border or joins it to its
-  // surroundings; halfway between the marker's own black and white still parts them. On the
-  // small-marker scenes (1-cell quiet zone, seeds 1000-1099) it read 43 more of the 900 smeared
-  // markers, for 8-13 % more of the full search's time. The decimated search, whose margin to
-  // its speed target is thin, does not try it.
-  void retryAtMidGrey(const cv::Rect& roi, const QuadFitParams& frame_params) {
+  // lightest grey, where these span at least `min_range` grey levels (nearly the frame's own: a
+  // black border and a white quiet zone both there). A smear that greys a border where the frame
+  // is mid-grey leaves the edge tiles' thresholds following the background, which breaks the
+  // border or joins it to its surroundings; halfway between the marker's own black and white
+  // still parts them. On the small-marker scenes it read 43 more of the 900 smeared markers of
+  // seeds 1000-1099 (where it was found) and 34 more of the held-out 10200-10299, for 5-14 % more
+  // of the full search's time. The decimated search, whose margin to its speed target is thin,
+  // does not try it. Components the frame's labelling fitted are fitted again here: a solid one
+  // was dropped there unfitted, and at this threshold it may be a marker's outline.
+  void retryAtMidGrey(const cv::Rect& roi, double min_range, const QuadFitParams& params) {
     const cv::Mat patch = (*searched)(roi);
     double darkest = 0.0, lightest = 0.0;
     cv::minMaxLoc(patch, &darkest, &lightest);
-    const auto [frame_darkest, frame_lightest] = adaptive.imageRange();
-    if (lightest - darkest < kMidGreyMinRange * (frame_lightest - frame_darkest)) return;
+    if (lightest - darkest < min_range) return;
     mid_grey_limits.create(patch.size(), CV_8UC1);
     mid_grey_limits.setTo(cv::Scalar(0.5 * (darkest + lightest)));
-    QuadFitParams params = frame_params;
-    params.lens = nullptr;  // region coordinates; ideal corners are computed below
-    roi_labels.label(patch, mid_grey_limits);
-    fitComponents(
-        patch, roi.tl(), params, [](const DarkComponent&) { return true; },
-        [&](Quad& quad) { addRetried(quad); });
+    fitRegion(roi, *searched, mid_grey_limits, params, [](const DarkComponent&) { return true; });
   }
 
   // True when the frame's labelling had this component (of a region at `origin`) and fitted it
@@ -604,16 +603,24 @@ struct MarkerDetector::Impl {
 
   // Binarises `roi` of `source` with edge tiles split at `split` sixteenths; adds the new quads.
   bool retryRegion(const cv::Rect& roi, const cv::Mat& source, int split,
-                   const QuadFitParams& frame_params) {
-    QuadFitParams params = frame_params;
-    params.lens = nullptr;  // region coordinates; ideal corners are computed below
-    const cv::Mat patch = source(roi);
+                   const QuadFitParams& params) {
     adaptive.roiLimits(roi, split, roi_limits);
-    roi_labels.label(patch, roi_limits);
+    return fitRegion(roi, source, roi_limits, params,
+                     [&](const DarkComponent& c) { return !wasTraced(c, roi.tl()); });
+  }
+
+  // Labels `roi` of `source` against `limits` (its size) and adds the quads of the components
+  // `wanted` accepts; true when one was added.
+  template <typename Wanted>
+  bool fitRegion(const cv::Rect& roi, const cv::Mat& source, const cv::Mat& limits,
+                 const QuadFitParams& frame_params, Wanted wanted) {
+    QuadFitParams params = frame_params;
+    params.lens = nullptr;  // region coordinates; ideal corners are computed in addRetried()
+    const cv::Mat patch = source(roi);
+    roi_labels.label(patch, limits);
     bool added = false;
-    fitComponents(
-        patch, roi.tl(), params, [&](const DarkComponent& c) { return !wasTraced(c, roi.tl()); },
-        [&](Quad& quad) { added = addRetried(quad) || added; });
+    fitComponents(patch, roi.tl(), params, wanted,
+                  [&](Quad& quad) { added = addRetried(quad) || added; });
     return added;
   }
 
