@@ -19,8 +19,8 @@
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/sample_clock.h"
 #include "arbci/bci/simulated_subject.h"
-#include "session/eeg_stage.h"
-#include "session/session_config.h"
+#include "arbci/session/eeg_sources.h"
+#include "arbci/session/session_config.h"
 
 using namespace arbci;
 
@@ -30,10 +30,10 @@ constexpr double kFeedbackPeriodS = 3.5;  // cue 1.5 s + result 1 s + pause 1 s
 
 // A calibration block of `feedbacks` feedbacks (a quarter wrong) by the simulated subject of
 // `eeg` with `seed`, as a recording whose stimuli are the feedbacks coded by class.
-bci::Recording calibrationBlock(app::EegSettings eeg, std::uint64_t seed, int feedbacks) {
+bci::Recording calibrationBlock(session::EegSettings eeg, std::uint64_t seed, int feedbacks) {
   eeg.seed = seed;
   eeg.photodiode_channel.clear();  // the ErrP pipeline's channels only
-  const bci::SimulatedSubjectConfig config = app::simulatedSubjectOf(eeg);
+  const bci::SimulatedSubjectConfig config = session::simulatedSubjectOf(eeg);
   bci::SimulatedSubject subject(config, std::make_shared<bci::UnboundedClock>());
 
   std::mt19937 random(static_cast<std::uint32_t>(seed * 7919 + 17));
@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
 
-  app::SessionConfig config = app::SessionConfig::load(std::nullopt);
+  session::SessionConfig config = session::SessionConfig::load(std::nullopt);
   if (errp_scale >= 0.0) config.eeg.errp_scale = errp_scale;
   const bci::PipelineSettings pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
   std::printf(

@@ -11,7 +11,8 @@
 #include <filesystem>
 
 #include "arbci/render/gl_context.h"
-#include "session/session.h"
+#include "arbci/session/session.h"
+#include "hmd/open_session.h"
 
 using namespace arbci;
 
@@ -55,21 +56,22 @@ int main(int argc, char** argv) {
                "no head motion (the cameras render only when the arm moves: several times faster)");
   CLI11_PARSE(cli, argc, argv);
   try {
-    app::SessionConfig config = app::SessionConfig::load(std::nullopt);
+    session::SessionConfig config = session::SessionConfig::load(std::nullopt);
     if (still_head) config.cameras.head_motion_m = config.cameras.head_motion_deg = 0.0;
     config.intended.clear();  // random intentions for the seed, as many as trials
     auto context = render::createHeadlessContext({64, 64});
-    app::SessionOptions options;
+    session::SessionOptions options;
     options.folder = std::filesystem::temp_directory_path() /
                      ("arbci-selection-bench-" + std::to_string(::getpid()));
     options.trials = trials;
     options.seed = static_cast<std::uint64_t>(seed);
     options.max_session_s = 1e6;
     options.progress = &std::cerr;
-    app::Session session(config, options, *context);
+    app::OpenedSession opened = app::openSession(config, options, *context);
+    session::Session& session = *opened.session;
     const nlohmann::json s = session.run();
     int objects_right = 0, objects_made = 0, cells_right = 0, cells_made = 0;
-    for (const app::TrialRecord& t : session.trials()) {
+    for (const session::TrialRecord& t : *session.last().paradigm.trials) {
       if (t.selected_object >= 0) {
         ++objects_made;
         objects_right += t.selected_object == t.intended_object;

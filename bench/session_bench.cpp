@@ -9,29 +9,31 @@
 #include <string>
 
 #include "arbci/render/gl_context.h"
-#include "session/session.h"
+#include "arbci/session/session.h"
+#include "hmd/open_session.h"
 
 using namespace arbci;
 
 namespace {
 
-void run(const char* name, app::SessionConfig config, int trials) {
+void run(const char* name, session::SessionConfig config, int trials) {
   auto context = render::createHeadlessContext({64, 64});
-  app::SessionOptions options;
+  session::SessionOptions options;
   options.folder = std::filesystem::temp_directory_path() /
                    ("arbci-session-bench-" + std::to_string(::getpid()));
   options.trials = trials;
-  app::Session session(config, options, *context);
+  app::OpenedSession opened = app::openSession(config, options, *context);
+  session::Session& session = *opened.session;
   const auto start = std::chrono::steady_clock::now();
   session.run();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const app::CycleTiming& t = session.timing();
+  const session::CycleTiming& t = session.timing();
   std::printf("\n%s: %zu cycles, %.1f s of session in %.1f s (%.1fx real time), ended: %s\n", name,
               t.cycles(), session.time(), wall, session.time() / wall, session.endReason().c_str());
   std::printf("%-10s %9s %9s %9s %9s %9s\n", "stage", "mean ms", "p50 ms", "p90 ms", "p99 ms",
               "max ms");
-  auto row = [](const std::string& stage, const app::Percentiles& p) {
+  auto row = [](const std::string& stage, const session::Percentiles& p) {
     std::printf("%-10s %9.3f %9.3f %9.3f %9.3f %9.3f\n", stage.c_str(), p.mean, p.p50, p.p90, p.p99,
                 p.max);
   };
@@ -54,7 +56,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
   try {
-    app::SessionConfig config = app::SessionConfig::load(std::nullopt);
+    session::SessionConfig config = session::SessionConfig::load(std::nullopt);
     run("simulated session (embedded default: head motion, camera noise, lens distortion)", config,
         trials);
     config.cameras.head_motion_m = 0.0;

@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "arbci/vision/frame_source.h"
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/marker_poses.h"
 #include "arbci/vision/marker_set.h"
@@ -16,7 +17,6 @@
 #include "commands/commands.h"
 #include "support/cli_error.h"
 #include "support/detection_json.h"
-#include "support/frame_source.h"
 #include "support/png.h"
 
 namespace arbci::app {
@@ -137,7 +137,7 @@ vision::DetectorConfig makeConfig(const DetectOptions& options) {
   return config;
 }
 
-void annotate(const std::filesystem::path& folder, const Frame& frame,
+void annotate(const std::filesystem::path& folder, const vision::Frame& frame,
               const std::vector<vision::MarkerDetection>& markers) {
   cv::Mat canvas;
   if (frame.image.channels() == 1) {
@@ -205,15 +205,19 @@ int runDetect(const DetectOptions& options) {
       throw CliError(error.what());
     }
   }();
-  std::unique_ptr<FrameSource> source;
-  if (!options.inputs.empty()) {
-    std::optional<RawFormat> raw;
-    if (!options.raw.empty()) raw = parseRawFormat(options.raw);
-    source = imageFiles(options.inputs, raw);
-  } else if (!options.video.empty()) {
-    source = videoFile(options.video, options.frames);
-  } else {
-    source = camera(options.device, options.frames);
+  std::unique_ptr<vision::FrameSource> source;
+  try {
+    if (!options.inputs.empty()) {
+      std::optional<vision::RawFormat> raw;
+      if (!options.raw.empty()) raw = vision::parseRawFormat(options.raw);
+      source = vision::imageFiles(options.inputs, raw);
+    } else if (!options.video.empty()) {
+      source = vision::videoFile(options.video, options.frames);
+    } else {
+      source = vision::camera(options.device, options.frames);
+    }
+  } catch (const vision::FrameSourceError& error) {
+    throw CliError(error.what());
   }
   if (!options.annotate.empty()) {
     std::error_code error;

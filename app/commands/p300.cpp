@@ -14,10 +14,10 @@
 #include "arbci/bci/channel_quality.h"
 #include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/p300_model.h"
+#include "arbci/session/session_config.h"
 #include "commands/commands.h"
 #include "eeg/p300_plots.h"
 #include "eeg/p300_report.h"
-#include "session/session_config.h"
 #include "support/cli_error.h"
 #include "support/name_list.h"
 #include "support/output_path.h"
@@ -143,8 +143,8 @@ void writeReportFiles(const std::string& report_path, const std::string& scores_
 // With --errp, what was not given on the command line is what a session's ErrP classifier uses
 // (the embedded session's "errp"), so an offline ErrP model compares with a session's own.
 void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
-  const ErrpSettings session = SessionConfig::load(std::nullopt).errp;
-  const bci::TrainingSettings training = session.training();
+  const session::ErrpSettings errp = session::SessionConfig::load(std::nullopt).errp;
+  const bci::TrainingSettings training = errp.training();
   const auto ms = [](double s) { return std::to_string(std::lround(s * 1000.0)); };
   const auto text = [](double v) {  // 20, not 20.000000
     std::ostringstream out;
@@ -156,10 +156,10 @@ void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
       {"--xdawn-filters",
        [&] { return std::to_string(o.training.xdawn.filters = training.xdawn.filters); }},
       {"--window-ms",
-       [&] { return o.window_ms = ms(session.window.start_s) + "," + ms(session.window.end_s); }},
-      {"--decimate-hz", [&] { return text(o.pipeline.decimate_hz = session.decimate_hz); }},
-      {"--highpass-hz", [&] { return text(o.pipeline.filter.highpass_hz = session.highpass_hz); }},
-      {"--lowpass-hz", [&] { return text(o.pipeline.filter.lowpass_hz = session.lowpass_hz); }},
+       [&] { return o.window_ms = ms(errp.window.start_s) + "," + ms(errp.window.end_s); }},
+      {"--decimate-hz", [&] { return text(o.pipeline.decimate_hz = errp.decimate_hz); }},
+      {"--highpass-hz", [&] { return text(o.pipeline.filter.highpass_hz = errp.highpass_hz); }},
+      {"--lowpass-hz", [&] { return text(o.pipeline.filter.lowpass_hz = errp.lowpass_hz); }},
       {"--folds", [&] { return std::to_string(o.training.folds = training.folds); }},
       {"--folds-by", [&] { return o.training.folds_by = training.folds_by; }}};
   std::string taken;

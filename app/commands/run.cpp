@@ -6,12 +6,14 @@
 #include <iostream>
 
 #include "arbci/render/window_context.h"
+#include "arbci/session/session.h"
 #include "commands/commands.h"
-#include "session/session.h"
-#include "session/workstation.h"
+#include "hmd/open_session.h"
 #include "support/cli_error.h"
+#include "support/headless_run.h"
 #include "support/interrupt.h"
 #include "support/session_file.h"
+#include "workstation/workstation.h"
 
 namespace arbci::app {
 namespace {
@@ -54,11 +56,13 @@ void claimFolder(const std::string& out, bool overwrite) {
   if (error) throw CliError("--overwrite: cannot empty " + out + ": " + error.message());
 }
 
-void printSummary(const Session& session) {
+void printSummary(const session::Session& session) {
   std::cout << "session folder: " << session.folder().string() << "\n";
   // The same lines as the Session panel's.
-  for (const std::string& line : session.selectionLines()) std::cout << line << "\n";
-  const Percentiles p = session.timing().totalPercentiles();
+  if (const auto& trials = session.last().paradigm.trials) {
+    for (const session::TrialRecord& t : *trials) std::cout << session::selectionLine(t) << "\n";
+  }
+  const session::Percentiles p = session.timing().totalPercentiles();
   std::cout << std::fixed << std::setprecision(2) << "cycle compute time: p50 " << p.p50
             << " ms, p99 " << p.p99 << " ms, max " << p.max << " ms; overruns (> "
             << session.timing().budgetMs() << " ms): " << session.timing().overruns() << "\n";
@@ -74,33 +78,33 @@ void printSummary(const Session& session) {
 }
 
 int runSession(const RunOptions& o) {
-  const SessionConfig config = loadSessionOption(o.session);
-  SessionOptions options;
+  const session::SessionConfig config = loadSessionOption(o.session);
+  session::SessionOptions options;
   if (!o.out.empty()) claimFolder(o.out, o.overwrite);
   options.folder = o.out.empty() ? defaultFolder() : o.out;
   if (o.trials > 0) options.trials = o.trials;
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
   options.fault_wait_s = o.fault_wait_s;
-  options.start_immediately = !o.wait_for_start;
-  options.close_window_when_ended = o.exit_when_done;
   options.progress = &std::cerr;
   const bool headless = o.headless || !render::displayAvailable();
   try {
     if (!o.script.empty() && headless)
       throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
-    if (!headless) return runWorkstation(config, options, o.script);
+    if (!headless)
+      return runWorkstation(config, options, {o.script, o.wait_for_start, o.exit_when_done});
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
-    options.simulated_clock = !o.realtime && !config.eeg.live();
+    options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped
+                                                      : session::Clock::Mode::RealTime;
     if (config.eeg.live() && !o.realtime)
       std::cerr << "eeg.source is \"" << config.eeg.source
                 << "\" (a live amplifier): running in real time\n";
     auto context = render::createHeadlessContext({64, 64});
     watchInterrupts();
-    Session session(config, options, *context);
-    session.run();
-    printSummary(session);
-    return session.endKind() == "finished" ? 0 : 3;
-  } catch (const SessionConfigError& error) {
+    OpenedSession opened = openSession(config, options, *context);
+    runHeadless(*opened.session);
+    printSummary(*opened.session);
+    return opened.session->endKind() == "finished" ? 0 : 3;
+  } catch (const session::SessionConfigError& error) {
     throw CliError(error.what());
   } catch (const render::GlError& error) {
     throw CliError(error.what());

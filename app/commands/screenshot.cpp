@@ -9,16 +9,18 @@
 
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/gl_context.h"
+#include "arbci/session/session.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panels.h"
 #include "commands/commands.h"
-#include "session/session.h"
-#include "session/session_model.h"
+#include "hmd/hmd_stage.h"
+#include "hmd/open_session.h"
 #include "support/cli_error.h"
 #include "support/output_path.h"
 #include "support/png.h"
 #include "support/session_file.h"
+#include "workstation/session_model.h"
 
 namespace arbci::app {
 namespace {
@@ -63,18 +65,19 @@ void renderPanels(render::GlContext& context, render::Size size,
 // Runs a simulated session (a still head, so it goes fast) until `ready`, then shows a panel, or
 // (no --panel) the experimenter window as `arbci run` opens it during the grid's flashing.
 void renderPanel(const ScreenshotOptions& options, render::Size size) {
-  SessionConfig config = loadSessionOption(options.session);
+  session::SessionConfig config = loadSessionOption(options.session);
   if (options.session.empty()) {
     config.cameras.head_motion_m = 0.0;
     config.cameras.head_motion_deg = 0.0;
     config.robot_speed_factor = 20.0;
   }
   auto context = render::createHeadlessContext(size);
-  SessionOptions session_options;
+  session::SessionOptions session_options;
   session_options.folder =
       std::filesystem::temp_directory_path() / ("arbci-screenshot-" + std::to_string(::getpid()));
   session_options.trials = 1;
-  Session session(config, session_options, *context);
+  OpenedSession opened = openSession(config, session_options, *context);
+  session::Session& session = *opened.session;
   SessionModel model(session);
   // A live amplifier runs in real time: the picture is taken after 10 s at most, whatever the
   // session has reached by then.
@@ -84,12 +87,13 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
       if (config.eeg.live() && std::chrono::steady_clock::now() > live_limit) break;
     }
   };
-  auto phase = [&] { return session.paradigm().phase(); };
+  auto phase = [&] { return session.last().paradigm.phase; };
+  auto sequence = [&] { return session.last().paradigm.sequence; };
   const std::string& panel = options.panel;
   if (panel == "threshold") {
     runUntil([&] { return session.frame() > 30; });
     ui::ThresholdPanel p(model);
-    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "calibration") {
     ui::CalibrationPanel p(model);
     p.holdBoard(true);
@@ -100,53 +104,51 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     }
     p.calibrate();
     runUntil([&] { return session.frame() % 4 == 0; });
-    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "training") {
     runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
     ui::TrainingPanel p(model);
     p.setRecordings((session.folder() / "recording.bdf").string());
     p.train(true);
-    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "session-model") {
     // The Training panel on the model the session trained after its calibration run (with
     // ErrPs on, the ErrP classifier's averages beside the P300 one's).
     runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
     ui::TrainingPanel p(model);
-    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "robot") {
     runUntil([&] {
-      return phase() == bci::Phase::Grasping && session.robotStatus() &&
-             session.robotStatus()->progress > 0.3;
+      const auto& status = session.last().robot.status;
+      return phase() == bci::Phase::Grasping && status && status->progress > 0.3;
     });
     ui::RobotPanel p(model);
-    renderPanels(*context, size, {&p}, session.statusLine(), options.out);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "session") {
-    runUntil(
-        [&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     ui::SessionPanel p(model);
-    renderPanels(*context, size, {&p}, session.statusLine(), options.out, [&] { session.step(); });
+    renderPanels(*context, size, {&p}, statusLine(session), options.out, [&] { session.step(); });
   } else if (panel == "hmd") {
-    runUntil(
-        [&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     // The HMD framebuffer itself, as the subject sees it.
     runUntil([&] { return session.frame() % 11 == 1; });
     ensureWritable(options.out);
-    session.screenshot(options.out);
+    opened.hmd->screenshot(options.out);
   } else if (panel.empty()) {
-    runUntil(
-        [&] { return phase() == bci::Phase::CellFlashing && session.paradigm().sequence() >= 2; });
+    runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     ui::SessionPanel session_panel(model);
-    ui::HmdPanel hmd_panel(session.hmdTexture(),
+    ui::HmdPanel hmd_panel(opened.hmd->texture(),
                            static_cast<float>(config.hmd_width) / config.hmd_height);
     ui::RobotPanel robot_panel(model);
     ui::ThresholdPanel threshold_panel(model);
     renderPanels(*context, size, {&session_panel, &hmd_panel, &robot_panel, &threshold_panel},
-                 session.statusLine(), options.out, [&] { session.step(); });
+                 statusLine(session), options.out, [&] { session.step(); });
   } else {
     throw CliError(
         "--panel must be threshold, calibration, training, session-model, robot, session or hmd");
   }
-  session.abort();
+  session.request(session::AbortRequest{});
+  session.step();
   session.step();
   std::error_code ignored;
   std::filesystem::remove_all(session_options.folder, ignored);

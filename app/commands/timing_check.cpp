@@ -8,13 +8,15 @@
 
 #include "arbci/bci/photodiode_check.h"
 #include "arbci/render/window_context.h"
+#include "arbci/session/session.h"
 #include "commands/commands.h"
 #include "eeg/timing_plot.h"
-#include "session/session.h"
-#include "session/workstation.h"
+#include "hmd/open_session.h"
 #include "support/cli_error.h"
+#include "support/headless_run.h"
 #include "support/interrupt.h"
 #include "support/session_file.h"
+#include "workstation/workstation.h"
 
 namespace arbci::app {
 namespace {
@@ -41,27 +43,26 @@ nlohmann::json toJson(const bci::PhotodiodeReport& r, double target_sd_ms) {
 }
 
 int runTimingCheck(const TimingCheckOptions& o) {
-  const SessionConfig config = loadSessionOption(o.session);
+  const session::SessionConfig config = loadSessionOption(o.session);
   if (config.eeg.photodiode_channel.empty())
     throw CliError(config.source +
                    ": eeg.photodiode_channel is empty: the timing check needs a photodiode "
                    "channel (simulated: any name adds a virtual one)");
   if (std::filesystem::exists(o.out) && !std::filesystem::is_empty(o.out))
     throw CliError(o.out + ": exists and is not empty; choose a new folder");
-  SessionOptions options;
+  session::SessionOptions options;
   options.folder = o.out;
   options.flashes_only_s = o.seconds;
-  options.close_window_when_ended = true;
   options.progress = &std::cerr;
   const bool headless = o.headless || !render::displayAvailable();
   try {
     if (headless) {
       auto context = render::createHeadlessContext({64, 64});
       watchInterrupts();
-      Session session(config, options, *context);
-      session.run();
+      OpenedSession opened = openSession(config, options, *context);
+      runHeadless(*opened.session);
     } else {
-      runWorkstation(config, options);
+      runWorkstation(config, options, {{}, false, true});
     }
   } catch (const std::runtime_error& error) {
     throw CliError(error.what());

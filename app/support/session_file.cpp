@@ -4,11 +4,11 @@
 
 namespace arbci::app {
 
-SessionConfig loadSessionOption(const std::string& path) {
+session::SessionConfig loadSessionOption(const std::string& path) {
   try {
-    return SessionConfig::load(path.empty() ? std::nullopt
-                                            : std::optional<std::filesystem::path>(path));
-  } catch (const SessionConfigError& error) {
+    return session::SessionConfig::load(path.empty() ? std::nullopt
+                                                     : std::optional<std::filesystem::path>(path));
+  } catch (const session::SessionConfigError& error) {
     throw CliError(error.what());
   }
 }

@@ -4,10 +4,10 @@
 
 #include <string>
 
-#include "session/session_config.h"
+#include "arbci/session/session_config.h"
 
 namespace arbci::app {
 
-SessionConfig loadSessionOption(const std::string& path);
+session::SessionConfig loadSessionOption(const std::string& path);
 
 }  // namespace arbci::app

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <thread>
 
-#include "session/camera_capture.h"
+#include "arbci/session/camera_capture.h"
 #include "support/run_process.h"
 #include "support/test_files.h"
 
@@ -54,7 +54,7 @@ TEST(CameraReader, DetectReadsEveryFrameOfAVideoInOrder) {
 TEST(CameraReader, ASessionsCaptureThreadPlaysTheFileAtItsOwnRate) {
   const auto video = sampleVideo();
   const auto start = std::chrono::steady_clock::now();
-  app::CameraCapture capture(-1, video.string(), "cameras.left");
+  session::CameraCapture capture(-1, video.string(), "cameras.left");
   while (!capture.finished() && std::chrono::steady_clock::now() - start < std::chrono::seconds(5))
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const double took =
@@ -66,7 +66,7 @@ TEST(CameraReader, ASessionsCaptureThreadPlaysTheFileAtItsOwnRate) {
   EXPECT_GT(took, 0.9);  // 20 frames at 20 per second: about a second, not at once
   EXPECT_LT(took, 2.5);
   try {
-    app::CameraCapture missing(-1, "/nonexistent/video.avi", "cameras.left");
+    session::CameraCapture missing(-1, "/nonexistent/video.avi", "cameras.left");
     FAIL() << "a missing video must be refused";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("cameras.left: cannot open video"), std::string::npos)

@@ -7,13 +7,11 @@
 #include <fstream>
 
 #include "arbci/assets.h"
-#include "session/eeg_stage.h"
-#include "session/robot_connection.h"
-#include "session/scene_source.h"
-#include "session/session_config.h"
+#include "arbci/session/session.h"
+#include "arbci/session/session_config.h"
 #include "support/test_files.h"
 
-namespace arbci::app {
+namespace arbci::session {
 namespace {
 
 std::filesystem::path sessionFile(const std::string& name, const std::string& json) {
@@ -132,9 +130,7 @@ TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
 std::string validationErrorOf(const std::string& json) {
   const SessionConfig config = SessionConfig::load(sessionFile("resources", json));
   try {
-    SceneSettings::of(config).validate();
-    EegStageSettings::of(config).validate();
-    RobotSettings::of(config).validate();
+    checkNamedResources(config);
   } catch (const SessionConfigError& error) {
     return error.what();
   }
@@ -168,4 +164,4 @@ TEST(StageSettings, EachStageNamesTheKeyOfAFileOrDeviceItCannotUse) {
 }
 
 }  // namespace
-}  // namespace arbci::app
+}  // namespace arbci::session

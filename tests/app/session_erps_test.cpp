@@ -11,9 +11,10 @@
 
 #include "arbci/bci/recording.h"
 #include "arbci/render/gl_context.h"
-#include "session/session.h"
-#include "session/session_model.h"
+#include "arbci/session/session.h"
+#include "hmd/open_session.h"
 #include "support/test_files.h"
+#include "workstation/session_model.h"
 
 namespace arbci::test {
 namespace {
@@ -37,30 +38,32 @@ TEST(SessionErps, TheTrainingPanelGetsTheAveragesOfBothClassifiers) {
   const auto file = folder.string() + ".json";
   std::ofstream(file) << R"({"errp": {"enabled": true},
     "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0}, "robot": {"speed_factor": 20}})";
-  const app::SessionConfig config = app::SessionConfig::load(file);
-  app::SessionOptions options;
+  const session::SessionConfig config = session::SessionConfig::load(file);
+  session::SessionOptions options;
   options.folder = folder;
   options.trials = 1;
   auto context = render::createHeadlessContext({64, 64});
   std::optional<bci::ErpCurves> p300, errp;
   {
-    app::Session session(config, options, *context);
+    app::OpenedSession opened = app::openSession(config, options, *context);
+    session::Session& session = *opened.session;
     app::SessionModel model(session);
     EXPECT_FALSE(model.sessionErrpErp());
-    for (int i = 0; i < 60 * 1200 && session.paradigm().phase() != bci::Phase::ObjectFlashing &&
+    for (int i = 0; i < 60 * 1200 && session.last().paradigm.phase != bci::Phase::ObjectFlashing &&
                     session.step();
          ++i) {
     }
-    ASSERT_EQ(session.paradigm().phase(), bci::Phase::ObjectFlashing);
+    ASSERT_EQ(session.last().paradigm.phase, bci::Phase::ObjectFlashing);
     p300 = model.sessionErp();
     errp = model.sessionErrpErp();
     ASSERT_TRUE(p300);
     ASSERT_TRUE(errp);
     // A model loaded in its place (here the same one, from its JSON) was not trained on them.
     model.useModel(*model.model());
+    session.step();  // the request is acted on in the next cycle
     EXPECT_FALSE(model.sessionErp());
     EXPECT_FALSE(model.sessionErrpErp());
-    session.abort();
+    session.request(session::AbortRequest{});
     session.step();
   }
   // Counted independently from the recording: flashes up to the first feedback are the

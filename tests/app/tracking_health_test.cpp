@@ -11,41 +11,44 @@
 
 #include "arbci/bci/recording.h"
 #include "arbci/render/gl_context.h"
-#include "session/session.h"
+#include "arbci/session/session.h"
+#include "hmd/open_session.h"
 #include "support/test_files.h"
+#include "workstation/session_model.h"
 
 namespace arbci::test {
 namespace {
 
 TEST(TrackingHealth, StalePosesWithholdFlashesAndRaiseTheAlarmUntilTrackingReturns) {
-  app::SessionConfig config = app::SessionConfig::load(std::nullopt);
-  app::SessionOptions options;
+  session::SessionConfig config = session::SessionConfig::load(std::nullopt);
+  session::SessionOptions options;
   options.folder = freshTempPath("tracking_health_test", "session");
   options.flashes_only_s = 30.0;  // cued flashing of the objects, nothing else
   auto context = render::createHeadlessContext({64, 64});
   nlohmann::json alarm_while_lost;
   {
-    app::Session session(config, options, *context);
+    app::OpenedSession opened = app::openSession(config, options, *context);
+    session::Session& session = *opened.session;
     auto runTo = [&](double t) {
       while (session.time() < t && session.step()) {
       }
     };
     runTo(6.0);
-    EXPECT_EQ(session.trackingAlarm(), "");
+    EXPECT_EQ(app::trackingAlarm(session), "");
     // Everything but pure white is dark: no marker square is found from here on.
     vision::ThresholdSettings blind;
     blind.mode = vision::ThresholdMode::Constant;
     blind.value = 254;
-    session.setThreshold(blind);
+    session.request(session::ThresholdRequest{blind});
     runTo(12.0);
-    const std::string alarm = session.trackingAlarm();
+    const std::string alarm = app::trackingAlarm(session);
     EXPECT_NE(alarm.find("tracking lost: reference 0"), std::string::npos) << alarm;
     for (const auto& o : config.world.objects)
       EXPECT_NE(alarm.find("object " + std::to_string(o.id)), std::string::npos) << alarm;
-    session.setThreshold(vision::ThresholdSettings{});
+    session.request(session::ThresholdRequest{vision::ThresholdSettings{}});
     runTo(18.0);
-    EXPECT_EQ(session.trackingAlarm(), "");
-    session.abort();
+    EXPECT_EQ(app::trackingAlarm(session), "");
+    session.request(session::AbortRequest{});
     session.step();
   }
   // The log: flashes shown before and after, withheld only while blind (from 0.5 s after the

@@ -1,0 +1,23 @@
+#include "hmd/open_session.h"
+
+#include "hmd/hmd_stage.h"
+#include "simulation/simulated_scene.h"
+
+namespace arbci::app {
+
+OpenedSession openSession(const session::SessionConfig& config,
+                          const session::SessionOptions& options, render::GlContext& context) {
+  registerSimulatedScene();
+  context.makeCurrent();
+  OpenedSession opened;
+  opened.session = std::make_unique<session::Session>(
+      config, options, [&](const session::StageServices&, const session::CycleRecord& warm_up) {
+        auto hmd =
+            std::make_unique<HmdStage>(HmdSettings::of(config), options.folder, context, warm_up);
+        opened.hmd = hmd.get();
+        return hmd;
+      });
+  return opened;
+}
+
+}  // namespace arbci::app

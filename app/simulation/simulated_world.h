@@ -1,0 +1,64 @@
+// The embedded default world: a table with the session's objects, the reference marker, and a
+// stereo camera rig at the subject's head with slight head motion. The objects stand where the
+// simulated robot's world says (its STATUS), so where the robot puts an object, the cameras see
+// it there. The cameras' frames go through the real tracker.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "arbci/render/scene.h"
+#include "arbci/render/simulated_camera.h"
+#include "arbci/robot/protocol.h"
+#include "arbci/robot/robot_config.h"
+#include "arbci/session/scene_source.h"
+
+namespace arbci::app {
+
+class SimulatedWorld {
+ public:
+  explicit SimulatedWorld(const session::SceneSettings& settings);  // needs a current GL context
+  ~SimulatedWorld();
+
+  // The arbci-robotd configuration for this world (objects, table, workspace).
+  robot::RobotConfig robotConfig() const;
+  // Moves objects and the gripper to where the robot reports them.
+  void update(const robot::StatusPayload& status);
+  // The cameras' true poses at time `t` (seconds): T_cam_world of the left and the right camera.
+  vision::Pose leftCamera(double t) const;
+  vision::Pose rightCamera(double t) const;
+  // The right camera's pose in the left's frame (the rig's extrinsics).
+  vision::Pose T_right_left() const;
+  const vision::CameraModel& camera() const { return camera_; }
+  struct Frame {
+    cv::Mat image;
+    bool changed = true;  // false: nothing in view moved since this camera's last frame (the same)
+  };
+  // One camera's frame at time `t` (the cycle renders the two on alternate frames, so no cycle
+  // pays for both). A frame is rendered again only when the head, an object or the gripper moved.
+  Frame captureLeft(double t);
+  Frame captureRight(double t);
+  const render::Scene& scene() const { return scene_; }
+  // Holds a 9x6 chessboard (25 mm squares) up in front of the left camera, each call at the next
+  // of a dozen poses (tilted, near and far, off centre), or puts it away.
+  void holdBoard(bool show, double t);
+  // The true top-centre position of object `id` (robot frame), if it exists.
+  std::optional<cv::Vec3d> objectPosition(int id) const;
+
+ private:
+  session::SceneSettings settings_;
+  vision::CameraModel camera_;
+  render::Scene scene_;
+  std::unique_ptr<render::SimulatedCamera> left_, right_;
+  struct Cache {
+    std::uint64_t scene_revision = 0;
+    std::optional<vision::Pose> pose;
+    cv::Mat image;
+  };
+  Frame capture(render::SimulatedCamera& camera, Cache& cache, const vision::Pose& pose);
+  std::uint64_t scene_revision_ = 1;
+  int board_pose_ = 0;
+  Cache left_cache_, right_cache_;
+};
+
+}  // namespace arbci::app

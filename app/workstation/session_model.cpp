@@ -1,0 +1,222 @@
+#include "workstation/session_model.h"
+
+#include <cstdio>
+
+namespace arbci::app {
+
+std::string timingWarning(const session::Session& session) {
+  const session::Presentation& p = session.last().presentation;
+  if (!p.display_too_slow || !p.median_frame_ms) return "";
+  char text[160];
+  std::snprintf(text, sizeof text, "display too slow: a frame every %.1f ms (configured %.1f ms)",
+                *p.median_frame_ms, 1000.0 / session.config().display_hz);
+  return text;
+}
+
+std::string trackingAlarm(const session::Session& session) {
+  const session::CycleRecord& last = session.last();
+  std::vector<int> ids;
+  for (const session::WorldObjectSettings& o : session.config().world.objects) {
+    if (last.robot.holding() != o.id) ids.push_back(o.id);
+  }
+  return last.tracking.alarm(ids, last.time_s);
+}
+
+std::string statusLine(const session::Session& session) {
+  const session::CycleRecord& last = session.last();
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "t=%.1f s  trial %d/%d  %s  cycle p50 %.1f ms  overruns %d  late frames %lld",
+                last.time_s, std::max(last.paradigm.trial, 0), session.config().paradigm.trials,
+                bci::toString(last.paradigm.phase), session.timing().totalPercentiles().p50,
+                session.timing().overruns(), static_cast<long long>(last.presentation.late_frames));
+  std::string line = text;
+  for (const std::string& warning : {timingWarning(session), trackingAlarm(session)}) {
+    if (!warning.empty()) line.append("  [").append(warning).append("]");
+  }
+  return line;
+}
+
+void SessionModel::setThreshold(const vision::ThresholdSettings& settings) {
+  threshold_ = settings;
+  session_.request(session::ThresholdRequest{settings});
+}
+
+std::vector<ui::TrackedObject> SessionModel::trackedObjects() {
+  std::vector<ui::TrackedObject> out;
+  const auto& world = record().tracking.world;
+  if (!world) return out;
+  for (const vision::ObjectState& o : world->objects()) {
+    out.push_back(
+        {o.id, o.T_robot_object.translation, o.age(session_.time()), o.reprojection_rms_px});
+  }
+  return out;
+}
+
+std::string SessionModel::worldStatus() {
+  const auto& world = record().tracking.world;
+  return world ? world->status(session_.time()) : "";
+}
+
+int SessionModel::referenceId() {
+  const auto& world = record().tracking.world;
+  return world ? world->reference().id : session_.config().world.reference_id;
+}
+
+cv::Vec3d SessionModel::referencePosition() {
+  const auto& world = record().tracking.world;
+  return world ? world->reference().T_robot_ref.translation
+               : session_.config().world.reference_position;
+}
+
+std::optional<double> SessionModel::referenceAgeS() {
+  const auto& world = record().tracking.world;
+  if (!world) return std::nullopt;
+  return world->referenceAge(session_.time());
+}
+
+std::optional<bci::P300Model> SessionModel::model() {
+  const auto& p300 = record().p300.model;
+  if (!p300) return std::nullopt;
+  bci::P300Model model = *p300;
+  if (const auto& errp = record().errp.model) model.errp = errp;
+  return model;
+}
+
+void SessionModel::useModel(const bci::P300Model& model) {
+  session_.request(session::UseModelRequest{std::make_shared<const bci::P300Model>(model)});
+}
+
+std::optional<bci::ErpCurves> SessionModel::sessionErp() {
+  const auto& erp = record().p300.erp;
+  return erp ? std::optional<bci::ErpCurves>(*erp) : std::nullopt;
+}
+
+std::optional<bci::ErpCurves> SessionModel::sessionErrpErp() {
+  const auto& erp = record().errp.erp;
+  return erp ? std::optional<bci::ErpCurves>(*erp) : std::nullopt;
+}
+
+std::vector<std::string> SessionModel::robotLog() {
+  const auto& messages = record().robot.messages;
+  return messages ? *messages : std::vector<std::string>{};
+}
+
+std::string SessionModel::whyNot(Action action) {
+  switch (action) {
+    case Action::Pause:
+      return session_.whyNot(session::Action::Pause);
+    case Action::Resume:
+      return session_.whyNot(session::Action::Resume);
+    case Action::Home:
+      return session_.whyNot(session::Action::Home);
+    case Action::OpenGripper:
+      return session_.whyNot(session::Action::OpenGripper);
+    case Action::RetryStep:
+      return session_.whyNot(session::Action::RetryStep);
+    case Action::SkipTrial:
+      return session_.whyNot(session::Action::SkipTrial);
+  }
+  return "";
+}
+
+std::string SessionModel::trackingAlarm() {
+  return app::trackingAlarm(session_);
+}
+
+std::string SessionModel::timingWarning() {
+  return app::timingWarning(session_);
+}
+
+std::string SessionModel::eegClockLine() {
+  const session::EegPart& eeg = record().eeg;
+  char text[160];
+  std::snprintf(text, sizeof text, "EEG: lost samples %lld, clock drift %+.1f ppm, jitter %.2f ms",
+                static_cast<long long>(eeg.lost_samples), eeg.drift_ppm, eeg.jitter_ms);
+  return eeg.source_line.empty() ? std::string(text) : std::string(text) + "\n" + eeg.source_line;
+}
+
+std::vector<std::string> SessionModel::selections() {
+  std::vector<std::string> lines;
+  if (const auto& trials = record().paradigm.trials) {
+    for (const session::TrialRecord& t : *trials) lines.push_back(session::selectionLine(t));
+  }
+  return lines;
+}
+
+std::vector<std::pair<std::string, std::string>> SessionModel::endSummary() {
+  // An ended session's summary no longer changes: built once, not on every frame it is shown.
+  if (!end_rows_.empty() || !session_.ended()) return end_rows_;
+  end_rows_ = summaryRows();
+  return end_rows_;
+}
+
+std::vector<std::pair<std::string, std::string>> SessionModel::summaryRows() const {
+  const nlohmann::json s = session_.summary();
+  std::vector<std::pair<std::string, std::string>> rows;
+  auto number = [](const nlohmann::json& v, const char* format, double scale = 1.0) {
+    if (!v.is_number()) return std::string("-");
+    char text[64];
+    std::snprintf(text, sizeof text, format, v.get<double>() * scale);
+    return std::string(text);
+  };
+  const std::string ended = s["ended"].get<std::string>();
+  const std::string reason = s["end_reason"].get<std::string>();
+  rows.emplace_back("ended", reason == ended ? ended : ended + " (" + reason + ")");
+  rows.emplace_back("duration", number(s["duration_s"], "%.1f s"));
+  for (const char* kind : {"objects", "cells"}) {
+    const nlohmann::json& r = s[kind];
+    if (r.is_null()) {
+      rows.emplace_back(kind, "no selections");
+      continue;
+    }
+    rows.emplace_back(kind, number(r["accuracy"], "accuracy %.0f %%", 100.0) + ", " +
+                                number(r["seconds_per_selection"], "%.1f s per selection") + ", " +
+                                number(r["bits_per_minute"], "%.1f bits/min"));
+  }
+  if (!s["all_inclusive"].is_null())
+    rows.emplace_back("all inclusive",
+                      number(s["all_inclusive"]["seconds_per_trial"], "%.1f s per trial") + ", " +
+                          number(s["all_inclusive"]["bits_per_minute"], "%.1f bits/min"));
+  int placed = 0;
+  for (const nlohmann::json& t : s["trials"]) {
+    const std::string outcome = t["outcome"].get<std::string>();
+    const int object = t["selected_object"].get<int>();
+    std::string line =
+        (object >= 0 ? "object " + std::to_string(object) : std::string("no object")) + ": " +
+        outcome;
+    if (t["placement_error_m"].is_number()) {
+      ++placed;
+      line += ", " + number(t["placement_error_m"], "%.1f mm off", 1000.0);
+    }
+    rows.emplace_back("trial " + std::to_string(t["trial"].get<int>()), line);
+  }
+  rows.emplace_back("placements", std::to_string(placed) + " of " +
+                                      std::to_string(s["trials"].size()) + " trials");
+  const nlohmann::json& timing = s["timing"];
+  rows.emplace_back("late frames", timing["late_frames"].dump() + ", lost EEG samples " +
+                                       timing["lost_samples"].dump());
+  rows.emplace_back("folder", session_.folder().string());
+  return rows;
+}
+
+std::string SessionModel::phase() {
+  std::string text = bci::toString(record().paradigm.phase);
+  if (session_.ended() && session_.endReason() != text) text += " (" + session_.endReason() + ")";
+  return text;
+}
+
+std::vector<ui::StageTiming> SessionModel::timing() {
+  std::vector<ui::StageTiming> out;
+  const auto& last = session_.timing().lastCycle();
+  for (const auto& [stage, p] : session_.timing().stagePercentiles()) {
+    const auto found = last.find(stage);
+    out.push_back({stage, p.p50, p.p90, p.p99, p.max, found == last.end() ? 0.0 : found->second});
+  }
+  const session::Percentiles total = session_.timing().totalPercentiles();
+  out.push_back(
+      {"total", total.p50, total.p90, total.p99, total.max, session_.timing().lastTotalMs()});
+  return out;
+}
+
+}  // namespace arbci::app

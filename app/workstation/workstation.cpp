@@ -1,0 +1,130 @@
+#include "workstation/workstation.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "arbci/render/framebuffer.h"
+#include "arbci/render/window_context.h"
+#include "arbci/ui/experimenter_shell.h"
+#include "arbci/ui/imgui_layer.h"
+#include "arbci/ui/panels.h"
+#include "hmd/hmd_stage.h"
+#include "hmd/open_session.h"
+#include "support/interrupt.h"
+#include "workstation/experimenter_script.h"
+#include "workstation/session_model.h"
+
+namespace arbci::app {
+namespace {
+
+// Where the panel layout is kept between runs.
+std::string layoutFile() {
+  const char* config = std::getenv("XDG_CONFIG_HOME");
+  const char* home = std::getenv("HOME");
+  std::filesystem::path dir = config ? std::filesystem::path(config)
+                              : home ? std::filesystem::path(home) / ".config"
+                                     : ".";
+  dir /= "arbci";
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  return (dir / "layout.ini").string();
+}
+
+}  // namespace
+
+int runWorkstation(const session::SessionConfig& config, session::SessionOptions options,
+                   const WorkstationOptions& workstation) {
+  // Read before the window opens: a bad script is refused at once.
+  std::optional<ExperimenterScript> script;
+  if (!workstation.script.empty()) script.emplace(workstation.script);
+  const bool close_when_ended = workstation.close_when_ended;
+  options.clock = session::Clock::Mode::RealTime;
+  options.experimenter = true;
+  options.presents_itself = false;  // the window's swap is the presentation
+  render::WindowOptions window;
+  window.title = "ARBCI workstation";
+  render::WindowContext main_window(window);
+  std::unique_ptr<render::WindowContext> mirror;
+  if (config.mirror_monitor >= 0 && config.mirror_monitor < render::WindowContext::monitorCount()) {
+    render::WindowOptions m;
+    m.title = "ARBCI HMD";
+    m.fullscreen_monitor = config.mirror_monitor;
+    m.share_with = main_window.window();
+    mirror = std::make_unique<render::WindowContext>(m);
+    main_window.makeCurrent();
+  }
+  OpenedSession opened = openSession(config, options, main_window);
+  session::Session& session = *opened.session;
+  if (!workstation.wait_for_start) session.request(session::StartRequest{});
+  SessionModel model(session);
+  ui::ImGuiLayer imgui(main_window, layoutFile());
+  ui::ExperimenterShell shell;
+  ui::SessionPanel session_panel(model);
+  ui::HmdPanel hmd_panel(opened.hmd->texture(),
+                         static_cast<float>(config.hmd_width) / config.hmd_height);
+  ui::ThresholdPanel threshold_panel(model);
+  ui::RobotPanel robot_panel(model);
+  ui::CalibrationPanel calibration_panel(model);
+  ui::TrainingPanel training_panel(model);
+  ui::SummaryPanel summary_panel(model);
+  shell.addPanel(session_panel);
+  shell.addPanel(hmd_panel);
+  shell.addPanel(robot_panel);
+  shell.addPanel(threshold_panel);
+  shell.addPanel(calibration_panel, false);
+  shell.addPanel(training_panel, false);
+  shell.addPanel(summary_panel, false);
+  shell.setEmergencyStop([&] { model.emergencyStop(); });
+  shell.setQuitHandler([&] { main_window.requestClose(); });
+  // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
+  watchInterrupts();
+  auto last = std::chrono::steady_clock::now();
+  bool summary_shown = false;
+  while (!main_window.shouldClose()) {
+    // A script runs to its end first (its last screenshot may show the ended session).
+    const bool script_over = !script || script->done();
+    if (interruptRequested() || (close_when_ended && session.ended() && script_over))
+      main_window.requestClose();
+    render::WindowContext::pollEvents();
+    main_window.makeCurrent();  // the simulated cameras render in it
+    session.step();
+    if (session.ended() && !summary_shown) {
+      shell.show(summary_panel);  // once: the experimenter may close it
+      summary_shown = true;
+    }
+    main_window.makeCurrent();
+    const auto now = std::chrono::steady_clock::now();
+    const float frame_ms = std::chrono::duration<float, std::milli>(now - last).count();
+    last = now;
+    const render::Size size = main_window.framebufferSize();
+    ui::SyntheticInput input;
+    if (script) input = script->beforeFrame(bci::hostSeconds(), model.phase());
+    imgui.beginFrame(frame_ms / 1000.0f, script ? &input : nullptr);
+    shell.draw(size, {frame_ms, model.phase(), statusLine(session)});
+    render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
+    imgui.endFrame();
+    if (script) {
+      script->afterFrame(main_window, size, model.phase(), session.time());
+      if (!script->error().empty()) {
+        std::cerr << "\nerror: " << script->error() << "\n";
+        main_window.requestClose();
+      }
+    }
+    main_window.present();
+    session.presented(bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
+    if (mirror) {
+      mirror->makeCurrent();
+      render::blitTexture(opened.hmd->texture(), opened.hmd->size(), mirror->framebufferSize());
+      mirror->present();
+      main_window.makeCurrent();
+    }
+  }
+  if (script && !script->error().empty()) return 4;
+  // Closed before the end: the session ends now (its summary says "closed"), not finished.
+  return session.ended() && session.endKind() == "finished" ? 0 : 3;
+}
+
+}  // namespace arbci::app

@@ -1,0 +1,21 @@
+// The windowed workstation: the experimenter window (panels over the running session) and,
+// when the session names a monitor, the HMD mirror full screen on it. Returns the exit status.
+#pragma once
+
+#include <filesystem>
+
+#include "arbci/session/session.h"
+
+namespace arbci::app {
+
+struct WorkstationOptions {
+  // A scripted experimenter (workstation/experimenter_script.h); exit status 4 when it fails.
+  std::filesystem::path script;
+  bool wait_for_start = false;    // the experimenter presses Start (else it runs at once)
+  bool close_when_ended = false;  // the window closes once the session has ended
+};
+
+int runWorkstation(const session::SessionConfig& config, session::SessionOptions options,
+                   const WorkstationOptions& workstation = {});
+
+}  // namespace arbci::app

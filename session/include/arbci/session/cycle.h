@@ -1,0 +1,271 @@
+// One cycle of the session (one displayed frame) and the record of what it produced. Stages are
+// peers on this record: each reads what earlier stages wrote this cycle (and, for what flows back
+// against the stage order, what later stages wrote last cycle: `previous`), and writes only its
+// own part. docs/architecture.md lists who writes each field.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "arbci/bci/acquisition.h"
+#include "arbci/bci/decision.h"
+#include "arbci/bci/erp.h"
+#include "arbci/bci/evaluation.h"
+#include "arbci/bci/paradigm.h"
+#include "arbci/bci/signal.h"
+#include "arbci/robot/protocol.h"
+#include "arbci/session/clock.h"
+#include "arbci/session/requests.h"
+#include "arbci/session/trial_record.h"
+#include "arbci/vision/camera_model.h"
+#include "arbci/vision/marker.h"
+#include "arbci/vision/pose.h"
+#include "arbci/vision/world_model.h"
+
+namespace arbci::session {
+
+// A flash the paradigm shows for the first time on a frame, labelled by what the subject attends:
+// T (target), N, or U when the attended codes are not known.
+struct Flash {
+  int code = 0;
+  bool objects = true;  // an object's code, else a grid row's or column's (recorded as 100 + code)
+  bool target = false;
+  bool known = true;
+  int selection = 0;  // the paradigm's selection it belongs to
+};
+
+// A selection's feedback shown for the first time.
+struct FeedbackShown {
+  std::set<int> codes;
+  bool objects = true;
+  std::optional<bool> error;  // known: the calibration block's, or against the intention
+  // "Feedback 3 error" (grid codes as 100 + code, several joined by '+'): its note in the
+  // recording and on the Markers stream.
+  std::string text() const;
+};
+
+// A new selection's stimuli and what the subject attends.
+struct SelectionStart {
+  int selection = 0;
+  bool objects = true;
+  bci::ParadigmLayout layout;
+  std::set<int> attended;     // the simulated subject looks there; empty: not known
+  std::optional<int> target;  // the calibration run's cued code
+};
+
+// The last frame as the screen showed it, stamped on the EEG sample clock once presented.
+struct Presentation {
+  bool shown = false;       // a frame was presented since the last cycle
+  double host_s = 0.0;      // when it reached the screen (host clock)
+  double at_s = 0.0;        // the same in session seconds
+  std::int64_t sample = 0;  // the first EEG sample taken at or after it
+  std::int64_t frame = 0;
+  struct Onset {
+    Flash flash;
+    std::int64_t sample = 0;
+  };
+  std::vector<Onset> onsets;  // flashes whose first frame it was
+  struct Ended {
+    std::int64_t onset_sample = 0;
+    int duration_samples = 0;
+  };
+  std::vector<Ended> ended;  // flashes it no longer showed
+  std::optional<FeedbackShown> feedback;
+  std::optional<bool> patch;  // the photodiode patch changed to lit (true) or dark on this frame
+  bool late = false;
+  // The current selection's duration from its onsets as presented (first to last, plus one SOA).
+  double selection_s = 0.0;
+  std::optional<double> median_frame_ms;  // once 60 frames were presented
+  std::int64_t late_frames = 0;
+  bool display_too_slow = false;
+};
+
+struct EegPart {
+  std::vector<bci::Block> blocks;      // as acquired: every channel (the photodiode too)
+  std::vector<bci::Block> eeg_blocks;  // the EEG channels only (filters, epochs, classifiers)
+  std::vector<bci::SampleLoss> losses;
+  std::string fault;        // why a live source delivers nothing now; empty while it does
+  std::string source_line;  // the source's own account (an LSL stream's name, host, rates)
+  std::int64_t lost_samples = 0;
+  double drift_ppm = 0.0, jitter_ms = 0.0;
+};
+
+struct RecordingPart {
+  std::int64_t samples = 0;  // written so far
+};
+
+struct P300Part {
+  int selection = 0;  // the selection the counts and the decision belong to
+  int presented = 0, scored = 0;
+  int sequences = 0;  // complete sequences scored
+  bci::Decision decision;
+  std::shared_ptr<const bci::P300Model> model;  // none before training (or a model file)
+  std::shared_ptr<const bci::ErpCurves> erp;    // the averages this session trained on
+  // Training ended this cycle: the model's cross-validation, or why it failed.
+  std::optional<bci::EvaluationReport> trained;
+  std::string training_error;
+  bool training = false;  // on its worker thread
+};
+
+struct ErrpPart {
+  std::shared_ptr<const bci::P300Model> model;  // the ErrP classifier, once there is one
+  std::shared_ptr<const bci::ErpCurves> erp;
+  // The score of a feedback epoch completed this cycle: {feedback onset sample, score}.
+  std::optional<std::pair<std::int64_t, double>> score;
+  std::optional<bci::EvaluationReport> trained;  // training ended this cycle
+  std::string training_error;
+  bool training = false;
+  bool enabled = false;  // the session trains and uses one
+};
+
+struct CameraPart {
+  cv::Mat left;                 // a new left frame (empty: none this cycle)
+  bool left_changed = true;     // false: the same picture as the last left frame
+  cv::Mat right;                // a new right frame (empty: none this cycle)
+  bool can_hold_board = false;  // a simulated scene can hold a chessboard up
+  bool any() const { return !left.empty() || !right.empty(); }
+};
+
+// What tracking knows after this cycle's frames (the world in the robot's frame).
+struct TrackingPart {
+  cv::Mat left_image, right_image;  // the latest frames (right: the left one when mono)
+  bool stereo = false;
+  vision::CameraModel left_camera, right_camera;
+  std::optional<vision::Pose> T_cam_world_left, T_cam_world_right;
+  vision::DetectionResult detection;  // of the latest left frame
+  cv::Mat binary;                     // the tracker's binary image of it
+  std::shared_ptr<const vision::WorldModel> world;
+  double max_pose_age_s = 0.5;
+  // The object's pose is known and no older than the allowed age at `now_s`.
+  bool fresh(int id, double now_s) const;
+  // "" while the reference and every object in `ids` are fresh, else "tracking lost: reference
+  // 0 (2.1 s), object 40 (never seen)".
+  std::string alarm(const std::vector<int>& ids, double now_s) const;
+};
+
+struct RobotPart {
+  std::optional<robot::StatusPayload> status;
+  bool silent = false;
+  bool busy = false;           // a trial's or the experimenter's command is running
+  bool at_home = true;         // HOME finished since the last motion
+  bool measuring = false;      // a placement still to be measured
+  std::optional<int> grasped;  // the object the arm was sent to grasp in this session
+  bool answered = false;       // the backend answered the last probe
+  std::string why_not_move, why_not_release;                 // "" when the experimenter may
+  std::shared_ptr<const std::vector<std::string>> messages;  // for the Robot panel
+  // This cycle: what the trial's robot step came to, in the order it happened.
+  struct Note {
+    enum class Kind { Outcome, Placement, Finished, PutDownEnded } kind;
+    bool success = true;
+    std::string text;
+    int trial = 0;  // Placement
+    double error_m = 0.0;
+  };
+  std::vector<Note> notes;
+  std::vector<int> moved;  // objects the robot moved: their poses are unknown until seen again
+  std::optional<int> holding() const {
+    if (!status || status->holding < 0) return std::nullopt;
+    return status->holding;
+  }
+};
+
+struct PhaseChange {
+  bci::Phase phase;
+  int trial = 0;
+};
+
+struct ParadigmPart {
+  bci::Phase phase = bci::Phase::Setup;
+  std::optional<bci::Phase> interrupted;
+  int trial = 0, sequence = 0;
+  bool errp_awaited = false;
+  bci::FrameStimulus stimulus;            // what this frame shows
+  std::vector<Flash> first_shown;         // flashes this frame shows for the first time
+  std::optional<FeedbackShown> feedback;  // a selection this frame shows for the first time
+  std::optional<SelectionStart> selection_started;
+  std::vector<PhaseChange> phase_changes;  // entered this cycle
+  std::vector<size_t> slots;               // stimulus code k: world.objects[slots[k - 1]]
+  std::optional<int> selected_object;      // the marker id selected in this trial
+  std::shared_ptr<const std::vector<TrialRecord>> trials;
+  std::optional<bci::EvaluationReport> calibration;
+  std::string status;  // the last reason given: a fault, a pause, a failed training
+};
+
+// What the HMD's render stage drew this cycle.
+struct DisplayPart {
+  bool redrawn = false;           // false: the same frame as the last one
+  std::optional<bool> patch_lit;  // the photodiode patch as read back from the frame drawn
+  bool photodiode = false;        // the frame carries a photodiode patch
+};
+
+struct PreflightPart {
+  bool running = false;
+  std::vector<std::string> lines;
+};
+
+struct CycleRecord {
+  // The cycle's own time (the session's): as in Cycle.
+  std::int64_t frame = 0;
+  double time_s = 0.0, due_s = 0.0, host_s = 0.0;
+  std::int64_t eeg_sample = 0;
+  // This cycle's frame reached the screen at `host_s`, the EEG sample then being `sample` (set by
+  // the window's owner once the buffer swap is done; headless, by the session).
+  struct Presented {
+    double host_s = 0.0;
+    std::int64_t sample = 0;
+  };
+  std::optional<Presented> presented;
+  // Each stage's compute time this cycle (ms), by name.
+  std::map<std::string, double> stage_ms;
+
+  Presentation presentation;  // the frame presented last
+  EegPart eeg;
+  RecordingPart recording;
+  P300Part p300;
+  ErrpPart errp;
+  CameraPart cameras;
+  RobotPart robot;
+  TrackingPart tracking;
+  PreflightPart preflight;
+  ParadigmPart paradigm;
+  DisplayPart display;
+  // Notes for the recording (and the LSL Markers stream), in the order made; recorded next cycle.
+  std::vector<bci::Annotation> annotations;
+  // Requests to act on this cycle (posted last cycle, or by the experimenter between frames).
+  std::vector<Request> requests;
+  // Requests posted this cycle, for the next.
+  std::vector<Request> posted;
+  // The run should end after this cycle, and why ("" while it goes on).
+  std::string end_reason, end_kind;
+};
+
+struct Cycle {
+  std::int64_t frame = 0;       // the display frame being made
+  double time_s = 0.0;          // session seconds at the cycle's start
+  double due_s = 0.0;           // when this frame is due on screen (session seconds)
+  double host_s = 0.0;          // time_s on the host clock
+  std::int64_t eeg_sample = 0;  // the EEG sample taken at time_s (the acquisition stage's)
+  const Clock& clock;
+  CycleRecord& record;
+  const CycleRecord& previous;
+
+  void post(Request request) { record.posted.push_back(std::move(request)); }
+  void annotate(std::int64_t sample, std::string text) {
+    record.annotations.push_back({sample, std::move(text), 0});
+  }
+  void end(std::string reason, std::string kind = "") {
+    if (!record.end_reason.empty()) return;
+    record.end_reason = std::move(reason);
+    record.end_kind = std::move(kind);
+  }
+};
+
+}  // namespace arbci::session

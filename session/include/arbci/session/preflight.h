@@ -1,0 +1,64 @@
+// The pre-flight check before the calibration run: camera frames arrive and show the reference
+// marker, the EEG flows at its rate, and the robot answers STATUS. It watches the cycle for at
+// least `min_s` and passes once all hold; past `timeout_s` (of session time and of the wall
+// clock both: a robot answers on the wall clock even when the session's is simulated) it fails,
+// each failure naming the session file's key to look at.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace arbci::session {
+
+struct PreflightSettings {
+  double min_s = 1.0;      // the EEG rate is measured over at least this long
+  double timeout_s = 5.0;  // session seconds, and wall seconds
+  double eeg_rate_hz = 256.0;
+  double eeg_tolerance = 0.1;  // a rate off by more than this fraction fails
+  // What to name in a failure: the key and a description of each source.
+  std::string camera_key, camera_what;
+  std::string eeg_key;
+  int reference_id = 0;
+  std::string robot_key, robot_what;
+};
+
+// What the cycle saw on one frame.
+struct PreflightObservation {
+  double time_s = 0.0;  // session time
+  double wall_s = 0.0;  // host clock
+  bool camera_frame = false;
+  std::optional<double> reference_age_s;  // since the reference marker was seen
+  double max_pose_age_s = 0.5;
+  long long eeg_samples = 0;  // recorded so far
+  bool robot_answered = false;
+};
+
+class Preflight {
+ public:
+  enum class State { Idle, Running, Passed, Failed };
+  explicit Preflight(PreflightSettings settings) : settings_(std::move(settings)) {}
+
+  void begin(const PreflightObservation& now);
+  // Running: updates the state from this frame's observation.
+  State update(const PreflightObservation& now);
+  State state() const { return state_; }
+  // Failed: one line per failure, each naming its key.
+  const std::vector<std::string>& failures() const { return failures_; }
+  // For the panel: one line per check with what was measured so far.
+  std::vector<std::string> lines() const;
+  double eegRateHz() const { return eeg_rate_hz_; }
+  int cameraFrames() const { return camera_frames_; }
+
+ private:
+  std::vector<std::string> check(bool final) const;
+  PreflightSettings settings_;
+  State state_ = State::Idle;
+  PreflightObservation first_, last_;
+  int camera_frames_ = 0;
+  bool reference_seen_ = false;
+  double eeg_rate_hz_ = 0.0;
+  std::vector<std::string> failures_;
+};
+
+}  // namespace arbci::session

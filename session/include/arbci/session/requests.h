@@ -1,0 +1,106 @@
+// Requests travel as records on the cycle, the way BCI2000's States carry what one module asks of
+// another: a stage (or the experimenter, between frames) posts one; the stage that owns it acts on
+// it in the next cycle, in the order posted. No stage calls another.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <opencv2/core/matx.hpp>
+
+#include "arbci/bci/p300_model.h"
+#include "arbci/vision/threshold.h"
+
+namespace arbci::session {
+
+// The experimenter's Start, to the pre-flight check; the check passed, to the paradigm.
+struct StartRequest {};
+struct BeginRequest {};
+// The experimenter, to the paradigm.
+struct PauseRequest {};
+struct ResumeRequest {};
+struct AbortRequest {};
+struct EmergencyStopRequest {};  // the arm was already told to stop by the session
+struct RetryStepRequest {};
+struct SkipTrialRequest {};
+struct EndSessionRequest {};
+
+// To the robot stage. `time_s`: when it was asked for (a stepped arm starts it then).
+struct GraspRequest {
+  int object = 0;  // marker id
+  cv::Vec3d at;    // robot frame
+  double time_s = 0.0;
+};
+struct DropRequest {
+  int trial = 0;
+  std::pair<int, int> cell{0, 0};
+  bool give_back = false;  // back where the object was grasped
+  double time_s = 0.0;
+};
+struct RobotStopRequest {
+  double time_s = 0.0;
+};
+struct RobotResetRequest {  // the experimenter's Reset
+  double time_s = 0.0;
+};
+struct RobotResetIfLatchedRequest {  // before motions go on after a stop
+  double time_s = 0.0;
+};
+struct RobotHomeRequest {
+  double time_s = 0.0;
+};
+struct RobotReleaseRequest {  // the experimenter's Open gripper
+  double time_s = 0.0;
+};
+// A put-down interrupted after the object was let go: the arm goes home and the put-down ends.
+struct FinishPutDownRequest {
+  double time_s = 0.0;
+};
+// The pre-flight check asks whether the backend answers STATUS.
+struct RobotProbeRequest {
+  double time_s = 0.0;
+};
+
+// To the P300 and ErrP stages.
+struct TrainRequest {
+  std::string method;
+};
+struct UseModelRequest {
+  std::shared_ptr<const bci::P300Model> model;
+};
+
+// To the tracking and camera stages (the panels).
+struct ThresholdRequest {
+  vision::ThresholdSettings threshold;
+};
+struct ReferenceRequest {
+  int id = 0;
+  cv::Vec3d position;
+};
+struct HoldBoardRequest {
+  bool show = false;
+};
+
+using Request =
+    std::variant<StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest,
+                 EmergencyStopRequest, RetryStepRequest, SkipTrialRequest, EndSessionRequest,
+                 GraspRequest, DropRequest, RobotStopRequest, RobotResetRequest,
+                 RobotResetIfLatchedRequest, RobotHomeRequest, RobotReleaseRequest,
+                 FinishPutDownRequest, RobotProbeRequest, TrainRequest, UseModelRequest,
+                 ThresholdRequest, ReferenceRequest, HoldBoardRequest>;
+
+// The requests of one kind among `requests`, in order.
+template <class T>
+std::vector<const T*> requestsOf(const std::vector<Request>& requests) {
+  std::vector<const T*> out;
+  for (const Request& r : requests) {
+    if (const T* found = std::get_if<T>(&r)) out.push_back(found);
+  }
+  return out;
+}
+
+}  // namespace arbci::session

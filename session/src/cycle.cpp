@@ -1,0 +1,47 @@
+#include "arbci/session/cycle.h"
+
+#include <cstdio>
+
+namespace arbci::session {
+
+std::string FeedbackShown::text() const {
+  std::string out = "Feedback ";
+  for (int code : codes) {
+    if (out.back() != ' ') out += '+';
+    out += std::to_string(objects ? code : code + 100);  // as the recording codes the grid
+  }
+  out += error ? (*error ? " error" : " correct") : " unknown";
+  return out;
+}
+
+bool TrackingPart::fresh(int id, double now_s) const {
+  if (!world) return false;
+  const auto state = world->object(id);
+  return state && state->age(now_s) <= max_pose_age_s;
+}
+
+std::string TrackingPart::alarm(const std::vector<int>& ids, double now_s) const {
+  if (!world) return "";
+  std::string lost;
+  auto add = [&lost](const std::string& what, std::optional<double> age) {
+    char text[64];
+    if (age) {
+      std::snprintf(text, sizeof text, " (%.1f s)", *age);
+    } else {
+      std::snprintf(text, sizeof text, " (never seen)");
+    }
+    lost.append(lost.empty() ? "" : ", ").append(what).append(text);
+  };
+  const auto reference = world->referenceAge(now_s);
+  if (!reference || *reference > max_pose_age_s)
+    add("reference " + std::to_string(world->reference().id), reference);
+  for (int id : ids) {
+    const auto state = world->object(id);
+    if (!state || state->age(now_s) > max_pose_age_s)
+      add("object " + std::to_string(id),
+          state ? std::optional<double>(state->age(now_s)) : std::nullopt);
+  }
+  return lost.empty() ? "" : "tracking lost: " + lost;
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,93 @@
+#include "arbci/session/preflight.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace arbci::session {
+namespace {
+
+std::string format(const char* pattern, double a, double b = 0.0) {
+  char text[160];
+  std::snprintf(text, sizeof text, pattern, a, b);
+  return text;
+}
+
+}  // namespace
+
+void Preflight::begin(const PreflightObservation& now) {
+  state_ = State::Running;
+  first_ = last_ = now;
+  camera_frames_ = 0;
+  reference_seen_ = false;
+  eeg_rate_hz_ = 0.0;
+  failures_.clear();
+}
+
+Preflight::State Preflight::update(const PreflightObservation& now) {
+  if (state_ != State::Running) return state_;
+  last_ = now;
+  camera_frames_ += now.camera_frame;
+  reference_seen_ |= now.reference_age_s && *now.reference_age_s <= now.max_pose_age_s;
+  const double elapsed = now.time_s - first_.time_s;
+  if (elapsed > 0.0)
+    eeg_rate_hz_ = static_cast<double>(now.eeg_samples - first_.eeg_samples) / elapsed;
+  if (elapsed < settings_.min_s) return state_;
+  if (check(false).empty()) {
+    state_ = State::Passed;
+  } else if (elapsed >= settings_.timeout_s && now.wall_s - first_.wall_s >= settings_.timeout_s) {
+    failures_ = check(true);
+    state_ = State::Failed;
+  }
+  return state_;
+}
+
+std::vector<std::string> Preflight::check(bool final) const {
+  std::vector<std::string> out;
+  const double waited = last_.time_s - first_.time_s;
+  if (camera_frames_ < 2) {
+    out.push_back(settings_.camera_key + ": " + std::to_string(camera_frames_) +
+                  " camera frame(s) in " + format("%.1f s", waited) + " from " +
+                  settings_.camera_what + " (cannot be decoded, or no picture)");
+  } else if (!reference_seen_) {
+    out.push_back("world.reference.id: the reference marker " +
+                  std::to_string(settings_.reference_id) + " was not seen in " +
+                  std::to_string(camera_frames_) +
+                  " camera frames (in view? the right id? see the Threshold panel)");
+  }
+  const double rate = settings_.eeg_rate_hz;
+  if (eeg_rate_hz_ <= 0.0) {
+    out.push_back(settings_.eeg_key + ": no EEG sample in " + format("%.1f s", waited));
+  } else if (std::abs(eeg_rate_hz_ - rate) > settings_.eeg_tolerance * rate) {
+    out.push_back(settings_.eeg_key + ": EEG samples arrive at " +
+                  format("%.1f Hz, the source says %.1f Hz", eeg_rate_hz_, rate));
+  }
+  if (!last_.robot_answered) {
+    out.push_back(settings_.robot_key + ": " + settings_.robot_what + " did not answer STATUS" +
+                  (final ? format(" in %.1f s", last_.wall_s - first_.wall_s) : ""));
+  }
+  return out;
+}
+
+std::vector<std::string> Preflight::lines() const {
+  std::vector<std::string> out;
+  switch (state_) {
+    case State::Idle:
+      return out;
+    case State::Passed:
+      out.push_back("pre-flight passed: " + std::to_string(camera_frames_) +
+                    " camera frames with the reference, " +
+                    format("EEG at %.1f Hz, the robot answers", eeg_rate_hz_));
+      return out;
+    case State::Failed:
+      out.push_back("pre-flight FAILED (Start checks again):");
+      for (const std::string& f : failures_) out.push_back("  " + f);
+      return out;
+    case State::Running:
+      out.push_back("pre-flight: checking cameras, reference, EEG and robot ...");
+      for (const std::string& f : check(false)) out.push_back("  waiting: " + f);
+      return out;
+  }
+  return out;
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,42 @@
+#include "robot_connection.h"
+
+#include <fstream>
+
+#include "arbci/robot/key_file.h"
+
+namespace arbci::session {
+
+RobotSettings RobotSettings::of(const SessionConfig& config) {
+  return {config.robot_backend, config.robot_speed_factor, config.robot_host,
+          config.robot_port,    config.robot_key_file,     config.source};
+}
+
+void RobotSettings::validate() const {
+  if (!key_file.empty() && !std::filesystem::exists(key_file))
+    throw SessionConfigError(session_file + ": robot.key_file = \"" + key_file +
+                             "\": no such file");
+}
+
+RobotLink connectRobot(const RobotSettings& settings, const robot::RobotConfig& simulated_world,
+                       const std::filesystem::path& folder, const Clock& clock) {
+  RobotLink link;
+  if (settings.backend != "simulated") {
+    link.client = std::make_unique<robot::RobotClient>(
+        robot::Endpoint::resolve(settings.host, settings.port), robot::loadKey(settings.key_file));
+    return link;
+  }
+  const robot::Key key = robot::generateKey();
+  const auto key_file = folder / "robot.key";
+  robot::saveKey(key_file, key);
+  std::ofstream(folder / "robot.json") << simulated_world.toJson();
+  // A simulated clock steps the arm too (the robot follows the session, frame by frame).
+  link.stepped = clock.stepped();
+  link.backend = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder / "robot.json",
+                                                settings.speed_factor, folder, link.stepped);
+  std::ofstream(folder / "robotd.pid") << link.backend->pid() << "\n";
+  link.client = std::make_unique<robot::RobotClient>(
+      robot::Endpoint::resolve("127.0.0.1", link.backend->port()), key);
+  return link;
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,220 @@
+#include "arbci/session/session.h"
+
+#include <fstream>
+
+#include "stage_assembly.h"
+#include "stages/robot_stage.h"
+
+namespace arbci::session {
+namespace {
+
+// A live amplifier runs on its own clock: a session on it cannot be stepped by a simulated
+// clock, whoever asked for one (a headless run, a screenshot).
+SessionOptions forSource(SessionOptions options, const SessionConfig& config) {
+  if (config.eeg.live()) options.clock = Clock::Mode::RealTime;
+  return options;
+}
+
+SessionConfig withOptions(SessionConfig config, const SessionOptions& options) {
+  if (options.seed) config.eeg.seed = *options.seed;
+  if (options.trials) config.paradigm.trials = *options.trials;
+  // The timing check: cued flashing until flashes_only_s, when the session ends.
+  if (options.flashes_only_s > 0.0) config.paradigm.flashes_only = true;
+  return config;
+}
+
+// The experimenter's action a request is, for its why-not; none for the panels' settings.
+std::optional<Action> actionOf(const Request& request) {
+  if (std::holds_alternative<StartRequest>(request)) return Action::Start;
+  if (std::holds_alternative<PauseRequest>(request)) return Action::Pause;
+  if (std::holds_alternative<ResumeRequest>(request)) return Action::Resume;
+  if (std::holds_alternative<AbortRequest>(request)) return Action::Abort;
+  if (std::holds_alternative<EmergencyStopRequest>(request)) return Action::EmergencyStop;
+  if (std::holds_alternative<RobotResetRequest>(request)) return Action::ResetRobot;
+  if (std::holds_alternative<RobotHomeRequest>(request)) return Action::Home;
+  if (std::holds_alternative<RobotReleaseRequest>(request)) return Action::OpenGripper;
+  if (std::holds_alternative<RetryStepRequest>(request)) return Action::RetryStep;
+  if (std::holds_alternative<SkipTrialRequest>(request)) return Action::SkipTrial;
+  if (std::holds_alternative<EndSessionRequest>(request)) return Action::EndSession;
+  return std::nullopt;
+}
+
+}  // namespace
+
+Session::Session(SessionConfig config, const SessionOptions& requested,
+                 const DisplayFactory& display)
+    : config_(withOptions(std::move(config), requested)),
+      options_(forSource(requested, config_)),
+      clock_(options_.clock, config_.display_hz),
+      folder_(options_.folder),
+      timing_(1000.0 * config_.eeg.block_size / config_.eeg.rate_hz) {
+  std::error_code error;
+  std::filesystem::create_directories(folder_, error);
+  if (error)
+    throw std::runtime_error(folder_.string() + ": cannot create the session folder (" +
+                             error.message() + ")");
+  log_ = std::make_unique<SessionLog>(folder_ / "log.jsonl");
+  const StageServices services{clock_, *log_, options_.progress};
+  AssembledStages assembled = assembleStages(config_, options_, clock_, folder_, services, display);
+  stages_ = std::move(assembled.stages);
+  robot_ = assembled.robot;
+  std::ofstream(folder_ / "session.json") << nlohmann::json{
+      {"source", config_.source},
+      {"seed", config_.eeg.seed},
+      {"trials", config_.paradigm.trials}}.dump(2);
+  log_->write(
+      "session_started", 0.0,
+      {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
+  clock_.start();
+  records_[current_].host_s = clock_.hostOf(0.0);
+  // Nobody will press Start: the pre-flight check runs from the first frame.
+  if (!options_.experimenter) queued_.push_back(StartRequest{});
+}
+
+Session::~Session() {
+  try {
+    if (!ended_) endRun("closed");
+  } catch (const std::exception&) {
+    // Nothing more can be saved from a destructor.
+  }
+}
+
+bool Session::request(Request request) {
+  const std::optional<Action> action = actionOf(request);
+  if (action) {
+    const std::string why = whyNot(*action);
+    if (!why.empty()) {
+      log_->write("refused", time(), {{"action", toString(*action)}, {"why", why}});
+      return false;
+    }
+    if (*action == Action::Resume || *action == Action::RetryStep || *action == Action::SkipTrial)
+      fault_since_ = -1.0;
+  }
+  if (std::holds_alternative<EmergencyStopRequest>(request)) {
+    log_->write("emergency_stop", time(), {{"by", "experimenter"}});
+    robot_->stopNow(time());  // not a frame later
+  }
+  queued_.push_back(std::move(request));
+  return true;
+}
+
+void Session::beginCycle() {
+  const int last = current_;
+  current_ = 1 - current_;
+  CycleRecord& record = records_[current_];
+  record = CycleRecord{};
+  record.requests = std::move(records_[last].posted);
+  records_[last].posted.clear();
+  for (Request& r : queued_) record.requests.push_back(std::move(r));
+  queued_.clear();
+  record.frame = frame_;
+  record.time_s = clock_.frameTime(frame_);
+  record.host_s = clock_.hostOf(record.time_s);
+  // When this frame will be on screen: stepped, now; in a window, a period after the last one
+  // (or now, when the cycle itself is late).
+  record.due_s = record.time_s;
+  if (!clock_.stepped() && records_[last].presented) {
+    const double last_shown = clock_.sessionOf(records_[last].presented->host_s);
+    record.due_s = std::max(record.time_s, last_shown + clock_.framePeriodS());
+  }
+}
+
+bool Session::step() {
+  if (ended_) return false;
+  beginCycle();
+  CycleRecord& record = records_[current_];
+  Cycle cycle{record.frame, record.time_s, record.due_s,          record.host_s, 0,
+              clock_,       record,        records_[1 - current_]};
+  timing_.beginCycle();
+  for (const auto& stage : stages_) {
+    stage->step(cycle);
+    timing_.mark(stage->name());
+  }
+  record.eeg_sample = cycle.eeg_sample;
+  if (options_.presents_itself) presented(clock_.presentedNow(record.time_s));
+  timing_.mark("present");
+  recordCycleTime();
+  endIfDone();
+  ++frame_;
+  clock_.pace(frame_);
+  return !ended_;
+}
+
+void Session::presented(double host_s) {
+  CycleRecord& record = records_[current_];
+  if (ended_ || record.presented) return;
+  record.presented = CycleRecord::Presented{host_s, clock_.sampleAt(host_s)};
+}
+
+void Session::recordCycleTime() {
+  CycleRecord& record = records_[current_];
+  const double total = timing_.endCycle();
+  record.stage_ms = timing_.lastCycle();
+  const nlohmann::json fields = {
+      {"frame", record.frame}, {"compute_ms", total}, {"stages", timing_.lastCycle()}};
+  if (total > timing_.budgetMs()) log_->write("overrun", record.time_s, fields);
+  if (record.frame % 6 == 0) log_->write("cycle", record.time_s, fields);
+}
+
+void Session::endIfDone() {
+  const CycleRecord& record = records_[current_];
+  const double time = record.time_s;
+  if (!record.end_reason.empty()) {
+    endRun(record.end_reason, record.end_kind);
+    return;
+  }
+  // Without an experimenter, a fault or a stop ends the run after a while.
+  const bci::Phase phase = record.paradigm.phase;
+  if (phase == bci::Phase::RobotFault || phase == bci::Phase::EmergencyStop) {
+    if (fault_since_ < 0.0) fault_since_ = time;
+    if (!options_.experimenter && time - fault_since_ > options_.fault_wait_s)
+      endRun(std::string("stopped waiting for the experimenter after: ") + bci::toString(phase));
+  } else {
+    fault_since_ = -1.0;
+  }
+  // The last placement is measured before the run ends (a status after the drop, or 3 s).
+  if (phase == bci::Phase::Finished && !record.robot.measuring) endRun("finished");
+  if (phase == bci::Phase::Aborted) endRun("aborted");
+  if (options_.flashes_only_s > 0.0 && time >= options_.flashes_only_s) endRun("timing check done");
+  if (!options_.experimenter && time > options_.max_session_s)
+    endRun("the session ran past its time limit");
+}
+
+void Session::endRun(const std::string& reason, const std::string& kind) {
+  if (ended_) return;
+  ended_ = true;
+  end_reason_ = reason;
+  end_kind_ = kind.empty() ? endKindOf(reason, last().paradigm.phase) : kind;
+  // A closing cycle at the last one's time: the last frame's stamps, the last samples, the end.
+  const CycleRecord& last_record = records_[current_];
+  CycleRecord closing;
+  closing.frame = last_record.frame;
+  closing.time_s = last_record.time_s;
+  closing.host_s = last_record.host_s;
+  closing.due_s = last_record.due_s;
+  closing.eeg_sample = last_record.eeg_sample;
+  Cycle cycle{closing.frame,      closing.time_s, closing.due_s, closing.host_s,
+              closing.eeg_sample, clock_,         closing,       last_record};
+  for (const auto& stage : stages_) stage->stop(cycle, reason);
+  log_->write("session_ended", last_record.time_s, {{"reason", reason}});
+  std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
+}
+
+nlohmann::json Session::summary() const {
+  nlohmann::json out = {
+      {"session", config_.source}, {"seed", config_.eeg.seed},       {"ended", end_kind_},
+      {"end_reason", end_reason_}, {"duration_s", last().time_s},    {"frames", frame_},
+      {"cycle", timing_.toJson()}, {"overruns", timing_.overruns()},
+  };
+  for (const auto& stage : stages_) stage->report(out);
+  return out;
+}
+
+nlohmann::json Session::run(const std::function<bool()>& interrupted) {
+  while (step()) {
+    if (interrupted && interrupted()) request(AbortRequest{});  // ends at the next frame
+  }
+  return summary();
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,176 @@
+#include "stage_assembly.h"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+
+#include "arbci/session/scene_source.h"
+#include "stages/camera_stage.h"
+#include "stages/eeg_acquisition_stage.h"
+#include "stages/errp_stage.h"
+#include "stages/lsl_markers_stage.h"
+#include "stages/p300_stage.h"
+#include "stages/paradigm_stage.h"
+#include "stages/preflight_stage.h"
+#include "stages/presentation_stage.h"
+#include "stages/recording_stage.h"
+#include "stages/robot_stage.h"
+#include "stages/tracking_stage.h"
+#include "trial_intents.h"
+
+namespace arbci::session {
+namespace {
+
+SceneSettings sceneSettingsOf(const SessionConfig& c) {
+  return {c.cameras,  c.world,      c.tracker_kind,       c.tracker_border,
+          c.eeg.seed, c.display_hz, c.robot_speed_factor, c.source};
+}
+
+TrackingSettings trackingSettingsOf(const SessionConfig& c, SceneSource& scene) {
+  TrackingSettings t{vision::markerKindFromString(c.tracker_kind),
+                     c.tracker_border,
+                     c.tracker_search_decimate,
+                     c.world.reference_id,
+                     c.world.reference_size_m,
+                     c.world.reference_position,
+                     {},
+                     c.max_pose_age_s,
+                     scene.leftCamera(),
+                     scene.rightCamera(),
+                     scene.T_right_left(),
+                     scene.warmUpFrames()};
+  for (const WorldObjectSettings& o : c.world.objects) t.marker_size[o.id] = o.marker_m;
+  return t;
+}
+
+PreflightSettings preflightSettingsOf(const SessionConfig& c, double eeg_rate_hz) {
+  PreflightSettings p;
+  p.eeg_rate_hz = eeg_rate_hz;
+  if (c.cameras.source == "simulated") {
+    p.camera_key = "cameras.source";
+    p.camera_what = "the simulated cameras";
+  } else if (!c.cameras.left.video.empty()) {
+    p.camera_key = "cameras.left.video";
+    p.camera_what = "the video " + c.cameras.left.video;
+  } else {
+    p.camera_key = "cameras.left.device";
+    p.camera_what = "camera device " + std::to_string(c.cameras.left.device);
+  }
+  p.eeg_key = c.eeg.source == "file" ? "eeg.file" : "eeg.rate_hz";
+  p.reference_id = c.world.reference_id;
+  if (c.robot_backend == "simulated") {
+    p.robot_key = "robot.backend";
+    p.robot_what = "the simulated arm (arbci-robotd)";
+  } else {
+    p.robot_key = "robot.host, robot.port";
+    p.robot_what = "the robot backend at " + c.robot_host + ":" + std::to_string(c.robot_port);
+  }
+  return p;
+}
+
+// What the recording says of the session at time 0 ("Param name=value").
+std::map<std::string, std::string> recordingParameters(const SessionConfig& c) {
+  return {
+      {"Session", c.source},
+      {"Seed", std::to_string(c.eeg.seed)},
+      {"Paradigm", "single stimulus, " + std::to_string(c.world.objects.size()) + " stimuli"},
+      {"GridCodes", "100 + row (1-" + std::to_string(c.world.grid.rows) + "), 100 + rows + column"},
+      {"FlashMs", std::to_string(c.paradigm.flash_ms)},
+      {"IsiMs", std::to_string(c.paradigm.isi_ms)},
+      {"DisplayHz", std::to_string(c.display_hz)},
+      {"Classifier", c.classifier_method},
+      {"PhotodiodeChannel", c.eeg.photodiode_channel},
+      {"SoaMs", std::to_string(c.paradigm.soaSeconds() * 1000.0)},
+      {"StimulusCodeMap", stimulusCodeMap(c.world, allSlots(c.world))},
+  };
+}
+
+}  // namespace
+
+void checkNamedResources(const SessionConfig& c) {
+  sceneSettingsOf(c).validate();
+  EegAcquisitionSettings{c.eeg, {}, 0.0, c.source}.validate();
+  if (!c.model_file.empty() && !std::filesystem::exists(c.model_file))
+    throw SessionConfigError(c.source + ": classifier.model = \"" + c.model_file +
+                             "\": no such file");
+  RobotSettings::of(c).validate();
+}
+
+AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& options, Clock& clock,
+                               const std::filesystem::path& folder, const StageServices& services,
+                               const DisplayFactory& display) {
+  // Every stage's settings, checked before anything starts.
+  checkNamedResources(c);
+  const SceneSettings scene_settings = sceneSettingsOf(c);
+  const RobotSettings robot_settings = RobotSettings::of(c);
+  EegAcquisitionSettings eeg_settings{c.eeg, {}, c.paradigm.flashSeconds(), c.source};
+  if (c.eeg.source == "lsl" || c.lsl.markers) eeg_settings.lsl = c.lsl.config(c.source);
+  const int camera_every =
+      std::max(1, static_cast<int>(std::lround(c.display_hz / c.cameras.rate_hz)));
+
+  AssembledStages out;
+  std::unique_ptr<SceneSource> scene = sceneSources().at(c.cameras.source).make(scene_settings);
+  // The robot: arbci-robotd on 127.0.0.1 with a fresh key, or a remote backend.
+  RobotLink link = connectRobot(robot_settings, scene->simulatedRobot(), folder, clock);
+  auto robot = std::make_unique<RobotStage>(RobotStageSettings{c.world, camera_every},
+                                            std::move(link), services);
+  out.robot = robot.get();
+  auto tracking = std::make_unique<TrackingStage>(trackingSettingsOf(c, *scene), services);
+  auto cameras = std::make_unique<CameraStage>(std::move(scene));
+
+  // EEG: acquired on its own clock (stepped: in lock-step with the frames), recorded, classified.
+  auto eeg = std::make_unique<EegAcquisitionStage>(eeg_settings, clock, services);
+  auto recording = std::make_unique<RecordingStage>(
+      RecordingSettings{folder / "recording.bdf", eeg->info(), recordingParameters(c)}, services);
+  const bci::SignalInfo& eeg_info = eeg->eegInfo();
+  auto p300 = std::make_unique<P300Stage>(
+      P300Settings{eeg_info, c.pipeline, c.paradigm.flashSeconds(),
+                   static_cast<int>(c.world.objects.size()), c.model_file, c.source},
+      services);
+  ErrpStageSettings errp_settings;
+  errp_settings.enabled = c.paradigm.errp;
+  errp_settings.info = eeg_info;
+  if (c.paradigm.errp) errp_settings.pipeline = c.errp.pipeline(c.pipeline, c.eeg.montage);
+  errp_settings.training = c.errp.training();
+  errp_settings.flash_s = c.paradigm.flashSeconds();
+  errp_settings.model_file = c.model_file;
+  errp_settings.threshold = c.errp.threshold;
+  auto errp = std::make_unique<ErrpStage>(errp_settings, services);
+  std::unique_ptr<LslMarkersStage> markers;
+  if (c.lsl.markers) {
+    markers = std::make_unique<LslMarkersStage>(
+        LslMarkersSettings{c.lsl.marker_stream, eeg_settings.lsl, eeg_info.rate_hz, c.source},
+        services);
+  }
+  auto presentation = std::make_unique<PresentationStage>(
+      PresentationSettings{c.paradigm, eeg_info.rate_hz}, services);
+  auto preflight = std::make_unique<PreflightStage>(
+      PreflightStageSettings{preflightSettingsOf(c, eeg_info.rate_hz), c.max_pose_age_s,
+                             options.experimenter},
+      services);
+  auto paradigm = std::make_unique<ParadigmStage>(
+      ParadigmStageSettings{c.paradigm, c.world, c.classifier_method, intendedTrials(c),
+                            c.eeg.seed + 11, c.errp.threshold, folder / "model.json"},
+      services);
+  CycleRecord warm_up;
+  tracking->publish(warm_up.tracking);
+  warm_up.paradigm.slots = allSlots(c.world);
+  std::unique_ptr<Stage> shown = display ? display(services, warm_up) : nullptr;
+
+  // The order data flows: the last frame as shown; acquire; process; decide; render.
+  out.stages.push_back(std::move(presentation));
+  out.stages.push_back(std::move(eeg));
+  out.stages.push_back(std::move(recording));
+  out.stages.push_back(std::move(p300));
+  out.stages.push_back(std::move(errp));
+  if (markers) out.stages.push_back(std::move(markers));
+  out.stages.push_back(std::move(cameras));
+  out.stages.push_back(std::move(robot));
+  out.stages.push_back(std::move(tracking));
+  out.stages.push_back(std::move(preflight));
+  out.stages.push_back(std::move(paradigm));
+  if (shown) out.stages.push_back(std::move(shown));
+  return out;
+}
+
+}  // namespace arbci::session

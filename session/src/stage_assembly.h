@@ -1,0 +1,24 @@
+// The wiring: which stage gets which part of the session file, in which order the stages run, and
+// what one stage's construction tells another's settings (the cameras' models to tracking, the
+// EEG channels to the classifiers). The one place that knows every stage.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "arbci/session/session.h"
+
+namespace arbci::session {
+
+struct AssembledStages {
+  std::vector<std::unique_ptr<Stage>> stages;  // in the order they run
+  RobotStage* robot = nullptr;
+};
+
+// Throws SessionConfigError naming the key, or std::runtime_error with the reason.
+AssembledStages assembleStages(const SessionConfig& config, const SessionOptions& options,
+                               Clock& clock, const std::filesystem::path& folder,
+                               const StageServices& services, const DisplayFactory& display);
+
+}  // namespace arbci::session

@@ -1,0 +1,151 @@
+#include "stages/eeg_acquisition_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "arbci/session/eeg_sources.h"
+
+namespace arbci::session {
+
+void EegAcquisitionSettings::validate() const {
+  if (!eeg.file.empty() && !std::filesystem::exists(eeg.file))
+    throw SessionConfigError(session_file + ": eeg.file = \"" + eeg.file + "\": no such file");
+}
+
+EegAcquisitionStage::EegAcquisitionStage(const EegAcquisitionSettings& settings, Clock& clock,
+                                         const StageServices& services)
+    : settings_(settings), s_(services) {
+  const EegSettings& eeg = settings_.eeg;
+  std::shared_ptr<bci::SampleClock> source_clock =
+      clock.sourceClock(eeg.source == "simulated" ? kSimulatedTransportS : 0.0);
+  bci::AcquisitionSettings acquisition;
+  acquisition.latency_s = eeg.latency_ms / 1000.0;
+  acquisition_ = std::make_unique<bci::Acquisition>(
+      openEegSource(eeg, settings_.lsl, source_clock, settings_.session_file), source_clock,
+      clock.stepped() ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live,
+      acquisition);
+  const bci::SignalInfo& all = acquisition_->info();
+  eeg_info_ = all;
+  if (!eeg.photodiode_channel.empty()) {
+    const auto found = std::find(all.channels.begin(), all.channels.end(), eeg.photodiode_channel);
+    if (found == all.channels.end()) {
+      std::string names;
+      for (const auto& c : all.channels) names += (names.empty() ? "" : ", ") + c;
+      throw SessionConfigError(
+          settings_.session_file + ": eeg.photodiode_channel = \"" + eeg.photodiode_channel +
+          "\": the EEG source has no such channel (it has: " + names + "; use \"\" for none)");
+    }
+    photodiode_ = static_cast<int>(found - all.channels.begin());
+    eeg_info_.channels.erase(eeg_info_.channels.begin() + photodiode_);
+  }
+  bci::Acquisition* acquisition_ptr = acquisition_.get();
+  clock.setSampleMap(
+      [acquisition_ptr](double host_s) { return acquisition_ptr->firstSampleAtOrAfter(host_s); },
+      [acquisition_ptr](double host_s) { return acquisition_ptr->sampleAt(host_s); });
+  acquisition_->start();
+}
+
+EegAcquisitionStage::~EegAcquisitionStage() {
+  acquisition_->stop();
+}
+
+void EegAcquisitionStage::toSource(const Cycle& cycle) {
+  // What the subject attends from the new selection on, what the screen showed (the photodiode
+  // patch, the flashes) and the feedback it saw, in the order they reached the subject.
+  const auto& started = cycle.previous.paradigm.selection_started;
+  const Presentation& shown = cycle.record.presentation;
+  const int nominal_duration = static_cast<int>(settings_.flash_s * settings_.eeg.rate_hz + 0.5);
+  acquisition_->withSource([&](bci::EegSource& source) {
+    if (started) source.attend(started->attended);
+    if (shown.patch) source.displayed(shown.host_s, *shown.patch);
+    for (const Presentation::Onset& onset : shown.onsets) {
+      source.present({onset.sample, onset.flash.code, onset.flash.target, nominal_duration,
+                      onset.flash.known});
+    }
+    if (shown.feedback) source.feedback(shown.sample, shown.feedback->codes);
+  });
+}
+
+bci::Block EegAcquisitionStage::eegOnly(const bci::Block& block) const {
+  if (photodiode_ < 0) return block;
+  bci::Block out(block.first_sample, block.channels - 1, block.samples);
+  out.data = bci::withoutChannel(block.data, block.channels, block.samples, photodiode_);
+  return out;
+}
+
+void EegAcquisitionStage::take(Cycle& cycle) {
+  EegPart& out = cycle.record.eeg;
+  for (bci::SampleLoss& loss : acquisition_->takeLosses()) out.losses.push_back(std::move(loss));
+  for (bci::Block& block : acquisition_->take()) {
+    next_sample_ = block.first_sample + block.samples;
+    out.eeg_blocks.push_back(eegOnly(block));
+    out.blocks.push_back(std::move(block));
+  }
+}
+
+void EegAcquisitionStage::step(Cycle& cycle) {
+  toSource(cycle);
+  if (cycle.clock.stepped()) acquisition_->advanceTo(cycle.time_s);
+  take(cycle);
+  EegPart& out = cycle.record.eeg;
+  out.lost_samples = acquisition_->lostSamples();
+  out.drift_ppm = acquisition_->driftPpm();
+  out.jitter_ms = acquisition_->jitterS() * 1000.0;
+  if (out.lost_samples != lost_logged_) {
+    s_.log.write("lost_samples", cycle.time_s,
+                 {{"total", out.lost_samples}, {"new", out.lost_samples - lost_logged_}});
+    if (s_.progress)
+      *s_.progress << "\nwarning: " << out.lost_samples - lost_logged_
+                   << " EEG samples lost (see the recording's annotations)\n";
+    lost_logged_ = out.lost_samples;
+  }
+  // A live source's fault (an LSL stream gone), logged when it starts and when it ends.
+  acquisition_->withSource([&](bci::EegSource& source) {
+    out.fault = source.fault();
+    out.source_line = source.describe();
+  });
+  if (out.fault != fault_logged_) {
+    s_.log.write("eeg_source", cycle.time_s,
+                 {{"fault", out.fault}, {"state", out.fault.empty() ? "delivering" : "fault"}});
+    if (s_.progress)
+      *s_.progress << "\n"
+                   << (out.fault.empty() ? "EEG source delivering again" : "warning: " + out.fault)
+                   << "\n";
+    fault_logged_ = out.fault;
+  }
+  cycle.eeg_sample = cycle.record.eeg_sample = acquisition_->firstSampleAtOrAfter(cycle.host_s);
+}
+
+void EegAcquisitionStage::stop(Cycle& cycle, const std::string&) {
+  toSource(cycle);
+  if (acquisition_->mode() == bci::Acquisition::Mode::Live) {
+    // The samples taken up to a tenth of a second from now, so the last flashes' EEG and
+    // photodiode edges are in the recording.
+    const std::int64_t wanted = acquisition_->firstSampleAtOrAfter(bci::hostSeconds() + 0.1);
+    const double give_up = bci::hostSeconds() + 1.0;
+    take(cycle);
+    while (next_sample_ < wanted && bci::hostSeconds() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      take(cycle);
+    }
+  }
+  acquisition_->stop();
+}
+
+std::string EegAcquisitionStage::sourceLine() const {
+  std::string line;
+  acquisition_->withSource([&](bci::EegSource& source) { line = source.describe(); });
+  return line;
+}
+
+void EegAcquisitionStage::report(nlohmann::json& summary) const {
+  summary["timing"]["lost_samples"] = acquisition_->lostSamples();
+  summary["timing"]["clock_drift_ppm"] = acquisition_->driftPpm();
+  summary["timing"]["clock_jitter_ms"] = acquisition_->jitterS() * 1000.0;
+  summary["eeg"]["lost_samples"] = acquisition_->lostSamples();
+  summary["eeg"]["source"] = sourceLine();
+}
+
+}  // namespace arbci::session

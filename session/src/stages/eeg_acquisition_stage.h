@@ -1,0 +1,65 @@
+// The EEG's first stage: the source (the simulated subject, a file replayed in real time, an LSL
+// stream, an eegdev amplifier) acquired on its own clock into a ring buffer; each cycle takes the
+// blocks that arrived (stepped: those generated up to the cycle's time), the losses (gaps,
+// overflows), and the source's fault, and stamps the cycle with its EEG sample. What the screen
+// showed and what the subject attends go to the source, as they would reach a subject: a
+// simulated one answers with its ERPs and its virtual photodiode. The clock model it fits lends
+// the session's clock its sample map.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "arbci/bci/acquisition.h"
+#include "arbci/bci/lsl/config.h"
+#include "arbci/session/session_config.h"
+#include "arbci/session/stage.h"
+
+namespace arbci::session {
+
+struct EegAcquisitionSettings {
+  EegSettings eeg;
+  bci::lsl::LslConfig lsl;   // source "lsl": lsl_api.cfg with the session's scope and peers
+  double flash_s = 0.06;     // a flash's nominal duration (the paradigm's, in whole frames)
+  std::string session_file;  // for messages naming a key
+  // Before the run: the files named exist; throws SessionConfigError naming the key and value.
+  void validate() const;
+};
+
+class EegAcquisitionStage final : public Stage {
+ public:
+  // Opens the source and starts acquiring. Throws SessionConfigError naming the key (a source
+  // that cannot be opened, a photodiode channel it lacks).
+  EegAcquisitionStage(const EegAcquisitionSettings& settings, Clock& clock,
+                      const StageServices& services);
+  ~EegAcquisitionStage() override;
+
+  const char* name() const override { return "eeg"; }
+  void step(Cycle& cycle) override;
+  // Live, the EEG of the last frames is still on its way: waits for it (at most 1 s), then stops.
+  void stop(Cycle& cycle, const std::string& reason) override;
+  void report(nlohmann::json& summary) const override;
+
+  // Every channel the source delivers (the photodiode too): what the recording holds.
+  const bci::SignalInfo& info() const { return acquisition_->info(); }
+  // The EEG channels only: what filters, epochs and models see.
+  const bci::SignalInfo& eegInfo() const { return eeg_info_; }
+
+ private:
+  void toSource(const Cycle& cycle);
+  void take(Cycle& cycle);
+  bci::Block eegOnly(const bci::Block& block) const;
+  std::string sourceLine() const;
+
+  EegAcquisitionSettings settings_;
+  StageServices s_;
+  std::unique_ptr<bci::Acquisition> acquisition_;
+  bci::SignalInfo eeg_info_;
+  int photodiode_ = -1;           // the photodiode's channel in the source's blocks
+  std::int64_t lost_logged_ = 0;  // lost samples already in the log
+  std::string fault_logged_;      // the source's fault last logged (empty: none)
+  std::int64_t next_sample_ = 0;  // after the last block taken
+};
+
+}  // namespace arbci::session

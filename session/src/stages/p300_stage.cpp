@@ -1,0 +1,191 @@
+#include "stages/p300_stage.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cmath>
+
+#include "arbci/bci/p300_dataset.h"
+#include "arbci/session/session_config.h"
+
+namespace arbci::session {
+
+P300Stage::P300Stage(const P300Settings& settings, const StageServices& services)
+    : settings_(settings), s_(services) {
+  const bci::SignalInfo& info = settings_.info;
+  filters_ = std::make_unique<bci::FilterChain>(settings_.pipeline.filter, info);
+  epocher_ = std::make_unique<bci::Epocher>(info.channelCount(), info.rate_hz,
+                                            settings_.pipeline.window, 10.0);
+  calibration_.source = "calibration run";
+  calibration_.format = "memory";
+  calibration_.info = info;
+  calibration_.parameters["Paradigm"] =
+      "single stimulus, " + std::to_string(settings_.object_stimuli) + " stimuli";
+  if (!settings_.model_file.empty()) setModel(bci::P300Model::load(settings_.model_file), 0.0);
+}
+
+P300Stage::~P300Stage() {
+  if (training_.valid()) training_.wait();
+}
+
+void P300Stage::setModel(const bci::P300Model& model, double time_s) {
+  model.checkCompatible(settings_.info, "the EEG source");
+  trained_erp_.reset();  // the averages belong to the model this session trained, not this one
+  if (model.pipeline.zero_phase) {
+    // Online filtering must be causal: the features lag where the model's did not.
+    const std::string text =
+        "the model was trained with zero-phase (offline) filters; the session filters causally, "
+        "so its features lag the model's: train without --zero-phase for online use";
+    s_.log.write("model_warning", time_s, {{"text", text}});
+    if (s_.progress) *s_.progress << "\nwarning: " << text << "\n";
+  }
+  extractor_.emplace(model.extractor(settings_.info));
+  // The online filter and window follow the model's pipeline.
+  filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, settings_.info);
+  model_ = std::make_shared<const bci::P300Model>(model);
+  keep_signal_ = false;
+  calibration_.data.clear();
+  calibration_.data.shrink_to_fit();
+}
+
+void P300Stage::startSelection(const SelectionStart& selection) {
+  selection_ = selection.selection;
+  calibrating_ = selection.target.has_value();
+  presented_ = scored_ = 0;
+  accumulator_.reset();
+  if (model_) accumulator_.emplace(selection.layout, model_->score_model);
+}
+
+void P300Stage::startTraining(const std::string& method) {
+  // A copy, channel-major as a recording holds its samples: the cycle keeps recording meanwhile.
+  bci::Recording recording = calibration_;
+  const int channels = settings_.info.channelCount();
+  recording.data.assign(calibration_.data.size(), 0.0f);
+  for (std::int64_t s = 0; s < calibration_.samples; ++s) {
+    for (int c = 0; c < channels; ++c) {
+      recording.data[static_cast<size_t>(c * calibration_.samples + s)] =
+          calibration_.data[static_cast<size_t>(s * channels + c)];
+    }
+  }
+  training_ = std::async(std::launch::async, [recording = std::move(recording),
+                                              pipeline = settings_.pipeline, method]() {
+    // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
+    // frames come first and the training takes what is left.
+    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+    bci::TrainingSettings settings;
+    settings.method = method;
+    settings.folds = 4;
+    const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+    bci::TrainingResult result = bci::trainModel(data, pipeline, settings);
+    result.model.provenance["training_files"] = {"this session's calibration run"};
+    return Outcome{std::move(result.model), result.cross_validation.report, data.erp};
+  });
+}
+
+void P300Stage::takeTraining(Cycle& cycle) {
+  P300Part& out = cycle.record.p300;
+  if (!cycle.clock.ready(training_)) return;
+  try {
+    Outcome outcome = training_.get();  // rethrows the worker's error
+    setModel(outcome.model, cycle.time_s);
+    trained_erp_ = std::make_shared<const bci::ErpCurves>(std::move(outcome.erp));
+    out.trained = outcome.report;
+  } catch (const std::exception& error) {
+    out.training_error = error.what();
+  }
+}
+
+bool P300Stage::touchesLoss(std::int64_t onset) const {
+  // The epoch's window, and a second before it for the filters to settle after a gap.
+  const double rate = settings_.info.rate_hz;
+  const auto from = onset + static_cast<std::int64_t>(
+                                std::floor((settings_.pipeline.window.start_s - 1.0) * rate));
+  const auto to =
+      onset + static_cast<std::int64_t>(std::ceil(settings_.pipeline.window.end_s * rate));
+  for (const auto& [first, end] : lost_spans_)
+    if (first < to && end > from) return true;
+  return false;
+}
+
+void P300Stage::process(const bci::Block& eeg, double time_s) {
+  bci::Block block = eeg;
+  if (keep_signal_) {
+    // Stored sample-major while collecting (appending is cheap); transposed when training.
+    for (int s = 0; s < block.samples; ++s) {
+      for (int c = 0; c < block.channels; ++c) calibration_.data.push_back(block.at(c, s));
+    }
+    calibration_.samples += block.samples;
+  }
+  filters_->process(block);
+  for (const bci::Epoch& epoch : epocher_->push(block)) {
+    const auto found = flashes_.find(epoch.event.sample);
+    if (found == flashes_.end()) continue;
+    const FlashRecord record = found->second;
+    flashes_.erase(found);
+    if (record.selection != selection_) continue;
+    ++scored_;
+    if (touchesLoss(epoch.event.sample)) {
+      // Zeros in place of lost samples (or the filters' ringing after them): no evidence.
+      ++discarded_;
+      s_.log.write("epoch_discarded", time_s,
+                   {{"sample", epoch.event.sample},
+                    {"code", record.code},
+                    {"reason", "it overlaps lost EEG samples"}});
+      continue;
+    }
+    if (accumulator_ && extractor_)
+      accumulator_->add(record.code, model_->classifier->score(extractor_->features(epoch)));
+  }
+}
+
+void P300Stage::step(Cycle& cycle) {
+  // What the paradigm and the experimenter asked for last cycle, in order: a new selection, a
+  // model to use, training.
+  if (const auto& started = cycle.previous.paradigm.selection_started) startSelection(*started);
+  for (const Request& request : cycle.record.requests) {
+    if (const auto* use = std::get_if<UseModelRequest>(&request)) {
+      try {
+        setModel(*use->model, cycle.time_s);
+        s_.log.write("model", cycle.time_s,
+                     {{"method", use->model->method}, {"provenance", use->model->provenance}});
+      } catch (const std::exception& error) {
+        s_.log.write("model_refused", cycle.time_s, {{"reason", error.what()}});
+        cycle.record.p300.training_error = error.what();
+      }
+    } else if (const auto* train = std::get_if<TrainRequest>(&request)) {
+      startTraining(train->method);
+    }
+  }
+  // The flashes the last frame showed for the first time.
+  const int duration = static_cast<int>(settings_.flash_s * settings_.info.rate_hz + 0.5);
+  for (const Presentation::Onset& onset : cycle.record.presentation.onsets) {
+    const Flash& f = onset.flash;
+    const bci::StimulusEvent event{onset.sample, f.code, f.target, duration, f.known};
+    if (calibrating_ && keep_signal_) calibration_.stimuli.push_back(event);
+    flashes_[onset.sample] = {selection_, f.code};
+    epocher_->addEvent(event);
+    ++presented_;
+  }
+  const EegPart& eeg = cycle.record.eeg;
+  for (const bci::SampleLoss& loss : eeg.losses)
+    lost_spans_.emplace_back(loss.first_sample, loss.first_sample + loss.samples);
+  for (const bci::Block& block : eeg.eeg_blocks) process(block, cycle.time_s);
+  takeTraining(cycle);
+
+  P300Part& out = cycle.record.p300;
+  out.selection = selection_;
+  out.presented = presented_;
+  out.scored = scored_;
+  out.sequences = accumulator_ ? accumulator_->completeSequences() : 0;
+  out.decision = accumulator_ ? accumulator_->decide() : bci::Decision{};
+  out.model = model_;
+  out.erp = trained_erp_;
+  out.training = training_.valid();
+}
+
+void P300Stage::report(nlohmann::json& summary) const {
+  summary["eeg"]["missed_epochs"] = epocher_->missed();
+  summary["eeg"]["discarded_epochs"] = discarded_;
+}
+
+}  // namespace arbci::session

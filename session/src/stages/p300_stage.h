@@ -1,0 +1,85 @@
+// The P300 classifier's stage: the EEG filtered causally, cut into epochs around the flashes as
+// presented, scored by the model and accumulated for the current selection (its decision and
+// certainty drive dynamic stopping). Until there is a model it keeps the calibration run's signal
+// and flashes, and trains on them, when asked, on a worker thread exactly as `arbci train` would;
+// the cycle goes on meanwhile. Epochs that touch lost samples are discarded, not scored.
+#pragma once
+
+#include <filesystem>
+#include <future>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "arbci/bci/epocher.h"
+#include "arbci/bci/features.h"
+#include "arbci/bci/filters.h"
+#include "arbci/bci/p300_model.h"
+#include "arbci/bci/recording.h"
+#include "arbci/session/stage.h"
+
+namespace arbci::session {
+
+struct P300Settings {
+  bci::SignalInfo info;  // the EEG channels (no photodiode)
+  bci::PipelineSettings pipeline;
+  double flash_s = 0.06;     // a flash's nominal duration (the paradigm's, in whole frames)
+  int object_stimuli = 0;    // stimuli of the calibration run (the objects)
+  std::string model_file;    // a trained model (empty: the calibration run trains one)
+  std::string session_file;  // for messages naming a key
+};
+
+class P300Stage final : public Stage {
+ public:
+  // Loads the model file when one is named; throws SessionConfigError naming the key when it
+  // cannot be used.
+  P300Stage(const P300Settings& settings, const StageServices& services);
+  ~P300Stage() override;
+  const char* name() const override { return "p300"; }
+  void step(Cycle& cycle) override;
+  void report(nlohmann::json& summary) const override;
+
+ private:
+  struct FlashRecord {
+    int selection = 0;
+    int code = 0;
+  };
+  struct Outcome {
+    bci::P300Model model;
+    bci::EvaluationReport report;
+    bci::ErpCurves erp;
+  };
+  // `why`: the request's origin, for the log.
+  void setModel(const bci::P300Model& model, double time_s);
+  void startSelection(const SelectionStart& selection);
+  void startTraining(const std::string& method);
+  void takeTraining(Cycle& cycle);
+  void process(const bci::Block& eeg, double time_s);
+  bool touchesLoss(std::int64_t onset) const;
+
+  P300Settings settings_;
+  StageServices s_;
+  std::unique_ptr<bci::FilterChain> filters_;
+  std::unique_ptr<bci::Epocher> epocher_;
+  std::shared_ptr<const bci::P300Model> model_;
+  std::optional<bci::FeatureExtractor> extractor_;
+  std::shared_ptr<const bci::ErpCurves> trained_erp_;
+  // The calibration run: its signal (sample-major while collecting) and cued flashes.
+  bci::Recording calibration_;
+  bool keep_signal_ = true;
+  std::future<Outcome> training_;
+  std::map<std::int64_t, FlashRecord> flashes_;  // by onset sample, until epoched
+  int selection_ = 0;
+  bool calibrating_ = false;  // the current selection is a cued one
+  std::optional<bci::SelectionAccumulator> accumulator_;
+  int presented_ = 0, scored_ = 0;
+  // Stretches of lost samples [first, end): epochs touching them are discarded, not scored.
+  std::vector<std::pair<std::int64_t, std::int64_t>> lost_spans_;
+  std::int64_t discarded_ = 0;
+};
+
+}  // namespace arbci::session

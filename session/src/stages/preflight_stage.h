@@ -1,0 +1,32 @@
+// The pre-flight check the experimenter's Start runs before any flash: camera frames arrive and
+// show the reference marker, the EEG flows at its rate, the robot answers STATUS (preflight.h).
+// Passed, it asks the paradigm to begin; failed, it names each key to look at in the log, on the
+// terminal and in the panel, and a run without an experimenter ends there.
+#pragma once
+
+#include "arbci/session/preflight.h"
+#include "arbci/session/stage.h"
+
+namespace arbci::session {
+
+struct PreflightStageSettings {
+  PreflightSettings check;
+  double max_pose_age_s = 0.5;
+  bool experimenter = true;  // false: nobody can fix a failure, so the run ends
+};
+
+class PreflightStage final : public Stage {
+ public:
+  PreflightStage(const PreflightStageSettings& settings, const StageServices& services);
+  const char* name() const override { return "preflight"; }
+  void step(Cycle& cycle) override;
+
+ private:
+  PreflightObservation observe(const Cycle& cycle) const;
+  void finish(Cycle& cycle, Preflight::State state);
+  PreflightStageSettings settings_;
+  StageServices s_;
+  Preflight preflight_;
+};
+
+}  // namespace arbci::session

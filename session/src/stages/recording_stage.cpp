@@ -1,0 +1,56 @@
+#include "stages/recording_stage.h"
+
+namespace arbci::session {
+namespace {
+
+bci::StimulusEvent stimulusOf(std::int64_t onset, const Flash& f, int duration) {
+  return {onset, f.objects ? f.code : f.code + 100, f.target, duration, f.known};
+}
+
+}  // namespace
+
+RecordingStage::RecordingStage(const RecordingSettings& settings, const StageServices& services)
+    : s_(services),
+      writer_(std::make_unique<bci::RecordingWriter>(settings.path, settings.info,
+                                                     settings.parameters)) {}
+
+void RecordingStage::record(Cycle& cycle) {
+  for (const bci::Annotation& note : cycle.previous.annotations) writer_->addAnnotation(note);
+  const Presentation& shown = cycle.record.presentation;
+  for (const Presentation::Ended& ended : shown.ended) {
+    const auto found = unrecorded_.find(ended.onset_sample);
+    if (found == unrecorded_.end()) continue;
+    writer_->addStimulus(stimulusOf(ended.onset_sample, found->second, ended.duration_samples));
+    unrecorded_.erase(found);
+  }
+  for (const Presentation::Onset& onset : shown.onsets) unrecorded_[onset.sample] = onset.flash;
+  if (shown.feedback) writer_->addAnnotation({shown.sample, shown.feedback->text(), 0});
+  const EegPart& eeg = cycle.record.eeg;
+  for (const bci::SampleLoss& loss : eeg.losses) {
+    writer_->addAnnotation({loss.first_sample,
+                            "Lost " + std::to_string(loss.samples) + " samples: " + loss.reason,
+                            static_cast<int>(loss.samples)});
+  }
+  for (const bci::Block& block : eeg.blocks) writer_->write(block);
+  cycle.record.recording.samples = writer_->samplesWritten();
+}
+
+void RecordingStage::step(Cycle& cycle) {
+  record(cycle);
+}
+
+void RecordingStage::stop(Cycle& cycle, const std::string& reason) {
+  record(cycle);
+  writer_->addAnnotation({cycle.clock.sampleAt(cycle.host_s), "Session ended: " + reason, 0});
+  for (const auto& [sample, flash] : unrecorded_)
+    writer_->addStimulus(stimulusOf(sample, flash, 0));
+  unrecorded_.clear();
+  writer_->close();
+}
+
+void RecordingStage::report(nlohmann::json& summary) const {
+  summary["eeg"]["recording"] = writer_->path().filename().string();
+  summary["eeg"]["samples"] = writer_->samplesWritten();
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,107 @@
+#include "arbci/session/stimulus_timing.h"
+
+#include <algorithm>
+
+#include "arbci/session/cycle_timing.h"
+
+namespace arbci::session {
+namespace {
+
+// A statistic of `values` in ms (they are in samples), or null when there are none.
+nlohmann::json inMs(const std::vector<double>& values, double Percentiles::*statistic,
+                    double samples_to_ms) {
+  if (values.empty()) return nullptr;
+  return percentiles(values).*statistic * samples_to_ms;
+}
+
+}  // namespace
+
+StimulusTiming::StimulusTiming(const bci::ParadigmSettings& paradigm, double eeg_rate_hz)
+    : paradigm_(paradigm), rate_hz_(eeg_rate_hz) {}
+
+StimulusTiming::Frame StimulusTiming::presented(double due_s, double presented_s,
+                                                std::int64_t sample, const std::set<int>& lit,
+                                                const std::vector<int>& first_shown) {
+  Frame frame;
+  const double period = 1.0 / paradigm_.display_hz;
+  ++frames_;
+  // Late: later than one frame period after it was due (a microsecond's grace for arithmetic).
+  frame.late = presented_s > due_s + period + 1e-6;
+  late_frames_ += frame.late;
+  if (last_presented_) {
+    frame_intervals_s_.push_back(presented_s - *last_presented_);
+    if (frame_intervals_s_.size() > 600)
+      frame_intervals_s_.erase(frame_intervals_s_.begin(), frame_intervals_s_.begin() + 300);
+  }
+  last_presented_ = presented_s;
+
+  // Flashes no longer shown have ended on this frame.
+  for (auto it = active_.begin(); it != active_.end();) {
+    if (lit.count(it->first)) {
+      ++it;
+      continue;
+    }
+    const auto duration = static_cast<int>(sample - it->second.onset_sample);
+    frame.ended.push_back({it->second.onset_sample, duration});
+    duration_samples_.push_back(duration);
+    it = active_.erase(it);
+  }
+  for (int code : first_shown) {
+    frame.onsets.push_back({code, sample});
+    active_.emplace_back(code, Active{sample});
+    if (!selection_onsets_.empty())
+      soa_samples_.push_back(static_cast<double>(sample - selection_onsets_.back()));
+    selection_onsets_.push_back(sample);
+  }
+  frame.patch_lit = !lit.empty();
+  return frame;
+}
+
+void StimulusTiming::startSelection() {
+  selection_onsets_.clear();
+}
+
+double StimulusTiming::medianSoaS() const {
+  if (soa_samples_.empty()) return paradigm_.soaSeconds();
+  return percentiles(soa_samples_).p50 / rate_hz_;
+}
+
+double StimulusTiming::selectionSeconds() const {
+  if (selection_onsets_.empty()) return 0.0;
+  return static_cast<double>(selection_onsets_.back() - selection_onsets_.front()) / rate_hz_ +
+         medianSoaS();
+}
+
+std::optional<double> StimulusTiming::medianFrameIntervalMs() const {
+  if (frame_intervals_s_.size() < 60) return std::nullopt;
+  return 1000.0 * percentiles(frame_intervals_s_).p50;
+}
+
+bool StimulusTiming::displayTooSlow() const {
+  const auto median = medianFrameIntervalMs();
+  return median && *median > 1.5 * 1000.0 / paradigm_.display_hz;
+}
+
+nlohmann::json StimulusTiming::summary() const {
+  const double to_ms = 1000.0 / rate_hz_;
+  const auto frame_median = medianFrameIntervalMs();
+  return {
+      {"soa_ms",
+       {{"configured", paradigm_.flash_ms + paradigm_.isi_ms},
+        {"median", inMs(soa_samples_, &Percentiles::p50, to_ms)},
+        {"p95", inMs(soa_samples_, &Percentiles::p95, to_ms)},
+        {"count", soa_samples_.size()}}},
+      {"flash_ms",
+       {{"configured", paradigm_.flash_ms},
+        {"median", inMs(duration_samples_, &Percentiles::p50, to_ms)},
+        {"count", duration_samples_.size()}}},
+      {"display",
+       {{"configured_hz", paradigm_.display_hz},
+        {"median_frame_ms", frame_median ? nlohmann::json(*frame_median) : nlohmann::json(nullptr)},
+        {"holds_rate", !displayTooSlow()}}},
+      {"frames", frames_},
+      {"late_frames", late_frames_},
+  };
+}
+
+}  // namespace arbci::session
