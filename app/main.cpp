@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
   arbci::app::addRobotCommand(root, exit_code);
   arbci::app::addRunCommand(root, exit_code);
   arbci::app::addTimingCheckCommand(root, exit_code);
+  arbci::app::addSettingsCommand(root, exit_code);
 
   try {
     root.parse(argc, argv);

@@ -6,7 +6,9 @@
 #include <random>
 
 #include "arbci/bci/epocher.h"
+#include "arbci/bci/features.h"
 #include "arbci/bci/filters.h"
+#include "arbci/bci/simulated_subject.h"
 
 namespace {
 
@@ -14,10 +16,13 @@ using namespace arbci::bci;
 
 void filterAndEpoch(benchmark::State& state) {
   const int channels = static_cast<int>(state.range(0));
+  const SimulatedSubjectConfig subject;  // a session's rate
   SignalInfo info;
+  info.rate_hz = subject.rate_hz;
   for (int c = 0; c < channels; ++c) info.channels.push_back("Ch" + std::to_string(c + 1));
-  FilterChain filters(FilterSettings{}, info);
-  Epocher epocher(channels, 256.0);
+  const PipelineSettings pipeline;  // a session's filters and window
+  FilterChain filters(pipeline.filter, info);
+  Epocher epocher(channels, info.rate_hz, pipeline.window);
   std::mt19937 random(1);
   std::normal_distribution<float> normal(0.0f, 10.0f);
   std::vector<Block> input(64, Block(0, channels, 15));

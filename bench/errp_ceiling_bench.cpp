@@ -114,7 +114,8 @@ int main(int argc, char** argv) {
 
   session::SessionConfig config = session::SessionConfig::load(std::nullopt);
   if (errp_scale >= 0.0) config.eeg.errp_scale = errp_scale;
-  const bci::PipelineSettings pipeline = config.errp.pipeline(config.pipeline, config.eeg.montage);
+  const bci::PipelineSettings pipeline =
+      config.errp.pipeline(config.classifier.pipeline, config.eeg.montage);
   std::printf(
       "ErrP classifier, cross-validated AUC [95 %%] (5 contiguous blocks); the embedded session's "
       "subject (errp_scale %.2f) and ErrP pipeline (%.1f-%.1f Hz, %.0f-%.0f ms, %.0f Hz "

@@ -37,15 +37,15 @@ int main(int argc, char** argv) {
       const int repeats = 5;
       double train_ms = 1e300;
       std::unique_ptr<Classifier> classifier;
+      TrainingSettings settings;
+      settings.method = method;
       for (int r = 0; r < repeats; ++r) {
-        classifier = makeClassifier(method);
+        classifier = makeClassifier(settings);
         start = Clock::now();
         classifier->train(train.features, train.target, train.shape);
         train_ms = std::min(
             train_ms, std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       }
-      TrainingSettings settings;
-      settings.method = method;
       start = Clock::now();
       trainModel(train, pipeline, settings);
       const double full_ms =

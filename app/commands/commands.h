@@ -17,5 +17,6 @@ void addP300Commands(CLI::App& root, int& exit_code);      // train, evaluate
 void addRobotCommand(CLI::App& root, int& exit_code);
 void addRunCommand(CLI::App& root, int& exit_code);
 void addTimingCheckCommand(CLI::App& root, int& exit_code);
+void addSettingsCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

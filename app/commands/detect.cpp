@@ -14,6 +14,7 @@
 #include "arbci/vision/marker_poses.h"
 #include "arbci/vision/marker_set.h"
 #include "arbci/vision/marker_tracker.h"
+#include "arbci/vision/settings.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
 #include "support/detection_json.h"
@@ -108,9 +109,9 @@ vision::DetectorConfig makeConfig(const DetectOptions& options) {
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
   }
-  config.border = options.border > 0.0                     ? options.border
-                  : config.kind == vision::MarkerKind::Bch ? 0.125
-                                                           : 0.25;
+  // The family's usual border unless given.
+  config.border =
+      options.border > 0.0 ? options.border : vision::markerFamilies().at(options.kind).make.border;
   config.threshold = parseThreshold(options);
   config.search_decimate = options.decimate;
   config.dictionary = options.dictionary;
@@ -316,12 +317,13 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   command->add_option("--raw", options->raw,
                       "Inputs are headerless: WIDTHxHEIGHT[:gray|rgb|bgr|rgba|bgra|abgr|rgb565]");
-  command->add_option("--kind", options->kind, "bch, simple, template, aruco or apriltag")
-      ->check(CLI::IsMember({"bch", "simple", "template", "aruco", "apriltag"}))
+  command->add_option("--kind", options->kind, vision::markerFamilies().list(", "))
+      ->check(CLI::IsMember(vision::markerFamilies().names()))
       ->capture_default_str();
   command
       ->add_option("--border", options->border,
-                   "Border as a fraction of the side (default 0.125 for bch, 0.25 otherwise)")
+                   "Border as a fraction of the side (default: the family's, 0.125 for bch, 0.25 "
+                   "for simple)")
       ->check(CLI::Range(0.01, 0.4));
   command
       ->add_option("--threshold", options->threshold,

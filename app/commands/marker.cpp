@@ -10,6 +10,7 @@
 #include "arbci/vision/id_codes.h"
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/marker_printer.h"
+#include "arbci/vision/settings.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
 #include "support/id_list.h"
@@ -37,10 +38,9 @@ void writeText(const std::filesystem::path& path, const std::string& text) {
 }
 
 void makeMarkers(const MakeOptions& options) {
-  const vision::MarkerKind kind = vision::markerKindFromString(options.kind);
-  if (kind != vision::MarkerKind::Bch && kind != vision::MarkerKind::Simple) {
-    throw CliError("--kind must be bch or simple");
-  }
+  const auto& family = vision::markerFamilies().at(options.kind);
+  if (!family.make.printable) throw CliError("--kind " + options.kind + " is not printable here");
+  const vision::MarkerKind kind = family.make.kind;
   const int max_id =
       kind == vision::MarkerKind::Bch ? vision::BchCode::kMaxId : vision::SimpleIdCode::kMaxId;
   const std::vector<int> ids = parseIdList(options.ids, max_id);
@@ -116,8 +116,11 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
   auto make = std::make_shared<MakeOptions>();
   auto* make_command = marker->add_subcommand(
       "make", "Write printable markers as PNG (at print resolution) and SVG");
+  std::vector<std::string> printable;
+  for (const auto& family : vision::markerFamilies().entries())
+    if (family.make.printable) printable.push_back(family.name);
   make_command->add_option("--kind", make->kind, "bch (0..4095) or simple (0..511)")
-      ->check(CLI::IsMember({"bch", "simple"}))
+      ->check(CLI::IsMember(printable))
       ->capture_default_str();
   make_command->add_option("--id", make->ids, "Marker id, list or range: 7, 1,4,9 or 0-11")
       ->required();

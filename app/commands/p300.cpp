@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "arbci/bci/channel_quality.h"
+#include "arbci/bci/classifier.h"
 #include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/session/session_config.h"
@@ -392,14 +393,13 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   auto t = std::make_shared<TrainOptions>();
   CLI::App* train_cmd = root.add_subcommand(
       "train",
-      "Train a P300 model (SWLDA as BCI2000, shrinkage LDA, xDAWN + LDA, or the\n"
-      "Riemannian method: xDAWN covariances in the tangent space, then LDA) on\n"
+      "Train a P300 model (--method: one of the classifiers, docs/settings.md) on\n"
       "recordings with known targets (BCI2000 .dat, ARBCI BDF+), cross-validated\n"
-      "by selection.");
+      "by selection. Options not given take a session's defaults (arbci settings).");
   train_cmd->add_option("FILES", t->files, "training recordings")->required();
-  train_cmd->add_option("--method", t->training.method, "swlda, slda, xdawn or riemann")
+  train_cmd->add_option("--method", t->training.method, bci::classifiers().list(", "))
       ->capture_default_str()
-      ->check(CLI::IsMember({"swlda", "slda", "xdawn", "riemann"}));
+      ->check(CLI::IsMember(bci::classifiers().names()));
   train_cmd->add_option("--out", t->out, "model file to write (JSON)")->required();
   train_cmd->add_option("--channels", t->channels,
                         "comma-separated channels to use (default: all)");

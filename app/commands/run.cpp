@@ -128,7 +128,7 @@ void addRunCommand(CLI::App& root, int& exit_code) {
       "the session and saves its summary (its \"ended\": finished, aborted, estop or fault).\n"
       "Exit status: 0 finished, 3 ended otherwise, 4 a --script failed.");
   run->add_option("--session", o->session,
-                  "session file (JSON; see assets/sessions/simulated.json)");
+                  "session file (JSON: the keys it changes; docs/settings.md, `arbci settings`)");
   run->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
   run->add_option("--trials", o->trials, "online trials (overrides the session file)")
       ->check(CLI::Range(1, 1000));

@@ -69,7 +69,7 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
   if (options.session.empty()) {
     config.cameras.head_motion_m = 0.0;
     config.cameras.head_motion_deg = 0.0;
-    config.robot_speed_factor = 20.0;
+    config.robot.speed_factor = 20.0;
   }
   auto context = render::createHeadlessContext(size);
   session::SessionOptions session_options;
@@ -138,7 +138,7 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     ui::SessionPanel session_panel(model);
     ui::HmdPanel hmd_panel(opened.hmd->texture(),
-                           static_cast<float>(config.hmd_width) / config.hmd_height);
+                           static_cast<float>(config.hmd.width) / config.hmd.height);
     ui::RobotPanel robot_panel(model);
     ui::ThresholdPanel threshold_panel(model);
     renderPanels(*context, size, {&session_panel, &hmd_panel, &robot_panel, &threshold_panel},

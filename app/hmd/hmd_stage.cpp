@@ -7,7 +7,7 @@
 namespace arbci::app {
 
 HmdSettings HmdSettings::of(const session::SessionConfig& config) {
-  return {config.hmd_width,     config.hmd_height, config.undistort,
+  return {config.hmd.width,     config.hmd.height, config.hmd.undistort,
           config.world.objects, config.world.grid, !config.eeg.photodiode_channel.empty()};
 }
 

@@ -9,6 +9,7 @@
 #include "arbci/robot/backend.h"
 #include "arbci/robot/key_file.h"
 #include "arbci/robot/robot_config.h"
+#include "arbci/robot/settings.h"
 #include "arbci/robot/simulated_arm.h"
 
 namespace {
@@ -30,7 +31,7 @@ int main(int argc, char** argv) {
       "docs/robot-protocol.md.",
       "arbci-robotd"};
   int port = 47800;
-  std::string host = "127.0.0.1", key_file, config_file, port_file;
+  std::string host = "127.0.0.1", key_file, config_file, port_file, driver = "simulated";
   double speed = 0.0;
   bool stepped = false;
   int watchdog_ms = 100;
@@ -42,6 +43,9 @@ int main(int argc, char** argv) {
   app.add_option("--host", host, "address to listen on (127.0.0.1: this machine only)")
       ->capture_default_str();
   app.add_option("--key-file", key_file, "the shared key")->required();
+  app.add_option("--driver", driver, "the arm to drive: " + arbci::robot::robotDrivers().list(", "))
+      ->capture_default_str()
+      ->check(CLI::IsMember(arbci::robot::robotDrivers().names()));
   app.add_option("--config", config_file,
                  "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
   app.add_option("--speed", speed,
@@ -72,8 +76,8 @@ int main(int argc, char** argv) {
     options.log = &std::cerr;
     options.stepped = stepped;
     options.watchdog_s = watchdog_ms / 1000.0;
-    arbci::robot::RobotBackend backend(key, std::make_unique<arbci::robot::SimulatedArm>(config),
-                                       options);
+    arbci::robot::RobotBackend backend(
+        key, arbci::robot::robotDrivers().at(driver).make.make(config), options);
     if (!port_file.empty()) {
       std::ofstream out(port_file);
       out << backend.port() << "\n";
@@ -81,8 +85,8 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port()
-              << " (simulated arm, speed x" << options.speed_factor << ", " << config.objects.size()
+    std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port() << " (" << driver
+              << " arm, speed x" << options.speed_factor << ", " << config.objects.size()
               << " objects, watchdog "
               << (stepped           ? std::string("off (stepped)")
                   : watchdog_ms > 0 ? std::to_string(watchdog_ms) + " ms"

@@ -56,11 +56,9 @@ class SimulatedScene final : public session::SceneSource {
 void registerSimulatedScene() {
   static std::once_flag once;
   std::call_once(once, [] {
-    session::sceneSources().add(
-        {"simulated",
-         "the simulated world: a table with the session's objects and the reference marker, "
-         "rendered for a stereo rig at the subject's head",
-         [](const session::SceneSettings& s) { return std::make_unique<SimulatedScene>(s); }});
+    session::sceneSources().provide("simulated", [](const session::SceneSettings& s) {
+      return std::make_unique<SimulatedScene>(s);
+    });
   });
 }
 

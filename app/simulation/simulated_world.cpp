@@ -14,13 +14,11 @@ SimulatedWorld::SimulatedWorld(const session::SceneSettings& settings) : setting
   const session::WorldSettings& w = settings.world;
   scene_.table_z = w.table_z;
   scene_.reference = {vision::MarkerKind::Bch, w.reference_id, w.reference_size_m,
-                      settings.tracker_border};
+                      settings.marker_border};
   scene_.T_world_reference = {cv::Matx33d::eye(), w.reference_position};
   for (const session::WorldObjectSettings& o : w.objects) {
     render::SceneObject object;
-    object.marker = {
-        settings.tracker_kind == "simple" ? vision::MarkerKind::Simple : vision::MarkerKind::Bch,
-        o.id, o.marker_m, settings.tracker_border};
+    object.marker = {settings.marker_kind, o.id, o.marker_m, settings.marker_border};
     object.T_world_top = {cv::Matx33d::eye(), o.position};
     object.width_m = o.width_m;
     object.height_m = o.height_m;

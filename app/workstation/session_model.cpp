@@ -9,7 +9,7 @@ std::string timingWarning(const session::Session& session) {
   if (!p.display_too_slow || !p.median_frame_ms) return "";
   char text[160];
   std::snprintf(text, sizeof text, "display too slow: a frame every %.1f ms (configured %.1f ms)",
-                *p.median_frame_ms, 1000.0 / session.config().display_hz);
+                *p.median_frame_ms, 1000.0 / session.config().paradigm.display_hz);
   return text;
 }
 

@@ -30,6 +30,12 @@ class SessionModel final : public ui::WorkstationModel {
 
   std::optional<bci::P300Model> model() override;
   void useModel(const bci::P300Model& model) override;
+  bci::TrainingSettings trainingSettings() override {
+    return session_.config().classifier.training;
+  }
+  bci::PipelineSettings pipelineSettings() override {
+    return session_.config().classifier.pipeline;
+  }
   std::optional<bci::ErpCurves> sessionErp() override;
   std::optional<bci::ErpCurves> sessionErrpErp() override;
   std::optional<double> errpThreshold() override {
@@ -59,7 +65,7 @@ class SessionModel final : public ui::WorkstationModel {
   bool preflightRunning() override { return record().preflight.running; }
   std::vector<std::pair<std::string, std::string>> endSummary() override;
   std::string trackingAlarm() override;
-  double maxPoseAgeS() override { return session_.config().max_pose_age_s; }
+  double maxPoseAgeS() override { return session_.config().tracker.max_pose_age_s; }
   std::optional<double> referenceAgeS() override;
   void start() override { session_.request(session::StartRequest{}); }
   void pause() override { session_.request(session::PauseRequest{}); }

@@ -10,6 +10,7 @@
 #include "arbci/render/window_context.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "hmd/hmd_stage.h"
 #include "hmd/open_session.h"
@@ -48,10 +49,11 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   window.title = "ARBCI workstation";
   render::WindowContext main_window(window);
   std::unique_ptr<render::WindowContext> mirror;
-  if (config.mirror_monitor >= 0 && config.mirror_monitor < render::WindowContext::monitorCount()) {
+  if (config.hmd.mirror_monitor >= 0 &&
+      config.hmd.mirror_monitor < render::WindowContext::monitorCount()) {
     render::WindowOptions m;
     m.title = "ARBCI HMD";
-    m.fullscreen_monitor = config.mirror_monitor;
+    m.fullscreen_monitor = config.hmd.mirror_monitor;
     m.share_with = main_window.window();
     mirror = std::make_unique<render::WindowContext>(m);
     main_window.makeCurrent();
@@ -62,21 +64,16 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   SessionModel model(session);
   ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;
-  ui::SessionPanel session_panel(model);
-  ui::HmdPanel hmd_panel(opened.hmd->texture(),
-                         static_cast<float>(config.hmd_width) / config.hmd_height);
-  ui::ThresholdPanel threshold_panel(model);
-  ui::RobotPanel robot_panel(model);
-  ui::CalibrationPanel calibration_panel(model);
-  ui::TrainingPanel training_panel(model);
-  ui::SummaryPanel summary_panel(model);
-  shell.addPanel(session_panel);
-  shell.addPanel(hmd_panel);
-  shell.addPanel(robot_panel);
-  shell.addPanel(threshold_panel);
-  shell.addPanel(calibration_panel, false);
-  shell.addPanel(training_panel, false);
-  shell.addPanel(summary_panel, false);
+  // Every registered panel, in the registry's order; the summary opens when the session ends.
+  const ui::PanelContext panel_context{model, opened.hmd->texture(),
+                                       static_cast<float>(config.hmd.width) / config.hmd.height};
+  std::vector<std::unique_ptr<ui::Panel>> panels;
+  ui::Panel* summary_panel = nullptr;
+  for (const auto& entry : ui::panels().entries()) {
+    panels.push_back(entry.make.make(panel_context));
+    shell.addPanel(*panels.back(), entry.make.open_at_start);
+    if (entry.name == "summary") summary_panel = panels.back().get();
+  }
   shell.setEmergencyStop([&] { model.emergencyStop(); });
   shell.setQuitHandler([&] { main_window.requestClose(); });
   // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
@@ -92,7 +89,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     main_window.makeCurrent();  // the simulated cameras render in it
     session.step();
     if (session.ended() && !summary_shown) {
-      shell.show(summary_panel);  // once: the experimenter may close it
+      if (summary_panel) shell.show(*summary_panel);  // once: the experimenter may close it
       summary_shown = true;
     }
     main_window.makeCurrent();

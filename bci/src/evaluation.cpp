@@ -220,8 +220,8 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
     if (!data.selections[s].target_codes.empty()) labelled.push_back(static_cast<int>(s));
   }
   // Settings the data cannot meet fail now, not in the first fold.
-  if (settings.method == "xdawn" || settings.method == "riemann")
-    checkFilterCount(settings.xdawn.filters, data.shape.channels);
+  const ClassifierParts& parts = classifiers().at(settings.method).make;
+  if (parts.check) parts.check(settings, data.shape);
   CrossValidation cv;
   cv.folds_by = foldScheme(data, settings.folds_by);
   cv.scores.assign(static_cast<size_t>(data.epochs()), 0.0);
@@ -258,7 +258,7 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
       x.row(static_cast<Eigen::Index>(i)) = data.features.row(train_rows[i]);
       y.push_back(data.target[static_cast<size_t>(train_rows[i])]);
     }
-    auto classifier = makeClassifier(settings.method, settings.swlda, settings.xdawn);
+    auto classifier = makeClassifier(settings);
     const Progress inner = progress ? Progress([&](double f, const std::string& stage) {
       progress((fold + f) / (cv.folds + 1.0),
                "fold " + std::to_string(fold + 1) + "/" + std::to_string(cv.folds) + ": " + stage);

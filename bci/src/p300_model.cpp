@@ -72,9 +72,13 @@ P300Model P300Model::fromJson(const nlohmann::json& json, const std::string& sou
     if (!(model.rate_hz > 0.0)) throw ModelError(source + ": signal.rate_hz must be positive");
     const auto& p = json.at("pipeline");
     const auto& f = p.at("filter");
-    model.pipeline.filter = {f.at("common_average").get<bool>(), f.at("highpass_hz").get<double>(),
-                             f.at("lowpass_hz").get<double>(),   f.at("order").get<int>(),
-                             f.at("notch_hz").get<double>(),     f.at("notch_q").get<double>()};
+    FilterSettings& filter = model.pipeline.filter;
+    filter.common_average = f.at("common_average").get<bool>();
+    filter.highpass_hz = f.at("highpass_hz").get<double>();
+    filter.lowpass_hz = f.at("lowpass_hz").get<double>();
+    filter.order = f.at("order").get<int>();
+    filter.notch_hz = f.at("notch_hz").get<double>();
+    filter.notch_q = f.at("notch_q").get<double>();
     const auto window = p.at("window_s").get<std::vector<double>>();
     if (window.size() != 2 || !(window[1] > window[0]))
       throw ModelError(source + ": pipeline.window_s must be [start, end]");
@@ -147,7 +151,7 @@ std::string P300Model::bci2000Fragment() const {
   if (w.size() != shape.size()) {
     throw ModelError("a " + method +
                      " model is not linear in its features: BCI2000's LinearClassifier cannot "
-                     "run it (train swlda, slda or xdawn for BCI2000)");
+                     "run it (train a linear method for BCI2000)");
   }
   std::ostringstream entries;
   int count = 0;
@@ -204,7 +208,7 @@ TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipel
     x.row(static_cast<Eigen::Index>(i)) = data.features.row(rows[i]);
     y.push_back(data.target[static_cast<size_t>(rows[i])]);
   }
-  auto classifier = makeClassifier(settings.method, settings.swlda, settings.xdawn);
+  auto classifier = makeClassifier(settings);
   classifier->train(x, y, data.shape,
                     progress ? Progress([&](double f, const std::string& stage) {
                       const double folds = result.cross_validation.folds;
@@ -230,13 +234,8 @@ TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipel
                         {"auc", report.auc},
                         {"accuracy_by_sequences", report.accuracy},
                         {"bits_per_minute", report.bits_per_minute}}}};
-  if (settings.method == "swlda") {
-    model.provenance["parameters"] = {{"p_enter", settings.swlda.p_enter},
-                                      {"p_remove", settings.swlda.p_remove},
-                                      {"max_features", settings.swlda.max_features}};
-  } else if (settings.method == "xdawn") {
-    model.provenance["parameters"] = {{"filters", settings.xdawn.filters}};
-  }
+  const ClassifierParts& parts = classifiers().at(settings.method).make;
+  if (parts.parameters) model.provenance["parameters"] = parts.parameters(settings);
   return result;
 }
 

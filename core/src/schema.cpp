@@ -83,8 +83,10 @@ Key& Table::add(Key key) {
 
 nlohmann::json Table::defaults() const {
   nlohmann::json out = nlohmann::json::object();
-  for (const Key& key : keys_)
+  for (const Key& key : keys_) {
+    if (key.required) continue;
     out[key.name] = key.type == Type::Section ? key.table->defaults() : key.fallback;
+  }
   return out;
 }
 

@@ -3,95 +3,123 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "arbci/robot/settings.h"
+
 namespace arbci::robot {
 namespace {
 
-Vec3 vec(const nlohmann::json& j, const std::string& field, const std::string& file) {
-  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() ||
-      !j[2].is_number()) {
-    throw ConfigError(file + ": " + field + " must be [x, y, z] in metres");
-  }
-  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+using Json = nlohmann::json;
+using core::Key;
+using core::Type;
+
+// A point in metres, [x, y, z] (robot frame).
+template <class S>
+core::Schema<S>& point(core::Schema<S>& t, const std::string& name, Vec3 S::*member, Json fallback,
+                       const std::string& doc, bool required = false) {
+  Key k{name, Type::Numbers, std::move(fallback), doc, "m"};
+  k.min_items = k.max_items = 3;
+  k.required = required;
+  return t.custom(
+      k,
+      [member](S& s, const Json& j) {
+        s.*member = {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+      },
+      [member](const S& s) {
+        return Json::array({(s.*member).x, (s.*member).y, (s.*member).z});
+      });
 }
 
-double positive(const nlohmann::json& j, const std::string& field, double fallback,
-                const std::string& file) {
-  if (!j.contains(field)) return fallback;
-  if (!j[field].is_number() || !(j[field].get<double>() > 0.0))
-    throw ConfigError(file + ": " + field + " must be a positive number");
-  return j[field].get<double>();
+constexpr double kTiny = 1e-6;  // "positive": above it
+
+const core::Schema<SimulatedObject>& objectSchema() {
+  static const core::Schema<SimulatedObject> table = [] {
+    core::Schema<SimulatedObject> t("object", "An object of the simulated world");
+    t.required(Key{"id", Type::Integer, nullptr, "its marker id", "", 0, 1 << 30},
+               &SimulatedObject::id);
+    point(t, "position", &SimulatedObject::position, nullptr, "the centre of its top face", true);
+    t.number("height", &SimulatedObject::height, 0.06, kTiny, 10.0, "its height", "m")
+        .number("radius", &SimulatedObject::radius, 0.03, kTiny, 10.0,
+                "its footprint's radius, for contact and grasping", "m");
+    return t;
+  }();
+  return table;
+}
+
+const core::Schema<RobotConfig>& workspaceSchema() {
+  static const core::Schema<RobotConfig> table = [] {
+    core::Schema<RobotConfig> t("workspace", "The box the tool may reach (robot frame)");
+    point(t, "min", &RobotConfig::workspace_min, {-0.7, 0.2, 0.0}, "its lower corner");
+    point(t, "max", &RobotConfig::workspace_max, {0.7, 1.1, 0.6}, "its upper corner");
+    t.rule([](const Json& w) -> std::optional<std::pair<std::string, std::string>> {
+      for (int i = 0; i < 3; ++i) {
+        if (!(w["min"][i].get<double>() < w["max"][i].get<double>()))
+          return std::pair{"min", "must lie below workspace.max on every axis"};
+      }
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return table;
 }
 
 }  // namespace
+
+const core::Schema<RobotConfig>& configSchema() {
+  static const core::Schema<RobotConfig> table = [] {
+    using R = RobotConfig;
+    core::Schema<R> t("robot backend", "The backend's configuration (arbci-robotd --config)");
+    t.number("speed_factor", &R::speed_factor, 1.0, 0.01, 100.0,
+             "simulated seconds per real second")
+        .number("table_z", &R::table_z, 0.0, -2.0, 2.0, "the table's height", "m")
+        .sectionOf("workspace", workspaceSchema())
+        .number("approach_height", &R::approach_height, 0.10, kTiny, 2.0,
+                "above the target before descending", "m")
+        .number("lift_height", &R::lift_height, 0.25, kTiny, 2.0, "above the table after grasping",
+                "m")
+        .number("cartesian_speed", &R::cartesian_speed, 0.30, kTiny, 5.0, "the tool's speed", "m/s")
+        .number("descend_speed", &R::descend_speed, 0.06, kTiny, 5.0,
+                "the tool's speed down to contact", "m/s")
+        .number("max_joint_speed", &R::max_joint_speed, 1.2, kTiny, 20.0, "any joint's limit",
+                "rad/s")
+        .number("gripper_seconds", &R::gripper_seconds, 0.5, kTiny, 60.0,
+                "how long the gripper takes to open or close", "s");
+    point(t, "home", &R::home, {0.0, 0.45, 0.45}, "where HOME parks the tool");
+    t.list("objects", &R::objects, objectSchema(), Json::array(), 0,
+           "the simulated world's objects (none: a real arm's world is its own)");
+    return t;
+  }();
+  return table;
+}
+
+SimulatedObject::SimulatedObject() : id(0), position{} {
+  objectSchema().applyDefaults(*this);
+}
+
+RobotConfig::RobotConfig() {
+  configSchema().applyDefaults(*this);
+}
 
 RobotConfig RobotConfig::load(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::ifstream in(path);
   if (!in) throw ConfigError(file + ": cannot open");
-  nlohmann::json j;
+  Json j;
   try {
     in >> j;
-  } catch (const nlohmann::json::exception& error) {
+  } catch (const Json::exception& error) {
     throw ConfigError(file + ": not JSON (" + error.what() + ")");
   }
-  if (!j.is_object()) throw ConfigError(file + ": must be a JSON object");
   RobotConfig c;
-  c.speed_factor = positive(j, "speed_factor", c.speed_factor, file);
-  if (j.contains("table_z")) {
-    if (!j["table_z"].is_number()) throw ConfigError(file + ": table_z must be a number");
-    c.table_z = j["table_z"].get<double>();
-  }
-  if (j.contains("workspace")) {
-    c.workspace_min = vec(j["workspace"].value("min", nlohmann::json()), "workspace.min", file);
-    c.workspace_max = vec(j["workspace"].value("max", nlohmann::json()), "workspace.max", file);
-    if (!(c.workspace_min.x < c.workspace_max.x && c.workspace_min.y < c.workspace_max.y &&
-          c.workspace_min.z < c.workspace_max.z)) {
-      throw ConfigError(file + ": workspace.min must lie below workspace.max on every axis");
-    }
-  }
-  c.approach_height = positive(j, "approach_height", c.approach_height, file);
-  c.lift_height = positive(j, "lift_height", c.lift_height, file);
-  c.cartesian_speed = positive(j, "cartesian_speed", c.cartesian_speed, file);
-  c.descend_speed = positive(j, "descend_speed", c.descend_speed, file);
-  c.max_joint_speed = positive(j, "max_joint_speed", c.max_joint_speed, file);
-  c.gripper_seconds = positive(j, "gripper_seconds", c.gripper_seconds, file);
-  if (j.contains("home")) c.home = vec(j["home"], "home", file);
-  if (j.contains("objects")) {
-    if (!j["objects"].is_array()) throw ConfigError(file + ": objects must be a list");
-    for (size_t i = 0; i < j["objects"].size(); ++i) {
-      const auto& o = j["objects"][i];
-      const std::string at = "objects[" + std::to_string(i) + "]";
-      if (!o.is_object() || !o.contains("id") || !o["id"].is_number_integer())
-        throw ConfigError(file + ": " + at + ".id must be an integer");
-      SimulatedObject object;
-      object.id = o["id"].get<int>();
-      object.position = vec(o.value("position", nlohmann::json()), at + ".position", file);
-      object.height = positive(o, "height", object.height, file);
-      object.radius = positive(o, "radius", object.radius, file);
-      c.objects.push_back(object);
-    }
+  try {
+    configSchema().read(configSchema().resolve(j, core::Place{file, ""}), c);
+  } catch (const core::SettingsError& error) {
+    throw ConfigError(error.what());
   }
   return c;
 }
 
 std::string RobotConfig::toJson() const {
-  auto v = [](const Vec3& p) { return nlohmann::json::array({p.x, p.y, p.z}); };
-  nlohmann::json j = {{"speed_factor", speed_factor},
-                      {"table_z", table_z},
-                      {"workspace", {{"min", v(workspace_min)}, {"max", v(workspace_max)}}},
-                      {"approach_height", approach_height},
-                      {"lift_height", lift_height},
-                      {"cartesian_speed", cartesian_speed},
-                      {"descend_speed", descend_speed},
-                      {"max_joint_speed", max_joint_speed},
-                      {"gripper_seconds", gripper_seconds},
-                      {"home", v(home)},
-                      {"objects", nlohmann::json::array()}};
-  for (const SimulatedObject& o : objects) {
-    j["objects"].push_back(
-        {{"id", o.id}, {"position", v(o.position)}, {"height", o.height}, {"radius", o.radius}});
-  }
-  return j.dump(2);
+  return configSchema().write(*this).dump(2);
 }
 
 }  // namespace arbci::robot

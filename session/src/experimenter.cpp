@@ -115,6 +115,21 @@ std::string whyNot(Action action, const CycleRecord& last, bool ended) {
   }
 }
 
+std::optional<Action> actionOf(const Request& request) {
+  if (std::holds_alternative<StartRequest>(request)) return Action::Start;
+  if (std::holds_alternative<PauseRequest>(request)) return Action::Pause;
+  if (std::holds_alternative<ResumeRequest>(request)) return Action::Resume;
+  if (std::holds_alternative<AbortRequest>(request)) return Action::Abort;
+  if (std::holds_alternative<EmergencyStopRequest>(request)) return Action::EmergencyStop;
+  if (std::holds_alternative<RobotResetRequest>(request)) return Action::ResetRobot;
+  if (std::holds_alternative<RobotHomeRequest>(request)) return Action::Home;
+  if (std::holds_alternative<RobotReleaseRequest>(request)) return Action::OpenGripper;
+  if (std::holds_alternative<RetryStepRequest>(request)) return Action::RetryStep;
+  if (std::holds_alternative<SkipTrialRequest>(request)) return Action::SkipTrial;
+  if (std::holds_alternative<EndSessionRequest>(request)) return Action::EndSession;
+  return std::nullopt;
+}
+
 std::string endKindOf(const std::string& reason, bci::Phase phase) {
   if (reason == "finished" || reason == "timing check done") return "finished";
   if (phase == bci::Phase::EmergencyStop) return "estop";

@@ -6,14 +6,9 @@
 
 namespace arbci::session {
 
-RobotSettings RobotSettings::of(const SessionConfig& config) {
-  return {config.robot_backend, config.robot_speed_factor, config.robot_host,
-          config.robot_port,    config.robot_key_file,     config.source};
-}
-
-void RobotSettings::validate() const {
-  if (!key_file.empty() && !std::filesystem::exists(key_file))
-    throw SessionConfigError(session_file + ": robot.key_file = \"" + key_file +
+void checkRobotKey(const RobotSettings& settings, const std::string& session_file) {
+  if (!settings.key_file.empty() && !std::filesystem::exists(settings.key_file))
+    throw SessionConfigError(session_file + ": robot.key_file = \"" + settings.key_file +
                              "\": no such file");
 }
 

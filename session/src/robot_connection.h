@@ -15,18 +15,9 @@
 
 namespace arbci::session {
 
-// What the robot link needs of the session file, and nothing else.
-struct RobotSettings {
-  std::string backend;  // "simulated" or "remote"
-  double speed_factor;  // the simulated arm's
-  std::string host;
-  int port;
-  std::string key_file;
-  std::string session_file;  // for messages naming a key
-  static RobotSettings of(const SessionConfig& config);
-  // Before the run: the key file exists; throws SessionConfigError naming the key and value.
-  void validate() const;
-};
+// Before the run: the key file a remote robot names exists; throws SessionConfigError naming the
+// key and value (`session_file` first).
+void checkRobotKey(const RobotSettings& settings, const std::string& session_file);
 
 struct RobotLink {
   std::unique_ptr<RobotProcess> backend;  // arbci-robotd, for a simulated robot

@@ -55,8 +55,14 @@ class DeviceScene final : public SceneSource {
 }  // namespace
 
 SceneSettings SceneSettings::of(const SessionConfig& config) {
-  return {config.cameras,  config.world,      config.tracker_kind,       config.tracker_border,
-          config.eeg.seed, config.display_hz, config.robot_speed_factor, config.source};
+  return {config.cameras,
+          config.world,
+          config.tracker.detector.kind,
+          config.tracker.detector.border,
+          config.eeg.seed,
+          config.paradigm.display_hz,
+          config.robot.speed_factor,
+          config.source};
 }
 
 void SceneSettings::validate() const {
@@ -87,6 +93,14 @@ void SceneSettings::validate() const {
 core::Registry<SceneFactory>& sceneSources() {
   static core::Registry<SceneFactory> registry = [] {
     core::Registry<SceneFactory> r("camera source", "cameras.source");
+    r.add({"simulated",
+           "the simulated world: the session's table, objects and reference marker rendered for "
+           "a stereo rig at the subject's head (cameras.width ... blur_px)",
+           [](const SceneSettings&) -> std::unique_ptr<SceneSource> {
+             throw std::logic_error(
+                 "the simulated cameras render with the application's GL context: "
+                 "app::registerSimulatedScene() provides them");
+           }});
     r.add({"devices", "camera devices (V4L2) or video files, each with its calibration",
            [](const SceneSettings& s) { return std::make_unique<DeviceScene>(s); }});
     return r;

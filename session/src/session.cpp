@@ -6,46 +6,11 @@
 #include "stages/robot_stage.h"
 
 namespace arbci::session {
-namespace {
-
-// A live amplifier runs on its own clock: a session on it cannot be stepped by a simulated
-// clock, whoever asked for one (a headless run, a screenshot).
-SessionOptions forSource(SessionOptions options, const SessionConfig& config) {
-  if (config.eeg.live()) options.clock = Clock::Mode::RealTime;
-  return options;
-}
-
-SessionConfig withOptions(SessionConfig config, const SessionOptions& options) {
-  if (options.seed) config.eeg.seed = *options.seed;
-  if (options.trials) config.paradigm.trials = *options.trials;
-  // The timing check: cued flashing until flashes_only_s, when the session ends.
-  if (options.flashes_only_s > 0.0) config.paradigm.flashes_only = true;
-  return config;
-}
-
-// The experimenter's action a request is, for its why-not; none for the panels' settings.
-std::optional<Action> actionOf(const Request& request) {
-  if (std::holds_alternative<StartRequest>(request)) return Action::Start;
-  if (std::holds_alternative<PauseRequest>(request)) return Action::Pause;
-  if (std::holds_alternative<ResumeRequest>(request)) return Action::Resume;
-  if (std::holds_alternative<AbortRequest>(request)) return Action::Abort;
-  if (std::holds_alternative<EmergencyStopRequest>(request)) return Action::EmergencyStop;
-  if (std::holds_alternative<RobotResetRequest>(request)) return Action::ResetRobot;
-  if (std::holds_alternative<RobotHomeRequest>(request)) return Action::Home;
-  if (std::holds_alternative<RobotReleaseRequest>(request)) return Action::OpenGripper;
-  if (std::holds_alternative<RetryStepRequest>(request)) return Action::RetryStep;
-  if (std::holds_alternative<SkipTrialRequest>(request)) return Action::SkipTrial;
-  if (std::holds_alternative<EndSessionRequest>(request)) return Action::EndSession;
-  return std::nullopt;
-}
-
-}  // namespace
-
 Session::Session(SessionConfig config, const SessionOptions& requested,
                  const DisplayFactory& display)
-    : config_(withOptions(std::move(config), requested)),
-      options_(forSource(requested, config_)),
-      clock_(options_.clock, config_.display_hz),
+    : config_(configFor(std::move(config), requested)),
+      options_(optionsFor(requested, config_)),
+      clock_(options_.clock, config_.paradigm.display_hz),
       folder_(options_.folder),
       timing_(1000.0 * config_.eeg.block_size / config_.eeg.rate_hz) {
   std::error_code error;

@@ -21,20 +21,15 @@
 namespace arbci::session {
 namespace {
 
-SceneSettings sceneSettingsOf(const SessionConfig& c) {
-  return {c.cameras,  c.world,      c.tracker_kind,       c.tracker_border,
-          c.eeg.seed, c.display_hz, c.robot_speed_factor, c.source};
-}
-
 TrackingSettings trackingSettingsOf(const SessionConfig& c, SceneSource& scene) {
-  TrackingSettings t{vision::markerKindFromString(c.tracker_kind),
-                     c.tracker_border,
-                     c.tracker_search_decimate,
+  TrackingSettings t{c.tracker.detector.kind,
+                     c.tracker.detector.border,
+                     c.tracker.detector.search_decimate,
                      c.world.reference_id,
                      c.world.reference_size_m,
                      c.world.reference_position,
                      {},
-                     c.max_pose_age_s,
+                     c.tracker.max_pose_age_s,
                      scene.leftCamera(),
                      scene.rightCamera(),
                      scene.T_right_left(),
@@ -58,12 +53,12 @@ PreflightSettings preflightSettingsOf(const SessionConfig& c, double eeg_rate_hz
   }
   p.eeg_key = c.eeg.source == "file" ? "eeg.file" : "eeg.rate_hz";
   p.reference_id = c.world.reference_id;
-  if (c.robot_backend == "simulated") {
+  if (c.robot.backend == "simulated") {
     p.robot_key = "robot.backend";
     p.robot_what = "the simulated arm (arbci-robotd)";
   } else {
     p.robot_key = "robot.host, robot.port";
-    p.robot_what = "the robot backend at " + c.robot_host + ":" + std::to_string(c.robot_port);
+    p.robot_what = "the robot backend at " + c.robot.host + ":" + std::to_string(c.robot.port);
   }
   return p;
 }
@@ -77,8 +72,8 @@ std::map<std::string, std::string> recordingParameters(const SessionConfig& c) {
       {"GridCodes", "100 + row (1-" + std::to_string(c.world.grid.rows) + "), 100 + rows + column"},
       {"FlashMs", std::to_string(c.paradigm.flash_ms)},
       {"IsiMs", std::to_string(c.paradigm.isi_ms)},
-      {"DisplayHz", std::to_string(c.display_hz)},
-      {"Classifier", c.classifier_method},
+      {"DisplayHz", std::to_string(c.paradigm.display_hz)},
+      {"Classifier", c.classifier.training.method},
       {"PhotodiodeChannel", c.eeg.photodiode_channel},
       {"SoaMs", std::to_string(c.paradigm.soaSeconds() * 1000.0)},
       {"StimulusCodeMap", stimulusCodeMap(c.world, allSlots(c.world))},
@@ -87,13 +82,25 @@ std::map<std::string, std::string> recordingParameters(const SessionConfig& c) {
 
 }  // namespace
 
+SessionConfig configFor(SessionConfig config, const SessionOptions& options) {
+  if (options.seed) config.eeg.seed = *options.seed;
+  if (options.trials) config.paradigm.trials = *options.trials;
+  if (options.flashes_only_s > 0.0) config.paradigm.flashes_only = true;
+  return config;
+}
+
+SessionOptions optionsFor(SessionOptions options, const SessionConfig& config) {
+  if (config.eeg.live()) options.clock = Clock::Mode::RealTime;
+  return options;
+}
+
 void checkNamedResources(const SessionConfig& c) {
-  sceneSettingsOf(c).validate();
+  SceneSettings::of(c).validate();
   EegAcquisitionSettings{c.eeg, {}, 0.0, c.source}.validate();
-  if (!c.model_file.empty() && !std::filesystem::exists(c.model_file))
-    throw SessionConfigError(c.source + ": classifier.model = \"" + c.model_file +
+  if (!c.classifier.model_file.empty() && !std::filesystem::exists(c.classifier.model_file))
+    throw SessionConfigError(c.source + ": classifier.model = \"" + c.classifier.model_file +
                              "\": no such file");
-  RobotSettings::of(c).validate();
+  checkRobotKey(c.robot, c.source);
 }
 
 AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& options, Clock& clock,
@@ -101,17 +108,16 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
                                const DisplayFactory& display) {
   // Every stage's settings, checked before anything starts.
   checkNamedResources(c);
-  const SceneSettings scene_settings = sceneSettingsOf(c);
-  const RobotSettings robot_settings = RobotSettings::of(c);
+  const SceneSettings scene_settings = SceneSettings::of(c);
   EegAcquisitionSettings eeg_settings{c.eeg, {}, c.paradigm.flashSeconds(), c.source};
-  if (c.eeg.source == "lsl" || c.lsl.markers) eeg_settings.lsl = c.lsl.config(c.source);
+  if (c.eeg.live() || c.lsl.markers) eeg_settings.lsl = c.lsl.config(c.source);
   const int camera_every =
-      std::max(1, static_cast<int>(std::lround(c.display_hz / c.cameras.rate_hz)));
+      std::max(1, static_cast<int>(std::lround(c.paradigm.display_hz / c.cameras.rate_hz)));
 
   AssembledStages out;
   std::unique_ptr<SceneSource> scene = sceneSources().at(c.cameras.source).make(scene_settings);
   // The robot: arbci-robotd on 127.0.0.1 with a fresh key, or a remote backend.
-  RobotLink link = connectRobot(robot_settings, scene->simulatedRobot(), folder, clock);
+  RobotLink link = connectRobot(c.robot, scene->simulatedRobot(), folder, clock);
   auto robot = std::make_unique<RobotStage>(RobotStageSettings{c.world, camera_every},
                                             std::move(link), services);
   out.robot = robot.get();
@@ -124,16 +130,18 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
       RecordingSettings{folder / "recording.bdf", eeg->info(), recordingParameters(c)}, services);
   const bci::SignalInfo& eeg_info = eeg->eegInfo();
   auto p300 = std::make_unique<P300Stage>(
-      P300Settings{eeg_info, c.pipeline, c.paradigm.flashSeconds(),
-                   static_cast<int>(c.world.objects.size()), c.model_file, c.source},
+      P300Settings{eeg_info, c.classifier.pipeline, c.classifier.training,
+                   c.paradigm.flashSeconds(), static_cast<int>(c.world.objects.size()),
+                   c.classifier.model_file, c.source},
       services);
   ErrpStageSettings errp_settings;
   errp_settings.enabled = c.paradigm.errp;
   errp_settings.info = eeg_info;
-  if (c.paradigm.errp) errp_settings.pipeline = c.errp.pipeline(c.pipeline, c.eeg.montage);
+  if (c.paradigm.errp)
+    errp_settings.pipeline = c.errp.pipeline(c.classifier.pipeline, c.eeg.montage);
   errp_settings.training = c.errp.training();
   errp_settings.flash_s = c.paradigm.flashSeconds();
-  errp_settings.model_file = c.model_file;
+  errp_settings.model_file = c.classifier.model_file;
   errp_settings.threshold = c.errp.threshold;
   auto errp = std::make_unique<ErrpStage>(errp_settings, services);
   std::unique_ptr<LslMarkersStage> markers;
@@ -145,11 +153,11 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto presentation = std::make_unique<PresentationStage>(
       PresentationSettings{c.paradigm, eeg_info.rate_hz}, services);
   auto preflight = std::make_unique<PreflightStage>(
-      PreflightStageSettings{preflightSettingsOf(c, eeg_info.rate_hz), c.max_pose_age_s,
+      PreflightStageSettings{preflightSettingsOf(c, eeg_info.rate_hz), c.tracker.max_pose_age_s,
                              options.experimenter},
       services);
   auto paradigm = std::make_unique<ParadigmStage>(
-      ParadigmStageSettings{c.paradigm, c.world, c.classifier_method, intendedTrials(c),
+      ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
                             c.eeg.seed + 11, c.errp.threshold, folder / "model.json"},
       services);
   CycleRecord warm_up;

@@ -11,6 +11,13 @@
 
 namespace arbci::session {
 
+// The session file's settings with the run's options over them (seed, trials, the timing
+// check's flashes only).
+SessionConfig configFor(SessionConfig config, const SessionOptions& options);
+// The run's options as the session's sources allow: a live amplifier runs on its own clock, so a
+// session on it cannot be stepped, whoever asked for it (a headless run, a screenshot).
+SessionOptions optionsFor(SessionOptions options, const SessionConfig& config);
+
 struct AssembledStages {
   std::vector<std::unique_ptr<Stage>> stages;  // in the order they run
   RobotStage* robot = nullptr;

@@ -57,9 +57,9 @@ void write(const std::filesystem::path& path, const bci::Recording& recording) {
 TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
   const auto model = scratch("erp_model.json"), plots = scratch("erp_plots");
   std::filesystem::remove_all(plots);
-  const ProcessResult r =
-      runProcess(kArbci, {"train", "--method", "slda", "--highpass-hz", "0", "--lowpass-hz", "0",
-                          eeg("eeg3_1.dat"), "--out", model.string(), "--plots", plots.string()});
+  const ProcessResult r = runProcess(
+      kArbci, {"train", "--method", "slda", "--highpass-hz", "0", "--lowpass-hz", "0", "--notch-hz",
+               "0", eeg("eeg3_1.dat"), "--out", model.string(), "--plots", plots.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("plot: " + (plots / "erp.json").string()), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("plot: " + (plots / "scalp.png").string()), std::string::npos) << r.out;
@@ -246,7 +246,7 @@ TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
       runProcess(kArbci, {"train", "--method", "slda", by_class.string(), "--out",
                           scratch("by_class.json").string(), "--report", report.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("10 folds by block (the default here"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("4 folds by block (the default here"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("no selection metrics"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("bits/min"), std::string::npos) << r.out;
   std::ifstream in(report);

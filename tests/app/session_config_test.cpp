@@ -1,14 +1,20 @@
-// The session file: the embedded session is the one source of defaults (a file that names one key
-// leaves every other as the embedded file has it), and a bad value or key is refused with a
-// message naming the key, the value and what is allowed.
+// The session file and its schema: every key has one default, declared once in the schema (a
+// file that names one key leaves every other at the schema's default, and the library structs
+// the session fills default to the same values); no two entries name one key; a bad value or key
+// is refused with a message naming the key, the value and what is allowed; docs/settings.md is
+// the schema's.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <sstream>
 
-#include "arbci/assets.h"
+#include "arbci/bci/settings.h"
 #include "arbci/session/session.h"
 #include "arbci/session/session_config.h"
+#include "arbci/session/settings_schema.h"
+#include "arbci/vision/settings.h"
 #include "support/test_files.h"
 
 namespace arbci::session {
@@ -29,59 +35,75 @@ std::string errorOf(const std::string& json) {
   return "";
 }
 
-TEST(SessionConfig, AFileNamingOneKeyKeepsEveryOtherEmbeddedDefault) {
-  const SessionConfig embedded = SessionConfig::load(std::nullopt);
+// Every key's full path in the schema (sections and list items by their dotted names).
+void collectKeys(const core::Table& table, const std::string& path, std::vector<std::string>& out) {
+  for (const core::Key& key : table.keys()) {
+    const std::string name = path.empty() ? key.name : path + "." + key.name;
+    out.push_back(name);
+    if (key.table) collectKeys(*key.table, name + (key.type == core::Type::List ? "[]" : ""), out);
+  }
+}
+
+TEST(SessionConfig, AFileNamingOneKeyKeepsEveryOtherDefault) {
+  const SessionConfig defaults = SessionConfig::load(std::nullopt);
   const SessionConfig c =
       SessionConfig::load(sessionFile("one_key", R"({"paradigm": {"trials": 7}})"));
   EXPECT_EQ(c.paradigm.trials, 7);
-  EXPECT_NE(embedded.paradigm.trials, 7);
-  EXPECT_EQ(c.paradigm.flash_ms, embedded.paradigm.flash_ms);
-  EXPECT_EQ(c.paradigm.isi_ms, embedded.paradigm.isi_ms);
-  EXPECT_EQ(c.paradigm.sequences, embedded.paradigm.sequences);
-  EXPECT_EQ(c.paradigm.min_sequences, embedded.paradigm.min_sequences);
-  EXPECT_EQ(c.paradigm.certainty, embedded.paradigm.certainty);
-  EXPECT_EQ(c.paradigm.calibration_selections, embedded.paradigm.calibration_selections);
-  EXPECT_EQ(c.paradigm.cue_s, embedded.paradigm.cue_s);
-  EXPECT_EQ(c.pipeline.window.end_s, embedded.pipeline.window.end_s);
-  EXPECT_EQ(c.pipeline.decimate_hz, embedded.pipeline.decimate_hz);
-  EXPECT_EQ(c.pipeline.filter.lowpass_hz, embedded.pipeline.filter.lowpass_hz);
-  EXPECT_EQ(c.eeg.photodiode_channel, "Photodiode");
-  EXPECT_EQ(c.eeg.latency_ms, 0.0);
+  EXPECT_NE(defaults.paradigm.trials, 7);
+  nlohmann::json expected = defaults.toJson();
+  expected["paradigm"]["trials"] = 7;
+  EXPECT_EQ(c.toJson(), expected);
 }
 
-TEST(SessionConfig, TheEmbeddedFileSetsWhatTheParserWouldOtherwiseDefault) {
-  // Changing a default in the embedded file (not in code) is what a change of default means:
-  // a file that sets a classifier value keeps the embedded window.
-  const SessionConfig c =
-      SessionConfig::load(sessionFile("classifier", R"({"classifier": {"decimate_hz": 32}})"));
-  EXPECT_EQ(c.pipeline.decimate_hz, 32.0);
-  EXPECT_EQ(c.pipeline.window.start_s, 0.0);
-  EXPECT_EQ(c.pipeline.window.end_s, 0.8);
+// The one place a default is written is the schema: an empty session file runs exactly the
+// schema's defaults, and the structs of bci/ and vision/ that a session fills default to the same.
+TEST(SessionSchema, EveryDefaultIsWhatARunWithAnEmptySessionFileUses) {
+  const SessionConfig empty = SessionConfig::load(sessionFile("empty", "{}"));
+  EXPECT_EQ(empty.toJson(), sessionSchema().defaults());
+  EXPECT_EQ(SessionConfig{}.toJson(), sessionSchema().defaults());
+  // The library structs carry no defaults of their own.
+  EXPECT_EQ(bci::paradigmSchema().write(bci::ParadigmSettings{}),
+            bci::paradigmSchema().write(empty.paradigm));
+  EXPECT_EQ(bci::pipelineSchema().write(bci::PipelineSettings{}),
+            bci::pipelineSchema().write(empty.classifier.pipeline));
+  EXPECT_EQ(bci::trainingSchema().write(bci::TrainingSettings{}),
+            bci::trainingSchema().write(empty.classifier.training));
+  EXPECT_EQ(vision::detectorSchema().write(vision::DetectorConfig{}),
+            vision::detectorSchema().write(empty.tracker.detector));
+  const bci::SimulatedSubjectConfig subject;
+  EXPECT_EQ(subject.montage, empty.eeg.montage);
+  EXPECT_EQ(subject.rate_hz, empty.eeg.rate_hz);
+  EXPECT_EQ(subject.block_size, empty.eeg.block_size);
+  EXPECT_EQ(subject.seed, empty.eeg.seed);
+  EXPECT_EQ(subject.line_hz, empty.eeg.line_hz);
+  EXPECT_EQ(subject.photodiode_channel, empty.eeg.photodiode_channel);
+  // The values the defaults have always had (the simulated session's).
+  EXPECT_EQ(empty.paradigm.sequences, 8);
+  EXPECT_EQ(empty.paradigm.certainty, 0.999);
+  EXPECT_EQ(empty.classifier.pipeline.filter.notch_hz, 50.0);
+  EXPECT_EQ(empty.eeg.rate_hz, 256.0);
+  EXPECT_EQ(empty.world.objects.size(), 4u);
 }
 
-// The embedded file is the one source of defaults: it must set every key the parser reads, so no
-// value in code is ever a session's default. Taking any key out of it is refused, naming the key.
-TEST(SessionConfig, TheEmbeddedDefaultsMustSetEveryKey) {
-  const std::string embedded(assets::embedded("sessions/simulated.json"));
-  EXPECT_NO_THROW(SessionConfig::defaults(embedded, "embedded"));
-  for (const auto& [setting, dotted] :
-       {std::pair{"\"cue_s\": 1.5,", "paradigm.cue_s"},
-        std::pair{"\"notch_hz\": 50, ", "classifier.notch_hz"},
-        std::pair{"\"speed_factor\": 8, ", "robot.speed_factor"},
-        std::pair{"\"photodiode_channel\": \"Photodiode\",", "eeg.photodiode_channel"},
-        std::pair{"\"blur_px\": 0.5,", "cameras.blur_px"}}) {
-    std::string lacking = embedded;
-    const size_t at = lacking.find(setting);
-    ASSERT_NE(at, std::string::npos) << setting;
-    lacking.erase(at, std::string(setting).size());
-    std::string message;
-    try {
-      SessionConfig::defaults(lacking, "embedded");
-    } catch (const SessionConfigError& error) {
-      message = error.what();
-    }
-    EXPECT_NE(message.find(std::string(dotted) + " has no default"), std::string::npos) << message;
-  }
+TEST(SessionSchema, NoTwoEntriesNameTheSameKey) {
+  std::vector<std::string> keys;
+  collectKeys(sessionSchema(), "", keys);
+  std::set<std::string> unique(keys.begin(), keys.end());
+  EXPECT_EQ(unique.size(), keys.size());
+  EXPECT_GT(keys.size(), 100u);
+  for (const char* key : {"display_hz", "paradigm.flash_ms", "errp.enabled", "classifier.method",
+                          "eeg.lsl.name", "eeg.eegdev.device", "world.objects[].id"})
+    EXPECT_TRUE(unique.count(key)) << key;
+}
+
+// docs/settings.md is generated from the schema (arbci settings --markdown): it is never stale.
+TEST(SessionSchema, DocsSettingsIsTheSchemas) {
+  std::ifstream in(std::string(ARBCI_SOURCE_DIR) + "/docs/settings.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find(settingsMarkdown()), std::string::npos)
+      << "docs/settings.md is out of date: regenerate it with "
+         "`build/release/arbci settings --markdown > docs/settings.md`";
 }
 
 TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
@@ -96,15 +118,31 @@ TEST(SessionConfig, ErrorsNameTheKeyTheValueAndWhatIsAllowed) {
   const std::string source = errorOf(R"({"eeg": {"source": "amplifier"}})");
   EXPECT_NE(source.find("eeg.source"), std::string::npos) << source;
   EXPECT_NE(source.find("simulated"), std::string::npos) << source;
+  const std::string minimum = errorOf(R"({"paradigm": {"sequences": 4, "min_sequences": 5}})");
+  EXPECT_NE(minimum.find("paradigm.min_sequences = 5 must lie in [1, 4]"), std::string::npos)
+      << minimum;
+  const std::string reference =
+      errorOf(R"({"world": {"objects": [{"id": 10, "position": [0, 0.4, 0]},
+    {"id": 0, "position": [0.1, 0.4, 0]}]}})");
+  EXPECT_NE(reference.find("world.objects[1].id = 0 is the reference marker's id"),
+            std::string::npos)
+      << reference;
+  const std::string method = errorOf(R"({"classifier": {"method": "svm"}})");
+  EXPECT_NE(method.find("classifier.method = \"svm\" must be one of swlda, slda"),
+            std::string::npos)
+      << method;
 }
 
 TEST(SessionConfig, TheTrackerSearchesAtFullOrHalfResolution) {
   EXPECT_EQ(SessionConfig::load(sessionFile("decimate", R"({"tracker": {"search_decimate": 2}})"))
-                .tracker_search_decimate,
+                .tracker.detector.search_decimate,
             2);
   const std::string refused = errorOf(R"({"tracker": {"search_decimate": 4}})");
   EXPECT_NE(refused.find("tracker.search_decimate = 4"), std::string::npos) << refused;
   EXPECT_NE(refused.find("[1, 2]"), std::string::npos) << refused;
+  const std::string kind = errorOf(R"({"tracker": {"kind": "aruco"}})");
+  EXPECT_NE(kind.find("tracker.kind = \"aruco\" must be one of bch, simple"), std::string::npos)
+      << kind;
 }
 
 // The ErrP classifier takes the whole montage by default (its xDAWN filter finds the response),
@@ -113,14 +151,15 @@ TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
   const SessionConfig embedded = SessionConfig::load(std::nullopt);
   EXPECT_EQ(embedded.errp.method, "riemann");
   EXPECT_EQ(embedded.errp.xdawn_filters, 1);
-  EXPECT_EQ(embedded.errp.pipeline(embedded.pipeline, embedded.eeg.montage).channels,
+  EXPECT_EQ(embedded.errp.pipeline(embedded.classifier.pipeline, embedded.eeg.montage).channels,
             embedded.eeg.montage);
   const SessionConfig listed = SessionConfig::load(sessionFile(
       "errp_channels", R"({"errp": {"channels": ["FCz", "Fz", "Cz"], "method": "slda"}})"));
-  EXPECT_EQ(listed.errp.pipeline(listed.pipeline, listed.eeg.montage).channels,
+  EXPECT_EQ(listed.errp.pipeline(listed.classifier.pipeline, listed.eeg.montage).channels,
             (std::vector<std::string>{"Fz", "Cz"}));
   const std::string none = errorOf(R"({"errp": {"enabled": true, "channels": ["FC5", "FC6"]}})");
-  EXPECT_NE(none.find("errp.channels: the EEG montage has none of FC5, FC6"), std::string::npos)
+  EXPECT_NE(none.find("errp.channels = [\"FC5\",\"FC6\"]: the EEG montage has none of them"),
+            std::string::npos)
       << none;
   const std::string filters = errorOf(R"({"errp": {"xdawn_filters": 0}})");
   EXPECT_NE(filters.find("errp.xdawn_filters = 0"), std::string::npos) << filters;

@@ -54,10 +54,11 @@ TEST(Swlda, SelectsThePlantedFeaturesAndRespectsItsLimit) {
   Eigen::MatrixXd x;
   std::vector<bool> target;
   plantedData(x, target);
-  SwldaSettings settings;
-  settings.p_enter = 0.001;
-  settings.p_remove = 0.01;
-  auto swlda = makeClassifier("swlda", settings);
+  TrainingSettings settings;
+  settings.method = "swlda";
+  settings.swlda.p_enter = 0.001;
+  settings.swlda.p_remove = 0.01;
+  auto swlda = makeClassifier(settings);
   swlda->train(x, target, FeatureShape{5, 10});
   const Eigen::VectorXd w = swlda->weights();
   std::vector<int> kept;
@@ -67,8 +68,8 @@ TEST(Swlda, SelectsThePlantedFeaturesAndRespectsItsLimit) {
   EXPECT_EQ(kept, (std::vector<int>{3, 17, 40}));
   EXPECT_GT(w[3], 0.0);
   EXPECT_LT(w[17], 0.0);
-  settings.max_features = 2;
-  auto limited = makeClassifier("swlda", settings);
+  settings.swlda.max_features = 2;
+  auto limited = makeClassifier(settings);
   limited->train(x, target, FeatureShape{5, 10});
   EXPECT_EQ((limited->weights().array() != 0.0).count(), 2);
 }
@@ -78,14 +79,40 @@ TEST(Classifiers, TooFewTargetsAndUnknownMethodsAreRefused) {
   std::vector<bool> target;
   plantedData(x, target, 40);
   for (const std::string method : {"swlda", "slda", "xdawn"}) {
+    TrainingSettings settings;
+    settings.method = method;
     try {
-      makeClassifier(method)->train(x, target, FeatureShape{5, 10});
+      makeClassifier(settings)->train(x, target, FeatureShape{5, 10});
       ADD_FAILURE() << method;
     } catch (const std::invalid_argument& error) {
       EXPECT_NE(std::string(error.what()).find("too few"), std::string::npos) << error.what();
     }
   }
-  EXPECT_THROW(makeClassifier("svm"), std::invalid_argument);
+  TrainingSettings unknown;
+  unknown.method = "svm";
+  EXPECT_THROW(makeClassifier(unknown), std::invalid_argument);
+}
+
+// Plain LDA, the unregularised baseline: on well-conditioned data (many epochs, few features) it
+// is shrinkage LDA without the shrinkage, the same direction; it is in the registry, and a model
+// with it survives its JSON.
+TEST(Classifiers, PlainLdaIsShrinkageLdaWithoutTheShrinkage) {
+  Eigen::MatrixXd x;
+  std::vector<bool> target;
+  plantedData(x, target, 2000);
+  TrainingSettings settings;
+  settings.method = "lda";
+  auto lda = makeClassifier(settings);
+  lda->train(x, target, FeatureShape{5, 10});
+  settings.method = "slda";
+  auto slda = makeClassifier(settings);
+  slda->train(x, target, FeatureShape{5, 10});
+  const Eigen::VectorXd a = lda->weights().normalized(), b = slda->weights().normalized();
+  EXPECT_GT(a.dot(b), 0.99);
+  const auto restored = classifierFromJson(lda->toJson(), FeatureShape{5, 10});
+  EXPECT_EQ(restored->method(), "lda");
+  EXPECT_DOUBLE_EQ(restored->score(x.row(3).transpose()), lda->score(x.row(3).transpose()));
+  EXPECT_NE(classifiers().list().find("lda"), std::string::npos);
 }
 
 TEST(Decisions, RowAndColumnWithCertaintyGrowingOverSequences) {

@@ -5,6 +5,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "widgets.h"
 
@@ -128,6 +129,13 @@ void CalibrationPanel::draw() {
     model_.setReference(reference_id_, cv::Vec3d(reference_position_[0], reference_position_[1],
                                                  reference_position_[2]));
   }
+}
+
+PanelRegistry::Entry calibrationPanel() {
+  return {
+      "calibration",
+      "camera calibration from chessboard views, and the reference marker",
+      {[](const PanelContext& c) { return std::make_unique<CalibrationPanel>(c.model); }, false}};
 }
 
 }  // namespace arbci::ui

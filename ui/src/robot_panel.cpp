@@ -1,5 +1,6 @@
 #include <imgui.h>
 
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "widgets.h"
 
@@ -91,6 +92,12 @@ void RobotPanel::draw() {
     }
   }
   ImGui::EndChild();
+}
+
+PanelRegistry::Entry robotPanel() {
+  return {"robot",
+          "the arm's state, command and progress, the gripper, recovery, the E-STOP",
+          {[](const PanelContext& c) { return std::make_unique<RobotPanel>(c.model); }}};
 }
 
 }  // namespace arbci::ui

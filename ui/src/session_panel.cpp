@@ -1,5 +1,6 @@
 #include <imgui.h>
 
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "widgets.h"
 
@@ -143,6 +144,24 @@ void SummaryPanel::draw() {
     }
     ImGui::EndTable();
   }
+}
+
+PanelRegistry::Entry sessionPanel() {
+  return {"session",
+          "the phase, start/pause/resume/abort, the sequence, the selections, the cycle's timing",
+          {[](const PanelContext& c) { return std::make_unique<SessionPanel>(c.model); }}};
+}
+
+PanelRegistry::Entry hmdPanel() {
+  return {"hmd", "the HMD view as the subject sees it (both eyes)", {[](const PanelContext& c) {
+            return std::make_unique<HmdPanel>(c.hmd_texture, c.hmd_aspect);
+          }}};
+}
+
+PanelRegistry::Entry summaryPanel() {
+  return {"summary",
+          "the end-of-session summary (opened when the session ends)",
+          {[](const PanelContext& c) { return std::make_unique<SummaryPanel>(c.model); }, false}};
 }
 
 }  // namespace arbci::ui

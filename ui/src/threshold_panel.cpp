@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 
 namespace arbci::ui {
@@ -93,6 +94,12 @@ void ThresholdPanel::draw() {
     }
     ImGui::EndTable();
   }
+}
+
+PanelRegistry::Entry thresholdPanel() {
+  return {"threshold",
+          "the tracker's threshold, the binary image and the markers found",
+          {[](const PanelContext& c) { return std::make_unique<ThresholdPanel>(c.model); }}};
 }
 
 }  // namespace arbci::ui

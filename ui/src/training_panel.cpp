@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "arbci/bci/p300_model.h"
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "erp_plots.h"
 #include "widgets.h"
@@ -26,10 +27,10 @@ void TrainingPanel::startTraining() {
     message_ = "name at least one recording (BCI2000 .dat or ARBCI .bdf)";
     return;
   }
-  const char* methods[] = {"swlda", "slda", "xdawn", "riemann"};
-  bci::TrainingSettings settings;
-  settings.method = methods[method_];
-  bci::PipelineSettings pipeline;
+  // The session's classifier settings, with what the panel changes.
+  bci::TrainingSettings settings = model_.trainingSettings();
+  settings.method = bci::classifiers().entries().at(static_cast<size_t>(method_)).name;
+  bci::PipelineSettings pipeline = model_.pipelineSettings();
   pipeline.window.end_s = window_end_ms_ / 1000.0;
   pipeline.decimate_hz = decimate_hz_;
   progress_ = 0.0;
@@ -102,11 +103,28 @@ void TrainingPanel::draw() {
   pathInput("recordings (BCI2000 .dat, GDF, EDF, BDF; several: separated by spaces)", files_,
             sizeof files_, ".dat .gdf .edf .bdf",
             "the recordings to train on; Browse picks one from the folder of the last");
-  const char* methods[] = {"SWLDA (as BCI2000)", "shrinkage LDA", "xDAWN + LDA",
-                           "Riemannian (xDAWN covariances, tangent space)"};
+  if (!initialised_) {
+    // The session's own settings are where the panel starts.
+    const bci::TrainingSettings training = model_.trainingSettings();
+    const bci::PipelineSettings pipeline = model_.pipelineSettings();
+    const auto& entries = bci::classifiers().entries();
+    for (size_t i = 0; i < entries.size(); ++i)
+      if (entries[i].name == training.method) method_ = static_cast<int>(i);
+    window_end_ms_ = static_cast<float>(pipeline.window.end_s * 1000.0);
+    decimate_hz_ = static_cast<float>(pipeline.decimate_hz);
+    initialised_ = true;
+  }
+  const auto& methods = bci::classifiers().entries();
   ImGui::TextUnformatted("method");
   ImGui::SetNextItemWidth(-FLT_MIN);
-  ImGui::Combo("##method", &method_, methods, 4);
+  if (ImGui::BeginCombo("##method", methods.at(static_cast<size_t>(method_)).name.c_str())) {
+    for (size_t i = 0; i < methods.size(); ++i) {
+      if (ImGui::Selectable(methods[i].name.c_str(), static_cast<int>(i) == method_))
+        method_ = static_cast<int>(i);
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", methods[i].doc.c_str());
+    }
+    ImGui::EndCombo();
+  }
   ImGui::TextUnformatted("window end (ms)");
   ImGui::SetNextItemWidth(-FLT_MIN);
   ImGui::SliderFloat("##window end", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
@@ -201,6 +219,12 @@ void TrainingPanel::draw() {
       message_ = error.what();
     }
   }
+}
+
+PanelRegistry::Entry trainingPanel() {
+  return {"training",
+          "train a classifier on recordings; the ERPs, AUC and accuracy by sequences",
+          {[](const PanelContext& c) { return std::make_unique<TrainingPanel>(c.model); }, false}};
 }
 
 }  // namespace arbci::ui

@@ -2,6 +2,7 @@
 #include <stdexcept>
 
 #include "arbci/vision/marker.h"
+#include "arbci/vision/settings.h"
 #include "arbci/vision/threshold.h"
 
 namespace arbci::vision {
@@ -23,12 +24,7 @@ std::string toString(MarkerKind kind) {
 }
 
 MarkerKind markerKindFromString(const std::string& text) {
-  for (MarkerKind kind : {MarkerKind::Bch, MarkerKind::Simple, MarkerKind::Template,
-                          MarkerKind::Aruco, MarkerKind::AprilTag}) {
-    if (toString(kind) == text) return kind;
-  }
-  throw std::invalid_argument("unknown marker kind '" + text +
-                              "' (bch, simple, template, aruco, apriltag)");
+  return markerFamilies().at(text).make.kind;
 }
 
 std::string toString(ThresholdMode mode) {

@@ -18,12 +18,19 @@ EegAcquisitionStage::EegAcquisitionStage(const EegAcquisitionSettings& settings,
                                          const StageServices& services)
     : settings_(settings), s_(services) {
   const EegSettings& eeg = settings_.eeg;
-  std::shared_ptr<bci::SampleClock> source_clock =
-      clock.sourceClock(eeg.source == "simulated" ? kSimulatedTransportS : 0.0);
+  const EegSourceRegistry::Entry* entry = eegSources().find(eeg.source);
+  if (!entry)
+    throw SessionConfigError(settings_.session_file + ": eeg.source = \"" + eeg.source +
+                             "\" must be one of " + eegSources().list());
+  std::shared_ptr<bci::SampleClock> source_clock = clock.sourceClock(entry->make.transport_lag_s);
+  static const nlohmann::json none = nlohmann::json::object();
+  const auto own = eeg.sources.find(eeg.source);
+  const EegSourceContext context{eeg, own == eeg.sources.end() ? none : own->second, settings_.lsl,
+                                 source_clock, settings_.session_file};
   bci::AcquisitionSettings acquisition;
   acquisition.latency_s = eeg.latency_ms / 1000.0;
   acquisition_ = std::make_unique<bci::Acquisition>(
-      openEegSource(eeg, settings_.lsl, source_clock, settings_.session_file), source_clock,
+      entry->make.make(context), source_clock,
       clock.stepped() ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live,
       acquisition);
   const bci::SignalInfo& all = acquisition_->info();

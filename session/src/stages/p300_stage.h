@@ -27,10 +27,11 @@ namespace arbci::session {
 struct P300Settings {
   bci::SignalInfo info;  // the EEG channels (no photodiode)
   bci::PipelineSettings pipeline;
-  double flash_s = 0.06;     // a flash's nominal duration (the paradigm's, in whole frames)
-  int object_stimuli = 0;    // stimuli of the calibration run (the objects)
-  std::string model_file;    // a trained model (empty: the calibration run trains one)
-  std::string session_file;  // for messages naming a key
+  bci::TrainingSettings training;  // the method is the paradigm's request's
+  double flash_s = 0.06;           // a flash's nominal duration (the paradigm's, in whole frames)
+  int object_stimuli = 0;          // stimuli of the calibration run (the objects)
+  std::string model_file;          // a trained model (empty: the calibration run trains one)
+  std::string session_file;        // for messages naming a key
 };
 
 class P300Stage final : public Stage {

@@ -1,11 +1,8 @@
-// Linear P300 classifiers behind one interface: trained on labelled feature vectors (rows of X,
-// target or not), scoring new ones (higher: more target-like).
-//  - SWLDA as BCI2000's P300Classifier: stepwise regression (p-enter 0.10, p-remove 0.15, at most
-//    60 features), least-squares weights on the features kept;
-//  - shrinkage LDA with the analytic Ledoit-Wolf shrinkage (no tuning);
-//  - xDAWN spatial filters (OpenViBE's P300 pipeline) followed by shrinkage LDA;
-//  - Riemannian: xDAWN-augmented covariances in the tangent space at their Riemannian mean,
-//    then shrinkage LDA (MOABB's best P300 pipeline); not linear, so no BCI2000 export.
+// P300 classifiers behind one interface, trained on labelled feature vectors (rows of X, target
+// or not) and scoring new ones (higher: more target-like), and the registry that names them
+// (classifiers(): docs/settings.md lists each with its line): SWLDA as BCI2000's, shrinkage LDA,
+// plain LDA, xDAWN + shrinkage LDA, and the Riemannian method. Adding one is a file in
+// bci/src/classifiers/ and a line in its registry.cpp.
 #pragma once
 
 #include <functional>
@@ -17,26 +14,29 @@
 #include <nlohmann/json.hpp>
 
 #include "arbci/bci/features.h"
+#include "arbci/core/registry.h"
 
 namespace arbci::bci {
 
 // Called during long training with a fraction done (0-1) and what is being done.
 using Progress = std::function<void(double fraction, const std::string& stage)>;
 
+// Their defaults and ranges: bci::trainingSchema() (bci/settings.h), which TrainingSettings
+// takes them from.
 struct SwldaSettings {
-  double p_enter = 0.10;
-  double p_remove = 0.15;
-  int max_features = 60;
+  double p_enter = 0.0;
+  double p_remove = 0.0;
+  int max_features = 0;
 };
 
 struct XdawnSettings {
-  int filters = 4;  // spatial filters kept (the Riemannian method: per class)
+  int filters = 0;  // spatial filters kept (the Riemannian method: per class)
 };
 
 class Classifier {
  public:
   virtual ~Classifier() = default;
-  virtual std::string method() const = 0;  // "swlda", "slda", "xdawn" or "riemann"
+  virtual std::string method() const = 0;  // its name in classifiers()
   // Throws std::invalid_argument when the data cannot train a model (too few targets, sizes).
   virtual void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
                      const FeatureShape& shape, const Progress& progress = {}) = 0;
@@ -48,10 +48,30 @@ class Classifier {
   virtual nlohmann::json toJson() const = 0;
 };
 
-// "swlda", "slda", "xdawn" or "riemann"; throws std::invalid_argument for anything else.
-std::unique_ptr<Classifier> makeClassifier(const std::string& method,
-                                           const SwldaSettings& swlda = {},
-                                           const XdawnSettings& xdawn = {});
+struct TrainingSettings;  // evaluation.h
+
+// What the registry knows of a method.
+struct ClassifierParts {
+  // A new, untrained classifier with its parameters from `settings`.
+  std::function<std::unique_ptr<Classifier>(const TrainingSettings& settings)> make;
+  // One restored from what its toJson() wrote; throws std::invalid_argument naming what is
+  // missing or inconsistent.
+  std::function<std::unique_ptr<Classifier>(const nlohmann::json& json, const FeatureShape& shape)>
+      restore;
+  // Throws std::invalid_argument when data of `shape` cannot meet `settings` (checked before any
+  // cross-validation fold); empty: nothing to check.
+  std::function<void(const TrainingSettings& settings, const FeatureShape& shape)> check;
+  // The parameters it is trained with, for the model's provenance; empty: none.
+  std::function<nlohmann::json(const TrainingSettings& settings)> parameters;
+  // Linear in the features: BCI2000's LinearClassifier can run it.
+  bool linear = true;
+};
+using ClassifierRegistry = core::Registry<ClassifierParts>;
+// Every method, by the name `classifier.method` and `arbci train --method` take.
+const ClassifierRegistry& classifiers();
+
+// `settings.method`, untrained; throws std::invalid_argument naming the methods there are.
+std::unique_ptr<Classifier> makeClassifier(const TrainingSettings& settings);
 // Throws std::invalid_argument naming what is missing or inconsistent.
 std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
                                                const FeatureShape& shape);

@@ -24,7 +24,9 @@ class EegdevError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// `device` is a setting (bci::eegdevSourceSchema(), bci/settings.h); the rest the session sets.
 struct EegdevSourceSettings {
+  EegdevSourceSettings();
   std::string device;  // e.g. "datafile|path|/data/s01.bdf"
   int block_size = 15;
   double expected_rate_hz = 0.0;  // the session's rate: a device at another rate is refused

@@ -10,9 +10,10 @@
 
 namespace arbci::bci {
 
+// The window is a setting (the classifier's window_ms, bci/settings.h): no default here.
 struct EpochWindow {
   double start_s = 0.0;  // relative to the stimulus onset
-  double end_s = 0.8;
+  double end_s = 0.0;
 };
 
 struct Epoch {
@@ -28,7 +29,7 @@ struct Epoch {
 class Epocher {
  public:
   // `history_s`: how long samples are kept for events that arrive late.
-  Epocher(int channels, double rate_hz, const EpochWindow& window = {}, double history_s = 5.0);
+  Epocher(int channels, double rate_hz, const EpochWindow& window, double history_s = 5.0);
 
   void addEvent(const StimulusEvent& event);
   // Appends a block (blocks must follow each other) and returns the epochs it completed, in

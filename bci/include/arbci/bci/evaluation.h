@@ -69,15 +69,19 @@ std::vector<double> alignScoresPerFile(const P300Dataset& data, std::vector<doub
 EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<double>& scores,
                                 const ScoreModel& model, const StoppingRule& dynamic);
 
+// Each setting's default, range and meaning: bci::trainingSchema() (bci/settings.h).
 struct TrainingSettings {
-  std::string method = "swlda";
+  TrainingSettings();  // the schema's defaults
+  std::string method;  // a name of bci::classifiers()
   SwldaSettings swlda;
   XdawnSettings xdawn;
-  int folds = 10;  // at most one per selection (or file)
+  int folds;  // at most one per selection (or file)
   // "selection" (no selection's flashes both trained on and tested), "block" (k contiguous blocks
   // of flashes in time), "file", or "" for the default: by selection, or by block where the data
   // have fewer than 2 selections or their codes are classes.
   std::string folds_by;
+  // Offline evaluation's dynamic stopping (the bit rate `arbci evaluate` reports with it), not
+  // the online paradigm's: up to the recordings' 15 sequences.
   StoppingRule dynamic{15, 2, 0.99};
 };
 

@@ -15,15 +15,17 @@
 namespace arbci::bci {
 
 // Everything between the raw signal and the classifier; saved with each model so training and
-// online use process the signal the same way.
+// online use process the signal the same way. Each field's default, range and meaning:
+// bci::pipelineSchema() (bci/settings.h).
 struct PipelineSettings {
-  FilterSettings filter{false, 0.5, 20.0, 4, 0.0, 25.0};  // no CAR, 0.5-20 Hz, no notch
-  EpochWindow window{0.0, 0.8};
-  double decimate_hz = 20.0;
+  PipelineSettings();  // the schema's defaults
+  FilterSettings filter;
+  EpochWindow window;
+  double decimate_hz;
   std::vector<std::string> channels;  // empty: all of the recording's
   // Offline only (arbci train/evaluate): the filters run forward and backward, so no phase lag;
   // the model records it, and the online cycle, which must stay causal, says so.
-  bool zero_phase = false;
+  bool zero_phase;
 
   int decimationFactor(double rate_hz) const;  // samples per bin: 13 at 256 Hz
 };

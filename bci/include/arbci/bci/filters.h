@@ -39,13 +39,15 @@ class IirFilter {
 // Subtracts the mean over channels from every sample.
 void commonAverageReference(Block& block);
 
+// Each field's default, range and meaning: bci::filterSchema() (bci/settings.h).
 struct FilterSettings {
-  bool common_average = true;
-  double highpass_hz = 0.5;  // 0: none
-  double lowpass_hz = 30.0;  // 0: none
-  int order = 4;             // of each Butterworth half
-  double notch_hz = 50.0;    // 0: none (60 in the Americas)
-  double notch_q = 25.0;
+  FilterSettings();  // the schema's defaults
+  bool common_average;
+  double highpass_hz;  // 0: none
+  double lowpass_hz;   // 0: none
+  int order;           // of each Butterworth half
+  double notch_hz;     // 0: none (60 in the Americas)
+  double notch_q;
 };
 
 // The cleaning stage of the cycle: CAR, band-pass and notch, in that order.

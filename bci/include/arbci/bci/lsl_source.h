@@ -22,10 +22,13 @@ namespace lsl {
 class Inlet;
 }
 
+// name, type and resolve_timeout_s are settings (bci::lslSourceSchema(), bci/settings.h, takes
+// their defaults); the rest the session sets from its EEG settings.
 struct LslSourceSettings {
+  LslSourceSettings();
   std::string name;  // the stream's name (empty: any)
-  std::string type = "EEG";
-  double resolve_timeout_s = 5.0;
+  std::string type;
+  double resolve_timeout_s;
   int block_size = 15;
   double expected_rate_hz = 0.0;  // the session's rate: a stream at another rate is refused
   // Refuse a stream that answers but sends no sample within resolve_timeout_s (pre-flight).

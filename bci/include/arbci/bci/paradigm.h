@@ -27,20 +27,23 @@
 
 namespace arbci::bci {
 
+// Each field's default, range and meaning: bci::paradigmSchema() (bci/settings.h).
 struct ParadigmSettings {
-  double display_hz = 60.0;
-  double flash_ms = 60.0;
-  double isi_ms = 120.0;
-  int sequences = 10;              // per online selection (the maximum with dynamic stopping)
-  int calibration_sequences = 10;  // per calibration selection (always all)
-  int min_sequences = 2;           // dynamic stopping never stops earlier
-  double certainty = 0.0;          // dynamic stopping threshold; 0: always `sequences`
-  double cue_s = 1.5;              // calibration: the target is shown before its flashes
-  double result_s = 1.0;           // a selection is shown this long
-  double pause_s = 1.0;            // between selections
-  int calibration_selections = 6;
-  int trials = 3;
-  // The timing check: cued calibration selections without end (never training, never trials).
+  ParadigmSettings();  // the schema's defaults
+  double display_hz;
+  double flash_ms;
+  double isi_ms;
+  int sequences;              // per online selection (the maximum with dynamic stopping)
+  int calibration_sequences;  // per calibration selection (always all)
+  int min_sequences;          // dynamic stopping never stops earlier
+  double certainty;           // dynamic stopping threshold; 0: always `sequences`
+  double cue_s;               // calibration: the target is shown before its flashes
+  double result_s;            // a selection is shown this long
+  double pause_s;             // between selections
+  int calibration_selections;
+  int trials;
+  // The timing check's mode, not a setting: cued calibration selections without end (never
+  // training, never trials).
   bool flashes_only = false;
   // Error-related potentials (docs/errp.md). A selection is shown for `result_s` as feedback,
   // and the robot waits for the ErrP verdict on it; a rejected selection is replaced by the
@@ -51,12 +54,12 @@ struct ParadigmSettings {
   // `errp_max_corrections` rejections the trial is skipped (an object already grasped is put back
   // where it was taken). The calibration run ends with `errp_calibration_feedbacks` cued feedbacks,
   // `errp_wrong_rate` of them deliberately wrong (in random order).
-  bool errp = false;
-  int errp_calibration_feedbacks = 100;
-  double errp_wrong_rate = 0.25;
-  double errp_runner_up = 0.5;
-  int errp_repeat_sequences = 0;
-  int errp_max_corrections = 2;
+  bool errp;
+  int errp_calibration_feedbacks;
+  double errp_wrong_rate;
+  double errp_runner_up;
+  int errp_repeat_sequences;
+  int errp_max_corrections;
 
   int flashFrames() const;  // frames a flash lasts (60 ms at 60 Hz: 4)
   int onsetFrames() const;  // frames from one flash onset to the next (180 ms: 11)

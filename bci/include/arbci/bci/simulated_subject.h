@@ -47,16 +47,19 @@ struct SubjectProfile {
   static SubjectProfile drawn(std::uint64_t seed);
 };
 
+// The settings (seed, montage, rate, block size, line frequency, photodiode channel) take their
+// defaults from bci::subjectSchema() (bci/settings.h); the rest is the model's physiology.
 struct SimulatedSubjectConfig {
-  std::vector<std::string> montage = {"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
-  double rate_hz = 256.0;
-  int block_size = 15;
-  std::uint64_t seed = 1;
+  SimulatedSubjectConfig();  // the schema's defaults
+  std::vector<std::string> montage;
+  double rate_hz;
+  int block_size;
+  std::uint64_t seed;
   double background_uv = 7.0;      // RMS of the 1/f background per channel
   double shared_background = 0.5;  // fraction of the background's variance common to all channels
   double alpha_hz = 10.0;
   double alpha_uv = 4.0;  // RMS at occipital channels
-  double line_hz = 50.0;
+  double line_hz;
   double line_uv = 1.5;
   double blinks_per_minute = 6.0;
   double blink_uv = 100.0;                // at Fp1/Fp2; less further back
@@ -65,7 +68,7 @@ struct SimulatedSubjectConfig {
   // patch is dark, `photodiode_lit_uv` while it is lit, switching on the first sample taken at or
   // after the presentation that changed it.
   bool photodiode = false;
-  std::string photodiode_channel = "Photodiode";
+  std::string photodiode_channel;
   double photodiode_lit_uv = 1000.0;
 };
 

@@ -43,6 +43,8 @@ struct Key {
   // Text: the values allowed (a registry's names; empty: any text).
   std::function<std::vector<std::string>()> choices;
   const Table* table = nullptr;  // Section, List: the table of the section or of each item
+  // No default: a file (or a list's item) must give it; `doc` says what to give.
+  bool required = false;
 
   Key(std::string key_name, Type key_type, nlohmann::json key_fallback, std::string key_doc,
       std::string key_unit = "", double key_low = -std::numeric_limits<double>::infinity(),
@@ -75,6 +77,9 @@ class Table {
  public:
   Table(std::string name, std::string doc) : name_(std::move(name)), doc_(std::move(doc)) {}
   virtual ~Table() = default;
+  // Built once (a function's static) and referred to by pointer: moved, never copied.
+  Table(Table&&) = default;
+  Table& operator=(Table&&) = default;
   Table(const Table&) = delete;
   Table& operator=(const Table&) = delete;
 
@@ -91,6 +96,11 @@ class Table {
   nlohmann::json resolve(const nlohmann::json& given, const Place& where) const;
   Table& rule(Rule rule) {
     rules_.push_back(std::move(rule));
+    return *this;
+  }
+  // The rules of `other`, whose keys this table holds under the same names (adopted or merged).
+  Table& rulesOf(const Table& other) {
+    rules_.insert(rules_.end(), other.rules_.begin(), other.rules_.end());
     return *this;
   }
 
@@ -183,6 +193,60 @@ class Schema : public Table {
     bindings_.push_back({std::move(read), std::move(write)});
     return *this;
   }
+  // A key whose value a file must give (a list item's id): no default.
+  template <class V>
+  Schema& required(Key key, V S::*member) {
+    key.required = true;
+    return bind(std::move(key), member);
+  }
+  // Every key of `other` (declared where its struct lives) at this level, read into `member`: the
+  // key keeps the one default and range it was declared with.
+  template <class T>
+  Schema& merge(const Schema<T>& other, T S::*member) {
+    for (std::size_t i = 0; i < other.keys().size(); ++i)
+      adopt(other, other.keys()[i].name, member);
+    return *this;
+  }
+  // One key of `other`, read into `member`'s struct, renamed `as` here when given.
+  template <class T>
+  Schema& adopt(const Schema<T>& other, const std::string& key, T S::*member,
+                const std::string& as = "") {
+    Key k = other.at(key);
+    if (!as.empty()) k.name = as;
+    const std::size_t i = other.indexOf(key);
+    return custom(
+        std::move(k),
+        [&other, i, member](S& s, const nlohmann::json& j) { other.readKey(i, j, s.*member); },
+        [&other, i, member](const S& s) { return other.writeKey(i, s.*member); });
+  }
+  // One key of `other`, which binds S itself (a key declared with S's module but shown here).
+  Schema& adopt(const Schema<S>& other, const std::string& key, const std::string& as = "") {
+    Key k = other.at(key);
+    if (!as.empty()) k.name = as;
+    const std::size_t i = other.indexOf(key);
+    return custom(
+        std::move(k), [&other, i](S& s, const nlohmann::json& j) { other.readKey(i, j, s); },
+        [&other, i](const S& s) { return other.writeKey(i, s); });
+  }
+  // A section of the file read into S itself (its keys bound to members of S).
+  Schema& sectionOf(std::string key, const Schema<S>& table) {
+    Key k{std::move(key), Type::Section, nullptr, table.doc()};
+    k.table = &table;
+    return custom(
+        std::move(k), [&table](S& s, const nlohmann::json& j) { table.read(j, s); },
+        [&table](const S& s) { return table.write(s); });
+  }
+
+  const Key& at(const std::string& key) const { return keys()[indexOf(key)]; }
+  std::size_t indexOf(const std::string& key) const {
+    for (std::size_t i = 0; i < keys().size(); ++i)
+      if (keys()[i].name == key) return i;
+    throw std::logic_error(name() + " has no key " + key);
+  }
+  void readKey(std::size_t i, const nlohmann::json& value, S& s) const {
+    bindings_[i].read(s, value);
+  }
+  nlohmann::json writeKey(std::size_t i, const S& s) const { return bindings_[i].write(s); }
 
   // Every member at its key's default: the struct's constructor calls it.
   void applyDefaults(S& s) const { read(defaults(), s); }

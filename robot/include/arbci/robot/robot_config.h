@@ -1,5 +1,6 @@
 // The backend's configuration (ROBOT.json): workspace, table, motion parameters, the simulated
-// arm's speed and the simulated world's objects. Every field has a default.
+// arm's speed and the simulated world's objects. Each field's default, range and meaning is in
+// robot::configSchema() (robot/settings.h); a file names only what differs.
 #pragma once
 
 #include <filesystem>
@@ -17,24 +18,28 @@ class ConfigError : public std::runtime_error {
 };
 
 struct SimulatedObject {
-  int id = 0;
+  SimulatedObject();  // the schema's defaults
+  SimulatedObject(int object_id, Vec3 top, double object_height, double object_radius)
+      : id(object_id), position(top), height(object_height), radius(object_radius) {}
+  int id;
   Vec3 position;  // the centre of its top face
-  double height = 0.06;
-  double radius = 0.03;  // of its footprint, for contact and grasping
+  double height;
+  double radius;  // of its footprint, for contact and grasping
 };
 
 struct RobotConfig {
-  double speed_factor = 1.0;  // simulated seconds per real second
-  double table_z = 0.0;
-  Vec3 workspace_min{-0.7, 0.2, 0.0};
-  Vec3 workspace_max{0.7, 1.1, 0.6};
-  double approach_height = 0.10;  // above the target before descending
-  double lift_height = 0.25;      // above the table after grasping
-  double cartesian_speed = 0.30;  // m/s
-  double descend_speed = 0.06;    // m/s, until contact
-  double max_joint_speed = 1.2;   // rad/s
-  double gripper_seconds = 0.5;
-  Vec3 home{0.0, 0.45, 0.45};
+  RobotConfig();
+  double speed_factor;  // simulated seconds per real second
+  double table_z;
+  Vec3 workspace_min;
+  Vec3 workspace_max;
+  double approach_height;  // above the target before descending
+  double lift_height;      // above the table after grasping
+  double cartesian_speed;  // m/s
+  double descend_speed;    // m/s, until contact
+  double max_joint_speed;  // rad/s
+  double gripper_seconds;
+  Vec3 home;
   std::vector<SimulatedObject> objects;
 
   // Throws ConfigError naming the file and the field.

@@ -1,33 +1,53 @@
-// The EEG sources a session can acquire from, by eeg.source: the simulated subject, a recording
-// replayed in real time, a Lab Streaming Layer stream, an eegdev amplifier.
+// The EEG sources a session can acquire from, by eeg.source (eegSources(): docs/settings.md
+// lists them): the simulated subject, a recording replayed in real time, a Lab Streaming Layer
+// stream, an eegdev amplifier, a BrainVision Recorder RDA stream. Each is one file in
+// session/src/eeg_sources/ with its own settings (the section eeg.<name>), and a line in its
+// registry.cpp.
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
+
+#include <nlohmann/json.hpp>
 
 #include "arbci/bci/eeg_source.h"
 #include "arbci/bci/lsl/config.h"
 #include "arbci/bci/sample_clock.h"
 #include "arbci/bci/simulated_subject.h"
+#include "arbci/core/registry.h"
 #include "arbci/session/session_config.h"
 
 namespace arbci::session {
+
+// What a source is opened with.
+struct EegSourceContext {
+  const EegSettings& eeg;          // the keys every source shares (rate, block size, montage)
+  const nlohmann::json& own;       // its own section, resolved by its schema ({} without one)
+  const bci::lsl::LslConfig& lsl;  // lsl_api.cfg with the session's scope and peers
+  std::shared_ptr<bci::SampleClock> clock;  // paces a source that has no clock of its own
+  const std::string& session_file;          // for messages naming a key
+};
+
+struct EegSourceParts {
+  // Opens it; throws SessionConfigError naming the key (session_file first) when it cannot.
+  std::function<std::unique_ptr<bci::EegSource>(const EegSourceContext&)> make;
+  // Runs on its own clock in real time (an amplifier): a session on it cannot be stepped.
+  bool live = false;
+  // How long it holds each block back, as a USB amplifier's buffer would (a simulation's own).
+  double transport_lag_s = 0.0;
+  // The session file's eeg section (resolved) lacks what it needs: the key and why; empty: none.
+  std::function<std::optional<std::pair<std::string, std::string>>(const nlohmann::json& eeg)>
+      required;
+};
+using EegSourceRegistry = core::Registry<EegSourceParts>;
+const EegSourceRegistry& eegSources();
 
 // The simulated subject a session with `eeg` (source "simulated") acquires from: its montage,
 // rate, seed and line noise, the seed's drawn profile with eeg.erp_scale and eeg.errp_scale
 // applied, and a virtual photodiode channel when one is named.
 bci::SimulatedSubjectConfig simulatedSubjectOf(const EegSettings& eeg);
-
-// Opens the source `eeg` names, paced by `clock` where it has no clock of its own. Throws
-// SessionConfigError naming the key (`session_file` first) when it cannot.
-std::unique_ptr<bci::EegSource> openEegSource(const EegSettings& eeg,
-                                              const bci::lsl::LslConfig& lsl,
-                                              std::shared_ptr<bci::SampleClock> clock,
-                                              const std::string& session_file);
-
-// A live simulated subject holds each block back this long, as a USB amplifier's buffer does;
-// it knows its own delay, so its stamps stay true (a real amplifier's is measured by
-// `arbci timing-check` and set as eeg.latency_ms).
-constexpr double kSimulatedTransportS = 0.020;
 
 }  // namespace arbci::session

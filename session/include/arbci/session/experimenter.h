@@ -3,6 +3,7 @@
 // session refuses (and logs) an action that cannot go.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "arbci/session/cycle.h"
@@ -23,6 +24,10 @@ enum class Action {
   EndSession,
 };
 const char* toString(Action action);  // as the log's "refused" lines name it
+
+// The experimenter's action a request is, for its why-not; none for a panel's setting (the
+// threshold, the reference, a model).
+std::optional<Action> actionOf(const Request& request);
 
 // "" when `action` can go now, else why not. `ended`: the run has ended.
 std::string whyNot(Action action, const CycleRecord& last, bool ended);

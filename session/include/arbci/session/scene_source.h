@@ -17,6 +17,7 @@
 #include "arbci/robot/robot_config.h"
 #include "arbci/session/session_config.h"
 #include "arbci/vision/camera_model.h"
+#include "arbci/vision/marker.h"
 #include "arbci/vision/pose.h"
 
 namespace arbci::session {
@@ -24,9 +25,9 @@ namespace arbci::session {
 // What the scene needs of the session file, and nothing else.
 struct SceneSettings {
   CameraSettings cameras;
-  WorldSettings world;  // a simulated scene builds its table from it
-  std::string tracker_kind;
-  double tracker_border;
+  WorldSettings world;             // a simulated scene builds its table from it
+  vision::MarkerKind marker_kind;  // the simulated world's markers
+  double marker_border;
   std::uint64_t seed;         // the simulated cameras' noise
   double display_hz;          // display frames per camera frame
   double robot_speed_factor;  // the simulated arm's

@@ -80,8 +80,9 @@ class TrainingPanel final : public Panel {
   WorkstationModel& model_;
   char files_[1024] = "";
   char save_path_[256] = "model.json";
-  int method_ = 1;  // swlda, slda, xdawn, riemann
-  float window_end_ms_ = 800.0f, decimate_hz_ = 20.0f;
+  int method_ = 0;  // in bci::classifiers()
+  float window_end_ms_ = 0.0f, decimate_hz_ = 0.0f;
+  bool initialised_ = false;  // from the session's settings, on the first draw
   std::atomic<double> progress_{0.0};
   std::mutex stage_mutex_;
   std::string stage_;

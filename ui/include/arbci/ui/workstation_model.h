@@ -10,6 +10,8 @@
 #include <opencv2/core/mat.hpp>
 
 #include "arbci/bci/erp.h"
+#include "arbci/bci/evaluation.h"
+#include "arbci/bci/features.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/vision/camera_model.h"
@@ -61,6 +63,9 @@ class WorkstationModel {
   virtual std::optional<bci::ErpCurves> sessionErp() { return std::nullopt; }
   virtual std::optional<bci::ErpCurves> sessionErrpErp() { return std::nullopt; }
   virtual void useModel(const bci::P300Model& model) = 0;
+  // The session's classifier settings, where the Training panel starts (default: the schema's).
+  virtual bci::TrainingSettings trainingSettings() { return {}; }
+  virtual bci::PipelineSettings pipelineSettings() { return {}; }
 
   // Robot.
   virtual std::optional<robot::StatusPayload> robotStatus() = 0;

@@ -22,11 +22,14 @@ namespace arbci::vision {
 
 enum class Smoothing { Auto, Always, Never };
 
+// kind, border and search_decimate are settings: their defaults and ranges are
+// vision::detectorSchema()'s (vision/settings.h); the rest tunes the tracker.
 struct DetectorConfig {
-  MarkerKind kind = MarkerKind::Bch;
+  DetectorConfig();
+  MarkerKind kind;
   // Border width as a fraction of the marker side: 0.125 (thin) or 0.25 (standard), or any other
   // value in (0, 0.4] for square kinds.
-  double border = 0.125;
+  double border;
   ThresholdSettings threshold;
   // 3x3 binomial blur before binarising: Auto smooths frames whose estimated noise exceeds 2.5
   // grey levels (sensor noise) or that show JPEG's 8 px block edges (an MJPEG camera), and leaves
@@ -37,7 +40,7 @@ struct DetectorConfig {
   // on the frame averaged over 2x2 pixels (a quarter of the pixels), then moves every side onto
   // the full-resolution edge, as AprilTag's quad_decimate. About twice as fast; markers need about
   // 24 px per side (a border of 3 px) to be found.
-  int search_decimate = 1;
+  int search_decimate;
   // BCH only: when ARToolKitPlus's hard decoding (at most 2 corrected bits) fails, try Chase
   // decoding on the least reliable cells (recovers blurred markers; see code_decoder.h).
   bool soft_decoding = true;

@@ -1,7 +1,7 @@
 #include <stdexcept>
 
-#include "linear_classifiers.h"
-#include "riemann_classifier.h"
+#include "arbci/bci/evaluation.h"
+#include "classifiers/linear.h"
 
 namespace arbci::bci {
 
@@ -57,14 +57,13 @@ void checkTrainingData(const Eigen::MatrixXd& features, const std::vector<bool>&
     throw std::invalid_argument("the features contain NaN or infinite values");
 }
 
-std::unique_ptr<Classifier> makeClassifier(const std::string& method, const SwldaSettings& swlda,
-                                           const XdawnSettings& xdawn) {
-  if (method == "swlda") return std::make_unique<SwldaClassifier>(swlda);
-  if (method == "slda") return std::make_unique<ShrinkageLdaClassifier>();
-  if (method == "xdawn") return std::make_unique<XdawnClassifier>(xdawn);
-  if (method == "riemann") return std::make_unique<RiemannClassifier>(xdawn);
-  throw std::invalid_argument("unknown classification method '" + method +
-                              "' (swlda, slda, xdawn or riemann)");
+std::unique_ptr<Classifier> makeClassifier(const TrainingSettings& settings) {
+  try {
+    return classifiers().at(settings.method).make.make(settings);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument("unknown classification method '" + settings.method + "' (" +
+                                classifiers().list() + ")");
+  }
 }
 
 std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
@@ -73,14 +72,11 @@ std::unique_ptr<Classifier> classifierFromJson(const nlohmann::json& json,
     throw std::invalid_argument("classifier: no method");
   }
   const std::string method = json["method"].get<std::string>();
-  if (method == "riemann") {
-    auto riemann = std::make_unique<RiemannClassifier>(XdawnSettings{});
-    riemann->restore(json, shape);
-    return riemann;
-  }
-  std::unique_ptr<Classifier> classifier = makeClassifier(method);
-  static_cast<LinearClassifierBase&>(*classifier).restore(json, shape);
-  return classifier;
+  const ClassifierRegistry::Entry* entry = classifiers().find(method);
+  if (!entry)
+    throw std::invalid_argument("classifier: unknown method '" + method + "' (" +
+                                classifiers().list() + ")");
+  return entry->make.restore(json, shape);
 }
 
 }  // namespace arbci::bci

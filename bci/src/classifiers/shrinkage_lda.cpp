@@ -3,9 +3,20 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 
-#include "linear_classifiers.h"
+#include "arbci/bci/evaluation.h"
+#include "classifiers/linear.h"
 
 namespace arbci::bci {
+namespace {
+
+class ShrinkageLdaClassifier final : public LinearClassifierBase {
+ public:
+  std::string method() const override { return "slda"; }
+  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+             const FeatureShape& shape, const Progress& progress) override;
+};
+
+}  // namespace
 
 double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target,
                          Eigen::VectorXd& weights, double& bias) {
@@ -56,6 +67,15 @@ void ShrinkageLdaClassifier::train(const Eigen::MatrixXd& features, const std::v
   const double shrinkage = trainShrinkageLda(features, target, weights_, bias_);
   details_ = {{"shrinkage", shrinkage}};
   if (progress) progress(1.0, "shrinkage LDA");
+}
+
+ClassifierRegistry::Entry shrinkageLdaClassifier() {
+  ClassifierParts parts;
+  parts.make = [](const TrainingSettings&) { return std::make_unique<ShrinkageLdaClassifier>(); };
+  parts.restore = [](const nlohmann::json& json, const FeatureShape& shape) {
+    return restoreLinear<ShrinkageLdaClassifier>(json, shape);
+  };
+  return {"slda", "LDA with the covariance shrunk by the analytic Ledoit-Wolf intensity", parts};
 }
 
 }  // namespace arbci::bci

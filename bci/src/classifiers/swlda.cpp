@@ -10,10 +10,26 @@
 #include <set>
 #include <stdexcept>
 
-#include "linear_classifiers.h"
+#include "arbci/bci/evaluation.h"
+#include "classifiers/linear.h"
 #include "statistics.h"
 
 namespace arbci::bci {
+namespace {
+
+class SwldaClassifier final : public LinearClassifierBase {
+ public:
+  explicit SwldaClassifier(const SwldaSettings& settings) : settings_(settings) {}
+  std::string method() const override { return "swlda"; }
+  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+             const FeatureShape& shape, const Progress& progress) override;
+
+ private:
+  SwldaSettings settings_;
+};
+
+}  // namespace
+
 namespace {
 
 struct Fit {
@@ -162,6 +178,23 @@ void SwldaClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
               {"max_features", settings_.max_features},
               {"features", kept}};
   if (progress) progress(1.0, "SWLDA: " + std::to_string(selected.size()) + " features");
+}
+
+ClassifierRegistry::Entry swldaClassifier() {
+  ClassifierParts parts;
+  parts.make = [](const TrainingSettings& s) { return std::make_unique<SwldaClassifier>(s.swlda); };
+  parts.restore = [](const nlohmann::json& json, const FeatureShape& shape) {
+    return restoreLinear<SwldaClassifier>(json, shape, SwldaSettings{});
+  };
+  parts.parameters = [](const TrainingSettings& s) {
+    return nlohmann::json{{"p_enter", s.swlda.p_enter},
+                          {"p_remove", s.swlda.p_remove},
+                          {"max_features", s.swlda.max_features}};
+  };
+  return {"swlda",
+          "stepwise LDA as BCI2000's P300Classifier: features enter below p_enter and leave "
+          "above p_remove, at most max_features; least-squares weights",
+          parts};
 }
 
 }  // namespace arbci::bci

@@ -4,10 +4,25 @@
 // still linear in the original features, so it is stored as equivalent weights.
 #include <algorithm>
 
-#include "linear_classifiers.h"
+#include "arbci/bci/evaluation.h"
+#include "classifiers/linear.h"
 #include "xdawn_filters.h"
 
 namespace arbci::bci {
+namespace {
+
+class XdawnClassifier final : public LinearClassifierBase {
+ public:
+  explicit XdawnClassifier(const XdawnSettings& settings) : settings_(settings) {}
+  std::string method() const override { return "xdawn"; }
+  void train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
+             const FeatureShape& shape, const Progress& progress) override;
+
+ private:
+  XdawnSettings settings_;
+};
+
+}  // namespace
 
 void XdawnClassifier::train(const Eigen::MatrixXd& features, const std::vector<bool>& target,
                             const FeatureShape& shape, const Progress& progress) {
@@ -47,6 +62,24 @@ void XdawnClassifier::train(const Eigen::MatrixXd& features, const std::vector<b
   }
   details_ = {{"filters", filter_rows}, {"shrinkage", shrinkage}};
   if (progress) progress(1.0, "xDAWN");
+}
+
+ClassifierRegistry::Entry xdawnClassifier() {
+  ClassifierParts parts;
+  parts.make = [](const TrainingSettings& s) { return std::make_unique<XdawnClassifier>(s.xdawn); };
+  parts.restore = [](const nlohmann::json& json, const FeatureShape& shape) {
+    return restoreLinear<XdawnClassifier>(json, shape, XdawnSettings{});
+  };
+  parts.check = [](const TrainingSettings& s, const FeatureShape& shape) {
+    checkFilterCount(s.xdawn.filters, shape.channels);
+  };
+  parts.parameters = [](const TrainingSettings& s) {
+    return nlohmann::json{{"filters", s.xdawn.filters}};
+  };
+  return {"xdawn",
+          "xDAWN spatial filters (xdawn_filters kept), then shrinkage LDA: OpenViBE's P300 "
+          "pipeline",
+          parts};
 }
 
 }  // namespace arbci::bci

@@ -1,0 +1,26 @@
+// The robot module's settings table (the backend's ROBOT.json) and its registry of drivers:
+// arbci-robotd --driver NAME drives robotDrivers()'s NAME with the configuration read through
+// configSchema() (docs/robot.md). Adding a driver is a file in robot/src/drivers/ and a line in
+// its registry.cpp.
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include "arbci/core/registry.h"
+#include "arbci/core/schema.h"
+#include "arbci/robot/robot_config.h"
+#include "arbci/robot/robot_driver.h"
+
+namespace arbci::robot {
+
+const core::Schema<RobotConfig>& configSchema();
+
+struct DriverParts {
+  // Throws std::runtime_error with the reason when the arm cannot be driven.
+  std::function<std::unique_ptr<RobotDriver>(const RobotConfig& config)> make;
+};
+using DriverRegistry = core::Registry<DriverParts>;
+const DriverRegistry& robotDrivers();
+
+}  // namespace arbci::robot

@@ -1,0 +1,20 @@
+// The session file's schema: one table per section, composed of the keys each module declares
+// where its structs live (bci/settings.h, vision/settings.h) and the session's own. From it come
+// SessionConfig's parser and messages, the defaults a run uses when a file leaves a key out,
+// the settings panel and docs/settings.md (`arbci settings --markdown`).
+#pragma once
+
+#include <string>
+
+#include "arbci/core/schema.h"
+#include "arbci/session/session_config.h"
+
+namespace arbci::session {
+
+const core::Schema<SessionConfig>& sessionSchema();
+
+// docs/settings.md: every section's table, then the registries' members (EEG sources,
+// classifiers, marker families, camera sources, robot drivers; the application adds its panels).
+std::string settingsMarkdown();
+
+}  // namespace arbci::session

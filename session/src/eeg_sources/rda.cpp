@@ -1,0 +1,280 @@
+// BrainVision Recorder's Remote Data Access (RDA): the TCP stream BrainAmp and actiCHamp labs
+// read their amplifiers from (Recorder, or BrainProducts' RDA servers), in its 32-bit form
+// (port 51244). Every message starts with a 24-byte header: the RDA GUID (16 bytes), the
+// message's whole size and its type (uint32 each, little-endian). A start message (type 1) gives
+// the channel count (uint32), the sampling interval in microseconds (double), each channel's
+// resolution in microvolts per unit (double) and the channel names (zero-terminated); a data
+// message (type 4) gives its block number, points and marker count (uint32 each), the samples
+// multiplexed as float (point by point, every channel), then the markers; a stop message (type 3)
+// ends the stream. Blocks carry no time stamps: they are stamped on arrival, and a jump in the
+// block number is a loss of that many blocks' points, filled with zeros and counted. Markers are
+// left to the recording's own events.
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <thread>
+
+#include "arbci/core/schema.h"
+#include "arbci/session/eeg_sources.h"
+
+namespace arbci::session {
+namespace {
+
+struct RdaSettings {
+  RdaSettings();
+  std::string host;
+  int port;
+  double connect_timeout_s;
+};
+
+const core::Schema<RdaSettings>& rdaSchema() {
+  static const core::Schema<RdaSettings> table = [] {
+    core::Schema<RdaSettings> t("rda", "BrainVision Recorder's RDA stream (eeg.source \"rda\")");
+    t.text("host", &RdaSettings::host, "127.0.0.1", "the computer running Recorder's RDA server")
+        .integer("port", &RdaSettings::port, 51244, 1, 65535,
+                 "its port: 51244 for 32-bit data (16-bit data on 51234 is not read)")
+        .number("connect_timeout_s", &RdaSettings::connect_timeout_s, 5.0, 0.1, 600.0,
+                "how long to wait for the server and its start message", "s");
+    return t;
+  }();
+  return table;
+}
+
+RdaSettings::RdaSettings() {
+  rdaSchema().applyDefaults(*this);
+}
+
+constexpr std::uint8_t kGuid[16] = {0x8e, 0x45, 0x58, 0x43, 0x96, 0xc9, 0x86, 0x4c,
+                                    0xaf, 0x4a, 0x98, 0xbb, 0xf6, 0xc9, 0x14, 0x50};
+constexpr std::uint32_t kStart = 1, kData16 = 2, kStop = 3, kData32 = 4;
+constexpr std::uint32_t kMaxMessage = 64u << 20;  // a message beyond this is not RDA
+
+std::uint32_t u32(const std::uint8_t* p) {
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+         static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+template <class T>
+T little(const std::uint8_t* p) {  // x86 and ARM hosts are little-endian, as RDA is
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+class RdaError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class RdaSource final : public bci::EegSource {
+ public:
+  RdaSource(const RdaSettings& settings, int block_size, double expected_rate_hz)
+      : settings_(settings), where_(settings.host + ":" + std::to_string(settings.port)) {
+    connect();
+    const double deadline = bci::hostSeconds() + settings_.connect_timeout_s;
+    std::vector<std::uint8_t> message;
+    std::uint32_t type = 0;
+    while (type != kStart) {
+      if (!receive(message, type, deadline))
+        throw RdaError("no start message from the RDA server at " + where_ + " in " +
+                       core::formatNumber(settings_.connect_timeout_s) + " s" +
+                       (closed_ ? " (it closed the connection)" : ""));
+      if (type == kData16)
+        throw RdaError("the RDA server at " + where_ +
+                       " sends 16-bit data: connect to its 32-bit port (51244)");
+    }
+    readStart(message);
+    info_.block_size = block_size;
+    if (expected_rate_hz > 0.0 &&
+        std::abs(info_.rate_hz - expected_rate_hz) > 1e-6 * expected_rate_hz)
+      throw RdaError("the RDA stream at " + where_ + " runs at " +
+                     core::formatNumber(info_.rate_hz) + " Hz, the session at " +
+                     core::formatNumber(expected_rate_hz) + " Hz (eeg.rate_hz)");
+    reader_ = std::thread([this] { readLoop(); });
+  }
+  ~RdaSource() override {
+    stop_ = true;
+    if (reader_.joinable()) reader_.join();
+    if (fd_ >= 0) ::close(fd_);
+  }
+
+  const bci::SignalInfo& info() const override { return info_; }
+
+  std::vector<bci::Block> poll(int max_blocks) override {
+    std::lock_guard lock(mutex_);
+    std::vector<bci::Block> out;
+    const int channels = info_.channelCount(), size = info_.block_size;
+    while (static_cast<int>(out.size()) < max_blocks &&
+           pending_.size() >= static_cast<size_t>(channels * size)) {
+      bci::Block block(next_sample_, channels, size);
+      for (int s = 0; s < size; ++s)
+        for (int c = 0; c < channels; ++c)
+          block.at(c, s) = pending_[static_cast<size_t>(s * channels + c)];
+      pending_.erase(pending_.begin(), pending_.begin() + channels * size);
+      next_sample_ += size;
+      out.push_back(std::move(block));
+    }
+    return out;
+  }
+  std::string fault() const override {
+    std::lock_guard lock(mutex_);
+    return fault_;
+  }
+  std::string describe() const override {
+    return "RDA stream at " + where_ + ": " + std::to_string(info_.channelCount()) +
+           " channels at " + core::formatNumber(info_.rate_hz) + " Hz";
+  }
+
+ private:
+  void connect() {
+    addrinfo hints{};
+    hints.ai_family = AF_INET;
+    hints.ai_socktype = SOCK_STREAM;
+    addrinfo* found = nullptr;
+    if (::getaddrinfo(settings_.host.c_str(), std::to_string(settings_.port).c_str(), &hints,
+                      &found) != 0 ||
+        !found)
+      throw RdaError("cannot resolve the RDA host " + settings_.host);
+    fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const int result = fd_ < 0 ? -1 : ::connect(fd_, found->ai_addr, found->ai_addrlen);
+    const int error = errno;
+    ::freeaddrinfo(found);
+    if (result != 0)
+      throw RdaError("cannot connect to the RDA server at " + where_ + ": " + std::strerror(error) +
+                     " (is Recorder's RDA enabled?)");
+  }
+
+  // Reads `count` bytes before `deadline` (host seconds); false on a timeout or a closed socket.
+  bool readBytes(std::uint8_t* into, size_t count, double deadline) {
+    size_t done = 0;
+    while (done < count) {
+      const double left = deadline - bci::hostSeconds();
+      if (left <= 0.0 || stop_) return false;
+      pollfd p{fd_, POLLIN, 0};
+      const int ready = ::poll(&p, 1, static_cast<int>(std::min(left, 0.1) * 1000.0) + 1);
+      if (ready <= 0) continue;
+      const ssize_t n = ::recv(fd_, into + done, count - done, 0);
+      if (n <= 0) {
+        closed_ = true;
+        return false;
+      }
+      done += static_cast<size_t>(n);
+    }
+    return true;
+  }
+
+  // The next whole message (its body after the header); false when none came by `deadline`.
+  bool receive(std::vector<std::uint8_t>& body, std::uint32_t& type, double deadline) {
+    std::uint8_t header[24];
+    if (!readBytes(header, sizeof header, deadline)) return false;
+    if (std::memcmp(header, kGuid, sizeof kGuid) != 0)
+      throw RdaError("the server at " + where_ + " does not speak RDA (no RDA GUID)");
+    const std::uint32_t size = u32(header + 16);
+    type = u32(header + 20);
+    if (size < 24 || size > kMaxMessage)
+      throw RdaError("an RDA message of " + std::to_string(size) + " bytes from " + where_);
+    body.resize(size - 24);
+    // A message's body follows its header: a partial one is a broken stream, not a slow one.
+    return readBytes(body.data(), body.size(), bci::hostSeconds() + 5.0);
+  }
+
+  void readStart(const std::vector<std::uint8_t>& m) {
+    if (m.size() < 12) throw RdaError("a short RDA start message from " + where_);
+    const std::uint32_t channels = u32(m.data());
+    const double interval_us = little<double>(m.data() + 4);
+    if (channels == 0 || channels > 4096 || m.size() < 12 + 8 * size_t{channels} ||
+        !(interval_us > 0.0))
+      throw RdaError("an RDA start message with " + std::to_string(channels) +
+                     " channels and a sampling interval of " + core::formatNumber(interval_us) +
+                     " us from " + where_);
+    info_.rate_hz = 1e6 / interval_us;
+    for (std::uint32_t c = 0; c < channels; ++c)
+      resolution_.push_back(little<double>(m.data() + 12 + 8 * c));
+    size_t at = 12 + 8 * size_t{channels};
+    for (std::uint32_t c = 0; c < channels; ++c) {
+      std::string name;
+      while (at < m.size() && m[at] != 0) name.push_back(static_cast<char>(m[at++]));
+      ++at;
+      info_.channels.push_back(name.empty() ? "Ch" + std::to_string(c + 1) : name);
+    }
+  }
+
+  void readData(const std::vector<std::uint8_t>& m) {
+    const size_t channels = resolution_.size();
+    if (m.size() < 12) throw RdaError("a short RDA data message");
+    const std::uint32_t block = u32(m.data()), points = u32(m.data() + 4);
+    if (m.size() < 12 + 4 * size_t{points} * channels)
+      throw RdaError("an RDA data message shorter than its " + std::to_string(points) + " points");
+    std::lock_guard lock(mutex_);
+    // Blocks the server sent and this client never got: their points are lost, as zeros.
+    if (last_block_ && block > *last_block_ + 1)
+      pending_.insert(pending_.end(), (block - *last_block_ - 1) * size_t{points} * channels, 0.0f);
+    last_block_ = block;
+    for (size_t i = 0; i < size_t{points} * channels; ++i)
+      pending_.push_back(little<float>(m.data() + 12 + 4 * i) *
+                         static_cast<float>(resolution_[i % channels]));
+  }
+
+  void readLoop() {
+    std::vector<std::uint8_t> message;
+    try {
+      while (!stop_) {
+        std::uint32_t type = 0;
+        if (!receive(message, type, bci::hostSeconds() + 0.2)) {
+          if (closed_) throw RdaError("the RDA server at " + where_ + " closed the connection");
+          continue;
+        }
+        if (type == kData32) readData(message);
+        if (type == kStop) throw RdaError("the RDA server at " + where_ + " stopped the stream");
+      }
+    } catch (const std::exception& error) {
+      std::lock_guard lock(mutex_);
+      fault_ = error.what();
+    }
+  }
+
+  RdaSettings settings_;
+  std::string where_;
+  int fd_ = -1;
+  bool closed_ = false;
+  bci::SignalInfo info_;
+  std::vector<double> resolution_;  // microvolts per unit, by channel
+  std::thread reader_;
+  std::atomic<bool> stop_{false};
+  mutable std::mutex mutex_;
+  std::vector<float> pending_;  // multiplexed microvolts not yet in a block
+  std::optional<std::uint32_t> last_block_;
+  std::int64_t next_sample_ = 0;
+  std::string fault_;
+};
+
+}  // namespace
+
+EegSourceRegistry::Entry rdaEegSource() {
+  EegSourceParts parts;
+  parts.make = [](const EegSourceContext& c) -> std::unique_ptr<bci::EegSource> {
+    RdaSettings rda;
+    rdaSchema().read(c.own, rda);
+    try {
+      return std::make_unique<RdaSource>(rda, c.eeg.block_size, c.eeg.rate_hz);
+    } catch (const RdaError& e) {
+      throw SessionConfigError(c.session_file + ": eeg.source = \"rda\": " + e.what());
+    }
+  };
+  parts.live = true;
+  return {"rda",
+          "BrainVision Recorder's Remote Data Access stream (eeg.rda; BrainAmp, actiCHamp), "
+          "32-bit, stamped on arrival",
+          parts, &rdaSchema()};
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,644 @@
+#include "arbci/session/settings_schema.h"
+
+#include <algorithm>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "arbci/bci/classifier.h"
+#include "arbci/bci/settings.h"
+#include "arbci/robot/settings.h"
+#include "arbci/session/eeg_sources.h"
+#include "arbci/session/scene_source.h"
+#include "arbci/vision/settings.h"
+
+namespace arbci::session {
+namespace {
+
+using core::Key;
+using core::Schema;
+using core::Type;
+using Json = nlohmann::json;
+using Broken = std::optional<std::pair<std::string, std::string>>;
+
+// A point or direction in metres (robot frame), as [x, y, z].
+template <class S>
+Schema<S>& vec3(Schema<S>& t, const std::string& name, cv::Vec3d S::*member, Json fallback,
+                const std::string& doc, bool required = false) {
+  Key k{name, Type::Numbers, std::move(fallback), doc, "m"};
+  k.min_items = k.max_items = 3;
+  k.required = required;
+  return t.custom(
+      k,
+      [member](S& s, const Json& j) {
+        s.*member = {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+      },
+      [member](const S& s) {
+        return Json::array({(s.*member)[0], (s.*member)[1], (s.*member)[2]});
+      });
+}
+
+const Schema<HmdConfig>& hmdSchema() {
+  static const Schema<HmdConfig> t = [] {
+    Schema<HmdConfig> t("hmd", "The subject's head-mounted display (both eyes side by side)");
+    t.integer("width", &HmdConfig::width, 1280, 64, 8192, "both eyes' width", "px")
+        .integer("height", &HmdConfig::height, 480, 48, 8192, "the eyes' height", "px")
+        .boolean("undistort", &HmdConfig::undistort, true,
+                 "the camera images undistorted before the overlays")
+        .integer("mirror_monitor", &HmdConfig::mirror_monitor, -1, -1, 15,
+                 "the monitor (0-based) the HMD's view is shown on full screen (-1: none)");
+    return t;
+  }();
+  return t;
+}
+
+const Schema<CameraSource>& cameraSourceSchema() {
+  static const Schema<CameraSource> t = [] {
+    Schema<CameraSource> t("camera", "A camera device or a video file, with its calibration");
+    t.integer("device", &CameraSource::device, -1, -1, 63, "the V4L2 device number (-1: none)")
+        .text("video", &CameraSource::video, "", "a video file instead of a device")
+        .text("calibration", &CameraSource::calibration, "",
+              "its calibration file (arbci calibrate)");
+    return t;
+  }();
+  return t;
+}
+
+std::string sideRule(const Json& side, const char* name, Broken& broken) {
+  const bool used = side["device"].get<int>() >= 0 || !side["video"].get<std::string>().empty() ||
+                    !side["calibration"].get<std::string>().empty();
+  if (!used) return "";
+  if (side["device"].get<int>() < 0 && side["video"].get<std::string>().empty())
+    broken = std::pair{std::string(name), "needs a device number or a video file"};
+  else if (side["calibration"].get<std::string>().empty())
+    broken = std::pair{std::string(name) + ".calibration",
+                       "is required: the camera's calibration file (arbci calibrate)"};
+  return "";
+}
+
+const Schema<CameraSettings>& camerasSchema() {
+  static const Schema<CameraSettings> t = [] {
+    using C = CameraSettings;
+    Schema<C> t("cameras", "The cameras at the subject's head: simulated, or devices and videos");
+    t.text("source", &C::source, "simulated", "where the frames come from (camera sources)",
+           [] { return sceneSources().names(); })
+        .number("rate_hz", &C::rate_hz, 30.0, 1.0, 240.0, "camera frames a second", "Hz")
+        .integer("width", &C::width, 640, 64, 4096, "simulated: the image width", "px")
+        .integer("height", &C::height, 480, 48, 4096, "simulated: the image height", "px")
+        .number("focal_px", &C::focal_px, 800.0, 10.0, 1e5, "simulated: the focal length", "px")
+        .numbers("distortion", &C::distortion, {-0.08, 0.02, 0.0, 0.0, 0.0}, 0, 8,
+                 "simulated: the lens's distortion coefficients (OpenCV's order)");
+    t.number("baseline_m", &C::baseline_m, 0.064, 0.0, 0.5, "simulated: the stereo rig's baseline",
+             "m");
+    vec3(t, "head_position", &C::head_position, {0.0, 1.20, 0.75},
+         "simulated: the cameras' position (robot frame)");
+    vec3(t, "look_at", &C::look_at, {0.0, 0.70, 0.0}, "simulated: where they look (robot frame)");
+    t.number("head_motion_m", &C::head_motion_m, 0.008, 0.0, 0.2,
+             "simulated: the head's sway (amplitude)", "m")
+        .number("head_motion_deg", &C::head_motion_deg, 0.6, 0.0, 20.0,
+                "simulated: the head's turning (amplitude)", "deg")
+        .number("noise", &C::noise, 2.0, 0.0, 50.0, "simulated: sensor noise (grey levels, sd)")
+        .number("blur_px", &C::blur_px, 0.5, 0.0, 10.0, "simulated: optical blur (sd)", "px")
+        .section("left", &C::left, cameraSourceSchema())
+        .section("right", &C::right, cameraSourceSchema())
+        .text("stereo_calibration", &C::stereo_calibration, "",
+              "the right camera's pose in the left's frame (arbci calibrate --stereo)");
+    t.rule([](const Json& c) -> Broken {
+      Broken broken;
+      sideRule(c["left"], "left", broken);
+      if (!broken) sideRule(c["right"], "right", broken);
+      if (!broken && c["source"] == "devices" && c["left"]["device"].get<int>() < 0 &&
+          c["left"]["video"].get<std::string>().empty())
+        broken = std::pair{"left", "is required when source is \"devices\""};
+      return broken;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<TrackerSettings>& trackerSchema() {
+  static const Schema<TrackerSettings> t = [] {
+    Schema<TrackerSettings> t("tracker", "The marker tracker and how old a pose may be");
+    t.merge(vision::detectorSchema(), &TrackerSettings::detector)
+        .number("max_pose_age_s", &TrackerSettings::max_pose_age_s, 0.5, 0.05, 10.0,
+                "an older pose is stale: its object is not flashed, offered or grasped", "s");
+    t.rule([](const Json& tracker) -> Broken {
+      const auto* family = vision::markerFamilies().find(tracker["kind"].get<std::string>());
+      if (family && family->make.in_sessions) return std::nullopt;
+      std::string list;
+      for (const auto& f : vision::markerFamilies().entries())
+        if (f.make.in_sessions) list += (list.empty() ? "" : ", ") + f.name;
+      return std::pair{"kind", "= " + tracker["kind"].dump() + " must be one of " + list +
+                                   " (a session tracks objects by their ids alone)"};
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<WorldObjectSettings>& objectSchema() {
+  static const Schema<WorldObjectSettings> t = [] {
+    using O = WorldObjectSettings;
+    Schema<O> t("object", "An object on the table, carrying a marker on its top face");
+    t.required(Key{"id", Type::Integer, nullptr, "the object's marker id", "", 0, 4095}, &O::id);
+    vec3(t, "position", &O::position, nullptr, "[x, y, z] of the top centre in metres", true);
+    t.number("marker_m", &O::marker_m, 0.05, 0.005, 0.5, "its marker's side", "m")
+        .number("width_m", &O::width_m, 0.07, 0.005, 0.6, "its width (at least the marker's)", "m")
+        .number("height_m", &O::height_m, 0.06, 0.005, 0.6, "its height", "m");
+    vec3(t, "color", &O::color, {0.8, 0.4, 0.3}, "its colour (red, green, blue, 0-1)");
+    t.rule([](const Json& o) -> Broken {
+      if (o["width_m"].get<double>() < o["marker_m"].get<double>())
+        return std::pair{"width_m", "= " + o["width_m"].dump() + " must lie in [" +
+                                        o["marker_m"].dump() + ", 0.6] (at least the marker)"};
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<GridSettings>& gridSchema() {
+  static const Schema<GridSettings> t = [] {
+    using G = GridSettings;
+    Schema<G> t("grid", "The grid of cells on the table where objects are put");
+    t.integer("rows", &G::rows, 3, 1, 12, "rows of cells")
+        .integer("columns", &G::columns, 3, 1, 12, "columns of cells")
+        .number("cell_m", &G::cell_m, 0.09, 0.01, 1.0, "a cell's side", "m");
+    vec3(t, "centre", &G::centre, {0.0, 0.66, 0.0}, "its centre on the table (robot frame)");
+    t.rule([](const Json& g) -> Broken {
+      if (g["rows"].get<int>() * g["columns"].get<int>() < 2)
+        return std::pair{"", "needs at least 2 cells"};
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<WorldSettings>& referenceSchema() {
+  static const Schema<WorldSettings> t = [] {
+    using W = WorldSettings;
+    Schema<W> t("reference", "The reference marker, at a known place in the robot's frame");
+    t.integer("id", &W::reference_id, 0, 0, 4095, "its marker id")
+        .number("size_m", &W::reference_size_m, 0.08, 0.005, 1.0, "its side", "m");
+    vec3(t, "position", &W::reference_position, {0.0, 0.90, 0.0},
+         "its centre in the robot frame (lying flat, axes along the robot's)");
+    return t;
+  }();
+  return t;
+}
+
+Json defaultObjects() {
+  auto object = [](int id, double x, Json color) {
+    return Json{{"id", id},         {"position", {x, 0.42, 0.06}},
+                {"marker_m", 0.05}, {"width_m", 0.07},
+                {"height_m", 0.06}, {"color", std::move(color)}};
+  };
+  return Json::array({object(10, -0.27, {0.85, 0.30, 0.25}), object(20, -0.09, {0.25, 0.55, 0.85}),
+                      object(30, 0.09, {0.30, 0.75, 0.35}), object(40, 0.27, {0.90, 0.75, 0.20})});
+}
+
+const Schema<WorldSettings>& worldSchema() {
+  static const Schema<WorldSettings> t = [] {
+    using W = WorldSettings;
+    Schema<W> t("world", "The table, the reference marker, the objects and the grid");
+    t.number("table_z", &W::table_z, 0.0, -2.0, 2.0, "the table's height (robot frame)", "m")
+        .sectionOf("reference", referenceSchema())
+        .list("objects", &W::objects, objectSchema(), defaultObjects(), 2,
+              "the objects the subject selects (at least 2)")
+        .section("grid", &W::grid, gridSchema());
+    t.rule([](const Json& w) -> Broken {
+      const int reference = w["reference"]["id"].get<int>();
+      std::set<int> seen;
+      for (size_t i = 0; i < w["objects"].size(); ++i) {
+        const int id = w["objects"][i]["id"].get<int>();
+        const std::string key = "objects[" + std::to_string(i) + "].id";
+        if (id == reference)
+          return std::pair{key, "= " + std::to_string(id) + " is the reference marker's id"};
+        if (!seen.insert(id).second)
+          return std::pair{key, "= " + std::to_string(id) + " is used twice"};
+      }
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<EegSettings>& eegSchema() {
+  static const Schema<EegSettings> t = [] {
+    using E = EegSettings;
+    Schema<E> t("eeg", "The EEG source and the signal's shape");
+    const auto& subject = bci::subjectSchema();
+    t.text("source", &E::source, "simulated", "where the EEG comes from (EEG sources)",
+           [] { return eegSources().names(); })
+        .custom(
+            subject.at("seed"), [](E& e, const Json& j) { e.seed = j.get<std::uint64_t>(); },
+            [](const E& e) { return Json(e.seed); })
+        .custom(
+            subject.at("montage"),
+            [](E& e, const Json& j) { e.montage = j.get<std::vector<std::string>>(); },
+            [](const E& e) { return Json(e.montage); })
+        .custom(
+            subject.at("rate_hz"), [](E& e, const Json& j) { e.rate_hz = j.get<double>(); },
+            [](const E& e) { return Json(e.rate_hz); })
+        .custom(
+            subject.at("block_size"), [](E& e, const Json& j) { e.block_size = j.get<int>(); },
+            [](const E& e) { return Json(e.block_size); })
+        .custom(
+            subject.at("line_hz"), [](E& e, const Json& j) { e.line_hz = j.get<double>(); },
+            [](const E& e) { return Json(e.line_hz); })
+        .number("erp_scale", &E::erp_scale, 1.0, 0.0, 10.0,
+                "simulated: the subject's P300 amplitude factor (weak subjects < 1)")
+        .number("errp_scale", &E::errp_scale, 1.0, 0.0, 10.0,
+                "simulated: its error-related potentials' amplitude factor (0: none)")
+        .text("file", &E::file, "", "source \"file\": the recording to replay")
+        .custom(
+            subject.at("photodiode_channel"),
+            [](E& e, const Json& j) { e.photodiode_channel = j.get<std::string>(); },
+            [](const E& e) { return Json(e.photodiode_channel); })
+        .number("latency_ms", &E::latency_ms, 0.0, 0.0, 1000.0,
+                "the amplifier's delivery latency, as arbci timing-check measures it", "ms");
+    // Each source's own section.
+    for (const auto& source : eegSources().entries()) {
+      if (!source.settings) continue;
+      Key k{source.name, Type::Section, nullptr, source.settings->doc()};
+      k.table = source.settings;
+      const std::string name = source.name;
+      t.custom(
+          k, [name](E& e, const Json& j) { e.sources[name] = j; },
+          [name](const E& e) {
+            const auto found = e.sources.find(name);
+            return found == e.sources.end() ? Json::object() : found->second;
+          });
+    }
+    t.rule([](const Json& eeg) -> Broken {
+      const auto* source = eegSources().find(eeg["source"].get<std::string>());
+      if (source && source->make.required) return source->make.required(eeg);
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<LslSettings>& lslSchema() {
+  static const Schema<LslSettings> t = [] {
+    using L = LslSettings;
+    Schema<L> t("lsl",
+                "The Lab Streaming Layer: where streams are looked for, what ARBCI "
+                "publishes (scope and peers default to lsl_api.cfg's)");
+    t.text("scope", &L::scope, "", "\"\" (lsl_api.cfg's), machine, link or site",
+           [] {
+             return std::vector<std::string>{"", "machine", "link", "site"};
+           })
+        .texts("known_peers", &L::known_peers, {}, 0,
+               "host names added to lsl_api.cfg's KnownPeers")
+        .boolean("markers", &L::markers, false,
+                 "publish every stimulus and note of the recording as an LSL Markers stream")
+        .text("marker_stream", &L::marker_stream, "ARBCI-Markers", "that stream's name");
+    t.rule([](const Json& l) -> Broken {
+      if (l["markers"].get<bool>() && l["marker_stream"].get<std::string>().empty())
+        return std::pair{"marker_stream", "must name the stream when markers is true"};
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<TrialIntent>& intentSchema() {
+  static const Schema<TrialIntent> t = [] {
+    Schema<TrialIntent> t("intended", "What the simulated subject means in a trial");
+    t.required(Key{"object", Type::Integer, nullptr, "the object's marker id", "", 0, 4095},
+               &TrialIntent::object);
+    Key cell{"cell", Type::Numbers, Json::array({1, 1}), "[row, column] of the cell, from 1"};
+    cell.min_items = cell.max_items = 2;
+    t.custom(
+        cell,
+        [](TrialIntent& i, const Json& j) {
+          i.row = static_cast<int>(j[0].get<double>());
+          i.column = static_cast<int>(j[1].get<double>());
+        },
+        [](const TrialIntent& i) {
+          return Json::array({i.row, i.column});
+        });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<SessionConfig>& paradigmSectionSchema() {
+  static const Schema<SessionConfig> t = [] {
+    Schema<SessionConfig> t("paradigm", bci::paradigmSchema().doc());
+    for (const char* key :
+         {"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "calibration_selections",
+          "calibration_sequences", "trials", "cue_s", "result_s", "pause_s"})
+      t.adopt(bci::paradigmSchema(), key, &SessionConfig::paradigm);
+    t.rulesOf(bci::paradigmSchema());
+    t.list("intended", &SessionConfig::intended, intentSchema(),
+           Json::array({{{"object", 20}, {"cell", {1, 3}}},
+                        {{"object", 40}, {"cell", {3, 1}}},
+                        {{"object", 10}, {"cell", {2, 2}}}}),
+           0,
+           "each trial's intention (the simulated subject's); trials beyond the list are drawn "
+           "from the seed");
+    return t;
+  }();
+  return t;
+}
+
+const Schema<ClassifierSettings>& classifierSchema() {
+  static const Schema<ClassifierSettings> t = [] {
+    using C = ClassifierSettings;
+    Schema<C> t("classifier", "The P300 classifier the calibration run trains");
+    for (const char* key : {"method", "window_ms", "decimate_hz", "highpass_hz", "lowpass_hz",
+                            "notch_hz", "notch_q", "filter_order", "common_average", "channels"}) {
+      if (bci::trainingSchema().find(key))
+        t.adopt(bci::trainingSchema(), key, &C::training);
+      else
+        t.adopt(bci::pipelineSchema(), key, &C::pipeline);
+    }
+    for (const char* key : {"folds", "p_enter", "p_remove", "max_features", "xdawn_filters"})
+      t.adopt(bci::trainingSchema(), key, &C::training);
+    t.text("model", &C::model_file, "", "a trained model (arbci train): no calibration run");
+    t.rulesOf(bci::pipelineSchema()).rulesOf(bci::trainingSchema());
+    return t;
+  }();
+  return t;
+}
+
+const Schema<ErrpSettings>& errpOwnSchema() {
+  static const Schema<ErrpSettings> t = [] {
+    using E = ErrpSettings;
+    Schema<E> t("errp", "The ErrP classifier");
+    t.number("threshold", &E::threshold, 0.5, 0.0, 1.0,
+             "a selection whose posterior probability of an error exceeds it is rejected")
+        .texts("channels", &E::channels, {}, 0,
+               "its channels ([]: all of the montage's; those listed that the montage has)");
+    Key window{"window_ms", Type::Numbers, Json::array({0, 800}), "its epoch after each feedback",
+               "ms"};
+    window.min_items = window.max_items = 2;
+    t.custom(
+        window,
+        [](E& e, const Json& j) {
+          e.window = {j[0].get<double>() / 1000.0, j[1].get<double>() / 1000.0};
+        },
+        [](const E& e) {
+          return Json::array({e.window.start_s * 1000.0, e.window.end_s * 1000.0});
+        });
+    t.number("decimate_hz", &E::decimate_hz, 20.0, 1.0, 500.0, "its features' rate", "Hz")
+        .number("highpass_hz", &E::highpass_hz, 1.0, 0.0, 100.0, "its band's lower edge", "Hz")
+        .number("lowpass_hz", &E::lowpass_hz, 10.0, 0.0, 500.0, "its band's upper edge", "Hz")
+        .text("method", &E::method, "riemann", "its classifier (classifiers)",
+              [] { return bci::classifiers().names(); })
+        .integer("xdawn_filters", &E::xdawn_filters, 1, 1, 64,
+                 "xDAWN filters kept (riemann: per class)")
+        .integer("folds", &E::folds, 5, 2, 100,
+                 "its cross-validation: contiguous blocks of the feedbacks");
+    t.rule([](const Json& e) -> Broken {
+      const double start = e["window_ms"][0].get<double>(), end = e["window_ms"][1].get<double>();
+      if (!(end > start) || start < 0.0)
+        return std::pair{"window_ms",
+                         "must start at or after the feedback and end after it starts"};
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+const Schema<SessionConfig>& errpSectionSchema() {
+  static const Schema<SessionConfig> t = [] {
+    Schema<SessionConfig> t("errp",
+                            "Error-related potentials: an ErrP classifier checks each "
+                            "selection before the robot acts (docs/errp.md)");
+    const auto& p = bci::paradigmSchema();
+    t.adopt(p, "errp", &SessionConfig::paradigm, "enabled")
+        .adopt(p, "errp_calibration_feedbacks", &SessionConfig::paradigm, "calibration_feedbacks")
+        .adopt(p, "errp_wrong_rate", &SessionConfig::paradigm, "wrong_feedback_rate")
+        .adopt(p, "errp_runner_up", &SessionConfig::paradigm, "runner_up")
+        .adopt(p, "errp_repeat_sequences", &SessionConfig::paradigm, "repeat_sequences")
+        .adopt(p, "errp_max_corrections", &SessionConfig::paradigm, "max_corrections")
+        .merge(errpOwnSchema(), &SessionConfig::errp)
+        .rulesOf(errpOwnSchema());
+    return t;
+  }();
+  return t;
+}
+
+const Schema<RobotSettings>& robotSchema() {
+  static const Schema<RobotSettings> t = [] {
+    using R = RobotSettings;
+    Schema<R> t("robot", "The robot backend the session commands");
+    t.text("backend", &R::backend, "simulated",
+           "simulated (arbci-robotd started here) or remote (host, port, key_file)",
+           [] {
+             return std::vector<std::string>{"simulated", "remote"};
+           })
+        .number("speed_factor", &R::speed_factor, 8.0, 0.1, 100.0,
+                "simulated: the arm's seconds per second of the session")
+        .text("host", &R::host, "127.0.0.1", "remote: the backend's host")
+        .integer("port", &R::port, 47800, 1, 65535, "remote: its UDP port")
+        .text("key_file", &R::key_file, "", "remote: the shared key (arbci robot keygen)");
+    t.rule([](const Json& r) -> Broken {
+      if (r["backend"] == "remote" && r["key_file"].get<std::string>().empty())
+        return std::pair{"key_file", "is required for a remote robot"};
+      return std::nullopt;
+    });
+    return t;
+  }();
+  return t;
+}
+
+// Rules between sections.
+Broken crossRules(const Json& c) {
+  std::set<int> objects;
+  for (const Json& o : c["world"]["objects"]) objects.insert(o["id"].get<int>());
+  const int rows = c["world"]["grid"]["rows"].get<int>();
+  const int columns = c["world"]["grid"]["columns"].get<int>();
+  const Json& intended = c["paradigm"]["intended"];
+  for (size_t i = 0; i < intended.size(); ++i) {
+    const std::string at = "paradigm.intended[" + std::to_string(i) + "]";
+    const int object = intended[i]["object"].get<int>();
+    if (!objects.count(object))
+      return std::pair{at + ".object",
+                       "= " + std::to_string(object) + " is not one of world.objects"};
+    const int row = static_cast<int>(intended[i]["cell"][0].get<double>());
+    const int column = static_cast<int>(intended[i]["cell"][1].get<double>());
+    if (row < 1 || row > rows || column < 1 || column > columns)
+      return std::pair{at + ".cell", "lies outside the " + std::to_string(rows) + "x" +
+                                         std::to_string(columns) + " grid"};
+  }
+  if (c["errp"]["enabled"].get<bool>() && !c["errp"]["channels"].empty()) {
+    const auto montage = c["eeg"]["montage"].get<std::vector<std::string>>();
+    bool any = false;
+    for (const Json& ch : c["errp"]["channels"])
+      any |= std::find(montage.begin(), montage.end(), ch.get<std::string>()) != montage.end();
+    if (!any)
+      return std::pair{"errp.channels",
+                       "= " + c["errp"]["channels"].dump() +
+                           ": the EEG montage has none of them (the ErrP is fronto-central: "
+                           "name the montage's channels there)"};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+const Schema<SessionConfig>& sessionSchema() {
+  static const Schema<SessionConfig> t = [] {
+    Schema<SessionConfig> t("session", "A session file: every key, its default and what it means");
+    t.text("description", &SessionConfig::description, "",
+           "what this session file is for (free text)")
+        .adopt(bci::paradigmSchema(), "display_hz", &SessionConfig::paradigm)
+        .section("hmd", &SessionConfig::hmd, hmdSchema())
+        .section("cameras", &SessionConfig::cameras, camerasSchema())
+        .section("tracker", &SessionConfig::tracker, trackerSchema())
+        .section("world", &SessionConfig::world, worldSchema())
+        .section("eeg", &SessionConfig::eeg, eegSchema())
+        .section("lsl", &SessionConfig::lsl, lslSchema())
+        .sectionOf("paradigm", paradigmSectionSchema())
+        .section("classifier", &SessionConfig::classifier, classifierSchema())
+        .sectionOf("errp", errpSectionSchema())
+        .section("robot", &SessionConfig::robot, robotSchema());
+    t.rule(crossRules);
+    return t;
+  }();
+  return t;
+}
+
+HmdConfig::HmdConfig() {
+  hmdSchema().applyDefaults(*this);
+}
+CameraSource::CameraSource() {
+  cameraSourceSchema().applyDefaults(*this);
+}
+CameraSettings::CameraSettings() {
+  camerasSchema().applyDefaults(*this);
+}
+TrackerSettings::TrackerSettings() {
+  trackerSchema().applyDefaults(*this);
+}
+WorldObjectSettings::WorldObjectSettings() : id(0), position(0.0, 0.0, 0.0) {
+  objectSchema().applyDefaults(*this);
+}
+GridSettings::GridSettings() {
+  gridSchema().applyDefaults(*this);
+}
+WorldSettings::WorldSettings() {
+  worldSchema().applyDefaults(*this);
+}
+EegSettings::EegSettings() {
+  eegSchema().applyDefaults(*this);
+}
+LslSettings::LslSettings() {
+  lslSchema().applyDefaults(*this);
+}
+ErrpSettings::ErrpSettings() {
+  errpOwnSchema().applyDefaults(*this);
+}
+TrialIntent::TrialIntent() : object(0) {
+  intentSchema().applyDefaults(*this);
+}
+RobotSettings::RobotSettings() {
+  robotSchema().applyDefaults(*this);
+}
+SessionConfig::SessionConfig() {
+  sessionSchema().applyDefaults(*this);
+}
+
+SessionConfig SessionConfig::parse(const Json& json, const std::string& name) {
+  SessionConfig config;
+  Json resolved;
+  try {
+    resolved = sessionSchema().resolve(json, core::Place{name, ""});
+  } catch (const core::SettingsError& error) {
+    throw SessionConfigError(error.what());
+  }
+  sessionSchema().read(resolved, config);
+  config.source = name;
+  return config;
+}
+
+SessionConfig SessionConfig::load(const std::optional<std::filesystem::path>& path) {
+  if (!path) return SessionConfig{};
+  std::ifstream in(*path);
+  if (!in) throw SessionConfigError(path->string() + ": cannot open the session file");
+  Json json;
+  try {
+    in >> json;
+  } catch (const Json::exception& error) {
+    throw SessionConfigError(path->string() + ": not JSON (" + std::string(error.what()) + ")");
+  }
+  return parse(json, path->string());
+}
+
+Json SessionConfig::toJson() const {
+  return sessionSchema().write(*this);
+}
+
+bci::PipelineSettings ErrpSettings::pipeline(const bci::PipelineSettings& p300,
+                                             const std::vector<std::string>& montage) const {
+  bci::PipelineSettings out = p300;
+  out.window = window;
+  out.decimate_hz = decimate_hz;
+  out.filter.highpass_hz = highpass_hz;
+  out.filter.lowpass_hz = lowpass_hz;
+  out.channels.clear();
+  if (channels.empty()) {
+    out.channels = montage;  // the EEG channels only, never the photodiode
+    return out;
+  }
+  for (const std::string& channel : channels) {
+    if (std::find(montage.begin(), montage.end(), channel) != montage.end())
+      out.channels.push_back(channel);
+  }
+  if (out.channels.empty()) {
+    std::string wanted;
+    for (const std::string& channel : channels) wanted += (wanted.empty() ? "" : ", ") + channel;
+    throw SessionConfigError("errp.channels: the EEG montage has none of " + wanted +
+                             " (the ErrP is fronto-central: name the montage's channels there)");
+  }
+  return out;
+}
+
+bci::TrainingSettings ErrpSettings::training() const {
+  bci::TrainingSettings t;
+  t.method = method;
+  t.xdawn.filters = xdawn_filters;
+  t.folds = folds;
+  t.folds_by = "block";
+  return t;
+}
+
+bci::lsl::LslConfig LslSettings::config(const std::string& session_file) const {
+  bci::lsl::LslConfig c;
+  try {
+    c = bci::lsl::LslConfig::load();
+  } catch (const bci::lsl::LslError& e) {
+    throw SessionConfigError(session_file + ": the LSL configuration: " + e.what());
+  }
+  if (!scope.empty()) c.resolve_scope = scope;
+  c.known_peers.insert(c.known_peers.end(), known_peers.begin(), known_peers.end());
+  return c;
+}
+
+std::string settingsMarkdown() {
+  std::ostringstream out;
+  out << core::markdown(sessionSchema(), "");
+  auto registry = [&out](const std::string& title, const auto& r) {
+    out << "## " << title << " (`" << r.key() << "`)\n\n| name | what it is |\n| --- | --- |\n";
+    for (const auto& e : r.entries()) out << "| `" << e.name << "` | " << e.doc << " |\n";
+    out << "\n";
+  };
+  registry("EEG sources", eegSources());
+  registry("Classifiers", bci::classifiers());
+  registry("Marker families", vision::markerFamilies());
+  registry("Camera sources", sceneSources());
+  registry("Robot drivers", robot::robotDrivers());
+  return out.str();
+}
+
+}  // namespace arbci::session

@@ -1,0 +1,30 @@
+// The experimenter panels, in the order the workstation opens them. A new panel is its file in
+// this folder defining its Entry, and its line here.
+#include "arbci/ui/panel_registry.h"
+
+namespace arbci::ui {
+
+PanelRegistry::Entry sessionPanel();
+PanelRegistry::Entry hmdPanel();
+PanelRegistry::Entry robotPanel();
+PanelRegistry::Entry thresholdPanel();
+PanelRegistry::Entry calibrationPanel();
+PanelRegistry::Entry trainingPanel();
+PanelRegistry::Entry summaryPanel();
+
+const PanelRegistry& panels() {
+  static const PanelRegistry registry = [] {
+    PanelRegistry r("panel", "the workstation's panels");
+    r.add(sessionPanel());
+    r.add(hmdPanel());
+    r.add(robotPanel());
+    r.add(thresholdPanel());
+    r.add(calibrationPanel());
+    r.add(trainingPanel());
+    r.add(summaryPanel());
+    return r;
+  }();
+  return registry;
+}
+
+}  // namespace arbci::ui

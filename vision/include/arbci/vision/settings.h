@@ -1,0 +1,26 @@
+// The vision module's settings and its registry of marker families. The session's tracker
+// section and `arbci detect` take the detector's defaults (kind, border, search_decimate) from
+// detectorSchema(); markerFamilies() names every kind of marker the tracker reads, with what each
+// is for (docs/settings.md lists them).
+#pragma once
+
+#include "arbci/core/registry.h"
+#include "arbci/core/schema.h"
+#include "arbci/vision/marker.h"
+#include "arbci/vision/marker_detector.h"
+
+namespace arbci::vision {
+
+struct MarkerFamily {
+  MarkerKind kind;
+  double border;             // its usual border, as a fraction of the side
+  bool printable = false;    // `arbci marker make` draws it
+  bool in_sessions = false;  // a session can track objects by it (ids alone: no extra files)
+};
+using MarkerFamilyRegistry = core::Registry<MarkerFamily>;
+const MarkerFamilyRegistry& markerFamilies();
+
+// kind, border, search_decimate (the DetectorConfig's settings).
+const core::Schema<DetectorConfig>& detectorSchema();
+
+}  // namespace arbci::vision
