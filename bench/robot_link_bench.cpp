@@ -94,9 +94,8 @@ int main(int argc, char** argv) {
                                 robot::testKey());
       const auto events =
           robot::waitFor(client, client.send(robot::MessageType::Grasp, {0.10, 0.60, 0.06}));
-      const robot::RobotEvent* last = robot::finalEvent(events);
-      if (last && last->kind == robot::RobotEvent::Kind::Finished &&
-          last->outcome == robot::Outcome::Success)
+      const robot::RobotEvent& last = robot::finalEvent(events);
+      if (last.kind == robot::RobotEvent::Kind::Finished && last.outcome == robot::Outcome::Success)
         ++finished;
       halted += rig.backend.stats().watchdog_halts > 0 ? 1 : 0;
     }

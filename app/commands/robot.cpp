@@ -9,6 +9,7 @@
 
 #include "arbci/robot/client.h"
 #include "arbci/robot/key_file.h"
+#include "arbci/robot/settings.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
 #include "support/output_path.h"
@@ -17,8 +18,8 @@ namespace arbci::app {
 namespace {
 
 struct RobotOptions {
-  std::string host = "127.0.0.1", key_file, out;
-  int port = 47800;
+  std::string host = robot::LinkSettings{}.host, key_file, out;
+  int port = robot::LinkSettings{}.port;
   double timeout_s = 120.0;
   double retry_budget_s = 15.0;
   std::vector<double> xyz;

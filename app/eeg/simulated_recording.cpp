@@ -6,6 +6,7 @@
 #include <set>
 #include <thread>
 
+#include "arbci/bci/paradigm.h"
 #include "arbci/bci/paradigm_layout.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
@@ -69,6 +70,20 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
 }
 
 }  // namespace
+
+SimulationOptions::SimulationOptions() {
+  const bci::SimulatedSubjectConfig subject;
+  const bci::ParadigmSettings paradigm;
+  seed = subject.seed;
+  rate_hz = subject.rate_hz;
+  for (const std::string& channel : subject.montage)
+    montage += (montage.empty() ? "" : ",") + channel;
+  sequences = paradigm.calibration_sequences;
+  flash_ms = paradigm.flash_ms;
+  isi_ms = paradigm.isi_ms;
+  line_hz = subject.line_hz;
+  alpha_hz = subject.alpha_hz;
+}
 
 SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& progress) {
   bci::SimulatedSubjectConfig config;

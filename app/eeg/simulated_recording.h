@@ -8,19 +8,21 @@
 
 namespace arbci::app {
 
+// The subject's and the paradigm's options default to a session's (bci/settings.h).
 struct SimulationOptions {
+  SimulationOptions();
   double seconds = 60.0;
   std::string out;
-  std::uint64_t seed = 1;
-  double rate_hz = 256.0;
-  std::string montage = "Fz,Cz,P3,Pz,P4,PO7,Oz,PO8";
+  std::uint64_t seed;
+  double rate_hz;
+  std::string montage;        // comma-separated
   int stimuli = 4;            // single-stimulus paradigm (objects)
   int rows = 0, columns = 0;  // row/column paradigm when both are set
-  int sequences = 10;
-  double flash_ms = 60.0;
-  double isi_ms = 120.0;
-  double line_hz = 50.0;
-  double alpha_hz = 10.0;
+  int sequences;              // a calibration selection's
+  double flash_ms;
+  double isi_ms;
+  double line_hz;
+  double alpha_hz;
   bool paced = false;
 };
 

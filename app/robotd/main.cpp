@@ -30,8 +30,9 @@ int main(int argc, char** argv) {
       "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: "
       "docs/robot-protocol.md.",
       "arbci-robotd"};
-  int port = 47800;
-  std::string host = "127.0.0.1", key_file, config_file, port_file, driver = "simulated";
+  const arbci::robot::LinkSettings link;  // the defaults a session's robot section has
+  int port = link.port;
+  std::string host = link.host, key_file, config_file, port_file, driver = "simulated";
   double speed = 0.0;
   bool stepped = false;
   int watchdog_ms = 100;

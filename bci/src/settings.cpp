@@ -137,7 +137,7 @@ const core::Schema<TrainingSettings>& trainingSchema() {
     using T = TrainingSettings;
     t.text("method", &T::method, "slda", "the classifier (docs/settings.md's classifiers)",
            [] { return classifiers().names(); })
-        .integer("folds", &T::folds, 4, 2, 100,
+        .integer("folds", &T::folds, 10, 2, 100,
                  "cross-validation folds (at most one per selection or file)")
         .text("folds_by", &T::folds_by, "",
               "selection, block or file (\"\": by selection, or by block when the codes are "

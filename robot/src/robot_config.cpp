@@ -91,6 +91,21 @@ const core::Schema<RobotConfig>& configSchema() {
   return table;
 }
 
+const core::Schema<LinkSettings>& linkSchema() {
+  static const core::Schema<LinkSettings> table = [] {
+    core::Schema<LinkSettings> t("link", "The robot backend's UDP address");
+    t.text("host", &LinkSettings::host, "127.0.0.1",
+           "the backend's host (arbci-robotd: the address it listens on)")
+        .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port");
+    return t;
+  }();
+  return table;
+}
+
+LinkSettings::LinkSettings() {
+  linkSchema().applyDefaults(*this);
+}
+
 SimulatedObject::SimulatedObject() : id(0), position{} {
   objectSchema().applyDefaults(*this);
 }

@@ -360,8 +360,15 @@ const Schema<ClassifierSettings>& classifierSchema() {
       else
         t.adopt(bci::pipelineSchema(), key, &C::pipeline);
     }
-    for (const char* key : {"folds", "p_enter", "p_remove", "max_features", "xdawn_filters"})
+    for (const char* key : {"p_enter", "p_remove", "max_features", "xdawn_filters"})
       t.adopt(bci::trainingSchema(), key, &C::training);
+    // The calibration run's cross-validation, not an offline analysis's (arbci train --folds):
+    // fewer folds, so the first trial starts sooner.
+    t.custom(
+        Key{"folds", Type::Integer, 4,
+            "the calibration run's cross-validation folds (by selection)", "", 2, 100},
+        [](C& c, const Json& j) { c.training.folds = j.get<int>(); },
+        [](const C& c) { return Json(c.training.folds); });
     t.text("model", &C::model_file, "", "a trained model (arbci train): no calibration run");
     t.rulesOf(bci::pipelineSchema()).rulesOf(bci::trainingSchema());
     return t;
@@ -439,8 +446,13 @@ const Schema<RobotSettings>& robotSchema() {
            })
         .number("speed_factor", &R::speed_factor, 8.0, 0.1, 100.0,
                 "simulated: the arm's seconds per second of the session")
-        .text("host", &R::host, "127.0.0.1", "remote: the backend's host")
-        .integer("port", &R::port, 47800, 1, 65535, "remote: its UDP port")
+        .custom(
+            robot::linkSchema().at("host"),
+            [](R& r, const Json& j) { r.host = j.get<std::string>(); },
+            [](const R& r) { return Json(r.host); })
+        .custom(
+            robot::linkSchema().at("port"), [](R& r, const Json& j) { r.port = j.get<int>(); },
+            [](const R& r) { return Json(r.port); })
         .text("key_file", &R::key_file, "", "remote: the shared key (arbci robot keygen)");
     t.rule([](const Json& r) -> Broken {
       if (r["backend"] == "remote" && r["key_file"].get<std::string>().empty())

@@ -66,8 +66,12 @@ TEST(SessionSchema, EveryDefaultIsWhatARunWithAnEmptySessionFileUses) {
             bci::paradigmSchema().write(empty.paradigm));
   EXPECT_EQ(bci::pipelineSchema().write(bci::PipelineSettings{}),
             bci::pipelineSchema().write(empty.classifier.pipeline));
-  EXPECT_EQ(bci::trainingSchema().write(bci::TrainingSettings{}),
+  // The calibration run's folds are the session's own setting (arbci train's default is more).
+  bci::TrainingSettings training;
+  training.folds = empty.classifier.training.folds;
+  EXPECT_EQ(bci::trainingSchema().write(training),
             bci::trainingSchema().write(empty.classifier.training));
+  EXPECT_EQ(empty.classifier.training.folds, 4);
   EXPECT_EQ(vision::detectorSchema().write(vision::DetectorConfig{}),
             vision::detectorSchema().write(empty.tracker.detector));
   const bci::SimulatedSubjectConfig subject;

@@ -80,6 +80,8 @@ class GappySource final : public EegSource {
  public:
   explicit GappySource(std::shared_ptr<const SampleClock> clock) : clock_(std::move(clock)) {
     info_.channels = {"Cz"};
+    info_.rate_hz = 256.0;
+    info_.block_size = 15;
   }
   const SignalInfo& info() const override { return info_; }
   std::vector<Block> poll(int) override {

@@ -147,6 +147,7 @@ TEST(Recording, FileCutShortIsRefusedWithAReasonOrSalvaged) {
 
 TEST(Recording, UnwritablePathNamesTheFile) {
   SignalInfo info;
+  info.rate_hz = 256.0;
   info.channels = {"Cz"};
   try {
     RecordingWriter writer("/nonexistent-folder/x.bdf", info);

@@ -35,6 +35,8 @@ Block slice(const Block& whole, int first, int count) {
 
 SignalInfo eightChannels() {
   SignalInfo info;
+  info.rate_hz = 256.0;
+  info.block_size = 15;
   info.channels = {"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
   return info;
 }

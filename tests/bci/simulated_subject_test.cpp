@@ -80,6 +80,8 @@ TEST(SimulatedSubject, TargetMinusNonTargetAtPzPeaksBetween250And500Ms) {
   const SimulatedRun run = simulate(config, 120.0);
   // Band-pass as the classifier will, then average 0-800 ms after each flash.
   SignalInfo info;
+  info.rate_hz = config.rate_hz;
+  info.block_size = config.block_size;
   info.channels = config.montage;
   Block all(0, static_cast<int>(config.montage.size()), static_cast<int>(run.channels[0].size()));
   for (int c = 0; c < all.channels; ++c)
@@ -139,6 +141,8 @@ FeedbackAverages feedbackAverages(const SimulatedSubjectConfig& config) {
     }
   }
   SignalInfo info;
+  info.rate_hz = config.rate_hz;
+  info.block_size = config.block_size;
   info.channels = config.montage;
   Block all(0, static_cast<int>(channels.size()), static_cast<int>(channels[0].size()));
   for (int c = 0; c < all.channels; ++c)

@@ -59,13 +59,13 @@ TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {
   RunningBackend backend(20.0);
   RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
   auto events = waitFor(client, client.send(MessageType::Grasp, {0.10, 0.60, 0.06}));
-  ASSERT_NE(finalEvent(events), nullptr);
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished) << finalEvent(events)->text;
-  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success) << finalEvent(events)->text;
+  ASSERT_FALSE(events.empty());
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished) << finalEvent(events).text;
+  EXPECT_EQ(finalEvent(events).outcome, Outcome::Success) << finalEvent(events).text;
   const Vec3 drop{-0.20, 0.75, 0.0};
   events = waitFor(client, client.send(MessageType::Drop, drop));
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
-  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success) << finalEvent(events)->text;
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events).outcome, Outcome::Success) << finalEvent(events).text;
   const StatusPayload status = freshStatus(client);
   ASSERT_EQ(status.objects.size(), 2u);
   const WorldObject& moved = status.objects[0];
@@ -87,9 +87,9 @@ TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
   for (int i = 0; i < 100; ++i) {
     const auto sequence = client.send(MessageType::Home);
     const auto events = waitFor(client, sequence, 10s);
-    ASSERT_NE(finalEvent(events), nullptr) << "command " << i;
-    ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished)
-        << "command " << i << ": " << finalEvent(events)->text;
+    ASSERT_FALSE(events.empty()) << "command " << i;
+    ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished)
+        << "command " << i << ": " << finalEvent(events).text;
     ++finished;
   }
   EXPECT_EQ(finished, 100);
@@ -176,7 +176,7 @@ TEST(RobotBackend, TenThousandBadDatagramsChangeNothing) {
   EXPECT_EQ(after.holding, -1);
   // A command replayed within its session is answered from the cache, never run again.
   const auto events = waitFor(client, client.send(MessageType::Home));
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
   EXPECT_EQ(backend.stats().executed, 1u);
 }
 
@@ -184,13 +184,13 @@ TEST(RobotBackend, OutsideTheWorkspaceIsRejectedWithTheReason) {
   RunningBackend backend(20.0);
   RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
   auto events = waitFor(client, client.send(MessageType::Grasp, {1.5, 0.6, 0.06}));
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Rejected);
-  EXPECT_EQ(finalEvent(events)->reason, RejectReason::OutsideWorkspace);
-  EXPECT_NE(finalEvent(events)->text.find("outside the workspace"), std::string::npos);
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Rejected);
+  EXPECT_EQ(finalEvent(events).reason, RejectReason::OutsideWorkspace);
+  EXPECT_NE(finalEvent(events).text.find("outside the workspace"), std::string::npos);
   events = waitFor(client, client.send(MessageType::Grasp, {0.1, 0.6, -0.2}));
-  EXPECT_EQ(finalEvent(events)->reason, RejectReason::OutsideWorkspace);
+  EXPECT_EQ(finalEvent(events).reason, RejectReason::OutsideWorkspace);
   events = waitFor(client, client.send(MessageType::Drop, {0.1, 0.6, 0.0}));
-  EXPECT_EQ(finalEvent(events)->reason, RejectReason::InvalidState);  // holding nothing
+  EXPECT_EQ(finalEvent(events).reason, RejectReason::InvalidState);  // holding nothing
   EXPECT_EQ(backend.stats().executed, 0u);
 }
 
@@ -202,9 +202,9 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
   std::this_thread::sleep_for(400ms);
   const auto stop = client.send(MessageType::Stop);
   auto events = waitFor(client, grasp, 3s);
-  ASSERT_NE(finalEvent(events), nullptr);
-  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
-  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Stopped);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events).outcome, Outcome::Stopped);
   (void)stop;
   const StatusPayload halted = freshStatus(client);
   std::this_thread::sleep_for(300ms);
@@ -218,16 +218,16 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
       0.01);
   // The stop is latched: no motion until an explicit RESET.
   events = waitFor(client, client.send(MessageType::Home), 3s);
-  ASSERT_NE(finalEvent(events), nullptr);
-  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Rejected);
-  EXPECT_EQ(finalEvent(events)->reason, RejectReason::Stopped) << finalEvent(events)->text;
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(finalEvent(events).kind, RobotEvent::Kind::Rejected);
+  EXPECT_EQ(finalEvent(events).reason, RejectReason::Stopped) << finalEvent(events).text;
   EXPECT_EQ(halted.stop_reason, "emergency stop");
   events = waitFor(client, client.send(MessageType::Reset), 3s);
-  ASSERT_NE(finalEvent(events), nullptr);
-  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
   events = waitFor(client, client.send(MessageType::Home), 15s);
-  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
-  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success);
+  EXPECT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events).outcome, Outcome::Success);
 }
 
 TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {
@@ -255,10 +255,10 @@ TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {
   EXPECT_LE(silent_after, 1.1);  // reported within a second (plus one poll)
   RunningBackend second(1.0, port);
   const auto events = waitFor(client, grasp, 3s);
-  ASSERT_NE(finalEvent(events), nullptr);
-  EXPECT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Failed);
-  EXPECT_NE(finalEvent(events)->text.find("restarted"), std::string::npos)
-      << finalEvent(events)->text;
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(finalEvent(events).kind, RobotEvent::Kind::Failed);
+  EXPECT_NE(finalEvent(events).text.find("restarted"), std::string::npos)
+      << finalEvent(events).text;
 }
 
 }  // namespace

@@ -128,7 +128,7 @@ TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
     test::UdpRelay relay(port, testKey());
     RobotClient client(local(relay.port()), testKey(), fastClient());
     const auto events = waitFor(client, client.send(MessageType::Grasp, kObject1));
-    ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+    ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
     captured = relay.captured(MessageType::Grasp);
   }
   ASSERT_FALSE(captured.empty());
@@ -198,8 +198,8 @@ TEST(RobotLink, AcceptanceIsReadFromTheStatusWhenEveryAcceptedIsLost) {
   pollFor(client, 300ms);
   EXPECT_EQ(backend.stats().duplicates, copies);  // no more retransmissions
   const auto events = waitFor(client, grasp, 10s);
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
-  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Success);
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events).outcome, Outcome::Success);
   EXPECT_EQ(backend.stats().executed, 1u);
   for (const Message& m : relay.replies()) EXPECT_NE(m.type, MessageType::Rejected);
 }
@@ -215,7 +215,7 @@ TEST(RobotLink, AStopStaysInForceUntilAResetAndEarlierCommandsNeverRun) {
   pollFor(client, 100ms);
   const std::uint64_t stop = client.send(MessageType::Stop);
   const auto events = waitFor(client, stop, 3s);
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
   int cancelled = 0;
   for (const RobotEvent& e : events) {
     if ((e.sequence == a || e.sequence == b) && e.kind == RobotEvent::Kind::Failed) ++cancelled;
@@ -228,7 +228,7 @@ TEST(RobotLink, AStopStaysInForceUntilAResetAndEarlierCommandsNeverRun) {
   EXPECT_EQ(refused->reason, RejectReason::Stopped) << refused->text;
   EXPECT_EQ(freshStatus(client).stop_reason, "emergency stop");
   const auto reset = waitFor(client, client.send(MessageType::Reset), 3s);
-  ASSERT_EQ(finalEvent(reset)->kind, RobotEvent::Kind::Finished);
+  ASSERT_EQ(finalEvent(reset).kind, RobotEvent::Kind::Finished);
   // After the RESET, a GRASP sent before the STOP still never runs.
   relay.release(b);
   const auto late = rejectionSeen(relay, b);
@@ -238,8 +238,8 @@ TEST(RobotLink, AStopStaysInForceUntilAResetAndEarlierCommandsNeverRun) {
   // A new GRASP works.
   relay.stopHolding();
   const auto fresh = waitFor(client, client.send(MessageType::Grasp, kObject1));
-  ASSERT_EQ(finalEvent(fresh)->kind, RobotEvent::Kind::Finished) << finalEvent(fresh)->text;
-  EXPECT_EQ(finalEvent(fresh)->outcome, Outcome::Success);
+  ASSERT_EQ(finalEvent(fresh).kind, RobotEvent::Kind::Finished) << finalEvent(fresh).text;
+  EXPECT_EQ(finalEvent(fresh).outcome, Outcome::Success);
   EXPECT_EQ(backend.stats().executed, 1u);
   EXPECT_TRUE(freshStatus(client).stop_reason.empty());
 }
@@ -270,9 +270,9 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWithin150msOfTheLinkBeingCut) {
   EXPECT_LE(latency_ms, 150.0);
   relay.setCut(false);
   const auto events = waitFor(client, grasp, 5s);
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Finished);
-  EXPECT_EQ(finalEvent(events)->outcome, Outcome::Stopped);
-  EXPECT_NE(finalEvent(events)->text.find("link lost"), std::string::npos);
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(events).outcome, Outcome::Stopped);
+  EXPECT_NE(finalEvent(events).text.find("link lost"), std::string::npos);
   const StatusPayload halted = freshStatus(client);
   EXPECT_EQ(halted.state, RobotState::Stopped);
   EXPECT_EQ(halted.stop_reason, "halted: link lost");
@@ -283,12 +283,12 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWithin150msOfTheLinkBeingCut) {
   EXPECT_EQ(later.tool.z, halted.tool.z);
   // Latched: a motion needs a RESET first.
   auto next = waitFor(client, client.send(MessageType::Home), 3s);
-  EXPECT_EQ(finalEvent(next)->reason, RejectReason::Stopped);
-  ASSERT_EQ(finalEvent(waitFor(client, client.send(MessageType::Reset), 3s))->kind,
+  EXPECT_EQ(finalEvent(next).reason, RejectReason::Stopped);
+  ASSERT_EQ(finalEvent(waitFor(client, client.send(MessageType::Reset), 3s)).kind,
             RobotEvent::Kind::Finished);
   next = waitFor(client, client.send(MessageType::Home), 15s);
-  EXPECT_EQ(finalEvent(next)->kind, RobotEvent::Kind::Finished);
-  EXPECT_EQ(finalEvent(next)->outcome, Outcome::Success);
+  EXPECT_EQ(finalEvent(next).kind, RobotEvent::Kind::Finished);
+  EXPECT_EQ(finalEvent(next).outcome, Outcome::Success);
 }
 
 TEST(RobotLink, ACommandTheClientGaveUpOnNeverStartsLater) {
@@ -301,8 +301,8 @@ TEST(RobotLink, ACommandTheClientGaveUpOnNeverStartsLater) {
   relay.hold(MessageType::Grasp);
   const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);
   const auto events = waitFor(client, grasp, 3s);
-  ASSERT_EQ(finalEvent(events)->kind, RobotEvent::Kind::Failed);
-  EXPECT_NE(finalEvent(events)->text.find("will not run later"), std::string::npos);
+  ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Failed);
+  EXPECT_NE(finalEvent(events).text.find("will not run later"), std::string::npos);
   pollFor(client, 100ms);  // heartbeats tell the backend what the client gave up
   relay.release(grasp);    // the copies arrive late
   const auto refused = rejectionSeen(relay, grasp);

@@ -89,8 +89,14 @@ std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence,
   return seen;
 }
 
-const RobotEvent* finalEvent(const std::vector<RobotEvent>& events) {
-  return events.empty() ? nullptr : &events.back();
+const RobotEvent& finalEvent(const std::vector<RobotEvent>& events) {
+  static const RobotEvent none = [] {
+    RobotEvent e{};
+    e.kind = RobotEvent::Kind::Failed;
+    e.text = "(no event came before the wait ended)";
+    return e;
+  }();
+  return events.empty() ? none : events.back();
 }
 
 StatusPayload freshStatus(RobotClient& client) {

@@ -46,7 +46,9 @@ ClientOptions fastClient();
 // Polls until an event for `sequence` ends it (finished, rejected, failed) or `timeout` passes.
 std::vector<RobotEvent> waitFor(RobotClient& client, std::uint64_t sequence,
                                 std::chrono::milliseconds timeout = std::chrono::seconds(20));
-const RobotEvent* finalEvent(const std::vector<RobotEvent>& events);
+// The last event seen; when none came before the wait ended, an event that says so (a failed
+// wait is a failed assertion, never a null pointer).
+const RobotEvent& finalEvent(const std::vector<RobotEvent>& events);
 // A status received after this call.
 StatusPayload freshStatus(RobotClient& client);
 // Polls the client for `duration`, keeping its events.

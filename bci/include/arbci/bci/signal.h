@@ -10,10 +10,11 @@
 
 namespace arbci::bci {
 
+// What a signal is (set by whoever has one: a reader, a source): no default rate or block.
 struct SignalInfo {
-  double rate_hz = 256.0;
+  double rate_hz = 0.0;
   std::vector<std::string> channels;
-  int block_size = 15;  // samples per block (15 at 256 Hz: one 58.6 ms cycle)
+  int block_size = 0;  // samples per block (15 at 256 Hz: one 58.6 ms cycle)
   int channelCount() const { return static_cast<int>(channels.size()); }
   double blockSeconds() const { return block_size / rate_hz; }
 };

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "arbci/core/registry.h"
 #include "arbci/core/schema.h"
@@ -15,6 +16,14 @@
 namespace arbci::robot {
 
 const core::Schema<RobotConfig>& configSchema();
+
+// Where a backend listens and a client finds it.
+struct LinkSettings {
+  LinkSettings();  // linkSchema()'s defaults
+  std::string host;
+  int port;
+};
+const core::Schema<LinkSettings>& linkSchema();
 
 struct DriverParts {
   // Throws std::runtime_error with the reason when the arm cannot be driven.

@@ -12,9 +12,9 @@
 namespace arbci::session {
 
 struct PreflightSettings {
-  double min_s = 1.0;      // the EEG rate is measured over at least this long
-  double timeout_s = 5.0;  // session seconds, and wall seconds
-  double eeg_rate_hz = 256.0;
+  double min_s = 1.0;          // the EEG rate is measured over at least this long
+  double timeout_s = 5.0;      // session seconds, and wall seconds
+  double eeg_rate_hz = 0.0;    // the source's
   double eeg_tolerance = 0.1;  // a rate off by more than this fraction fails
   // What to name in a failure: the key and a description of each source.
   std::string camera_key, camera_what;
