@@ -17,7 +17,12 @@ void runHeadless(session::Session& session) {
     if (!session.last().paradigm.phase_changes.empty() || session.frame() % 600 == 0) show();
     if (interruptRequested()) session.request(session::AbortRequest{});
   }
-  std::cerr << "\r" << statusLine(session) << "\nsession ended: " << session.endReason() << "\n";
+  // A session that did not finish says why (the last reason the paradigm gave: a fault, a failed
+  // training), not only how it ended.
+  std::cerr << "\r" << statusLine(session) << "\nsession ended: " << session.endReason();
+  const std::string& why = session.last().paradigm.status;
+  if (session.endReason() != "finished" && !why.empty()) std::cerr << " (" << why << ")";
+  std::cerr << "\n";
   setStatusLineOpen(false);
 }
 

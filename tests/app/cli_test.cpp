@@ -92,7 +92,7 @@ TEST(Cli, GlInfoHeadlessPrintsVendorRendererAndVersion) {
   EXPECT_NE(result.out.find("version:"), std::string::npos);
 }
 
-TEST(Cli, HeadlessScreenshotWritesAPngOfTheRequestedSizeThatIsNotOneColour) {
+TEST(Cli, HeadlessScreenshotWritesAPngOfTheRequestedSizeWithItsStatusBar) {
   const auto path = tempPath("shell.png");
   std::filesystem::remove(path);
   const ProcessResult result = runProcess(

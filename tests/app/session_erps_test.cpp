@@ -36,7 +36,12 @@ double meanBetween(const bci::ErpCurves& erp, const std::vector<double>& row, do
 TEST(SessionErps, TheTrainingPanelGetsTheAveragesOfBothClassifiers) {
   const auto folder = freshTempPath("session_erps_test", "session");
   const auto file = folder.string() + ".json";
-  std::ofstream(file) << R"({"errp": {"enabled": true},
+  // A short calibration run (the averages are counted, not judged): 4 cued selections of 4
+  // sequences, then 80 feedbacks (a fifth of them errors: the ErrP classifier
+  // needs at least 10 of each kind).
+  std::ofstream(file) << R"({"errp": {"enabled": true, "calibration_feedbacks": 80},
+    "paradigm": {"calibration_selections": 4, "calibration_sequences": 4, "cue_s": 0.5,
+                 "pause_s": 0.5},
     "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0}, "robot": {"speed_factor": 20}})";
   const session::SessionConfig config = session::SessionConfig::load(file);
   session::SessionOptions options;
