@@ -4,6 +4,10 @@ target_compile_options(arbci_options INTERFACE -Wall -Wextra -Werror)
 target_compile_definitions(arbci_options INTERFACE
   ARBCI_VERSION="${PROJECT_VERSION}"
   ARBCI_ASSETS_DIR="${CMAKE_SOURCE_DIR}/assets")
+if(ARBCI_SANITIZE_THREAD)
+  target_compile_options(arbci_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(arbci_options INTERFACE -fsanitize=thread)
+endif()
 if(ARBCI_SANITIZE)
   target_compile_options(arbci_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
                                                  -fno-sanitize-recover=undefined)
