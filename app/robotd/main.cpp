@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   std::string host = link.host, key_file, config_file, port_file, driver = "simulated";
   double speed = 0.0;
   bool stepped = false;
-  int watchdog_ms = 100;
+  int watchdog_ms = link.watchdog_ms;
   app.add_option("--port", port, "UDP port to listen on (0: any free port)")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
@@ -55,9 +55,7 @@ int main(int argc, char** argv) {
   app.add_flag("--stepped", stepped,
                "move the arm only when a STATUS carries the client's clock (reproducible "
                "simulations: arbci run headless starts it so), never on the wall clock");
-  app.add_option("--watchdog-ms", watchdog_ms,
-                 "halt a running motion (and latch the stop) when the commanding client has sent "
-                 "nothing authenticated for this long; 0: off (not for a real arm)")
+  app.add_option("--watchdog-ms", watchdog_ms, arbci::robot::linkSchema().at("watchdog_ms").doc)
       ->capture_default_str()
       ->check(CLI::Range(0, 60000));
   app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);

@@ -49,8 +49,16 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   window.title = "ARBCI workstation";
   render::WindowContext main_window(window);
   std::unique_ptr<render::WindowContext> mirror;
-  if (config.hmd.mirror_monitor >= 0 &&
-      config.hmd.mirror_monitor < render::WindowContext::monitorCount()) {
+  if (config.hmd.mirror_monitor >= render::WindowContext::monitorCount()) {
+    // Refused before any flash: the subject would otherwise see the HMD view nowhere.
+    const int monitors = render::WindowContext::monitorCount();
+    throw session::SessionConfigError(
+        config.source + ": hmd.mirror_monitor = " + std::to_string(config.hmd.mirror_monitor) +
+        ": there is no such monitor (this display has " + std::to_string(monitors) +
+        (monitors == 1 ? " monitor: 0" : " monitors: 0 to " + std::to_string(monitors - 1)) +
+        "; -1 for none)");
+  }
+  if (config.hmd.mirror_monitor >= 0) {
     render::WindowOptions m;
     m.title = "ARBCI HMD";
     m.fullscreen_monitor = config.hmd.mirror_monitor;
@@ -110,13 +118,19 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
         main_window.requestClose();
       }
     }
-    main_window.present();
-    session.presented(bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
+    // The subject's view is stamped at its own swap: the HMD window's when there is one (its
+    // picture carries the photodiode patch), else the experimenter window's, which shows it.
     if (mirror) {
       mirror->makeCurrent();
       render::blitTexture(opened.hmd->texture(), opened.hmd->size(), mirror->framebufferSize());
       mirror->present();
+      session.presented(bci::hostSeconds());  // the HMD's swap is done: its flashes are on screen
       main_window.makeCurrent();
+      main_window.present();
+    } else {
+      main_window.present();
+      session.presented(
+          bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
     }
   }
   if (script && !script->error().empty()) return 4;

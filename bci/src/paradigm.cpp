@@ -168,7 +168,14 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
       ScheduledFlash& f = schedule_[i];
       if (due_s < f.onset_s - kSlack) break;
       if (i == next_flash_) {
-        // Its first frame. A display too slow for the SOA shows one new flash per frame.
+        // Its first frame. One overdue by more than a flash (the process or the display stalled)
+        // moves the rest of the sequence with it: shown one per frame, the flashes missed in a
+        // stall would follow each other closer than the SOA, their ERPs overlapping and the
+        // photodiode patch never going dark between them.
+        if (due_s > f.onset_s + settings_.flashSeconds()) {
+          const double late = due_s - f.onset_s;
+          for (size_t j = i; j < schedule_.size(); ++j) schedule_[j].onset_s += late;
+        }
         ParadigmEvent e{ParadigmEvent::Kind::Flash};
         e.code = f.code;
         e.objects_layout = flashing_objects_;

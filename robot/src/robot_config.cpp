@@ -96,7 +96,14 @@ const core::Schema<LinkSettings>& linkSchema() {
     core::Schema<LinkSettings> t("link", "The robot backend's UDP address");
     t.text("host", &LinkSettings::host, "127.0.0.1",
            "the backend's host (arbci-robotd: the address it listens on)")
-        .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port");
+        .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port")
+        // 250 ms: a killed or paused client halts the arm within a quarter second, while the
+        // client's 50 Hz heartbeat (on a thread of the highest priority it may take) can be held
+        // up 10 times over on a loaded PC before the arm stops for nothing.
+        .integer("watchdog_ms", &LinkSettings::watchdog_ms, 250, 0, 60000,
+                 "the backend halts a running motion (and latches the stop) when the commanding "
+                 "client has sent nothing authenticated for this long; 0: off (not for a real arm)",
+                 "ms");
     return t;
   }();
   return table;

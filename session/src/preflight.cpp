@@ -20,6 +20,9 @@ void Preflight::begin(const PreflightObservation& now) {
   camera_frames_ = 0;
   reference_seen_ = false;
   eeg_rate_hz_ = 0.0;
+  eeg_from_.reset();
+  first_eeg_s_.reset();
+  eeg_last_ = now;
   failures_.clear();
 }
 
@@ -29,10 +32,24 @@ Preflight::State Preflight::update(const PreflightObservation& now) {
   camera_frames_ += now.camera_frame;
   reference_seen_ |= now.reference_age_s && *now.reference_age_s <= now.max_pose_age_s;
   const double elapsed = now.time_s - first_.time_s;
-  if (elapsed > 0.0)
-    eeg_rate_hz_ = static_cast<double>(now.eeg_samples - first_.eeg_samples) / elapsed;
-  if (elapsed < settings_.min_s) return state_;
-  if (check(false).empty()) {
+  // The rate is counted from a moment after the first samples arrived: a source's first
+  // deliveries carry what it buffered before the session asked (a start-up backlog), which would
+  // read as a rate too high. It is counted between frames on which samples arrived (not up to
+  // now): over a second, a block of 15 samples counted or not would be 6 % of the rate.
+  const bool arrived = now.eeg_samples > eeg_last_.eeg_samples;
+  if (arrived) {
+    if (!first_eeg_s_) first_eeg_s_ = now.time_s;
+    if (!eeg_from_ && now.time_s - *first_eeg_s_ >= kSettleS) eeg_from_ = now;
+    eeg_last_ = now;
+  }
+  const double counted = eeg_from_ ? eeg_last_.time_s - eeg_from_->time_s : 0.0;
+  if (counted > 0.0)
+    eeg_rate_hz_ = static_cast<double>(eeg_last_.eeg_samples - eeg_from_->eeg_samples) / counted;
+  if (elapsed < settings_.min_s || (first_eeg_s_ && counted < settings_.min_s)) {
+    // Still counting, unless time is up: then judge what there is.
+    if (elapsed < settings_.timeout_s) return state_;
+  }
+  if (elapsed >= settings_.min_s && check(false).empty()) {
     state_ = State::Passed;
   } else if (elapsed >= settings_.timeout_s && now.wall_s - first_.wall_s >= settings_.timeout_s) {
     failures_ = check(true);
@@ -55,8 +72,11 @@ std::vector<std::string> Preflight::check(bool final) const {
                   " camera frames (in view? the right id? see the Threshold panel)");
   }
   const double rate = settings_.eeg_rate_hz;
+  const double silent = last_.time_s - eeg_last_.time_s;
   if (eeg_rate_hz_ <= 0.0) {
     out.push_back(settings_.eeg_key + ": no EEG sample in " + format("%.1f s", waited));
+  } else if (silent > kSilentS) {
+    out.push_back(settings_.eeg_key + ": no EEG sample for the last " + format("%.1f s", silent));
   } else if (std::abs(eeg_rate_hz_ - rate) > settings_.eeg_tolerance * rate) {
     out.push_back(settings_.eeg_key + ": EEG samples arrive at " +
                   format("%.1f Hz, the source says %.1f Hz", eeg_rate_hz_, rate));

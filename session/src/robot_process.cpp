@@ -31,7 +31,7 @@ std::filesystem::path robotdNextToMe() {
 RobotProcess::RobotProcess(const std::filesystem::path& executable,
                            const std::filesystem::path& key_file,
                            const std::filesystem::path& config_file, double speed_factor,
-                           const std::filesystem::path& folder, bool stepped) {
+                           int watchdog_ms, const std::filesystem::path& folder, bool stepped) {
   if (!std::filesystem::exists(executable))
     throw std::runtime_error(executable.string() +
                              ": the robot backend is not there (build arbci-robotd)");
@@ -39,6 +39,7 @@ RobotProcess::RobotProcess(const std::filesystem::path& executable,
   const auto log_file = folder / "robotd.log";
   std::filesystem::remove(port_file);
   const std::string speed = std::to_string(speed_factor);
+  const std::string watchdog = std::to_string(watchdog_ms);
   pid_ = fork();
   if (pid_ < 0) throw std::runtime_error("cannot start arbci-robotd: fork failed");
   if (pid_ == 0) {
@@ -50,7 +51,7 @@ RobotProcess::RobotProcess(const std::filesystem::path& executable,
     }
     execl(executable.c_str(), executable.c_str(), "--port", "0", "--port-file", port_file.c_str(),
           "--key-file", key_file.c_str(), "--config", config_file.c_str(), "--speed", speed.c_str(),
-          stepped ? "--stepped" : nullptr, nullptr);
+          "--watchdog-ms", watchdog.c_str(), stepped ? "--stepped" : nullptr, nullptr);
     _exit(127);
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);

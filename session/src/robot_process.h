@@ -14,7 +14,7 @@ class RobotProcess {
   // Starts `executable` and waits (at most 10 s) until it listens. Throws std::runtime_error
   // with the reason (and the end of its log) when it does not come up.
   RobotProcess(const std::filesystem::path& executable, const std::filesystem::path& key_file,
-               const std::filesystem::path& config_file, double speed_factor,
+               const std::filesystem::path& config_file, double speed_factor, int watchdog_ms,
                const std::filesystem::path& folder, bool stepped = false);
   ~RobotProcess();  // SIGTERM, then SIGKILL after 2 s
   RobotProcess(const RobotProcess&) = delete;

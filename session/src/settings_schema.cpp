@@ -453,6 +453,10 @@ const Schema<RobotSettings>& robotSchema() {
         .custom(
             robot::linkSchema().at("port"), [](R& r, const Json& j) { r.port = j.get<int>(); },
             [](const R& r) { return Json(r.port); })
+        .custom(
+            robot::linkSchema().at("watchdog_ms"),
+            [](R& r, const Json& j) { r.watchdog_ms = j.get<int>(); },
+            [](const R& r) { return Json(r.watchdog_ms); })
         .text("key_file", &R::key_file, "", "remote: the shared key (arbci robot keygen)");
     t.rule([](const Json& r) -> Broken {
       if (r["backend"] == "remote" && r["key_file"].get<std::string>().empty())

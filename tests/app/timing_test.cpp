@@ -6,9 +6,16 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
+
+#include <chrono>
+#include <thread>
+
 #include "arbci/bci/recording.h"
+#include "support/background_process.h"
 #include "support/run_process.h"
 #include "support/test_files.h"
 #include "support/xvfb_server.h"
@@ -51,13 +58,31 @@ TEST(TimingCheck, HeadlessOnsetsMeetThePhotodiode) {
   EXPECT_EQ(readJson(folder / "timing.json")["mode"], "headless");
 }
 
-TEST(TimingCheck, InAWindowUnderXvfbOnsetsMeetThePhotodiode) {
+// The subject's view in a window of its own (the HMD mirror, full screen on monitor 0 of the
+// Xvfb display) beside the experimenter's: the flashes are stamped at the HMD window's swap.
+// (The simulated photodiode sees what the session says it presented; a real one on the HMD is
+// what tells one swap from the other.)
+TEST(TimingCheck, InTheHmdWindowUnderXvfbOnsetsMeetThePhotodiode) {
   const auto folder = fresh("window");
-  const ProcessResult r =
-      runInWindow({"timing-check", "--seconds", "15", "--out", folder.string()}, 300.0);
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"hmd": {"mirror_monitor": 0}})";
+  const ProcessResult r = runInWindow(
+      {"timing-check", "--session", session, "--seconds", "15", "--out", folder.string()}, 300.0);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   expectOnTarget(folder);
   EXPECT_EQ(readJson(folder / "timing.json")["mode"], "window");
+}
+
+TEST(TimingCheck, AnHmdMonitorTheDisplayLacksIsRefusedBeforeAnyFlash) {
+  const auto folder = fresh("nomonitor");
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"hmd": {"mirror_monitor": 3}})";
+  const ProcessResult r = runInWindow(
+      {"timing-check", "--session", session, "--seconds", "5", "--out", folder.string()}, 120.0);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("hmd.mirror_monitor = 3: there is no such monitor"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(folder / "recording.bdf"));
 }
 
 TEST(TimingCheck, RefusesASessionWithoutAPhotodiodeChannel) {
@@ -138,6 +163,84 @@ TEST(WindowedSession, SummaryTimingAgreesWithTheRecordedOnsets) {
   ASSERT_TRUE(trained_event);
   std::cout << "training: " << trained_event->dump() << "\n";
   EXPECT_GE((*trained_event)["frames_while_training"].get<int>(), 2) << trained_event->dump();
+}
+
+// A real-time session whose process is paused for 2 s (SIGSTOP, as a busy PC or a debugger would)
+// while it flashes: the simulated amplifier goes on sampling, and its backlog arrives at once on
+// resumption. The flashes from 5 s after the pause on meet their photodiode edges within one
+// sample, and the stall is in the log, the recording and the summary.
+TEST(TimingUnderStall, APausedProcessIsLoggedAndFlashesFiveSecondsLaterMeetThePhotodiode) {
+  const auto folder = fresh("stall");
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 6, "calibration_sequences": 4, "cue_s": 0.5,
+                 "pause_s": 0.5}})";
+  BackgroundProcess run(
+      kArbci, {"run", "--headless", "--realtime", "--session", session, "--out", folder.string()});
+  // Paused once flashing has gone on a while (the recording holds a few seconds).
+  auto recorded = [&] {
+    std::error_code error;
+    const auto size = std::filesystem::file_size(folder / "recording.bdf", error);
+    return error ? 0u : size;
+  };
+  for (int i = 0; i < 600 && recorded() < 60000; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_GE(recorded(), 60000u) << "the session never got going";
+  run.signal(SIGSTOP);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  run.signal(SIGCONT);
+  // The calibration run's flashing goes on for about 20 s more; then the session is ended.
+  std::this_thread::sleep_for(std::chrono::seconds(14));
+  run.signal(SIGTERM);
+  ASSERT_TRUE(run.wait(120.0).has_value());
+
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  const nlohmann::json& stalls = summary["timing"]["eeg_stalls"];
+  ASSERT_GE(stalls["count"].get<int>(), 1) << summary["timing"].dump(2);
+  EXPECT_GT(stalls["longest_s"].get<double>(), 1.5) << stalls.dump();
+  bool logged = false;
+  std::ifstream log(folder / "log.jsonl");
+  for (std::string line; std::getline(log, line);)
+    logged |= nlohmann::json::parse(line).value("event", "") == "eeg_stall";
+  EXPECT_TRUE(logged);
+
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  std::int64_t stall_sample = -1;
+  for (const auto& a : recording.annotations) {
+    if (a.text.rfind("EEG delivery stalled", 0) == 0 && stall_sample < 0) stall_sample = a.sample;
+  }
+  ASSERT_GE(stall_sample, 0) << "no stall annotated in the recording";
+  // The photodiode's rising edges, and each later flash onset's nearest one.
+  const auto& names = recording.info.channels;
+  const int diode =
+      static_cast<int>(std::find(names.begin(), names.end(), "Photodiode") - names.begin());
+  ASSERT_LT(diode, static_cast<int>(names.size()));
+  std::vector<std::int64_t> edges;
+  for (std::int64_t s = 1; s < recording.samples; ++s) {
+    if (recording.at(diode, s) > 500.0f && recording.at(diode, s - 1) <= 500.0f) edges.push_back(s);
+  }
+  const std::int64_t settled = stall_sample + 2 * 256 + 5 * 256;  // the stall, then 5 s
+  int checked = 0, off = 0, early = 0, early_off = 0;             // early: within 5 s of the stall
+  for (const auto& onset : recording.stimuli) {
+    if (onset.sample < stall_sample) continue;
+    const auto after = std::lower_bound(edges.begin(), edges.end(), onset.sample);
+    std::int64_t best = 1 << 30;
+    if (after != edges.end()) best = *after - onset.sample;
+    if (after != edges.begin() && onset.sample - *(after - 1) < std::llabs(best))
+      best = *(after - 1) - onset.sample;
+    if (onset.sample < settled) {
+      ++early;
+      early_off += std::llabs(best) > 1;
+      continue;
+    }
+    ++checked;
+    off += std::llabs(best) > 1;
+  }
+  std::cout << checked << " onsets checked from 5 s after the stall, " << off
+            << " more than one sample off (in the 5 s before: " << early_off << " of " << early
+            << "); " << stalls.dump() << "\n";
+  EXPECT_GT(checked, 20);
+  EXPECT_EQ(off, 0) << off << " of " << checked << " onsets more than one sample from their edge";
 }
 
 }  // namespace

@@ -70,6 +70,94 @@ TEST(ClockModel, BurstyArrivalsFromASlowClockStayWithinOneSample) {
   EXPECT_NEAR(model.driftPpm(), -150.0, 20.0);
 }
 
+// What a source stamped by arrival gives the model: each delivery's blocks share the instant the
+// delivery arrived. The amplifier runs `drift_ppm` fast, deliveries come every block, 0.8 ms late
+// on average; `held` says for which stretches of sample time deliveries are held up (a stall: the
+// blocks queue and arrive together when it ends), `drain_each_block` that a held-up queue drains
+// block by block (one delivery each, 1 ms apart) instead of at once.
+struct Stall {
+  double from_s, seconds;
+};
+struct Replay {
+  int worst_after = 0;       // the worst stamp error (samples) from 5 s after each disturbance on
+  double drift_error = 0.0;  // the worst |drift - truth| while the model called it reliable
+  int stalls = 0;            // observations the model called stalls
+};
+Replay replay(double drift_ppm, double startup_backlog_s, const std::vector<Stall>& stalls,
+              bool drain_each_block, std::uint64_t seed) {
+  const double true_rate = 256.0 * (1.0 + drift_ppm * 1e-6);
+  ClockModel model(256.0);
+  std::mt19937_64 random(seed);
+  std::exponential_distribution<double> late(1.0 / 0.0008);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double t0 = 1000.0;
+  Replay out;
+  std::vector<std::int64_t> queue;  // block ends waiting to be delivered
+  double settled_after = startup_backlog_s + 5.0;
+  auto held = [&](double t) {
+    for (const Stall& s : stalls)
+      if (t >= s.from_s && t < s.from_s + s.seconds) return true;
+    return false;
+  };
+  for (std::int64_t end = 15; end <= static_cast<std::int64_t>(300 * true_rate); end += 15) {
+    const double complete = end / true_rate;  // sample time when the block is complete
+    queue.push_back(end);
+    if (complete < startup_backlog_s || held(complete)) continue;
+    for (const Stall& s : stalls)
+      if (complete >= s.from_s + s.seconds && complete < s.from_s + s.seconds + 0.1)
+        settled_after = std::max(settled_after, s.from_s + s.seconds + 5.0);
+    const double arrival = t0 + complete + late(random);
+    for (size_t i = 0; i < queue.size(); ++i) {
+      // Drained block by block: the older blocks of the queue 1 ms apart, before this one.
+      const double at =
+          drain_each_block ? arrival - 0.001 * static_cast<double>(queue.size() - 1 - i) : arrival;
+      out.stalls += model.observe(queue[i], std::max(at, t0 + queue[i] / true_rate)).stall;
+    }
+    queue.clear();
+    if (complete < settled_after) continue;
+    const double host = t0 + (end - 15 * unit(random)) / true_rate;
+    const auto truth = static_cast<std::int64_t>(std::ceil((host - t0) * true_rate - 1e-9));
+    out.worst_after = std::max(
+        out.worst_after, static_cast<int>(std::llabs(model.firstSampleAtOrAfter(host) - truth)));
+    if (model.driftReliable())
+      out.drift_error = std::max(out.drift_error, std::abs(model.driftPpm() - drift_ppm));
+  }
+  return out;
+}
+
+TEST(ClockModel, AStartUpBacklogAndAFiveSecondStallLeaveTheStampsWithinOneSampleAfterFiveSeconds) {
+  for (const std::uint64_t seed : {1u, 2u, 3u}) {
+    const Replay r = replay(60.0, 2.0, {{60.0, 5.0}, {150.0, 2.0}}, false, seed);
+    EXPECT_LE(r.worst_after, 1) << "seed " << seed;
+    EXPECT_LE(r.drift_error, 20.0) << "seed " << seed;
+  }
+}
+
+TEST(ClockModel, AStallDrainedBlockByBlockIsReportedAndNotFitted) {
+  const Replay r = replay(-80.0, 0.0, {{40.0, 2.0}, {120.0, 5.0}}, true, 4);
+  EXPECT_LE(r.worst_after, 1);
+  EXPECT_LE(r.drift_error, 20.0);
+  EXPECT_GT(r.stalls, 20);  // the blocks that waited more than the late limit
+}
+
+TEST(ClockModel, ANominalRateFarFromTheTruthIsHeldAtTheBoundAndCalledUnreliable) {
+  ClockModel model(256.0);
+  const double true_rate = 256.0 * 1.002;  // 2000 ppm: a wrong nominal rate, not a crystal
+  for (std::int64_t end = 15; end < 60 * 256; end += 15) model.observe(end, end / true_rate);
+  EXPECT_TRUE(model.driftAtBound());
+  EXPECT_FALSE(model.driftReliable());
+  EXPECT_NEAR(model.driftPpm(), ClockModel::kMaxDriftPpm, 1.0);
+}
+
+TEST(ClockModel, DriftIsNotCalledReliableOnAFewSecondsOfJitteredArrivals) {
+  ClockModel model(256.0);
+  std::mt19937_64 random(9);
+  std::exponential_distribution<double> late(1.0 / 0.004);  // a jittery USB path: 4 ms mean
+  for (std::int64_t end = 15; end < 3 * 256; end += 15)
+    model.observe(end, end / 256.0 + late(random));
+  EXPECT_FALSE(model.driftReliable()) << model.driftUncertaintyPpm() << " ppm";
+}
+
 TEST(ClockModel, RefusesNonsense) {
   EXPECT_THROW(ClockModel(0.0), std::invalid_argument);
   EXPECT_THROW(ClockModel(256.0, -1.0), std::invalid_argument);
@@ -164,6 +252,90 @@ TEST(Acquisition, SteppedStampsAreExactAndTheSameEveryRun) {
     return all;
   };
   EXPECT_EQ(run(), run());
+}
+
+// A source that sends some samples twice: its third delivery overlaps the second by 5 samples,
+// its fourth repeats the first outright.
+class RepeatingSource final : public EegSource {
+ public:
+  RepeatingSource() {
+    info_.channels = {"Cz"};
+    info_.rate_hz = 256.0;
+    info_.block_size = 15;
+  }
+  const SignalInfo& info() const override { return info_; }
+  std::vector<Block> poll(int) override {
+    std::vector<Block> out;
+    const std::int64_t firsts[] = {0, 15, 25, 0, 40};
+    if (call_ < 5) {
+      Block b(firsts[call_], 1, 15);
+      for (int s = 0; s < 15; ++s) b.at(0, s) = static_cast<float>(b.first_sample + s);
+      out.push_back(b);
+    }
+    ++call_;
+    return out;
+  }
+
+ private:
+  SignalInfo info_;
+  int call_ = 0;
+};
+
+TEST(Acquisition, OverlappingAndRepeatedBlocksAreTrimmedAndCountedNeverThrown) {
+  auto clock = std::make_shared<ManualClock>();
+  Acquisition acquisition(std::make_unique<RepeatingSource>(), clock, Acquisition::Mode::Stepped);
+  for (int i = 1; i <= 6; ++i) EXPECT_NO_THROW(acquisition.advanceTo(0.1 * i));
+  std::vector<float> values;
+  for (const Block& b : acquisition.take())
+    values.insert(values.end(), b.data.begin(), b.data.end());
+  ASSERT_EQ(values.size(), 55u);  // samples 0 to 54, each once, in order
+  for (size_t i = 0; i < values.size(); ++i) EXPECT_EQ(values[i], static_cast<float>(i));
+  EXPECT_EQ(acquisition.repeatedSamples(), 5 + 15);
+  EXPECT_EQ(acquisition.lostSamples(), 0);
+}
+
+// A live source that queues 2 s of signal once (a stall upstream), then delivers as usual.
+class StallingSource final : public EegSource {
+ public:
+  StallingSource() {
+    info_.channels = {"Cz"};
+    info_.rate_hz = 256.0;
+    info_.block_size = 16;
+  }
+  const SignalInfo& info() const override { return info_; }
+  std::vector<Block> poll(int) override {
+    std::vector<Block> out;
+    const int blocks = call_ == 3 ? 32 : call_ < 8 ? 1 : 0;  // 32 blocks: 2 s at once
+    for (int i = 0; i < blocks; ++i) {
+      out.emplace_back(next_, 1, 16);
+      next_ += 16;
+    }
+    ++call_;
+    return out;
+  }
+
+ private:
+  SignalInfo info_;
+  int call_ = 0;
+  std::int64_t next_ = 0;
+};
+
+TEST(Acquisition, ABacklogDeliveredAtOnceIsReportedAsAStallWithItsSize) {
+  auto clock = std::make_shared<WallClock>(0.0);
+  Acquisition acquisition(std::make_unique<StallingSource>(), clock, Acquisition::Mode::Live);
+  acquisition.start();
+  std::vector<DeliveryStall> stalls;
+  // Bounded wait (the source is done after its eighth poll, a few milliseconds).
+  for (int i = 0; i < 1000 && stalls.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    for (const DeliveryStall& s : acquisition.takeStalls()) stalls.push_back(s);
+  }
+  acquisition.stop();
+  ASSERT_EQ(stalls.size(), 1u);
+  EXPECT_EQ(stalls[0].first_sample, 48);  // after the first three single blocks
+  EXPECT_EQ(stalls[0].samples, 512);
+  EXPECT_LT(stalls[0].since_host_s, stalls[0].host_s);
+  EXPECT_TRUE(acquisition.fault().empty());
 }
 
 TEST(Acquisition, LiveSubjectRunsOnItsOwnClockAndItsPhotodiodeRisesOnTheStampedSample) {

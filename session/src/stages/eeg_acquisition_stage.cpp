@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <thread>
 
@@ -92,14 +93,67 @@ void EegAcquisitionStage::take(Cycle& cycle) {
   }
 }
 
+void EegAcquisitionStage::noteStall(Cycle& cycle, const bci::DeliveryStall& stall) {
+  const double rate = acquisition_->info().rate_hz;
+  const double held_s = stall.host_s - stall.since_host_s;
+  std::vector<std::int64_t> uncertain;
+  for (const auto& [host_s, sample] : recent_onsets_) {
+    if (host_s > stall.since_host_s && host_s <= stall.host_s) uncertain.push_back(sample);
+  }
+  ++stalls_.count;
+  stalls_.longest_s = std::max(stalls_.longest_s, held_s);
+  stalls_.samples += stall.samples;
+  stalls_.uncertain_flashes += static_cast<int>(uncertain.size());
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "EEG delivery stalled %.2f s: %lld samples arrived at once; %zu flash stamp(s) "
+                "in it extrapolated",
+                held_s, static_cast<long long>(stall.samples), uncertain.size());
+  cycle.annotate(stall.first_sample, text);
+  for (const std::int64_t sample : uncertain)
+    cycle.annotate(sample, "stamp uncertain: EEG delivery stalled");
+  s_.log.write("eeg_stall", cycle.time_s,
+               {{"first_sample", stall.first_sample},
+                {"samples", stall.samples},
+                {"seconds_of_signal", static_cast<double>(stall.samples) / rate},
+                {"held_s", held_s},
+                {"late_s", stall.late_s},
+                {"uncertain_flashes", uncertain.size()}});
+  if (s_.progress) *s_.progress << "\nwarning: " << text << "\n";
+}
+
 void EegAcquisitionStage::step(Cycle& cycle) {
   toSource(cycle);
   if (cycle.clock.stepped()) acquisition_->advanceTo(cycle.time_s);
   take(cycle);
   EegPart& out = cycle.record.eeg;
+  const Presentation& shown = cycle.previous.presentation;
+  for (const Presentation::Onset& onset : shown.onsets)
+    recent_onsets_.emplace_back(shown.host_s, onset.sample);
+  while (!recent_onsets_.empty() && recent_onsets_.front().first < cycle.host_s - 60.0)
+    recent_onsets_.pop_front();
+  for (bci::DeliveryStall& stall : acquisition_->takeStalls()) {
+    noteStall(cycle, stall);
+    out.stalls.push_back(stall);
+  }
   out.lost_samples = acquisition_->lostSamples();
-  out.drift_ppm = acquisition_->driftPpm();
-  out.jitter_ms = acquisition_->jitterS() * 1000.0;
+  const bci::ClockReport clock = acquisition_->clockReport();
+  out.drift_ppm = clock.drift_ppm;
+  out.drift_reliable = clock.drift_reliable;
+  out.jitter_ms = clock.jitter_s * 1000.0;
+  if (clock.drift_at_bound && clock.drift_uncertainty_ppm < bci::ClockModel::kMaxDriftPpm / 5 &&
+      !drift_warned_) {
+    // The data disagree with the nominal rate by more than any amplifier's crystal would (and
+    // the fit is sure of it: a young fit over a second or two can touch the bound by chance).
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the EEG clock runs more than %.0f ppm off the source's %.1f Hz (fit held at the "
+                  "bound): check eeg.rate_hz against the amplifier; stamps are uncertain",
+                  bci::ClockModel::kMaxDriftPpm, acquisition_->info().rate_hz);
+    s_.log.write("eeg_clock", cycle.time_s, {{"warning", text}});
+    if (s_.progress) *s_.progress << "\nwarning: " << text << "\n";
+    drift_warned_ = true;
+  }
   if (out.lost_samples != lost_logged_) {
     s_.log.write("lost_samples", cycle.time_s,
                  {{"total", out.lost_samples}, {"new", out.lost_samples - lost_logged_}});
@@ -113,6 +167,7 @@ void EegAcquisitionStage::step(Cycle& cycle) {
     out.fault = source.fault();
     out.source_line = source.describe();
   });
+  if (const std::string fault = acquisition_->fault(); !fault.empty()) out.fault = fault;
   if (out.fault != fault_logged_) {
     s_.log.write("eeg_source", cycle.time_s,
                  {{"fault", out.fault}, {"state", out.fault.empty() ? "delivering" : "fault"}});
@@ -149,8 +204,16 @@ std::string EegAcquisitionStage::sourceLine() const {
 
 void EegAcquisitionStage::report(nlohmann::json& summary) const {
   summary["timing"]["lost_samples"] = acquisition_->lostSamples();
-  summary["timing"]["clock_drift_ppm"] = acquisition_->driftPpm();
-  summary["timing"]["clock_jitter_ms"] = acquisition_->jitterS() * 1000.0;
+  const bci::ClockReport clock = acquisition_->clockReport();
+  summary["timing"]["clock_drift_ppm"] = clock.drift_ppm;
+  summary["timing"]["clock_drift_uncertainty_ppm"] = clock.drift_uncertainty_ppm;
+  summary["timing"]["clock_drift_reliable"] = clock.drift_reliable;
+  summary["timing"]["clock_jitter_ms"] = clock.jitter_s * 1000.0;
+  summary["timing"]["eeg_stalls"] = {{"count", stalls_.count},
+                                     {"longest_s", stalls_.longest_s},
+                                     {"samples", stalls_.samples},
+                                     {"uncertain_flashes", stalls_.uncertain_flashes}};
+  summary["eeg"]["repeated_samples"] = acquisition_->repeatedSamples();
   summary["eeg"]["lost_samples"] = acquisition_->lostSamples();
   summary["eeg"]["source"] = sourceLine();
 }

@@ -7,6 +7,7 @@
 // the session's clock its sample map.
 #pragma once
 
+#include <deque>
 #include <map>
 #include <memory>
 #include <string>
@@ -50,6 +51,9 @@ class EegAcquisitionStage final : public Stage {
   void toSource(const Cycle& cycle);
   void take(Cycle& cycle);
   bci::Block eegOnly(const bci::Block& block) const;
+  // A held-up delivery: logged, annotated in the recording with the flashes whose stamps were
+  // extrapolated across it, counted for the summary.
+  void noteStall(Cycle& cycle, const bci::DeliveryStall& stall);
   std::string sourceLine() const;
 
   EegAcquisitionSettings settings_;
@@ -60,6 +64,15 @@ class EegAcquisitionStage final : public Stage {
   std::int64_t lost_logged_ = 0;  // lost samples already in the log
   std::string fault_logged_;      // the source's fault last logged (empty: none)
   std::int64_t next_sample_ = 0;  // after the last block taken
+  // The flashes presented lately (host time, onset sample): those a stall covered are named.
+  std::deque<std::pair<double, std::int64_t>> recent_onsets_;
+  struct StallTotals {
+    int count = 0;
+    double longest_s = 0.0;
+    std::int64_t samples = 0;
+    int uncertain_flashes = 0;
+  } stalls_;
+  bool drift_warned_ = false;
 };
 
 }  // namespace arbci::session

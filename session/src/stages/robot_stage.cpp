@@ -221,6 +221,8 @@ void RobotStage::handleEvents(RobotPart& out, double time_s) {
                              {"text", e.text}};
     if (e.kind == Kind::Rejected) fields["reason"] = robot::toString(e.reason);
     if (e.kind == Kind::Finished) fields["outcome"] = robot::toString(e.outcome);
+    // How the heartbeat that keeps the backend's watchdog quiet is scheduled.
+    if (e.kind == Kind::Connected) fields["heartbeat_priority"] = client_.heartbeatPriority();
     s_.log.write("robot", time_s, fields);
     // Link events (connected, silent, restarted) belong to no command.
     const std::string what =

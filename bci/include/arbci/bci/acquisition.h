@@ -42,6 +42,23 @@ struct SampleLoss {
   std::string reason;
 };
 
+// A delivery held up (a stall of the source, the transport or this process): `samples` arrived at
+// once from `first_sample` on, and/or the newest of them arrived `late_s` after the clock model
+// expected it. Between `since_host_s` (the delivery before) and `host_s` (this one) the model had
+// nothing new: a flash stamped in that interval rests on its extrapolation.
+struct DeliveryStall {
+  std::int64_t first_sample = 0;
+  std::int64_t samples = 0;
+  double late_s = 0.0;
+  double since_host_s = 0.0, host_s = 0.0;
+};
+
+// What the clock model says of itself (see ClockModel).
+struct ClockReport {
+  double drift_ppm = 0.0, drift_uncertainty_ppm = 0.0, jitter_s = 0.0;
+  bool drift_reliable = false, drift_at_bound = false;
+};
+
 class Acquisition {
  public:
   enum class Mode { Live, Stepped };
@@ -66,19 +83,27 @@ class Acquisition {
   std::vector<Block> take();
   std::vector<SampleLoss> takeLosses();
   std::int64_t lostSamples() const { return lost_.load(); }
+  // Deliveries held up since the last call (only sources stamped by arrival: a source that stamps
+  // its own samples, LSL, keeps true stamps through a stall).
+  std::vector<DeliveryStall> takeStalls();
+  // Samples a source delivered twice (a block overlapping what was already delivered): dropped.
+  std::int64_t repeatedSamples() const { return repeated_.load(); }
+  // A fault on the acquisition thread (the source threw): the stream stops; "" while healthy.
+  std::string fault() const;
 
   // The clock model (thread-safe copies of what the cycle needs).
   std::int64_t firstSampleAtOrAfter(double host_s) const;
   double sampleAt(double host_s) const;
   double driftPpm() const;
   double jitterS() const;
+  ClockReport clockReport() const;
 
   // Calls into the source from the cycle's thread (stimuli, attention, the screen).
   void withSource(const std::function<void(EegSource&)>& call);
 
  private:
   void pump();
-  void deliver(const Block& block, double host_s);
+  ClockModel::Observation deliver(const Block& block, double host_s);
   void loop();
 
   std::unique_ptr<EegSource> source_;
@@ -91,10 +116,14 @@ class Acquisition {
   RingBuffer ring_;
   std::optional<RingBuffer::Reader> reader_;  // the cycle's; from the stream's first sample
   std::vector<SampleLoss> losses_;
+  std::vector<DeliveryStall> stalls_;
+  double last_delivery_host_ = 0.0;
+  std::string fault_;
   ClockModel model_;
   std::int64_t first_sample_ = 0;  // of the stream
   std::int64_t next_sample_ = -1;  // after the newest block delivered (-1: none yet)
   std::atomic<std::int64_t> lost_{0};
+  std::atomic<std::int64_t> repeated_{0};
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -13,6 +13,7 @@
 
 #include "arbci/robot/protocol.h"
 #include "arbci/robot/robot_driver.h"
+#include "arbci/robot/settings.h"
 #include "arbci/robot/udp_socket.h"
 
 namespace arbci::robot {
@@ -30,7 +31,7 @@ struct BackendOptions {
   // While a motion runs, the arm halts (and the stop latches) when no authenticated datagram
   // from the commanding session has arrived for this long; 0 turns it off. A stepped backend
   // needs none: its arm moves only when the client's clock says so.
-  double watchdog_s = 0.1;
+  double watchdog_s = LinkSettings().watchdog_ms / 1000.0;
   // Asked of the kernel for the socket; it grants at most net.core.rmem_max (times 2).
   int receive_buffer_bytes = 4 << 20;
   std::ostream* log = nullptr;  // rejected and ignored datagrams (rate-limited)

@@ -77,6 +77,12 @@ class RobotClient {
   const std::optional<StatusPayload>& status() const { return status_; }
   bool silent() const { return silent_; }
   bool connected() const { return connected_; }
+  // The scheduling the heartbeat thread got ("real-time (FIFO 99)", "nice -20", ...; "" before
+  // it started), for the session's log.
+  std::string heartbeatPriority() const {
+    std::lock_guard lock(priority_mutex_);
+    return heartbeat_priority_;
+  }
   bool busy() const { return !pending_.empty(); }  // commands not yet finished
   // Whether command `sequence` is known to have been accepted (and so may have moved the arm).
   bool accepted(std::uint64_t sequence) const;
@@ -123,6 +129,8 @@ class RobotClient {
   std::chrono::steady_clock::time_point last_heard_, next_status_, next_hello_, created_;
   std::mutex heartbeat_mutex_;
   std::condition_variable heartbeat_wake_;
+  mutable std::mutex priority_mutex_;
+  std::string heartbeat_priority_;
   bool stopping_ = false;
   std::thread heartbeat_;
 };

@@ -22,6 +22,7 @@ struct LinkSettings {
   LinkSettings();  // linkSchema()'s defaults
   std::string host;
   int port;
+  int watchdog_ms;
 };
 const core::Schema<LinkSettings>& linkSchema();
 

@@ -96,6 +96,8 @@ struct EegPart {
   std::string source_line;  // the source's own account (an LSL stream's name, host, rates)
   std::int64_t lost_samples = 0;
   double drift_ppm = 0.0, jitter_ms = 0.0;
+  bool drift_reliable = false;             // see bci::ClockModel::driftReliable
+  std::vector<bci::DeliveryStall> stalls;  // deliveries held up, taken this cycle
 };
 
 struct RecordingPart {

@@ -12,7 +12,8 @@
 namespace arbci::session {
 
 struct PreflightSettings {
-  double min_s = 1.0;          // the EEG rate is measured over at least this long
+  double min_s = 1.0;          // the EEG rate is measured over at least this long (after the
+                               // first samples' start-up backlog)
   double timeout_s = 5.0;      // session seconds, and wall seconds
   double eeg_rate_hz = 0.0;    // the source's
   double eeg_tolerance = 0.1;  // a rate off by more than this fraction fails
@@ -58,6 +59,13 @@ class Preflight {
   int camera_frames_ = 0;
   bool reference_seen_ = false;
   double eeg_rate_hz_ = 0.0;
+  // The EEG's start-up backlog drains within this long of the first samples arriving.
+  static constexpr double kSettleS = 0.25;
+  // Samples that stop arriving for this long: the stream has stopped (blocks come every 60 ms).
+  static constexpr double kSilentS = 0.5;
+  std::optional<double> first_eeg_s_;             // when the first samples arrived
+  std::optional<PreflightObservation> eeg_from_;  // where the rate is counted from
+  PreflightObservation eeg_last_;                 // the last frame on which samples arrived
   std::vector<std::string> failures_;
 };
 

@@ -181,6 +181,7 @@ struct RobotSettings {
   double speed_factor;  // the simulated arm's
   std::string host;
   int port;
+  int watchdog_ms;  // simulated: the arbci-robotd started here halts after this much silence
   std::string key_file;
 };
 

@@ -1,0 +1,187 @@
+// eeg_clock_bench: the EEG clock of real-time sessions as a lab PC treats them (run it alone and
+// under load: bench/under-load runs both).
+//   1. stalls: `arbci run --headless --realtime` (a still head, the simulated subject and its
+//      virtual photodiode) paused for 2 s by SIGSTOP while flashing, ended 14 s later; every flash
+//      onset after the pause against its photodiode edge, the drift the session reports (truth:
+//      0 ppm), the stalls its summary counts;
+//   2. pre-flight: the default real-time session started N times; the EEG rate its pre-flight
+//      measured (truth: 256 Hz) and whether it passed.
+#include <signal.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "arbci/bci/recording.h"
+#include "support/background_process.h"
+
+namespace {
+
+using namespace arbci;
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+std::uintmax_t sizeOf(const fs::path& file) {
+  std::error_code error;
+  const auto size = fs::file_size(file, error);
+  return error ? 0 : size;
+}
+
+std::optional<nlohmann::json> logEvent(const fs::path& log, const std::string& name) {
+  std::ifstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    const auto event = nlohmann::json::parse(line, nullptr, false);
+    if (!event.is_discarded() && event.value("event", "") == name) return event;
+  }
+  return std::nullopt;
+}
+
+struct StallRun {
+  int onsets_early = 0, off_early = 0;  // within 5 s after the pause
+  int onsets_late = 0, off_late = 0;    // from 5 s after it on
+  int worst_late = 0;                   // samples
+  double drift_ppm = 0.0, drift_uncertainty_ppm = 0.0;
+  bool drift_reliable = false;
+  int stalls = 0;
+  double preflight_hz = 0.0;
+};
+
+std::optional<StallRun> stallRun(const std::string& arbci, const fs::path& folder) {
+  fs::remove_all(folder);
+  const std::string session = folder.string() + ".json";
+  std::ofstream(session) << R"({"cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 6, "calibration_sequences": 4, "cue_s": 0.5,
+                 "pause_s": 0.5}})";
+  test::BackgroundProcess run(
+      arbci, {"run", "--headless", "--realtime", "--session", session, "--out", folder.string()});
+  for (int i = 0; i < 600 && sizeOf(folder / "recording.bdf") < 60000; ++i)
+    std::this_thread::sleep_for(100ms);
+  run.signal(SIGSTOP);
+  std::this_thread::sleep_for(2s);
+  run.signal(SIGCONT);
+  std::this_thread::sleep_for(14s);
+  run.signal(SIGTERM);
+  if (!run.wait(120.0)) return std::nullopt;
+  StallRun out;
+  std::ifstream summary_file(folder / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  const nlohmann::json& timing = summary["timing"];
+  out.drift_ppm = timing["clock_drift_ppm"];
+  out.drift_uncertainty_ppm = timing["clock_drift_uncertainty_ppm"];
+  out.drift_reliable = timing["clock_drift_reliable"];
+  out.stalls = timing["eeg_stalls"]["count"];
+  if (const auto preflight = logEvent(folder / "log.jsonl", "preflight"))
+    out.preflight_hz = preflight->value("eeg_rate_hz", 0.0);
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  std::int64_t stall = -1;
+  for (const auto& a : recording.annotations)
+    if (stall < 0 && a.text.rfind("EEG delivery stalled", 0) == 0) stall = a.sample;
+  const auto& names = recording.info.channels;
+  const int diode =
+      static_cast<int>(std::find(names.begin(), names.end(), "Photodiode") - names.begin());
+  if (stall < 0 || diode >= static_cast<int>(names.size())) return out;
+  std::vector<std::int64_t> edges;
+  for (std::int64_t s = 1; s < recording.samples; ++s)
+    if (recording.at(diode, s) > 500.0f && recording.at(diode, s - 1) <= 500.0f) edges.push_back(s);
+  const double rate = recording.info.rate_hz;
+  for (const auto& onset : recording.stimuli) {
+    if (onset.sample < stall) continue;
+    const auto after = std::lower_bound(edges.begin(), edges.end(), onset.sample);
+    std::int64_t best = 1 << 30;
+    if (after != edges.end()) best = *after - onset.sample;
+    if (after != edges.begin() && onset.sample - *(after - 1) < std::llabs(best))
+      best = *(after - 1) - onset.sample;
+    const bool off = std::llabs(best) > 1;
+    if (onset.sample < stall + static_cast<std::int64_t>(7 * rate)) {  // 2 s paused + 5 s
+      ++out.onsets_early;
+      out.off_early += off;
+    } else {
+      ++out.onsets_late;
+      out.off_late += off;
+      out.worst_late = std::max(out.worst_late, static_cast<int>(std::llabs(best)));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"eeg_clock_bench: stamps and drift across a 2 s stall, pre-flight EEG rates"};
+  std::string arbci = "build/release/arbci";
+  int stall_runs = 2, starts = 50;
+  app.add_option("--arbci", arbci, "the arbci executable")->capture_default_str();
+  app.add_option("--stall-runs", stall_runs, "sessions paused once")->capture_default_str();
+  app.add_option("--starts", starts, "real-time starts for the pre-flight")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  const fs::path scratch =
+      fs::temp_directory_path() / ("arbci-clock-bench-" + std::to_string(getpid()));
+  fs::create_directories(scratch);
+
+  std::printf("A real-time session paused 2 s (SIGSTOP) while flashing\n");
+  std::printf(
+      "| run | onsets 0-5 s after | > 1 sample off | onsets later | > 1 sample off | worst | "
+      "stalls in the summary | drift ppm (truth 0) | +/- | reliable | pre-flight Hz |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|\n");
+  int failures = 0;
+  for (int i = 0; i < stall_runs; ++i) {
+    const auto r = stallRun(arbci, scratch / ("stall" + std::to_string(i)));
+    if (!r) {
+      std::printf("| %d | did not end |\n", i + 1);
+      ++failures;
+      continue;
+    }
+    std::printf("| %d | %d | %d | %d | %d | %d | %d | %+.1f | %.1f | %s | %.1f |\n", i + 1,
+                r->onsets_early, r->off_early, r->onsets_late, r->off_late, r->worst_late,
+                r->stalls, r->drift_ppm, r->drift_uncertainty_ppm, r->drift_reliable ? "yes" : "no",
+                r->preflight_hz);
+    failures +=
+        r->off_late > 0 || r->stalls < 1 || (r->drift_reliable && std::abs(r->drift_ppm) > 20.0);
+  }
+
+  std::vector<double> rates;
+  int refused = 0, unfinished = 0;
+  for (int i = 0; i < starts; ++i) {
+    const fs::path folder = scratch / ("start" + std::to_string(i));
+    test::BackgroundProcess run(arbci,
+                                {"run", "--headless", "--realtime", "--out", folder.string()});
+    std::optional<nlohmann::json> preflight;
+    for (int k = 0; k < 300 && !preflight; ++k) {
+      std::this_thread::sleep_for(100ms);
+      preflight = logEvent(folder / "log.jsonl", "preflight");
+    }
+    run.signal(SIGTERM);
+    run.wait(30.0);
+    if (!preflight) {
+      ++unfinished;
+    } else if (!preflight->value("passed", false)) {
+      ++refused;
+      std::fprintf(stderr, "start %d refused: %s\n", i, preflight->dump().c_str());
+    } else {
+      rates.push_back(preflight->value("eeg_rate_hz", 0.0));
+    }
+    fs::remove_all(folder);
+  }
+  std::sort(rates.begin(), rates.end());
+  std::printf("\nPre-flight of the default real-time session (simulated subject, 256 Hz)\n");
+  std::printf(
+      "| starts | passed | refused | no verdict in 30 s | rate min | median | max |\n"
+      "|---|---|---|---|---|---|---|\n");
+  if (rates.empty()) {
+    std::printf("| %d | 0 | %d | %d | - | - | - |\n", starts, refused, unfinished);
+  } else {
+    std::printf("| %d | %zu | %d | %d | %.1f | %.1f | %.1f |\n", starts, rates.size(), refused,
+                unfinished, rates.front(), rates[rates.size() / 2], rates.back());
+  }
+  fs::remove_all(scratch);
+  return failures == 0 && refused == 0 && unfinished == 0 ? 0 : 1;
+}
