@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "arbci/bci/photodiode_check.h"
 #include "arbci/bci/recording.h"
 #include "support/background_process.h"
 
@@ -85,31 +86,25 @@ std::optional<StallRun> stallRun(const std::string& arbci, const fs::path& folde
   std::int64_t stall = -1;
   for (const auto& a : recording.annotations)
     if (stall < 0 && a.text.rfind("EEG delivery stalled", 0) == 0) stall = a.sample;
-  const auto& names = recording.info.channels;
-  const int diode =
-      static_cast<int>(std::find(names.begin(), names.end(), "Photodiode") - names.begin());
-  if (stall < 0 || diode >= static_cast<int>(names.size())) return out;
-  std::vector<std::int64_t> edges;
-  for (std::int64_t s = 1; s < recording.samples; ++s)
-    if (recording.at(diode, s) > 500.0f && recording.at(diode, s - 1) <= 500.0f) edges.push_back(s);
+  if (stall < 0) return out;
+  const bci::PhotodiodeReport paired = bci::checkPhotodiode(recording, "Photodiode", 0.5);
   const double rate = recording.info.rate_hz;
-  for (const auto& onset : recording.stimuli) {
-    if (onset.sample < stall) continue;
-    const auto after = std::lower_bound(edges.begin(), edges.end(), onset.sample);
-    std::int64_t best = 1 << 30;
-    if (after != edges.end()) best = *after - onset.sample;
-    if (after != edges.begin() && onset.sample - *(after - 1) < std::llabs(best))
-      best = *(after - 1) - onset.sample;
-    const bool off = std::llabs(best) > 1;
-    if (onset.sample < stall + static_cast<std::int64_t>(7 * rate)) {  // 2 s paused + 5 s
+  auto count = [&](std::int64_t onset, int samples_off) {
+    if (onset < stall) return;
+    const bool off = samples_off > 1;
+    if (onset < stall + static_cast<std::int64_t>(7 * rate)) {  // 2 s paused + 5 s
       ++out.onsets_early;
       out.off_early += off;
     } else {
       ++out.onsets_late;
       out.off_late += off;
-      out.worst_late = std::max(out.worst_late, static_cast<int>(std::llabs(best)));
+      out.worst_late = std::max(out.worst_late, samples_off);
     }
-  }
+  };
+  for (size_t i = 0; i < paired.paired_onsets.size(); ++i)
+    count(paired.paired_onsets[i],
+          static_cast<int>(std::lround(std::abs(paired.offsets_ms[i]) * rate / 1000.0)));
+  for (const std::int64_t onset : paired.unmatched_onsets) count(onset, 1 << 20);
   return out;
 }
 

@@ -51,8 +51,10 @@ PhotodiodeReport checkPhotodiode(const Recording& recording, const std::string& 
     }
     if (best < 0) {
       ++r.unmatched_flashes;
+      r.unmatched_onsets.push_back(onset);
       continue;
     }
+    r.paired_onsets.push_back(onset);
     edge_used[static_cast<size_t>(best)] = true;
     r.offsets_ms.push_back(1000.0 * static_cast<double>(edges[static_cast<size_t>(best)] - onset) /
                            r.rate_hz);

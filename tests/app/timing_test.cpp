@@ -14,6 +14,7 @@
 #include <chrono>
 #include <thread>
 
+#include "arbci/bci/photodiode_check.h"
 #include "arbci/bci/recording.h"
 #include "support/background_process.h"
 #include "support/run_process.h"
@@ -210,32 +211,18 @@ TEST(TimingUnderStall, APausedProcessIsLoggedAndFlashesFiveSecondsLaterMeetThePh
     if (a.text.rfind("EEG delivery stalled", 0) == 0 && stall_sample < 0) stall_sample = a.sample;
   }
   ASSERT_GE(stall_sample, 0) << "no stall annotated in the recording";
-  // The photodiode's rising edges, and each later flash onset's nearest one.
-  const auto& names = recording.info.channels;
-  const int diode =
-      static_cast<int>(std::find(names.begin(), names.end(), "Photodiode") - names.begin());
-  ASSERT_LT(diode, static_cast<int>(names.size()));
-  std::vector<std::int64_t> edges;
-  for (std::int64_t s = 1; s < recording.samples; ++s) {
-    if (recording.at(diode, s) > 500.0f && recording.at(diode, s - 1) <= 500.0f) edges.push_back(s);
-  }
+  // Each flash onset after the stall against its photodiode edge (the timing check's pairing).
+  const bci::PhotodiodeReport paired = bci::checkPhotodiode(recording, "Photodiode", 0.5);
   const std::int64_t settled = stall_sample + 2 * 256 + 5 * 256;  // the stall, then 5 s
   int checked = 0, off = 0, early = 0, early_off = 0;             // early: within 5 s of the stall
-  for (const auto& onset : recording.stimuli) {
-    if (onset.sample < stall_sample) continue;
-    const auto after = std::lower_bound(edges.begin(), edges.end(), onset.sample);
-    std::int64_t best = 1 << 30;
-    if (after != edges.end()) best = *after - onset.sample;
-    if (after != edges.begin() && onset.sample - *(after - 1) < std::llabs(best))
-      best = *(after - 1) - onset.sample;
-    if (onset.sample < settled) {
-      ++early;
-      early_off += std::llabs(best) > 1;
-      continue;
-    }
-    ++checked;
-    off += std::llabs(best) > 1;
-  }
+  auto count = [&](std::int64_t onset, bool is_off) {
+    if (onset < stall_sample) return;
+    (onset < settled ? early : checked) += 1;
+    (onset < settled ? early_off : off) += is_off;
+  };
+  for (size_t i = 0; i < paired.paired_onsets.size(); ++i)
+    count(paired.paired_onsets[i], std::abs(paired.offsets_ms[i]) * 256.0 / 1000.0 > 1.0 + 1e-9);
+  for (const std::int64_t onset : paired.unmatched_onsets) count(onset, true);
   std::cout << checked << " onsets checked from 5 s after the stall, " << off
             << " more than one sample off (in the 5 s before: " << early_off << " of " << early
             << "); " << stalls.dump() << "\n";

@@ -254,16 +254,25 @@ TEST(Acquisition, SteppedStampsAreExactAndTheSameEveryRun) {
   EXPECT_EQ(run(), run());
 }
 
-// A source that sends some samples twice: its third delivery overlaps the second by 5 samples,
-// its fourth repeats the first outright.
-class RepeatingSource final : public EegSource {
+// One channel, Cz, at 256 Hz, in blocks of `block_size`: the test sources below.
+class OneChannelSource : public EegSource {
  public:
-  RepeatingSource() {
+  explicit OneChannelSource(int block_size) {
     info_.channels = {"Cz"};
     info_.rate_hz = 256.0;
-    info_.block_size = 15;
+    info_.block_size = block_size;
   }
   const SignalInfo& info() const override { return info_; }
+
+ private:
+  SignalInfo info_;
+};
+
+// A source that sends some samples twice: its third delivery overlaps the second by 5 samples,
+// its fourth repeats the first outright.
+class RepeatingSource final : public OneChannelSource {
+ public:
+  RepeatingSource() : OneChannelSource(15) {}
   std::vector<Block> poll(int) override {
     std::vector<Block> out;
     const std::int64_t firsts[] = {0, 15, 25, 0, 40};
@@ -277,7 +286,6 @@ class RepeatingSource final : public EegSource {
   }
 
  private:
-  SignalInfo info_;
   int call_ = 0;
 };
 
@@ -295,14 +303,9 @@ TEST(Acquisition, OverlappingAndRepeatedBlocksAreTrimmedAndCountedNeverThrown) {
 }
 
 // A live source that queues 2 s of signal once (a stall upstream), then delivers as usual.
-class StallingSource final : public EegSource {
+class StallingSource final : public OneChannelSource {
  public:
-  StallingSource() {
-    info_.channels = {"Cz"};
-    info_.rate_hz = 256.0;
-    info_.block_size = 16;
-  }
-  const SignalInfo& info() const override { return info_; }
+  StallingSource() : OneChannelSource(16) {}
   std::vector<Block> poll(int) override {
     std::vector<Block> out;
     const int blocks = call_ == 3 ? 32 : call_ < 8 ? 1 : 0;  // 32 blocks: 2 s at once
@@ -315,7 +318,6 @@ class StallingSource final : public EegSource {
   }
 
  private:
-  SignalInfo info_;
   int call_ = 0;
   std::int64_t next_ = 0;
 };

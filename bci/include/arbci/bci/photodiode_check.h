@@ -4,6 +4,7 @@
 // counted, never dropped silently.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ struct PhotodiodeReport {
   int count = 0;           // pairs
   int unmatched_flashes = 0, unmatched_edges = 0;
   std::vector<double> offsets_ms;  // edge minus onset, per pair (positive: the diode saw it later)
+  std::vector<std::int64_t> paired_onsets;     // each pair's onset sample (as offsets_ms)
+  std::vector<std::int64_t> unmatched_onsets;  // the onsets no edge was near
   double mean_ms = 0.0, sd_ms = 0.0, min_ms = 0.0, max_ms = 0.0;
 };
 
