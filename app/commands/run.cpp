@@ -72,6 +72,15 @@ void printSummary(const session::Session& session) {
             << " ms (configured " << ms(timing["soa_ms"]["configured"]) << "), flash median "
             << ms(timing["flash_ms"]["median"]) << " ms; late frames " << timing["late_frames"]
             << ", lost EEG samples " << timing["lost_samples"] << "\n";
+  const nlohmann::json stalls = timing.value("eeg_stalls", nlohmann::json::object());
+  std::cout << "EEG clock: drift " << ms(timing["clock_drift_ppm"]) << " ppm +/- "
+            << ms(timing["clock_drift_uncertainty_ppm"])
+            << (timing.value("clock_drift_reliable", false) ? "" : " (not reliable yet)")
+            << "; stalls " << stalls.value("count", 0);
+  if (stalls.value("count", 0) > 0)
+    std::cout << " (longest " << ms(stalls["longest_s"]) << " s, "
+              << stalls.value("uncertain_flashes", 0) << " flash stamps uncertain)";
+  std::cout << "\n";
   std::cout << "ended: " << session.endKind();
   if (session.endReason() != session.endKind()) std::cout << " (" << session.endReason() << ")";
   std::cout << "\n";

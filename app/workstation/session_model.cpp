@@ -196,6 +196,14 @@ std::vector<std::pair<std::string, std::string>> SessionModel::summaryRows() con
   const nlohmann::json& timing = s["timing"];
   rows.emplace_back("late frames", timing["late_frames"].dump() + ", lost EEG samples " +
                                        timing["lost_samples"].dump());
+  const nlohmann::json stalls = timing.value("eeg_stalls", nlohmann::json::object());
+  rows.emplace_back(
+      "EEG stalls",
+      stalls.value("count", 0) == 0
+          ? std::string("none")
+          : std::to_string(stalls.value("count", 0)) + ", longest " +
+                number(stalls.value("longest_s", nlohmann::json(0.0)), "%.2f s", 1.0) + ", " +
+                std::to_string(stalls.value("uncertain_flashes", 0)) + " flash stamps uncertain");
   rows.emplace_back("folder", session_.folder().string());
   return rows;
 }

@@ -168,6 +168,10 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
       ScheduledFlash& f = schedule_[i];
       if (due_s < f.onset_s - kSlack) break;
       if (i == next_flash_) {
+        // Never on the frame right after one that showed a flash: on a display too slow for the
+        // SOA the two would run together (one onset to the subject, one photodiode edge); it
+        // waits a frame, with the screen dark between them.
+        if (lit_last_frame_) break;
         // Its first frame. One overdue by more than a flash (the process or the display stalled)
         // moves the rest of the sequence with it: shown one per frame, the flashes missed in a
         // stall would follow each other closer than the SOA, their ERPs overlapping and the
@@ -263,6 +267,7 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   }
   if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping)
     out.selected_cell = selected_cell_;
+  lit_last_frame_ = !out.lit.empty();
   return out;
 }
 

@@ -206,9 +206,10 @@ class Paradigm {
   std::optional<StimulusSequencer> sequencer_;
   Phase phase_ = Phase::Setup;
   Phase paused_from_ = Phase::Setup;
-  std::int64_t frame_ = 0;    // the last frame shown
-  double now_ = 0.0;          // its due time
-  double phase_until_ = 0.0;  // timed phases end then (while paused: the time still to go)
+  std::int64_t frame_ = 0;       // the last frame shown
+  double now_ = 0.0;             // its due time
+  bool lit_last_frame_ = false;  // the last frame showed a flash
+  double phase_until_ = 0.0;     // timed phases end then (while paused: the time still to go)
   // Flashing: the current sequence's flashes, and when each was first shown.
   struct ScheduledFlash {
     double onset_s;
