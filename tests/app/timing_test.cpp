@@ -63,12 +63,19 @@ TEST(TimingCheck, HeadlessOnsetsMeetThePhotodiode) {
 // Xvfb display) beside the experimenter's: the flashes are stamped at the HMD window's swap.
 // (The simulated photodiode sees what the session says it presented; a real one on the HMD is
 // what tells one swap from the other.)
+// `arbci timing-check` in a window, with the HMD mirror on `monitor`, for `seconds`.
+ProcessResult windowedCheckWithMirror(const std::filesystem::path& folder, int monitor,
+                                      int seconds) {
+  const auto session = folder.string() + ".json";
+  std::ofstream(session) << R"({"hmd": {"mirror_monitor": )" << monitor << "}}";
+  return runInWindow({"timing-check", "--session", session, "--seconds", std::to_string(seconds),
+                      "--out", folder.string()},
+                     300.0);
+}
+
 TEST(TimingCheck, InTheHmdWindowUnderXvfbOnsetsMeetThePhotodiode) {
   const auto folder = fresh("window");
-  const auto session = folder.string() + ".json";
-  std::ofstream(session) << R"({"hmd": {"mirror_monitor": 0}})";
-  const ProcessResult r = runInWindow(
-      {"timing-check", "--session", session, "--seconds", "15", "--out", folder.string()}, 300.0);
+  const ProcessResult r = windowedCheckWithMirror(folder, 0, 15);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   expectOnTarget(folder);
   EXPECT_EQ(readJson(folder / "timing.json")["mode"], "window");
@@ -76,10 +83,7 @@ TEST(TimingCheck, InTheHmdWindowUnderXvfbOnsetsMeetThePhotodiode) {
 
 TEST(TimingCheck, AnHmdMonitorTheDisplayLacksIsRefusedBeforeAnyFlash) {
   const auto folder = fresh("nomonitor");
-  const auto session = folder.string() + ".json";
-  std::ofstream(session) << R"({"hmd": {"mirror_monitor": 3}})";
-  const ProcessResult r = runInWindow(
-      {"timing-check", "--session", session, "--seconds", "5", "--out", folder.string()}, 120.0);
+  const ProcessResult r = windowedCheckWithMirror(folder, 3, 5);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("hmd.mirror_monitor = 3: there is no such monitor"), std::string::npos)
       << r.err;
