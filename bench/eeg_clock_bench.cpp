@@ -4,8 +4,9 @@
 //      virtual photodiode) paused for 2 s by SIGSTOP while flashing, ended 14 s later; every flash
 //      onset after the pause against its photodiode edge, the drift the session reports (truth:
 //      0 ppm), the stalls its summary counts;
-//   2. pre-flight: the default real-time session started N times; the EEG rate its pre-flight
-//      measured (truth: 256 Hz) and whether it passed.
+//   2. pre-flight: the default real-time session started N times, and a session reading a
+//      recording streamed over LSL (`arbci eeg stream`) M times; the EEG rate each pre-flight
+//      measured (truth: the source's) and whether it passed.
 #include <signal.h>
 #include <unistd.h>
 
@@ -16,6 +17,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <thread>
@@ -108,15 +111,65 @@ std::optional<StallRun> stallRun(const std::string& arbci, const fs::path& folde
   return out;
 }
 
+// The session started `starts` times in real time (`session_for(folder)` names its session file,
+// empty for the default, and may start what it needs); the EEG rate each pre-flight measured.
+// Prints a table row; true when every start passed.
+bool preflightStarts(const std::string& arbci, const fs::path& scratch, int starts,
+                     const std::string& what,
+                     const std::function<std::string(const fs::path&)>& session_for) {
+  std::vector<double> rates;
+  int refused = 0, unfinished = 0;
+  for (int i = 0; i < starts; ++i) {
+    const fs::path folder = scratch / ("start" + std::to_string(i));
+    std::vector<std::string> args = {"run", "--headless", "--realtime", "--out", folder.string()};
+    if (const std::string session = session_for(folder); !session.empty()) {
+      args.push_back("--session");
+      args.push_back(session);
+    }
+    test::BackgroundProcess run(arbci, args);
+    std::optional<nlohmann::json> preflight;
+    for (int k = 0; k < 300 && !preflight; ++k) {
+      std::this_thread::sleep_for(100ms);
+      preflight = logEvent(folder / "log.jsonl", "preflight");
+    }
+    run.signal(SIGTERM);
+    run.wait(30.0);
+    if (!preflight) {
+      ++unfinished;
+    } else if (!preflight->value("passed", false)) {
+      ++refused;
+      std::fprintf(stderr, "start %d refused: %s\n", i, preflight->dump().c_str());
+    } else {
+      rates.push_back(preflight->value("eeg_rate_hz", 0.0));
+    }
+    fs::remove_all(folder);
+  }
+  std::sort(rates.begin(), rates.end());
+  if (rates.empty()) {
+    std::printf("| %s | %d | 0 | %d | %d | - | - | - |\n", what.c_str(), starts, refused,
+                unfinished);
+  } else {
+    std::printf("| %s | %d | %zu | %d | %d | %.1f | %.1f | %.1f |\n", what.c_str(), starts,
+                rates.size(), refused, unfinished, rates.front(), rates[rates.size() / 2],
+                rates.back());
+  }
+  return refused == 0 && unfinished == 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"eeg_clock_bench: stamps and drift across a 2 s stall, pre-flight EEG rates"};
   std::string arbci = "build/release/arbci";
-  int stall_runs = 2, starts = 50;
+  int stall_runs = 2, starts = 50, lsl_starts = 20;
+  std::string lsl_file = std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
   app.add_option("--arbci", arbci, "the arbci executable")->capture_default_str();
   app.add_option("--stall-runs", stall_runs, "sessions paused once")->capture_default_str();
-  app.add_option("--starts", starts, "real-time starts for the pre-flight")->capture_default_str();
+  app.add_option("--starts", starts, "real-time starts for the pre-flight (simulated subject)")
+      ->capture_default_str();
+  app.add_option("--lsl-starts", lsl_starts, "real-time starts for the pre-flight (LSL source)")
+      ->capture_default_str();
+  app.add_option("--lsl-file", lsl_file, "the recording streamed over LSL")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   const fs::path scratch =
       fs::temp_directory_path() / ("arbci-clock-bench-" + std::to_string(getpid()));
@@ -143,40 +196,36 @@ int main(int argc, char** argv) {
         r->off_late > 0 || r->stalls < 1 || (r->drift_reliable && std::abs(r->drift_ppm) > 20.0);
   }
 
-  std::vector<double> rates;
-  int refused = 0, unfinished = 0;
-  for (int i = 0; i < starts; ++i) {
-    const fs::path folder = scratch / ("start" + std::to_string(i));
-    test::BackgroundProcess run(arbci,
-                                {"run", "--headless", "--realtime", "--out", folder.string()});
-    std::optional<nlohmann::json> preflight;
-    for (int k = 0; k < 300 && !preflight; ++k) {
-      std::this_thread::sleep_for(100ms);
-      preflight = logEvent(folder / "log.jsonl", "preflight");
-    }
-    run.signal(SIGTERM);
-    run.wait(30.0);
-    if (!preflight) {
-      ++unfinished;
-    } else if (!preflight->value("passed", false)) {
-      ++refused;
-      std::fprintf(stderr, "start %d refused: %s\n", i, preflight->dump().c_str());
-    } else {
-      rates.push_back(preflight->value("eeg_rate_hz", 0.0));
-    }
-    fs::remove_all(folder);
-  }
-  std::sort(rates.begin(), rates.end());
-  std::printf("\nPre-flight of the default real-time session (simulated subject, 256 Hz)\n");
+  std::printf("\nPre-flight of real-time sessions (the EEG rate it measured)\n");
   std::printf(
-      "| starts | passed | refused | no verdict in 30 s | rate min | median | max |\n"
-      "|---|---|---|---|---|---|---|\n");
-  if (rates.empty()) {
-    std::printf("| %d | 0 | %d | %d | - | - | - |\n", starts, refused, unfinished);
-  } else {
-    std::printf("| %d | %zu | %d | %d | %.1f | %.1f | %.1f |\n", starts, rates.size(), refused,
-                unfinished, rates.front(), rates[rates.size() / 2], rates.back());
-  }
+      "| source | starts | passed | refused | no verdict in 30 s | rate min | median | max |\n"
+      "|---|---|---|---|---|---|---|---|\n");
+  const bool simulated_ok = preflightStarts(arbci, scratch, starts, "simulated subject, 256 Hz",
+                                            [](const fs::path&) { return std::string(); });
+  // A live source: `arbci eeg stream` publishes a recording over LSL (machine scope) and the
+  // session reads it as it would an amplifier's outlet.
+  const bci::Recording file = bci::readRecording(lsl_file);
+  const std::string stream = "clock-bench-" + std::to_string(getpid());
+  const nlohmann::json lsl_session = {
+      {"eeg",
+       {{"source", "lsl"},
+        {"rate_hz", file.info.rate_hz},
+        {"photodiode_channel", ""},
+        {"lsl", {{"name", stream}, {"type", "EEG"}, {"resolve_timeout_s", 10}}}}},
+      {"lsl", {{"scope", "machine"}}}};
+  const fs::path lsl_session_file = scratch / "lsl.json";
+  std::ofstream(lsl_session_file) << lsl_session.dump(2);
+  char what[160];
+  std::snprintf(what, sizeof what, "LSL outlet of arbci eeg stream, %.0f Hz", file.info.rate_hz);
+  std::unique_ptr<test::BackgroundProcess> streamer;
+  const bool lsl_ok = preflightStarts(arbci, scratch, lsl_starts, what, [&](const fs::path&) {
+    // A fresh outlet for each start: `--wait` streams from the first consumer on, once.
+    streamer = std::make_unique<test::BackgroundProcess>(
+        arbci, std::vector<std::string>{"eeg", "stream", lsl_file, "--name", stream, "--wait",
+                                        "--scope", "machine"});
+    return lsl_session_file.string();
+  });
+  streamer.reset();
   fs::remove_all(scratch);
-  return failures == 0 && refused == 0 && unfinished == 0 ? 0 : 1;
+  return failures == 0 && simulated_ok && lsl_ok ? 0 : 1;
 }

@@ -62,12 +62,21 @@ int runTimingCheck(const TimingCheckOptions& o) {
       OpenedSession opened = openSession(config, options, *context);
       runHeadless(*opened.session);
     } else {
-      runWorkstation(config, options, {{}, false, true});
+      runWorkstation(config, options, {{}, false, true, true});
     }
   } catch (const std::runtime_error& error) {
     throw CliError(error.what());
   }
   const auto folder = std::filesystem::path(o.out);
+  // A run that ended early (a failed pre-flight, an interrupt) has no flashes to judge.
+  std::ifstream summary_file(folder / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file, nullptr, false);
+  if (summary.is_discarded())
+    throw CliError("the timing check did not run: " + (folder / "summary.json").string() +
+                   " is missing or unreadable");
+  if (summary.value("ended", "") != "finished")
+    throw CliError("the timing check did not run: " +
+                   summary.value("end_reason", std::string("?")));
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
   bci::PhotodiodeReport report;
   try {

@@ -43,22 +43,22 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   if (!workstation.script.empty()) script.emplace(workstation.script);
   const bool close_when_ended = workstation.close_when_ended;
   options.clock = session::Clock::Mode::RealTime;
-  options.experimenter = true;
+  // Unattended (the timing check), a failed pre-flight ends the run as it does headless.
+  options.experimenter = !workstation.unattended;
   options.presents_itself = false;  // the window's swap is the presentation
   render::WindowOptions window;
   window.title = "ARBCI workstation";
   render::WindowContext main_window(window);
   std::unique_ptr<render::WindowContext> mirror;
-  if (config.hmd.mirror_monitor >= render::WindowContext::monitorCount()) {
-    // Refused before any flash: the subject would otherwise see the HMD view nowhere.
-    const int monitors = render::WindowContext::monitorCount();
-    throw session::SessionConfigError(
-        config.source + ": hmd.mirror_monitor = " + std::to_string(config.hmd.mirror_monitor) +
+  const int monitors = render::WindowContext::monitorCount();
+  if (config.hmd.mirror_monitor >= monitors) {
+    // A pre-flight failure, shown in the window: the subject would see the HMD view nowhere.
+    options.display_failures.push_back(
+        "hmd.mirror_monitor = " + std::to_string(config.hmd.mirror_monitor) +
         ": there is no such monitor (this display has " + std::to_string(monitors) +
         (monitors == 1 ? " monitor: 0" : " monitors: 0 to " + std::to_string(monitors - 1)) +
         "; -1 for none)");
-  }
-  if (config.hmd.mirror_monitor >= 0) {
+  } else if (config.hmd.mirror_monitor >= 0) {
     render::WindowOptions m;
     m.title = "ARBCI HMD";
     m.fullscreen_monitor = config.hmd.mirror_monitor;
@@ -68,7 +68,9 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   }
   OpenedSession opened = openSession(config, options, main_window);
   session::Session& session = *opened.session;
-  if (!workstation.wait_for_start) session.request(session::StartRequest{});
+  // Unattended, the session starts itself.
+  if (!workstation.wait_for_start && !workstation.unattended)
+    session.request(session::StartRequest{});
   SessionModel model(session);
   ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;

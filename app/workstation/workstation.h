@@ -13,6 +13,9 @@ struct WorkstationOptions {
   std::filesystem::path script;
   bool wait_for_start = false;    // the experimenter presses Start (else it runs at once)
   bool close_when_ended = false;  // the window closes once the session has ended
+  // Nobody at the window (the timing check): the session starts itself and a failed pre-flight
+  // ends it, as headless.
+  bool unattended = false;
 };
 
 int runWorkstation(const session::SessionConfig& config, session::SessionOptions options,

@@ -29,6 +29,11 @@ void Preflight::begin(const PreflightObservation& now) {
 Preflight::State Preflight::update(const PreflightObservation& now) {
   if (state_ != State::Running) return state_;
   last_ = now;
+  if (!settings_.known_failures.empty()) {
+    failures_ = check(true);
+    state_ = State::Failed;
+    return state_;
+  }
   camera_frames_ += now.camera_frame;
   reference_seen_ |= now.reference_age_s && *now.reference_age_s <= now.max_pose_age_s;
   const double elapsed = now.time_s - first_.time_s;
@@ -59,7 +64,7 @@ Preflight::State Preflight::update(const PreflightObservation& now) {
 }
 
 std::vector<std::string> Preflight::check(bool final) const {
-  std::vector<std::string> out;
+  std::vector<std::string> out = settings_.known_failures;
   const double waited = last_.time_s - first_.time_s;
   if (camera_frames_ < 2) {
     out.push_back(settings_.camera_key + ": " + std::to_string(camera_frames_) +

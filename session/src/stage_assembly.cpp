@@ -38,9 +38,11 @@ TrackingSettings trackingSettingsOf(const SessionConfig& c, SceneSource& scene) 
   return t;
 }
 
-PreflightSettings preflightSettingsOf(const SessionConfig& c, double eeg_rate_hz) {
+PreflightSettings preflightSettingsOf(const SessionConfig& c, const SessionOptions& options,
+                                      double eeg_rate_hz) {
   PreflightSettings p;
   p.eeg_rate_hz = eeg_rate_hz;
+  p.known_failures = options.display_failures;
   if (c.cameras.source == "simulated") {
     p.camera_key = "cameras.source";
     p.camera_what = "the simulated cameras";
@@ -153,8 +155,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto presentation = std::make_unique<PresentationStage>(
       PresentationSettings{c.paradigm, eeg_info.rate_hz}, services);
   auto preflight = std::make_unique<PreflightStage>(
-      PreflightStageSettings{preflightSettingsOf(c, eeg_info.rate_hz), c.tracker.max_pose_age_s,
-                             options.experimenter},
+      PreflightStageSettings{preflightSettingsOf(c, options, eeg_info.rate_hz),
+                             c.tracker.max_pose_age_s, options.experimenter},
       services);
   auto paradigm = std::make_unique<ParadigmStage>(
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),

@@ -81,13 +81,21 @@ TEST(TimingCheck, InTheHmdWindowUnderXvfbOnsetsMeetThePhotodiode) {
   EXPECT_EQ(readJson(folder / "timing.json")["mode"], "window");
 }
 
-TEST(TimingCheck, AnHmdMonitorTheDisplayLacksIsRefusedBeforeAnyFlash) {
+// A pre-flight failure: the window opens, the check fails on its first frame, nothing flashes.
+TEST(TimingCheck, AnHmdMonitorTheDisplayLacksFailsThePreflightBeforeAnyFlash) {
   const auto folder = fresh("nomonitor");
   const ProcessResult r = windowedCheckWithMirror(folder, 3, 5);
-  EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.err.find("hmd.mirror_monitor = 3: there is no such monitor"), std::string::npos)
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("pre-flight failed: hmd.mirror_monitor = 3: there is no such monitor"),
+            std::string::npos)
       << r.err;
-  EXPECT_FALSE(std::filesystem::exists(folder / "recording.bdf"));
+  EXPECT_NE(r.err.find("the timing check did not run"), std::string::npos) << r.err;
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "aborted");
+  EXPECT_EQ(
+      summary["end_reason"].get<std::string>().rfind("pre-flight failed: hmd.mirror_monitor", 0),
+      0u)
+      << summary.dump();
 }
 
 TEST(TimingCheck, RefusesASessionWithoutAPhotodiodeChannel) {

@@ -22,6 +22,9 @@ struct PreflightSettings {
   std::string eeg_key;
   int reference_id = 0;
   std::string robot_key, robot_what;
+  // Failures known before the check begins (the display's: a missing HMD monitor); any fails
+  // the pre-flight on its first frame.
+  std::vector<std::string> known_failures;
 };
 
 // What the cycle saw on one frame.

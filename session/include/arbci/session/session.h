@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -44,6 +45,9 @@ struct SessionOptions {
   // The timing check: flashes only (a calibration run that never ends) for this many seconds of
   // session time, then the session ends ("timing check done"); 0: a normal session.
   double flashes_only_s = 0.0;
+  // What the display found wrong when its windows opened (a named HMD monitor that does not
+  // exist), one line each naming its key: the pre-flight fails with these before any flash.
+  std::vector<std::string> display_failures;
   std::ostream* progress = nullptr;
 };
 
