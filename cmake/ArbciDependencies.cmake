@@ -15,8 +15,6 @@ find_package(orocos_kdl REQUIRED)
 find_package(pugixml REQUIRED)
 # Amplifiers through eegdev (Debian libeegdev-dev; its plugins in eegdev-plugins-free). Found
 # directly: its pkg-config file requires xdffileio's and libusb's development files.
-# XDF files (LabRecorder) through libxdf (Debian libxdf-dev).
-find_package(libxdf REQUIRED)
 find_library(EEGDEV_LIBRARY eegdev REQUIRED)
 find_path(EEGDEV_INCLUDE_DIR eegdev.h REQUIRED)
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)

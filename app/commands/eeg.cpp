@@ -37,6 +37,7 @@ void printInfo(const bci::Recording& r) {
             << r.seconds() << " s)\n";
   if (r.truncated)
     std::cout << "truncated: " << r.truncation_note << "; read up to the last complete record\n";
+  for (const std::string& note : r.notes) std::cout << "note:      " << note << "\n";
   std::map<int, std::pair<int, int>> by_code;  // code -> (count, targets)
   int targets = 0;
   for (const bci::StimulusEvent& e : r.stimuli) {

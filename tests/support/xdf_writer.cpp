@@ -1,7 +1,9 @@
 #include "support/xdf_writer.h"
 
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
+#include <string>
 
 namespace arbci::test {
 namespace {
@@ -41,7 +43,7 @@ std::string withStream(std::uint32_t id, const std::string& rest) {
 }  // namespace
 
 void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
-              const std::vector<XdfMarker>& markers) {
+              const std::vector<XdfMarker>& markers, const XdfExtras& extras) {
   std::ofstream file(path, std::ios::binary);
   file << "XDF:";
   chunk(file, 1, "<?xml version=\"1.0\"?><info><version>1.0</version></info>");
@@ -58,20 +60,37 @@ void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
                           "</nominal_srate><channel_format>float32</channel_format>"
                           "<created_at>50.0</created_at><desc><channels>" +
                           channels + "</channels></desc></info>"));
+  std::string parameters;
+  for (const auto& [name, value] : extras.marker_parameters)
+    parameters += "<parameter name=\"" + name + "\">" + value + "</parameter>";
   chunk(file, 2,
         withStream(2, "<?xml version=\"1.0\"?><info><name>" + eeg.name +
                           "-Markers</name>"
-                          "<type>Markers</type><channel_count>1</channel_count><nominal_srate>0"
+                          "<type>Markers</type><channel_count>" +
+                          std::to_string(extras.marker_channels) +
+                          "</channel_count><nominal_srate>0"
                           "</nominal_srate><channel_format>string</channel_format>"
-                          "<created_at>50.0</created_at><desc/></info>"));
+                          "<created_at>50.0</created_at><desc><arbci>" +
+                          parameters + "</arbci></desc></info>"));
+  if (extras.empty_stream) {
+    chunk(file, 2,
+          withStream(3,
+                     "<?xml version=\"1.0\"?><info><name>Empty</name><type>EEG</type>"
+                     "<channel_count>2</channel_count><nominal_srate>100</nominal_srate>"
+                     "<channel_format>float32</channel_format><desc/></info>"));
+  }
   const size_t n = eeg.samples.size();
+  auto stamp = [&](size_t s) {
+    return extras.eeg_stamps.empty() ? eeg.first_timestamp + static_cast<double>(s) / eeg.rate
+                                     : extras.eeg_stamps[s];
+  };
   for (size_t first = 0; first < n; first += 100) {
     const size_t count = std::min<size_t>(100, n - first);
     std::string content;
     putLength(content, count);
     for (size_t s = first; s < first + count; ++s) {
       content += static_cast<char>(8);
-      put(content, eeg.first_timestamp + static_cast<double>(s) / eeg.rate);
+      put(content, stamp(s));
       for (float v : eeg.samples[s]) put(content, v);
     }
     chunk(file, 3, withStream(1, content));
@@ -81,19 +100,29 @@ void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
     putLength(content, 1);
     content += static_cast<char>(8);
     put(content, m.timestamp);
-    putLength(content, m.text.size());
-    content += m.text;
+    for (int c = 0; c < extras.marker_channels; ++c) {
+      const std::string& text = c == 0 ? m.text
+                                : static_cast<size_t>(c) <= m.more.size()
+                                    ? m.more[static_cast<size_t>(c - 1)]
+                                    : std::string();
+      putLength(content, text.size());
+      content += text;
+    }
     chunk(file, 3, withStream(2, content));
   }
+  const std::vector<std::pair<double, double>> one{{eeg.first_timestamp, 0.0}};
   for (std::uint32_t id : {1u, 2u}) {
-    std::string content;
-    put(content, eeg.first_timestamp);
-    put(content, 0.0);  // the streams' clocks are the recorder's
-    chunk(file, 4, withStream(id, content));
+    const auto& offsets = id == 1 ? extras.eeg_offsets : extras.marker_offsets;
+    for (const auto& [time, value] : offsets.empty() ? one : offsets) {
+      std::string content;
+      put(content, time);
+      put(content, value);
+      chunk(file, 4, withStream(id, content));
+    }
   }
+  if (!extras.footers) return;
   char last[32];
-  std::snprintf(last, sizeof last, "%.17g",
-                eeg.first_timestamp + static_cast<double>(n - 1) / eeg.rate);
+  std::snprintf(last, sizeof last, "%.17g", n > 0 ? stamp(n - 1) : 0.0);
   chunk(
       file, 6,
       withStream(1, "<?xml version=\"1.0\"?><info><first_timestamp>" +
@@ -103,6 +132,11 @@ void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
   chunk(file, 6,
         withStream(2, "<?xml version=\"1.0\"?><info><sample_count>" +
                           std::to_string(markers.size()) + "</sample_count></info>"));
+  if (extras.empty_stream)
+    chunk(file, 6,
+          withStream(3,
+                     "<?xml version=\"1.0\"?><info><sample_count>0</sample_count>"
+                     "</info>"));
 }
 
 }  // namespace arbci::test

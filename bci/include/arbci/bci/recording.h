@@ -36,6 +36,9 @@ struct Recording {
   // The file was cut short and was read up to its last complete record (salvage mode).
   bool truncated = false;
   std::string truncation_note;
+  // What the reader had to make of the file, one line each (an XDF's clock resets re-anchored,
+  // breaks in its EEG, markers outside the EEG): printed by `arbci eeg info`.
+  std::vector<std::string> notes;
 
   float at(int channel, std::int64_t sample) const {
     return data[static_cast<size_t>(channel) * samples + sample];
@@ -52,9 +55,13 @@ struct ReadOptions {
 Recording readRecording(const std::filesystem::path& path, const ReadOptions& options = {});
 Recording readBci2000(const std::filesystem::path& path, const ReadOptions& options = {});
 Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& options = {});
-// XDF (LabRecorder) through libxdf: the first regular stream of type EEG (else the regular one
-// with most channels), with the string streams' markers as stimuli ("flash <code> target",
-// "<code> nontarget", a bare code) or annotations, each at the first sample at or after it.
+// XDF (LabRecorder) by a reader of our own (bci/src/xdf/): the first regular stream of type EEG
+// with samples (else the regular one with most channels), its stamps and every string stream's
+// on the recorder's clock (clock resets re-anchored, stretches dejittered, breaks annotated), the
+// markers as stimuli ("flash <code> target", "<code> nontarget", a bare code) or annotations,
+// each at the first EEG sample at or after it; ARBCI's marker streams' parameters (the stimulus
+// layout) as the recording's. A file cut short, or whose streams lack their footers, is refused
+// unless salvaging. See docs/eeg.md.
 Recording readXdf(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // A BCI2000 parameter's numeric value with its unit: "256Hz" -> 256, "800ms" -> 0.8 (seconds),

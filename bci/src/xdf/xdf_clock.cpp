@@ -1,0 +1,151 @@
+#include "xdf_clock.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace arbci::bci::xdf {
+namespace {
+
+// A step between two samples longer than one period by more than this is a break: LSL stamps
+// jitter by milliseconds, and 100 ms of missing EEG (25 samples at 256 Hz) is worth reporting.
+constexpr double kBreakS = 0.1;
+// A clock reset: successive offsets whose collection times step back, or forward by more than
+// kResetTimeS and kResetStds spreads beyond the usual interval, while their values jump by more
+// than kResetValueS and kResetStds spreads (pyxdf's criteria, with its thresholds).
+constexpr double kResetTimeS = 5.0, kResetValueS = 1.0;
+constexpr double kResetTimeStds = 5.0, kResetValueStds = 10.0;
+// A stamp this far outside its segment's offsets (before the first, after the last) may belong
+// to the next segment, if it lies within that one.
+constexpr double kSegmentMarginS = 10.0;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), middle, v.end());
+  return *middle;
+}
+
+struct Line {
+  double a = 0.0, b = 0.0;  // y = a + b * x
+};
+
+// Least squares, centred (collection times are large numbers and the slope tiny).
+Line fit(const std::vector<double>& x, const std::vector<double>& y, std::size_t first,
+         std::size_t last) {
+  const double n = static_cast<double>(last - first + 1);
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = first; i <= last; ++i) {
+    mx += x[i];
+    my += y[i];
+  }
+  mx /= n;
+  my /= n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = first; i <= last; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  Line line;
+  line.b = sxx > 0.0 ? sxy / sxx : 0.0;
+  line.a = my - line.b * mx;
+  return line;
+}
+
+struct Segment {
+  double start = 0.0, end = 0.0;  // collection times of its first and last offset
+  Line offset;                    // offset = a + b * stamp
+  bool contains(double t) const {
+    return t >= start - kSegmentMarginS && t <= end + kSegmentMarginS;
+  }
+};
+
+std::vector<Segment> clockSegments(const Stream& s, int& resets) {
+  std::vector<double> times, values;
+  for (const auto& [time, value] : s.offsets) {
+    times.push_back(time);
+    values.push_back(value);
+  }
+  const std::size_t n = times.size();
+  std::vector<std::size_t> starts{0};
+  if (n >= 3) {
+    std::vector<double> dt(n - 1), dv(n - 1);
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      dt[i] = times[i + 1] - times[i];
+      dv[i] = std::abs(values[i + 1] - values[i]);
+    }
+    const double eps = std::numeric_limits<double>::epsilon();
+    const double mt = median(dt), mv = median(dv);
+    std::vector<double> st(n - 1), sv(n - 1);
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      st[i] = std::abs(dt[i] - mt);
+      sv[i] = std::abs(dv[i] - mv);
+    }
+    const double spread_t = median(st) + eps, spread_v = median(sv) + eps;
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      const bool time_glitch =
+          dt[i] < 0 || ((dt[i] - mt) / spread_t > kResetTimeStds && dt[i] - mt > kResetTimeS);
+      const bool value_glitch =
+          (dv[i] - mv) / spread_v > kResetValueStds && dv[i] - mv > kResetValueS;
+      if (time_glitch && value_glitch) starts.push_back(i + 1);
+    }
+  }
+  resets += static_cast<int>(starts.size()) - 1;
+  std::vector<Segment> out;
+  if (n == 0) return out;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const std::size_t first = starts[k];
+    const std::size_t last = k + 1 < starts.size() ? starts[k + 1] - 1 : n - 1;
+    Segment segment;
+    segment.start = times[first];
+    segment.end = times[last];
+    segment.offset = fit(times, values, first, last);
+    out.push_back(segment);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<double> recorderStamps(const Stream& s, ClockReport& report) {
+  std::vector<double> stamps = s.stamps;
+  const std::vector<Segment> segments = clockSegments(s, report.resets);
+  // Each stamp, in the order recorded, in the segment of its clock: the next one once the
+  // stream's own stamps step back (its clock was reset), or once a stamp lies in a later one.
+  std::size_t current = 0;
+  for (std::size_t i = 0; i < stamps.size() && !segments.empty(); ++i) {
+    const double t = s.stamps[i];
+    if (i > 0 && t < s.stamps[i - 1] - 1.0 && current + 1 < segments.size()) {
+      ++current;
+    } else if (!segments[current].contains(t)) {
+      for (std::size_t j = current + 1; j < segments.size(); ++j) {
+        if (segments[j].contains(t)) {
+          current = j;
+          break;
+        }
+      }
+    }
+    const Line& line = segments[current].offset;
+    stamps[i] = t + line.a + line.b * t;
+  }
+  if (s.nominal_rate <= 0.0 || stamps.size() < 2) return stamps;
+  // Dejitter each stretch between breaks: stamps = a + b * index.
+  const double period = 1.0 / s.nominal_rate;
+  std::vector<double> index(stamps.size());
+  for (std::size_t i = 0; i < index.size(); ++i) index[i] = static_cast<double>(i);
+  std::size_t first = 0;
+  for (std::size_t i = 1; i <= stamps.size(); ++i) {
+    const bool end = i == stamps.size();
+    const double step = end ? 0.0 : stamps[i] - stamps[i - 1];
+    if (!end && step >= 0.0 && step <= period + kBreakS) continue;
+    if (!end) report.breaks.push_back({i, step - period});
+    if (i - first >= 2) {
+      const Line line = fit(index, stamps, first, i - 1);
+      for (std::size_t k = first; k < i; ++k) stamps[k] = line.a + line.b * index[k];
+    }
+    first = i;
+  }
+  return stamps;
+}
+
+}  // namespace arbci::bci::xdf

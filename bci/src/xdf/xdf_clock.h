@@ -1,0 +1,30 @@
+// An XDF stream's timestamps on the recorder's clock, as pyxdf puts them: the stream's clock
+// offsets (measured by the recorder every few seconds) fitted by a line per clock segment and
+// added to its stamps, a segment ending where the stream's clock was reset (its offsets jump in
+// both collection time and value); then, for a regular stream, the stamps of each stretch without
+// a break replaced by a straight line through them (LSL stamps chunks, not samples). A break (no
+// samples for over a second) is kept and reported, never closed up.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "xdf_file.h"
+
+namespace arbci::bci::xdf {
+
+struct ClockReport {
+  int resets = 0;  // clock resets found in the offsets
+  // Regular streams: where a break falls (the index of the first sample after it) and how long
+  // it is, in seconds beyond one sample period.
+  struct Break {
+    std::size_t sample = 0;
+    double seconds = 0.0;
+  };
+  std::vector<Break> breaks;
+};
+
+// The stream's stamps on the recorder's clock (dejittered when `regular`).
+std::vector<double> recorderStamps(const Stream& stream, ClockReport& report);
+
+}  // namespace arbci::bci::xdf
