@@ -8,6 +8,7 @@
 
 #include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/lsl/resolver.h"
+#include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/recording.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
@@ -93,6 +94,7 @@ void streamFile(const LslOptions& o) {
   markers.channel_count = 1;
   markers.channel_format = bci::lsl::ChannelFormat::String;
   markers.source_id = eeg.source_id + ":markers";
+  markers.parameters = bci::layoutParameters(r);  // a recorder's XDF keeps the layout
   std::unique_ptr<bci::lsl::Outlet> eeg_outlet, marker_outlet;
   try {
     eeg_outlet = std::make_unique<bci::lsl::Outlet>(eeg, config);

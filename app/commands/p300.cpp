@@ -14,6 +14,7 @@
 #include "arbci/bci/channel_quality.h"
 #include "arbci/bci/classifier.h"
 #include "arbci/bci/errp_feedback.h"
+#include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/session/session_config.h"
 #include "commands/commands.h"
@@ -325,6 +326,19 @@ void evaluate(EvaluateOptions& o) {
     } catch (const bci::ModelError& error) {
       throw CliError(error.what());
     }
+    // A model picks among its layout's choices: scored on another layout's selections, its
+    // accuracy would mean nothing.
+    const bci::ParadigmLayout layout = bci::layoutOf(r);
+    const bool row_column = layout.kind == bci::ParadigmLayout::Kind::RowColumn;
+    const bool differs =
+        layout.kind != model.layout.kind ||
+        (row_column ? layout.rows != model.layout.rows || layout.columns != model.layout.columns
+                    : layout.stimuli > model.layout.stimuli);
+    if (differs)
+      throw CliError(r.source + " is a " + layout.describeShape() +
+                     " recording, but the model was trained on " + model.layout.describeShape() +
+                     " recordings; evaluate it on recordings of its layout (an XDF carries its "
+                     "layout only from ARBCI's marker stream)");
   }
   try {
     bci::P300Dataset data = bci::buildDataset(recordings, model.pipeline, {}, o.reject_uv);

@@ -118,6 +118,16 @@ ParadigmLayout layoutOf(const Recording& r) {
   return ParadigmLayout::single(std::max(highest, 2), soa);
 }
 
+std::vector<std::pair<std::string, std::string>> layoutParameters(const Recording& r) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const char* name : {"Paradigm", "GridCodes", "NumMatrixRows", "NumMatrixColumns",
+                           "TargetDefinitions", "PhotodiodeChannel"}) {
+    if (const auto found = r.parameters.find(name); found != r.parameters.end())
+      out.emplace_back(found->first, found->second);
+  }
+  return out;
+}
+
 P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSettings& settings,
                          const Progress& progress, double reject_uv) {
   if (given.empty()) throw std::invalid_argument("no recordings given");

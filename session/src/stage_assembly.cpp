@@ -148,8 +148,14 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto errp = std::make_unique<ErrpStage>(errp_settings, services);
   std::unique_ptr<LslMarkersStage> markers;
   if (c.lsl.markers) {
+    // The stream's description says what the recording's parameters say (the layout).
+    const std::map<std::string, std::string> parameters = recordingParameters(c);
     markers = std::make_unique<LslMarkersStage>(
-        LslMarkersSettings{c.lsl.marker_stream, eeg_settings.lsl, eeg_info.rate_hz, c.source},
+        LslMarkersSettings{c.lsl.marker_stream,
+                           eeg_settings.lsl,
+                           eeg_info.rate_hz,
+                           c.source,
+                           {parameters.begin(), parameters.end()}},
         services);
   }
   auto presentation = std::make_unique<PresentationStage>(

@@ -43,13 +43,23 @@ void build(const StreamInfo& s, pugi::xml_document& doc, bool full) {
   addText(info, "v6data_port", "0");
   addText(info, "v6service_port", "0");
   pugi::xml_node desc = info.append_child("desc");
-  if (!full || s.channels.empty()) return;
-  pugi::xml_node channels = desc.append_child("channels");
-  for (const auto& c : s.channels) {
-    pugi::xml_node channel = channels.append_child("channel");
-    addText(channel, "label", c.label);
-    if (!c.unit.empty()) addText(channel, "unit", c.unit);
-    if (!c.type.empty()) addText(channel, "type", c.type);
+  if (!full) return;
+  if (!s.channels.empty()) {
+    pugi::xml_node channels = desc.append_child("channels");
+    for (const auto& c : s.channels) {
+      pugi::xml_node channel = channels.append_child("channel");
+      addText(channel, "label", c.label);
+      if (!c.unit.empty()) addText(channel, "unit", c.unit);
+      if (!c.type.empty()) addText(channel, "type", c.type);
+    }
+  }
+  if (!s.parameters.empty()) {
+    pugi::xml_node arbci = desc.append_child("arbci");
+    for (const auto& [name, value] : s.parameters) {
+      pugi::xml_node parameter = arbci.append_child("parameter");
+      parameter.append_attribute("name").set_value(name.c_str());
+      parameter.append_child(pugi::node_pcdata).set_value(value.c_str());
+    }
   }
 }
 
@@ -165,6 +175,8 @@ StreamInfo StreamInfo::fromXml(const std::string& xml) {
   for (pugi::xml_node c = info.child("desc").child("channels").child("channel"); c;
        c = c.next_sibling("channel"))
     s.channels.push_back({c.child_value("label"), c.child_value("unit"), c.child_value("type")});
+  for (pugi::xml_node p : info.child("desc").child("arbci").children("parameter"))
+    s.parameters.emplace_back(p.attribute("name").value(), p.child_value());
   return s;
 }
 

@@ -13,6 +13,7 @@ LslMarkersStage::LslMarkersStage(const LslMarkersSettings& settings, const Stage
   info.channel_count = 1;
   info.channel_format = bci::lsl::ChannelFormat::String;
   info.source_id = "arbci-session-markers:" + settings_.stream;
+  info.parameters = settings_.parameters;
   try {
     outlet_ = std::make_unique<bci::lsl::Outlet>(info, settings_.lsl);
   } catch (const bci::lsl::LslError& e) {

@@ -5,6 +5,8 @@
 
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "arbci/bci/lsl/config.h"
 #include "arbci/bci/lsl/outlet.h"
@@ -17,6 +19,9 @@ struct LslMarkersSettings {
   bci::lsl::LslConfig lsl;   // lsl_api.cfg with the session's scope and peers
   double eeg_rate_hz = 0.0;  // to place a note's sample on the host clock
   std::string session_file;  // for messages naming a key
+  // The recording's parameters that describe the paradigm (bci::layoutParameters), in the
+  // stream's description: a recorder's XDF carries the layout.
+  std::vector<std::pair<std::string, std::string>> parameters;
 };
 
 class LslMarkersStage final : public Stage {

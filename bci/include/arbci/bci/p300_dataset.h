@@ -53,6 +53,10 @@ struct P300Dataset {
 // The layout a recording declares: BCI2000 NumMatrixRows/NumMatrixColumns (with the symbols of
 // TargetDefinitions), ARBCI's "Paradigm" parameter, or single stimuli numbered by the codes.
 ParadigmLayout layoutOf(const Recording& recording);
+// The recording's parameters that layoutOf() reads (and the photodiode's name), to carry the
+// layout where a file format has no parameters of its own (an LSL marker stream's description,
+// hence XDF).
+std::vector<std::pair<std::string, std::string>> layoutParameters(const Recording& recording);
 
 // Filters each recording as the online cycle does, cuts the response windows and computes the
 // features. Throws std::invalid_argument naming the file for recordings without stimuli, with

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace arbci::bci::lsl {
@@ -47,6 +48,9 @@ struct StreamInfo {
   std::string v4address;
   int v4data_port = 0, v4service_port = 0;
   std::vector<ChannelDescription> channels;  // from <desc><channels>; empty when not described
+  // <desc><arbci><parameter name="..">: what ARBCI's marker outlets say of the paradigm (the
+  // stimulus layout), so that a recorder's file (XDF) carries it as a BDF's Param annotations do.
+  std::vector<std::pair<std::string, std::string>> parameters;
 
   // Serialized for the wire. `full` adds <desc> with the channels.
   std::string toXml(bool full) const;
