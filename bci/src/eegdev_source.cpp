@@ -17,6 +17,35 @@ double microvoltsPer(const std::string& unit) {
   return 1.0;  // uV (eegdev's usual unit), or not said
 }
 
+// The labels of a device's channels of sensor type `type`, comma-separated.
+std::string labelsOf(eegdev* device, const char* type) {
+  const int stype = egd_sensor_type(type);
+  const int count = egd_get_numch(device, stype);
+  std::string out;
+  for (int c = 0; c < count; ++c) {
+    char label[64] = "";
+    egd_channel_info(device, stype, static_cast<unsigned>(c), EGD_LABEL, label, EGD_EOL);
+    out += (out.empty() ? "" : ", ") + std::string(label[0] ? label : "(no label)");
+  }
+  return out;
+}
+
+// eegdev decides a channel's type from its label (checked on BDF files played by its datafile
+// device): EEG when the label starts with "EEG", "E" and a number, or a 10-20/10-10 electrode
+// name as usually written (Fz, Cz, Fp1, AF3, T7, TP9, ...); "Status" is the trigger; anything
+// else (Ch1, EXG1, M1, a lower-case "fz") is "undefined" and not EEG.
+std::string whyNoEeg(eegdev* device) {
+  const std::string undefined = labelsOf(device, "undefined");
+  return std::string(
+             " (eegdev takes a channel as EEG only when its label starts with \"EEG\", \"E\" and "
+             "a number, or a 10-20 electrode name as usually written: Fz, Cz, Fp1, AF3, T7, ...)") +
+         (undefined.empty() ? ""
+                            : "; its other channels are labelled " + undefined +
+                                  " (relabel them, or read the "
+                                  "file with eeg.source \"file\", which takes every "
+                                  "channel)");
+}
+
 }  // namespace
 
 void EegdevSource::Closer::operator()(eegdev* device) const {
@@ -52,7 +81,7 @@ EegdevSource::EegdevSource(const EegdevSourceSettings& settings) : settings_(set
         " Hz (eeg.rate_hz); ARBCI does not resample: set eeg.rate_hz to the device's rate");
   const int eeg = egd_sensor_type("eeg");
   const int channels = egd_get_numch(device_.get(), eeg);
-  if (channels <= 0) throw EegdevError(where + ": has no EEG channels");
+  if (channels <= 0) throw EegdevError(where + ": has no EEG channels" + whyNoEeg(device_.get()));
   info_.rate_hz = rate;
   info_.block_size = std::max(1, settings.block_size);
   for (int c = 0; c < channels; ++c) {
@@ -78,14 +107,22 @@ std::vector<Block> EegdevSource::poll(int max_blocks) {
   std::vector<Block> out;
   if (!fault_.empty()) return out;
   const int channels = info_.channelCount();
+  // eegdev reports an error only once every sample before it has been read.
   const ssize_t available = egd_get_available(device_.get());
   if (available < 0) {
     const int error = errno;
-    fault_ = "eegdev device \"" + settings_.device + "\" stopped: " +
-             (error == EAGAIN   ? std::string("connection lost (a cable, or the power)")
-              : error == EIO    ? std::string("synchronisation lost")
-              : error == ENOMEM ? std::string("its buffer overflowed, or the file ended")
-                                : std::string(std::strerror(error)));
+    // The samples short of a whole block are delivered too: nothing read is lost at a fault.
+    const size_t partial = pending_.size() / static_cast<size_t>(channels);
+    if (partial > 0) out.push_back(takeBlock(static_cast<int>(partial)));
+    const bool file = settings_.device.rfind("datafile", 0) == 0;
+    const std::string samples = std::to_string(next_sample_) + " samples";
+    fault_ =
+        "eegdev device \"" + settings_.device + "\" stopped: " +
+        (file && (error == EAGAIN || error == ENOMEM) ? "the file ended (" + samples + " played)"
+         : error == EAGAIN ? "connection lost (a cable, or the power) after " + samples
+         : error == EIO    ? "synchronisation lost after " + samples
+         : error == ENOMEM ? "its buffer overflowed after " + samples
+                           : std::string(std::strerror(error)) + " after " + samples);
     return out;
   }
   const size_t wanted = std::min<size_t>(static_cast<size_t>(available),
@@ -97,19 +134,21 @@ std::vector<Block> EegdevSource::poll(int max_blocks) {
       pending_.insert(pending_.end(), samples.begin(), samples.begin() + read * channels);
   }
   const size_t per_block = static_cast<size_t>(info_.block_size) * channels;
-  size_t used = 0;
-  while (pending_.size() - used >= per_block) {
-    Block block(next_sample_, channels, info_.block_size);
-    for (int s = 0; s < info_.block_size; ++s)
-      for (int c = 0; c < channels; ++c)
-        block.at(c, s) =
-            static_cast<float>(pending_[used + static_cast<size_t>(s) * channels + c] * scale_[c]);
-    used += per_block;
-    next_sample_ += info_.block_size;
-    out.push_back(std::move(block));
-  }
-  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(used));
+  while (pending_.size() >= per_block) out.push_back(takeBlock(info_.block_size));
   return out;
+}
+
+Block EegdevSource::takeBlock(int samples) {
+  const int channels = info_.channelCount();
+  Block block(next_sample_, channels, samples);
+  for (int s = 0; s < samples; ++s)
+    for (int c = 0; c < channels; ++c)
+      block.at(c, s) =
+          static_cast<float>(pending_[static_cast<size_t>(s) * channels + c] * scale_[c]);
+  pending_.erase(pending_.begin(),
+                 pending_.begin() + static_cast<std::ptrdiff_t>(samples) * channels);
+  next_sample_ += samples;
+  return block;
 }
 
 std::string EegdevSource::describe() const {

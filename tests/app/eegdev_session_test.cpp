@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "arbci/bci/eegdev_source.h"
 #include "arbci/bci/recording.h"
@@ -113,6 +115,67 @@ TEST(EegdevSession, TheDatafileDeviceDeliversTheBdfIntoTheRecordingUnchanged) {
   std::printf(
       "[ measured ] %lld samples x %d channels from eegdev datafile; worst difference %.4f uV\n",
       static_cast<long long>(recorded.samples), recorded.info.channelCount(), worst);
+}
+
+// `seconds` of a ramp on `labels` at 256 Hz: sample s of channel c is (c + 1) * 10 + s / 100 uV.
+bci::Recording ramp(const std::vector<std::string>& labels, int seconds) {
+  bci::Recording r;
+  r.info.rate_hz = 256;
+  r.info.channels = labels;
+  r.samples = 256 * seconds;
+  r.data.resize(labels.size() * static_cast<size_t>(r.samples));
+  for (size_t c = 0; c < labels.size(); ++c)
+    for (std::int64_t s = 0; s < r.samples; ++s)
+      r.data[c * r.samples + s] = static_cast<float>((c + 1) * 10 + s / 100.0);
+  return r;
+}
+
+// A file of 512 samples (34 blocks of 15 and 2 more) played to its end: all 512 arrive, the last
+// block short, and the end is named as the end of the file, not as a lost connection.
+TEST(EegdevSource, AFilePlayedToItsEndDeliversEverySampleAndSaysItEnded) {
+  const auto folder = test::freshTempPath("eegdev_source", "end");
+  std::filesystem::create_directories(folder);
+  const auto bdf = folder / "short.bdf";
+  writeBiosemiBdf(ramp({"Fz", "Cz", "Pz"}, 2), bdf);
+  bci::EegdevSourceSettings settings;
+  settings.device = "datafile|path|" + bdf.string();
+  bci::EegdevSource source(settings);
+  std::int64_t next = 0;
+  double worst = 0;
+  for (int i = 0; i < 400 && source.fault().empty(); ++i) {
+    for (const bci::Block& b : source.poll()) {
+      EXPECT_EQ(b.first_sample, next);
+      for (int s = 0; s < b.samples; ++s)
+        worst = std::max(worst, std::abs(b.at(1, s) - (20 + (b.first_sample + s) / 100.0)));
+      next += b.samples;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  }
+  EXPECT_EQ(next, 512);
+  EXPECT_LT(worst, 0.01) << "microvolts";
+  EXPECT_NE(source.fault().find("the file ended (512 samples played)"), std::string::npos)
+      << source.fault();
+  EXPECT_EQ(source.poll().size(), 0u);  // nothing after the end
+}
+
+// A BDF whose labels eegdev does not take as EEG: the refusal says which labels it takes, and
+// names the file's.
+TEST(EegdevSource, AFileWithoutEegLabelsIsRefusedNamingTheRuleAndItsLabels) {
+  const auto folder = test::freshTempPath("eegdev_source", "labels");
+  std::filesystem::create_directories(folder);
+  const auto bdf = folder / "numbered.bdf";
+  writeBiosemiBdf(ramp({"Ch1", "Ch2"}, 1), bdf);
+  bci::EegdevSourceSettings settings;
+  settings.device = "datafile|path|" + bdf.string();
+  try {
+    bci::EegdevSource source(settings);
+    FAIL() << "a file without EEG channels was accepted";
+  } catch (const bci::EegdevError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("has no EEG channels"), std::string::npos) << what;
+    EXPECT_NE(what.find("10-20 electrode name"), std::string::npos) << what;
+    EXPECT_NE(what.find("labelled Ch1, Ch2"), std::string::npos) << what;
+  }
 }
 
 TEST(EegdevSource, AnUnreadableDeviceIsRefusedWithTheReasonAndTheSyntax) {

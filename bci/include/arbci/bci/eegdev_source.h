@@ -5,7 +5,8 @@
 //
 // The device's EEG channels are read in the session's blocks, stamped on arrival like any
 // amplifier's; trigger and other sensor channels are left out. A device error (a cable
-// pulled, a file played to its end) is reported by fault(); nothing is delivered after it.
+// pulled, a file played to its end) is reported by fault(), named as such; the samples read
+// before it are all delivered (the last block may be shorter), nothing after it.
 #pragma once
 
 #include <memory>
@@ -47,6 +48,8 @@ class EegdevSource final : public EegSource {
   std::string describe() const override;
 
  private:
+  // The first `samples` pending samples as one block (the last block at a fault may be short).
+  Block takeBlock(int samples);
   EegdevSourceSettings settings_;
   struct Closer {
     void operator()(eegdev* device) const;
