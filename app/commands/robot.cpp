@@ -12,7 +12,6 @@
 #include "arbci/robot/settings.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
-#include "support/output_path.h"
 
 namespace arbci::app {
 namespace {
@@ -23,6 +22,7 @@ struct RobotOptions {
   double timeout_s = 120.0;
   double retry_budget_s = 15.0;
   std::vector<double> xyz;
+  bool force = false;
 };
 
 void printStatus(const robot::StatusPayload& s) {
@@ -187,12 +187,14 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(0.1, 600.0));
 
   CLI::App* keygen = robot_cmd->add_subcommand(
-      "keygen", "Write a fresh random key (64 hex characters, mode 0600)");
-  keygen->add_option("--out", o->out, "key file to write")->required();
+      "keygen",
+      "Write a fresh random key (64 hex characters and a newline, mode 0600) to a new file;\n"
+      "an existing key is replaced only with --force, anything but a regular file never");
+  keygen->add_option("--out", o->out, "key file to write (a new file)")->required();
+  keygen->add_flag("--force", o->force, "replace an existing key file");
   keygen->callback([o, &exit_code] {
-    ensureWritable(o->out);
     try {
-      robot::saveKey(o->out, robot::generateKey());
+      robot::saveKey(o->out, robot::generateKey(), o->force);
     } catch (const robot::KeyError& error) {
       throw CliError(error.what());
     }

@@ -27,7 +27,9 @@ const std::string kArbci = ARBCI_EXECUTABLE;
 const std::string kRobotd = ARBCI_ROBOTD_EXECUTABLE;
 
 std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "arbci_robot_cli_test";
+  // Per process: keygen never replaces a key, so a folder kept from an earlier run would refuse.
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("arbci_robot_cli_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return dir / name;
 }
@@ -83,6 +85,27 @@ TEST(RobotCommand, KeygenWritesAPrivateKey) {
   std::string hex;
   in >> hex;
   EXPECT_EQ(hex.size(), 64u);
+  // A second keygen to the same file is refused and leaves the key; --force replaces it.
+  const ProcessResult again = runProcess(kArbci, {"robot", "keygen", "--out", key.string()});
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_NE(again.err.find("never replaced silently"), std::string::npos) << again.err;
+  std::ifstream kept(key);
+  std::string still;
+  kept >> still;
+  EXPECT_EQ(still, hex);
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--force", "--out", key.string()}).exit_code, 0);
+  std::ifstream replaced(key);
+  std::string fresh;
+  replaced >> fresh;
+  EXPECT_NE(fresh, hex);
+  // A FIFO is refused at once (it used to block keygen) and is still a FIFO afterwards.
+  const auto fifo = scratch("cli.fifo");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const ProcessResult to_fifo =
+      runProcess(kArbci, {"robot", "keygen", "--force", "--out", fifo.string()}, 60.0);
+  EXPECT_EQ(to_fifo.exit_code, 1);
+  EXPECT_NE(to_fifo.err.find("not a regular file"), std::string::npos) << to_fifo.err;
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
 }
 
 TEST(RobotCommand, GraspDropAndRejectionsThroughTheBackend) {

@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "arbci/robot/key_file.h"
 #include "arbci/robot/protocol.h"
@@ -158,7 +162,9 @@ TEST(Protocol, TamperingOtherKeysVersionsAndCutsAreCaught) {
 }
 
 TEST(KeyFile, WrittenPrivateAndCheckedOnLoad) {
-  const auto path = std::filesystem::temp_directory_path() / "arbci_test.key";
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("arbci_test_" + std::to_string(::getpid()) + ".key");
+  std::filesystem::remove(path);
   const Key key = generateKey();
   saveKey(path, key);
   struct stat info {};
@@ -216,6 +222,102 @@ TEST(KeyFile, RefusesWeakKeysTrailingTextFifosAndDevices) {
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_NE(refusal(fifo).find("not a regular file"), std::string::npos);
   EXPECT_NE(refusal("/dev/null").find("not a regular file"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// What the last round's review found accepted: each is refused now, with its reason.
+TEST(KeyFile, RefusesLineEndingsOtherThanOneLfAndGuessableKeys) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("arbci_key_strict_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto refusal = [&](const std::string& name, const std::string& text) -> std::string {
+    const auto path = dir / name;
+    std::ofstream(path) << text;
+    chmod(path.c_str(), 0600);
+    try {
+      loadKey(path);
+    } catch (const KeyError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  auto hexOf = [](const std::vector<int>& bytes) {
+    std::string text;
+    char two[3];
+    for (int b : bytes) {
+      std::snprintf(two, sizeof two, "%02x", b & 0xff);
+      text += two;
+    }
+    return text;
+  };
+  const std::string good = "3f9a1c77e20b5d4468f1a0c93e7b2d5106a8e4f19c3b7d20e5a6f8014c9d2b73";
+  EXPECT_EQ(refusal("good.key", good + "\n"), "");
+  EXPECT_NE(refusal("crlf.key", good + "\r\n").find("one newline"), std::string::npos);
+  EXPECT_NE(refusal("lflf.key", good + "\n\n").find("one newline"), std::string::npos);
+  EXPECT_NE(refusal("none.key", good).find("one newline"), std::string::npos);
+  EXPECT_NE(refusal("garbage.key", good + "\n# my key").find("one newline"), std::string::npos);
+  std::vector<int> counting, passphrase, twelve;
+  const std::string phrase = "Tr0ub4dor&3-Zx!qWmK9#pL@vN$yB^hJ";  // 32 distinct characters
+  for (int i = 0; i < 32; ++i) {
+    counting.push_back(i);
+    passphrase.push_back(phrase[i]);
+    twelve.push_back((i % 12) * 17 + 3);
+  }
+  EXPECT_NE(refusal("count.key", hexOf(counting) + "\n").find("constant step"), std::string::npos);
+  EXPECT_NE(refusal("phrase.key", hexOf(passphrase) + "\n").find("printable"), std::string::npos);
+  EXPECT_NE(refusal("twelve.key", hexOf(twelve) + "\n").find("distinct bytes"), std::string::npos);
+  // What keygen makes always loads.
+  for (int i = 0; i < 200; ++i) {
+    const auto path = dir / ("made" + std::to_string(i) + ".key");
+    const Key key = generateKey();
+    saveKey(path, key);
+    EXPECT_EQ(loadKey(path), key);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// keygen writes only a new regular file: a FIFO (which would block the writer), a device node, a
+// link or an existing key are refused and left as they were; --force replaces only a key file.
+TEST(KeyFile, SavedOnlyToANewRegularFileOrOverAKeyWhenAskedTo) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("arbci_key_save_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto refusal = [](const std::filesystem::path& path, bool replace) -> std::string {
+    try {
+      saveKey(path, generateKey(), replace);
+    } catch (const KeyError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  const auto fifo = dir / "fifo";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(refusal(fifo, true).find("not a regular file"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_NE(refusal("/dev/null", true).find("not a regular file"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
+  const auto target = dir / "notes.txt", link = dir / "link.key";
+  std::ofstream(target) << "not a key\n";
+  std::filesystem::create_symlink(target, link);
+  EXPECT_NE(refusal(link, true).find("not a regular file"), std::string::npos);
+  EXPECT_EQ(std::filesystem::file_size(target), 10u);
+  EXPECT_NE(refusal(dir, true).find("not a regular file"), std::string::npos);
+
+  const auto key_file = dir / "robot.key";
+  const Key first = generateKey();
+  saveKey(key_file, first);
+  EXPECT_NE(refusal(key_file, false).find("--force"), std::string::npos);
+  EXPECT_EQ(loadKey(key_file), first);  // untouched
+  const Key second = generateKey();
+  saveKey(key_file, second, true);
+  EXPECT_EQ(loadKey(key_file), second);
+  struct stat info {};
+  ASSERT_EQ(stat(key_file.c_str(), &info), 0);
+  EXPECT_EQ(info.st_mode & 0777, 0600u);
+  // Nothing else left behind in the folder (no half-written temporary).
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 4);  // fifo, notes.txt, link.key, robot.key
   std::filesystem::remove_all(dir);
 }
 

@@ -13,10 +13,15 @@ class KeyError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-Key generateKey();  // from OpenSSL's CSPRNG; throws KeyError if it fails
-// Writes the key with mode 0600 (replacing any file). Throws KeyError naming the file.
-void saveKey(const std::filesystem::path& path, const Key& key);
-// Throws KeyError naming the file: missing, readable by others, or not 64 hex characters.
+// From OpenSSL's CSPRNG, one that loadKey() accepts; throws KeyError if the generator fails.
+Key generateKey();
+// Writes the key with mode 0600 to a new regular file. An existing regular file is replaced only
+// with `replace` (atomically, by rename); anything else there (a FIFO, a device, a link, a
+// folder) is refused and left alone. Throws KeyError naming the file.
+void saveKey(const std::filesystem::path& path, const Key& key, bool replace = false);
+// Throws KeyError naming the file: missing, not a regular file, readable by others, not exactly
+// 64 hex characters and one newline, or a key that could be guessed (fewer than 24 distinct
+// bytes, all printable characters, a constant step).
 Key loadKey(const std::filesystem::path& path);
 
 }  // namespace arbci::robot
