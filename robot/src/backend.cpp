@@ -76,14 +76,20 @@ struct RobotBackend::Impl {
     ++(stats.*field);
   }
 
+  // What the datagrams did wrong: at most one line per kind a second, so that a flood does not
+  // become a flood of log lines.
   void log(const std::string& kind, const std::string& line) {
     if (!options.log) return;
-    // At most one line per kind a second: a flood must not become a flood of log lines.
     const auto now = SteadyClock::now();
     auto& last = last_log[kind];
     if (now - last < std::chrono::seconds(1)) return;
     last = now;
-    *options.log << "arbci-robotd: " << line << std::endl;
+    note(line);
+  }
+
+  // What the arm did (a halt, a stop, a reset): every one, once, whatever came just before.
+  void note(const std::string& line) {
+    if (options.log) *options.log << "arbci-robotd: " << line << std::endl;
   }
 
   void send(const Message& m, const Endpoint& to) {
@@ -151,10 +157,18 @@ struct RobotBackend::Impl {
 
   // Halts the arm at once; motion commands are refused until a RESET.
   void latchStop(const std::string& reason, const std::string& outcome_text) {
+    const bool halted = running.has_value();
+    const std::string what = halted ? toString(running->type) + std::string(" halted") : "";
     driver->stop();
     finish(Outcome::Stopped, outcome_text);
-    if (stop_reason.empty()) stop_reason = reason;
-    log("stop", "stopped: " + reason + " (motion commands refused until RESET)");
+    const bool latched = stop_reason.empty();
+    if (latched) stop_reason = reason;
+    if (halted || latched) {
+      note("stopped: " + reason + (halted ? " (" + what + ")" : "") +
+           "; motion commands refused until RESET");
+    } else {
+      log("stop again", "stopped again: " + reason + " (already stopped: " + stop_reason + ")");
+    }
   }
 
   void handle(const Datagram& d) {
@@ -292,7 +306,7 @@ struct RobotBackend::Impl {
         return;
       }
       case MessageType::Reset:
-        if (!stop_reason.empty()) log("reset", "RESET: the stop (" + stop_reason + ") is lifted");
+        if (!stop_reason.empty()) note("RESET: the stop (" + stop_reason + ") is lifted");
         stop_reason.clear();
         accept(m, s);
         return;

@@ -11,6 +11,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
 #include "support/halt_recording_arm.h"
 #include "support/robot_test_support.h"
@@ -291,6 +292,42 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
   next = waitFor(client, client.send(MessageType::Home), 15s);
   EXPECT_EQ(finalEvent(next).kind, RobotEvent::Kind::Finished);
   EXPECT_EQ(finalEvent(next).outcome, Outcome::Success);
+}
+
+// A STOP, a RESET and a watchdog halt in quick succession: each is in the backend's log once,
+// with its cause (a halt right after a STOP's line was once dropped by the log's flood limit).
+TEST(RobotLink, EveryStopResetAndHaltIsLoggedOnceWithItsCause) {
+  std::ostringstream log;
+  BackendOptions options;
+  options.status_interval_s = 0.05;
+  options.speed_factor = 1.0;
+  options.log = &log;
+  auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
+  RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
+                         options);
+  test::UdpRelay relay(backend.port(), testKey());
+  RobotClient client(local(relay.port()), testKey(), fastClient());
+  ASSERT_EQ(finalEvent(waitFor(client, client.send(MessageType::Stop), 3s)).kind,
+            RobotEvent::Kind::Finished);
+  ASSERT_EQ(finalEvent(waitFor(client, client.send(MessageType::Reset), 3s)).kind,
+            RobotEvent::Kind::Finished);
+  const std::uint64_t grasp = client.send(MessageType::Grasp, kObject1);
+  ASSERT_TRUE(waitUntilAccepted(client, grasp));
+  halted_at->store(0);  // the STOP's halt is behind us
+  relay.setCut(true);   // the client's heartbeats stop arriving: the watchdog halts the grasp
+  const Clock::time_point give_up = Clock::now() + 10s;
+  while (*halted_at == 0 && Clock::now() < give_up) std::this_thread::sleep_for(1ms);
+  ASSERT_NE(*halted_at, 0) << "the arm was not halted";
+  backend.halt();  // its thread has written all it will
+  const std::string text = log.str();
+  auto count = [&](const std::string& line) {
+    int n = 0;
+    for (size_t at = text.find(line); at != std::string::npos; at = text.find(line, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("stopped: emergency stop"), 1) << text;
+  EXPECT_EQ(count("RESET: the stop (emergency stop) is lifted"), 1) << text;
+  EXPECT_EQ(count("stopped: halted: link lost (GRASP halted)"), 1) << text;
 }
 
 TEST(RobotLink, ACommandTheClientGaveUpOnNeverStartsLater) {

@@ -34,7 +34,9 @@ struct BackendOptions {
   double watchdog_s = LinkSettings().watchdog_ms / 1000.0;
   // Asked of the kernel for the socket; it grants at most net.core.rmem_max (times 2).
   int receive_buffer_bytes = 4 << 20;
-  std::ostream* log = nullptr;  // rejected and ignored datagrams (rate-limited)
+  // Rejected and ignored datagrams (at most a line per kind a second), and every halt, stop
+  // and reset (each once).
+  std::ostream* log = nullptr;
 };
 
 struct BackendStats {
