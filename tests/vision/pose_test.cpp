@@ -134,6 +134,50 @@ TEST(PoseAccuracy, PositionWithinHalfAPercentAtAnyTiltForEveryMethod) {
   }
 }
 
+// libapriltag's own canonical image of a tag (apriltag_to_image, as the tags are printed), upright
+// in a white frame: the first corner reported is the printed top-left, then clockwise.
+TEST(AprilTagCorners, TheCanonicalImageIsReadTopLeftFirstClockwise) {
+  const int cell = 20;
+  const cv::Mat tag = test::markerImage(test::MarkerFamily::AprilTag36h11, 0, cell);
+  cv::Mat frame(tag.rows + 200, tag.cols + 200, CV_8UC1, cv::Scalar(255));
+  tag.copyTo(frame(cv::Rect(100, 100, tag.cols, tag.rows)));
+  DetectorConfig config;
+  config.kind = MarkerKind::AprilTag;
+  const auto markers = MarkerDetector(config).detect(frame).markers;
+  ASSERT_EQ(markers.size(), 1u);
+  EXPECT_EQ(markers[0].id, 0);
+  // The black square spans cells 1..9 of the 10 (libapriltag's white ring is cell 0), in pixel
+  // areas; OpenCV pixel centres sit 0.5 inside.
+  const float lo = 100 + cell - 0.5f, hi = 100 + 9 * cell - 0.5f;
+  const cv::Point2f printed[4] = {{lo, lo}, {hi, lo}, {hi, hi}, {lo, hi}};
+  for (int k = 0; k < 4; ++k)
+    EXPECT_LT(cv::norm(markers[0].corners[k] - printed[k]), 1.0)
+        << "corner " << k << " at " << markers[0].corners[k];
+}
+
+// A tilted tag36h11 at a known pose: its pose from the reported corners is the true one (a tag
+// whose corners came rotated would be 180 degrees off about its normal).
+TEST(AprilTagCorners, APoseFromTheCornersIsTheTruePose) {
+  const CameraModel camera = hmdCamera();
+  std::mt19937 random(11);
+  for (int trial = 0; trial < 8; ++trial) {
+    const Pose truth = randomPose(random, 10.0, 50.0);
+    cv::Mat frame(camera.image_size, CV_8UC1, cv::Scalar(190));
+    const test::Corners drawn = test::drawPosedMarker(frame, camera.camera_matrix, truth, 0.05,
+                                                      test::MarkerFamily::AprilTag36h11, 42);
+    DetectorConfig config;
+    config.kind = MarkerKind::AprilTag;
+    const auto markers = MarkerDetector(config).detect(frame).markers;
+    ASSERT_EQ(markers.size(), 1u) << "at " << truth.translation;
+    for (int k = 0; k < 4; ++k) EXPECT_LT(cv::norm(markers[0].corners[k] - drawn[k]), 1.0);
+    const PoseEstimate estimate = estimatePose(kMarker5cm, ideal(markers[0]), camera.camera_matrix);
+    EXPECT_LT(rotationAngleDeg(estimate.pose.rotation, truth.rotation), 2.0)
+        << "at " << truth.translation;
+    EXPECT_LT(cv::norm(estimate.pose.translation - truth.translation),
+              0.01 * cv::norm(truth.translation));
+  }
+}
+
 TEST(PoseAmbiguity, NoFlipWhileAMarkerSweepsThroughFaceOn) {
   const CameraModel camera = hmdCamera();
   MarkerDetector detector(DetectorConfig{});

@@ -62,7 +62,8 @@ struct AprilTagDetector::Impl {
   }
 };
 
-AprilTagDetector::AprilTagDetector(const std::string& family) : impl_(std::make_unique<Impl>()) {
+AprilTagDetector::AprilTagDetector(const std::string& family, bool refine_edges)
+    : impl_(std::make_unique<Impl>()) {
   impl_->family = &familyNamed(family);
   impl_->tags = impl_->family->create();
   impl_->detector = apriltag_detector_create();
@@ -71,8 +72,7 @@ AprilTagDetector::AprilTagDetector(const std::string& family) : impl_(std::make_
   apriltag_detector_add_family(impl_->detector, impl_->tags);
   impl_->detector->quad_decimate = 1.0f;
   impl_->detector->nthreads = 1;
-  // Edges as the library's regression reference (refined, one of its 47 tags was lost).
-  impl_->detector->refine_edges = 0;
+  impl_->detector->refine_edges = refine_edges;
 }
 
 AprilTagDetector::~AprilTagDetector() = default;
@@ -88,10 +88,13 @@ std::vector<MarkerDetection> AprilTagDetector::detect(const cv::Mat& gray) {
     MarkerDetection m;
     m.id = d->id;
     m.kind = MarkerKind::AprilTag;
-    // libapriltag's corners wrap counter-clockwise with p[1] at the printed tag's top-left (as
-    // OpenCV's aruco module reads the same tag), and its pixel centres sit at +0.5 of OpenCV's.
+    // libapriltag's corners are the tag frame's (-1,1), (1,1), (1,-1), (-1,-1): on the tag as
+    // printed (its own canonical image, apriltag_to_image) p[3] is the top-left, and the four
+    // wrap counter-clockwise; ours start top-left and go clockwise. (OpenCV's DICT_APRILTAG_*
+    // reads the printed tag rotated 180 degrees: its first corner is the printed bottom-right.)
+    // Its pixel centres sit at +0.5 of OpenCV's.
     for (int k = 0; k < 4; ++k) {
-      const double* p = d->p[(5 - k) % 4];
+      const double* p = d->p[3 - k];
       m.corners[k] = cv::Point2f(static_cast<float>(p[0] - 0.5), static_cast<float>(p[1] - 0.5));
     }
     m.ideal_corners = m.corners;

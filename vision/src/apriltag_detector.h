@@ -18,14 +18,15 @@ std::string aprilTagFamilies();
 class AprilTagDetector {
  public:
   // `family`: a libapriltag family name, or OpenCV's DICT_APRILTAG_16h5/25h9/36h10/36h11 for
-  // the same families; empty: tag36h11. Throws std::invalid_argument naming the accepted ones.
-  explicit AprilTagDetector(const std::string& family);
+  // the same families; empty: tag36h11. `refine_edges`: libapriltag's edge refinement (its
+  // default). Throws std::invalid_argument naming the accepted ones.
+  AprilTagDetector(const std::string& family, bool refine_edges);
   ~AprilTagDetector();
   AprilTagDetector(const AprilTagDetector&) = delete;
   AprilTagDetector& operator=(const AprilTagDetector&) = delete;
 
-  // Full-resolution quads (no decimation: small tags count), one thread, edges not refined.
-  // Corners as every detection here: top-left, top-right, bottom-right, bottom-left, OpenCV
+  // Full-resolution quads (no decimation: small tags count), one thread. Corners as every
+  // detection here: the printed tag's top-left, top-right, bottom-right, bottom-left, OpenCV
   // pixels.
   std::vector<MarkerDetection> detect(const cv::Mat& gray);
 

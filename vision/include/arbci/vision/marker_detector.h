@@ -53,6 +53,9 @@ struct DetectorConfig {
   // MarkerKind::AprilTag: a libapriltag family (tag36h11, tagStandard41h12, ...; OpenCV's
   // DICT_APRILTAG_* names the same families; empty: tag36h11), found by libapriltag itself.
   std::string dictionary;
+  // MarkerKind::AprilTag: libapriltag's edge refinement (its default, on), which moves each side
+  // onto the strongest gradient; off gives the corners of the library's regression references.
+  bool apriltag_refine_edges;
 };
 
 using SquareCorners = std::array<cv::Point2f, 4>;
