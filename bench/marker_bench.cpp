@@ -43,18 +43,6 @@ struct Cell {
   int missed = 0, missed_with_square = 0, missed_readable = 0;
 };
 
-void addStages(vision::StageTimes& sum, const vision::StageTimes& t) {
-  sum.convert += t.convert;
-  sum.smooth += t.smooth;
-  sum.threshold += t.threshold;
-  sum.label += t.label;
-  sum.quads += t.quads;
-  sum.retry += t.retry;
-  sum.refine += t.refine;
-  sum.decode += t.decode;
-  sum.total += t.total;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -181,7 +169,7 @@ int main(int argc, char** argv) {
             }
           }
           cell.seconds += seconds;
-          if (const auto stages = detectors[d]->lastStageTimes()) addStages(cell.stages, *stages);
+          if (const auto stages = detectors[d]->lastStageTimes()) cell.stages += *stages;
           ++cell.frames;
           cell.marker_free_false_positives +=
               static_cast<int>(detectors[d]->detect(marker_free).size());
@@ -213,8 +201,7 @@ int main(int argc, char** argv) {
         const Cell& cell = cells[{static_cast<int>(d), static_cast<int>(c)}];
         const vision::StageTimes& t = cell.stages;
         const double n = cell.frames;
-        const double other =
-            t.total - t.smooth - t.threshold - t.label - t.quads - t.retry - t.refine - t.decode;
+        const double other = t.other + t.convert;
         std::printf("%-13s %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f %7.0f\n",
                     test::toString(conditions[c]).c_str(), t.smooth / n, t.threshold / n,
                     t.label / n, t.quads / n, t.retry / n, t.refine / n, t.decode / n, other / n,

@@ -164,11 +164,6 @@ void annotate(const std::filesystem::path& folder, const vision::Frame& frame,
   writePng(folder / (stem.empty() ? frame.name : stem + ".png"), canvas);
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0.0 : values[values.size() / 2];
-}
-
 Geometry makeGeometry(const DetectOptions& options, cv::Size frame_size) {
   Geometry geometry;
   try {
@@ -252,17 +247,8 @@ int runDetect(const DetectOptions& options) {
       result = detector.detect(frame->image);
       times.push_back(result.timing);
     }
-    if (options.repeat > 1) {
-      auto stage = [&](double vision::StageTimes::*field) {
-        std::vector<double> v;
-        for (const auto& t : times) v.push_back(t.*field);
-        return median(v);
-      };
-      using S = vision::StageTimes;
-      result.timing = {stage(&S::convert), stage(&S::smooth), stage(&S::threshold),
-                       stage(&S::label),   stage(&S::quads),  stage(&S::decode),
-                       stage(&S::total)};
-    }
+    // The run with the median total, whole: its stages add up to its total.
+    result.timing = vision::medianRun(times);
     std::vector<vision::MarkerDetection> markers = result.markers;
     if (options.track || options.smooth)
       markers = tracker.update(markers, detector.lastSquares(), index / 30.0,
@@ -354,8 +340,9 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   command
-      ->add_option("--repeat", options->repeat,
-                   "Detect each frame N times, report median stage times")
+      ->add_option(
+          "--repeat", options->repeat,
+          "Detect each frame N times; report the stage times of the run with the median total")
       ->check(CLI::Range(1, 100000));
   command
       ->add_option(

@@ -26,9 +26,9 @@ nlohmann::json markerJson(const vision::MarkerDetection& marker) {
 
 nlohmann::json stageTimesJson(const vision::StageTimes& t) {
   auto us = [](double value) { return rounded(value, 10); };
-  return {{"total", us(t.total)},         {"convert", us(t.convert)}, {"smooth", us(t.smooth)},
-          {"threshold", us(t.threshold)}, {"label", us(t.label)},     {"quads", us(t.quads)},
-          {"retry", us(t.retry)},         {"refine", us(t.refine)},   {"decode", us(t.decode)}};
+  nlohmann::json out = {{"total", us(t.total)}};
+  for (const auto& [name, part] : vision::kStageParts) out[name] = us(t.*part);
+  return out;
 }
 
 }  // namespace arbci::app

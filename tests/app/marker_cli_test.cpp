@@ -53,9 +53,16 @@ TEST(DetectCommand, PrintsOneJsonObjectPerFrameWithMarkersAndStageTimes) {
     EXPECT_EQ(marker["kind"], "simple");
     ASSERT_EQ(marker["corners"].size(), 4u);
     EXPECT_GT(marker["confidence"].get<double>(), 0.9);
-    for (const char* stage : {"total", "convert", "threshold", "label", "quads", "decode"}) {
-      EXPECT_TRUE(frame["timing_us"].contains(stage)) << stage;
+    // Every stage, and (--repeat reports one whole run, the median's) they add up to the total.
+    double parts = 0.0;
+    for (const char* stage : {"convert", "smooth", "threshold", "label", "quads", "retry", "refine",
+                              "decode", "other"}) {
+      ASSERT_TRUE(frame["timing_us"].contains(stage)) << stage;
+      parts += frame["timing_us"][stage].get<double>();
     }
+    const double total = frame["timing_us"]["total"].get<double>();
+    EXPECT_GT(total, 0.0);
+    EXPECT_NEAR(parts, total, 1.0) << frame["timing_us"].dump();  // each rounded to 0.1 us
   }
   // nr031's printed top-left corner comes first.
   EXPECT_NEAR(lines[0]["markers"][0]["corners"][0][0].get<double>(), 215.9, 1.0);

@@ -64,6 +64,38 @@ TEST(ThresholdModes, ConstantUsesAndReportsItsValue) {
   EXPECT_TRUE(too_low.markers.empty());
 }
 
+// The stage times of a frame add up to its total (what no stage timed is "other"); of repeated
+// timings, medianRun() keeps one whole run, the one with the median total.
+TEST(StageTimes, PartsAddUpToTheTotalAndTheMedianRunIsWhole) {
+  DetectorConfig config;
+  config.threshold.mode = ThresholdMode::Adaptive;
+  MarkerDetector detector(config);
+  std::vector<StageTimes> runs;
+  for (int i = 0; i < 5; ++i) {
+    const StageTimes t = detector.detect(card(0.6f)).timing;
+    double parts = 0.0;
+    for (const auto& [name, part] : kStageParts) {
+      EXPECT_GE(t.*part, 0.0) << name;
+      parts += t.*part;
+    }
+    EXPECT_GT(t.total, 0.0);
+    EXPECT_NEAR(parts, t.total, 1e-6 * t.total);
+    runs.push_back(t);
+  }
+  const StageTimes median = medianRun(runs);
+  int below = 0, above = 0;
+  bool one_of_them = false;
+  for (const StageTimes& t : runs) {
+    below += t.total < median.total;
+    above += t.total > median.total;
+    one_of_them |= t.total == median.total && t.label == median.label && t.quads == median.quads;
+  }
+  EXPECT_TRUE(one_of_them);
+  EXPECT_LE(below, 2);
+  EXPECT_LE(above, 2);
+  EXPECT_EQ(medianRun({}).total, 0.0);
+}
+
 TEST(ThresholdModes, VignettingCompensationRecoversTheDarkCorner) {
   const cv::Mat frame = card(0.25f);  // the corner marker's paper is ~60 grey levels
   DetectorConfig config;

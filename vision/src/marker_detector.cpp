@@ -991,6 +991,11 @@ struct MarkerDetector::Impl {
       result = detectSquares(time);
     }
     time.total = microseconds(start, Clock::now());
+    // What no stage timed (bookkeeping between them), so that the parts add up to the total.
+    double timed = 0.0;
+    for (const auto& entry : kStageParts) timed += time.*entry.second;
+    time.other = std::max(0.0, time.total - timed);
+    time.total = timed + time.other;
     result.timing = time;
     return result;
   }

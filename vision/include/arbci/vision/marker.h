@@ -3,6 +3,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core/types.hpp>
@@ -33,13 +34,31 @@ struct MarkerDetection {
   bool from_history = false;
 };
 
-// Microseconds spent in each stage of one frame.
-// Microseconds per stage: quads is the quad search on the image searched, retry the re-binarised
-// near misses and fragments, refine the decimated search's quads moved onto the frame's edges.
+// Microseconds spent in each stage of one frame: quads is the quad search on the image searched,
+// retry the re-binarised near misses and fragments, refine the decimated search's quads moved
+// onto the frame's edges, other the work between the timed stages. The parts add up to total.
 struct StageTimes {
   double convert = 0, smooth = 0, threshold = 0, label = 0, quads = 0, retry = 0, refine = 0,
-         decode = 0, total = 0;
+         decode = 0, other = 0, total = 0;
+  StageTimes& operator+=(const StageTimes& more);
 };
+
+// Every part of StageTimes with its name, in pipeline order (total is not a part).
+inline constexpr std::array<std::pair<const char*, double StageTimes::*>, 9> kStageParts{{
+    {"convert", &StageTimes::convert},
+    {"smooth", &StageTimes::smooth},
+    {"threshold", &StageTimes::threshold},
+    {"label", &StageTimes::label},
+    {"quads", &StageTimes::quads},
+    {"retry", &StageTimes::retry},
+    {"refine", &StageTimes::refine},
+    {"decode", &StageTimes::decode},
+    {"other", &StageTimes::other},
+}};
+
+// Of several timings of the same frame, the one whose total is the median: a whole run, so its
+// parts still add up to its total (the medians of each part would not). Empty: all zero.
+StageTimes medianRun(std::vector<StageTimes> runs);
 
 struct DetectionResult {
   std::vector<MarkerDetection> markers;
