@@ -399,6 +399,29 @@ TEST(TrainAndEvaluate, FlashesWithUnknownTargetsAreLeftOutAndCounted) {
       << r.out;
 }
 
+// A model scores its own layout's choices: evaluated on a recording of another layout (as an XDF
+// without ARBCI's marker description reads), it is refused with both layouts named.
+TEST(TrainAndEvaluate, ARecordingOfAnotherLayoutThanTheModelsIsRefusedNamingBoth) {
+  const auto grid = scratch("grid_3x3.bdf"), single = scratch("single_4.bdf");
+  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "90", "--rows", "3", "--columns",
+                                "3", "--out", grid.string()})
+                .exit_code,
+            0);
+  ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "30", "--seed", "2", "--out",
+                                single.string()})
+                .exit_code,
+            0);
+  const auto model = scratch("grid_3x3.json");
+  ASSERT_EQ(runProcess(kArbci, {"train", grid.string(), "--out", model.string()}).exit_code, 0);
+  const ProcessResult r =
+      runProcess(kArbci, {"evaluate", single.string(), "--model", model.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("is a single stimulus, 4 stimuli recording, but the model was trained on "
+                       "row/column 3x3 recordings"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
   ASSERT_EQ(
