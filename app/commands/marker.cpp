@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -23,7 +24,7 @@ namespace {
 struct MakeOptions {
   std::string kind = "bch";
   std::string ids;
-  double border = 0.125;
+  double border = 0.0;  // 0: the kind's own (bch 0.125, simple 0.25)
   double size_mm = 80.0;
   int dpi = 300;
   bool sheet = false;
@@ -41,6 +42,8 @@ void makeMarkers(const MakeOptions& options) {
   const auto& family = vision::markerFamilies().at(options.kind);
   if (!family.make.printable) throw CliError("--kind " + options.kind + " is not printable here");
   const vision::MarkerKind kind = family.make.kind;
+  // The kind's own border unless given: what detect --kind expects of it.
+  const double border = options.border > 0.0 ? options.border : family.make.border;
   const int max_id =
       kind == vision::MarkerKind::Bch ? vision::BchCode::kMaxId : vision::SimpleIdCode::kMaxId;
   const std::vector<int> ids = parseIdList(options.ids, max_id);
@@ -70,14 +73,14 @@ void makeMarkers(const MakeOptions& options) {
   };
   try {
     if (options.sheet) {
-      write(base, vision::renderSheetImage(kind, ids, options.border, layout),
-            vision::renderSheetSvg(kind, ids, options.border, layout));
+      write(base, vision::renderSheetImage(kind, ids, border, layout),
+            vision::renderSheetSvg(kind, ids, border, layout));
     } else {
       for (int id : ids) {
         std::filesystem::path stem = base;
         if (ids.size() > 1) stem += "-" + std::to_string(id);
-        write(stem, vision::renderMarkerImage(kind, id, options.border, layout),
-              vision::renderMarkerSvg(kind, id, options.border, layout));
+        write(stem, vision::renderMarkerImage(kind, id, border, layout),
+              vision::renderMarkerSvg(kind, id, border, layout));
       }
     }
   } catch (const std::invalid_argument& error) {
@@ -88,7 +91,7 @@ void makeMarkers(const MakeOptions& options) {
 struct TrainOptions {
   std::string image;
   int id = 0;
-  double border = 0.25;
+  double border = 0.0;  // 0: the square's border as printed, 0.25 or 0.125 (marker make's)
   std::string out;
 };
 
@@ -97,9 +100,28 @@ void trainPattern(const TrainOptions& options) {
   const cv::Mat image = cv::imread(options.image, cv::IMREAD_GRAYSCALE);
   if (image.empty()) throw CliError("cannot read image " + options.image);
   ensureWritable(options.out);
-  const auto pattern = vision::trainTemplate(image, options.id, options.border);
-  if (!pattern) throw CliError("no black-bordered square found in " + options.image);
+  // Not given: the standard borders in turn, the wide one (ARToolKit's patterns) first, then
+  // marker make's thin BCH border, so a marker made with marker make's defaults trains as it is.
+  const std::vector<double> borders =
+      options.border > 0.0 ? std::vector<double>{options.border} : std::vector<double>{0.25, 0.125};
+  std::optional<vision::TemplatePattern> pattern;
+  double used = 0.0;
+  for (double border : borders) {
+    if ((pattern = vision::trainTemplate(image, options.id, border))) {
+      used = border;
+      break;
+    }
+  }
+  if (!pattern) {
+    throw CliError("no black-bordered square found in " + options.image + " (border " +
+                   (borders.size() == 1 ? std::to_string(borders[0]) : "0.25 or 0.125") +
+                   " of the side; --border for another)");
+  }
   pattern->save(options.out);
+  if (options.border <= 0.0) {
+    std::cerr << "trained with a border of " << used << " of the side (detect --kind template"
+              << " --border " << used << ")\n";
+  }
   if (pattern->rotationalSymmetry() > 0.9f) {
     std::cerr << "arbci: warning: the pattern looks alike when turned; its orientation will be "
                  "ambiguous\n";
@@ -124,9 +146,11 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
       ->capture_default_str();
   make_command->add_option("--id", make->ids, "Marker id, list or range: 7, 1,4,9 or 0-11")
       ->required();
-  make_command->add_option("--border", make->border, "Border width as a fraction of the side")
-      ->check(CLI::IsMember({0.125, 0.25}))
-      ->capture_default_str();
+  make_command
+      ->add_option("--border", make->border,
+                   "Border width as a fraction of the side (default: the kind's, bch 0.125, "
+                   "simple 0.25, as detect --kind expects)")
+      ->check(CLI::IsMember({0.125, 0.25}));
   make_command->add_option("--size-mm", make->size_mm, "Side of the black square in millimetres")
       ->check(CLI::Range(1.0, 1000.0))
       ->capture_default_str();
@@ -147,9 +171,11 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
   train_command->add_option("--image", train->image, "Image of the marker, seen face-on")
       ->required();
   train_command->add_option("--id", train->id, "Id to give the pattern")->capture_default_str();
-  train_command->add_option("--border", train->border, "Border width as a fraction of the side")
-      ->check(CLI::Range(0.05, 0.4))
-      ->capture_default_str();
+  train_command
+      ->add_option("--border", train->border,
+                   "Border width as a fraction of the side (default: 0.25, else 0.125, marker "
+                   "make's for bch; the one used is printed)")
+      ->check(CLI::Range(0.05, 0.4));
   train_command->add_option("--out", train->out, "Pattern file to write")->required();
   train_command->callback([train, &exit_code] {
     trainPattern(*train);

@@ -119,6 +119,39 @@ TEST(MarkerCommand, WritesPrintScaleMarkersThatDetectAsTheirIds) {
   EXPECT_EQ(markers[0]["id"], 42);
 }
 
+// marker make's defaults, then marker train's: the pattern trains (at the border the marker was
+// printed with, which it says) and finds the marker again as a template; a simple marker is
+// printed with the border detect --kind simple expects.
+TEST(MarkerCommand, APatternTrainsFromAMarkerMadeWithTheDefaults) {
+  const auto base = scratch("made_default");
+  ASSERT_EQ(runProcess(kArbci, {"marker", "make", "--id", "9", "--out", base.string()}).exit_code,
+            0);
+  const auto pattern = scratch("made_default.patt");
+  const ProcessResult train = runProcess(
+      kArbci, {"marker", "train", "--image", base.string() + ".png", "--out", pattern.string()});
+  ASSERT_EQ(train.exit_code, 0) << train.err;
+  EXPECT_NE(train.err.find("--border 0.125"), std::string::npos) << train.err;
+  const ProcessResult found =
+      runProcess(kArbci, {"detect", "--kind", "template", "--border", "0.125",
+                          base.string() + ".png", "--pattern", "9=" + pattern.string()});
+  ASSERT_EQ(found.exit_code, 0) << found.err;
+  const auto markers = jsonLines(found.out)[0]["markers"];
+  ASSERT_EQ(markers.size(), 1u);
+  EXPECT_EQ(markers[0]["id"], 9);
+
+  const auto simple = scratch("simple_default");
+  ASSERT_EQ(runProcess(kArbci, {"marker", "make", "--kind", "simple", "--id", "77", "--out",
+                                simple.string()})
+                .exit_code,
+            0);
+  const ProcessResult read =
+      runProcess(kArbci, {"detect", "--kind", "simple", simple.string() + ".png"});
+  ASSERT_EQ(read.exit_code, 0) << read.err;
+  const auto simple_markers = jsonLines(read.out)[0]["markers"];
+  ASSERT_EQ(simple_markers.size(), 1u);
+  EXPECT_EQ(simple_markers[0]["id"], 77);
+}
+
 // A still marker under sensor noise: its corners wander from frame to frame by the noise alone.
 // --smooth (One-Euro) must cut that wander, and the average corner must stay where it was.
 TEST(DetectCommand, SmoothingStillsTheCornersOfAStillMarker) {

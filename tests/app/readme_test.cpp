@@ -16,6 +16,7 @@ struct Synopsis {
   std::string program;             // arbci or arbci-robotd
   std::vector<std::string> chain;  // the subcommands, e.g. {"eeg", "convert"}
   std::vector<std::string> options;
+  std::vector<std::string> after;  // what the synopsis shows after each option ("" at its end)
   std::string line;
 };
 
@@ -30,8 +31,13 @@ std::vector<Synopsis> readmeCommands() {
   auto addOptions = [&](const std::string& text, Synopsis& s) {
     // The synopsis ends where two spaces start its description.
     const std::string synopsis = text.substr(0, text.find("  "));
-    for (std::sregex_iterator it(synopsis.begin(), synopsis.end(), option), end; it != end; ++it)
+    for (std::sregex_iterator it(synopsis.begin(), synopsis.end(), option), end; it != end; ++it) {
       s.options.push_back(it->str());
+      std::istringstream rest(synopsis.substr(static_cast<size_t>(it->position() + it->length())));
+      std::string next;
+      rest >> next;
+      s.after.push_back(next);
+    }
   };
   while (std::getline(in, line)) {
     if (line.rfind("## ", 0) == 0) in_section = line == "## Commands";
@@ -69,10 +75,20 @@ TEST(Readme, EveryCommandAndOptionInTheCommandSummaryExists) {
     arguments.push_back("--help");
     const ProcessResult help = runProcess(program, arguments, 30.0);
     ASSERT_EQ(help.exit_code, 0) << s.line << "\n" << help.err;
-    for (const std::string& option : s.options) {
+    for (size_t k = 0; k < s.options.size(); ++k) {
+      const std::string& option = s.options[k];
       EXPECT_NE(help.out.find(option), std::string::npos) << "README: " << s.line << "\n"
                                                           << option << " is not in its --help:\n"
                                                           << help.out;
+      // An option that takes a value (its --help shows TEXT, INT, FLOAT ...) is shown with one:
+      // `--pose` alone would be refused by the command (the README once showed it so).
+      const std::regex takes_value(option + "( [A-Z]+|,[^ ]* [A-Z]+)");
+      const std::string& next = s.after[k];
+      if (std::regex_search(help.out, takes_value)) {
+        EXPECT_FALSE(next.empty() || next.rfind("--", 0) == 0 || next[0] == ']' || next[0] == '|')
+            << "README: " << s.line << "\n"
+            << option << " needs a value but is shown without one";
+      }
     }
   }
 }
