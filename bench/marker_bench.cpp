@@ -49,6 +49,17 @@ int main(int argc, char** argv) {
   CLI::App cli{
       "Marker detection of the ARBCI tracker beside AprilTag 3 and OpenCV ArUco on synthetic "
       "scenes with exact truth"};
+  cli.footer(
+      "Conditions (each a row of every table):\n"
+      "  clean          the scene as drawn (anti-aliased by 4x supersampling)\n"
+      "  blur           Gaussian blur, sigma 1.5 px (a soft focus)\n"
+      "  noise          Gaussian noise, SD 12 grey levels (a dim sensor)\n"
+      "  uneven light   a gain of 0.15-1: a gradient, a vignette and a soft shadow band\n"
+      "  combined       uneven light, then the blur, then the noise\n"
+      "  motion blur    a linear kernel 5-15 px long at a random angle (a head turning)\n"
+      "  motion+JPEG    the motion blur, then JPEG at quality 50 (a compressing camera)\n"
+      "  fast motion+J  a 9-15 px kernel (a faster turn), then JPEG at quality 50\n"
+      "Each scene also has a marker-free frame of the same condition (false positives).");
   int frames = 40;
   std::vector<std::string> size_names{"640x480", "1280x720"};
   cli.add_option("--frames", frames, "frames per condition and size")

@@ -321,8 +321,13 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
   command->add_option("--dictionary", options->dictionary,
                       "aruco: an OpenCV dictionary (default DICT_6X6_250); apriltag: a libapriltag "
                       "family (default tag36h11; tagStandard41h12, tag25h9, ...)");
-  command->add_option("--pattern", options->patterns,
-                      "Template patterns for --kind template: FILE.patt or ID=FILE.patt");
+  // One pattern per --pattern (repeat it for more): a list would swallow the image names after.
+  command
+      ->add_option("--pattern", options->patterns,
+                   "A template pattern for --kind template: FILE.patt or ID=FILE.patt (one per "
+                   "--pattern; repeat it for more)")
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command->add_flag("--track", options->track,
                     "Keep identities over frames (video, camera, image sequences)");
   command->add_flag("--smooth", options->smooth,

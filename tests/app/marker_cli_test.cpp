@@ -132,8 +132,8 @@ TEST(MarkerCommand, APatternTrainsFromAMarkerMadeWithTheDefaults) {
   ASSERT_EQ(train.exit_code, 0) << train.err;
   EXPECT_NE(train.err.find("--border 0.125"), std::string::npos) << train.err;
   const ProcessResult found =
-      runProcess(kArbci, {"detect", "--kind", "template", "--border", "0.125",
-                          base.string() + ".png", "--pattern", "9=" + pattern.string()});
+      runProcess(kArbci, {"detect", "--kind", "template", "--border", "0.125", "--pattern",
+                          "9=" + pattern.string(), base.string() + ".png"});  // not swallowed
   ASSERT_EQ(found.exit_code, 0) << found.err;
   const auto markers = jsonLines(found.out)[0]["markers"];
   ASSERT_EQ(markers.size(), 1u);
