@@ -262,7 +262,8 @@ void train(TrainOptions& o) {
   std::cout << "\n\ncross-validation, " << cv.folds << " folds by " << cv.folds_by
             << (o.training.folds_by.empty() ? " (the default here; --folds-by to change)" : "")
             << ":\n";
-  printReport(std::cout, cv.report);
+  printReport(std::cout, cv.report,
+              o.errp ? ReportWords{"error", "correct", "feedbacks"} : ReportWords{});
   nlohmann::json facts = datasetFacts(data, quality);
   if (o.errp) {
     // What the threshold does to the cross-validated feedbacks (a prior of 0.5 for an error).

@@ -25,7 +25,7 @@ nlohmann::json toJson(const bci::Interval& i) {
 
 }  // namespace
 
-void printReport(std::ostream& out, const bci::EvaluationReport& r) {
+void printReport(std::ostream& out, const bci::EvaluationReport& r, const ReportWords& words) {
   out << std::fixed;
   out << "paradigm: " << r.layout.describeShape();
   if (r.selection_metrics) {
@@ -34,8 +34,8 @@ void printReport(std::ostream& out, const bci::EvaluationReport& r) {
   }
   out << ", stimulus onset asynchrony " << std::setprecision(3) << r.layout.soa_s << " s\n";
   out << "single-flash AUC: " << std::setprecision(3) << r.auc << " (95 % interval "
-      << interval(r.auc_interval) << ", " << r.target_flashes << " target and " << r.other_flashes
-      << " non-target flashes)\n";
+      << interval(r.auc_interval) << ", " << r.target_flashes << " " << words.target << " and "
+      << r.other_flashes << " " << words.other << " " << words.events << ")\n";
   if (!r.selection_metrics) {
     out << "no selection metrics: every stimulus code is always or never the target (an "
            "oddball, or codes that are classes), so codes are not choices\n";

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <ostream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -13,7 +14,14 @@
 
 namespace arbci::app {
 
-void printReport(std::ostream& out, const bci::EvaluationReport& report);
+// How the two classes are named: a P300 report's "target and non-target flashes", an ErrP
+// report's "error and correct feedbacks".
+struct ReportWords {
+  std::string target = "target", other = "non-target", events = "flashes";
+};
+
+void printReport(std::ostream& out, const bci::EvaluationReport& report,
+                 const ReportWords& words = {});
 // Everything printReport prints, as JSON.
 nlohmann::json reportJson(const bci::EvaluationReport& report);
 // One row per flash: file, sample, code, label (1 target, 0 non-target), score, fold (-1: none).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -237,6 +238,13 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       if (e.target) data.selections.back().target_codes.insert(e.code);
       ++in_selection;
     }
+  }
+  if (rows.empty() && data.rejected_epochs > 0) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", reject_uv);
+    throw std::invalid_argument("every epoch (" + std::to_string(data.rejected_epochs) +
+                                ") is over the rejection limit of " + limit +
+                                " uV peak-to-peak: nothing is left; raise --reject-uv (or 0: off)");
   }
   data.features.resize(static_cast<Eigen::Index>(rows.size()), data.shape.size());
   for (size_t i = 0; i < rows.size(); ++i)

@@ -422,6 +422,18 @@ TEST(TrainAndEvaluate, ARecordingOfAnotherLayoutThanTheModelsIsRefusedNamingBoth
       << r.err;
 }
 
+// A rejection limit that every epoch exceeds leaves nothing to train on, and says so.
+TEST(TrainAndEvaluate, ALimitThatRejectsEveryEpochSaysSo) {
+  const auto file = scratch("reject_all.bdf");
+  write(file, simulated("reject_all", 30, 4));
+  const ProcessResult r = runProcess(kArbci, {"train", file.string(), "--reject-uv", "1", "--out",
+                                              scratch("reject_all.json").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("is over the rejection limit of 1 uV peak-to-peak: nothing is left"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   const auto model = scratch("slda.json");
   ASSERT_EQ(

@@ -478,6 +478,9 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
   ASSERT_EQ(train.exit_code, 0) << train.err << train.out;
   EXPECT_NE(train.out.find("error and"), std::string::npos) << train.out;
   EXPECT_NE(train.out.find("errors caught"), std::string::npos) << train.out;
+  // The report speaks of feedbacks, not of flashes.
+  EXPECT_NE(train.out.find(" correct feedbacks)"), std::string::npos) << train.out;
+  EXPECT_EQ(train.out.find("non-target flashes"), std::string::npos) << train.out;
   const nlohmann::json both = readJson(folder / "both.json");
   EXPECT_EQ(both["format"], "arbci-p300-model");
   EXPECT_EQ(both["errp"]["pipeline"]["channels"], (nlohmann::json{"Fz", "Cz"}));
