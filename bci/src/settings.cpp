@@ -38,6 +38,11 @@ const core::Schema<ParadigmSettings>& paradigmSchema() {
                 "calibration: the target is shown this long before its flashes", "s")
         .number("result_s", &P::result_s, 1.0, 0.0, 60.0, "a selection is shown this long", "s")
         .number("pause_s", &P::pause_s, 1.0, 0.0, 60.0, "the pause between selections", "s")
+        .number("no_view_pause_s", &P::no_view_pause_s, 10.0, 1.0, 600.0,
+                "a selection whose every flash is withheld this long (its objects or the "
+                "reference marker out of view) pauses the session with that reason and resumes "
+                "when they are seen again; headless, the run ends",
+                "s")
         .boolean("errp", &P::errp, false,
                  "error-related potentials: train an ErrP classifier and correct the selections "
                  "it rejects")

@@ -334,7 +334,7 @@ const Schema<SessionConfig>& paradigmSectionSchema() {
     Schema<SessionConfig> t("paradigm", bci::paradigmSchema().doc());
     for (const char* key :
          {"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "calibration_selections",
-          "calibration_sequences", "trials", "cue_s", "result_s", "pause_s"})
+          "calibration_sequences", "trials", "cue_s", "result_s", "pause_s", "no_view_pause_s"})
       t.adopt(bci::paradigmSchema(), key, &SessionConfig::paradigm);
     t.rulesOf(bci::paradigmSchema());
     t.list("intended", &SessionConfig::intended, intentSchema(),

@@ -166,7 +166,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
       services);
   auto paradigm = std::make_unique<ParadigmStage>(
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
-                            c.eeg.seed + 11, c.errp.threshold, folder / "model.json"},
+                            c.eeg.seed + 11, c.errp.threshold, folder / "model.json",
+                            options.experimenter},
       services);
   CycleRecord warm_up;
   tracking->publish(warm_up.tracking);

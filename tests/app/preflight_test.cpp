@@ -89,6 +89,42 @@ TEST(Preflight, AVideoWithoutTheReferenceMarkerEndsTheRunBeforeAnyFlashNamingThe
   expectNoFlash(out);
 }
 
+// Every object out of the cameras' view once the session runs: no flash can be shown, so the
+// selection can never be scored. Headless, the run ends after paradigm.no_view_pause_s (here 4 s
+// of flashes all withheld) with the reason, instead of waiting out the hour.
+TEST(NoObjectInView, AHeadlessRunEndsWithTheReasonAfterTheSetting) {
+  const auto folder = freshTempPath("preflight_test", "no_object_in_view");
+  std::filesystem::create_directories(folder);
+  const ProcessResult settings = runProcess(kArbci, {"settings"});
+  ASSERT_EQ(settings.exit_code, 0) << settings.err;
+  nlohmann::json objects = nlohmann::json::parse(settings.out)["world"]["objects"];
+  for (auto& o : objects) {
+    o["position"][0] = o["position"][0].get<double>() + 3.0;  // 3 m off to the side
+    o["position"][1] = o["position"][1].get<double>() + 3.0;
+  }
+  const auto session = folder / "session.json";
+  std::ofstream(session) << nlohmann::json{{"world", {{"objects", objects}}},
+                                           {"paradigm", {{"no_view_pause_s", 4}}}}
+                                .dump();
+  const auto out = folder / "out";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 300.0);
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["ended"], "aborted");
+  const std::string reason = summary["end_reason"];
+  EXPECT_EQ(reason.rfind("no object in view: the reference marker or objects (10, 20, 30, 40) "
+                         "lost for 4 s (paradigm.no_view_pause_s)",
+                         0),
+            0u)
+      << reason;
+  EXPECT_LT(summary["duration_s"].get<double>(), 60.0);  // session time, not the wall clock
+  bool logged = false;
+  for (const nlohmann::json& e : logOf(out))
+    logged |= e["event"] == "paused" && e["reason"].get<std::string>() == reason;
+  EXPECT_TRUE(logged);
+}
+
 // A file that is not a video at all is refused as the camera opens, before the session starts.
 TEST(Preflight, ACameraPointingAtANonVideoFileExitsBeforeAnyFlashNamingTheKey) {
   const auto folder = freshTempPath("preflight_test", "not_a_video");

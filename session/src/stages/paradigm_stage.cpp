@@ -74,6 +74,7 @@ void ParadigmStage::step(Cycle& cycle) {
   decideIfReady(cycle);
   judgeFeedback(cycle);
   watchEegSource(cycle);
+  watchWithheldFlashes(cycle);
   publish(cycle);
 }
 
@@ -439,8 +440,10 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
           s_.log.write(
               "flash_withheld", time,
               {{"code", e.code}, {"object", objectOfCode(e.code).id}, {"why", "tracking lost"}});
+          if (withheld_since_ < 0.0) withheld_since_ = time;
           break;
         }
+        withheld_since_ = -1.0;
         // Stamped when the frame that shows it is presented.
         part.first_shown.push_back(
             {e.code, selection_objects_, truth_.count(e.code) > 0, !truth_.empty(), selection_});
@@ -621,6 +624,50 @@ void ParadigmStage::watchEegSource(Cycle& cycle) {
     s_.log.write("resumed", time, {{"reason", "EEG source delivering again"}});
     if (s_.progress) *s_.progress << "\nresumed: the EEG source delivers again\n";
   }
+}
+
+void ParadigmStage::watchWithheldFlashes(Cycle& cycle) {
+  using bci::Phase;
+  const Phase phase = paradigm_->phase();
+  const double time = cycle.time_s;
+  if (paused_for_view_) {
+    if (phase != Phase::Paused) {
+      paused_for_view_ = false;  // the experimenter resumed or ended it
+      withheld_since_ = -1.0;
+      return;
+    }
+    in_view_since_ = stale_.empty() ? (in_view_since_ < 0.0 ? time : in_view_since_) : -1.0;
+    if (in_view_since_ >= 0.0 && time - in_view_since_ >= 1.0) {
+      paradigm_->resume();
+      paused_for_view_ = false;
+      withheld_since_ = -1.0;
+      status_.clear();
+      s_.log.write("resumed", time, {{"reason", "the objects are in view again"}});
+      if (s_.progress) *s_.progress << "\nresumed: the objects are in view again\n";
+    }
+    return;
+  }
+  const bool flashing = phase == Phase::ObjectFlashing || phase == Phase::CalibrationFlashing;
+  if (!flashing) withheld_since_ = -1.0;
+  if (withheld_since_ < 0.0 || time - withheld_since_ < settings_.paradigm.no_view_pause_s) return;
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%g", settings_.paradigm.no_view_pause_s);
+  std::string lost;
+  for (int id : stale_) lost += (lost.empty() ? "" : ", ") + std::to_string(id);
+  const std::string reason = std::string("no object in view: the reference marker or objects (") +
+                             lost + ") lost for " + seconds +
+                             " s (paradigm.no_view_pause_s), every flash withheld";
+  s_.log.write("paused", time, {{"reason", reason}});
+  if (!settings_.experimenter) {
+    // Nobody can bring them back into view: the run ends, saying why.
+    cycle.end(reason, "aborted");
+    return;
+  }
+  paradigm_->pause();
+  paused_for_view_ = true;
+  in_view_since_ = -1.0;
+  status_ = "paused: " + reason + "; resumes once they are seen again";
+  if (s_.progress) *s_.progress << "\npaused: " << reason << "\n";
 }
 
 void ParadigmStage::report(nlohmann::json& summary) const {

@@ -31,6 +31,7 @@ struct ParadigmStageSettings {
   std::uint64_t seed;                 // the paradigm's random flash order
   double errp_threshold = 0.5;        // ErrP: reject a selection above this posterior of error
   std::filesystem::path model_file;   // where the model trained goes
+  bool experimenter = false;  // someone at the window: a wait pauses rather than ends the run
 };
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
@@ -56,6 +57,9 @@ class ParadigmStage final : public Stage {
   // The ErrP verdict on the selection shown, once its feedback epoch is scored.
   void judgeFeedback(Cycle& cycle);
   void watchEegSource(Cycle& cycle);
+  // A selection with every flash withheld for paradigm.no_view_pause_s: a pause with the reason
+  // (or, with nobody at the window, the end), never a silent wait.
+  void watchWithheldFlashes(Cycle& cycle);
   TrialRecord& currentTrial();
   // The codes the subject means in this trial's current selection (objects or cell).
   std::set<int> intendedCodes(bool objects) const;
@@ -112,6 +116,11 @@ class ParadigmStage final : public Stage {
   // An EEG source fault pauses the paradigm; it resumes once the source has delivered 2 s again.
   bool paused_for_eeg_ = false;
   double eeg_ok_since_ = -1.0;
+  // Since when every flash of the selection has been withheld (-1: a flash was shown since);
+  // a pause for that resumes once every offered object has been in view for a second.
+  double withheld_since_ = -1.0;
+  bool paused_for_view_ = false;
+  double in_view_since_ = -1.0;
   std::string status_;
 };
 

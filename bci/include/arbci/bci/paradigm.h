@@ -40,6 +40,9 @@ struct ParadigmSettings {
   double cue_s;               // calibration: the target is shown before its flashes
   double result_s;            // a selection is shown this long
   double pause_s;             // between selections
+  // A selection whose every flash was withheld (its objects out of view) this long pauses the
+  // session with the reason (one without an experimenter ends); the session stage enforces it.
+  double no_view_pause_s;
   int calibration_selections;
   int trials;
   // The timing check's mode, not a setting: cued calibration selections without end (never
