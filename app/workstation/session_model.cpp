@@ -181,10 +181,10 @@ std::vector<std::pair<std::string, std::string>> SessionModel::summaryRows() con
   int placed = 0;
   for (const nlohmann::json& t : s["trials"]) {
     const std::string outcome = t["outcome"].get<std::string>();
-    const int object = t["selected_object"].get<int>();
-    std::string line =
-        (object >= 0 ? "object " + std::to_string(object) : std::string("no object")) + ": " +
-        outcome;
+    // null: no object selection was accepted (none made, or every one rejected by the ErrP).
+    const nlohmann::json& object = t["selected_object"];
+    std::string line = (object.is_number() ? "object " + object.dump() : std::string("no object")) +
+                       ": " + outcome;
     if (t["placement_error_m"].is_number()) {
       ++placed;
       line += ", " + number(t["placement_error_m"], "%.1f mm off", 1000.0);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <set>
 
@@ -338,6 +339,14 @@ struct RobotBackend::Impl {
         running = Running{m.session, m.sequence, m.type};
         count(&BackendStats::executed);
         accept(m, s);
+        if (m.type != MessageType::Home) {
+          // The robot's own record of where it went (a session's summary is checked against it).
+          char target[96];
+          std::snprintf(target, sizeof target, "(%.4f, %.4f, %.4f)", m.target.x, m.target.y,
+                        m.target.z);
+          note(std::string("ran ") + toString(m.type) + " " + std::to_string(m.sequence) + " at " +
+               target);
+        }
         last_push = SteadyClock::now();
       }
     }

@@ -6,6 +6,25 @@
 
 namespace arbci::session {
 
+std::optional<int> TrialRecord::acceptedObject() const {
+  std::optional<int> out;
+  for (const SelectionMade& s : selections)
+    if (s.object && !s.vetoed.value_or(false)) out = s.object_id;
+  return out;
+}
+
+std::optional<std::pair<int, int>> TrialRecord::acceptedCell() const {
+  std::optional<std::pair<int, int>> out;
+  for (const SelectionMade& s : selections)
+    if (!s.object && !s.vetoed.value_or(false)) out = s.cell;
+  return out;
+}
+
+int TrialRecord::wrongRobotActions() const {
+  return (robot_object && *robot_object != intended_object) +
+         (robot_cell && *robot_cell != intended_cell);
+}
+
 std::string selectionLine(const TrialRecord& t) {
   std::string line = "trial " + std::to_string(t.trial) + ": object ";
   line += t.selected_object >= 0
@@ -37,12 +56,36 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
   int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0, completed = 0;
   double object_seconds = 0, cell_seconds = 0, trial_seconds = 0;
   auto orNull = [](double v) { return v >= 0.0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  auto cellJson = [](const std::optional<std::pair<int, int>>& c) {
+    return c ? nlohmann::json{c->first, c->second} : nlohmann::json(nullptr);
+  };
+  auto idJson = [](const std::optional<int>& id) {
+    return id ? nlohmann::json(*id) : nlohmann::json(nullptr);
+  };
+  int wrong_robot_actions = 0;
   for (const TrialRecord& t : records) {
+    nlohmann::json selections = nlohmann::json::array();
+    for (const SelectionMade& s : t.selections) {
+      nlohmann::json one = {{"kind", s.object ? "object" : "cell"},
+                            {"correct", s.correct},
+                            {"vetoed", s.vetoed ? nlohmann::json(*s.vetoed) : nullptr}};
+      if (s.object)
+        one["object"] = s.object_id;
+      else
+        one["cell"] = {s.cell.first, s.cell.second};
+      selections.push_back(one);
+    }
+    wrong_robot_actions += t.wrongRobotActions();
     trials.push_back({{"trial", t.trial},
                       {"intended_object", t.intended_object},
-                      {"selected_object", t.selected_object},
+                      {"selected_object", idJson(t.acceptedObject())},
                       {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
-                      {"selected_cell", {t.selected_cell.first, t.selected_cell.second}},
+                      {"selected_cell", cellJson(t.acceptedCell())},
+                      {"selections", selections},
+                      {"robot",
+                       {{"object", idJson(t.robot_object)},
+                        {"cell", cellJson(t.robot_cell)},
+                        {"returned", t.robot_returned}}},
                       {"object_flashes", t.object_flashes},
                       {"cell_flashes", t.cell_flashes},
                       {"object_selection_s", t.object_selection_s},
@@ -87,6 +130,7 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
            {"bits_per_minute", bits / trial_seconds * 60.0}};
   }
   return {{"trials", trials},
+          {"wrong_robot_actions", wrong_robot_actions},
           {"objects", rate(object_choices, objects_right, objects_made, object_seconds)},
           {"cells", rate(cell_choices, cells_right, cells_made, cell_seconds)},
           {"all_inclusive", all}};

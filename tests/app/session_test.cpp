@@ -456,6 +456,47 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
   }
   EXPECT_GT(grasps, 0);
 
+  // The summary tells what the robot did, trial by trial: where it was sent (the session's
+  // commands), how many of those motions went wrong, and as many motions as the robot's own log
+  // says it ran. A selection the ErrP rejected is listed as vetoed, never as the one selected.
+  int logged_wrong = 0, grasp_trials = 0, drop_trials = 0;
+  trial = 0;
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    if (line["event"] == "phase") trial = line["trial"].get<int>();
+    if (line["event"] != "robot_command" || line.contains("by")) continue;
+    if (line["command"] == "GRASP")
+      logged_wrong += line["object"] != intended[trial]["intended_object"];
+    if (line["command"] == "DROP" && !line["returning"].get<bool>())
+      logged_wrong += line["cell"] != intended[trial]["intended_cell"];
+  }
+  int vetoed = 0;
+  for (const auto& t : summary["trials"]) {
+    grasp_trials += !t["robot"]["object"].is_null();
+    drop_trials += !t["robot"]["cell"].is_null() || t["robot"]["returned"].get<bool>();
+    std::map<std::string, std::pair<int, int>> made;  // kind: selections, vetoed
+    for (const auto& s : t["selections"]) {
+      const bool veto = s["vetoed"].is_boolean() && s["vetoed"].get<bool>();
+      ++made[s["kind"]].first;
+      made[s["kind"]].second += veto;
+      vetoed += veto;
+    }
+    for (const auto& [kind, counts] : made) {
+      if (counts.first > 0 && counts.first == counts.second) {  // every one rejected
+        EXPECT_TRUE(t["selected_" + kind].is_null()) << t.dump();
+      }
+    }
+  }
+  EXPECT_EQ(vetoed, errp["wrong_caught"].get<int>() + errp["correct_vetoed"].get<int>());
+  EXPECT_EQ(summary["wrong_robot_actions"], logged_wrong) << summary["trials"].dump();
+  std::ifstream robotd(folder / "robotd.log");
+  int ran_grasps = 0, ran_drops = 0;
+  for (std::string l; std::getline(robotd, l);) {
+    ran_grasps += l.find(": ran GRASP ") != std::string::npos;
+    ran_drops += l.find(": ran DROP ") != std::string::npos;
+  }
+  EXPECT_EQ(ran_grasps, grasp_trials);
+  EXPECT_EQ(ran_drops, drop_trials);
+
   // The recording says what was shown and what the ErrP classifier decided.
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
   int feedback = 0, wrong = 0, verdicts = 0;

@@ -315,6 +315,7 @@ void ParadigmStage::judgeFeedback(Cycle& cycle) {
     fields["veto"] = false;
     fields["why"] = "no ErrP classifier: executed";
     s_.log.write("errp_decision", time, fields);
+    markVerdict(false);
     paradigm_->errpVerdict(false);
     return;
   }
@@ -345,7 +346,15 @@ void ParadigmStage::judgeFeedback(Cycle& cycle) {
   }
   if (veto && s_.progress)
     *s_.progress << "\n" << text << " in trial " << paradigm_->trial() << "\n";
+  markVerdict(veto);
   paradigm_->errpVerdict(veto);
+}
+
+void ParadigmStage::markVerdict(bool veto) {
+  const int trial = paradigm_->trial();
+  if (trial < 1 || trial > static_cast<int>(trials_.size())) return;
+  std::vector<SelectionMade>& made = trials_[static_cast<size_t>(trial - 1)].selections;
+  if (!made.empty()) made.back().vetoed = veto;
 }
 
 std::set<int> ParadigmStage::attendedCodes(bool objects, const Cycle& cycle) {
@@ -376,6 +385,12 @@ void ParadigmStage::recordSelection(const bci::ParadigmEvent& e, Cycle& cycle) {
   }
   const bool correct = e.objects_layout ? trial.selected_object == trial.intended_object
                                         : trial.selected_cell == trial.intended_cell;
+  SelectionMade made;
+  made.object = e.objects_layout;
+  made.object_id = e.objects_layout ? trial.selected_object : -1;
+  made.cell = e.objects_layout ? std::pair<int, int>{0, 0} : e.cell;
+  made.correct = correct;
+  trial.selections.push_back(made);
   nlohmann::json fields = {{"trial", trial.trial},
                            {"kind", e.objects_layout ? "object" : "cell"},
                            {"certainty", e.certainty},
@@ -523,6 +538,7 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
           break;
         }
         cycle.post(GraspRequest{id, seen->T_robot_object.translation, time});
+        currentTrial().robot_object = id;
         break;
       }
       case Kind::RobotDrop: {
@@ -549,6 +565,10 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
         }
         cycle.post(
             DropRequest{currentTrial().trial, e.cell, other.has_value() || e.give_back, time});
+        if (other || e.give_back)
+          currentTrial().robot_returned = true;
+        else
+          currentTrial().robot_cell = e.cell;
         break;
       }
       case Kind::RobotStop:

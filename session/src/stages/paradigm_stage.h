@@ -56,6 +56,8 @@ class ParadigmStage final : public Stage {
   void decideIfReady(const Cycle& cycle);
   // The ErrP verdict on the selection shown, once its feedback epoch is scored.
   void judgeFeedback(Cycle& cycle);
+  // The verdict on the trial's last selection, for the summary.
+  void markVerdict(bool veto);
   void watchEegSource(Cycle& cycle);
   // A selection with every flash withheld for paradigm.no_view_pause_s: a pause with the reason
   // (or, with nobody at the window, the end), never a silent wait.

@@ -3,6 +3,7 @@
 // and the summary's per-trial list with the rates over all trials.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,6 +11,16 @@
 #include <nlohmann/json.hpp>
 
 namespace arbci::session {
+
+// One selection made in a trial (an ErrP rejection makes another): what was selected, and the
+// ErrP classifier's verdict on it (nullopt: none was asked; executed as selected).
+struct SelectionMade {
+  bool object = true;  // an object's selection, else a cell's
+  int object_id = -1;
+  std::pair<int, int> cell{0, 0};
+  bool correct = false;
+  std::optional<bool> vetoed;
+};
 
 struct TrialRecord {
   int trial = 0;
@@ -21,14 +32,26 @@ struct TrialRecord {
   double started_s = 0.0, ended_s = -1.0;  // session time: after the last trial, its put-down
   double placement_error_m = -1.0;
   std::string outcome = "incomplete";
+  std::vector<SelectionMade> selections;  // in the order made
+  // Where the robot was sent in this trial: the object it grasped, the cell it put it on
+  // (nullopt: it did not go); returned: it put the object back where it was taken.
+  std::optional<int> robot_object;
+  std::optional<std::pair<int, int>> robot_cell;
+  bool robot_returned = false;
+  // The last object (cell) selection the ErrP classifier did not reject: what was executed.
+  std::optional<int> acceptedObject() const;
+  std::optional<std::pair<int, int>> acceptedCell() const;
+  // Robot motions to another object or cell than the intended one (0, 1 or 2).
+  int wrongRobotActions() const;
 };
 
 // "trial 2: object 40 (intended), cell 3,1 (intended 2,2), placed 2.2 mm off [placed]".
 std::string selectionLine(const TrialRecord& trial);
 
-// The summary's "trials", "objects" and "cells" (accuracy, seconds per selection and bits per
-// minute, timed from the flash onsets as presented) and "all_inclusive" (over all of each
-// completed trial's time: cues, pauses, feedback, the robot).
+// The summary's "trials" (each with the selections made and vetoed, the accepted ones or null,
+// and where the robot went or null), "wrong_robot_actions", "objects" and "cells" (accuracy,
+// seconds per selection and bits per minute, timed from the flash onsets as presented) and
+// "all_inclusive" (over all of each completed trial's time: cues, pauses, feedback, the robot).
 nlohmann::json trialsSummary(const std::vector<TrialRecord>& trials, int object_choices,
                              int cell_choices);
 
