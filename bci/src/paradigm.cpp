@@ -172,6 +172,13 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
         // SOA the two would run together (one onset to the subject, one photodiode edge); it
         // waits a frame, with the screen dark between them.
         if (lit_last_frame_) break;
+        // Never closer than the SOA to the previous onset, nor than the dark gap (SOA less the
+        // flash, in whole frames) to the frame that ended it: after late frames the schedule
+        // slips (the selection takes longer) rather than squeezing flashes together.
+        const double soa = settings_.soaSeconds();
+        const double ready =
+            std::max(last_onset_s_ + soa, last_dark_s_ + soa - settings_.flashSeconds());
+        if (due_s < ready - kSlack) break;
         // Its first frame. One overdue by more than a flash (the process or the display stalled)
         // moves the rest of the sequence with it: shown one per frame, the flashes missed in a
         // stall would follow each other closer than the SOA, their ERPs overlapping and the
@@ -185,6 +192,7 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
         e.objects_layout = flashing_objects_;
         event(e);
         f.shown_s = due_s;
+        last_onset_s_ = due_s;
         next_flash_ = i + 1;
         out.lit.insert(f.code);
         break;
@@ -267,6 +275,7 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   }
   if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping)
     out.selected_cell = selected_cell_;
+  if (lit_last_frame_ && out.lit.empty()) last_dark_s_ = due_s;
   lit_last_frame_ = !out.lit.empty();
   return out;
 }

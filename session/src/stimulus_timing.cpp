@@ -14,6 +14,14 @@ nlohmann::json inMs(const std::vector<double>& values, double Percentiles::*stat
   return percentiles(values).*statistic * samples_to_ms;
 }
 
+// The 5th percentile (nearest rank) in ms, or null.
+nlohmann::json fifthPercentile(std::vector<double> values, double samples_to_ms) {
+  if (values.empty()) return nullptr;
+  const auto at = values.begin() + static_cast<std::ptrdiff_t>(0.05 * (values.size() - 1));
+  std::nth_element(values.begin(), at, values.end());
+  return *at * samples_to_ms;
+}
+
 }  // namespace
 
 StimulusTiming::StimulusTiming(const bci::ParadigmSettings& paradigm, double eeg_rate_hz)
@@ -43,8 +51,15 @@ StimulusTiming::Frame StimulusTiming::presented(double due_s, double presented_s
     }
     const auto duration = static_cast<int>(sample - it->second.onset_sample);
     frame.ended.push_back({it->second.onset_sample, duration});
+    last_end_sample_ = sample;
     duration_samples_.push_back(duration);
     it = active_.erase(it);
+  }
+  // Rules a P300 paradigm must keep: one stimulus at a time, a dark frame before each onset.
+  for (size_t k = 0; k < first_shown.size(); ++k) {
+    overlapped_ += !active_.empty() || k > 0;
+    gapless_ += last_patch_lit_;
+    if (last_end_sample_) gap_samples_.push_back(static_cast<double>(sample - *last_end_sample_));
   }
   for (int code : first_shown) {
     frame.onsets.push_back({code, sample});
@@ -54,6 +69,7 @@ StimulusTiming::Frame StimulusTiming::presented(double due_s, double presented_s
     selection_onsets_.push_back(sample);
   }
   frame.patch_lit = !lit.empty();
+  last_patch_lit_ = frame.patch_lit;
   return frame;
 }
 
@@ -85,12 +101,29 @@ bool StimulusTiming::displayTooSlow() const {
 nlohmann::json StimulusTiming::summary() const {
   const double to_ms = 1000.0 / rate_hz_;
   const auto frame_median = medianFrameIntervalMs();
+  // An SOA over the paradigm's (in whole frames) by more than half a frame: the schedule slipped.
+  const double soa_limit = (paradigm_.soaSeconds() + 0.5 / paradigm_.display_hz) * rate_hz_;
+  const auto slipped = std::count_if(soa_samples_.begin(), soa_samples_.end(),
+                                     [&](double soa) { return soa > soa_limit; });
+  auto least = [&](const std::vector<double>& v) {
+    return v.empty() ? nlohmann::json(nullptr)
+                     : nlohmann::json(*std::min_element(v.begin(), v.end()) * to_ms);
+  };
   return {
       {"soa_ms",
        {{"configured", paradigm_.flash_ms + paradigm_.isi_ms},
+        {"frames", paradigm_.soaSeconds() * 1000.0},
         {"median", inMs(soa_samples_, &Percentiles::p50, to_ms)},
         {"p95", inMs(soa_samples_, &Percentiles::p95, to_ms)},
+        {"p5", fifthPercentile(soa_samples_, to_ms)},
+        {"min", least(soa_samples_)},
+        {"slipped", slipped},
         {"count", soa_samples_.size()}}},
+      {"flash_rules",
+       {{"overlapped", overlapped_},
+        {"gapless", gapless_},
+        {"min_gap_ms", least(gap_samples_)},
+        {"gap_ms_configured", (paradigm_.soaSeconds() - paradigm_.flashSeconds()) * 1000.0}}},
       {"flash_ms",
        {{"configured", paradigm_.flash_ms},
         {"median", inMs(duration_samples_, &Percentiles::p50, to_ms)},

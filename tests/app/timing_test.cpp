@@ -45,6 +45,13 @@ void expectOnTarget(const std::filesystem::path& folder) {
   EXPECT_GT(t["flashes"].get<int>(), 30);
   EXPECT_EQ(t["count"], t["flashes"]) << t.dump(2);
   EXPECT_EQ(t["unmatched_edges"], 0) << t.dump(2);
+  // The paradigm's rules, each judged and met: one stimulus at a time, a dark frame before each,
+  // no SOA or dark gap under the paradigm's.
+  ASSERT_EQ(t["rules"].size(), 5u) << t.dump(2);
+  for (const nlohmann::json& rule : t["rules"]) EXPECT_TRUE(rule["met"].get<bool>()) << rule;
+  const nlohmann::json rules = readJson(folder / "summary.json")["timing"]["flash_rules"];
+  EXPECT_EQ(rules["overlapped"], 0);
+  EXPECT_EQ(rules["gapless"], 0);
   // The figure is there and the session's own files beside it.
   EXPECT_GT(std::filesystem::file_size(folder / "timing.png"), 5000u);
   EXPECT_TRUE(std::filesystem::exists(folder / "recording.bdf"));

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "arbci/bci/decision.h"
 #include "arbci/bci/paradigm.h"
@@ -228,10 +229,12 @@ TEST(Paradigm, RetryStepAsksForTheInterruptedGraspAgainAndSkipTrialEndsTheTrial)
   EXPECT_EQ(p.phase(), Phase::ObjectFlashing);
 }
 
-// A display that manages a frame every 28 ms, not the 16.7 ms of its nominal 60 Hz: the onsets
-// keep to the 183 ms SOA (each on the first frame due at or after it), no frame shows two flashes,
-// and every flash is shown.
-TEST(Paradigm, OnASlowDisplayFlashesKeepTheirScheduleInTime) {
+// A display that manages a frame every 28 ms, not the 16.7 ms of its nominal 60 Hz: no frame shows
+// two flashes, every flash is shown, and each comes at least one SOA after the previous onset and
+// the dark gap after its end; a flash lasting a frame longer (84 ms) and its successor waiting for
+// the next frame, the SOA is under two frames more than the paradigm's (the schedule slips rather
+// than squeezes).
+TEST(Paradigm, OnASlowDisplayEachSoaIsAtLeastTheParadigmsAndUnderTwoFramesMore) {
   ParadigmSettings s = fast();
   Paradigm p(s, 4, 3, 3, 5);
   p.start(false);
@@ -248,16 +251,68 @@ TEST(Paradigm, OnASlowDisplayFlashesKeepTheirScheduleInTime) {
   }
   ASSERT_EQ(onsets.size(), 12u);  // 3 sequences of 4 objects
   const double soa = s.soaSeconds();
-  for (size_t i = 0; i < onsets.size(); ++i) {
-    // Flashing starts a nominal frame after start() (frame 0, at 0 s).
-    const double scheduled = 1.0 / s.display_hz + static_cast<double>(i) * soa;
-    EXPECT_GE(onsets[i], scheduled - 1e-9) << i;
-    EXPECT_LT(onsets[i], scheduled + period) << i;
+  // Flashing starts a nominal frame after start() (frame 0, at 0 s).
+  EXPECT_GE(onsets[0], 1.0 / s.display_hz - 1e-9);
+  EXPECT_LT(onsets[0], 1.0 / s.display_hz + period);
+  for (size_t i = 1; i < onsets.size(); ++i) {
+    EXPECT_GE(onsets[i] - onsets[i - 1], soa - 1e-9) << i;
+    EXPECT_LT(onsets[i] - onsets[i - 1], soa + 2 * period) << i;
   }
   EXPECT_EQ(frames_with_two, 0);
   // 66.7 ms of flash on 28 ms frames: 2 or 3 frames each.
   EXPECT_GE(lit_frames, 24);
   EXPECT_LE(lit_frames, 36);
+}
+
+// Frames late at random (a loaded machine, a slow display: 0.1 to 5 periods late, a fifth of
+// them), over a whole calibration run: no two stimuli are ever lit together, a flash never starts
+// on the frame right after a lit one, and every flash follows the previous one by at least the
+// SOA and at least the configured dark gap after it went dark; the schedule slips instead.
+TEST(Paradigm, OnLateFramesFlashesNeverSqueezeTheirSoaOrGap) {
+  ParadigmSettings s = fast();
+  s.calibration_selections = 4;
+  Paradigm p(s, 4, 3, 3, 5);
+  p.start(true);
+  const double period = 1.0 / s.display_hz;
+  const double gap = s.soaSeconds() - s.flashSeconds();  // the dark gap, in whole frames
+  std::uint32_t state = 77;
+  auto unit = [&] {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 8) / 16777216.0;
+  };
+  double due = 0.0, last_onset = -1.0, last_dark = -1.0;
+  bool was_lit = false;
+  int onsets = 0, two_lit = 0, gapless = 0, short_soa = 0, short_gap = 0, slipped = 0;
+  std::set<int> lit_before;
+  for (std::int64_t frame = 0; frame < 4000 && p.phase() != Phase::Training; ++frame) {
+    due += period + (unit() < 0.2 ? period * (0.1 + 4.9 * unit()) : 0.0);
+    const FrameStimulus shown = p.frame(frame, due);
+    if (p.awaitingDecision()) p.decide(Decision{});  // calibration: the next cue
+    two_lit += shown.lit.size() > 1;
+    if (!shown.lit.empty() && !was_lit) {
+      ++onsets;
+      gapless += last_dark >= 0.0 && last_dark == due;  // never: a dark frame comes between
+      if (last_onset >= 0.0) {
+        short_soa += due - last_onset < s.soaSeconds() - 1e-9;
+        slipped += due - last_onset > s.soaSeconds() + period / 2;
+      }
+      if (last_dark >= 0.0) short_gap += due - last_dark < gap - 1e-9;
+      last_onset = due;
+    }
+    if (shown.lit.empty() && was_lit) last_dark = due;
+    // Lit on the frame right after another stimulus was lit: two flashes run together.
+    for (int code : shown.lit) gapless += !lit_before.empty() && !lit_before.count(code);
+    lit_before = shown.lit;
+    was_lit = !shown.lit.empty();
+    p.takeEvents();
+  }
+  EXPECT_EQ(p.phase(), Phase::Training);
+  EXPECT_EQ(onsets, 4 * 3 * 4);  // 4 selections, 3 sequences, 4 stimuli
+  EXPECT_EQ(two_lit, 0);
+  EXPECT_EQ(gapless, 0);
+  EXPECT_EQ(short_soa, 0);
+  EXPECT_EQ(short_gap, 0);
+  EXPECT_GT(slipped, 0);  // the late frames did make the schedule slip
 }
 
 // The timing check's paradigm: cued calibration selections that go on, never to training.

@@ -212,7 +212,9 @@ class Paradigm {
   std::int64_t frame_ = 0;       // the last frame shown
   double now_ = 0.0;             // its due time
   bool lit_last_frame_ = false;  // the last frame showed a flash
-  double phase_until_ = 0.0;     // timed phases end then (while paused: the time still to go)
+  // The last flash's onset, and the first frame after it that showed nothing (session seconds).
+  double last_onset_s_ = -1e9, last_dark_s_ = -1e9;
+  double phase_until_ = 0.0;  // timed phases end then (while paused: the time still to go)
   // Flashing: the current sequence's flashes, and when each was first shown.
   struct ScheduledFlash {
     double onset_s;

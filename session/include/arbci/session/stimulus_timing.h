@@ -50,7 +50,9 @@ class StimulusTiming {
   // periods (the display cannot hold its rate).
   std::optional<double> medianFrameIntervalMs() const;
   bool displayTooSlow() const;
-  // The summary's "timing": soa_ms, flash_ms (configured, median, p95), display, late_frames.
+  // The summary's "timing": soa_ms (configured, in frames, median, p95, p5, min, slipped: over
+  // the SOA by half a frame), flash_rules (overlapped and gapless flashes, the least dark gap),
+  // flash_ms, display, late_frames.
   nlohmann::json summary() const;
   double medianSoaS() const;
 
@@ -65,6 +67,11 @@ class StimulusTiming {
   std::vector<double> frame_intervals_s_;       // the last few hundred, for the display check
   std::vector<std::pair<int, Active>> active_;  // code, its onset, while lit
   std::vector<double> soa_samples_, duration_samples_;
+  // A flash started while another was lit; on the frame right after a lit one; the dark gaps.
+  std::int64_t overlapped_ = 0, gapless_ = 0;
+  bool last_patch_lit_ = false;
+  std::optional<std::int64_t> last_end_sample_;
+  std::vector<double> gap_samples_;
   std::vector<std::int64_t> selection_onsets_;
 };
 
