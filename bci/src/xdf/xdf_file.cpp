@@ -118,10 +118,6 @@ class Parser {
       chunk(content);
     }
     file_.whole_bytes = at;
-    for (Stream& s : file_.streams) {
-      // A stream whose header came but no sample at all: kept, with nothing in it.
-      if (s.numeric()) s.values.shrink_to_fit();
-    }
     return std::move(file_);
   }
 
