@@ -1,8 +1,12 @@
 // `arbci robot keygen` writes a shared key; `arbci robot ... status|home|stop|reset|grasp|drop`
-// talks to a backend from the shell, waits for the outcome and exits 0 only on success. It says
-// whether a motion ran: 1 when it did not (or shows no sign of it), 3 when it ran but its answer
-// was lost; a motion it cannot confirm is STOPped, so it never runs on unsupervised.
+// talks to a backend from the shell, waits for the outcome and exits 0 only on success. It gives
+// one of three honest answers about a motion: it ran (0 when it succeeded, 3 when it failed, was
+// stopped, or its outcome was lost), it did not run (1: the backend said so, or it was never
+// sent), or nobody can tell (4: the backend restarted or fell silent after it may have received
+// it). A motion it cannot confirm is STOPped, so it never runs on unsupervised.
 #include <chrono>
+#include <cstdio>
+#include <optional>
 #include <iomanip>
 #include <iostream>
 #include <thread>
@@ -69,33 +73,61 @@ void pollFor(robot::RobotClient& client, double seconds, Done done) {
   }
 }
 
+std::string armState(const robot::StatusPayload& s) {
+  char tool[96];
+  std::snprintf(tool, sizeof tool, "(%.3f, %.3f, %.3f)", s.tool.x, s.tool.y, s.tool.z);
+  return std::string("the arm is ") + robot::toString(s.state) + ", holding " +
+         (s.holding >= 0 ? "object " + std::to_string(s.holding) : std::string("nothing")) +
+         ", tool at " + tool + " m";
+}
+
 // The motion could not be confirmed: STOP it (so it never runs on, or later), then ask the
-// backend whether it ran. Always throws: exit 3 when it ran, 1 when there is no sign it did.
+// backend whether it ran. Always throws: 3 when it ran, 1 when the same backend run shows it did
+// not (and after the STOP it never will), 4 when nobody can tell (the backend restarted, or the
+// STOP was not confirmed either); the arm's state as the backend reports it now goes with it.
 [[noreturn]] void stopUnconfirmed(robot::RobotClient& client, robot::MessageType type,
-                                  std::uint64_t sequence, const std::string& why) {
+                                  std::uint64_t sequence, const std::string& why,
+                                  bool restarted) {
   const std::string name = robot::toString(type);
-  client.takeEvents();
   const std::uint64_t stop = client.send(robot::MessageType::Stop);
   bool stopped = false;
   pollFor(client, 5.0, [&] {
-    for (const robot::RobotEvent& e : client.takeEvents())
+    for (const robot::RobotEvent& e : client.takeEvents()) {
       stopped |= e.sequence == stop && e.kind == robot::RobotEvent::Kind::Finished;
+      restarted |= e.kind == robot::RobotEvent::Kind::Restarted;
+    }
     return stopped;
   });
-  bool ran = client.accepted(sequence);
+  bool ran = client.accepted(sequence) && !restarted;
+  std::optional<robot::StatusPayload> now;
   if (stopped) {
     client.requestStatus();
+    const auto asked = std::chrono::steady_clock::now();
     pollFor(client, 1.0, [&] {
       const auto& s = client.status();
-      ran |= s && s->last_finished_sequence == sequence;
-      return ran;
+      // A status answered after the STOP was accepted: the backend's state now.
+      if (s && std::chrono::steady_clock::now() - asked > std::chrono::milliseconds(250)) now = s;
+      return now.has_value();
     });
+    if (now && !restarted)
+      ran |= now->last_finished_sequence == sequence ||
+             (now->current_is_yours && now->current_sequence == sequence);
   }
   const std::string stop_note =
       stopped ? "STOP sent and accepted: motion is refused until `arbci robot reset`"
               : "STOP sent but not confirmed either: check the arm";
-  if (ran) throw CliError(name + " ran, but the answer was lost (" + why + "); " + stop_note, 3);
-  throw CliError(name + " not run: " + why + "; " + stop_note, 1);
+  const std::string state = now ? "; " + armState(*now) : "";
+  if (client.accepted(sequence) && restarted)
+    throw CliError(name + " ran, then the backend restarted during it (" + why + "); " +
+                       stop_note + state,
+                   3);
+  if (ran)
+    throw CliError(name + " ran, but the answer was lost (" + why + "); " + stop_note + state, 3);
+  if (stopped && !restarted)
+    throw CliError(name + " not run: " + why + "; the backend shows it never ran, and " +
+                       stop_note + state,
+                   1);
+  throw CliError(name + ": unknown, it may have run: " + why + "; " + stop_note + state, 4);
 }
 
 int talk(const RobotOptions& o, robot::MessageType type) {
@@ -107,7 +139,7 @@ int talk(const RobotOptions& o, robot::MessageType type) {
   const bool motion = robot::isMotion(type);
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t sequence = type == robot::MessageType::Status ? 0 : client.send(type, target);
-  bool told_silent = false, ever_connected = false;
+  bool told_silent = false, ever_connected = false, restarted = false;
   using Kind = robot::RobotEvent::Kind;
   while (Seconds(std::chrono::steady_clock::now() - start).count() < o.timeout_s) {
     client.poll();
@@ -118,7 +150,10 @@ int talk(const RobotOptions& o, robot::MessageType type) {
         std::cerr << "no answer yet from the backend at " << endpoint.toString()
                   << "; retrying for up to " << o.retry_budget_s << " s\n";
       }
-      if (e.kind == Kind::Restarted) std::cerr << "the backend restarted\n";
+      if (e.kind == Kind::Restarted) {
+        restarted = true;
+        std::cerr << "the backend restarted\n";
+      }
       ever_connected |= e.kind == Kind::Connected;
       if (e.sequence != sequence || sequence == 0) continue;
       if (e.kind == Kind::Accepted) std::cerr << name << " accepted\n";
@@ -130,12 +165,13 @@ int talk(const RobotOptions& o, robot::MessageType type) {
           throw CliError(name + " not run: no answer from the backend at " + endpoint.toString() +
                          " in " + std::to_string(static_cast<int>(o.retry_budget_s)) +
                          " s (is arbci-robotd running, with the same key?)");
-        if (motion) stopUnconfirmed(client, type, sequence, e.text);
-        throw CliError(name + " not confirmed: " + e.text);
+        if (!e.may_have_run) throw CliError(e.text, 1);
+        if (motion) stopUnconfirmed(client, type, sequence, e.text, restarted);
+        throw CliError(name + ": unknown, it may have taken effect: " + e.text, 4);
       }
       if (e.kind == Kind::Finished) {
         if (e.outcome != robot::Outcome::Success)
-          throw CliError(name + " ran: " + robot::toString(e.outcome) + ": " + e.text);
+          throw CliError(name + " ran: " + robot::toString(e.outcome) + ": " + e.text, 3);
         std::cout << name << " finished: " << e.text << "\n";
         return 0;
       }
@@ -156,9 +192,11 @@ int talk(const RobotOptions& o, robot::MessageType type) {
                    " s (is arbci-robotd running, with the same key?)");
   if (motion)
     stopUnconfirmed(client, type, sequence,
-                    "no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) + " s");
-  throw CliError(name + ": no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) +
-                 " s");
+                    "no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) + " s",
+                    restarted);
+  throw CliError(name + ": unknown, no outcome within " +
+                     std::to_string(static_cast<int>(o.timeout_s)) + " s",
+                 4);
 }
 
 }  // namespace
@@ -168,10 +206,12 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
   CLI::App* robot_cmd = root.add_subcommand(
       "robot",
       "Talk to a robot backend (arbci-robotd) or make a key for it.\n"
-      "Commands wait for FINISHED: exit 0 on success; 1 when the command did not run (rejected,\n"
-      "or no answer within the retry budget) or ran and failed or was stopped; 3 when it ran\n"
-      "but its answer was lost. A motion that cannot be confirmed is followed by a STOP, which\n"
-      "stays in force until `arbci robot reset`.");
+      "Commands wait for FINISHED. Exit 0: it ran and succeeded; 1: it did not run (the backend\n"
+      "refused it or shows it never ran, or no backend answered, so it was never sent); 3: it\n"
+      "ran but failed, was stopped, or its outcome was lost; 4: unknown, it may have run (the\n"
+      "backend restarted or fell silent after it may have received it: the arm's state is\n"
+      "printed when the backend can say). A motion that cannot be confirmed is followed by a\n"
+      "STOP, which stays in force until `arbci robot reset`.");
   robot_cmd->require_subcommand(1);
   robot_cmd->add_option("--host", o->host, "backend address")->capture_default_str();
   robot_cmd->add_option("--port", o->port, "backend UDP port")

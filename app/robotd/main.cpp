@@ -11,6 +11,7 @@
 #include "arbci/robot/robot_config.h"
 #include "arbci/robot/settings.h"
 #include "arbci/robot/simulated_arm.h"
+#include "arbci/robot/thread_priority.h"
 
 namespace {
 
@@ -84,24 +85,27 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
+    // A motion controller's loop: a busy PC must not delay a STOP or the watchdog's halt.
+    const std::string priority = arbci::robot::raiseThreadPriority();
     std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port() << " (" << driver
               << " arm, speed x" << options.speed_factor << ", " << config.objects.size()
               << " objects, watchdog "
               << (stepped           ? std::string("off (stepped)")
                   : watchdog_ms > 0 ? std::to_string(watchdog_ms) + " ms"
                                     : "off")
-              << ", receive buffer " << backend.receiveBufferBytes() / 1024 << " KiB)" << std::endl;
+              << ", receive buffer " << backend.receiveBufferBytes() / 1024 << " KiB, scheduling "
+              << priority << ")" << std::endl;
     if (backend.receiveBufferBytes() < options.receive_buffer_bytes)
       std::cerr << "arbci-robotd: the kernel granted a smaller receive buffer than the "
                 << options.receive_buffer_bytes / 1024
-                << " KiB asked; a burst of junk datagrams may crowd out commands (raise "
+                << " KiB asked; a burst of datagrams may crowd out commands (raise "
                    "net.core.rmem_max)"
                 << std::endl;
     backend.run(stop_requested);
     const arbci::robot::BackendStats s = backend.stats();
     std::cerr << "arbci-robotd: stopped; " << s.datagrams << " datagrams, " << s.executed
               << " commands run, " << s.rejected << " rejected, " << s.replayed << " replayed, "
-              << s.ignored << " ignored, " << s.watchdog_halts << " watchdog halts" << std::endl;
+              << s.ignored << " ignored, " << s.shed << " shed unread, " << s.watchdog_halts << " watchdog halts" << std::endl;
   } catch (const std::exception& error) {
     std::cerr << "arbci-robotd: " << error.what() << "\n";
     return 1;

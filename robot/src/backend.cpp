@@ -9,6 +9,8 @@
 #include <mutex>
 #include <set>
 
+#include "arbci/robot/thread_priority.h"
+
 namespace arbci::robot {
 namespace {
 
@@ -16,6 +18,11 @@ using SteadyClock = std::chrono::steady_clock;
 constexpr std::uint64_t kReplayWindow = 1024;
 constexpr size_t kCachedReplies = 256;
 constexpr auto kSessionLifetime = std::chrono::minutes(5);
+// A WELCOME's challenge must be answered within this long; a session keeps this many open (a
+// replayed HELLO adds one without displacing the real client's).
+constexpr auto kChallengeLifetime = std::chrono::seconds(5);
+constexpr size_t kChallengesPerSession = 4;
+constexpr size_t kMaxChallenges = 256;
 
 std::uint64_t randomId() {
   std::uint64_t id = 0;
@@ -29,6 +36,23 @@ bool belowWindow(std::uint64_t sequence, std::uint64_t highest) {
   return sequence < highest && highest - sequence >= kReplayWindow;
 }
 
+// A budget of `rate` a second, at most one second's worth saved up.
+class TokenBucket {
+ public:
+  explicit TokenBucket(double rate) : rate_(rate), tokens_(rate) {}
+  bool take(SteadyClock::time_point now) {
+    tokens_ = std::min(rate_, tokens_ + rate_ * std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+    if (tokens_ < 1.0) return false;
+    tokens_ -= 1.0;
+    return true;
+  }
+
+ private:
+  double rate_, tokens_;
+  SteadyClock::time_point last_ = SteadyClock::now();
+};
+
 }  // namespace
 
 struct RobotBackend::Impl {
@@ -37,40 +61,66 @@ struct RobotBackend::Impl {
   BackendOptions options;
   UdpSocket socket;
   std::uint64_t boot = randomId();
+  // Motion commands must carry this; RESET starts the next, so whatever was made before a STOP
+  // (in an older epoch) never runs.
+  std::uint64_t stop_epoch = 1;
 
   struct Session {
-    Endpoint peer;  // bound at the HELLO: every reply to this session goes there
+    Endpoint peer;  // bound by a BIND: every reply to this session goes there
     std::uint64_t highest = 0;
     std::set<std::uint64_t> seen;              // within the window
     std::map<std::uint64_t, Message> replies;  // cached answers to commands, by sequence
     std::uint64_t last_finished = 0;
     Outcome last_outcome = Outcome::Success;
     std::string last_text;
-    // Motion commands below this sequence never start: abandoned by the client (its heartbeat)
-    // or sent before a STOP.
+    // Motion commands below this sequence never start: abandoned by the client (its heartbeat).
     std::uint64_t abandon_below = 0;
+    // The send time (this backend's clock) of the newest heartbeat, never later than its receipt.
+    std::optional<std::int64_t> heartbeat_us;
+    // How old the heartbeat received last was when it arrived: over the watchdog, the link
+    // delays it too much to protect a motion (a lost heartbeat sets nothing here).
+    std::int64_t last_heartbeat_age_us = 0;
+    // The challenge of the BIND that bound it: a retransmission of that BIND from the bound
+    // address is answered again (its BOUND may have been lost).
+    std::uint64_t bound_challenge = 0, bind_sequence = 0;
     SteadyClock::time_point active;
   };
   std::map<std::uint64_t, Session> sessions;
 
+  // WELCOMEs sent and not yet answered by a BIND, by session.
+  struct Challenge {
+    std::uint64_t client_nonce = 0, backend_nonce = 0, hello_sequence = 0;
+    SteadyClock::time_point sent;
+  };
+  std::map<std::uint64_t, std::vector<Challenge>> challenges;
+
   struct Running {
     std::uint64_t session = 0, sequence = 0;
     MessageType type = MessageType::Home;
+    std::int64_t started_us = 0;
   };
   std::optional<Running> running;
   std::string stop_reason;              // a latched stop: motion commands are refused until a RESET
   std::optional<double> stepped_clock;  // stepped: the clock the robot has reached
   SteadyClock::time_point last_step = SteadyClock::now(), last_push = SteadyClock::now();
+  TokenBucket unbound_budget, refusal_budget;
   BackendStats stats;
   mutable std::mutex stats_mutex;
+  std::string priority;
   std::map<std::string, SteadyClock::time_point> last_log;
 
   Impl(const Key& k, std::unique_ptr<RobotDriver> d, const BackendOptions& o)
-      : key(k), driver(std::move(d)), options(o), socket(o.port, o.host) {
+      : key(k),
+        driver(std::move(d)),
+        options(o),
+        socket(o.port, o.host),
+        unbound_budget(o.unbound_per_s),
+        refusal_budget(o.refusals_per_s) {
     if (options.receive_buffer_bytes > 0) socket.setReceiveBuffer(options.receive_buffer_bytes);
   }
 
   bool watchdogActive() const { return !options.stepped && options.watchdog_s > 0.0; }
+  std::int64_t watchdogMicros() const { return std::llround(options.watchdog_s * 1e6); }
 
   void count(std::uint64_t BackendStats::*field) {
     std::lock_guard lock(stats_mutex);
@@ -93,12 +143,14 @@ struct RobotBackend::Impl {
     if (options.log) *options.log << "arbci-robotd: " << line << std::endl;
   }
 
-  void send(const Message& m, const Endpoint& to) {
+  std::vector<std::uint8_t> stamped(const Message& m) {
     Message out = m;
     out.boot = boot;
     out.timestamp_ms = wallClockMs();
-    socket.sendTo(encode(out, key), to);
+    return encode(out, key);
   }
+
+  void send(const Message& m, const Endpoint& to) { socket.sendTo(stamped(m), to); }
 
   Message reply(const Message& command, MessageType type) {
     Message m;
@@ -117,6 +169,7 @@ struct RobotBackend::Impl {
     StatusPayload& s = m.status;
     s.state = stop_reason.empty() ? d.state : RobotState::Stopped;
     s.stop_reason = stop_reason;
+    s.stop_epoch = stop_epoch;
     s.tool = d.tool;
     s.gripper_opening = d.gripper_opening;
     s.holding = d.holding;
@@ -133,6 +186,7 @@ struct RobotBackend::Impl {
       s.last_outcome_text = found->second.last_text;
     }
     s.objects = driver->world();
+    s.backend_time_us = steadyMicros();
     return m;
   }
 
@@ -172,8 +226,33 @@ struct RobotBackend::Impl {
     }
   }
 
+  // Whether a datagram deserves a MAC check: from a bound session's own address always (the
+  // real client's STOP and heartbeats are never crowded out); anything else within the unbound
+  // budget, so a flood of forgeries costs a header read each.
+  bool worthVerifying(const Datagram& d, SteadyClock::time_point now) {
+    const auto header = peek(d.bytes.data(), d.bytes.size());
+    if (header) {
+      const auto found = sessions.find(header->session);
+      if (found != sessions.end() && found->second.peer == d.from) return true;
+    }
+    if (unbound_budget.take(now)) return true;
+    count(&BackendStats::shed);
+    log("shed", "dropped datagrams unread (not from a bound client, over " +
+                    std::to_string(static_cast<int>(options.unbound_per_s)) + " a second), e.g. from " +
+                    d.from.toString());
+    return false;
+  }
+
+  bool fromBoundPeer(const Datagram& d) const {
+    const auto header = peek(d.bytes.data(), d.bytes.size());
+    if (!header) return false;
+    const auto found = sessions.find(header->session);
+    return found != sessions.end() && found->second.peer == d.from;
+  }
+
   void handle(const Datagram& d) {
     count(&BackendStats::datagrams);
+    if (!worthVerifying(d, SteadyClock::now())) return;
     const Decoded decoded = decode(d.bytes.data(), d.bytes.size(), key);
     if (!decoded.ok()) {
       {
@@ -190,15 +269,14 @@ struct RobotBackend::Impl {
       count(&BackendStats::ignored);
       return;  // a reply sent to the backend: nothing to do
     }
+    const auto found = sessions.find(m.session);
     const double skew =
         std::abs(static_cast<double>(wallClockMs()) - static_cast<double>(m.timestamp_ms)) / 1000.0;
     if (skew > options.max_clock_skew_s) {
-      reject(m, d.from, RejectReason::Replayed,
-             "timestamp " + std::to_string(static_cast<long>(skew)) +
-                 " s away from the backend's clock");
+      stale(m, d, RejectReason::Replayed,
+            "timestamp " + std::to_string(static_cast<long>(skew)) + " s off");
       return;
     }
-    const auto found = sessions.find(m.session);
     if (m.type == MessageType::Hello) {
       hello(m, d.from);
       return;
@@ -206,13 +284,15 @@ struct RobotBackend::Impl {
     if (m.boot != boot) {
       // Sent to another run of the backend (a capture replayed after a restart, or a client
       // that has not noticed the restart yet): never run; the client learns it must HELLO.
-      reject(m, found != sessions.end() ? found->second.peer : d.from, RejectReason::UnknownBoot,
-             "sent to backend run " + std::to_string(m.boot) + ", this is run " +
-                 std::to_string(boot) + ": the backend restarted; say HELLO again");
+      stale(m, d, RejectReason::UnknownBoot, "backend restarted: HELLO");
+      return;
+    }
+    if (m.type == MessageType::Bind) {
+      bind(m, d.from);
       return;
     }
     if (found == sessions.end()) {
-      reject(m, d.from, RejectReason::NotAuthenticated, "no HELLO from this session in this run");
+      stale(m, d, RejectReason::NotAuthenticated, "no BIND in this run");
       return;
     }
     Session& s = found->second;
@@ -237,29 +317,114 @@ struct RobotBackend::Impl {
     s.seen.insert(m.sequence);
     s.highest = std::max(s.highest, m.sequence);
     while (!s.seen.empty() && belowWindow(*s.seen.begin(), s.highest)) s.seen.erase(s.seen.begin());
-    s.active = SteadyClock::now();  // fresh and authenticated: feeds the watchdog
+    s.active = SteadyClock::now();
     process(m, s);
     while (s.replies.size() > kCachedReplies) s.replies.erase(s.replies.begin());
   }
 
-  // HELLO binds the session to this run and to the sender's address. Only a HELLO newer than
-  // anything the session sent this run does so: a replayed one cannot redirect the replies.
+  // A stale or unplaceable command (old timestamp, another run, no session): answered at the
+  // session's bound address when there is one; otherwise only with a refusal smaller than the
+  // datagram and within the refusal budget, so the backend cannot be used to reflect or
+  // amplify traffic towards a forged sender address.
+  void stale(const Message& m, const Datagram& d, RejectReason reason, const std::string& text) {
+    count(&BackendStats::replayed);
+    log(toString(reason), std::string("refused ") + toString(m.type) + " from " +
+                              d.from.toString() + ": " + text);
+    const auto found = sessions.find(m.session);
+    if (m.type == MessageType::Heartbeat || m.type == MessageType::Bind) return;
+    Message r = reply(m, MessageType::Rejected);
+    r.reason = reason;
+    r.text = text;
+    if (found != sessions.end()) {
+      if (refusal_budget.take(SteadyClock::now())) send(r, found->second.peer);
+      return;
+    }
+    const auto bytes = stamped(r);
+    if (bytes.size() < d.bytes.size() && refusal_budget.take(SteadyClock::now()))
+      socket.sendTo(bytes, d.from);
+  }
+
+  // HELLO asks for a challenge; it binds nothing, so a replayed one cannot move a session. Its
+  // WELCOME is no larger than the HELLO (which is padded to its size) and within the unbound
+  // budget, like every datagram not from a bound address.
   void hello(const Message& m, const Endpoint& from) {
     const auto found = sessions.find(m.session);
     if (found != sessions.end() && m.sequence <= found->second.highest) {
-      reject(m, found->second.peer, RejectReason::Replayed,
-             "HELLO " + std::to_string(m.sequence) + " is not newer than the session's last");
+      count(&BackendStats::replayed);
+      log("old hello", "ignored HELLO " + std::to_string(m.sequence) + " from " +
+                           from.toString() + ": not newer than the session's last");
       return;
     }
-    Session& s = sessions[m.session];
-    s.peer = from;
-    s.highest = m.sequence;
-    s.seen.insert(m.sequence);
-    s.active = SteadyClock::now();
+    const auto now = SteadyClock::now();
+    auto& open = challenges[m.session];
+    std::erase_if(open, [&](const Challenge& c) { return now - c.sent > kChallengeLifetime; });
+    auto same = std::find_if(open.begin(), open.end(),
+                             [&](const Challenge& c) { return c.client_nonce == m.nonce; });
+    if (same == open.end()) {
+      // A copy of a HELLO gets the same challenge again; a new nonce a new one.
+      if (open.size() >= kChallengesPerSession) open.erase(open.begin());
+      open.push_back({m.nonce, randomId(), m.sequence, now});
+      same = open.end() - 1;
+    }
+    if (challenges.size() > kMaxChallenges) {
+      // Forget the session whose newest challenge is the oldest (never the one just made).
+      auto oldest = challenges.end();
+      for (auto it = challenges.begin(); it != challenges.end(); ++it) {
+        if (it->first == m.session || it->second.empty()) continue;
+        if (oldest == challenges.end() || it->second.back().sent < oldest->second.back().sent)
+          oldest = it;
+      }
+      if (oldest != challenges.end()) challenges.erase(oldest);
+    }
     Message welcome = reply(m, MessageType::Welcome);
     welcome.watchdog_ms =
         watchdogActive() ? static_cast<std::uint32_t>(std::lround(options.watchdog_s * 1000)) : 0;
+    welcome.nonce = m.nonce;
+    welcome.challenge = same->backend_nonce;
+    welcome.stop_epoch = stop_epoch;
+    welcome.time_us = steadyMicros();
     send(welcome, from);
+  }
+
+  // BIND answers one of this session's open challenges: the client holds the key and saw this
+  // run's WELCOME just now. Binds the session to this run and to the sender's address.
+  void bind(const Message& m, const Endpoint& from) {
+    auto open = challenges.find(m.session);
+    const auto now = SteadyClock::now();
+    if (const auto known = sessions.find(m.session);
+        known != sessions.end() && known->second.bound_challenge == m.challenge &&
+        known->second.bind_sequence == m.sequence && known->second.peer == from) {
+      count(&BackendStats::duplicates);
+      Message bound = reply(m, MessageType::Bound);
+      bound.stop_epoch = stop_epoch;
+      send(bound, from);
+      return;
+    }
+    auto matches = [&](const Challenge& c) {
+      return c.backend_nonce == m.challenge && now - c.sent <= kChallengeLifetime &&
+             m.sequence > c.hello_sequence;
+    };
+    if (open == challenges.end() ||
+        std::none_of(open->second.begin(), open->second.end(), matches)) {
+      count(&BackendStats::replayed);
+      log("bind", "ignored BIND from " + from.toString() + ": no open challenge matches it");
+      return;
+    }
+    challenges.erase(open);  // answered: every open challenge of the session is spent
+    Session& s = sessions[m.session];
+    if (m.sequence <= s.highest) {
+      count(&BackendStats::replayed);
+      return;
+    }
+    s.peer = from;
+    s.highest = m.sequence;
+    s.seen.insert(m.sequence);
+    s.active = now;
+    s.bound_challenge = m.challenge;
+    s.bind_sequence = m.sequence;
+    Message bound = reply(m, MessageType::Bound);
+    bound.stop_epoch = stop_epoch;
+    send(bound, from);
   }
 
   void reject(const Message& m, const Endpoint& to, RejectReason reason, const std::string& text) {
@@ -276,9 +441,24 @@ struct RobotBackend::Impl {
   }
 
   void accept(const Message& m, Session& s) {
-    const Message accepted = reply(m, MessageType::Accepted);
+    Message accepted = reply(m, MessageType::Accepted);
+    accepted.stop_epoch = stop_epoch;
     s.replies[m.sequence] = accepted;
     send(accepted, s.peer);
+  }
+
+  // A heartbeat's send time, as the client puts it on this backend's clock: one sent longer ago
+  // than the watchdog (a delayed link, a client that stalled before sending) feeds nothing.
+  void heartbeat(const Message& m, Session& s) {
+    const std::int64_t now = steadyMicros();
+    const std::int64_t sent = std::min(m.time_us, now);  // a clock error cannot extend the deadline
+    s.last_heartbeat_age_us = now - sent;
+    if (watchdogActive() && now - sent > watchdogMicros()) count(&BackendStats::stale_heartbeats);
+    if (!s.heartbeat_us || sent > *s.heartbeat_us) s.heartbeat_us = sent;
+    s.abandon_below = std::max(s.abandon_below, m.abandon_below);
+    if (running && running->session == m.session && running->sequence < s.abandon_below)
+      latchStop("halted: the client gave up on the command",
+                "halted: the client gave up on the command");
   }
 
   void process(const Message& m, Session& s) {
@@ -288,68 +468,79 @@ struct RobotBackend::Impl {
         send(statusFor(m.session, m.sequence), s.peer);
         return;
       case MessageType::Heartbeat:
-        s.abandon_below = std::max(s.abandon_below, m.abandon_below);
-        if (running && running->session == m.session && running->sequence < s.abandon_below)
-          latchStop("halted: the client gave up on the command",
-                    "halted: the client gave up on the command");
+        heartbeat(m, s);
         return;
-      case MessageType::Stop: {
+      case MessageType::Stop:
         latchStop("emergency stop", "stopped by STOP");
-        // Everything sent before the STOP stays unrun, however late it arrives (and after a
-        // RESET too): this session's by sequence, other sessions' up to what they had sent.
-        for (auto& [id, other] : sessions) {
-          if (id != m.session)
-            other.abandon_below =
-                std::max(other.abandon_below, other.highest + (other.highest < UINT64_MAX));
-        }
-        s.abandon_below = std::max(s.abandon_below, m.sequence);
         accept(m, s);
         return;
-      }
       case MessageType::Reset:
-        if (!stop_reason.empty()) note("RESET: the stop (" + stop_reason + ") is lifted");
+        if (!stop_reason.empty()) {
+          // Commands made before now carry an older epoch: none of them runs, from any client.
+          ++stop_epoch;
+          note("RESET: the stop (" + stop_reason + ") is lifted; stop epoch " +
+               std::to_string(stop_epoch));
+        }
         stop_reason.clear();
         accept(m, s);
         return;
-      default: {
-        if (!isMotion(m.type)) return;
-        if (!stop_reason.empty()) {
-          reject(m, s.peer, RejectReason::Stopped,
-                 "the robot is stopped (" + stop_reason + "): RESET first");
-          return;
-        }
-        if (m.sequence < s.abandon_below) {
-          reject(m, s.peer, RejectReason::Cancelled,
-                 "sequence " + std::to_string(m.sequence) +
-                     " was given up by the client or sent before a STOP");
-          return;
-        }
-        if (running) {
-          reject(m, s.peer, RejectReason::Busy,
-                 std::string("busy with ") + toString(running->type) + " " +
-                     std::to_string(running->sequence));
-          return;
-        }
-        const DriverCommand command{m.type, m.target};
-        if (const auto refusal = driver->check(command)) {
-          reject(m, s.peer, refusal->reason, refusal->text);
-          return;
-        }
-        driver->start(command);
-        running = Running{m.session, m.sequence, m.type};
-        count(&BackendStats::executed);
-        accept(m, s);
-        if (m.type != MessageType::Home) {
-          // The robot's own record of where it went (a session's summary is checked against it).
-          char target[96];
-          std::snprintf(target, sizeof target, "(%.4f, %.4f, %.4f)", m.target.x, m.target.y,
-                        m.target.z);
-          note(std::string("ran ") + toString(m.type) + " " + std::to_string(m.sequence) + " at " +
-               target);
-        }
-        last_push = SteadyClock::now();
-      }
+      default:
+        if (isMotion(m.type)) motion(m, s);
     }
+  }
+
+  void motion(const Message& m, Session& s) {
+    if (!stop_reason.empty()) {
+      reject(m, s.peer, RejectReason::Stopped,
+             "the robot is stopped (" + stop_reason + "): RESET first");
+      return;
+    }
+    if (m.stop_epoch != stop_epoch) {
+      reject(m, s.peer, RejectReason::BeforeStop,
+             std::string(toString(m.type)) + " " + std::to_string(m.sequence) +
+                 " was made in stop epoch " + std::to_string(m.stop_epoch) + ", before the STOP " +
+                 "that a RESET lifted (epoch now " + std::to_string(stop_epoch) +
+                 "): it never runs; send it again if it is still wanted");
+      return;
+    }
+    if (m.sequence < s.abandon_below) {
+      reject(m, s.peer, RejectReason::Cancelled,
+             "sequence " + std::to_string(m.sequence) + " was given up by the client");
+      return;
+    }
+    if (running) {
+      reject(m, s.peer, RejectReason::Busy,
+             std::string("busy with ") + toString(running->type) + " " +
+                 std::to_string(running->sequence));
+      return;
+    }
+    const std::int64_t now_us = steadyMicros();
+    if (watchdogActive() && s.last_heartbeat_age_us > watchdogMicros()) {
+      // The link delays the heartbeats past the watchdog: it could not halt the arm in time.
+      reject(m, s.peer, RejectReason::Unreachable,
+             "the last heartbeat arrived " + std::to_string(s.last_heartbeat_age_us / 1000) +
+                 " ms after it was sent, over the watchdog's " +
+                 std::to_string(watchdogMicros() / 1000) + " ms: the link is too slow to move safely");
+      return;
+    }
+    const DriverCommand command{m.type, m.target};
+    if (const auto refusal = driver->check(command)) {
+      reject(m, s.peer, refusal->reason, refusal->text);
+      return;
+    }
+    driver->start(command);
+    running = Running{m.session, m.sequence, m.type, now_us};
+    count(&BackendStats::executed);
+    accept(m, s);
+    if (m.type != MessageType::Home) {
+      // The robot's own record of where it went (a session's summary is checked against it).
+      char target[96];
+      std::snprintf(target, sizeof target, "(%.4f, %.4f, %.4f)", m.target.x, m.target.y,
+                    m.target.z);
+      note(std::string("ran ") + toString(m.type) + " " + std::to_string(m.sequence) + " at " +
+           target);
+    }
+    last_push = SteadyClock::now();
   }
 
   // Stepped: the robot's time follows the requester's clock.
@@ -366,19 +557,21 @@ struct RobotBackend::Impl {
     if (!stepped_clock || clock_s > *stepped_clock) stepped_clock = clock_s;
   }
 
-  // When the watchdog must next look (nothing when no motion runs).
-  std::optional<SteadyClock::time_point> watchdogDeadline() const {
+  // When the watchdog halts the running motion (nothing when none runs): the watchdog time after
+  // the later of its start and the newest heartbeat's send time.
+  std::optional<std::int64_t> watchdogDeadlineUs() const {
     if (!running || !watchdogActive()) return std::nullopt;
+    std::int64_t fed = running->started_us;
     const auto found = sessions.find(running->session);
-    if (found == sessions.end()) return SteadyClock::now();
-    return found->second.active + std::chrono::duration_cast<SteadyClock::duration>(
-                                      std::chrono::duration<double>(options.watchdog_s));
+    if (found != sessions.end() && found->second.heartbeat_us)
+      fed = std::max(fed, *found->second.heartbeat_us);
+    return fed + watchdogMicros();
   }
 
   void advance() {
     const auto now = SteadyClock::now();
-    if (const auto deadline = watchdogDeadline(); deadline && now >= *deadline) {
-      latchStop("halted: link lost", "halted: link lost (no heartbeat from the client)");
+    if (const auto deadline = watchdogDeadlineUs(); deadline && steadyMicros() >= *deadline) {
+      latchStop("halted: link lost", "halted: link lost (no fresh heartbeat from the client)");
       count(&BackendStats::watchdog_halts);
     }
     const double elapsed = std::chrono::duration<double>(now - last_step).count();
@@ -420,26 +613,44 @@ void RobotBackend::poll(int wait_ms) {
   Impl& m = *impl_;
   // Never sleep past the watchdog's deadline: the halt comes on time, not a poll later.
   auto wait = std::chrono::microseconds(wait_ms * 1000LL);
-  if (const auto deadline = m.watchdogDeadline()) {
-    wait = std::clamp(std::chrono::ceil<std::chrono::microseconds>(*deadline - SteadyClock::now()),
+  if (const auto deadline = m.watchdogDeadlineUs()) {
+    wait = std::clamp(std::chrono::microseconds(*deadline - steadyMicros()),
                       std::chrono::microseconds(0), wait);
   }
   m.socket.wait(wait);
-  for (int i = 0; i < 256; ++i) {  // bounded, so a flood cannot starve the arm
+  // Bounded, so a flood cannot starve the arm; the bound clients' datagrams (a STOP, the
+  // heartbeats) are handled before the rest of the batch.
+  std::vector<Datagram> later;
+  for (int i = 0; i < 256; ++i) {
     auto datagram = m.socket.receive();
     if (!datagram) break;
-    m.handle(*datagram);
+    if (m.fromBoundPeer(*datagram)) {
+      m.handle(*datagram);
+    } else {
+      later.push_back(std::move(*datagram));
+    }
   }
+  for (const Datagram& d : later) m.handle(d);
   m.advance();
 }
 
 void RobotBackend::run(const std::atomic<bool>& stop) {
+  if (impl_->options.raise_priority) {
+    const std::string got = raiseThreadPriority();
+    std::lock_guard lock(impl_->stats_mutex);
+    impl_->priority = got;
+  }
   while (!stop.load()) poll(5);
 }
 
 BackendStats RobotBackend::stats() const {
   std::lock_guard lock(impl_->stats_mutex);
   return impl_->stats;
+}
+
+std::string RobotBackend::priority() const {
+  std::lock_guard lock(impl_->stats_mutex);
+  return impl_->priority;
 }
 
 }  // namespace arbci::robot

@@ -1,15 +1,13 @@
 #include "arbci/robot/client.h"
 
 #include <openssl/rand.h>
-#include <pthread.h>
-#include <sched.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
+
+#include "arbci/robot/thread_priority.h"
 
 namespace arbci::robot {
 namespace {
@@ -24,9 +22,21 @@ RobotEvent event(RobotEvent::Kind kind, std::string text) {
   return {kind, 0, MessageType::Status, {}, {}, std::move(text)};
 }
 
-RobotEvent failure(std::uint64_t sequence, MessageType type, std::string text) {
-  return {RobotEvent::Kind::Failed, sequence, type, {}, Outcome::Failed, std::move(text)};
+RobotEvent failure(std::uint64_t sequence, MessageType type, std::string text,
+                   bool may_have_run) {
+  return {RobotEvent::Kind::Failed, sequence, type, {},
+          Outcome::Failed,          std::move(text), may_have_run};
 }
+
+std::uint64_t randomNonce() {
+  std::uint64_t n = 0;
+  while (n == 0) RAND_bytes(reinterpret_cast<unsigned char*>(&n), sizeof n);
+  return n;
+}
+
+// Offset samples kept (about 6 s of statuses at 5 a second): long enough to hold one taken on a
+// quiet link, short enough that clock drift between machines does not matter.
+constexpr size_t kOffsetSamples = 32;
 
 }  // namespace
 
@@ -69,44 +79,31 @@ RobotClient::~RobotClient() {
   if (heartbeat_.joinable()) heartbeat_.join();
 }
 
-namespace {
-// The heartbeat must not share the fate of a busy machine: the highest priority this process may
-// take (real-time FIFO where it may, else the lowest nice value allowed, else as it is). It sleeps
-// between beats, so it takes almost nothing from the rest.
-std::string raiseThisThread() {
-  sched_param param{};
-  param.sched_priority = sched_get_priority_max(SCHED_FIFO);
-  if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0)
-    return "real-time (FIFO " + std::to_string(param.sched_priority) + ")";
-  rlimit limit{};
-  int lowest = 0;
-  if (getrlimit(RLIMIT_NICE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
-    lowest = 20 - static_cast<int>(limit.rlim_cur);  // RLIMIT_NICE is 20 - the lowest nice
-  for (int nice = -20; nice < 0; ++nice) {
-    if (nice < lowest) continue;
-    if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice) == 0)
-      return "nice " + std::to_string(nice);
-  }
-  return "normal (the process may not raise a thread's priority)";
-}
-}  // namespace
-
-// While connected, whatever the cycle is doing: the backend halts a motion when these stop. Shares
-// with the cycle only atomics and the socket (a send is one system call).
+// While connected, whatever the cycle is doing: the backend halts a motion when these stop or
+// arrive late. Each carries its send time on the backend's clock, so a heartbeat delayed by the
+// link (or by this thread's starvation before the send) counts as missing. Shares with the
+// cycle only atomics and the socket (a send is one system call). It takes the highest priority
+// the process may: a busy machine must not starve it into a false halt.
 void RobotClient::heartbeatLoop() {
   {
-    const std::string priority = raiseThisThread();
+    const std::string priority = raiseThreadPriority();
     std::lock_guard lock(priority_mutex_);
     heartbeat_priority_ = priority;
   }
   const auto period = seconds(1.0 / options_.heartbeat_hz);
   std::unique_lock lock(heartbeat_mutex_);
   while (!heartbeat_wake_.wait_for(lock, period, [this] { return stopping_; })) {
-    if (!connected_) continue;
+    if (!connected_ || !offset_known_) continue;
     Message m = fresh(MessageType::Heartbeat, next_sequence_++);
     m.abandon_below = abandon_below_;
+    m.time_us = steadyMicros() + offset_us_.load();
     socket_.sendTo(encode(m, key_), backend_);
   }
+}
+
+std::optional<std::int64_t> RobotClient::clockOffsetUs() const {
+  if (!offset_known_) return std::nullopt;
+  return offset_us_.load();
 }
 
 Message RobotClient::fresh(MessageType type, std::uint64_t sequence) const {
@@ -119,24 +116,27 @@ Message RobotClient::fresh(MessageType type, std::uint64_t sequence) const {
   return m;
 }
 
+// Every HELLO has a nonce of its own; the WELCOME that echoes one of the last few is the
+// backend's answer now, not a copy of an old one.
 void RobotClient::sendHello() {
-  socket_.sendTo(encode(fresh(MessageType::Hello, next_sequence_++), key_), backend_);
+  Message m = fresh(MessageType::Hello, next_sequence_++);
+  m.nonce = randomNonce();
+  hellos_.emplace_back(m.nonce, steadyMicros());
+  if (hellos_.size() > 8) hellos_.erase(hellos_.begin());
+  socket_.sendTo(encode(m, key_), backend_);
   next_hello_ = Clock::now() + seconds(hello_interval_);
   hello_interval_ = std::min(hello_interval_ * 2.0, options_.max_retransmit_s);
 }
 
+void RobotClient::sendStatus(std::uint64_t sequence, std::optional<double> clock_s) {
+  Message m = fresh(MessageType::Status, sequence);
+  m.clock_s = clock_s;
+  status_sent_.emplace_back(sequence, steadyMicros());
+  if (status_sent_.size() > 16) status_sent_.erase(status_sent_.begin());
+  socket_.sendTo(encode(m, key_), backend_);
+}
+
 std::uint64_t RobotClient::send(MessageType type, const Vec3& target) {
-  if (type == MessageType::Stop) {
-    // Nothing sent before a STOP may start after it: the backend refuses it too, however late.
-    // (An accepted one is halted by the STOP and finishes "stopped".)
-    std::vector<Pending> cancelled;
-    for (const Pending& p : pending_) {
-      if (isMotion(p.type) && !p.accepted) cancelled.push_back(p);
-    }
-    for (const Pending& p : cancelled)
-      complete(p.sequence, failure(p.sequence, p.type,
-                                   std::string(toString(p.type)) + " cancelled: STOP sent"));
-  }
   Pending p;
   p.sequence = next_sequence_++;
   p.type = type;
@@ -150,9 +150,23 @@ std::uint64_t RobotClient::send(MessageType type, const Vec3& target) {
 }
 
 void RobotClient::transmit(Pending& p) {
+  if (isMotion(p.type) && !p.epoch) {
+    // Made after a RESET of this client that the backend has not confirmed: it waits for the
+    // RESET's epoch (stamped with the old one it could never run).
+    const bool reset_pending = std::any_of(pending_.begin(), pending_.end(), [&](const Pending& q) {
+      return q.type == MessageType::Reset && q.sequence < p.sequence;
+    });
+    if (reset_pending) {
+      p.next_send = Clock::now() + seconds(p.interval);
+      return;
+    }
+    p.epoch = epoch_;
+  }
   Message m = fresh(p.type, p.sequence);
   m.target = p.target;
+  m.stop_epoch = p.epoch.value_or(0);
   socket_.sendTo(encode(m, key_), backend_);
+  if (!p.transmitted) p.transmitted = true;
   p.next_send = Clock::now() + seconds(p.interval);
   p.interval = std::min(p.interval * 2.0, options_.max_retransmit_s);
 }
@@ -197,24 +211,84 @@ void RobotClient::markAccepted(Pending& p) {
   }
 }
 
-// The backend run this client was bound to is gone: whatever was pending fails (an accepted
-// command died with it; one not yet accepted is never sent to the new run), and the client
-// binds to the new run.
+// The backend run this client was bound to is gone (a WELCOME answering this client's fresh
+// HELLO came from another run): whatever was pending fails, saying whether it may have run on
+// the old run; none is sent to the new run.
 void RobotClient::restarted() {
   events_.push_back(event(RobotEvent::Kind::Restarted, "the backend restarted"));
   const std::vector<Pending> lost = pending_;
   for (const Pending& p : lost) {
     const std::string name = toString(p.type);
-    complete(p.sequence,
-             failure(p.sequence, p.type,
-                     p.accepted ? name + " lost: the backend restarted during the command"
-                                : name + " not confirmed: the backend restarted before accepting "
-                                         "it; it is not sent to the new run"));
+    std::string text =
+        p.accepted ? name + " ran on the backend's previous run, which restarted during it: how "
+                            "far it got is unknown"
+        : p.transmitted
+            ? name + " may have run: the backend restarted before answering it; it is not sent "
+                     "to the new run"
+            : name + " not run: never sent before the backend restarted; it is not sent to the "
+                     "new run";
+    complete(p.sequence, failure(p.sequence, p.type, std::move(text), p.transmitted));
   }
   connected_ = false;
   boot_ = 0;
-  hello_interval_ = options_.first_retransmit_s;
-  sendHello();
+  offsets_.clear();
+  offset_known_ = false;
+}
+
+void RobotClient::clockSample(std::int64_t sent_us, std::int64_t backend_us) {
+  const std::int64_t now = steadyMicros();
+  offsets_.emplace_back(now - sent_us, backend_us - (sent_us + now) / 2);
+  if (offsets_.size() > kOffsetSamples) offsets_.erase(offsets_.begin());
+  const auto best = std::min_element(offsets_.begin(), offsets_.end());
+  offset_us_ = best->second;
+  offset_known_ = true;
+}
+
+// A WELCOME echoing one of this client's recent nonces: the backend answers now. Another boot id
+// than the bound one is a restart; either way the client answers the challenge (BIND).
+bool RobotClient::welcome(const Message& m) {
+  const auto asked = std::find_if(hellos_.begin(), hellos_.end(),
+                                  [&](const auto& h) { return h.first == m.nonce; });
+  if (asked == hellos_.end()) return false;  // an old WELCOME, or a replay: not an answer now
+  const std::int64_t sent_us = asked->second;
+  hellos_.clear();
+  if (boot_ != 0 && m.boot != boot_) restarted();
+  if (m.boot != boot_) offsets_.clear();
+  clockSample(sent_us, m.time_us);
+  binding_boot_ = m.boot;
+  bind_challenge_ = m.challenge;
+  bind_sequence_ = next_sequence_++;
+  bind_started_ = Clock::now();
+  bind_interval_ = options_.first_retransmit_s;
+  watchdog_ms_ = m.watchdog_ms;
+  sendBind();
+  return true;
+}
+
+// Retransmitted (the same sequence and challenge) until BOUND, as commands are.
+void RobotClient::sendBind() {
+  Message bind = fresh(MessageType::Bind, bind_sequence_);
+  bind.boot = binding_boot_;
+  bind.challenge = bind_challenge_;
+  socket_.sendTo(encode(bind, key_), backend_);
+  next_bind_ = Clock::now() + seconds(bind_interval_);
+  bind_interval_ = std::min(bind_interval_ * 2.0, options_.max_retransmit_s);
+}
+
+// The backend took the BIND: commands go to this run now.
+void RobotClient::bound(const Message& m) {
+  bind_sequence_ = 0;
+  boot_ = m.boot;
+  epoch_ = m.stop_epoch;
+  if (connected_) return;  // a rebinding (after silence): nothing else changes
+  connected_ = true;
+  events_.push_back(
+      event(RobotEvent::Kind::Connected,
+            "bound to backend run " + std::to_string(m.boot) +
+                (watchdog_ms_ ? ", watchdog " + std::to_string(watchdog_ms_) + " ms"
+                              : ", no watchdog")));
+  next_status_ = Clock::now();
+  for (Pending& p : pending_) transmit(p);
 }
 
 void RobotClient::handle(const Message& m) {
@@ -222,30 +296,28 @@ void RobotClient::handle(const Message& m) {
   const double skew =
       std::abs(static_cast<double>(wallClockMs()) - static_cast<double>(m.timestamp_ms)) / 1000.0;
   if (skew > 30.0) return;  // a stale reply: ignore it
+  if (m.type == MessageType::Welcome) {
+    if (!welcome(m)) return;
+  } else if (m.type == MessageType::Bound && bind_sequence_ != 0 &&
+             m.sequence == bind_sequence_ && m.boot == binding_boot_) {
+    bound(m);
+  } else if (boot_ == 0 || m.boot != boot_) {
+    // From a run this client is not bound to: a replayed reply, or a sign of a restart. Only a
+    // WELCOME answering a fresh HELLO can tell which, so ask (at the HELLO back-off).
+    if (bind_sequence_ == 0 && Clock::now() >= next_hello_) sendHello();
+    return;
+  }
   last_heard_ = Clock::now();
   heard_ = true;
   if (silent_) {
     silent_ = false;
     events_.push_back(event(RobotEvent::Kind::Reachable, "the backend answers again"));
   }
-  if (boot_ != 0 && m.boot != boot_) restarted();
-  if (m.type == MessageType::Welcome) {
-    if (connected_) return;  // a copy of the answer to an earlier HELLO
-    boot_ = m.boot;
-    connected_ = true;
-    events_.push_back(
-        event(RobotEvent::Kind::Connected,
-              "bound to backend run " + std::to_string(m.boot) +
-                  (m.watchdog_ms ? ", watchdog " + std::to_string(m.watchdog_ms) + " ms"
-                                 : ", no watchdog")));
-    next_status_ = Clock::now();
-    for (Pending& p : pending_) transmit(p);
-    return;
-  }
-  if (!connected_ || m.boot != boot_) return;  // from a run this client is not bound to
+  if (!connected_ || m.boot != boot_) return;
   Pending* p = find(m.sequence);
   switch (m.type) {
     case MessageType::Accepted:
+      epoch_ = std::max(epoch_, m.stop_epoch);
       if (p) markAccepted(*p);
       break;
     case MessageType::Rejected:
@@ -264,6 +336,13 @@ void RobotClient::handle(const Message& m) {
       break;
     case MessageType::StatusReply: {
       status_ = m.status;
+      epoch_ = std::max(epoch_, m.status.stop_epoch);
+      const auto asked = std::find_if(status_sent_.begin(), status_sent_.end(),
+                                      [&](const auto& q) { return q.first == m.sequence; });
+      if (asked != status_sent_.end()) {
+        clockSample(asked->second, m.status.backend_time_us);
+        status_sent_.erase(asked);
+      }
       if (sync_sequence_ != 0 && m.sequence == sync_sequence_) synced_ = true;
       // A lost ACCEPTED shows in the status as this session's running command...
       if (m.status.current_is_yours) {
@@ -298,8 +377,17 @@ void RobotClient::poll() {
     if (decoded.ok()) handle(decoded.message);
   }
   const auto now = Clock::now();
+  // Answering a challenge: BIND until BOUND; a challenge unanswered for long may have expired
+  // (or its WELCOME came from a run now gone): start again with a HELLO.
+  if (bind_sequence_ != 0) {
+    if (now - bind_started_ > seconds(2.0)) {
+      bind_sequence_ = 0;
+    } else if (now >= next_bind_) {
+      sendBind();
+    }
+  }
   // Not bound (or silent, when the backend may have lost our address): HELLO, with back-off.
-  if ((!connected_ || silent_) && now >= next_hello_) sendHello();
+  if ((!connected_ || silent_) && bind_sequence_ == 0 && now >= next_hello_) sendHello();
   std::vector<Pending> expired;
   for (Pending& p : pending_) {
     if (p.accepted) continue;
@@ -310,15 +398,19 @@ void RobotClient::poll() {
     }
   }
   for (const Pending& p : expired) {
+    const std::string name = toString(p.type);
     complete(p.sequence,
              failure(p.sequence, p.type,
-                     std::string(toString(p.type)) +
-                         " was never accepted: no answer from the backend (given up; it will "
-                         "not run later)"));
+                     p.transmitted
+                         ? name + " may have run: sent, but no answer from the backend (given "
+                                  "up; the backend will not start it later once it hears this "
+                                  "client's heartbeat)"
+                         : name + " not run: never sent, no backend run bound this client",
+                     p.transmitted));
   }
   if (connected_ && now >= next_status_) {
     next_status_ = now + seconds(options_.status_interval_s);
-    socket_.sendTo(encode(fresh(MessageType::Status, next_sequence_++), key_), backend_);
+    sendStatus(next_sequence_++, std::nullopt);
   }
   const auto quiet_since = heard_ ? last_heard_ : created_;
   if (!silent_ && now - quiet_since > seconds(options_.silence_s)) {
@@ -336,9 +428,7 @@ bool RobotClient::syncClock(double clock_s, double timeout_s) {
   while (!synced_ && Clock::now() < give_up) {
     if (connected_ && Clock::now() >= resend) {
       if (sync_sequence_ == 0) sync_sequence_ = next_sequence_++;
-      Message m = fresh(MessageType::Status, sync_sequence_);
-      m.clock_s = clock_s;
-      socket_.sendTo(encode(m, key_), backend_);
+      sendStatus(sync_sequence_, clock_s);
       resend = Clock::now() + seconds(0.05);
     }
     socket_.wait(2);

@@ -95,8 +95,12 @@ std::array<std::uint8_t, kMacBytes> mac(const std::uint8_t* data, size_t size, c
 }
 
 bool validType(std::uint8_t t) {
-  return (t >= 1 && t <= 8) || (t >= 0x81 && t <= 0x85);
+  return (t >= 1 && t <= 9) || (t >= 0x81 && t <= 0x86);
 }
+
+// A HELLO is padded to the size of the WELCOME it asks for, so that a HELLO replayed with
+// another sender's address cannot make the backend send more bytes than it was sent.
+constexpr size_t kHelloPadding = 28;
 bool finite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -106,15 +110,35 @@ void writePayload(Writer& w, const Message& m) {
     case MessageType::Grasp:
     case MessageType::Drop:
       w.vec(m.target);
+      w.integer(m.stop_epoch);
+      break;
+    case MessageType::Home:
+      w.integer(m.stop_epoch);
       break;
     case MessageType::Status:
       if (m.clock_s) w.real(*m.clock_s);
       break;
+    case MessageType::Hello:
+      w.integer(m.nonce);
+      for (size_t i = 0; i < kHelloPadding; ++i) w.integer(std::uint8_t{0});
+      break;
+    case MessageType::Bind:
+      w.integer(m.challenge);
+      break;
     case MessageType::Heartbeat:
       w.integer(m.abandon_below);
+      w.integer(m.time_us);
       break;
     case MessageType::Welcome:
       w.integer(m.watchdog_ms);
+      w.integer(m.nonce);
+      w.integer(m.challenge);
+      w.integer(m.time_us);
+      w.integer(m.stop_epoch);
+      break;
+    case MessageType::Accepted:
+    case MessageType::Bound:
+      w.integer(m.stop_epoch);
       break;
     case MessageType::Rejected:
       w.integer(static_cast<std::uint8_t>(m.reason));
@@ -138,6 +162,8 @@ void writePayload(Writer& w, const Message& m) {
       w.integer(static_cast<std::uint8_t>(s.last_outcome));
       w.text(s.last_outcome_text.substr(0, 200));
       w.text(s.stop_reason.substr(0, 200));
+      w.integer(s.stop_epoch);
+      w.integer(s.backend_time_us);
       const size_t n = std::min<size_t>(s.objects.size(), kMaxWorldObjects);
       w.integer(static_cast<std::uint8_t>(n));
       for (size_t i = 0; i < n; ++i) {
@@ -157,7 +183,24 @@ bool readPayload(Reader& r, Message& m) {
     case MessageType::Grasp:
     case MessageType::Drop:
       m.target = r.vec();
+      m.stop_epoch = r.integer<std::uint64_t>();
       return !r.failed && finite(m.target);
+    case MessageType::Home:
+      m.stop_epoch = r.integer<std::uint64_t>();
+      return !r.failed;
+    case MessageType::Hello: {
+      m.nonce = r.integer<std::uint64_t>();
+      bool zero = true;
+      for (size_t i = 0; i < kHelloPadding; ++i) zero &= r.integer<std::uint8_t>() == 0;
+      return !r.failed && zero;
+    }
+    case MessageType::Bind:
+      m.challenge = r.integer<std::uint64_t>();
+      return !r.failed;
+    case MessageType::Accepted:
+    case MessageType::Bound:
+      m.stop_epoch = r.integer<std::uint64_t>();
+      return !r.failed;
     case MessageType::Status:
       // Empty, or the requester's clock for a stepped backend.
       if (r.done()) return true;
@@ -165,13 +208,18 @@ bool readPayload(Reader& r, Message& m) {
       return !r.failed && std::isfinite(*m.clock_s) && *m.clock_s >= 0.0;
     case MessageType::Heartbeat:
       m.abandon_below = r.integer<std::uint64_t>();
+      m.time_us = r.integer<std::int64_t>();
       return !r.failed;
     case MessageType::Welcome:
       m.watchdog_ms = r.integer<std::uint32_t>();
+      m.nonce = r.integer<std::uint64_t>();
+      m.challenge = r.integer<std::uint64_t>();
+      m.time_us = r.integer<std::int64_t>();
+      m.stop_epoch = r.integer<std::uint64_t>();
       return !r.failed;
     case MessageType::Rejected: {
       const auto reason = r.integer<std::uint8_t>();
-      if (reason < 1 || reason > 10) return false;
+      if (reason < 1 || reason > 11) return false;
       m.reason = static_cast<RejectReason>(reason);
       m.text = r.text();
       return !r.failed;
@@ -192,7 +240,7 @@ bool readPayload(Reader& r, Message& m) {
       s.gripper_opening = r.real();
       s.holding = r.integer<std::int32_t>();
       const auto command = r.integer<std::uint8_t>();
-      if (command < 1 || command > 8) return false;
+      if (command < 1 || command > 9) return false;
       s.current_command = static_cast<MessageType>(command);
       s.current_sequence = r.integer<std::uint64_t>();
       const auto yours = r.integer<std::uint8_t>();
@@ -205,6 +253,8 @@ bool readPayload(Reader& r, Message& m) {
       s.last_outcome = static_cast<Outcome>(outcome);
       s.last_outcome_text = r.text();
       s.stop_reason = r.text();
+      s.stop_epoch = r.integer<std::uint64_t>();
+      s.backend_time_us = r.integer<std::int64_t>();
       const auto n = r.integer<std::uint8_t>();
       if (n > kMaxWorldObjects) return false;
       for (int i = 0; i < n && !r.failed; ++i) {
@@ -273,6 +323,17 @@ Decoded decode(const std::uint8_t* data, size_t size, const Key& key) {
   return result;
 }
 
+std::optional<Peek> peek(const std::uint8_t* data, size_t size) {
+  if (size < kHeaderBytes + kMacBytes || size > kMaxDatagram) return std::nullopt;
+  if (std::memcmp(data, "ARBR", 4) != 0 || data[4] != kProtocolVersion) return std::nullopt;
+  if (data[6] != 0 || data[7] != 0 || !validType(data[5])) return std::nullopt;
+  const size_t payload = static_cast<size_t>(data[40]) | (static_cast<size_t>(data[41]) << 8);
+  if (kHeaderBytes + payload + kMacBytes != size) return std::nullopt;
+  std::uint64_t session = 0;
+  for (size_t i = 0; i < 8; ++i) session |= static_cast<std::uint64_t>(data[8 + i]) << (8 * i);
+  return Peek{static_cast<MessageType>(data[5]), session};
+}
+
 bool isCommand(MessageType type) {
   return static_cast<std::uint8_t>(type) < 0x80;
 }
@@ -297,10 +358,14 @@ const char* toString(MessageType type) {
       return "HELLO";
     case MessageType::Reset:
       return "RESET";
+    case MessageType::Bind:
+      return "BIND";
     case MessageType::Heartbeat:
       return "HEARTBEAT";
     case MessageType::Welcome:
       return "WELCOME";
+    case MessageType::Bound:
+      return "BOUND";
     case MessageType::Accepted:
       return "ACCEPTED";
     case MessageType::Finished:
@@ -335,6 +400,8 @@ const char* toString(RejectReason reason) {
       return "another backend run";
     case RejectReason::Cancelled:
       return "cancelled";
+    case RejectReason::BeforeStop:
+      return "made before a STOP";
   }
   return "unknown";
 }
@@ -389,6 +456,12 @@ const char* toString(DecodeError error) {
       return "malformed payload";
   }
   return "unknown";
+}
+
+std::int64_t steadyMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 std::uint64_t wallClockMs() {

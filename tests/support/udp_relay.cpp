@@ -23,6 +23,22 @@ void UdpRelay::setCut(bool cut) {
   cut_ = cut;
 }
 
+void UdpRelay::setDelay(std::chrono::milliseconds delay) {
+  std::lock_guard lock(mutex_);
+  delay_ = delay;
+}
+
+// Called with the mutex held.
+void UdpRelay::forward(Bytes bytes, bool to_backend) {
+  if (delay_.count() > 0) {
+    delayed_.push_back({std::chrono::steady_clock::now() + delay_, std::move(bytes), to_backend});
+  } else if (to_backend) {
+    back_.sendTo(bytes, backend_);
+  } else if (client_) {
+    front_.sendTo(bytes, *client_);
+  }
+}
+
 void UdpRelay::hold(robot::MessageType command) {
   std::lock_guard lock(mutex_);
   holding_.insert(command);
@@ -60,13 +76,27 @@ std::vector<robot::Message> UdpRelay::replies() const {
   return replies_;
 }
 
+std::vector<UdpRelay::Bytes> UdpRelay::capturedReplies(robot::MessageType reply) const {
+  std::lock_guard lock(mutex_);
+  std::vector<Bytes> out;
+  for (const auto& [type, bytes] : captured_replies_) {
+    if (type == reply) out.push_back(bytes);
+  }
+  return out;
+}
+
+void UdpRelay::injectReply(const Bytes& bytes) {
+  std::lock_guard lock(mutex_);
+  if (client_) front_.sendTo(bytes, *client_);
+}
+
 bool UdpRelay::lose(double probability) {
   return probability > 0.0 &&
          std::uniform_real_distribution<double>(0.0, 1.0)(random_) < probability;
 }
 
 void UdpRelay::run() {
-  std::optional<robot::Endpoint> client;
+  std::optional<robot::Endpoint>& client = client_;
   while (!stop_) {
     front_.wait(1);
     std::lock_guard lock(mutex_);
@@ -79,19 +109,32 @@ void UdpRelay::run() {
       } else if (decoded.ok() && holding_.count(decoded.message.type)) {
         held_.emplace_back(decoded.message.sequence, d->bytes);
       } else {
-        back_.sendTo(d->bytes, backend_);
+        forward(std::move(d->bytes), true);
       }
     }
     while (auto d = back_.receive()) {
       const robot::Decoded decoded = robot::decode(d->bytes.data(), d->bytes.size(), key_);
-      if (decoded.ok()) replies_.push_back(decoded.message);
+      if (decoded.ok()) {
+        replies_.push_back(decoded.message);
+        captured_replies_.emplace_back(decoded.message.type, d->bytes);
+      }
       if (!client || cut_ || lose(loss_to_client_) ||
           (decoded.ok() && dropping_.count(decoded.message.type))) {
         ++dropped_;
       } else {
-        front_.sendTo(d->bytes, *client);
+        forward(std::move(d->bytes), false);
       }
     }
+    const auto now = std::chrono::steady_clock::now();
+    for (const Delayed& d : delayed_) {
+      if (d.due > now) continue;
+      if (d.to_backend) {
+        back_.sendTo(d.bytes, backend_);
+      } else if (client) {
+        front_.sendTo(d.bytes, *client);
+      }
+    }
+    std::erase_if(delayed_, [&](const Delayed& d) { return d.due <= now; });
   }
 }
 

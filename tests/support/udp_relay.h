@@ -31,6 +31,9 @@ class UdpRelay {
   void setLoss(double to_backend, double to_client);
   // Everything, both ways, is dropped while cut.
   void setCut(bool cut);
+  // Everything forwarded from now on, both ways, arrives this much later (a congested or
+  // stalled link).
+  void setDelay(std::chrono::milliseconds delay);
   // Commands of this type from the client are held back from now on until release().
   void hold(robot::MessageType command);
   // Sends the held copies of command `sequence` to the backend (in arrival order).
@@ -42,10 +45,15 @@ class UdpRelay {
   std::vector<Bytes> captured(robot::MessageType command) const;
   // The backend's replies that reached the relay (dropped ones included).
   std::vector<robot::Message> replies() const;
+  // Copies of the backend's replies of this type, as sent (to replay them).
+  std::vector<Bytes> capturedReplies(robot::MessageType reply) const;
+  // Sends `bytes` to the client as if the backend had (a replay from the backend's address).
+  void injectReply(const Bytes& bytes);
   std::uint64_t dropped() const { return dropped_; }
 
  private:
   void run();
+  void forward(Bytes bytes, bool to_backend);
   bool lose(double probability);
 
   robot::UdpSocket front_, back_;
@@ -55,10 +63,19 @@ class UdpRelay {
   mutable std::mutex mutex_;
   double loss_to_backend_ = 0.0, loss_to_client_ = 0.0;
   bool cut_ = false;
+  std::chrono::milliseconds delay_{0};
+  struct Delayed {
+    std::chrono::steady_clock::time_point due;
+    Bytes bytes;
+    bool to_backend;
+  };
+  std::vector<Delayed> delayed_;
   std::set<robot::MessageType> holding_, dropping_;
   std::vector<std::pair<std::uint64_t, Bytes>> held_;  // by command sequence
   std::vector<std::pair<robot::MessageType, Bytes>> captured_;
   std::vector<robot::Message> replies_;
+  std::vector<std::pair<robot::MessageType, Bytes>> captured_replies_;
+  std::optional<robot::Endpoint> client_;
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<bool> stop_{false};
   std::thread thread_;

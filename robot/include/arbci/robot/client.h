@@ -1,12 +1,15 @@
-// The client the session's cycle uses: never blocks. It binds to one run of the backend (HELLO;
-// the WELCOME's boot id goes with every command), and a thread of its own sends heartbeats while
-// connected, so the backend's watchdog halts the arm when this process or the link dies. send()
-// queues a command; poll() (once a frame) retransmits with back-off until the backend accepts,
-// asks for the status five times a second, and turns what arrives into events: accepted
-// (from the reply or from a status showing the command running), rejected (with the reason),
-// finished (with the outcome), and failures the backend cannot report itself: silence for a
-// second, a restart (every pending command fails and is never sent to the new run), no answer
-// at all (the command is given up and, through the heartbeat, never started later).
+// The client the session's cycle uses: never blocks. It binds to one run of the backend (HELLO
+// with a fresh nonce, the WELCOME that echoes it, BIND answering the WELCOME's challenge; the
+// run's boot id and stop epoch go with every command), and a thread of its own sends heartbeats
+// while connected, stamped with their send time on the backend's clock (the offset estimated
+// from the WELCOME and the status round trips), so the backend's watchdog halts the arm when this
+// process or the link dies or slows. send() queues a command; poll() (once a frame) retransmits
+// with back-off until the backend answers, asks for the status five times a second, and turns
+// what arrives into events with three honest answers: the command ran (accepted, finished with
+// its outcome), did not run (rejected, with the backend's reason, or never sent), or may have run
+// (failed with `may_have_run`: the backend restarted or fell silent after it may have received
+// the command). A reply from another backend run is only a reason to ask (a fresh HELLO): a
+// restart is believed when a WELCOME answering this client's own fresh nonce shows it.
 #pragma once
 
 #include <atomic>
@@ -49,6 +52,9 @@ struct RobotEvent {
   RejectReason reason = RejectReason::Malformed;
   Outcome outcome = Outcome::Success;
   std::string text;
+  // Failed: true when the backend may have received the command and run it (it restarted or went
+  // silent before saying); false when it certainly did not run (it was never sent).
+  bool may_have_run = false;
 };
 
 const char* toString(RobotEvent::Kind kind);
@@ -61,7 +67,9 @@ class RobotClient {
   RobotClient& operator=(const RobotClient&) = delete;
 
   // Queues a command (GRASP, DROP, HOME, STOP, RESET); returns its sequence number. It goes out
-  // once connected. A STOP cancels every other pending command: they fail and never run.
+  // once connected, a motion stamped with the stop epoch this client knows then (after a RESET
+  // of its own, with the RESET's). After a STOP the backend refuses every motion made before it:
+  // the pending ones are still sent until the backend says whether they ran.
   std::uint64_t send(MessageType type, const Vec3& target = {});
   void poll();
   // The next poll() asks for a status at once rather than at the status interval (the session
@@ -84,6 +92,10 @@ class RobotClient {
     return heartbeat_priority_;
   }
   bool busy() const { return !pending_.empty(); }  // commands not yet finished
+  // The stop epoch this client's new motion commands carry (0 before the first WELCOME).
+  std::uint64_t stopEpoch() const { return epoch_; }
+  // The estimated offset of the backend's clock from this one (microseconds), if known.
+  std::optional<std::int64_t> clockOffsetUs() const;
   // Whether command `sequence` is known to have been accepted (and so may have moved the arm).
   bool accepted(std::uint64_t sequence) const;
 
@@ -92,6 +104,8 @@ class RobotClient {
     std::uint64_t sequence = 0;
     MessageType type = MessageType::Home;
     Vec3 target;
+    std::optional<std::uint64_t> epoch;  // stamped at the first transmission
+    bool transmitted = false;            // it may have reached the backend
     bool accepted = false;
     std::chrono::steady_clock::time_point first_sent, next_send;
     double interval = 0.05;
@@ -100,7 +114,12 @@ class RobotClient {
   Message fresh(MessageType type, std::uint64_t sequence) const;
   void transmit(Pending& p);
   void sendHello();
+  void sendBind();
+  void sendStatus(std::uint64_t sequence, std::optional<double> clock_s);
   void handle(const Message& m);
+  bool welcome(const Message& m);
+  void bound(const Message& m);
+  void clockSample(std::int64_t sent_us, std::int64_t backend_us);
   void restarted();
   Pending* find(std::uint64_t sequence);
   void complete(std::uint64_t sequence, RobotEvent event);
@@ -122,6 +141,19 @@ class RobotClient {
   std::atomic<std::uint64_t> boot_{0};
   std::atomic<bool> connected_{false};
   std::atomic<std::uint64_t> abandon_below_{1};
+  std::atomic<std::int64_t> offset_us_{0};
+  std::atomic<bool> offset_known_{false};
+  std::uint64_t epoch_ = 0;
+  // HELLOs awaiting their WELCOME: nonce and send time (this clock); the BIND awaiting ACCEPTED.
+  std::vector<std::pair<std::uint64_t, std::int64_t>> hellos_;
+  std::uint64_t bind_sequence_ = 0, binding_boot_ = 0, bind_challenge_ = 0;
+  double bind_interval_ = 0.05;
+  std::chrono::steady_clock::time_point bind_started_, next_bind_;
+  std::uint32_t watchdog_ms_ = 0;  // the bound run's, for the Connected event
+  // STATUS requests awaiting an answer (sequence, send time): clock-offset samples.
+  std::vector<std::pair<std::uint64_t, std::int64_t>> status_sent_;
+  // Recent offset samples (round trip, offset); the one with the shortest round trip is used.
+  std::vector<std::pair<std::int64_t, std::int64_t>> offsets_;
   bool heard_ = false, silent_ = false;
   double hello_interval_ = 0.05;
   std::uint64_t sync_sequence_ = 0;  // the clock request awaited

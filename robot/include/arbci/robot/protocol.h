@@ -1,7 +1,10 @@
-// The ARBCI robot protocol, version 2: UDP datagrams, little-endian, each authenticated with
+// The ARBCI robot protocol, version 3: UDP datagrams, little-endian, each authenticated with
 // HMAC-SHA256 over its content under a shared key. A client binds its session to one run of the
-// backend (HELLO/WELCOME: the backend's random boot id, carried by every later command), keeps
-// a watchdog fed with HEARTBEATs while connected, and a STOP stays in force until a RESET.
+// backend by a challenge and response (HELLO with the client's nonce, WELCOME echoing it with
+// the backend's, BIND echoing that: a replayed HELLO or BIND binds nothing, a replayed WELCOME is
+// not taken), carries the run's boot id and stop epoch in its commands, keeps a watchdog fed with
+// HEARTBEATs stamped with their send time on the backend's clock, and a STOP stays in force
+// until a RESET, which starts a new stop epoch: nothing made before the STOP ever runs.
 // docs/robot-protocol.md describes it for anyone writing a backend.
 #pragma once
 
@@ -13,7 +16,7 @@
 
 namespace arbci::robot {
 
-constexpr std::uint8_t kProtocolVersion = 2;
+constexpr std::uint8_t kProtocolVersion = 3;
 constexpr size_t kHeaderBytes = 42;
 constexpr size_t kMacBytes = 32;
 constexpr size_t kMaxDatagram = 1400;
@@ -26,15 +29,17 @@ enum class MessageType : std::uint8_t {
   Home = 3,
   Stop = 4,
   Status = 5,
-  Hello = 6,      // binds the session to this backend run and to the sender's address
-  Reset = 7,      // ends a latched stop (an experimenter's decision)
-  Heartbeat = 8,  // feeds the watchdog; carries the lowest command sequence still wanted
+  Hello = 6,      // asks for a WELCOME (a challenge); binds nothing by itself
+  Reset = 7,      // ends a latched stop (an experimenter's decision) and starts a new stop epoch
+  Heartbeat = 8,  // feeds the watchdog; carries its send time and the lowest sequence still wanted
+  Bind = 9,       // answers a WELCOME's challenge: binds the session to this run and this address
   // Replies (backend to client).
   Accepted = 0x81,
   Finished = 0x82,
   Rejected = 0x83,
   StatusReply = 0x84,
-  Welcome = 0x85,  // answers HELLO; its header's boot field is the id every command must carry
+  Welcome = 0x85,  // answers HELLO with a challenge; its boot field is the run's id
+  Bound = 0x86,    // answers BIND: the session is bound to this run and address
 };
 
 enum class RejectReason : std::uint8_t {
@@ -47,7 +52,8 @@ enum class RejectReason : std::uint8_t {
   InvalidState = 7,  // e.g. a DROP while holding nothing
   Stopped = 8,       // a latched stop is in force: RESET first
   UnknownBoot = 9,   // sent to another run of the backend (it restarted): HELLO again
-  Cancelled = 10,    // the client gave up on it, or a STOP came after it: never runs
+  Cancelled = 10,    // the client gave up on it: never runs
+  BeforeStop = 11,   // made before a STOP (an older stop epoch): never runs, also after a RESET
 };
 
 enum class Outcome : std::uint8_t { Success = 0, Failed = 1, Stopped = 2 };
@@ -82,6 +88,11 @@ struct StatusPayload {
   // Why motion commands are refused until a RESET ("emergency stop", "halted: link lost"); empty
   // when no stop is latched.
   std::string stop_reason;
+  // The stop epoch motion commands must carry (RESET starts the next one).
+  std::uint64_t stop_epoch = 0;
+  // The backend's clock when it sent this (microseconds, steady): the client estimates the
+  // offset between the clocks from it, for the send times its heartbeats carry.
+  std::int64_t backend_time_us = 0;
   std::vector<WorldObject> objects;
 };
 
@@ -99,6 +110,16 @@ struct Message {
   std::optional<double> clock_s;
   // Heartbeat: motion commands of this session below this sequence are abandoned by the client.
   std::uint64_t abandon_below = 0;
+  // Grasp, Drop, Home: the stop epoch the client knew when it made the command; Welcome,
+  // Accepted, Bound: the backend's current one.
+  std::uint64_t stop_epoch = 0;
+  // Hello: the client's fresh nonce; Welcome: that nonce, echoed.
+  std::uint64_t nonce = 0;
+  // Welcome: the backend's fresh nonce; Bind: that nonce, echoed.
+  std::uint64_t challenge = 0;
+  // Welcome: the backend's clock (microseconds, steady) when it sent it; Heartbeat: the send
+  // time on the backend's clock as the client estimates it.
+  std::int64_t time_us = 0;
   std::uint32_t watchdog_ms = 0;                  // Welcome: the backend's watchdog (0: none)
   RejectReason reason = RejectReason::Malformed;  // Rejected
   Outcome outcome = Outcome::Success;             // Finished
@@ -128,6 +149,13 @@ struct Decoded {
 };
 
 std::vector<std::uint8_t> encode(const Message& message, const Key& key);
+// The header fields a backend may look at before spending a MAC on a datagram (a flood of
+// forgeries is sorted by these); nothing when the datagram cannot be a message of this version.
+struct Peek {
+  MessageType type;
+  std::uint64_t session;
+};
+std::optional<Peek> peek(const std::uint8_t* data, size_t size);
 // Never throws and never reads outside `size` bytes: any input yields a message or an error.
 Decoded decode(const std::uint8_t* data, size_t size, const Key& key);
 
@@ -138,6 +166,7 @@ const char* toString(RobotState state);
 const char* toString(DecodeError error);
 bool isCommand(MessageType type);
 bool isMotion(MessageType type);  // GRASP, DROP, HOME: they move the arm
+std::int64_t steadyMicros();      // the monotonic clock the backend's times are on
 
 std::uint64_t wallClockMs();
 
