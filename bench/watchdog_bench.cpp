@@ -55,8 +55,9 @@ int main(int argc, char** argv) {
   app.add_option("--grasps", grasps, "grasps by a live client")->capture_default_str();
   app.add_option("--dead", dead, "grasps whose client is paused or killed")->capture_default_str();
   app.add_option("--speed", speed, "the simulated arm's speed factor")->capture_default_str();
+  double watchdog_ms = robot::BackendOptions{}.watchdog_s * 1000.0;
+  app.add_option("--watchdog-ms", watchdog_ms, "the backend's watchdog")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  const double watchdog_ms = robot::BackendOptions{}.watchdog_s * 1000.0;
 
   // 1. Live clients: the motions alternate grasping object 1 and putting it back.
   int false_halts = 0, finished = 0;
@@ -64,6 +65,8 @@ int main(int argc, char** argv) {
   {
     robot::BackendOptions options;
     options.speed_factor = speed;
+    options.watchdog_s = watchdog_ms / 1000.0;
+    options.raise_priority = true;  // as arbci-robotd runs
     robot::RunningBackend backend(std::make_unique<robot::SimulatedArm>(robot::twoObjects()),
                                   options);
     robot::RobotClient client(robot::Endpoint::resolve("127.0.0.1", backend.port()),
@@ -106,6 +109,8 @@ int main(int argc, char** argv) {
     auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
     robot::BackendOptions options;
     options.speed_factor = 1.0;  // real time: the grasp takes seconds
+    options.watchdog_s = watchdog_ms / 1000.0;
+    options.raise_priority = true;
     robot::RunningBackend backend(
         std::make_unique<test::HaltRecordingArm>(robot::twoObjects(), halted_at), options);
     int ready[2];
@@ -142,7 +147,7 @@ int main(int argc, char** argv) {
                             .count());
   }
 
-  std::printf("Watchdog %.0f ms (the default), client heartbeat 50 Hz at %s\n\n", watchdog_ms,
+  std::printf("Watchdog %.0f ms, client heartbeat 50 Hz at %s\n\n", watchdog_ms,
               priority.c_str());
   std::printf("| live motions | finished | halted by the watchdog (false) |\n|---|---|---|\n");
   std::printf("| %d | %d | %d |\n\n", grasps, finished, false_halts);

@@ -23,6 +23,9 @@ constexpr auto kSessionLifetime = std::chrono::minutes(5);
 constexpr auto kChallengeLifetime = std::chrono::seconds(5);
 constexpr size_t kChallengesPerSession = 4;
 constexpr size_t kMaxChallenges = 256;
+// The watchdog looks this much before its deadline, so that waking from the socket wait (tens of
+// microseconds, more on a busy machine) does not carry the halt past the watchdog time.
+constexpr std::int64_t kWakeMarginUs = 1000;
 
 std::uint64_t randomId() {
   std::uint64_t id = 0;
@@ -339,6 +342,7 @@ struct RobotBackend::Impl {
       if (refusal_budget.take(SteadyClock::now())) send(r, found->second.peer);
       return;
     }
+    r.text.clear();  // the reason is enough; the least sent to an address nobody bound
     const auto bytes = stamped(r);
     if (bytes.size() < d.bytes.size() && refusal_budget.take(SteadyClock::now()))
       socket.sendTo(bytes, d.from);
@@ -565,7 +569,7 @@ struct RobotBackend::Impl {
     const auto found = sessions.find(running->session);
     if (found != sessions.end() && found->second.heartbeat_us)
       fed = std::max(fed, *found->second.heartbeat_us);
-    return fed + watchdogMicros();
+    return fed + watchdogMicros() - kWakeMarginUs;
   }
 
   void advance() {

@@ -97,12 +97,15 @@ const core::Schema<LinkSettings>& linkSchema() {
     t.text("host", &LinkSettings::host, "127.0.0.1",
            "the backend's host (arbci-robotd: the address it listens on)")
         .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port")
-        // 250 ms: a killed or paused client halts the arm within a quarter second, while the
-        // client's 50 Hz heartbeat (on a thread of the highest priority it may take) can be held
-        // up 10 times over on a loaded PC before the arm stops for nothing.
-        .integer("watchdog_ms", &LinkSettings::watchdog_ms, 250, 0, 60000,
-                 "the backend halts a running motion (and latches the stop) when the commanding "
-                 "client has sent nothing authenticated for this long; 0: off (not for a real arm)",
+        // 100 ms: five heartbeats at 50 Hz. The deadline counts from each heartbeat's send time,
+        // so a delayed link halts as a dead one does; a busy PC only delays the heartbeat
+        // thread (the highest priority the process may take), which sleeps between beats and is
+        // woken promptly even at normal priority (docs/robot.md has the false-halt counts).
+        .integer("watchdog_ms", &LinkSettings::watchdog_ms, 100, 0, 60000,
+                 "the backend halts a running motion (and latches the stop) this long after the "
+                 "send time of the commanding client's newest heartbeat (a heartbeat the link "
+                 "delayed counts as missing); 0: off (not for a real arm); raise it on a lossy "
+                 "link",
                  "ms");
     return t;
   }();

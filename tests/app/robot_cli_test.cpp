@@ -187,13 +187,21 @@ TEST(RobotCommand, AStopHoldsUntilReset) {
 
 // An in-process backend (its counts are the ground truth), with one object, behind a relay the
 // test controls.
-robot::RunningBackend backendWith(const robot::Key& key, double speed, double watchdog_s = 0.1) {
+robot::BackendOptions backendOptions(double speed, double watchdog_s, int port) {
   robot::BackendOptions options;
   options.speed_factor = speed;
   options.watchdog_s = watchdog_s;
+  options.port = port;
+  return options;
+}
+std::unique_ptr<robot::SimulatedArm> oneObjectArm() {
   robot::RobotConfig config;
   config.objects = {{4, {0.1, 0.6, 0.06}, 0.06, 0.03}};
-  return robot::RunningBackend(std::make_unique<robot::SimulatedArm>(config), options, key);
+  return std::make_unique<robot::SimulatedArm>(config);
+}
+robot::RunningBackend backendWith(const robot::Key& key, double speed, double watchdog_s = 0.1,
+                                  int port = 0) {
+  return robot::RunningBackend(oneObjectArm(), backendOptions(speed, watchdog_s, port), key);
 }
 
 // 100 commands in four lanes of 25 (a backend and a relay each, run side by side to save time).
@@ -271,6 +279,106 @@ TEST(RobotCommand, AMotionWhoseAnswersWereLostIsReportedAsRunAndStopped) {
   EXPECT_NE(r.err.find("GRASP ran, but the answer was lost"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("STOP sent and accepted"), std::string::npos) << r.err;
   EXPECT_EQ(backend.stats().executed, 1u);
+}
+
+// Every answer lost from the moment the GRASP went out (a link that fails one way): the
+// client cannot know whether it ran, and says so (exit 4); its STOP is not confirmed either.
+TEST(RobotCommand, AMotionWhoseEveryAnswerIsLostIsReportedAsUnknown) {
+  const auto key_file = scratch("oneway.key");
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const robot::Key key = robot::loadKey(key_file);
+  robot::RunningBackend backend = backendWith(key, 1.0, 5.0);
+  test::UdpRelay relay(backend.port(), key);
+  // The handshake gets through; nothing after it does.
+  relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
+                     robot::MessageType::Finished, robot::MessageType::Rejected});
+  const ProcessResult r = runProcess(
+      kArbci,
+      {"robot", "--port", std::to_string(relay.port()), "--key-file", key_file.string(),
+       "--retry-budget", "1", "grasp", "0.1", "0.6", "0.06"},
+      60.0);
+  std::cout << r.err;
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("GRASP: unknown, it may have run"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("STOP sent but not confirmed"), std::string::npos) << r.err;
+  EXPECT_EQ(backend.stats().executed, 1u);  // it did run: "not run" would have been a lie
+}
+
+// The backend restarts after the GRASP may have reached it, its acceptance lost: unknown (exit
+// 4), with the arm's state as the new run reports it.
+TEST(RobotCommand, AMotionLostInARestartIsReportedAsUnknownWithTheArmsState) {
+  const auto key_file = scratch("restart.key");
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const robot::Key key = robot::loadKey(key_file);
+  auto backend = std::make_unique<robot::RunningBackend>(oneObjectArm(),
+                                                         backendOptions(1.0, 5.0, 0), key);
+  const int port = backend->port();
+  test::UdpRelay relay(port, key);
+  relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
+                     robot::MessageType::Finished});
+  auto cli = std::async(std::launch::async, [&] {
+    return runProcess(kArbci,
+                      {"robot", "--port", std::to_string(relay.port()), "--key-file",
+                       key_file.string(), "grasp", "0.1", "0.6", "0.06"},
+                      60.0);
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (backend->stats().executed == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(backend->stats().executed, 1u);
+  backend.reset();  // killed mid-grasp
+  // Its last replies, already on their way, are lost too.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  relay.dropReplies({});
+  robot::RunningBackend restarted = backendWith(key, 1.0, 5.0, port);
+  const ProcessResult r = cli.get();
+  std::cout << r.err;
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_NE(r.err.find("the backend restarted"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("GRASP: unknown, it may have run"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the arm is stopped, holding nothing"), std::string::npos) << r.err;
+  EXPECT_EQ(restarted.stats().executed, 0u);
+}
+
+// A GRASP from one shell held back by the network across `arbci robot stop` and `reset` from
+// another: refused when it arrives, and the first shell says it did not run and why.
+TEST(RobotCommand, AGraspHeldBackAcrossAStopAndResetNeverRuns) {
+  const auto key_file = scratch("held.key");
+  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const robot::Key key = robot::loadKey(key_file);
+  robot::RunningBackend backend = backendWith(key, 50.0, 5.0);
+  test::UdpRelay relay(backend.port(), key);
+  relay.hold(robot::MessageType::Grasp);
+  auto cli = std::async(std::launch::async, [&] {
+    return runProcess(kArbci,
+                      {"robot", "--port", std::to_string(relay.port()), "--key-file",
+                       key_file.string(), "grasp", "0.1", "0.6", "0.06"},
+                      60.0);
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (relay.captured(robot::MessageType::Grasp).empty() &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_FALSE(relay.captured(robot::MessageType::Grasp).empty());
+  const std::vector<std::string> direct = {"robot", "--port", std::to_string(backend.port()),
+                                           "--key-file", key_file.string()};
+  auto with = [&](const char* command) {
+    std::vector<std::string> arguments = direct;
+    arguments.push_back(command);
+    return runProcess(kArbci, arguments, 30.0);
+  };
+  ASSERT_EQ(with("stop").exit_code, 0);
+  ASSERT_EQ(with("reset").exit_code, 0);
+  // Every copy the first shell sent so far, then the rest as they come.
+  for (const auto& bytes : relay.captured(robot::MessageType::Grasp)) {
+    const robot::Decoded d = robot::decode(bytes.data(), bytes.size(), key);
+    relay.release(d.message.sequence);
+  }
+  relay.stopHolding();
+  const ProcessResult r = cli.get();
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("GRASP not run: rejected: made before a STOP"), std::string::npos) << r.err;
+  EXPECT_EQ(backend.stats().executed, 0u);
 }
 
 }  // namespace

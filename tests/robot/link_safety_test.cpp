@@ -158,6 +158,20 @@ TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
   ASSERT_TRUE(backendReceived(second, 5));
   EXPECT_EQ(second.stats().executed, 0u);
   EXPECT_EQ(second.stats().replayed, 5u);
+  // What came back to the sender's address: only refusals smaller than what was sent (the
+  // backend cannot be used to amplify traffic towards a forged address).
+  size_t sent_bytes = 0, received_bytes = 0;
+  for (int i = 0; i < 5; ++i) sent_bytes += captured[static_cast<size_t>(i) % captured.size()].size();
+  const auto quiet_until = Clock::now() + 300ms;
+  while (Clock::now() < quiet_until) {
+    attacker.wait(2);
+    while (auto d = attacker.receive()) {
+      EXPECT_LT(d->bytes.size(), captured.front().size());
+      received_bytes += d->bytes.size();
+    }
+  }
+  EXPECT_LT(received_bytes, sent_bytes);
+  std::cout << "replayed " << sent_bytes << " bytes, " << received_bytes << " came back\n";
   RobotClient observer(local(port), testKey(), fastClient());
   const StatusPayload status = freshStatus(observer);
   EXPECT_EQ(status.holding, -1);
@@ -293,7 +307,7 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
   BackendOptions options;
   options.status_interval_s = 0.05;
   options.speed_factor = 1.0;                  // real time: the grasp takes seconds
-  ASSERT_DOUBLE_EQ(options.watchdog_s, 0.25);  // the default (robot.watchdog_ms)
+  ASSERT_DOUBLE_EQ(options.watchdog_s, 0.1);  // the default (robot.watchdog_ms)
   RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
                          options);
   test::UdpRelay relay(backend.port(), testKey());

@@ -109,6 +109,9 @@ void UdpRelay::run() {
       } else if (decoded.ok() && holding_.count(decoded.message.type)) {
         held_.emplace_back(decoded.message.sequence, d->bytes);
       } else {
+        if (decoded.ok() && decoded.message.type == robot::MessageType::Heartbeat &&
+            delay_.count() == 0)
+          last_heartbeat_us_ = decoded.message.time_us;
         forward(std::move(d->bytes), true);
       }
     }

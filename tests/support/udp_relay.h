@@ -50,6 +50,9 @@ class UdpRelay {
   // Sends `bytes` to the client as if the backend had (a replay from the backend's address).
   void injectReply(const Bytes& bytes);
   std::uint64_t dropped() const { return dropped_; }
+  // The send time (the backend's clock, as the client stamped it) of the newest HEARTBEAT passed
+  // on to the backend; 0 before any.
+  std::int64_t lastHeartbeatForwardedUs() const { return last_heartbeat_us_; }
 
  private:
   void run();
@@ -77,6 +80,7 @@ class UdpRelay {
   std::vector<std::pair<robot::MessageType, Bytes>> captured_replies_;
   std::optional<robot::Endpoint> client_;
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::int64_t> last_heartbeat_us_{0};
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

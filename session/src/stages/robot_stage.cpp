@@ -221,6 +221,7 @@ void RobotStage::handleEvents(RobotPart& out, double time_s) {
                              {"text", e.text}};
     if (e.kind == Kind::Rejected) fields["reason"] = robot::toString(e.reason);
     if (e.kind == Kind::Finished) fields["outcome"] = robot::toString(e.outcome);
+    if (e.kind == Kind::Failed) fields["may_have_run"] = e.may_have_run;
     // How the heartbeat that keeps the backend's watchdog quiet is scheduled.
     if (e.kind == Kind::Connected) fields["heartbeat_priority"] = client_.heartbeatPriority();
     s_.log.write("robot", time_s, fields);

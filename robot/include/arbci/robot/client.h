@@ -85,6 +85,7 @@ class RobotClient {
   const std::optional<StatusPayload>& status() const { return status_; }
   bool silent() const { return silent_; }
   bool connected() const { return connected_; }
+  std::uint64_t sessionId() const { return session_; }
   // The scheduling the heartbeat thread got ("real-time (FIFO 99)", "nice -20", ...; "" before
   // it started), for the session's log.
   std::string heartbeatPriority() const {
