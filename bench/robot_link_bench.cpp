@@ -44,8 +44,7 @@ struct Rig {
   robot::RunningBackend backend{
       std::make_unique<test::HaltRecordingArm>(robot::twoObjects(), halted_at), benchOptions()};
   std::int64_t haltedUs() const {
-    return std::chrono::duration_cast<std::chrono::microseconds>(
-               Clock::duration(halted_at->load()))
+    return std::chrono::duration_cast<std::chrono::microseconds>(Clock::duration(halted_at->load()))
         .count();
   }
 };
@@ -94,16 +93,16 @@ Latencies halts(int runs, unsigned seed, Fault fault) {
 }
 
 void printHalts(const char* what, int runs, const Latencies& l) {
-  std::printf("| %s | %d | %zu | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f |\n", what,
-              runs, l.from_event.size(), percentile(l.from_event, 0.5),
-              percentile(l.from_event, 0.95), percentile(l.from_event, 0.99),
-              l.from_event.empty() ? 0.0
-                                   : *std::max_element(l.from_event.begin(), l.from_event.end()),
-              percentile(l.from_heartbeat, 0.5), percentile(l.from_heartbeat, 0.95),
-              percentile(l.from_heartbeat, 0.99),
-              l.from_heartbeat.empty()
-                  ? 0.0
-                  : *std::max_element(l.from_heartbeat.begin(), l.from_heartbeat.end()));
+  std::printf(
+      "| %s | %d | %zu | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f |\n", what, runs,
+      l.from_event.size(), percentile(l.from_event, 0.5), percentile(l.from_event, 0.95),
+      percentile(l.from_event, 0.99),
+      l.from_event.empty() ? 0.0 : *std::max_element(l.from_event.begin(), l.from_event.end()),
+      percentile(l.from_heartbeat, 0.5), percentile(l.from_heartbeat, 0.95),
+      percentile(l.from_heartbeat, 0.99),
+      l.from_heartbeat.empty()
+          ? 0.0
+          : *std::max_element(l.from_heartbeat.begin(), l.from_heartbeat.end()));
 }
 
 // Forged datagrams at `rate` a second from another address, in 1 ms bursts: half carry the real
@@ -214,8 +213,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--lossy-runs", lossy_runs, "grasps per loss rate (0: skip)")
       ->capture_default_str();
-  app.add_option("--stops", stops, "STOPs timed with and without the flood")
-      ->capture_default_str();
+  app.add_option("--stops", stops, "STOPs timed with and without the flood")->capture_default_str();
   app.add_option("--flood-motions", flood_motions, "motions under the flood (false halts)")
       ->capture_default_str();
   app.add_option("--flood-rate", flood_rate, "forged datagrams a second")->capture_default_str();
@@ -223,9 +221,10 @@ int main(int argc, char** argv) {
   app.add_option("--watchdog-ms", watchdog_ms, "the backend's watchdog")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   g_watchdog_s = watchdog_ms / 1000.0;
-  std::printf("Watchdog halts during a grasp (watchdog %.0f ms, heartbeat 50 Hz); ms as "
-              "median / p95 / p99 / max\n",
-              watchdog_ms);
+  std::printf(
+      "Watchdog halts during a grasp (watchdog %.0f ms, heartbeat 50 Hz); ms as "
+      "median / p95 / p99 / max\n",
+      watchdog_ms);
   std::printf(
       "| fault | runs | halted | from the fault | from the last heartbeat's send time |\n"
       "|---|---|---|---|---|\n");
@@ -261,22 +260,25 @@ int main(int argc, char** argv) {
     std::printf("\n");
   }
 
-  std::printf("STOP to ACCEPTED (ms, median / p99 / max) and false watchdog halts of live motions\n");
   std::printf(
-      "| flood | STOPs | STOP to ACCEPTED | motions | false halts | forged sent | dropped unread |\n"
+      "STOP to ACCEPTED (ms, median / p99 / max) and false watchdog halts of live motions\n");
+  std::printf(
+      "| flood | STOPs | STOP to ACCEPTED | motions | false halts | forged sent | dropped unread "
+      "|\n"
       "|---|---|---|---|---|---|---|\n");
   int status = cut.not_halted + delayed.not_halted == 0 ? 0 : 1;
   for (const double rate : {0.0, flood_rate}) {
     const FloodRow row = floodRow(rate, stops, flood_motions);
-    std::printf("| %.0f/s | %zu | %.2f / %.2f / %.2f | %d | %d | %llu | %llu |\n", rate,
-                row.stop_ms.size(), percentile(row.stop_ms, 0.5), percentile(row.stop_ms, 0.99),
-                row.stop_ms.empty() ? 0.0
-                                    : *std::max_element(row.stop_ms.begin(), row.stop_ms.end()),
-                row.motions, row.false_halts, static_cast<unsigned long long>(row.sent),
-                static_cast<unsigned long long>(row.shed));
+    std::printf(
+        "| %.0f/s | %zu | %.2f / %.2f / %.2f | %d | %d | %llu | %llu |\n", rate, row.stop_ms.size(),
+        percentile(row.stop_ms, 0.5), percentile(row.stop_ms, 0.99),
+        row.stop_ms.empty() ? 0.0 : *std::max_element(row.stop_ms.begin(), row.stop_ms.end()),
+        row.motions, row.false_halts, static_cast<unsigned long long>(row.sent),
+        static_cast<unsigned long long>(row.shed));
     if (row.false_halts > 0) status = 1;
   }
-  std::printf("target: with 40,000 forged datagrams a second, STOP to ACCEPTED p99 <= 20 ms and "
-              "0 false halts\n");
+  std::printf(
+      "target: with 40,000 forged datagrams a second, STOP to ACCEPTED p99 <= 20 ms and "
+      "0 false halts\n");
   return status;
 }

@@ -147,8 +147,7 @@ int main(int argc, char** argv) {
                             .count());
   }
 
-  std::printf("Watchdog %.0f ms, client heartbeat 50 Hz at %s\n\n", watchdog_ms,
-              priority.c_str());
+  std::printf("Watchdog %.0f ms, client heartbeat 50 Hz at %s\n\n", watchdog_ms, priority.c_str());
   std::printf("| live motions | finished | halted by the watchdog (false) |\n|---|---|---|\n");
   std::printf("| %d | %d | %d |\n\n", grasps, finished, false_halts);
   std::printf(

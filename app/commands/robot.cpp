@@ -6,9 +6,9 @@
 // it). A motion it cannot confirm is STOPped, so it never runs on unsupervised.
 #include <chrono>
 #include <cstdio>
-#include <optional>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <thread>
 
 #include "arbci/robot/client.h"
@@ -86,8 +86,7 @@ std::string armState(const robot::StatusPayload& s) {
 // not (and after the STOP it never will), 4 when nobody can tell (the backend restarted, or the
 // STOP was not confirmed either); the arm's state as the backend reports it now goes with it.
 [[noreturn]] void stopUnconfirmed(robot::RobotClient& client, robot::MessageType type,
-                                  std::uint64_t sequence, const std::string& why,
-                                  bool restarted) {
+                                  std::uint64_t sequence, const std::string& why, bool restarted) {
   const std::string name = robot::toString(type);
   const std::uint64_t stop = client.send(robot::MessageType::Stop);
   bool stopped = false;
@@ -118,15 +117,14 @@ std::string armState(const robot::StatusPayload& s) {
               : "STOP sent but not confirmed either: check the arm";
   const std::string state = now ? "; " + armState(*now) : "";
   if (client.accepted(sequence) && restarted)
-    throw CliError(name + " ran, then the backend restarted during it (" + why + "); " +
-                       stop_note + state,
-                   3);
+    throw CliError(
+        name + " ran, then the backend restarted during it (" + why + "); " + stop_note + state, 3);
   if (ran)
     throw CliError(name + " ran, but the answer was lost (" + why + "); " + stop_note + state, 3);
   if (stopped && !restarted)
-    throw CliError(name + " not run: " + why + "; the backend shows it never ran, and " +
-                       stop_note + state,
-                   1);
+    throw CliError(
+        name + " not run: " + why + "; the backend shows it never ran, and " + stop_note + state,
+        1);
   throw CliError(name + ": unknown, it may have run: " + why + "; " + stop_note + state, 4);
 }
 
@@ -194,9 +192,9 @@ int talk(const RobotOptions& o, robot::MessageType type) {
     stopUnconfirmed(client, type, sequence,
                     "no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) + " s",
                     restarted);
-  throw CliError(name + ": unknown, no outcome within " +
-                     std::to_string(static_cast<int>(o.timeout_s)) + " s",
-                 4);
+  throw CliError(
+      name + ": unknown, no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) + " s",
+      4);
 }
 
 }  // namespace

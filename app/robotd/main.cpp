@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
     const arbci::robot::BackendStats s = backend.stats();
     std::cerr << "arbci-robotd: stopped; " << s.datagrams << " datagrams, " << s.executed
               << " commands run, " << s.rejected << " rejected, " << s.replayed << " replayed, "
-              << s.ignored << " ignored, " << s.shed << " shed unread, " << s.watchdog_halts << " watchdog halts" << std::endl;
+              << s.ignored << " ignored, " << s.shed << " shed unread, " << s.watchdog_halts
+              << " watchdog halts" << std::endl;
   } catch (const std::exception& error) {
     std::cerr << "arbci-robotd: " << error.what() << "\n";
     return 1;

@@ -241,8 +241,8 @@ struct RobotBackend::Impl {
     if (unbound_budget.take(now)) return true;
     count(&BackendStats::shed);
     log("shed", "dropped datagrams unread (not from a bound client, over " +
-                    std::to_string(static_cast<int>(options.unbound_per_s)) + " a second), e.g. from " +
-                    d.from.toString());
+                    std::to_string(static_cast<int>(options.unbound_per_s)) +
+                    " a second), e.g. from " + d.from.toString());
     return false;
   }
 
@@ -331,8 +331,8 @@ struct RobotBackend::Impl {
   // amplify traffic towards a forged sender address.
   void stale(const Message& m, const Datagram& d, RejectReason reason, const std::string& text) {
     count(&BackendStats::replayed);
-    log(toString(reason), std::string("refused ") + toString(m.type) + " from " +
-                              d.from.toString() + ": " + text);
+    log(toString(reason),
+        std::string("refused ") + toString(m.type) + " from " + d.from.toString() + ": " + text);
     const auto found = sessions.find(m.session);
     if (m.type == MessageType::Heartbeat || m.type == MessageType::Bind) return;
     Message r = reply(m, MessageType::Rejected);
@@ -355,8 +355,8 @@ struct RobotBackend::Impl {
     const auto found = sessions.find(m.session);
     if (found != sessions.end() && m.sequence <= found->second.highest) {
       count(&BackendStats::replayed);
-      log("old hello", "ignored HELLO " + std::to_string(m.sequence) + " from " +
-                           from.toString() + ": not newer than the session's last");
+      log("old hello", "ignored HELLO " + std::to_string(m.sequence) + " from " + from.toString() +
+                           ": not newer than the session's last");
       return;
     }
     const auto now = SteadyClock::now();
@@ -524,7 +524,8 @@ struct RobotBackend::Impl {
       reject(m, s.peer, RejectReason::Unreachable,
              "the last heartbeat arrived " + std::to_string(s.last_heartbeat_age_us / 1000) +
                  " ms after it was sent, over the watchdog's " +
-                 std::to_string(watchdogMicros() / 1000) + " ms: the link is too slow to move safely");
+                 std::to_string(watchdogMicros() / 1000) +
+                 " ms: the link is too slow to move safely");
       return;
     }
     const DriverCommand command{m.type, m.target};

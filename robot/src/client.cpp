@@ -22,9 +22,8 @@ RobotEvent event(RobotEvent::Kind kind, std::string text) {
   return {kind, 0, MessageType::Status, {}, {}, std::move(text)};
 }
 
-RobotEvent failure(std::uint64_t sequence, MessageType type, std::string text,
-                   bool may_have_run) {
-  return {RobotEvent::Kind::Failed, sequence, type, {},
+RobotEvent failure(std::uint64_t sequence, MessageType type, std::string text, bool may_have_run) {
+  return {RobotEvent::Kind::Failed, sequence,        type,        {},
           Outcome::Failed,          std::move(text), may_have_run};
 }
 
@@ -220,13 +219,16 @@ void RobotClient::restarted() {
   for (const Pending& p : lost) {
     const std::string name = toString(p.type);
     std::string text =
-        p.accepted ? name + " ran on the backend's previous run, which restarted during it: how "
-                            "far it got is unknown"
+        p.accepted ? name +
+                         " ran on the backend's previous run, which restarted during it: how "
+                         "far it got is unknown"
         : p.transmitted
-            ? name + " may have run: the backend restarted before answering it; it is not sent "
-                     "to the new run"
-            : name + " not run: never sent before the backend restarted; it is not sent to the "
-                     "new run";
+            ? name +
+                  " may have run: the backend restarted before answering it; it is not sent "
+                  "to the new run"
+            : name +
+                  " not run: never sent before the backend restarted; it is not sent to the "
+                  "new run";
     complete(p.sequence, failure(p.sequence, p.type, std::move(text), p.transmitted));
   }
   connected_ = false;
@@ -282,11 +284,10 @@ void RobotClient::bound(const Message& m) {
   epoch_ = m.stop_epoch;
   if (connected_) return;  // a rebinding (after silence): nothing else changes
   connected_ = true;
-  events_.push_back(
-      event(RobotEvent::Kind::Connected,
-            "bound to backend run " + std::to_string(m.boot) +
-                (watchdog_ms_ ? ", watchdog " + std::to_string(watchdog_ms_) + " ms"
-                              : ", no watchdog")));
+  events_.push_back(event(
+      RobotEvent::Kind::Connected,
+      "bound to backend run " + std::to_string(m.boot) +
+          (watchdog_ms_ ? ", watchdog " + std::to_string(watchdog_ms_) + " ms" : ", no watchdog")));
   next_status_ = Clock::now();
   for (Pending& p : pending_) transmit(p);
 }
@@ -298,8 +299,8 @@ void RobotClient::handle(const Message& m) {
   if (skew > 30.0) return;  // a stale reply: ignore it
   if (m.type == MessageType::Welcome) {
     if (!welcome(m)) return;
-  } else if (m.type == MessageType::Bound && bind_sequence_ != 0 &&
-             m.sequence == bind_sequence_ && m.boot == binding_boot_) {
+  } else if (m.type == MessageType::Bound && bind_sequence_ != 0 && m.sequence == bind_sequence_ &&
+             m.boot == binding_boot_) {
     bound(m);
   } else if (boot_ == 0 || m.boot != boot_) {
     // From a run this client is not bound to: a replayed reply, or a sign of a restart. Only a
@@ -399,14 +400,14 @@ void RobotClient::poll() {
   }
   for (const Pending& p : expired) {
     const std::string name = toString(p.type);
-    complete(p.sequence,
-             failure(p.sequence, p.type,
-                     p.transmitted
-                         ? name + " may have run: sent, but no answer from the backend (given "
-                                  "up; the backend will not start it later once it hears this "
-                                  "client's heartbeat)"
-                         : name + " not run: never sent, no backend run bound this client",
-                     p.transmitted));
+    complete(
+        p.sequence,
+        failure(p.sequence, p.type,
+                p.transmitted ? name + " may have run: sent, but no answer from the backend (given "
+                                       "up; the backend will not start it later once it hears this "
+                                       "client's heartbeat)"
+                              : name + " not run: never sent, no backend run bound this client",
+                p.transmitted));
   }
   if (connected_ && now >= next_status_) {
     next_status_ = now + seconds(options_.status_interval_s);

@@ -292,11 +292,11 @@ TEST(RobotCommand, AMotionWhoseEveryAnswerIsLostIsReportedAsUnknown) {
   // The handshake gets through; nothing after it does.
   relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
                      robot::MessageType::Finished, robot::MessageType::Rejected});
-  const ProcessResult r = runProcess(
-      kArbci,
-      {"robot", "--port", std::to_string(relay.port()), "--key-file", key_file.string(),
-       "--retry-budget", "1", "grasp", "0.1", "0.6", "0.06"},
-      60.0);
+  const ProcessResult r =
+      runProcess(kArbci,
+                 {"robot", "--port", std::to_string(relay.port()), "--key-file", key_file.string(),
+                  "--retry-budget", "1", "grasp", "0.1", "0.6", "0.06"},
+                 60.0);
   std::cout << r.err;
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("GRASP: unknown, it may have run"), std::string::npos) << r.err;
@@ -310,8 +310,8 @@ TEST(RobotCommand, AMotionLostInARestartIsReportedAsUnknownWithTheArmsState) {
   const auto key_file = scratch("restart.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
   const robot::Key key = robot::loadKey(key_file);
-  auto backend = std::make_unique<robot::RunningBackend>(oneObjectArm(),
-                                                         backendOptions(1.0, 5.0, 0), key);
+  auto backend =
+      std::make_unique<robot::RunningBackend>(oneObjectArm(), backendOptions(1.0, 5.0, 0), key);
   const int port = backend->port();
   test::UdpRelay relay(port, key);
   relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,

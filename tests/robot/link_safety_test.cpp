@@ -161,7 +161,8 @@ TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
   // What came back to the sender's address: only refusals smaller than what was sent (the
   // backend cannot be used to amplify traffic towards a forged address).
   size_t sent_bytes = 0, received_bytes = 0;
-  for (int i = 0; i < 5; ++i) sent_bytes += captured[static_cast<size_t>(i) % captured.size()].size();
+  for (int i = 0; i < 5; ++i)
+    sent_bytes += captured[static_cast<size_t>(i) % captured.size()].size();
   const auto quiet_until = Clock::now() + 300ms;
   while (Clock::now() < quiet_until) {
     attacker.wait(2);
@@ -306,7 +307,7 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
   auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
   BackendOptions options;
   options.status_interval_s = 0.05;
-  options.speed_factor = 1.0;                  // real time: the grasp takes seconds
+  options.speed_factor = 1.0;                 // real time: the grasp takes seconds
   ASSERT_DOUBLE_EQ(options.watchdog_s, 0.1);  // the default (robot.watchdog_ms)
   RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
                          options);

@@ -55,13 +55,13 @@ struct BackendOptions {
 
 struct BackendStats {
   std::uint64_t datagrams = 0;
-  std::uint64_t ignored = 0;     // undecodable or unauthenticated: no answer
-  std::uint64_t shed = 0;        // dropped unread: unknown session, or over the unbound budget
+  std::uint64_t ignored = 0;  // undecodable or unauthenticated: no answer
+  std::uint64_t shed = 0;     // dropped unread: unknown session, or over the unbound budget
   std::uint64_t stale_heartbeats = 0;  // sent longer ago than the watchdog: fed nothing
-  std::uint64_t replayed = 0;    // authenticated but replayed or stale
-  std::uint64_t duplicates = 0;  // retransmissions answered from the cache
-  std::uint64_t rejected = 0;    // commands refused (workspace, busy, state)
-  std::uint64_t executed = 0;    // motion commands started
+  std::uint64_t replayed = 0;          // authenticated but replayed or stale
+  std::uint64_t duplicates = 0;        // retransmissions answered from the cache
+  std::uint64_t rejected = 0;          // commands refused (workspace, busy, state)
+  std::uint64_t executed = 0;          // motion commands started
   std::uint64_t watchdog_halts = 0;
   std::map<DecodeError, std::uint64_t> by_error;
 };
