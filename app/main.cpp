@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   arbci::app::addEegCommand(root, exit_code);
   arbci::app::addP300Commands(root, exit_code);
   arbci::app::addRobotCommand(root, exit_code);
+  arbci::app::addBidsCommand(root, exit_code);
   arbci::app::addRunCommand(root, exit_code);
   arbci::app::addTimingCheckCommand(root, exit_code);
   arbci::app::addSettingsCommand(root, exit_code);

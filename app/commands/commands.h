@@ -18,5 +18,6 @@ void addRobotCommand(CLI::App& root, int& exit_code);
 void addRunCommand(CLI::App& root, int& exit_code);
 void addTimingCheckCommand(CLI::App& root, int& exit_code);
 void addSettingsCommand(CLI::App& root, int& exit_code);
+void addBidsCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app

@@ -7,6 +7,7 @@
 
 #include "arbci/render/window_context.h"
 #include "arbci/session/session.h"
+#include "commands/bids_options.h"
 #include "commands/commands.h"
 #include "hmd/open_session.h"
 #include "support/cli_error.h"
@@ -25,6 +26,8 @@ struct RunOptions {
   int trials = 0;
   long long seed = -1;
   double fault_wait_s = 5.0;
+  std::string bids_root;  // --bids: export the session folder there when it ends
+  BidsEntities bids;
 };
 
 // arbci-session-<date>-<time>, with -2, -3, ... when a session of the same second exists.
@@ -84,6 +87,34 @@ void printSummary(const session::Session& session) {
   std::cout << "ended: " << session.endKind();
   if (session.endReason() != session.endKind()) std::cout << " (" << session.endReason() << ")";
   std::cout << "\n";
+}
+
+int runSession(const RunOptions& o);
+
+// The session's folder into the BIDS dataset, once it has ended; the folder stays as it is.
+int runAndExport(const RunOptions& o) {
+  if (!o.bids_root.empty()) {
+    if (o.bids.subject.empty()) throw CliError("--bids needs --subject (the BIDS subject label)");
+    try {
+      checkBidsEntities(o.bids);
+    } catch (const BidsError& error) {
+      throw CliError(error.what());
+    }
+  } else if (!o.bids.subject.empty() || !o.bids.session.empty() || !o.bids.run.empty()) {
+    throw CliError("--subject, --bids-session and --run go with --bids ROOT");
+  }
+  RunOptions run = o;
+  if (run.out.empty()) run.out = defaultFolder();
+  const int status = runSession(run);
+  if (o.bids_root.empty()) return status;
+  try {
+    reportBidsExport(exportToBids(run.out, o.bids_root, o.bids));
+  } catch (const std::exception& error) {
+    throw CliError(std::string("the session ended, but its BIDS export failed: ") + error.what() +
+                   "; the session folder " + run.out +
+                   " is intact: export it with `arbci bids export`");
+  }
+  return status;
 }
 
 int runSession(const RunOptions& o) {
@@ -162,7 +193,8 @@ void addRunCommand(CLI::App& root, int& exit_code) {
   run->add_option("--fault-wait", o->fault_wait_s,
                   "headless: seconds to wait for an experimenter after a robot fault")
       ->capture_default_str();
-  run->callback([o, &exit_code] { exit_code = runSession(*o); });
+  addBidsOptions(run, o->bids, o->bids_root, true);
+  run->callback([o, &exit_code] { exit_code = runAndExport(*o); });
 }
 
 }  // namespace arbci::app

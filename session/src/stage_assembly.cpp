@@ -79,6 +79,10 @@ std::map<std::string, std::string> recordingParameters(const SessionConfig& c) {
       {"PhotodiodeChannel", c.eeg.photodiode_channel},
       {"SoaMs", std::to_string(c.paradigm.soaSeconds() * 1000.0)},
       {"StimulusCodeMap", stimulusCodeMap(c.world, allSlots(c.world))},
+      // For the recording's description (a BIDS export's _eeg.json): where the EEG came from
+      // and the power line the online filter notched.
+      {"EegSource", c.eeg.source},
+      {"PowerLineHz", std::to_string(c.classifier.pipeline.filter.notch_hz)},
   };
 }
 

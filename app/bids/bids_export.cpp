@@ -1,0 +1,232 @@
+#include "bids/bids_export.h"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "arbci/bci/recording.h"
+#include "bids/bids_events.h"
+
+namespace arbci::app {
+namespace fs = std::filesystem;
+namespace {
+
+// The BIDS version the files follow.
+constexpr const char* kBidsVersion = "1.8.0";
+
+void checkLabel(const std::string& what, const std::string& label, bool digits_only) {
+  const bool ok = !label.empty() && std::all_of(label.begin(), label.end(), [&](unsigned char c) {
+    return digits_only ? std::isdigit(c) : std::isalnum(c);
+  });
+  if (!ok)
+    throw BidsError("the " + what + " label \"" + label + "\" is not allowed in BIDS: use " +
+                    (digits_only ? "digits only (e.g. 1)" : "letters and digits only (e.g. 01, P3)"));
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw BidsError("cannot write " + path.string());
+}
+
+std::string number(double value) {
+  std::ostringstream s;
+  s << std::setprecision(10) << value;
+  return s.str();
+}
+
+// A TSV cell: tabs and line breaks would break the table.
+std::string cell(std::string s) {
+  for (char& c : s) {
+    if (c == '\t' || c == '\n' || c == '\r') c = ' ';
+  }
+  return s.empty() ? "n/a" : s;
+}
+
+// The numbers of the runs already in `eeg_dir` for these entities.
+std::set<int> existingRuns(const fs::path& eeg_dir, const std::string& stem_prefix) {
+  std::set<int> runs;
+  if (!fs::is_directory(eeg_dir)) return runs;
+  const std::regex pattern(std::regex_replace(stem_prefix, std::regex(R"([.^$|()\[\]{}*+?\\])"),
+                                              R"(\$&)") +
+                           "_run-([0-9]+)_eeg\\.bdf");
+  for (const auto& entry : fs::directory_iterator(eeg_dir)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, m, pattern)) runs.insert(std::stoi(m[1].str()));
+  }
+  return runs;
+}
+
+void ensureDatasetFiles(const fs::path& root, const std::string& subject) {
+  fs::create_directories(root);
+  if (!fs::exists(root / "dataset_description.json")) {
+    nlohmann::ordered_json d;
+    d["Name"] = "ARBCI sessions";
+    d["BIDSVersion"] = kBidsVersion;
+    d["DatasetType"] = "raw";
+    d["GeneratedBy"] = {{{"Name", "ARBCI"}, {"Version", ARBCI_VERSION}}};
+    writeText(root / "dataset_description.json", d.dump(2) + "\n");
+  }
+  if (!fs::exists(root / "README"))
+    writeText(root / "README",
+              "EEG of augmented-reality P300 brain-computer interface sessions recorded with "
+              "ARBCI: objects on a table flash in a video see-through head-mounted display, the "
+              "subject attends one, a robot arm moves it to a grid cell selected the same way.\n"
+              "Each run's events table lists every flash (T attended, N not, U unknown), the "
+              "phases, selections, feedback, robot commands and error-potential verdicts.\n"
+              "ARBCI's own files for each run (summary, log, model, screenshots) are under "
+              "derivatives/arbci/.\n");
+  const fs::path participants = root / "participants.tsv";
+  std::set<std::string> known;
+  if (std::ifstream in(participants); in) {
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) known.insert(line.substr(0, line.find('\t')));
+  } else {
+    writeText(participants, "participant_id\n");
+  }
+  if (!known.count("sub-" + subject)) {
+    std::ofstream out(participants, std::ios::app);
+    out << "sub-" << subject << "\n";
+    if (!out) throw BidsError("cannot write " + participants.string());
+  }
+  const fs::path derivatives = root / "derivatives" / "arbci";
+  if (!fs::exists(derivatives / "dataset_description.json")) {
+    fs::create_directories(derivatives);
+    nlohmann::ordered_json d;
+    d["Name"] = "ARBCI session files";
+    d["BIDSVersion"] = kBidsVersion;
+    d["DatasetType"] = "derivative";
+    d["GeneratedBy"] = {{{"Name", "ARBCI"}, {"Version", ARBCI_VERSION}}};
+    writeText(derivatives / "dataset_description.json", d.dump(2) + "\n");
+  }
+}
+
+std::string parameter(const bci::Recording& r, const std::string& key) {
+  const auto found = r.parameters.find(key);
+  return found == r.parameters.end() ? "" : found->second;
+}
+
+std::string eegSidecar(const bci::Recording& r, const std::string& task, int misc) {
+  nlohmann::ordered_json j;
+  j["TaskName"] = task;
+  j["TaskDescription"] =
+      "P300 selection in augmented reality: objects, then grid rows and columns, flash in a "
+      "head-mounted display; the subject attends the object to move and the cell to put it on.";
+  j["Instructions"] = "Attend the cued (calibration) or chosen object and count its flashes.";
+  j["SamplingFrequency"] = r.info.rate_hz;
+  j["EEGReference"] = "n/a";
+  const std::string line = parameter(r, "PowerLineHz");
+  double line_hz = 0.0;
+  try {
+    line_hz = line.empty() ? 0.0 : std::stod(line);
+  } catch (const std::exception&) {
+  }
+  if (line_hz > 0.0) {
+    j["PowerLineFrequency"] = line_hz;
+  } else {
+    j["PowerLineFrequency"] = "n/a";
+  }
+  j["SoftwareFilters"] = "n/a";  // the recording is unfiltered; the online filter is ARBCI's own
+  const std::string source = parameter(r, "EegSource");
+  j["Manufacturer"] = source == "simulated" || source.empty()
+                          ? "n/a (ARBCI's simulated subject)"
+                          : "n/a (ARBCI EEG source: " + source + ")";
+  j["SoftwareVersions"] = std::string("ARBCI ") + ARBCI_VERSION;
+  j["EEGChannelCount"] = r.info.channelCount() - misc;
+  j["MiscChannelCount"] = misc;
+  j["RecordingDuration"] = r.seconds();
+  j["RecordingType"] = "continuous";
+  return j.dump(2) + "\n";
+}
+
+}  // namespace
+
+void checkBidsEntities(const BidsEntities& entities) {
+  checkLabel("subject", entities.subject, false);
+  if (!entities.session.empty()) checkLabel("session", entities.session, false);
+  checkLabel("task", entities.task, false);
+  if (!entities.run.empty()) checkLabel("run", entities.run, true);
+}
+
+BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
+                        const BidsEntities& entities) {
+  checkBidsEntities(entities);
+  const fs::path bdf = session_dir / "recording.bdf";
+  if (!fs::exists(bdf))
+    throw BidsError("no recording.bdf in " + session_dir.string() +
+                    ": give an ARBCI session folder (the --out of arbci run)");
+  bci::Recording recording;
+  try {
+    recording = bci::readRecording(bdf);
+  } catch (const std::exception& error) {
+    throw BidsError("cannot read " + bdf.string() + ": " + error.what());
+  }
+  const std::string sub = "sub-" + entities.subject;
+  const std::string ses = entities.session.empty() ? "" : "ses-" + entities.session;
+  const fs::path relative = ses.empty() ? fs::path(sub) : fs::path(sub) / ses;
+  const fs::path eeg_dir = root / relative / "eeg";
+  const std::string prefix = sub + (ses.empty() ? "" : "_" + ses) + "_task-" + entities.task;
+  const std::set<int> runs = existingRuns(eeg_dir, prefix);
+  int run = entities.run.empty() ? (runs.empty() ? 1 : *runs.rbegin() + 1) : std::stoi(entities.run);
+  if (runs.count(run))
+    throw BidsError("run " + std::to_string(run) + " of " + prefix + " is already in " +
+                    root.string() + "; runs are never overwritten (leave --run out for the next, " +
+                    std::to_string(*runs.rbegin() + 1) + ")");
+  ensureDatasetFiles(root, entities.subject);
+  fs::create_directories(eeg_dir);
+  const std::string stem = prefix + "_run-" + std::to_string(run);
+  BidsExport out;
+  out.run = std::to_string(run);
+  out.eeg_file = eeg_dir / (stem + "_eeg.bdf");
+  fs::copy_file(bdf, out.eeg_file, fs::copy_options::none);
+
+  // Channels: EEG in microvolts, the photodiode a MISC channel.
+  const std::string photodiode = parameter(recording, "PhotodiodeChannel");
+  std::ostringstream channels;
+  channels << "name\ttype\tunits\tstatus\tstatus_description\n";
+  int misc = 0;
+  for (const std::string& name : recording.info.channels) {
+    const bool is_photodiode = name == photodiode || name == "Photodiode";
+    misc += is_photodiode ? 1 : 0;
+    channels << cell(name) << "\t" << (is_photodiode ? "MISC" : "EEG") << "\t"
+             << (is_photodiode ? "n/a" : "uV") << "\tgood\t"
+             << (is_photodiode ? "photodiode on the display: the flashes' presented onsets" : "n/a")
+             << "\n";
+  }
+  writeText(eeg_dir / (stem + "_channels.tsv"), channels.str());
+  writeText(eeg_dir / (stem + "_eeg.json"), eegSidecar(recording, entities.task, misc));
+
+  const BidsEvents events = sessionEvents(recording, session_dir / "log.jsonl");
+  std::ostringstream table;
+  table << "onset\tduration\ttrial_type\tvalue\tsample\tstimulus\ttarget\tdescription\n";
+  for (const BidsEvent& e : events.rows) {
+    table << number(e.onset_s) << "\t" << number(e.duration_s) << "\t" << cell(e.trial_type)
+          << "\t" << cell(e.value) << "\t" << e.sample << "\t" << cell(e.stimulus) << "\t"
+          << cell(e.target) << "\t" << cell(e.description) << "\n";
+  }
+  writeText(eeg_dir / (stem + "_events.tsv"), table.str());
+  writeText(eeg_dir / (stem + "_events.json"), eventsSidecar());
+  out.events = events.rows.size();
+  out.notes = events.notes;
+
+  // ARBCI's own files, beside the same entities in the derivatives dataset.
+  const fs::path own = root / "derivatives" / "arbci" / relative / "eeg" / stem;
+  fs::create_directories(own);
+  for (const auto& entry : fs::directory_iterator(session_dir)) {
+    const std::string name = entry.path().filename().string();
+    const bool wanted = name == "summary.json" || name == "log.jsonl" || name == "model.json" ||
+                        name == "session.json" || name == "robotd.log" ||
+                        (name.rfind("hmd_", 0) == 0 && entry.path().extension() == ".png");
+    if (wanted && entry.is_regular_file()) fs::copy_file(entry.path(), own / name);
+  }
+  return out;
+}
+
+}  // namespace arbci::app
