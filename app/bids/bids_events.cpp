@@ -53,10 +53,12 @@ class LogClock {
         recorded.push_back(static_cast<double>(a.sample) / recording.info.rate_hz);
     }
     for (const nlohmann::json& e : log) {
-      if (e.value("event", "") == "phase" && e.contains("t")) logged.push_back(e["t"].get<double>());
+      if (e.value("event", "") == "phase" && e.contains("t"))
+        logged.push_back(e["t"].get<double>());
     }
     if (recorded.size() != logged.size()) return;  // not the same run's: nothing is placed
-    for (size_t i = 0; i < logged.size(); ++i) pairs_.emplace_back(logged[i], recorded[i] - logged[i]);
+    for (size_t i = 0; i < logged.size(); ++i)
+      pairs_.emplace_back(logged[i], recorded[i] - logged[i]);
   }
   bool usable() const { return !pairs_.empty(); }
   double recordingTime(double log_t) const {
@@ -82,9 +84,9 @@ std::string describeLogEvent(const nlohmann::json& e) {
   if (event == "robot") {
     // Link events (connected, silent, restarted) belong to no command.
     const bool link = e.value("sequence", 0) == 0;
-    std::string text = link ? "robot link " + e.value("kind", std::string(""))
-                            : e.value("command", std::string("")) + " " +
-                                  e.value("kind", std::string(""));
+    std::string text =
+        link ? "robot link " + e.value("kind", std::string(""))
+             : e.value("command", std::string("")) + " " + e.value("kind", std::string(""));
     if (e.contains("outcome")) text += " " + e["outcome"].get<std::string>();
     if (e.contains("reason")) text += " (" + e["reason"].get<std::string>() + ")";
     const std::string detail = e.value("text", std::string(""));
@@ -191,11 +193,13 @@ std::string eventsSidecar() {
         {"errp", "the error-potential classifier's verdict on a feedback, or a correction"},
         {"placement", "where the robot put the object, against the cell's centre"},
         {"annotation", "another note of the recording"}}}};
-  j["value"] = {{"Description", "A flash's stimulus code (1-99 objects, 100 + code grid rows and "
-                                "columns), n/a otherwise."}};
+  j["value"] = {{"Description",
+                 "A flash's stimulus code (1-99 objects, 100 + code grid rows and "
+                 "columns), n/a otherwise."}};
   j["sample"] = {{"Description", "The recording's sample (from 0) at the onset."}};
-  j["stimulus"] = {{"Description", "What a flash's code stood for then (the recording's "
-                                   "StimulusCodeMap): \"object 10\", \"row 1\", \"column 2\"."}};
+  j["stimulus"] = {{"Description",
+                    "What a flash's code stood for then (the recording's "
+                    "StimulusCodeMap): \"object 10\", \"row 1\", \"column 2\"."}};
   j["target"] = {{"Description", "Whether the subject attended the flashed stimulus."},
                  {"Levels",
                   {{"T", "attended (the cued or intended one)"},

@@ -24,8 +24,9 @@ void checkLabel(const std::string& what, const std::string& label, bool digits_o
     return digits_only ? std::isdigit(c) : std::isalnum(c);
   });
   if (!ok)
-    throw BidsError("the " + what + " label \"" + label + "\" is not allowed in BIDS: use " +
-                    (digits_only ? "digits only (e.g. 1)" : "letters and digits only (e.g. 01, P3)"));
+    throw BidsError(
+        "the " + what + " label \"" + label + "\" is not allowed in BIDS: use " +
+        (digits_only ? "digits only (e.g. 1)" : "letters and digits only (e.g. 01, P3)"));
 }
 
 void writeText(const fs::path& path, const std::string& text) {
@@ -52,9 +53,9 @@ std::string cell(std::string s) {
 std::set<int> existingRuns(const fs::path& eeg_dir, const std::string& stem_prefix) {
   std::set<int> runs;
   if (!fs::is_directory(eeg_dir)) return runs;
-  const std::regex pattern(std::regex_replace(stem_prefix, std::regex(R"([.^$|()\[\]{}*+?\\])"),
-                                              R"(\$&)") +
-                           "_run-([0-9]+)_eeg\\.bdf");
+  const std::regex pattern(
+      std::regex_replace(stem_prefix, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
+      "_run-([0-9]+)_eeg\\.bdf");
   for (const auto& entry : fs::directory_iterator(eeg_dir)) {
     std::smatch m;
     const std::string name = entry.path().filename().string();
@@ -174,7 +175,8 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
   const fs::path eeg_dir = root / relative / "eeg";
   const std::string prefix = sub + (ses.empty() ? "" : "_" + ses) + "_task-" + entities.task;
   const std::set<int> runs = existingRuns(eeg_dir, prefix);
-  int run = entities.run.empty() ? (runs.empty() ? 1 : *runs.rbegin() + 1) : std::stoi(entities.run);
+  int run =
+      entities.run.empty() ? (runs.empty() ? 1 : *runs.rbegin() + 1) : std::stoi(entities.run);
   if (runs.count(run))
     throw BidsError("run " + std::to_string(run) + " of " + prefix + " is already in " +
                     root.string() + "; runs are never overwritten (leave --run out for the next, " +
@@ -207,9 +209,9 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
   std::ostringstream table;
   table << "onset\tduration\ttrial_type\tvalue\tsample\tstimulus\ttarget\tdescription\n";
   for (const BidsEvent& e : events.rows) {
-    table << number(e.onset_s) << "\t" << number(e.duration_s) << "\t" << cell(e.trial_type)
-          << "\t" << cell(e.value) << "\t" << e.sample << "\t" << cell(e.stimulus) << "\t"
-          << cell(e.target) << "\t" << cell(e.description) << "\n";
+    table << number(e.onset_s) << "\t" << number(e.duration_s) << "\t" << cell(e.trial_type) << "\t"
+          << cell(e.value) << "\t" << e.sample << "\t" << cell(e.stimulus) << "\t" << cell(e.target)
+          << "\t" << cell(e.description) << "\n";
   }
   writeText(eeg_dir / (stem + "_events.tsv"), table.str());
   writeText(eeg_dir / (stem + "_events.json"), eventsSidecar());

@@ -15,10 +15,10 @@
 namespace arbci::app {
 
 struct BidsEntities {
-  std::string subject;          // letters and digits only
-  std::string session;          // optional; letters and digits only
-  std::string task = "arbci";   // letters and digits only
-  std::string run;              // optional: the next free run when empty; digits only
+  std::string subject;         // letters and digits only
+  std::string session;         // optional; letters and digits only
+  std::string task = "arbci";  // letters and digits only
+  std::string run;             // optional: the next free run when empty; digits only
 };
 
 struct BidsExport {
@@ -39,7 +39,7 @@ void checkBidsEntities(const BidsEntities& entities);
 
 // Throws BidsError with a message a person can act on (not a session folder, a label BIDS does
 // not allow, a run that exists).
-BidsExport exportToBids(const std::filesystem::path& session_dir,
-                        const std::filesystem::path& root, const BidsEntities& entities);
+BidsExport exportToBids(const std::filesystem::path& session_dir, const std::filesystem::path& root,
+                        const BidsEntities& entities);
 
 }  // namespace arbci::app

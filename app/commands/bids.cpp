@@ -16,8 +16,7 @@ void addBidsOptions(CLI::App* command, BidsEntities& entities, std::string& root
     command->add_option("--bids", root,
                         "also write the session into this EEG-BIDS dataset when it ends "
                         "(needs --subject)");
-  command->add_option("--subject", entities.subject,
-                      "BIDS subject label (letters and digits)");
+  command->add_option("--subject", entities.subject, "BIDS subject label (letters and digits)");
   // `arbci run` has --session (the session file): there the BIDS session is --bids-session.
   command->add_option(root_option ? "--bids-session" : "--session", entities.session,
                       "BIDS session label (optional)");

@@ -9,8 +9,7 @@
 namespace arbci::app {
 
 // --subject, --session, --task, --run; with `root_option`, also --bids ROOT.
-void addBidsOptions(CLI::App* command, BidsEntities& entities, std::string& root,
-                    bool root_option);
+void addBidsOptions(CLI::App* command, BidsEntities& entities, std::string& root, bool root_option);
 void reportBidsExport(const BidsExport& done);
 
 }  // namespace arbci::app

@@ -56,13 +56,14 @@ void listStreams(const LslOptions& o) {
     std::cout << "no LSL streams seen\n";
     return;
   }
-  std::printf("%-24s %-10s %8s %10s %-9s %-20s %s\n", "name", "type", "channels", "rate (Hz)",
-              "format", "host", "address");
+  std::printf("%-24s %-10s %8s %10s %-9s %-20s %-32s %s\n", "name", "type", "channels", "rate (Hz)",
+              "format", "host", "source_id", "address");
   for (const auto& s : streams) {
     const std::string rate = s.nominal_srate > 0 ? std::to_string(s.nominal_srate) : "irregular";
-    std::printf("%-24s %-10s %8d %10.10s %-9s %-20s %s:%d\n", s.name.c_str(), s.type.c_str(),
+    std::printf("%-24s %-10s %8d %10.10s %-9s %-20s %-32s %s:%d\n", s.name.c_str(), s.type.c_str(),
                 s.channel_count, rate.c_str(), bci::lsl::formatName(s.channel_format),
-                s.hostname.c_str(), s.v4address.c_str(), s.v4data_port);
+                s.hostname.c_str(), s.source_id.empty() ? "-" : s.source_id.c_str(),
+                s.v4address.c_str(), s.v4data_port);
   }
 }
 

@@ -26,17 +26,23 @@ std::string describeStreams(const std::vector<lsl::StreamInfo>& streams) {
   std::string text;
   for (const auto& s : streams)
     text += (text.empty() ? "" : "; ") + s.name + " (type " + s.type + ", " +
-            std::to_string(s.channel_count) + " channels, on " + s.hostname + ")";
+            std::to_string(s.channel_count) + " channels, source_id \"" + s.source_id + "\", on " +
+            s.hostname + ")";
   return text;
 }
 
 }  // namespace
 
 LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
-  const std::string query =
-      lsl::buildQuery(settings.config.session_id, settings.name, settings.type);
-  const std::string wanted = (settings.name.empty() ? "" : "name \"" + settings.name + "\" ") +
-                             (settings.type.empty() ? "" : "type \"" + settings.type + "\"");
+  const std::string query = lsl::buildQuery(settings.config.session_id, settings.name,
+                                            settings.type, settings.source_id, settings.host);
+  std::string wanted;
+  for (const auto& [field, value] : {std::pair<std::string, std::string>{"name", settings.name},
+                                     {"type", settings.type},
+                                     {"source_id", settings.source_id},
+                                     {"host", settings.host}}) {
+    if (!value.empty()) wanted += (wanted.empty() ? "" : " ") + field + " \"" + value + "\"";
+  }
   // Returns shortly after the first answer (the others on the network answer within the grace).
   auto found = lsl::resolveStreams(settings.config, query, settings.resolve_timeout_s, 1);
   if (found.empty()) {
@@ -49,7 +55,9 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
   }
   if (found.size() > 1)
     throw lsl::LslError(std::to_string(found.size()) + " LSL streams match " + wanted + ": " +
-                        describeStreams(found) + ". Name the one to use (eeg.lsl.name)");
+                        describeStreams(found) +
+                        ". Choose one by eeg.lsl.source_id (or eeg.lsl.host, or eeg.lsl.name "
+                        "where the names differ)");
   const lsl::StreamInfo& stream = found.front();
   if (stream.channel_format == lsl::ChannelFormat::String)
     throw lsl::LslError("LSL stream \"" + stream.name + "\" carries strings, not EEG samples");

@@ -229,6 +229,11 @@ const core::Schema<LslSourceSettings>& lslSourceSchema() {
     using L = LslSourceSettings;
     t.text("name", &L::name, "", "the stream's name (\"\": any of the type)")
         .text("type", &L::type, "EEG", "the stream's type (\"\": any of the name)")
+        .text("source_id", &L::source_id, "",
+              "the stream's source id (\"\": any): picks one of several streams of the same "
+              "name (`arbci eeg streams` lists them)")
+        .text("host", &L::host, "",
+              "the host the stream comes from, as `arbci eeg streams` shows it (\"\": any)")
         .number("resolve_timeout_s", &L::resolve_timeout_s, 5.0, 0.1, 600.0,
                 "how long to look for the stream (and wait for its first sample)", "s");
     t.rule([](const Json& l) -> std::optional<std::pair<std::string, std::string>> {

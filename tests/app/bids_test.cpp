@@ -44,17 +44,17 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
       << BIDS_VALIDATOR << " is missing: scripts/install-deps installs it (npm)";
   const fs::path dir = scratch();
   const fs::path root = dir / "bids";
-  const ProcessResult run =
-      runProcess(kArbci,
-                 {"run", "--headless", "--trials", "1", "--seed", "3", "--out",
-                  (dir / "session").string(), "--bids", root.string(), "--subject", "01",
-                  "--bids-session", "1"},
-                 600.0);
+  const ProcessResult run = runProcess(
+      kArbci,
+      {"run", "--headless", "--trials", "1", "--seed", "3", "--out", (dir / "session").string(),
+       "--bids", root.string(), "--subject", "01", "--bids-session", "1"},
+      600.0);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("BIDS: wrote"), std::string::npos) << run.out;
   const fs::path eeg = root / "sub-01" / "ses-1" / "eeg";
   const std::string stem = "sub-01_ses-1_task-arbci_run-1";
-  for (const char* suffix : {"_eeg.bdf", "_eeg.json", "_channels.tsv", "_events.tsv", "_events.json"})
+  for (const char* suffix :
+       {"_eeg.bdf", "_eeg.json", "_channels.tsv", "_events.tsv", "_events.json"})
     EXPECT_TRUE(fs::exists(eeg / (stem + suffix))) << stem << suffix;
   EXPECT_TRUE(fs::exists(root / "derivatives" / "arbci" / "sub-01" / "ses-1" / "eeg" / stem /
                          "summary.json"));
@@ -73,14 +73,14 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
 
   // The same folder again, as an older session: the next run, never over the first; a run given
   // that exists is refused.
-  const ProcessResult again = runProcess(
-      kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject", "01",
-               "--session", "1"});
+  const ProcessResult again =
+      runProcess(kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject",
+                          "01", "--session", "1"});
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_TRUE(fs::exists(eeg / "sub-01_ses-1_task-arbci_run-2_eeg.bdf"));
-  const ProcessResult taken = runProcess(
-      kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject", "01",
-               "--session", "1", "--run", "1"});
+  const ProcessResult taken =
+      runProcess(kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject",
+                          "01", "--session", "1", "--run", "1"});
   EXPECT_EQ(taken.exit_code, 1);
   EXPECT_NE(taken.err.find("never overwritten"), std::string::npos) << taken.err;
   const ProcessResult bad = runProcess(
@@ -97,10 +97,10 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
 
   // MNE reads the recording and the events table: the attended flashes' average is positive at
   // Cz and Pz in 250-500 ms, and above the others'.
-  const ProcessResult mne =
-      runProcess(DEBIAN_PYTHON, {MNE_SCRIPT, (eeg / (stem + "_eeg.bdf")).string(),
-                                 (eeg / (stem + "_events.tsv")).string()},
-                 300.0);
+  const ProcessResult mne = runProcess(
+      DEBIAN_PYTHON,
+      {MNE_SCRIPT, (eeg / (stem + "_eeg.bdf")).string(), (eeg / (stem + "_events.tsv")).string()},
+      300.0);
   ASSERT_EQ(mne.exit_code, 0) << mne.out << mne.err;
   std::cout << mne.out;
   EXPECT_EQ(lines(mne.out, "Cz ") + lines(mne.out, "Pz "), 2) << mne.out;

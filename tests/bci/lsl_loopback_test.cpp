@@ -1,6 +1,10 @@
 // ARBCI's LSL outlet and inlet talking over loopback (127.0.0.1 only: the machine scope), in one
 // process and in two. Every wait is bounded.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -153,6 +157,75 @@ TEST(LslSource, NoStreamIsRefusedWithAMessageNamingItAndTheScope) {
     EXPECT_NE(std::string(e.what()).find(settings.name), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("scope machine"), std::string::npos) << e.what();
   }
+}
+
+// Two outlets of the same name (two amplifiers of one model): the refusal names their source ids,
+// and the source id picks one.
+TEST(LslSource, StreamsOfTheSameNameAreToldApartBySourceId) {
+  const std::string name = uniqueName("twin");
+  StreamInfo first = eegStream(name, 2, 256, ChannelFormat::Float32);
+  StreamInfo second = eegStream(name, 3, 256, ChannelFormat::Float32);
+  first.source_id = name + "-left";
+  second.source_id = name + "-right";
+  Outlet a(first, machineScope()), b(second, machineScope());
+  LslSourceSettings settings;
+  settings.name = name;
+  settings.resolve_timeout_s = 1.0;
+  settings.config = machineScope();
+  settings.require_samples = false;
+  try {
+    LslSource source(settings);
+    FAIL() << "two streams of one name were not refused";
+  } catch (const LslError& e) {
+    const std::string text = e.what();
+    EXPECT_NE(text.find(first.source_id), std::string::npos) << text;
+    EXPECT_NE(text.find(second.source_id), std::string::npos) << text;
+    EXPECT_NE(text.find("eeg.lsl.source_id"), std::string::npos) << text;
+  }
+  settings.source_id = second.source_id;
+  LslSource chosen(settings);
+  EXPECT_EQ(chosen.info().channelCount(), 3);
+}
+
+// The discovery port is shared as liblsl shares it: bound on any address. With an ARBCI outlet's
+// responder running, a responder bound afterwards as liblsl binds its own (0.0.0.0:16571, the
+// address reusable) still receives a unicast query to 127.0.0.1 (Linux hands a unicast datagram
+// to the most specific binding, the newest among equals): a 127.0.0.1 binding of ARBCI's would
+// have taken every such query from liblsl's outlets.
+TEST(LslLoopback, TheDiscoveryPortIsSharedAsLiblslBindsIt) {
+  const std::string name = uniqueName("shared");
+  Outlet outlet(eegStream(name, 2, 256, ChannelFormat::Float32), machineScope());
+  const int port = machineScope().multicast_port;
+  auto udp = [](const char* address, int at, bool reuse) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    const int one = 1;
+    if (reuse) ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(at));
+    ::inet_pton(AF_INET, address, &a.sin_addr);
+    EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0) << address << ":" << at;
+    return fd;
+  };
+  const int liblsl_like = udp("0.0.0.0", port, true);
+  const int asker = udp("127.0.0.1", 0, false);
+  const std::string query = "LSL:shortinfo\r\nname='" + name + "'\r\n12345 query-1\r\n";
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  ::inet_pton(AF_INET, "127.0.0.1", &to.sin_addr);
+  ::sendto(asker, query.data(), query.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  pollfd watched{liblsl_like, POLLIN, 0};
+  std::string received;
+  if (::poll(&watched, 1, 2000) == 1) {
+    char buffer[2048];
+    const ssize_t n = ::recv(liblsl_like, buffer, sizeof buffer, 0);
+    if (n > 0) received.assign(buffer, static_cast<size_t>(n));
+  }
+  ::close(liblsl_like);
+  ::close(asker);
+  EXPECT_EQ(received, query) << "the query to 127.0.0.1 did not reach a responder bound as "
+                                "liblsl's";
 }
 
 TEST(LslSource, AStreamThatSendsNothingIsRefusedBeforeTheSession) {

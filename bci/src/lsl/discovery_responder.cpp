@@ -51,15 +51,17 @@ std::shared_ptr<DiscoveryResponder> DiscoveryResponder::shared(const LslConfig& 
 
 DiscoveryResponder::DiscoveryResponder(const LslConfig& config,
                                        std::vector<std::string>& warnings) {
-  // Loopback addresses are bound as themselves; broadcast and multicast on any address (joining
-  // the group). All share the port with other processes' outlets.
+  // Every address on the discovery port bound on any address, with the port shared, as liblsl's
+  // responders bind it (joining the group where the address is multicast). A loopback address
+  // bound as itself would be more specific than liblsl's binding: the kernel would hand every
+  // unicast query to 127.0.0.1 to ARBCI alone, and liblsl's consumers would stop finding liblsl's
+  // outlets in the machine scope.
   for (const auto& a : config.queryAddresses()) {
     try {
       net::Fd fd = net::udpSocket();
       const sockaddr_in group = net::endpoint(a, config.multicast_port);
       const bool multicast = IN_MULTICAST(ntohl(group.sin_addr.s_addr));
-      const bool loopback = a.rfind("127.", 0) == 0;
-      net::bindExact(fd, loopback ? a : "0.0.0.0", config.multicast_port, true);
+      net::bindExact(fd, "0.0.0.0", config.multicast_port, true);
       if (multicast) {
         ip_mreq membership{};
         membership.imr_multiaddr = group.sin_addr;

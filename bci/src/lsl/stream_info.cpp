@@ -202,11 +202,14 @@ std::vector<std::string> StreamInfo::channelLabels() const {
 }
 
 std::string buildQuery(const std::string& session_id, const std::string& name,
-                       const std::string& type) {
+                       const std::string& type, const std::string& source_id,
+                       const std::string& hostname) {
   std::string query;
   for (const auto& [field, value] : {std::pair<std::string, std::string>{"session_id", session_id},
                                      {"name", name},
-                                     {"type", type}}) {
+                                     {"type", type},
+                                     {"source_id", source_id},
+                                     {"hostname", hostname}}) {
     if (value.empty()) continue;
     if (value.find('\'') != std::string::npos)
       throw LslError("LSL " + field + " \"" + value +

@@ -22,12 +22,14 @@ namespace lsl {
 class Inlet;
 }
 
-// name, type and resolve_timeout_s are settings (bci::lslSourceSchema(), bci/settings.h, takes
-// their defaults); the rest the session sets from its EEG settings.
+// name, type, source_id, host and resolve_timeout_s are settings (bci::lslSourceSchema(),
+// bci/settings.h, takes their defaults); the rest the session sets from its EEG settings.
 struct LslSourceSettings {
   LslSourceSettings();
   std::string name;  // the stream's name (empty: any)
   std::string type;
+  std::string source_id;  // the stream's source id (empty: any): tells same-named streams apart
+  std::string host;       // the host it streams from (empty: any)
   double resolve_timeout_s;
   int block_size = 15;
   double expected_rate_hz = 0.0;  // the session's rate: a stream at another rate is refused

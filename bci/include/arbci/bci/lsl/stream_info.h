@@ -63,9 +63,11 @@ struct StreamInfo {
   std::vector<std::string> channelLabels() const;
 };
 
-// A query for streams by name and/or type in a session: "session_id='S' and name='N' and
-// type='T'" (single quotes in values are refused: XPath 1.0 has no escape for them).
+// A query for streams by name, type, source id and/or host in a session: "session_id='S' and
+// name='N' and type='T' and source_id='I' and hostname='H'" (empty fields left out; single quotes
+// in values are refused: XPath 1.0 has no escape for them).
 std::string buildQuery(const std::string& session_id, const std::string& name,
-                       const std::string& type);
+                       const std::string& type, const std::string& source_id = "",
+                       const std::string& hostname = "");
 
 }  // namespace arbci::bci::lsl
