@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <iostream>
 #include <random>
 #include <thread>
 #include <vector>
@@ -30,8 +31,11 @@ using namespace std::chrono_literals;
 
 double g_watchdog_s = robot::BackendOptions{}.watchdog_s;
 
+std::ostream* g_log = nullptr;  // --log: the backend's lines (halts with their cause)
+
 robot::BackendOptions benchOptions(double speed = 1.0) {
   robot::BackendOptions options;
+  options.log = g_log;
   options.speed_factor = speed;
   options.watchdog_s = g_watchdog_s;
   options.raise_priority = true;  // as arbci-robotd runs
@@ -219,7 +223,10 @@ int main(int argc, char** argv) {
   app.add_option("--flood-rate", flood_rate, "forged datagrams a second")->capture_default_str();
   double watchdog_ms = g_watchdog_s * 1000.0;
   app.add_option("--watchdog-ms", watchdog_ms, "the backend's watchdog")->capture_default_str();
+  bool log = false;
+  app.add_flag("--log", log, "print the backends' log (every halt with its cause) to stderr");
   CLI11_PARSE(app, argc, argv);
+  if (log) g_log = &std::cerr;
   g_watchdog_s = watchdog_ms / 1000.0;
   std::printf(
       "Watchdog halts during a grasp (watchdog %.0f ms, heartbeat 50 Hz); ms as "

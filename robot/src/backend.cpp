@@ -82,7 +82,7 @@ struct RobotBackend::Impl {
     std::optional<std::int64_t> heartbeat_us;
     // How old the heartbeat received last was when it arrived: over the watchdog, the link
     // delays it too much to protect a motion (a lost heartbeat sets nothing here).
-    std::int64_t last_heartbeat_age_us = 0;
+    std::int64_t last_heartbeat_age_us = 0, heartbeat_received_us = 0;
     // The challenge of the BIND that bound it: a retransmission of that BIND from the bound
     // address is answered again (its BOUND may have been lost).
     std::uint64_t bound_challenge = 0, bind_sequence = 0;
@@ -214,7 +214,8 @@ struct RobotBackend::Impl {
   }
 
   // Halts the arm at once; motion commands are refused until a RESET.
-  void latchStop(const std::string& reason, const std::string& outcome_text) {
+  void latchStop(const std::string& reason, const std::string& outcome_text,
+                 const std::string& detail = "") {
     const bool halted = running.has_value();
     const std::string what = halted ? toString(running->type) + std::string(" halted") : "";
     driver->stop();
@@ -223,7 +224,7 @@ struct RobotBackend::Impl {
     if (latched) stop_reason = reason;
     if (halted || latched) {
       note("stopped: " + reason + (halted ? " (" + what + ")" : "") +
-           "; motion commands refused until RESET");
+           "; motion commands refused until RESET" + detail);
     } else {
       log("stop again", "stopped again: " + reason + " (already stopped: " + stop_reason + ")");
     }
@@ -416,12 +417,14 @@ struct RobotBackend::Impl {
     }
     challenges.erase(open);  // answered: every open challenge of the session is spent
     Session& s = sessions[m.session];
-    if (m.sequence <= s.highest) {
+    // A rebinding session has sent heartbeats since; its BIND is new if its sequence is unused
+    // and inside the replay window (the challenge already proved it fresh).
+    if (s.seen.count(m.sequence) || belowWindow(m.sequence, s.highest)) {
       count(&BackendStats::replayed);
       return;
     }
     s.peer = from;
-    s.highest = m.sequence;
+    s.highest = std::max(s.highest, m.sequence);
     s.seen.insert(m.sequence);
     s.active = now;
     s.bound_challenge = m.challenge;
@@ -457,6 +460,7 @@ struct RobotBackend::Impl {
     const std::int64_t now = steadyMicros();
     const std::int64_t sent = std::min(m.time_us, now);  // a clock error cannot extend the deadline
     s.last_heartbeat_age_us = now - sent;
+    s.heartbeat_received_us = now;
     if (watchdogActive() && now - sent > watchdogMicros()) count(&BackendStats::stale_heartbeats);
     if (!s.heartbeat_us || sent > *s.heartbeat_us) s.heartbeat_us = sent;
     s.abandon_below = std::max(s.abandon_below, m.abandon_below);
@@ -573,10 +577,22 @@ struct RobotBackend::Impl {
     return fed + watchdogMicros() - kWakeMarginUs;
   }
 
+  // Why the watchdog fired, for the log: how old the newest heartbeat is and when one last came.
+  std::string watchdogDetail() const {
+    const auto found = running ? sessions.find(running->session) : sessions.end();
+    if (found == sessions.end() || !found->second.heartbeat_us) return " (no heartbeat yet)";
+    const Session& s = found->second;
+    const std::int64_t now = steadyMicros();
+    return " (newest heartbeat sent " + std::to_string((now - *s.heartbeat_us) / 1000) +
+           " ms ago; the last to arrive was " + std::to_string(s.last_heartbeat_age_us / 1000) +
+           " ms old, " + std::to_string((now - s.heartbeat_received_us) / 1000) + " ms ago)";
+  }
+
   void advance() {
     const auto now = SteadyClock::now();
     if (const auto deadline = watchdogDeadlineUs(); deadline && steadyMicros() >= *deadline) {
-      latchStop("halted: link lost", "halted: link lost (no fresh heartbeat from the client)");
+      latchStop("halted: link lost", "halted: link lost (no fresh heartbeat from the client)",
+                watchdogDetail());
       count(&BackendStats::watchdog_halts);
     }
     const double elapsed = std::chrono::duration<double>(now - last_step).count();

@@ -501,6 +501,34 @@ TEST(RobotLink, RepliesGoOnlyToTheAddressBoundByTheChallenge) {
   EXPECT_EQ(still->type, MessageType::StatusReply);
 }
 
+// A bound client says HELLO again (after silence, or a new address) while its heartbeats go on:
+// its BIND carries a sequence below those heartbeats' and is still taken (unused, inside the
+// replay window); a second copy of that BIND is answered again, not bound anew.
+TEST(RobotLink, ARebindingClientsBindIsTakenAfterItsHeartbeats) {
+  RunningBackend backend(20.0);
+  RawSession raw(backend.port());
+  ASSERT_TRUE(raw.hello(100));  // HELLO 100, BIND 101
+  Message hello = raw.message(MessageType::Hello, 102);
+  hello.nonce = 777;
+  raw.send(hello);
+  const auto welcome = raw.answer(102);
+  ASSERT_TRUE(welcome);
+  ASSERT_EQ(welcome->type, MessageType::Welcome);
+  raw.send(raw.message(MessageType::Heartbeat, 110));  // heartbeats went on meanwhile
+  raw.send(raw.message(MessageType::Status, 111));
+  ASSERT_TRUE(raw.answer(111));
+  Message bind = raw.message(MessageType::Bind, 103);
+  bind.challenge = welcome->challenge;
+  raw.send(bind);
+  const auto bound = raw.answer(103);
+  ASSERT_TRUE(bound);
+  EXPECT_EQ(bound->type, MessageType::Bound);
+  raw.send(bind);  // its BOUND lost: the copy is answered from the binding
+  const auto again = raw.answer(103);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->type, MessageType::Bound);
+}
+
 // A captured HELLO replayed to a restarted backend gets a WELCOME, but without the key nobody can
 // answer its challenge: nothing is bound, and the real client binds as before. A captured BIND
 // replayed binds nothing either (its challenge is spent, or belongs to another run).
