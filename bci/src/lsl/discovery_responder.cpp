@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <sstream>
 
 namespace arbci::bci::lsl {
@@ -49,8 +50,8 @@ std::shared_ptr<DiscoveryResponder> DiscoveryResponder::shared(const LslConfig& 
   return made;
 }
 
-DiscoveryResponder::DiscoveryResponder(const LslConfig& config,
-                                       std::vector<std::string>& warnings) {
+DiscoveryResponder::DiscoveryResponder(const LslConfig& config, std::vector<std::string>& warnings)
+    : base_port_(config.base_port), port_range_(config.port_range) {
   // Every address on the discovery port bound on any address, with the port shared, as liblsl's
   // responders bind it (joining the group where the address is multicast). A loopback address
   // bound as itself would be more specific than liblsl's binding: the kernel would hand every
@@ -113,6 +114,7 @@ void DiscoveryResponder::serve() {
           trimmed(datagram->bytes.substr(0, newline)) != "LSL:shortinfo")
         continue;
       const std::string rest = datagram->bytes.substr(newline + 1);
+      if (ntohl(datagram->from.sin_addr.s_addr) == INADDR_LOOPBACK) passOn(i, datagram->bytes);
       std::lock_guard lock(mutex_);
       for (const auto& [owner, outlet] : outlets_) {
         if (auto reply = shortinfoReply(rest, outlet.first, outlet.second)) {
@@ -122,6 +124,20 @@ void DiscoveryResponder::serve() {
         }
       }
     }
+  }
+}
+
+// The query as it came, to each port of the range on 127.0.0.1 but this process's outlets' (it
+// answers for them itself). Sent from 127.0.0.1, so each outlet's reply goes to the asker.
+void DiscoveryResponder::passOn(size_t socket, const std::string& bytes) {
+  std::vector<int> own;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [owner, outlet] : outlets_) own.push_back(outlet.first.v4service_port);
+  }
+  for (int port = base_port_; port < base_port_ + port_range_; ++port) {
+    if (std::find(own.begin(), own.end(), port) != own.end()) continue;
+    net::sendDatagram(sockets_[socket], bytes, net::endpoint("127.0.0.1", port));
   }
 }
 

@@ -1,7 +1,11 @@
 // Answers LSL discovery queries on the configuration's discovery addresses (port 16571) for all
 // of this process's outlets at once. Many sockets may share that port, but a unicast query (the
-// machine scope asks 127.0.0.1) reaches only one of them: one responder per process lets every
-// outlet of the process be found, not just the last one opened.
+// machine scope asks 127.0.0.1) reaches only one of them, the newest bound: one responder per
+// process lets every outlet of the process be found, not just the last one opened. A unicast
+// query from this machine is passed on to every port of the outlet range on 127.0.0.1, where
+// every outlet (liblsl's too) answers shortinfo queries itself, to the asker's address and
+// return port: so the outlets of other processes that the kernel did not hand it to, liblsl's
+// included, are still found, which liblsl's own responders do not do for one another.
 #pragma once
 
 #include <atomic>
@@ -36,7 +40,9 @@ class DiscoveryResponder {
 
  private:
   void serve();
+  void passOn(size_t socket, const std::string& bytes);
   std::vector<net::Fd> sockets_;
+  int base_port_ = 0, port_range_ = 0;
   std::mutex mutex_;
   std::map<const void*, std::pair<StreamInfo, std::string>> outlets_;
   std::atomic<bool> stop_{false};
