@@ -159,14 +159,44 @@ TEST(LslSource, NoStreamIsRefusedWithAMessageNamingItAndTheScope) {
   }
 }
 
-// A unicast query to 127.0.0.1:16571 that ARBCI's responder takes (the kernel hands it to one
-// socket only) is passed on to the outlet port range on 127.0.0.1, where every outlet, liblsl's
-// included, answers it to the asker: here a socket in the range stands in for a liblsl outlet's
-// unicast server and gets the query as sent.
-TEST(LslLoopback, AUnicastQueryIsPassedOnToTheOtherOutletsOfTheMachine) {
-  const std::string name = uniqueName("passon");
+// Two outlets of the same name (two amplifiers of one model): the refusal names their source ids,
+// and the source id picks one.
+TEST(LslSource, StreamsOfTheSameNameAreToldApartBySourceId) {
+  const std::string name = uniqueName("twin");
+  StreamInfo first = eegStream(name, 2, 256, ChannelFormat::Float32);
+  StreamInfo second = eegStream(name, 3, 256, ChannelFormat::Float32);
+  first.source_id = name + "-left";
+  second.source_id = name + "-right";
+  Outlet a(first, machineScope()), b(second, machineScope());
+  LslSourceSettings settings;
+  settings.name = name;
+  settings.resolve_timeout_s = 1.0;
+  settings.config = machineScope();
+  settings.require_samples = false;
+  try {
+    LslSource source(settings);
+    FAIL() << "two streams of one name were not refused";
+  } catch (const LslError& e) {
+    const std::string text = e.what();
+    EXPECT_NE(text.find(first.source_id), std::string::npos) << text;
+    EXPECT_NE(text.find(second.source_id), std::string::npos) << text;
+    EXPECT_NE(text.find("eeg.lsl.source_id"), std::string::npos) << text;
+  }
+  settings.source_id = second.source_id;
+  LslSource chosen(settings);
+  EXPECT_EQ(chosen.info().channelCount(), 3);
+}
+
+// A unicast query to 127.0.0.1:16571 that ARBCI's responder (in another process) takes (the
+// kernel hands it to one socket only) is passed on to the outlet port range on 127.0.0.1, where
+// every outlet, liblsl's included, answers it to the asker: here a socket in the range stands in
+// for a liblsl outlet's unicast server and gets the query as sent. (Called from the test below:
+// a plain responder bound by a test running beside it would take the query and pass nothing on.)
+void checkPassedOn(const std::string& name) {
   const LslConfig config = machineScope();
-  Outlet outlet(eegStream(name, 2, 256, ChannelFormat::Float32), config);
+  arbci::test::BackgroundProcess outlet(
+      LSL_OUTLET_HELPER, {name, name + "-src", "2", "256", "1", "0", "1000", "-1", "30"});
+  ASSERT_TRUE(outlet.waitForLine("ready", 10.0)) << "the outlet process did not start";
   int other = -1;
   for (int port = config.base_port; port < config.base_port + config.port_range && other < 0;
        ++port) {
@@ -207,42 +237,16 @@ TEST(LslLoopback, AUnicastQueryIsPassedOnToTheOtherOutletsOfTheMachine) {
   EXPECT_EQ(ntohl(from.sin_addr.s_addr), INADDR_LOOPBACK);  // so replies go to the asker
 }
 
-// Two outlets of the same name (two amplifiers of one model): the refusal names their source ids,
-// and the source id picks one.
-TEST(LslSource, StreamsOfTheSameNameAreToldApartBySourceId) {
-  const std::string name = uniqueName("twin");
-  StreamInfo first = eegStream(name, 2, 256, ChannelFormat::Float32);
-  StreamInfo second = eegStream(name, 3, 256, ChannelFormat::Float32);
-  first.source_id = name + "-left";
-  second.source_id = name + "-right";
-  Outlet a(first, machineScope()), b(second, machineScope());
-  LslSourceSettings settings;
-  settings.name = name;
-  settings.resolve_timeout_s = 1.0;
-  settings.config = machineScope();
-  settings.require_samples = false;
-  try {
-    LslSource source(settings);
-    FAIL() << "two streams of one name were not refused";
-  } catch (const LslError& e) {
-    const std::string text = e.what();
-    EXPECT_NE(text.find(first.source_id), std::string::npos) << text;
-    EXPECT_NE(text.find(second.source_id), std::string::npos) << text;
-    EXPECT_NE(text.find("eeg.lsl.source_id"), std::string::npos) << text;
-  }
-  settings.source_id = second.source_id;
-  LslSource chosen(settings);
-  EXPECT_EQ(chosen.info().channelCount(), 3);
-}
-
 // The discovery port is shared as liblsl shares it: bound on any address. With an ARBCI outlet's
-// responder running, a responder bound afterwards as liblsl binds its own (0.0.0.0:16571, the
-// address reusable) still receives a unicast query to 127.0.0.1 (Linux hands a unicast datagram
-// to the most specific binding, the newest among equals): a 127.0.0.1 binding of ARBCI's would
-// have taken every such query from liblsl's outlets.
+// responder running in another process, a responder bound afterwards as liblsl binds its own
+// (0.0.0.0:16571, the address reusable) still receives a unicast query to 127.0.0.1 (Linux hands a
+// unicast datagram to the most specific binding, the newest among equals): a 127.0.0.1 binding of
+// ARBCI's would have taken every such query from liblsl's outlets.
 TEST(LslLoopback, TheDiscoveryPortIsSharedAsLiblslBindsIt) {
   const std::string name = uniqueName("shared");
-  Outlet outlet(eegStream(name, 2, 256, ChannelFormat::Float32), machineScope());
+  arbci::test::BackgroundProcess outlet(
+      LSL_OUTLET_HELPER, {name, name + "-src", "2", "256", "1", "0", "1000", "-1", "30"});
+  ASSERT_TRUE(outlet.waitForLine("ready", 10.0)) << "the outlet process did not start";
   const int port = machineScope().multicast_port;
   auto udp = [](const char* address, int at, bool reuse) {
     const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -277,6 +281,7 @@ TEST(LslLoopback, TheDiscoveryPortIsSharedAsLiblslBindsIt) {
   ::close(asker);
   EXPECT_EQ(received, query) << "the query to 127.0.0.1 did not reach a responder bound as "
                                 "liblsl's";
+  checkPassedOn(name);
 }
 
 TEST(LslSource, AStreamThatSendsNothingIsRefusedBeforeTheSession) {
