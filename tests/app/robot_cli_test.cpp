@@ -204,10 +204,29 @@ robot::RunningBackend backendWith(const robot::Key& key, double speed, double wa
   return robot::RunningBackend(oneObjectArm(), backendOptions(speed, watchdog_s, port), key);
 }
 
+// A fresh key file for one test (arbci robot keygen), and the key in it.
+std::filesystem::path newKeyFile(const std::string& name) {
+  const auto key_file = scratch(name);
+  const ProcessResult made = runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()});
+  EXPECT_EQ(made.exit_code, 0) << made.err;
+  return key_file;
+}
+
+// `arbci robot [OPTIONS] grasp 0.1 0.6 0.06` to the relay's port, run in the background.
+std::future<ProcessResult> graspThrough(const test::UdpRelay& relay,
+                                        const std::filesystem::path& key_file,
+                                        std::vector<std::string> options = {}) {
+  std::vector<std::string> arguments = {"robot", "--port", std::to_string(relay.port()),
+                                        "--key-file", key_file.string()};
+  arguments.insert(arguments.end(), options.begin(), options.end());
+  arguments.insert(arguments.end(), {"grasp", "0.1", "0.6", "0.06"});
+  return std::async(std::launch::async,
+                    [arguments] { return runProcess(kArbci, arguments, 60.0); });
+}
+
 // 100 commands in four lanes of 25 (a backend and a relay each, run side by side to save time).
 TEST(RobotCommand, AtHalfTheDatagramsLostEachWayEveryCommandThatRanIsReportedAsRun) {
-  const auto key_file = scratch("lossy.key");
-  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const auto key_file = newKeyFile("lossy.key");
   const robot::Key key = robot::loadKey(key_file);
   struct Lane {
     Lane(const robot::Key& key, unsigned seed)
@@ -252,8 +271,7 @@ TEST(RobotCommand, AtHalfTheDatagramsLostEachWayEveryCommandThatRanIsReportedAsR
 }
 
 TEST(RobotCommand, AMotionWhoseAnswersWereLostIsReportedAsRunAndStopped) {
-  const auto key_file = scratch("deaf.key");
-  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const auto key_file = newKeyFile("deaf.key");
   const robot::Key key = robot::loadKey(key_file);
   // Real time: the grasp takes seconds. The watchdog is not under test here: a generous one, so a
   // heartbeat starved on a loaded machine does not halt the grasp before the client's STOP.
@@ -261,12 +279,7 @@ TEST(RobotCommand, AMotionWhoseAnswersWereLostIsReportedAsRunAndStopped) {
   test::UdpRelay relay(backend.port(), key);
   relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
                      robot::MessageType::Finished});
-  auto cli = std::async(std::launch::async, [&] {
-    return runProcess(kArbci,
-                      {"robot", "--port", std::to_string(relay.port()), "--key-file",
-                       key_file.string(), "--retry-budget", "1", "grasp", "0.1", "0.6", "0.06"},
-                      60.0);
-  });
+  auto cli = graspThrough(relay, key_file, {"--retry-budget", "1"});
   // Answers come back once the client has given up, which it shows by sending its STOP: the
   // STOP's answer and the status get through.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
@@ -284,19 +297,14 @@ TEST(RobotCommand, AMotionWhoseAnswersWereLostIsReportedAsRunAndStopped) {
 // Every answer lost from the moment the GRASP went out (a link that fails one way): the
 // client cannot know whether it ran, and says so (exit 4); its STOP is not confirmed either.
 TEST(RobotCommand, AMotionWhoseEveryAnswerIsLostIsReportedAsUnknown) {
-  const auto key_file = scratch("oneway.key");
-  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const auto key_file = newKeyFile("oneway.key");
   const robot::Key key = robot::loadKey(key_file);
   robot::RunningBackend backend = backendWith(key, 1.0, 5.0);
   test::UdpRelay relay(backend.port(), key);
   // The handshake gets through; nothing after it does.
   relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
                      robot::MessageType::Finished, robot::MessageType::Rejected});
-  const ProcessResult r =
-      runProcess(kArbci,
-                 {"robot", "--port", std::to_string(relay.port()), "--key-file", key_file.string(),
-                  "--retry-budget", "1", "grasp", "0.1", "0.6", "0.06"},
-                 60.0);
+  const ProcessResult r = graspThrough(relay, key_file, {"--retry-budget", "1"}).get();
   std::cout << r.err;
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_NE(r.err.find("GRASP: unknown, it may have run"), std::string::npos) << r.err;
@@ -307,8 +315,7 @@ TEST(RobotCommand, AMotionWhoseEveryAnswerIsLostIsReportedAsUnknown) {
 // The backend restarts after the GRASP may have reached it, its acceptance lost: unknown (exit
 // 4), with the arm's state as the new run reports it.
 TEST(RobotCommand, AMotionLostInARestartIsReportedAsUnknownWithTheArmsState) {
-  const auto key_file = scratch("restart.key");
-  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const auto key_file = newKeyFile("restart.key");
   const robot::Key key = robot::loadKey(key_file);
   auto backend =
       std::make_unique<robot::RunningBackend>(oneObjectArm(), backendOptions(1.0, 5.0, 0), key);
@@ -316,12 +323,7 @@ TEST(RobotCommand, AMotionLostInARestartIsReportedAsUnknownWithTheArmsState) {
   test::UdpRelay relay(port, key);
   relay.dropReplies({robot::MessageType::Accepted, robot::MessageType::StatusReply,
                      robot::MessageType::Finished});
-  auto cli = std::async(std::launch::async, [&] {
-    return runProcess(kArbci,
-                      {"robot", "--port", std::to_string(relay.port()), "--key-file",
-                       key_file.string(), "grasp", "0.1", "0.6", "0.06"},
-                      60.0);
-  });
+  auto cli = graspThrough(relay, key_file);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (backend->stats().executed == 0 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -343,18 +345,12 @@ TEST(RobotCommand, AMotionLostInARestartIsReportedAsUnknownWithTheArmsState) {
 // A GRASP from one shell held back by the network across `arbci robot stop` and `reset` from
 // another: refused when it arrives, and the first shell says it did not run and why.
 TEST(RobotCommand, AGraspHeldBackAcrossAStopAndResetNeverRuns) {
-  const auto key_file = scratch("held.key");
-  ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()}).exit_code, 0);
+  const auto key_file = newKeyFile("held.key");
   const robot::Key key = robot::loadKey(key_file);
   robot::RunningBackend backend = backendWith(key, 50.0, 5.0);
   test::UdpRelay relay(backend.port(), key);
   relay.hold(robot::MessageType::Grasp);
-  auto cli = std::async(std::launch::async, [&] {
-    return runProcess(kArbci,
-                      {"robot", "--port", std::to_string(relay.port()), "--key-file",
-                       key_file.string(), "grasp", "0.1", "0.6", "0.06"},
-                      60.0);
-  });
+  auto cli = graspThrough(relay, key_file);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (relay.captured(robot::MessageType::Grasp).empty() &&
          std::chrono::steady_clock::now() < deadline)

@@ -61,6 +61,14 @@ std::optional<Message> rejectionSeen(const test::UdpRelay& relay, std::uint64_t 
   return found;
 }
 
+// A backend on the wall clock at real speed (a grasp takes seconds), pushing status often.
+BackendOptions realTime() {
+  BackendOptions options;
+  options.status_interval_s = 0.05;
+  options.speed_factor = 1.0;
+  return options;
+}
+
 bool has(const std::vector<RobotEvent>& events, RobotEvent::Kind kind) {
   return std::any_of(events.begin(), events.end(),
                      [&](const RobotEvent& e) { return e.kind == kind; });
@@ -305,9 +313,7 @@ TEST(RobotLink, AnotherClientsCommandMadeBeforeAStopNeverRunsAfterTheReset) {
 
 TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
   auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
-  BackendOptions options;
-  options.status_interval_s = 0.05;
-  options.speed_factor = 1.0;                 // real time: the grasp takes seconds
+  BackendOptions options = realTime();
   ASSERT_DOUBLE_EQ(options.watchdog_s, 0.1);  // the default (robot.watchdog_ms)
   RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
                          options);
@@ -357,9 +363,7 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
 // nothing. While the link stays that slow, a new motion is refused with the reason.
 TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsDelayed) {
   auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
-  BackendOptions options;
-  options.status_interval_s = 0.05;
-  options.speed_factor = 1.0;  // real time: the grasp takes seconds
+  BackendOptions options = realTime();
   RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
                          options);
   test::UdpRelay relay(backend.port(), testKey());
@@ -398,9 +402,7 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsDelayed) {
 // with its cause (a halt right after a STOP's line was once dropped by the log's flood limit).
 TEST(RobotLink, EveryStopResetAndHaltIsLoggedOnceWithItsCause) {
   std::ostringstream log;
-  BackendOptions options;
-  options.status_interval_s = 0.05;
-  options.speed_factor = 1.0;
+  BackendOptions options = realTime();
   options.log = &log;
   auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
   RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
