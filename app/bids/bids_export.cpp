@@ -64,16 +64,20 @@ std::set<int> existingRuns(const fs::path& eeg_dir, const std::string& stem_pref
   return runs;
 }
 
+// A dataset's dataset_description.json, when it has none.
+void describeDataset(const fs::path& dir, const std::string& name, const std::string& type) {
+  if (fs::exists(dir / "dataset_description.json")) return;
+  fs::create_directories(dir);
+  nlohmann::ordered_json d;
+  d["Name"] = name;
+  d["BIDSVersion"] = kBidsVersion;
+  d["DatasetType"] = type;
+  d["GeneratedBy"] = {{{"Name", "ARBCI"}, {"Version", ARBCI_VERSION}}};
+  writeText(dir / "dataset_description.json", d.dump(2) + "\n");
+}
+
 void ensureDatasetFiles(const fs::path& root, const std::string& subject) {
-  fs::create_directories(root);
-  if (!fs::exists(root / "dataset_description.json")) {
-    nlohmann::ordered_json d;
-    d["Name"] = "ARBCI sessions";
-    d["BIDSVersion"] = kBidsVersion;
-    d["DatasetType"] = "raw";
-    d["GeneratedBy"] = {{{"Name", "ARBCI"}, {"Version", ARBCI_VERSION}}};
-    writeText(root / "dataset_description.json", d.dump(2) + "\n");
-  }
+  describeDataset(root, "ARBCI sessions", "raw");
   if (!fs::exists(root / "README"))
     writeText(root / "README",
               "EEG of augmented-reality P300 brain-computer interface sessions recorded with "
@@ -97,16 +101,7 @@ void ensureDatasetFiles(const fs::path& root, const std::string& subject) {
     out << "sub-" << subject << "\n";
     if (!out) throw BidsError("cannot write " + participants.string());
   }
-  const fs::path derivatives = root / "derivatives" / "arbci";
-  if (!fs::exists(derivatives / "dataset_description.json")) {
-    fs::create_directories(derivatives);
-    nlohmann::ordered_json d;
-    d["Name"] = "ARBCI session files";
-    d["BIDSVersion"] = kBidsVersion;
-    d["DatasetType"] = "derivative";
-    d["GeneratedBy"] = {{{"Name", "ARBCI"}, {"Version", ARBCI_VERSION}}};
-    writeText(derivatives / "dataset_description.json", d.dump(2) + "\n");
-  }
+  describeDataset(root / "derivatives" / "arbci", "ARBCI session files", "derivative");
 }
 
 std::string parameter(const bci::Recording& r, const std::string& key) {

@@ -233,13 +233,8 @@ struct RobotBackend::Impl {
   // Whether a datagram deserves a MAC check: from a bound session's own address always (the
   // real client's STOP and heartbeats are never crowded out); anything else within the unbound
   // budget, so a flood of forgeries costs a header read each.
-  bool worthVerifying(const Datagram& d, SteadyClock::time_point now) {
-    const auto header = peek(d.bytes.data(), d.bytes.size());
-    if (header) {
-      const auto found = sessions.find(header->session);
-      if (found != sessions.end() && found->second.peer == d.from) return true;
-    }
-    if (unbound_budget.take(now)) return true;
+  bool worthVerifying(const Datagram& d, bool from_bound_peer, SteadyClock::time_point now) {
+    if (from_bound_peer || unbound_budget.take(now)) return true;
     count(&BackendStats::shed);
     log("shed", "dropped datagrams unread (not from a bound client, over " +
                     std::to_string(static_cast<int>(options.unbound_per_s)) +
@@ -254,9 +249,10 @@ struct RobotBackend::Impl {
     return found != sessions.end() && found->second.peer == d.from;
   }
 
-  void handle(const Datagram& d) {
+  // `from_bound_peer`: fromBoundPeer(d), which the poll loop has sorted the batch by.
+  void handle(const Datagram& d, bool from_bound_peer) {
     count(&BackendStats::datagrams);
-    if (!worthVerifying(d, SteadyClock::now())) return;
+    if (!worthVerifying(d, from_bound_peer, SteadyClock::now())) return;
     const Decoded decoded = decode(d.bytes.data(), d.bytes.size(), key);
     if (!decoded.ok()) {
       {
@@ -646,12 +642,13 @@ void RobotBackend::poll(int wait_ms) {
     auto datagram = m.socket.receive();
     if (!datagram) break;
     if (m.fromBoundPeer(*datagram)) {
-      m.handle(*datagram);
+      m.handle(*datagram, true);
     } else {
       later.push_back(std::move(*datagram));
     }
   }
-  for (const Datagram& d : later) m.handle(d);
+  // Checked again: a BIND earlier in the batch may have bound one of these.
+  for (const Datagram& d : later) m.handle(d, m.fromBoundPeer(d));
   m.advance();
 }
 
