@@ -87,7 +87,7 @@ std::string utcNow() {
 struct TrainOptions {
   std::vector<std::string> files;
   std::string out, channels, window_ms = "0,800", bci2000, plots, report, scores;
-  double reject_uv = 0.0;
+  bci::DatasetOptions dataset;  // --reject-uv, --causal
   bool exclude_bad_channels = false;
   bci::TrainingSettings training;
   bci::PipelineSettings pipeline;
@@ -217,7 +217,7 @@ void train(TrainOptions& o) {
       }
     }
     quality = checkChannels(recordings, o.exclude_bad_channels);
-    data = bci::buildDataset(recordings, o.pipeline, progress, o.reject_uv);
+    data = bci::buildDataset(recordings, o.pipeline, progress, o.dataset);
     result = bci::trainModel(data, o.pipeline, o.training, progress);
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
@@ -245,8 +245,8 @@ void train(TrainOptions& o) {
             << data.sources.size() << " file(s)";
   if (data.dropped_epochs > 0)
     std::cout << "; " << data.dropped_epochs << " flashes too close to a file's end left out";
-  if (o.reject_uv > 0.0) {
-    std::cout << "; " << data.rejected_epochs << " epochs over " << o.reject_uv
+  if (o.dataset.reject_uv > 0.0) {
+    std::cout << "; " << data.rejected_epochs << " epochs over " << o.dataset.reject_uv
               << " uV peak-to-peak rejected";
   }
   if (o.pipeline.zero_phase) std::cout << "; zero-phase filters (offline only)";
@@ -304,7 +304,7 @@ void train(TrainOptions& o) {
 
 struct EvaluateOptions {
   std::string model, plots, report, scores;
-  double reject_uv = 0.0;
+  bci::DatasetOptions dataset;  // --reject-uv, --causal
   std::vector<std::string> files;
   int sequences = 0;
   bci::StoppingRule dynamic{15, 2, 0.99};
@@ -342,9 +342,9 @@ void evaluate(EvaluateOptions& o) {
                      "layout only from ARBCI's marker stream)");
   }
   try {
-    bci::P300Dataset data = bci::buildDataset(recordings, model.pipeline, {}, o.reject_uv);
-    if (o.reject_uv > 0.0) {
-      std::cout << data.rejected_epochs << " epochs over " << o.reject_uv
+    bci::P300Dataset data = bci::buildDataset(recordings, model.pipeline, {}, o.dataset);
+    if (o.dataset.reject_uv > 0.0) {
+      std::cout << data.rejected_epochs << " epochs over " << o.dataset.reject_uv
                 << " uV peak-to-peak rejected\n";
     }
     std::vector<double> scores(static_cast<size_t>(data.epochs()));
@@ -393,9 +393,14 @@ void evaluate(EvaluateOptions& o) {
   }
 }
 
-void addRejectOption(CLI::App& command, double& reject_uv) {
+void addDatasetOptions(CLI::App& command, bci::DatasetOptions& dataset) {
+  command.add_flag_function(
+      "--causal",
+      [&dataset](std::int64_t) { dataset.erp_filter = bci::DatasetOptions::ErpFilter::AsFeatures; },
+      "ERP figures filtered as the features (causal, what the online classifier sees) "
+      "instead of zero-phase (the response's true latency and shape)");
   command
-      .add_option("--reject-uv", reject_uv,
+      .add_option("--reject-uv", dataset.reject_uv,
                   "leave out epochs whose filtered peak-to-peak amplitude exceeds this (0: keep "
                   "all)")
       ->capture_default_str()
@@ -441,7 +446,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd->add_flag("--zero-phase", t->pipeline.zero_phase,
                       "filter forward and backward (no phase lag; offline only: the model says "
                       "so, and a session filters causally)");
-  addRejectOption(*train_cmd, t->reject_uv);
+  addDatasetOptions(*train_cmd, t->dataset);
   train_cmd->add_flag("--exclude-bad-channels", t->exclude_bad_channels,
                       "leave out flat (SD < 0.5 uV) and drifting (SD > 20x the median channel's) "
                       "channels, which are always reported");
@@ -534,7 +539,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                    "(scores drift between sessions); none: as the model gives them")
       ->capture_default_str()
       ->check(CLI::IsMember({"per-file", "none"}));
-  addRejectOption(*eval_cmd, e->reject_uv);
+  addDatasetOptions(*eval_cmd, e->dataset);
   eval_cmd->add_option("--report", e->report, "also write the report as JSON (everything printed)");
   eval_cmd->add_option("--scores", e->scores,
                        "also write every flash's score as CSV (file,sample,code,label,score,fold)");

@@ -35,15 +35,40 @@ struct Panel {
         area.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * area.width)),
         area.y + area.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * area.height))};
   }
-  void axes(cv::Mat& image, const std::string& title, int x_decimals, int y_decimals) const {
+  // The frame, the zero line, the title above, and ticks: every `x_step` and `y_step` from the
+  // first multiple inside the range (zero among them where the range holds it), each labelled,
+  // and the axes' names with their units.
+  void axes(cv::Mat& image, const std::string& title, double x_step, double y_step,
+            const std::string& x_name, const std::string& y_name) const {
     cv::rectangle(image, area, kGrey, 1);
     if (y0 < 0.0 && y1 > 0.0) cv::line(image, map(x0, 0.0), map(x1, 0.0), kGrey, 1);
     text(image, title, {area.x, area.y - 6}, 0.45);  // above: curves reach the top
-    text(image, format(y1, y_decimals), {area.x - 42, area.y + 10}, 0.35);
-    text(image, format(y0, y_decimals), {area.x - 42, area.y + area.height}, 0.35);
-    text(image, format(x0, x_decimals), {area.x - 4, area.y + area.height + 14}, 0.35);
-    text(image, format(x1, x_decimals), {area.x + area.width - 20, area.y + area.height + 14},
-         0.35);
+    const int x_decimals = x_step < 1.0 ? 1 : 0, y_decimals = y_step < 1.0 ? 1 : 0;
+    for (double x = std::ceil(x0 / x_step - 1e-9) * x_step; x <= x1 + 1e-9; x += x_step) {
+      const cv::Point at = map(x, y0);
+      cv::line(image, at, at + cv::Point(0, 4), kBlack, 1);
+      const std::string label = format(std::abs(x) < 1e-9 ? 0.0 : x, x_decimals);
+      text(image, label, at + cv::Point(-4 * static_cast<int>(label.size()), 16), 0.35);
+    }
+    for (double y = std::ceil(y0 / y_step - 1e-9) * y_step; y <= y1 + 1e-9; y += y_step) {
+      const cv::Point at = map(x0, y);
+      cv::line(image, at, at - cv::Point(4, 0), kBlack, 1);
+      const std::string label = format(std::abs(y) < 1e-9 ? 0.0 : y, y_decimals);
+      text(image, label, at + cv::Point(-8 - 7 * static_cast<int>(label.size()), 4), 0.35);
+    }
+    text(image, x_name,
+         {area.x + area.width / 2 - 4 * static_cast<int>(x_name.size()), area.y + area.height + 32},
+         0.38);
+    // The y axis' name, rotated to run up its side.
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(y_name, cv::FONT_HERSHEY_SIMPLEX, 0.38, 1, &baseline);
+    cv::Mat label(size.height + baseline + 2, size.width + 2, CV_8UC3, kWhite);
+    cv::putText(label, y_name, {1, size.height + 1}, cv::FONT_HERSHEY_SIMPLEX, 0.38, kBlack, 1,
+                cv::LINE_AA);
+    cv::rotate(label, label, cv::ROTATE_90_COUNTERCLOCKWISE);
+    const cv::Rect where(area.x - 58, area.y + area.height / 2 - label.rows / 2, label.cols,
+                         label.rows);
+    if ((where & cv::Rect(0, 0, image.cols, image.rows)) == where) label.copyTo(image(where));
   }
   void curve(cv::Mat& image, const std::vector<double>& xs, const std::vector<double>& ys,
              const cv::Scalar& colour, bool dots = false, int thickness = 2) const {
@@ -67,6 +92,15 @@ void Panel::band(cv::Mat& image, const std::vector<double>& xs, const std::vecto
   cv::Mat layer = image.clone();
   cv::fillPoly(layer, std::vector<std::vector<cv::Point>>{outline}, colour, cv::LINE_AA);
   cv::addWeighted(layer, 0.25, image, 0.75, 0.0, image);
+}
+
+// A tick spacing of 1, 2 or 5 times a power of ten giving about `ticks` intervals over `range`.
+double niceStep(double range, int ticks) {
+  const double raw = range / std::max(1, ticks);
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (const double m : {1.0, 2.0, 5.0})
+    if (m * power >= raw) return m * power;
+  return 10.0 * power;
 }
 
 void save(const std::filesystem::path& path, const cv::Mat& image) {
@@ -183,7 +217,7 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const 
   const int samples = erp.samples();
   if (channels == 0 || samples < 2) return {};
   const int columns = std::min(4, channels), rows = (channels + columns - 1) / columns;
-  const int panel_w = 300, panel_h = 190, left = 70, gap_x = 70, gap_y = 62, top = 84;
+  const int panel_w = 300, panel_h = 190, left = 80, gap_x = 90, gap_y = 72, top = 100;
   cv::Mat image(top + rows * (panel_h + gap_y), left + columns * (panel_w + gap_x), CV_8UC3,
                 kWhite);
   text(image,
@@ -192,17 +226,21 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const 
            " ms subtracted): " + std::to_string(erp.targets) + " " + names.target + ", " +
            std::to_string(erp.others) + " " + names.other + " epochs",
        {left, 26}, 0.5);
+  text(image, "filter: " + erp.filterText(), {left, 46}, 0.45);
   // Legend.
   const std::pair<std::string, cv::Scalar> legend[] = {
       {names.target, kTarget}, {names.other, kOther}, {"difference", kBlack}};
   int x = left;
   for (const auto& [name, colour] : legend) {
-    cv::line(image, {x, 48}, {x + 24, 48}, colour, 2, cv::LINE_AA);
-    text(image, name, {x + 30, 52}, 0.45);
+    cv::line(image, {x, 68}, {x + 24, 68}, colour, 2, cv::LINE_AA);
+    text(image, name, {x + 30, 72}, 0.45);
     x += 150;
   }
-  cv::rectangle(image, cv::Rect(x, 41, 24, 14), kWindow, cv::FILLED);
-  text(image, "analysis window", {x + 30, 52}, 0.45);
+  cv::rectangle(image, cv::Rect(x, 61, 24, 14), kWindow, cv::FILLED);
+  text(image,
+       "the classifier's window, " + format(erp.window_start_s * 1000.0, 0) + "-" +
+           format(erp.window_end_s * 1000.0, 0) + " ms",
+       {x + 30, 72}, 0.45);
 
   const Eigen::MatrixXd difference = erp.difference();
   const Eigen::MatrixXd band_t = 1.96 * erp.target_se, band_o = 1.96 * erp.other_se;
@@ -220,16 +258,9 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const 
                   cv::Rect(panel.map(erp.window_start_s * 1000.0, limit),
                            panel.map(std::min(erp.window_end_s * 1000.0, ms.back()), -limit)),
                   kWindow, cv::FILLED);
-    panel.axes(image, erp.channels[static_cast<size_t>(c)], 0, 0);
-    // Time ticks every 200 ms; the stimulus (0 ms) is the vertical line.
-    for (double t = 0.0; t <= ms.back(); t += 200.0) {
-      const cv::Point at = panel.map(t, -limit);
-      cv::line(image, at, at + cv::Point(0, 4), kBlack, 1);
-      if (t > 0.0 && t < ms.back() - 60.0) text(image, format(t, 0), at + cv::Point(-12, 16), 0.35);
-    }
-    cv::line(image, panel.map(0.0, -limit), panel.map(0.0, limit), kGrey, 1);
-    text(image, "ms", panel.map(ms.back(), -limit) + cv::Point(-18, 30), 0.35);
-    text(image, "uV", panel.map(ms.front(), 0.0) + cv::Point(-30, 4), 0.35);
+    panel.axes(image, erp.channels[static_cast<size_t>(c)], 100.0, niceStep(2.0 * limit, 4),
+               "ms after the stimulus", "amplitude (uV)");
+    cv::line(image, panel.map(0.0, -limit), panel.map(0.0, limit), kGrey, 1);  // the stimulus
     panel.band(image, ms, bci::ErpCurves::row(erp.other_mean, c), bci::ErpCurves::row(band_o, c),
                kOther);
     panel.band(image, ms, bci::ErpCurves::row(erp.target_mean, c), bci::ErpCurves::row(band_t, c),
@@ -264,6 +295,12 @@ nlohmann::json erpJson(const bci::ErpCurves& erp) {
           {"rate_hz", erp.rate_hz},
           {"baseline_ms", {erp.start_s * 1000.0, (erp.start_s + erp.baseline_s) * 1000.0}},
           {"window_ms", {erp.window_start_s * 1000.0, erp.window_end_s * 1000.0}},
+          {"filter",
+           {{"highpass_hz", erp.highpass_hz},
+            {"lowpass_hz", erp.lowpass_hz},
+            {"notch_hz", erp.notch_hz},
+            {"zero_phase", erp.zero_phase},
+            {"text", erp.filterText()}}},
           {"target_epochs", erp.targets},
           {"non_target_epochs", erp.others},
           {"peak_ms", erp.samples() > 0 ? erp.timeS(erp.peakSample()) * 1000.0 : 0.0},
@@ -300,15 +337,17 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
     n.push_back(k);
     percent.push_back(100.0 * report.accuracy[static_cast<size_t>(k - 1)]);
   }
-  cv::Mat image(330, 820, CV_8UC3, kWhite);
+  cv::Mat image(380, 940, CV_8UC3, kWhite);
   text(image, "Selection accuracy and bit rate by number of sequences (" + title + ")", {50, 24},
        0.5);
   const double x1 = std::max(2.0, static_cast<double>(report.max_sequences));
-  const Panel accuracy{{60, 50, 320, 230}, 1.0, x1, 0.0, 100.0};
-  accuracy.axes(image, "accuracy % (95 % intervals)", 0, 0);
+  const double x_step = niceStep(x1 - 1.0, 10) < 1.0 ? 1.0 : niceStep(x1 - 1.0, 10);
+  const Panel accuracy{{90, 70, 320, 230}, 1.0, x1, 0.0, 100.0};
+  accuracy.axes(image, "accuracy (95 % intervals)", x_step, 20.0, "sequences", "accuracy (%)");
   // Guessing: the chance level, and the accuracy that beats it at p < 0.05 (dashed).
   cv::line(image, accuracy.map(1.0, 100.0 * report.chance), accuracy.map(x1, 100.0 * report.chance),
            kGrey, 1);
+  text(image, "chance", accuracy.map(x1, 100.0 * report.chance) + cv::Point(-48, -4), 0.35, kGrey);
   for (double x = 1.0; x < x1; x += (x1 - 1.0) / 40.0) {
     cv::line(image, accuracy.map(x, 100.0 * report.chance_95),
              accuracy.map(std::min(x1, x + (x1 - 1.0) / 80.0), 100.0 * report.chance_95), kBlack,
@@ -322,11 +361,18 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
   accuracy.curve(image, n, percent, kTarget, true);
   const double top = std::max(
       1.0, *std::max_element(report.bits_per_minute.begin(), report.bits_per_minute.end()) * 1.1);
-  const Panel bits{{470, 50, 320, 230}, 1.0, x1, 0.0, top};
-  bits.axes(image, "bits/min (Wolpaw)", 0, 1);
+  const Panel bits{{540, 70, 320, 230}, 1.0, x1, 0.0, top};
+  bits.axes(image, "bit rate (Wolpaw)", x_step, niceStep(top, 5), "sequences", "bits/min");
   bits.curve(image, n, report.bits_per_minute, kOther, true);
-  text(image, "sequences", {190, 310});
-  text(image, "sequences", {600, 310});
+  // The legend: the flashes alone, and with the recording's cues and pauses where it has them.
+  cv::line(image, {540, 356}, {564, 356}, kOther, 2, cv::LINE_AA);
+  text(image, "flashes only", {570, 360}, 0.38);
+  if (!report.bits_per_minute_with_pauses.empty()) {
+    bits.curve(image, n, report.bits_per_minute_with_pauses, kBlack, true);
+    cv::line(image, {670, 356}, {694, 356}, kBlack, 2, cv::LINE_AA);
+    text(image, "+ " + format(report.pause_seconds_per_selection, 1) + " s cues and pauses",
+         {700, 360}, 0.38);
+  }
   written.push_back(folder / "accuracy.png");
   save(written.back(), image);
   return written;

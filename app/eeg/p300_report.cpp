@@ -95,12 +95,16 @@ nlohmann::json reportJson(const bci::EvaluationReport& r) {
   nlohmann::json by_sequences = nlohmann::json::array();
   for (int n = 1; n <= r.max_sequences; ++n) {
     const size_t i = static_cast<size_t>(n - 1);
-    by_sequences.push_back({{"sequences", n},
-                            {"accuracy", r.accuracy[i]},
-                            {"accuracy_interval_95", toJson(r.accuracy_interval[i])},
-                            {"seconds_per_selection", r.seconds_per_selection[i]},
-                            {"bits_per_minute", r.bits_per_minute[i]},
-                            {"selected", r.selected(n)}});
+    by_sequences.push_back(
+        {{"sequences", n},
+         {"accuracy", r.accuracy[i]},
+         {"accuracy_interval_95", toJson(r.accuracy_interval[i])},
+         {"seconds_per_selection", r.seconds_per_selection[i]},
+         {"bits_per_minute", r.bits_per_minute[i]},
+         {"bits_per_minute_with_pauses", i < r.bits_per_minute_with_pauses.size()
+                                             ? nlohmann::json(r.bits_per_minute_with_pauses[i])
+                                             : nlohmann::json(nullptr)},
+         {"selected", r.selected(n)}});
   }
   nlohmann::json selections = nlohmann::json::array();
   for (const bci::SelectionResult& s : r.selections) {
@@ -133,7 +137,10 @@ nlohmann::json reportJson(const bci::EvaluationReport& r) {
                                     : nlohmann::json(nullptr)},
       {"bits_per_minute", r.recorded_seconds_per_selection > 0.0
                               ? nlohmann::json(r.recorded_bits_per_minute)
-                              : nlohmann::json(nullptr)}};
+                              : nlohmann::json(nullptr)},
+      {"pause_seconds_per_selection", r.recorded_seconds_per_selection > 0.0
+                                          ? nlohmann::json(r.pause_seconds_per_selection)
+                                          : nlohmann::json(nullptr)}};
   out["per_selection"] = selections;
   return out;
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace arbci::bci {
@@ -37,6 +38,25 @@ void ErpAccumulator::add(const std::vector<float>& epoch, bool target) {
       sum_sq_[k](c, s) += v * v;
     }
   }
+}
+
+std::string ErpCurves::filterText() const {
+  const auto hz = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return std::string(text);
+  };
+  std::string band;
+  if (highpass_hz > 0.0 && lowpass_hz > 0.0)
+    band = hz(highpass_hz) + "-" + hz(lowpass_hz) + " Hz band-pass";
+  else if (highpass_hz > 0.0)
+    band = hz(highpass_hz) + " Hz high-pass";
+  else if (lowpass_hz > 0.0)
+    band = hz(lowpass_hz) + " Hz low-pass";
+  else
+    return "unfiltered";
+  if (notch_hz > 0.0) band += ", " + hz(notch_hz) + " Hz notch";
+  return band + (zero_phase ? ", zero-phase" : ", causal (as online)");
 }
 
 int ErpCurves::peakSample() const {

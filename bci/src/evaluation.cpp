@@ -169,6 +169,14 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     report.recorded_seconds_per_selection = recorded / gaps / data.info.rate_hz;
     report.recorded_bits_per_minute =
         wolpawBits(choices, report.accuracy.back()) * 60.0 / report.recorded_seconds_per_selection;
+    report.pause_seconds_per_selection =
+        std::max(0.0, report.recorded_seconds_per_selection - report.seconds_per_selection.back());
+    for (int n = 0; n < n_max; ++n) {
+      const size_t i = static_cast<size_t>(n);
+      report.bits_per_minute_with_pauses.push_back(
+          wolpawBits(choices, report.accuracy[i]) * 60.0 /
+          (report.seconds_per_selection[i] + report.pause_seconds_per_selection));
+    }
   }
   return report;
 }

@@ -30,6 +30,13 @@ void reverseInTime(Block& block) {
   }
 }
 
+// Backward through a fresh chain after the forward pass: the phase lags of the two cancel.
+void backwardPass(Block& signal, const FilterSettings& filter, const SignalInfo& info) {
+  reverseInTime(signal);
+  FilterChain(filter, info).process(signal);
+  reverseInTime(signal);
+}
+
 // The largest peak-to-peak amplitude of `channels` in the epoch.
 double peakToPeak(const Epoch& epoch, const std::vector<int>& channels) {
   double largest = 0.0;
@@ -130,7 +137,11 @@ std::vector<std::pair<std::string, std::string>> layoutParameters(const Recordin
 }
 
 P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSettings& settings,
-                         const Progress& progress, double reject_uv) {
+                         const Progress& progress, const DatasetOptions& options) {
+  const double reject_uv = options.reject_uv;
+  // A second, zero-phase pass for the figures only where the features' own is causal.
+  const bool erp_own_pass =
+      options.erp_filter == DatasetOptions::ErpFilter::ZeroPhase && !settings.zero_phase;
   if (given.empty()) throw std::invalid_argument("no recordings given");
   std::vector<Recording> eeg_only;  // copies, only of recordings that carry a photodiode
   std::vector<const Recording*> chosen;
@@ -183,12 +194,15 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
     Block signal(0, r.info.channelCount(), static_cast<int>(r.samples));
     signal.data = r.data;
     FilterChain(settings.filter, r.info).process(signal);
-    if (settings.zero_phase) {
-      // Backward through a fresh chain: the phase lags of the two passes cancel.
-      reverseInTime(signal);
-      FilterChain(settings.filter, r.info).process(signal);
-      reverseInTime(signal);
+    if (settings.zero_phase) backwardPass(signal, settings.filter, r.info);
+    Block erp_signal;
+    if (erp_own_pass) {
+      erp_signal = Block(0, r.info.channelCount(), static_cast<int>(r.samples));
+      erp_signal.data = r.data;
+      FilterChain(settings.filter, r.info).process(erp_signal);
+      backwardPass(erp_signal, settings.filter, r.info);
     }
+    const Block& erp_source = erp_own_pass ? erp_signal : signal;
 
     // Selections: runs of flashes separated by pauses longer than four stimulus intervals.
     const double gap_limit = std::max(1.0, 4.0 * layout.soa_s) * r.info.rate_hz;
@@ -227,7 +241,7 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       rows.push_back(extractor.features(epoch));
       const std::int64_t erp_first = e.sample - erp_baseline;
       if (erp_first >= 0 && erp_first + erp_length <= r.samples)
-        erps.add(span(signal, erp_first, erp_length), e.target);
+        erps.add(span(erp_source, erp_first, erp_length), e.target);
       data.target.push_back(e.target);
       data.code.push_back(e.code);
       data.sequence.push_back(in_selection / layout.codes());
@@ -268,7 +282,13 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   data.erp.start_s = -erp_baseline / data.info.rate_hz;
   data.erp.baseline_s = erp_baseline / data.info.rate_hz;
   data.erp.window_start_s = settings.window.start_s;
-  data.erp.window_end_s = settings.window.start_s + length / data.info.rate_hz;
+  // The features average whole bins: the samples past the last whole bin are not used.
+  data.erp.window_end_s =
+      settings.window.start_s + data.shape.bins * extractor.factor() / data.info.rate_hz;
+  data.erp.highpass_hz = settings.filter.highpass_hz;
+  data.erp.lowpass_hz = settings.filter.lowpass_hz;
+  data.erp.notch_hz = settings.filter.notch_hz;
+  data.erp.zero_phase = settings.zero_phase || erp_own_pass;
   if (progress) progress(1.0, "epochs ready");
   return data;
 }

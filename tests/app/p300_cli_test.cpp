@@ -146,6 +146,64 @@ TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
   EXPECT_LE(fz["time_ms"][peak].get<double>(), 350.0);
 }
 
+// The largest target - non-target difference of a channel of erp.json between `from_ms` and
+// `to_ms`: {uV, ms}.
+std::pair<double, double> largestDifference(const nlohmann::json& channel, double from_ms,
+                                            double to_ms) {
+  std::pair<double, double> best{-1e9, 0.0};
+  for (size_t i = 0; i < channel["time_ms"].size(); ++i) {
+    const double ms = channel["time_ms"][i].get<double>();
+    const double uv = channel["difference"][i].get<double>();
+    if (ms >= from_ms && ms <= to_ms && uv > best.first) best = {uv, ms};
+  }
+  return best;
+}
+
+// The default figure is zero-phase and shows eeg3_1's parietal P300 as a positivity at 300-500
+// ms; --causal shows what the online filter makes of it (a late trough); both state the band.
+TEST(TrainAndEvaluate, DefaultErpFigureShowsTheParietalP300AndStatesItsFilter) {
+  const auto model = scratch("zero_phase_erp.json");
+  nlohmann::json erp[2];
+  for (const bool causal : {false, true}) {
+    const auto plots = scratch(causal ? "causal_erp_plots" : "zero_phase_erp_plots");
+    std::filesystem::remove_all(plots);
+    std::vector<std::string> args{"train", "--method",     "slda",    eeg("eeg3_1.dat"),
+                                  "--out", model.string(), "--plots", plots.string()};
+    if (causal) args.push_back("--causal");
+    const ProcessResult r = runProcess(kArbci, args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(plots / "erp.json");
+    erp[causal] = nlohmann::json::parse(in);
+    EXPECT_EQ(erp[causal]["filter"]["highpass_hz"], 0.5);
+    EXPECT_EQ(erp[causal]["filter"]["lowpass_hz"], 20.0);
+    EXPECT_EQ(erp[causal]["filter"]["zero_phase"], !causal);
+    // The window the features use: 15 bins of 13 samples at 256 Hz, 0-762 ms (not 800).
+    EXPECT_NEAR(erp[causal]["window_ms"][1].get<double>(), 15 * 13 * 1000.0 / 256.0, 1e-6);
+  }
+  for (const char* name : {"Pz", "P3", "P4"}) {
+    const auto channel = std::find_if(erp[0]["channels"].begin(), erp[0]["channels"].end(),
+                                      [&](const nlohmann::json& c) { return c["name"] == name; });
+    ASSERT_NE(channel, erp[0]["channels"].end()) << name;
+    const auto [uv, ms] = largestDifference(*channel, 300.0, 500.0);
+    EXPECT_GT(uv, 10.0) << name << " at " << ms << " ms";
+    // The peak over the whole window is inside 300-500 ms, not at its edge.
+    const auto [whole_uv, whole_ms] = largestDifference(*channel, 0.0, 800.0);
+    EXPECT_GE(whole_ms, 300.0) << name;
+    EXPECT_LE(whole_ms, 500.0) << name;
+    EXPECT_GT(ms, 310.0) << name;
+    EXPECT_LT(ms, 490.0) << name;
+  }
+  // Causally filtered, Pz's difference dips below zero after 500 ms (the filter's ringing).
+  for (const nlohmann::json& channel : erp[1]["channels"]) {
+    if (channel["name"] != "Pz") continue;
+    double lowest = 0.0;
+    for (size_t i = 0; i < channel["time_ms"].size(); ++i)
+      if (channel["time_ms"][i].get<double>() > 500.0)
+        lowest = std::min(lowest, channel["difference"][i].get<double>());
+    EXPECT_LT(lowest, -5.0);
+  }
+}
+
 TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
   const auto model = scratch("swlda.json"), prm = scratch("swlda.prm"), plots = scratch("plots");
   std::filesystem::remove_all(plots);

@@ -17,8 +17,13 @@ struct ErpCurves {
   double rate_hz = 0.0;
   double start_s = 0.0;     // the first sample's time after the stimulus (negative: the baseline)
   double baseline_s = 0.0;  // [start_s, start_s + baseline_s) is each epoch's baseline
-  double window_start_s = 0.0, window_end_s = 0.0;  // the classifier's analysis window
-  int targets = 0, others = 0;                      // epochs averaged
+  double window_start_s = 0.0, window_end_s = 0.0;  // the samples the features use
+  // The filter the averaged signal went through, stated on every figure: a figure's filter
+  // changes the ERP's shape (a causal band-pass delays and rings), so it is part of the result.
+  double highpass_hz = 0.0, lowpass_hz = 0.0, notch_hz = 0.0;  // 0: none
+  bool zero_phase = false;         // forward and backward (no lag) rather than causal (as online)
+  std::string filterText() const;  // "0.5-20 Hz band-pass, zero-phase"
+  int targets = 0, others = 0;     // epochs averaged
   // Channels (rows) x samples (columns), microvolts.
   Eigen::MatrixXd target_mean, other_mean, target_se, other_se;
   // Signed r^2 (the point-biserial correlation of amplitude with target/non-target, squared,

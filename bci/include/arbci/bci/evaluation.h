@@ -53,6 +53,11 @@ struct EvaluationReport {
   // pauses and cues included) and the bit rate at the full number of sequences over it; 0 when
   // the recording has one selection.
   double recorded_seconds_per_selection = 0.0, recorded_bits_per_minute = 0.0;
+  // The recording's time per selection outside the flashes (cues, feedback, pauses), and the bit
+  // rate by sequences with it added to each selection: what a user gets, not the flashes alone.
+  // Empty, and 0, when the recording has one selection.
+  double pause_seconds_per_selection = 0.0;
+  std::vector<double> bits_per_minute_with_pauses;  // [n - 1]
 
   // The selections after n sequences as text: the speller's symbols, or "object 2, object 4".
   std::string selected(int sequences) const;

@@ -43,8 +43,8 @@ struct P300Dataset {
   // Every stimulus code is always a target or never one (an oddball, or a recording coded by
   // class): the codes are the classes, not choices, so there are no selections to score.
   bool codes_are_classes = false;
-  // The ERPs of the filtered signal at the full rate, all channels, from 100 ms before each
-  // stimulus (the baseline) to the end of the analysis window, for the figures.
+  // The ERPs at the full rate, all channels, from 100 ms before each stimulus (the baseline) to
+  // the end of the analysis window, for the figures; filtered as DatasetOptions::erp_filter says.
   ErpCurves erp;
 
   int epochs() const { return static_cast<int>(features.rows()); }
@@ -58,12 +58,21 @@ ParadigmLayout layoutOf(const Recording& recording);
 // hence XDF).
 std::vector<std::pair<std::string, std::string>> layoutParameters(const Recording& recording);
 
+struct DatasetOptions {
+  // > 0: epochs whose filtered peak-to-peak amplitude exceeds it on any feature channel are left
+  // out (counted in rejected_epochs).
+  double reject_uv = 0.0;
+  // The ERP figures' filter: the pipeline's band run forward and backward (ZeroPhase: the
+  // response's true latency and shape; a causal band-pass delays a slow P300 and rings after it,
+  // turning a parietal positivity into a late trough) or exactly as the features (AsFeatures:
+  // what the online classifier sees).
+  enum class ErpFilter { ZeroPhase, AsFeatures } erp_filter = ErpFilter::ZeroPhase;
+};
+
 // Filters each recording as the online cycle does, cuts the response windows and computes the
 // features. Throws std::invalid_argument naming the file for recordings without stimuli, with
-// other channels or rates than the first, or another paradigm.
-// `reject_uv` > 0: epochs whose filtered peak-to-peak amplitude exceeds it on any feature channel
-// are left out (counted in rejected_epochs).
+// other channels or rates than the first, or another paradigm, and when every epoch is rejected.
 P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings,
-                         const Progress& progress = {}, double reject_uv = 0.0);
+                         const Progress& progress = {}, const DatasetOptions& options = {});
 
 }  // namespace arbci::bci
