@@ -93,7 +93,8 @@ struct TrainOptions {
   bci::PipelineSettings pipeline;
   // ErrP: the recordings' feedback events instead of their flashes.
   bool errp = false;
-  std::string p300_model;  // the ErrP classifier is written inside this P300 model
+  bool calibration_only = false;  // only the calibration blocks' feedbacks
+  std::string p300_model;         // the ErrP classifier is written inside this P300 model
   double errp_threshold = 0.5;
 };
 
@@ -142,6 +143,25 @@ void writeReportFiles(const std::string& report_path, const std::string& scores_
   }
 }
 
+// Where a recording's feedbacks come from and which are used.
+void printFeedbackCounts(std::ostream& out, const std::string& source,
+                         const bci::FeedbackRecording& feedback, bool calibration_only) {
+  const auto counts = [](const bci::FeedbackCounts& c) {
+    return std::to_string(c.total()) + " feedbacks (" + std::to_string(c.errors) + " error, " +
+           std::to_string(c.correct) + " correct)";
+  };
+  out << source << ": calibration block " << counts(feedback.calibration) << ", online "
+      << counts(feedback.online);
+  if (feedback.unknown > 0) out << ", " << feedback.unknown << " of unknown correctness (left out)";
+  out << "; training on " << feedback.errors << " error and " << feedback.correct
+      << " correct feedbacks";
+  if (calibration_only)
+    out << ", the calibration block's";
+  else if (feedback.calibration.total() > 0 && feedback.online.total() > 0)
+    out << ", both parts (--calibration-only: the calibration block's alone)";
+  out << "\n";
+}
+
 // With --errp, what was not given on the command line is what a session's ErrP classifier uses
 // (the embedded session's "errp"), so an offline ErrP model compares with a session's own.
 void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
@@ -188,6 +208,8 @@ void train(TrainOptions& o) {
     throw CliError("--bci2000: BCI2000 has no ErrP classifier; leave out --bci2000 with --errp");
   if (!o.errp && !o.p300_model.empty())
     throw CliError("--p300-model takes the ErrP classifier: it needs --errp");
+  if (!o.errp && o.calibration_only)
+    throw CliError("--calibration-only picks ErrP feedbacks: it needs --errp");
   std::optional<bci::P300Model> p300;
   if (!o.p300_model.empty()) {
     try {
@@ -207,12 +229,9 @@ void train(TrainOptions& o) {
     std::vector<bci::Recording> recordings = readAll(o.files);
     if (o.errp) {
       for (bci::Recording& r : recordings) {
-        bci::FeedbackRecording feedback = bci::feedbackRecording(r);
-        std::cout << r.source << ": " << feedback.errors << " error and " << feedback.correct
-                  << " correct feedbacks";
-        if (feedback.unknown > 0)
-          std::cout << " (" << feedback.unknown << " of unknown correctness left out)";
-        std::cout << "\n";
+        bci::FeedbackRecording feedback = bci::feedbackRecording(
+            r, o.calibration_only ? bci::FeedbackPart::Calibration : bci::FeedbackPart::Both);
+        printFeedbackCounts(std::cout, r.source, feedback, o.calibration_only);
         r = std::move(feedback.recording);
       }
     }
@@ -262,8 +281,7 @@ void train(TrainOptions& o) {
   std::cout << "\n\ncross-validation, " << cv.folds << " folds by " << cv.folds_by
             << (o.training.folds_by.empty() ? " (the default here; --folds-by to change)" : "")
             << ":\n";
-  printReport(std::cout, cv.report,
-              o.errp ? ReportWords{"error", "correct", "feedbacks"} : ReportWords{});
+  printReport(std::cout, cv.report, o.errp ? ReportWords::errp() : ReportWords{});
   nlohmann::json facts = datasetFacts(data, quality);
   if (o.errp) {
     // What the threshold does to the cross-validated feedbacks (a prior of 0.5 for an error).
@@ -465,6 +483,9 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                       "events (Feedback ... correct|error; a session with errp.enabled records "
                       "them) instead of a P300 model on their flashes; options not given take "
                       "the embedded session's ErrP defaults (it prints which)");
+  train_cmd->add_flag("--calibration-only", t->calibration_only,
+                      "with --errp: only the calibration block's feedbacks (those before the "
+                      "session trained), not the online selections'");
   train_cmd->add_option("--p300-model", t->p300_model,
                         "with --errp: write the ErrP classifier inside this P300 model (a session "
                         "needs both in one file) to --out");

@@ -27,18 +27,21 @@ nlohmann::json toJson(const bci::Interval& i) {
 
 void printReport(std::ostream& out, const bci::EvaluationReport& r, const ReportWords& words) {
   out << std::fixed;
-  out << "paradigm: " << r.layout.describeShape();
-  if (r.selection_metrics) {
-    out << ", " << r.selections.size() << " selections (" << r.selections_with_truth
-        << " with known targets)";
+  if (words.event == "flash") {  // feedbacks have no paradigm of their own
+    out << "paradigm: " << r.layout.describeShape();
+    if (r.selection_metrics) {
+      out << ", " << r.selections.size() << " selections (" << r.selections_with_truth
+          << " with known targets)";
+    }
+    out << ", stimulus onset asynchrony " << std::setprecision(3) << r.layout.soa_s << " s\n";
   }
-  out << ", stimulus onset asynchrony " << std::setprecision(3) << r.layout.soa_s << " s\n";
-  out << "single-flash AUC: " << std::setprecision(3) << r.auc << " (95 % interval "
+  out << "single-" << words.event << " AUC: " << std::setprecision(3) << r.auc << " (95 % interval "
       << interval(r.auc_interval) << ", " << r.target_flashes << " " << words.target << " and "
       << r.other_flashes << " " << words.other << " " << words.events << ")\n";
   if (!r.selection_metrics) {
-    out << "no selection metrics: every stimulus code is always or never the target (an "
-           "oddball, or codes that are classes), so codes are not choices\n";
+    if (words.event == "flash")
+      out << "no selection metrics: every stimulus code is always or never the target (an "
+             "oddball, or codes that are classes), so codes are not choices\n";
     out.unsetf(std::ios::fixed);
     return;
   }

@@ -18,6 +18,8 @@ namespace arbci::app {
 // report's "error and correct feedbacks".
 struct ReportWords {
   std::string target = "target", other = "non-target", events = "flashes";
+  std::string event = "flash";  // "single-flash AUC"
+  static ReportWords errp() { return {"error", "correct", "feedbacks", "feedback"}; }
 };
 
 void printReport(std::ostream& out, const bci::EvaluationReport& report,

@@ -215,7 +215,12 @@ std::string foldScheme(const P300Dataset& data, const std::string& requested) {
                                 std::to_string(data.sources.size()));
   }
   if (scheme == "block" && data.epochs() < 4)
-    throw std::invalid_argument("cross-validation by block needs at least 4 flashes");
+    throw std::invalid_argument("cross-validation by block needs at least 4 epochs, " +
+                                std::to_string(data.epochs()) + " are left" +
+                                (data.rejected_epochs > 0
+                                     ? " (" + std::to_string(data.rejected_epochs) +
+                                           " over the rejection limit: raise --reject-uv)"
+                                     : std::string()));
   if (scheme != "selection" && scheme != "file" && scheme != "block")
     throw std::invalid_argument("folds by \"" + scheme + "\": must be selection, block or file");
   return scheme;

@@ -534,6 +534,23 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
             std::string::npos)
       << defaults.out;
   EXPECT_EQ(readJson(folder / "errp_defaults.json")["method"], "riemann");
+  // Where the feedbacks come from is said; --calibration-only takes the calibration block alone.
+  const std::string online = "online " + std::to_string(errp["decisions"].get<int>()) +
+                             " feedbacks (" + std::to_string(errp["wrong_selections"].get<int>()) +
+                             " error";
+  EXPECT_NE(defaults.out.find("calibration block 60 feedbacks (15 error, 45 correct), " + online),
+            std::string::npos)
+      << defaults.out;
+  const ProcessResult calibration = runProcess(
+      kArbci, {"train", "--errp", "--calibration-only", (folder / "recording.bdf").string(),
+               "--out", (folder / "errp_calibration.json").string()});
+  ASSERT_EQ(calibration.exit_code, 0) << calibration.err << calibration.out;
+  EXPECT_NE(calibration.out.find(
+                "training on 15 error and 45 correct feedbacks, the calibration block's"),
+            std::string::npos)
+      << calibration.out;
+  EXPECT_NE(calibration.out.find("15 error and 45 correct feedbacks)"), std::string::npos)
+      << calibration.out;
   // A recording without feedback events is refused with the reason.
   const ProcessResult none =
       runProcess(kArbci, {"train", "--errp", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"),

@@ -14,13 +14,28 @@ namespace arbci::bci {
 constexpr int kErrorFeedbackCode = 1;  // the ErrP classifier's target
 constexpr int kCorrectFeedbackCode = 2;
 
-struct FeedbackRecording {
-  Recording recording;  // the signal, with one stimulus per feedback of known correctness
+// A session's feedbacks come from two parts: the calibration block (a cued target, then a shown
+// selection, a quarter of them wrong by design) before the classifiers are trained, and the
+// online selections after. They differ: the calibration's are evenly spaced and the subject
+// expects errors there; online errors follow from the P300 classifier.
+enum class FeedbackPart { Both, Calibration };
+
+struct FeedbackCounts {
   int errors = 0, correct = 0;
+  int total() const { return errors + correct; }
+};
+
+struct FeedbackRecording {
+  Recording recording;                 // the signal, with one stimulus per feedback taken
+  FeedbackCounts calibration, online;  // of known correctness, taken or not
+  int errors = 0, correct = 0;         // taken
   int unknown = 0;  // feedback whose correctness the session did not know: left out
 };
 
-// Throws std::invalid_argument naming the file when it holds no feedback event.
-FeedbackRecording feedbackRecording(const Recording& session);
+// A feedback is the calibration's when it comes before the session's "Phase training the
+// classifier" annotation (or the recording has calibration phases and no training). Throws
+// std::invalid_argument naming the file when it holds no feedback event, or none of `part`.
+FeedbackRecording feedbackRecording(const Recording& session,
+                                    FeedbackPart part = FeedbackPart::Both);
 
 }  // namespace arbci::bci
