@@ -9,9 +9,11 @@
 //                      [--errp-scale F]
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "arbci/bci/errp_feedback.h"
@@ -84,6 +86,32 @@ bci::Recording calibrationBlock(session::EegSettings eeg, std::uint64_t seed, in
   return recording;
 }
 
+// Epochs [first, end) of `data` as a dataset of their own (one contiguous calibration block).
+bci::P300Dataset epochRange(const bci::P300Dataset& data, int first, int end) {
+  bci::P300Dataset out = data;
+  const auto take = [&](auto& v) {
+    v = std::decay_t<decltype(v)>(v.begin() + first, v.begin() + end);
+  };
+  out.features = data.features.middleRows(first, end - first);
+  take(out.target);
+  take(out.code);
+  take(out.sequence);
+  take(out.selection);
+  take(out.file);
+  take(out.sample);
+  out.selections.clear();
+  for (const bci::SelectionEpochs& s : data.selections) {
+    bci::SelectionEpochs kept{{}, s.target_codes, s.file};
+    for (const int e : s.epochs)
+      if (e >= first && e < end) kept.epochs.push_back(e - first);
+    if (kept.epochs.empty()) continue;
+    for (const int e : kept.epochs)
+      out.selection[static_cast<size_t>(e)] = static_cast<int>(out.selections.size());
+    out.selections.push_back(std::move(kept));
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -106,16 +134,26 @@ int main(int argc, char** argv) {
                  "the simulated ErrP's size against the subject's drawn one (default: the "
                  "embedded session's eeg.errp_scale)")
       ->check(CLI::Range(0.0, 100.0));
-  cli.add_option("--methods", methods, "ErrP classifiers (swlda, slda, xdawn, riemann)")
+  double decimate_hz = 0.0;
+  cli.add_option("--decimate-hz", decimate_hz,
+                 "the features' rate (default: the embedded session's errp.decimate_hz)")
+      ->check(CLI::Range(1.0, 256.0));
+  int blocks = 0;
+  cli.add_option("--blocks", blocks,
+                 "instead of one block per size: a recording of this many blocks of each size, "
+                 "each block cross-validated on its own (mean, SD, range over the blocks)")
+      ->check(CLI::Range(2, 1000));
+  cli.add_option("--methods", methods, "ErrP classifiers (swlda, slda, xdawn, riemann, shift-lda)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"swlda", "slda", "xdawn", "riemann"}))
+      ->check(CLI::IsMember({"swlda", "slda", "xdawn", "riemann", "shift-lda"}))
       ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
 
   session::SessionConfig config = session::SessionConfig::load(std::nullopt);
   if (errp_scale >= 0.0) config.eeg.errp_scale = errp_scale;
-  const bci::PipelineSettings pipeline =
+  bci::PipelineSettings pipeline =
       config.errp.pipeline(config.classifier.pipeline, config.eeg.montage);
+  if (decimate_hz > 0.0) pipeline.decimate_hz = decimate_hz;
   std::printf(
       "ErrP classifier, cross-validated AUC [95 %%] (5 contiguous blocks); the embedded session's "
       "subject (errp_scale %.2f) and ErrP pipeline (%.1f-%.1f Hz, %.0f-%.0f ms, %.0f Hz "
@@ -125,15 +163,31 @@ int main(int argc, char** argv) {
       pipeline.channels.size(), config.errp.xdawn_filters, "seed", "feedbacks", "method", "AUC");
   for (const int seed : seeds) {
     for (const int size : sizes) {
-      const bci::Recording block =
-          calibrationBlock(config.eeg, static_cast<std::uint64_t>(seed), size);
-      const bci::P300Dataset data = bci::buildDataset({block}, pipeline);
+      const bci::Recording recording = calibrationBlock(
+          config.eeg, static_cast<std::uint64_t>(seed), size * std::max(1, blocks));
+      const bci::P300Dataset whole = bci::buildDataset({recording}, pipeline);
       for (const std::string& method : methods) {
         bci::TrainingSettings training = config.errp.training();
         training.method = method;
-        const bci::CrossValidation cv = bci::crossValidate(data, training);
-        std::printf("%6d %9d %-8s %.3f [%.3f, %.3f]\n", seed, size, method.c_str(), cv.report.auc,
-                    cv.report.auc_interval.low, cv.report.auc_interval.high);
+        if (blocks == 0) {
+          const bci::CrossValidation cv = bci::crossValidate(whole, training);
+          std::printf("%6d %9d %-9s %.3f [%.3f, %.3f]\n", seed, size, method.c_str(), cv.report.auc,
+                      cv.report.auc_interval.low, cv.report.auc_interval.high);
+        } else {
+          std::vector<double> aucs;
+          for (int b = 0; b < blocks; ++b) {
+            const bci::CrossValidation cv =
+                bci::crossValidate(epochRange(whole, b * size, (b + 1) * size), training);
+            aucs.push_back(cv.report.auc);
+          }
+          double mean = 0.0, spread = 0.0;
+          for (const double a : aucs) mean += a / blocks;
+          for (const double a : aucs) spread += (a - mean) * (a - mean) / (blocks - 1);
+          std::printf("%6d %9d %-9s mean %.3f SD %.3f range %.3f-%.3f over %d blocks\n", seed, size,
+                      method.c_str(), mean, std::sqrt(spread),
+                      *std::min_element(aucs.begin(), aucs.end()),
+                      *std::max_element(aucs.begin(), aucs.end()), blocks);
+        }
         std::fflush(stdout);
       }
     }

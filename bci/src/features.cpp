@@ -34,6 +34,7 @@ FeatureExtractor::FeatureExtractor(const PipelineSettings& settings, const Signa
       std::lround((settings.window.end_s - settings.window.start_s) * info.rate_hz));
   shape_.channels = static_cast<int>(channel_indices_.size());
   shape_.bins = samples / factor_;
+  shape_.bin_s = factor_ / info.rate_hz;
   if (shape_.bins < 1)
     throw std::invalid_argument("the response window is shorter than one decimation bin");
 }

@@ -142,6 +142,10 @@ const core::Schema<TrainingSettings>& trainingSchema() {
     using T = TrainingSettings;
     t.text("method", &T::method, "slda", "the classifier (docs/settings.md's classifiers)",
            [] { return classifiers().names(); })
+        .number("shift_ms", &T::shift_ms, 94.0, 0.0, 400.0,
+                "shift-lda: the largest latency shift tried, each way (the response's latency "
+                "spread)",
+                "ms")
         .integer("folds", &T::folds, 10, 2, 100,
                  "cross-validation folds (at most one per selection or file)")
         .text("folds_by", &T::folds_by, "",

@@ -398,7 +398,7 @@ const Schema<ErrpSettings>& errpOwnSchema() {
     t.number("decimate_hz", &E::decimate_hz, 20.0, 1.0, 500.0, "its features' rate", "Hz")
         .number("highpass_hz", &E::highpass_hz, 1.0, 0.0, 100.0, "its band's lower edge", "Hz")
         .number("lowpass_hz", &E::lowpass_hz, 10.0, 0.0, 500.0, "its band's upper edge", "Hz")
-        .text("method", &E::method, "riemann", "its classifier (classifiers)",
+        .text("method", &E::method, "shift-lda", "its classifier (classifiers)",
               [] { return bci::classifiers().names(); })
         .integer("xdawn_filters", &E::xdawn_filters, 1, 1, 64,
                  "xDAWN filters kept (riemann: per class)")

@@ -428,10 +428,11 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
   ASSERT_TRUE(errp["classifier"].get<bool>()) << errp.dump();
   EXPECT_GE(errp["calibration_auc"].get<double>(), 0.85) << errp.dump();
   EXPECT_GT(errp["wrong_selections"].get<int>(), 0) << errp.dump();  // the P300 guessed wrong
-  // The default ErrP classifier: the Riemannian method, one xDAWN filter per class, the montage.
+  // The default ErrP classifier: latency-tolerant LDA on one xDAWN filter of the montage.
   const nlohmann::json model = readJson(folder / "model.json");
-  EXPECT_EQ(model["errp"]["method"], "riemann");
-  EXPECT_EQ(model["errp"]["classifier"]["filters_per_class"], 1);
+  EXPECT_EQ(model["errp"]["method"], "shift-lda");
+  EXPECT_EQ(model["errp"]["classifier"]["spatial_filters"], 1);
+  EXPECT_EQ(model["errp"]["classifier"]["shift_ms"], 94.0);
   EXPECT_EQ(model["errp"]["pipeline"]["channels"].size(), 8u) << model["errp"]["pipeline"].dump();
   EXPECT_EQ(errp["wrong_caught"], errp["wrong_selections"]) << errp.dump();
 
@@ -530,10 +531,10 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
       runProcess(kArbci, {"train", "--errp", (folder / "recording.bdf").string(), "--out",
                           (folder / "errp_defaults.json").string()});
   ASSERT_EQ(defaults.exit_code, 0) << defaults.err << defaults.out;
-  EXPECT_NE(defaults.out.find("--method riemann --xdawn-filters 1 --window-ms 0,800"),
+  EXPECT_NE(defaults.out.find("--method shift-lda --xdawn-filters 1 --window-ms 0,800"),
             std::string::npos)
       << defaults.out;
-  EXPECT_EQ(readJson(folder / "errp_defaults.json")["method"], "riemann");
+  EXPECT_EQ(readJson(folder / "errp_defaults.json")["method"], "shift-lda");
   // Where the feedbacks come from is said; --calibration-only takes the calibration block alone.
   const std::string online = "online " + std::to_string(errp["decisions"].get<int>()) +
                              " feedbacks (" + std::to_string(errp["wrong_selections"].get<int>()) +

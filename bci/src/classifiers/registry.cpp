@@ -9,6 +9,7 @@ ClassifierRegistry::Entry shrinkageLdaClassifier();
 ClassifierRegistry::Entry xdawnClassifier();
 ClassifierRegistry::Entry riemannClassifier();
 ClassifierRegistry::Entry plainLdaClassifier();
+ClassifierRegistry::Entry shiftLdaClassifier();
 
 const ClassifierRegistry& classifiers() {
   static const ClassifierRegistry registry = [] {
@@ -18,6 +19,7 @@ const ClassifierRegistry& classifiers() {
     r.add(xdawnClassifier());
     r.add(riemannClassifier());
     r.add(plainLdaClassifier());
+    r.add(shiftLdaClassifier());
     return r;
   }();
   return registry;

@@ -80,7 +80,8 @@ struct TrainingSettings {
   std::string method;  // a name of bci::classifiers()
   SwldaSettings swlda;
   XdawnSettings xdawn;
-  int folds;  // at most one per selection (or file)
+  double shift_ms;  // shift-lda: the largest latency shift tried, each way
+  int folds;        // at most one per selection (or file)
   // "selection" (no selection's flashes both trained on and tested), "block" (k contiguous blocks
   // of flashes in time), "file", or "" for the default: by selection, or by block where the data
   // have fewer than 2 selections or their codes are classes.

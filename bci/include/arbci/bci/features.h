@@ -33,6 +33,7 @@ struct PipelineSettings {
 struct FeatureShape {
   int channels = 0;
   int bins = 0;
+  double bin_s = 0.0;  // each bin's duration (0: not known)
   int size() const { return channels * bins; }
 };
 
