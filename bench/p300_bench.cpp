@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
   try {
-    const PipelineSettings pipeline;
+    const PipelineSettings pipeline = withMethodRate(PipelineSettings{}, "slda");  // 20 Hz
     auto start = Clock::now();
     const P300Dataset train = buildDataset({readRecording(dir + "/eeg3_1.dat")}, pipeline);
     const double prepare_ms =

@@ -221,6 +221,11 @@ void train(TrainOptions& o) {
   checkOutputs(o.plots, {o.out, o.bci2000, o.report, o.scores});
   o.pipeline.window = parseWindow(o.window_ms);
   o.pipeline.channels = splitNameList(o.channels);
+  try {
+    o.pipeline = bci::withMethodRate(o.pipeline, o.training.method);
+  } catch (const std::invalid_argument& error) {
+    throw CliError(error.what());
+  }
   const bci::Progress progress = progressLine(std::cerr);
   bci::TrainingResult result;
   bci::P300Dataset data;
@@ -445,9 +450,10 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->capture_default_str();
   train_cmd
       ->add_option("--decimate-hz", t->pipeline.decimate_hz,
-                   "feature rate after moving-average decimation (at most the signal's rate)")
+                   "feature rate after moving-average decimation (at most the signal's rate; 0: "
+                   "the method's own, 20 Hz for the linear methods, 64 Hz for riemann)")
       ->capture_default_str()
-      ->check(CLI::Range(0.1, 10000.0));
+      ->check(CLI::Range(0.0, 10000.0));
   train_cmd
       ->add_option("--highpass-hz", t->pipeline.filter.highpass_hz,
                    "Butterworth high-pass (0: none)")
@@ -514,9 +520,10 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(1, 100000));
   train_cmd
       ->add_option("--xdawn-filters", t->training.xdawn.filters,
-                   "xDAWN: spatial filters kept; riemann: per class (1 to the number of channels)")
+                   "xDAWN: spatial filters kept; riemann: per class (1 to the number of channels; "
+                   "0: the method's own, xdawn 4, riemann 2, shift-lda 1)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 256));
+      ->check(CLI::Range(0, 256));
   train_cmd
       ->add_option("--certainty", t->training.dynamic.certainty,
                    "dynamic stopping: stop at this posterior probability (0: never early)")

@@ -234,7 +234,7 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
   }
   // Settings the data cannot meet fail now, not in the first fold.
   const ClassifierParts& parts = classifiers().at(settings.method).make;
-  if (parts.check) parts.check(settings, data.shape);
+  if (parts.check) parts.check(withMethodDefaults(settings), data.shape);
   CrossValidation cv;
   cv.folds_by = foldScheme(data, settings.folds_by);
   cv.scores.assign(static_cast<size_t>(data.epochs()), 0.0);

@@ -8,7 +8,10 @@
 namespace arbci::bci {
 
 int PipelineSettings::decimationFactor(double rate_hz) const {
-  if (!(decimate_hz > 0.0)) return 1;
+  if (!(decimate_hz > 0.0))
+    throw std::invalid_argument(
+        "decimate_hz 0 stands for the method's own rate: the pipeline was not resolved for a "
+        "method (bci::withMethodRate) before its features were taken");
   return std::max(1, static_cast<int>(std::lround(rate_hz / decimate_hz)));
 }
 

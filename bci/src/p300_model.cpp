@@ -218,7 +218,7 @@ TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipel
   P300Model& model = result.model;
   model.method = settings.method;
   model.rate_hz = data.info.rate_hz;
-  model.pipeline = pipeline;
+  model.pipeline = withMethodRate(pipeline, settings.method);
   model.pipeline.channels = data.feature_channels;
   model.shape = data.shape;
   model.classifier = std::move(classifier);
@@ -235,7 +235,8 @@ TrainingResult trainModel(const P300Dataset& data, const PipelineSettings& pipel
                         {"accuracy_by_sequences", report.accuracy},
                         {"bits_per_minute", report.bits_per_minute}}}};
   const ClassifierParts& parts = classifiers().at(settings.method).make;
-  if (parts.parameters) model.provenance["parameters"] = parts.parameters(settings);
+  if (parts.parameters)
+    model.provenance["parameters"] = parts.parameters(withMethodDefaults(settings));
   return result;
 }
 

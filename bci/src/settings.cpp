@@ -117,8 +117,10 @@ const core::Schema<PipelineSettings>& pipelineSchema() {
          [](const P& p) {
            return Json::array({p.window.start_s * 1000.0, p.window.end_s * 1000.0});
          })
-        .number("decimate_hz", &P::decimate_hz, 20.0, 1.0, 500.0,
-                "the features' rate: the epoch is averaged in bins to it", "Hz")
+        .number("decimate_hz", &P::decimate_hz, 0.0, 0.0, 500.0,
+                "the features' rate: the epoch is averaged in bins to it (0: the method's own, "
+                "20 Hz as BCI2000 for the linear methods, 64 Hz for riemann)",
+                "Hz")
         .texts("channels", &P::channels, {}, 0, "the feature channels ([]: every EEG channel)")
         .boolean("zero_phase", &P::zero_phase, false,
                  "offline only: filter forward and backward (no phase lag; never online)");
@@ -163,10 +165,11 @@ const core::Schema<TrainingSettings>& trainingSchema() {
     Key max_features{"max_features", Type::Integer, 60, "SWLDA: most features kept", "", 1, 1000};
     Key filters{"xdawn_filters",
                 Type::Integer,
-                4,
-                "xDAWN: spatial filters kept (riemann: per class)",
+                0,
+                "xDAWN spatial filters kept (riemann: per class; 0: the method's own, xdawn 4, "
+                "riemann 2, shift-lda 1)",
                 "",
-                1,
+                0,
                 64};
     t.custom(
          p_enter, [](T& s, const Json& j) { s.swlda.p_enter = j.get<double>(); },

@@ -341,6 +341,54 @@ TEST(TrainAndEvaluate, OddballEeg2_1TrainsAsOneFileAndEvaluatesOnEeg2_2) {
   EXPECT_GE(best_auc, 0.90);
 }
 
+// The Riemannian method with its defaults (covariances of the causally band-passed epoch at
+// 64 Hz, 2 xDAWN filters per class) against an independent computation of the same pipeline:
+// a BCI2000 reader of its own (the simulated files read by MNE), scipy's Butterworth and notch
+// filters, numpy's xDAWN covariances (Ledoit-Wolf), Riemannian mean and tangent space as
+// pyriemann computes them, and scikit-learn's shrinkage LDA. Run once by hand; its AUCs are the
+// numbers below (docs/classification.md says how they were obtained).
+TEST(TrainAndEvaluate, RiemannianMethodAgreesWithAnIndependentComputation) {
+  const auto simulated = [](int sequences) {
+    const auto path = scratch("riemann_sim7_" + std::to_string(sequences) + ".bdf");
+    const ProcessResult r =
+        runProcess(kArbci, {"eeg", "simulate", "--seconds", "240", "--seed", "7", "--sequences",
+                            std::to_string(sequences), "--out", path.string()});
+    if (r.exit_code != 0) throw std::runtime_error("arbci eeg simulate failed: " + r.err);
+    return path.string();
+  };
+  const std::string sim_a = simulated(8), sim_b = simulated(10);
+  struct Case {
+    std::string train, test;
+    double independent_auc;
+    std::string spelled;
+  };
+  const std::vector<Case> cases{{eeg("eeg3_1.dat"), eeg("eeg3_2.dat"), 0.8800, "6MK?"},
+                                {eeg("eeg3_2.dat"), eeg("eeg3_1.dat"), 0.8269, "T3OF"},
+                                {eeg("eeg2_1.dat"), eeg("eeg2_2.dat"), 0.9231, ""},
+                                {eeg("eeg2_2.dat"), eeg("eeg2_1.dat"), 0.8944, ""},
+                                {sim_a, sim_b, 0.8653, ""},
+                                {sim_b, sim_a, 0.8703, ""}};
+  const auto model = scratch("riemann_independent.json");
+  const auto report = scratch("riemann_independent_report.json");
+  for (const Case& c : cases) {
+    ProcessResult r =
+        runProcess(kArbci, {"train", "--method", "riemann", c.train, "--out", model.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = runProcess(kArbci,
+                   {"evaluate", "--model", model.string(), c.test, "--report", report.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(report);
+    const double auc = nlohmann::json::parse(in)["auc"].get<double>();
+    EXPECT_NEAR(auc, c.independent_auc, 0.02) << c.train << " -> " << c.test;
+    if (!c.spelled.empty()) {
+      EXPECT_NE(r.out.find("selected with 15 sequences: " + c.spelled), std::string::npos) << r.out;
+    }
+    if (c.spelled == "6MK?") {
+      EXPECT_GE(auc, 0.86);
+    }
+  }
+}
+
 // The Riemannian method through the CLI: trained, saved, loaded and applied to the other session.
 TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
   const auto model = scratch("riemann.json");
@@ -528,7 +576,7 @@ TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   for (const auto& [option, expected] :
        std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"--certainty", "2"}, "--certainty"},
-           {{"--xdawn-filters", "0"}, "--xdawn-filters"},
+           {{"--xdawn-filters", "-1"}, "--xdawn-filters"},
            {{"--method", "xdawn", "--xdawn-filters", "99"}, "the features have 8 channels"},
            {{"--decimate-hz", "1000"}, "exceeds the signal's rate 256 Hz"},
            {{"--p-enter", "0.2", "--p-remove", "0.1"}, "must exceed --p-enter"},

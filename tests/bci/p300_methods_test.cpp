@@ -286,7 +286,8 @@ Recording simulatedCopyTask(std::uint64_t seed, int selections) {
 TEST(SimulatedSubject, SingleFlashesAreHardAndRepetitionsHelp) {
   TrainingSettings settings;
   settings.method = "slda";
-  const P300Dataset data = buildDataset({simulatedCopyTask(5, 24)}, PipelineSettings{});
+  const P300Dataset data =
+      buildDataset({simulatedCopyTask(5, 24)}, withMethodRate(PipelineSettings{}, "slda"));
   const CrossValidation cv = crossValidate(data, settings);
   EXPECT_GT(cv.report.auc, 0.75);
   EXPECT_LT(cv.report.auc, 0.95);
@@ -296,10 +297,12 @@ TEST(SimulatedSubject, SingleFlashesAreHardAndRepetitionsHelp) {
 }
 
 TEST(P300Model, JsonRoundTripScoresTheSameAndKeepsItsProvenance) {
-  const P300Dataset data = buildDataset({simulatedCopyTask(6, 12)}, PipelineSettings{});
+  const P300Dataset data =
+      buildDataset({simulatedCopyTask(6, 12)}, withMethodRate(PipelineSettings{}, "slda"));
   TrainingSettings settings;
   settings.method = "xdawn";
-  const TrainingResult trained = trainModel(data, PipelineSettings{}, settings);
+  const TrainingResult trained =
+      trainModel(data, withMethodRate(PipelineSettings{}, "slda"), settings);
   const auto path = std::filesystem::temp_directory_path() / "arbci_model_test.json";
   trained.model.save(path);
   const P300Model loaded = P300Model::load(path);
@@ -328,8 +331,9 @@ TEST(P300Dataset, ASessionsPhotodiodeChannelIsNeverClassified) {
       diode[static_cast<size_t>(s)] = 1000.0f;
   }
   with_diode.data.insert(with_diode.data.end(), diode.begin(), diode.end());
-  const P300Dataset plain = buildDataset({eeg}, PipelineSettings{});
-  const P300Dataset session = buildDataset({with_diode}, PipelineSettings{});
+  const P300Dataset plain = buildDataset({eeg}, withMethodRate(PipelineSettings{}, "slda"));
+  const P300Dataset session =
+      buildDataset({with_diode}, withMethodRate(PipelineSettings{}, "slda"));
   EXPECT_EQ(session.info.channels, eeg.info.channels);
   EXPECT_EQ(session.feature_channels, plain.feature_channels);
   EXPECT_EQ(
@@ -341,10 +345,12 @@ TEST(P300Dataset, ASessionsPhotodiodeChannelIsNeverClassified) {
 }
 
 TEST(P300Model, RefusesTheWrongSignalAndBrokenFiles) {
-  const P300Dataset data = buildDataset({simulatedCopyTask(6, 6)}, PipelineSettings{});
+  const P300Dataset data =
+      buildDataset({simulatedCopyTask(6, 6)}, withMethodRate(PipelineSettings{}, "slda"));
   TrainingSettings settings;
   settings.method = "slda";
-  const P300Model model = trainModel(data, PipelineSettings{}, settings).model;
+  const P300Model model =
+      trainModel(data, withMethodRate(PipelineSettings{}, "slda"), settings).model;
   SignalInfo other = data.info;
   other.rate_hz = 512.0;
   EXPECT_THROW(model.checkCompatible(other, "x.bdf"), ModelError);
@@ -369,7 +375,8 @@ TEST(P300Model, RefusesTheWrongSignalAndBrokenFiles) {
   }
   Recording silent = simulatedCopyTask(6, 2);
   silent.stimuli.clear();
-  EXPECT_THROW(buildDataset({silent}, PipelineSettings{}), std::invalid_argument);
+  EXPECT_THROW(buildDataset({silent}, withMethodRate(PipelineSettings{}, "slda")),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -30,9 +30,9 @@ const Evaluated& trainedOnEeg3_1(const std::string& method) {
   static std::map<std::string, Evaluated> cache;
   auto found = cache.find(method);
   if (found != cache.end()) return found->second;
-  const PipelineSettings pipeline;
   TrainingSettings settings;
   settings.method = method;
+  const PipelineSettings pipeline = withMethodRate(PipelineSettings{}, method);
   Evaluated e;
   e.trained = trainModel(buildDataset({sample("eeg3_1.dat")}, pipeline), pipeline, settings);
   const P300Dataset test = buildDataset({sample("eeg3_2.dat")}, e.trained.model.pipeline);
@@ -95,7 +95,7 @@ TEST(P300RealEeg, SwldaKeepsAtMost60FeaturesAndExportsToBci2000) {
 }
 
 TEST(P300RealEeg, SyntheticSpellerFileSpellsSPELL) {
-  const PipelineSettings pipeline;
+  const PipelineSettings pipeline = withMethodRate(PipelineSettings{}, TrainingSettings{}.method);
   const P300Dataset data = buildDataset({sample("P3SpellerS001R01_synthetic.dat")}, pipeline);
   ASSERT_EQ(data.selections.size(), 5u);
   TrainingSettings settings;
@@ -132,8 +132,8 @@ TEST(P300RealEeg, Eeg3_1ThroughXdfWithItsLayoutTrainsAsTheOriginal) {
   const ParadigmLayout layout = layoutOf(through);
   EXPECT_EQ(layout.describeShape(), layoutOf(original).describeShape());
 
-  const PipelineSettings pipeline;
   TrainingSettings settings;
+  const PipelineSettings pipeline = withMethodRate(PipelineSettings{}, settings.method);
   const TrainingResult from_xdf = trainModel(buildDataset({through}, pipeline), pipeline, settings);
   const TrainingResult from_dat =
       trainModel(buildDataset({original}, pipeline), pipeline, settings);

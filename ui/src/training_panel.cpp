@@ -33,6 +33,7 @@ void TrainingPanel::startTraining() {
   bci::PipelineSettings pipeline = model_.pipelineSettings();
   pipeline.window.end_s = window_end_ms_ / 1000.0;
   pipeline.decimate_hz = decimate_hz_;
+  pipeline = bci::withMethodRate(pipeline, settings.method);
   progress_ = 0.0;
   message_.clear();
   outcome_.reset();
@@ -130,7 +131,8 @@ void TrainingPanel::draw() {
   ImGui::SliderFloat("##window end", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
   ImGui::TextUnformatted("decimate to (Hz)");
   ImGui::SetNextItemWidth(-FLT_MIN);
-  ImGui::SliderFloat("##decimate", &decimate_hz_, 10.0f, 64.0f, "%.0f");
+  ImGui::SliderFloat("##decimate", &decimate_hz_, 0.0f, 128.0f,
+                     decimate_hz_ > 0.0f ? "%.0f Hz" : "the method's own");
   collect();
   const bool running = training_.valid();
   const bool named = std::string(files_).find_first_not_of(" \t\n") != std::string::npos;

@@ -57,9 +57,31 @@ void checkTrainingData(const Eigen::MatrixXd& features, const std::vector<bool>&
     throw std::invalid_argument("the features contain NaN or infinite values");
 }
 
+namespace {
+
+const ClassifierParts& partsOf(const std::string& method) {
+  const ClassifierRegistry::Entry* entry = classifiers().find(method);
+  if (!entry)
+    throw std::invalid_argument("unknown classification method '" + method + "' (" +
+                                classifiers().list() + ")");
+  return entry->make;
+}
+
+}  // namespace
+
+PipelineSettings withMethodRate(PipelineSettings pipeline, const std::string& method) {
+  if (!(pipeline.decimate_hz > 0.0)) pipeline.decimate_hz = partsOf(method).feature_rate_hz;
+  return pipeline;
+}
+
+TrainingSettings withMethodDefaults(TrainingSettings settings) {
+  if (settings.xdawn.filters == 0) settings.xdawn.filters = partsOf(settings.method).xdawn_filters;
+  return settings;
+}
+
 std::unique_ptr<Classifier> makeClassifier(const TrainingSettings& settings) {
   try {
-    return classifiers().at(settings.method).make.make(settings);
+    return classifiers().at(settings.method).make.make(withMethodDefaults(settings));
   } catch (const std::invalid_argument&) {
     throw std::invalid_argument("unknown classification method '" + settings.method + "' (" +
                                 classifiers().list() + ")");

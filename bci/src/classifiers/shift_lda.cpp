@@ -2,12 +2,12 @@
 // error-related potential: its negativity and positivity move by tens of milliseconds between
 // feedbacks, which smears a fixed-latency template and caps every linear method on fixed bins).
 //
-// Training: the epochs through the target class's xDAWN spatial filters (xdawn_filters; 0 keeps
-// the channels), then shrinkage LDA on the window's central part (a margin of shift_ms cut off
-// each side). Scoring: the same weights slid over the window a bin at a time, up to shift_ms each
-// way; the score is the score at no shift plus the largest over the shifts. The unshifted score
-// keeps what a fixed template knows; the largest catches a response that came early or late.
-// Their equal sum has no parameter to fit: with a calibration block's 25 errors a fitted
+// Training: the epochs through the target class's xDAWN spatial filters (xdawn_filters, 1 by
+// default: one virtual channel), then shrinkage LDA on the window's central part (a margin of
+// shift_ms cut off each side). Scoring: the same weights slid over the window a bin at a time, up
+// to shift_ms each way; the score is the score at no shift plus the largest over the shifts. The
+// unshifted score keeps what a fixed template knows; the largest catches a response that came early
+// or late. Their equal sum has no parameter to fit: with a calibration block's 25 errors a fitted
 // combination (logistic regression on out-of-fold scores) was worse on every one of five
 // simulated subjects (seeds 11-15, 100-feedback blocks) and no better with 6,400 feedbacks.
 // Not linear in the features: no BCI2000 export.
@@ -181,6 +181,7 @@ ClassifierRegistry::Entry shiftLdaClassifier() {
     return nlohmann::json{{"shift_ms", s.shift_ms}, {"filters", s.xdawn.filters}};
   };
   parts.linear = false;
+  parts.xdawn_filters = 1;
   return {"shift-lda",
           "latency-tolerant shrinkage LDA: the weights of the window's centre slid up to shift_ms "
           "each way, the centred and the best score combined (for ErrPs, whose latency varies); "

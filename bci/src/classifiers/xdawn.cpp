@@ -76,6 +76,7 @@ ClassifierRegistry::Entry xdawnClassifier() {
   parts.parameters = [](const TrainingSettings& s) {
     return nlohmann::json{{"filters", s.xdawn.filters}};
   };
+  parts.xdawn_filters = 4;  // OpenViBE's P300 scenario
   return {"xdawn",
           "xDAWN spatial filters (xdawn_filters kept), then shrinkage LDA: OpenViBE's P300 "
           "pipeline",

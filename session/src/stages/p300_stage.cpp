@@ -69,16 +69,17 @@ void P300Stage::startTraining(const std::string& method) {
   }
   bci::TrainingSettings training = settings_.training;
   training.method = method;
-  training_ = std::async(std::launch::async, [recording = std::move(recording),
-                                              pipeline = settings_.pipeline, training]() {
-    // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
-    // frames come first and the training takes what is left.
-    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
-    const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
-    bci::TrainingResult result = bci::trainModel(data, pipeline, training);
-    result.model.provenance["training_files"] = {"this session's calibration run"};
-    return Outcome{std::move(result.model), result.cross_validation.report, data.erp};
-  });
+  training_ = std::async(
+      std::launch::async, [recording = std::move(recording),
+                           pipeline = bci::withMethodRate(settings_.pipeline, method), training]() {
+        // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
+        // frames come first and the training takes what is left.
+        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+        bci::TrainingResult result = bci::trainModel(data, pipeline, training);
+        result.model.provenance["training_files"] = {"this session's calibration run"};
+        return Outcome{std::move(result.model), result.cross_validation.report, data.erp};
+      });
 }
 
 void P300Stage::takeTraining(Cycle& cycle) {

@@ -65,10 +65,20 @@ struct ClassifierParts {
   std::function<nlohmann::json(const TrainingSettings& settings)> parameters;
   // Linear in the features: BCI2000's LinearClassifier can run it.
   bool linear = true;
+  // What the method takes where a setting leaves it to the method (0): the features' rate
+  // (pipeline decimate_hz) and the xDAWN filters it keeps (training xdawn_filters; unused by
+  // methods without spatial filters).
+  double feature_rate_hz = 20.0;  // BCI2000's P300 features
+  int xdawn_filters = 0;
 };
 using ClassifierRegistry = core::Registry<ClassifierParts>;
 // Every method, by the name `classifier.method` and `arbci train --method` take.
 const ClassifierRegistry& classifiers();
+
+// The settings with what is left to the method (0) filled in from its registry entry; throw
+// std::invalid_argument naming the methods there are when `method` is unknown.
+PipelineSettings withMethodRate(PipelineSettings pipeline, const std::string& method);
+TrainingSettings withMethodDefaults(TrainingSettings settings);
 
 // `settings.method`, untrained; throws std::invalid_argument naming the methods there are.
 std::unique_ptr<Classifier> makeClassifier(const TrainingSettings& settings);
