@@ -153,7 +153,7 @@ TEST(SessionConfig, TheTrackerSearchesAtFullOrHalfResolution) {
 // a list of channels picks those the montage has, and a list with none of them is refused.
 TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
   const SessionConfig embedded = SessionConfig::load(std::nullopt);
-  EXPECT_EQ(embedded.errp.method, "riemann");
+  EXPECT_EQ(embedded.errp.method, "shift-lda");
   EXPECT_EQ(embedded.errp.xdawn_filters, 1);
   EXPECT_EQ(embedded.errp.pipeline(embedded.classifier.pipeline, embedded.eeg.montage).channels,
             embedded.eeg.montage);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -460,15 +461,40 @@ TEST(Session, WithErrPsTheRobotIsNeverSentToAWrongObjectOrCell) {
   // The summary tells what the robot did, trial by trial: where it was sent (the session's
   // commands), how many of those motions went wrong, and as many motions as the robot's own log
   // says it ran. A selection the ErrP rejected is listed as vetoed, never as the one selected.
-  int logged_wrong = 0, grasp_trials = 0, drop_trials = 0;
+  // The session's commands by sequence number, with the trial each was sent in.
+  struct Sent {
+    nlohmann::json command;
+    int trial = 0;
+  };
+  std::map<long, Sent> sent;
   trial = 0;
   for (const auto& line : readLog(folder / "log.jsonl")) {
     if (line["event"] == "phase") trial = line["trial"].get<int>();
-    if (line["event"] != "robot_command" || line.contains("by")) continue;
-    if (line["command"] == "GRASP")
-      logged_wrong += line["object"] != intended[trial]["intended_object"];
-    if (line["command"] == "DROP" && !line["returning"].get<bool>())
-      logged_wrong += line["cell"] != intended[trial]["intended_cell"];
+    if (line["event"] == "robot_command" && line.contains("sequence"))
+      sent[line["sequence"].get<long>()] = {line, trial};
+  }
+  // What the robot's own log says it ran ("ran GRASP 4272 at (x, y, z)"), each run motion matched
+  // to the command of that sequence and its trial's intention; a motion ran where it was sent.
+  int logged_wrong = 0, grasp_trials = 0, drop_trials = 0;
+  std::ifstream robot_log(folder / "robotd.log");
+  for (std::string l; std::getline(robot_log, l);) {
+    char kind[8] = {};
+    long sequence = 0;
+    double x = 0.0, y = 0.0, z = 0.0;
+    const auto at = l.find(": ran ");
+    if (at == std::string::npos || std::sscanf(l.c_str() + at, ": ran %7s %ld at (%lf, %lf, %lf)",
+                                               kind, &sequence, &x, &y, &z) != 5)
+      continue;
+    ASSERT_TRUE(sent.count(sequence)) << l;
+    const Sent& s = sent[sequence];
+    if (s.command.contains("by")) continue;  // the experimenter's, not the BCI's
+    EXPECT_EQ(s.command["command"], kind) << l;
+    EXPECT_NEAR(s.command["target"][0].get<double>(), x, 1e-3) << l;
+    EXPECT_NEAR(s.command["target"][1].get<double>(), y, 1e-3) << l;
+    if (std::string(kind) == "GRASP")
+      logged_wrong += s.command["object"] != intended[s.trial]["intended_object"];
+    if (std::string(kind) == "DROP" && !s.command["returning"].get<bool>())
+      logged_wrong += s.command["cell"] != intended[s.trial]["intended_cell"];
   }
   int vetoed = 0;
   for (const auto& t : summary["trials"]) {
