@@ -330,10 +330,11 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command->add_flag("--track", options->track,
                     "Keep identities over frames (video, camera, image sequences)");
-  command->add_flag("--smooth", options->smooth,
-                    "With --track (implied): One-Euro smoothing of the corners, frames taken as "
-                    "1/30 s apart. docs/bench/tracker-log.md measures it: still markers lose their jitter, "
-                    "moving ones gain latency (about 5 ms at the defaults, 1 ms at 3 Hz, beta 1)");
+  command->add_flag(
+      "--smooth", options->smooth,
+      "With --track (implied): One-Euro smoothing of the corners, frames taken as "
+      "1/30 s apart. docs/bench/tracker-log.md measures it: still markers lose their jitter, "
+      "moving ones gain latency (about 5 ms at the defaults, 1 ms at 3 Hz, beta 1)");
   command
       ->add_option("--min-cutoff-hz", options->min_cutoff_hz,
                    "--smooth: the One-Euro cutoff at rest (lower: steadier, laggier)")
