@@ -2,8 +2,10 @@
 // headless (chosen automatically without a display) for batch work and tests.
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "arbci/render/window_context.h"
 #include "arbci/session/session.h"
@@ -43,21 +45,61 @@ std::string defaultFolder() {
   return folder;
 }
 
+// A session that ended in its pre-flight never started: its folder holds the reason and no data
+// (no calibration, no trial), and a retry may take its place.
+bool holdsOnlyAFailedStart(const std::filesystem::path& folder) {
+  std::ifstream in(folder / "summary.json");
+  if (!in) return false;
+  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+  if (summary.is_discarded() || !summary.is_object()) return false;
+  const std::string reason = summary.value("end_reason", "");
+  return reason.rfind("pre-flight failed", 0) == 0 &&
+         summary.value("trials", nlohmann::json::array()).empty();
+}
+
 // A session's data are never overwritten by accident: an existing, non-empty --out is refused
-// unless --overwrite, which empties it first.
+// unless --overwrite, which empties it first, or it holds only a failed start.
 void claimFolder(const std::string& out, bool overwrite) {
   std::error_code error;
   if (!std::filesystem::exists(out, error) || std::filesystem::is_empty(out, error)) return;
   if (!std::filesystem::is_directory(out))
     throw CliError("--out " + out + ": exists and is not a folder");
-  if (!overwrite) {
+  if (!overwrite && holdsOnlyAFailedStart(out)) {
+    std::cerr << "--out " << out << ": holds a session that failed its pre-flight; replacing it\n";
+  } else if (!overwrite) {
     throw CliError("--out " + out +
                    ": the folder exists and is not empty (an earlier session?); choose another "
                    "--out, leave it out for a new time-stamped folder, or add --overwrite");
   }
   std::filesystem::remove_all(out, error);
-  if (error) throw CliError("--overwrite: cannot empty " + out + ": " + error.message());
+  if (error) throw CliError("--out: cannot empty " + out + ": " + error.message());
 }
+
+// Until the session has opened, what this run wrote into its folder is removed again when it
+// fails (a bad setting, a missing key file): a failed start leaves nothing that blocks a retry.
+class FolderClaim {
+ public:
+  explicit FolderClaim(std::filesystem::path folder)
+      : folder_(std::move(folder)), existed_(std::filesystem::exists(folder_)) {}
+  ~FolderClaim() {
+    if (kept_) return;
+    std::error_code error;
+    if (existed_) {  // claimed empty: empty it again
+      for (const auto& entry : std::filesystem::directory_iterator(folder_, error))
+        std::filesystem::remove_all(entry.path(), error);
+    } else {
+      std::filesystem::remove_all(folder_, error);
+    }
+  }
+  FolderClaim(const FolderClaim&) = delete;
+  FolderClaim& operator=(const FolderClaim&) = delete;
+  void keep() { kept_ = true; }
+
+ private:
+  std::filesystem::path folder_;
+  bool existed_;
+  bool kept_ = false;
+};
 
 void printSummary(const session::Session& session) {
   std::cout << "session folder: " << session.folder().string() << "\n";
@@ -122,6 +164,7 @@ int runSession(const RunOptions& o) {
   session::SessionOptions options;
   if (!o.out.empty()) claimFolder(o.out, o.overwrite);
   options.folder = o.out.empty() ? defaultFolder() : o.out;
+  FolderClaim claim(options.folder);
   if (o.trials > 0) options.trials = o.trials;
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
   options.fault_wait_s = o.fault_wait_s;
@@ -130,8 +173,10 @@ int runSession(const RunOptions& o) {
   try {
     if (!o.script.empty() && headless)
       throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
-    if (!headless)
+    if (!headless) {
+      claim.keep();  // the window shows its own failures and offers a retry in place
       return runWorkstation(config, options, {o.script, o.wait_for_start, o.exit_when_done});
+    }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped
                                                       : session::Clock::Mode::RealTime;
@@ -141,6 +186,7 @@ int runSession(const RunOptions& o) {
     auto context = render::createHeadlessContext({64, 64});
     watchInterrupts();
     OpenedSession opened = openSession(config, options, *context);
+    claim.keep();
     runHeadless(*opened.session);
     printSummary(*opened.session);
     return opened.session->endKind() == "finished" ? 0 : 3;
@@ -175,8 +221,9 @@ void addRunCommand(CLI::App& root, int& exit_code) {
   run->add_option("--seed", o->seed, "random seed of the simulated subject and world")
       ->check(CLI::Range(0LL, 1LL << 30));
   run->add_option("--out", o->out,
-                  "session folder, which must not hold a session already (default: a new "
-                  "arbci-session-<date>-<time>)");
+                  "session folder, which must not hold a session already; one that failed its "
+                  "pre-flight is replaced, and a start that fails leaves nothing in it (default: "
+                  "a new arbci-session-<date>-<time>)");
   run->add_flag("--overwrite", o->overwrite, "empty an existing --out folder first");
   run->add_flag("--realtime", o->realtime,
                 "headless: the EEG, the frames and the arm on the wall clock (not reproducible)\n"
