@@ -6,7 +6,8 @@
 // them wrong in random order. An AUC that stops rising with thousands of feedbacks is the
 // subject's, not the classifier's.
 //   errp_ceiling_bench [--feedbacks 100,400,1600,6400] [--seeds 1] [--methods riemann,slda]
-//                      [--errp-scale F]
+//                      [--errp-scale F] [--decimate-hz F] [--shift-ms F] [--xdawn-filters N]
+//                      [--blocks N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -138,6 +139,14 @@ int main(int argc, char** argv) {
   cli.add_option("--decimate-hz", decimate_hz,
                  "the features' rate (default: the embedded session's errp.decimate_hz)")
       ->check(CLI::Range(1.0, 256.0));
+  double shift_ms = -1.0;
+  cli.add_option("--shift-ms", shift_ms,
+                 "shift-lda: the largest latency shift (default: the training setting's)")
+      ->check(CLI::Range(0.0, 400.0));
+  int xdawn_filters = 0;
+  cli.add_option("--xdawn-filters", xdawn_filters,
+                 "spatial filters (default: the embedded session's errp.xdawn_filters)")
+      ->check(CLI::Range(1, 64));
   int blocks = 0;
   cli.add_option("--blocks", blocks,
                  "instead of one block per size: a recording of this many blocks of each size, "
@@ -169,6 +178,8 @@ int main(int argc, char** argv) {
       for (const std::string& method : methods) {
         bci::TrainingSettings training = config.errp.training();
         training.method = method;
+        if (shift_ms >= 0.0) training.shift_ms = shift_ms;
+        if (xdawn_filters > 0) training.xdawn.filters = xdawn_filters;
         if (blocks == 0) {
           const bci::CrossValidation cv = bci::crossValidate(whole, training);
           std::printf("%6d %9d %-9s %.3f [%.3f, %.3f]\n", seed, size, method.c_str(), cv.report.auc,
