@@ -36,8 +36,8 @@ class ShiftLdaClassifier final : public Classifier {
   void restore(const nlohmann::json& json, const FeatureShape& shape);
 
  private:
-  // The central bins of each spatially filtered channel shifted by `shift` bins, as one row;
-  // `x` already filtered (filtered_ bins per filter).
+  // The central bins of each row of `x` (rows of shape_.bins: the filtered epoch) moved by
+  // `shift` bins, as one vector.
   Eigen::VectorXd core(const Eigen::Ref<const Eigen::VectorXd>& x, int shift) const;
   // An epoch's features through `filters` (channels x kept): kept x bins, as one row.
   Eigen::VectorXd filtered(const Eigen::Ref<const Eigen::VectorXd>& x,
@@ -61,9 +61,8 @@ int shiftBins(double shift_ms, const FeatureShape& shape) {
   const int shift = static_cast<int>(std::lround(shift_ms / 1000.0 / shape.bin_s));
   if (shape.bins - 2 * shift < 2) {
     throw std::invalid_argument("shift-lda: a window of " + std::to_string(shape.bins) +
-                                " bins leaves fewer than 2 " + "after cutting " +
-                                std::to_string(shift) +
-                                " bins of shift each way: widen the window " + "or lower shift_ms");
+                                " bins leaves fewer than 2 after cutting " + std::to_string(shift) +
+                                " bins of shift each way: widen the window or lower shift_ms");
   }
   return shift;
 }
