@@ -451,7 +451,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd
       ->add_option("--decimate-hz", t->pipeline.decimate_hz,
                    "feature rate after moving-average decimation (at most the signal's rate; 0: "
-                   "the method's own, 20 Hz for the linear methods, 64 Hz for riemann)")
+                   "the method's own, which its line in --method's list gives)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10000.0));
   train_cmd
@@ -521,7 +521,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd
       ->add_option("--xdawn-filters", t->training.xdawn.filters,
                    "xDAWN: spatial filters kept; riemann: per class (1 to the number of channels; "
-                   "0: the method's own, xdawn 4, riemann 2, shift-lda 1)")
+                   "0: the method's own, which its line in --method's list gives)")
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
   train_cmd

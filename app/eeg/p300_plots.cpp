@@ -141,7 +141,8 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const b
        "signed r^2 (" + names.target + " vs " + names.other +
            ") per channel and time: " + std::to_string(erp.targets) + " " + names.target + ", " +
            std::to_string(erp.others) + " " + names.other + " epochs",
-       {left, 28}, 0.5);
+       {left, 24}, 0.5);
+  text(image, "filter: " + erp.filterText(), {left, 44}, 0.4);
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
   const int label_every = (14 + row_h - 1) / row_h;
   const double t0 = erp.timeS(0) * 1000.0, t1 = erp.timeS(samples - 1) * 1000.0;
@@ -202,6 +203,7 @@ std::filesystem::path writeScalpMap(const std::filesystem::path& folder, const b
        names.target + " - " + names.other + " at " + format(map->time_s * 1000.0, 0) +
            " ms (the difference's peak over channels)",
        {10, 24}, 0.45);
+  text(image, "filter: " + erp.filterText(), {10, 44}, 0.4);
   colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40, 16, size - 40), map->limit_uv,
             "uV", 1);
   const std::filesystem::path path = folder / "scalp.png";

@@ -27,7 +27,7 @@ nlohmann::json toJson(const bci::Interval& i) {
 
 void printReport(std::ostream& out, const bci::EvaluationReport& r, const ReportWords& words) {
   out << std::fixed;
-  if (words.event == "flash") {  // feedbacks have no paradigm of their own
+  if (words.paradigm) {
     out << "paradigm: " << r.layout.describeShape();
     if (r.selection_metrics) {
       out << ", " << r.selections.size() << " selections (" << r.selections_with_truth
@@ -39,7 +39,7 @@ void printReport(std::ostream& out, const bci::EvaluationReport& r, const Report
       << interval(r.auc_interval) << ", " << r.target_flashes << " " << words.target << " and "
       << r.other_flashes << " " << words.other << " " << words.events << ")\n";
   if (!r.selection_metrics) {
-    if (words.event == "flash")
+    if (words.paradigm)
       out << "no selection metrics: every stimulus code is always or never the target (an "
              "oddball, or codes that are classes), so codes are not choices\n";
     out.unsetf(std::ios::fixed);

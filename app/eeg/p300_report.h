@@ -19,7 +19,8 @@ namespace arbci::app {
 struct ReportWords {
   std::string target = "target", other = "non-target", events = "flashes";
   std::string event = "flash";  // "single-flash AUC"
-  static ReportWords errp() { return {"error", "correct", "feedbacks", "feedback"}; }
+  bool paradigm = true;         // the events are a paradigm's stimuli (feedbacks are not)
+  static ReportWords errp() { return {"error", "correct", "feedbacks", "feedback", false}; }
 };
 
 void printReport(std::ostream& out, const bci::EvaluationReport& report,

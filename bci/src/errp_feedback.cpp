@@ -1,5 +1,7 @@
 #include "arbci/bci/errp_feedback.h"
 
+#include "arbci/bci/paradigm.h"
+
 #include <limits>
 #include <stdexcept>
 
@@ -16,8 +18,10 @@ bool startsWith(const std::string& text, const std::string& prefix) {
 std::int64_t calibrationEnd(const Recording& session) {
   bool calibration = false;
   for (const Annotation& a : session.annotations) {
-    if (startsWith(a.text, "Phase training the classifier")) return a.sample;
-    calibration |= startsWith(a.text, "Phase calibration");
+    if (startsWith(a.text, kPhaseAnnotation + std::string(toString(Phase::Training))))
+      return a.sample;
+    // Every calibration phase's name starts so: "calibration: target cued", "...: flashing".
+    calibration |= startsWith(a.text, kPhaseAnnotation + std::string("calibration"));
   }
   return calibration ? std::numeric_limits<std::int64_t>::max() : 0;
 }

@@ -118,8 +118,9 @@ const core::Schema<PipelineSettings>& pipelineSchema() {
            return Json::array({p.window.start_s * 1000.0, p.window.end_s * 1000.0});
          })
         .number("decimate_hz", &P::decimate_hz, 0.0, 0.0, 500.0,
-                "the features' rate: the epoch is averaged in bins to it (0: the method's own, "
-                "20 Hz as BCI2000 for the linear methods, 64 Hz for riemann)",
+                "the features' rate: the epoch is averaged in bins to it (0: the method's own, " +
+                    std::to_string(static_cast<int>(ClassifierParts{}.feature_rate_hz)) +
+                    " Hz as BCI2000 unless its line in the classifiers' list says otherwise)",
                 "Hz")
         .texts("channels", &P::channels, {}, 0, "the feature channels ([]: every EEG channel)")
         .boolean("zero_phase", &P::zero_phase, false,
@@ -166,8 +167,8 @@ const core::Schema<TrainingSettings>& trainingSchema() {
     Key filters{"xdawn_filters",
                 Type::Integer,
                 0,
-                "xDAWN spatial filters kept (riemann: per class; 0: the method's own, xdawn 4, "
-                "riemann 2, shift-lda 1)",
+                "xDAWN spatial filters kept (riemann: per class; 0: the method's own, as its "
+                "line in the classifiers' list says)",
                 "",
                 0,
                 64};

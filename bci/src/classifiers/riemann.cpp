@@ -234,8 +234,11 @@ ClassifierRegistry::Entry riemannClassifier() {
   parts.feature_rate_hz = 64.0;
   parts.xdawn_filters = 2;
   return {"riemann",
-          "xDAWN covariances (xdawn_filters per class) in the tangent space at their Riemannian "
-          "mean, then shrinkage LDA: MOABB's best P300 pipeline; not linear (no BCI2000 export)",
+          "xDAWN covariances (xdawn_filters per class, by default " +
+              std::to_string(parts.xdawn_filters) + ") of " +
+              std::to_string(static_cast<int>(parts.feature_rate_hz)) +
+              " Hz features by default, in the tangent space at their Riemannian mean, then "
+              "shrinkage LDA: MOABB's best P300 pipeline; not linear (no BCI2000 export)",
           parts};
 }
 

@@ -47,7 +47,7 @@ class ShiftLdaClassifier final : public Classifier {
                               double b) const;
 
   double shift_ms_;
-  int spatial_filters_;  // xDAWN filters of the target class kept (0: the channels as they are)
+  int spatial_filters_;  // xDAWN filters of the target class kept
   FeatureShape shape_;
   Eigen::MatrixXd filters_;  // channels x kept
   int shift_bins_ = 0, core_bins_ = 0;
@@ -102,10 +102,7 @@ void ShiftLdaClassifier::train(const Eigen::MatrixXd& features, const std::vecto
   shift_bins_ = shiftBins(shift_ms_, shape);
   core_bins_ = shape.bins - 2 * shift_bins_;
   if (progress) progress(0.0, "shift-LDA");
-  Eigen::MatrixXd filters =
-      spatial_filters_ > 0
-          ? xdawnFilters(features, shape, target, spatial_filters_).filters
-          : Eigen::MatrixXd(Eigen::MatrixXd::Identity(shape.channels, shape.channels));
+  Eigen::MatrixXd filters = xdawnFilters(features, shape, target, spatial_filters_).filters;
   Eigen::MatrixXd cores(features.rows(), filters.cols() * core_bins_);
   for (Eigen::Index i = 0; i < features.rows(); ++i)
     cores.row(i) = core(filtered(features.row(i).transpose(), filters), 0).transpose();
@@ -147,9 +144,10 @@ void ShiftLdaClassifier::restore(const nlohmann::json& json, const FeatureShape&
     throw std::invalid_argument("shift-lda classifier: shift_bins does not fit the window");
   bias_ = number("bias");
   spatial_filters_ = static_cast<int>(number("spatial_filters"));
-  const int kept = spatial_filters_ > 0 ? spatial_filters_ : shape.channels;
+  const int kept = spatial_filters_;
   const std::vector<double> filters = json.value("filters", std::vector<double>{});
-  if (kept > shape.channels || static_cast<int>(filters.size()) != shape.channels * kept)
+  if (kept < 1 || kept > shape.channels ||
+      static_cast<int>(filters.size()) != shape.channels * kept)
     throw std::invalid_argument(
         "shift-lda classifier: the spatial filters do not fit the channels");
   filters_ = Eigen::Map<const Eigen::MatrixXd>(filters.data(), shape.channels, kept);
@@ -182,9 +180,11 @@ ClassifierRegistry::Entry shiftLdaClassifier() {
   parts.linear = false;
   parts.xdawn_filters = 1;
   return {"shift-lda",
-          "latency-tolerant shrinkage LDA: the weights of the window's centre slid up to shift_ms "
-          "each way, the centred and the best score combined (for ErrPs, whose latency varies); "
-          "not linear (no BCI2000 export)",
+          "latency-tolerant shrinkage LDA on xdawn_filters (by default " +
+              std::to_string(parts.xdawn_filters) +
+              ") spatial filters: the weights of the window's centre slid up to shift_ms each "
+              "way, the centred and the best score summed (for ErrPs, whose latency varies); not "
+              "linear (no BCI2000 export)",
           parts};
 }
 

@@ -78,8 +78,9 @@ ClassifierRegistry::Entry xdawnClassifier() {
   };
   parts.xdawn_filters = 4;  // OpenViBE's P300 scenario
   return {"xdawn",
-          "xDAWN spatial filters (xdawn_filters kept), then shrinkage LDA: OpenViBE's P300 "
-          "pipeline",
+          "xDAWN spatial filters (xdawn_filters kept, by default " +
+              std::to_string(parts.xdawn_filters) +
+              "), then shrinkage LDA: OpenViBE's P300 pipeline",
           parts};
 }
 

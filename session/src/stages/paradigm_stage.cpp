@@ -425,7 +425,7 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
       case Kind::PhaseChanged:
         s_.log.write("phase", time,
                      {{"phase", bci::toString(e.phase)}, {"text", e.text}, {"trial", e.trial}});
-        cycle.annotate(cycle.eeg_sample, "Phase " + e.text);
+        cycle.annotate(cycle.eeg_sample, bci::kPhaseAnnotation + e.text);
         part.phase_changes.push_back({e.phase, e.trial});
         break;
       case Kind::SelectionStarted: {

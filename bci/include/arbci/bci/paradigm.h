@@ -89,6 +89,9 @@ enum class Phase {
   RobotFault,
 };
 const char* toString(Phase phase);
+// A recording's annotation of a phase change: this prefix, then the PhaseChanged event's text
+// (toString(phase), then ": " and details when it has some).
+inline constexpr const char* kPhaseAnnotation = "Phase ";
 
 // What one displayed frame shows.
 struct FrameStimulus {
