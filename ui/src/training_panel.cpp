@@ -18,7 +18,22 @@ TrainingPanel::~TrainingPanel() {
   if (training_.valid()) training_.wait();
 }
 
+// The session's own settings are where the panel starts, whether it is drawn or asked to train
+// first (a screenshot trains before the first frame).
+void TrainingPanel::initialise() {
+  if (initialised_) return;
+  const bci::TrainingSettings training = model_.trainingSettings();
+  const bci::PipelineSettings pipeline = model_.pipelineSettings();
+  const auto& entries = bci::classifiers().entries();
+  for (size_t i = 0; i < entries.size(); ++i)
+    if (entries[i].name == training.method) method_ = static_cast<int>(i);
+  window_end_ms_ = static_cast<float>(pipeline.window.end_s * 1000.0);
+  decimate_hz_ = static_cast<float>(pipeline.decimate_hz);
+  initialised_ = true;
+}
+
 void TrainingPanel::startTraining() {
+  initialise();
   std::vector<std::string> files;
   std::istringstream in(files_);
   std::string file;
@@ -104,17 +119,7 @@ void TrainingPanel::draw() {
   pathInput("recordings (BCI2000 .dat, GDF, EDF, BDF; several: separated by spaces)", files_,
             sizeof files_, ".dat .gdf .edf .bdf",
             "the recordings to train on; Browse picks one from the folder of the last");
-  if (!initialised_) {
-    // The session's own settings are where the panel starts.
-    const bci::TrainingSettings training = model_.trainingSettings();
-    const bci::PipelineSettings pipeline = model_.pipelineSettings();
-    const auto& entries = bci::classifiers().entries();
-    for (size_t i = 0; i < entries.size(); ++i)
-      if (entries[i].name == training.method) method_ = static_cast<int>(i);
-    window_end_ms_ = static_cast<float>(pipeline.window.end_s * 1000.0);
-    decimate_hz_ = static_cast<float>(pipeline.decimate_hz);
-    initialised_ = true;
-  }
+  initialise();
   const auto& methods = bci::classifiers().entries();
   ImGui::TextUnformatted("method");
   ImGui::SetNextItemWidth(-FLT_MIN);
@@ -130,9 +135,19 @@ void TrainingPanel::draw() {
   ImGui::SetNextItemWidth(-FLT_MIN);
   ImGui::SliderFloat("##window end", &window_end_ms_, 300.0f, 1200.0f, "%.0f");
   ImGui::TextUnformatted("decimate to (Hz)");
-  ImGui::SetNextItemWidth(-FLT_MIN);
-  ImGui::SliderFloat("##decimate", &decimate_hz_, 0.0f, 128.0f,
-                     decimate_hz_ > 0.0f ? "%.0f Hz" : "the method's own");
+  bool own_rate = decimate_hz_ <= 0.0f;  // 0: the method's own rate
+  if (ImGui::Checkbox("the method's own", &own_rate)) {
+    const std::string& method = methods.at(static_cast<size_t>(method_)).name;
+    decimate_hz_ =
+        own_rate
+            ? 0.0f
+            : static_cast<float>(bci::withMethodRate(bci::PipelineSettings{}, method).decimate_hz);
+  }
+  if (!own_rate) {
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(-FLT_MIN);
+    ImGui::SliderFloat("##decimate", &decimate_hz_, 10.0f, 128.0f, "%.0f Hz");
+  }
   collect();
   const bool running = training_.valid();
   const bool named = std::string(files_).find_first_not_of(" \t\n") != std::string::npos;

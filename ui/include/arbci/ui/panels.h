@@ -75,6 +75,7 @@ class TrainingPanel final : public Panel {
     std::string error;
   };
   void startTraining();
+  void initialise();
   void collect();
   void drawSessionErps();
   WorkstationModel& model_;
@@ -82,7 +83,7 @@ class TrainingPanel final : public Panel {
   char save_path_[256] = "model.json";
   int method_ = 0;  // in bci::classifiers()
   float window_end_ms_ = 0.0f, decimate_hz_ = 0.0f;
-  bool initialised_ = false;  // from the session's settings, on the first draw
+  bool initialised_ = false;  // from the session's settings, on first use
   std::atomic<double> progress_{0.0};
   std::mutex stage_mutex_;
   std::string stage_;
