@@ -104,10 +104,18 @@ std::vector<std::string> SessionModel::robotLog() {
 
 std::string SessionModel::whyNot(Action action) {
   switch (action) {
+    case Action::Start:
+      return session_.whyNot(session::Action::Start);
     case Action::Pause:
       return session_.whyNot(session::Action::Pause);
     case Action::Resume:
       return session_.whyNot(session::Action::Resume);
+    case Action::Abort:
+      return session_.whyNot(session::Action::Abort);
+    case Action::EmergencyStop:
+      return session_.whyNot(session::Action::EmergencyStop);
+    case Action::ResetRobot:
+      return session_.whyNot(session::Action::ResetRobot);
     case Action::Home:
       return session_.whyNot(session::Action::Home);
     case Action::OpenGripper:
@@ -116,6 +124,8 @@ std::string SessionModel::whyNot(Action action) {
       return session_.whyNot(session::Action::RetryStep);
     case Action::SkipTrial:
       return session_.whyNot(session::Action::SkipTrial);
+    case Action::EndSession:
+      return session_.whyNot(session::Action::EndSession);
   }
   return "";
 }
@@ -209,9 +219,26 @@ std::vector<std::pair<std::string, std::string>> SessionModel::summaryRows() con
 }
 
 std::string SessionModel::phase() {
-  std::string text = bci::toString(record().paradigm.phase);
-  if (session_.ended() && session_.endReason() != text) text += " (" + session_.endReason() + ")";
-  return text;
+  if (!session_.ended()) return bci::toString(record().paradigm.phase);
+  // The summary's words: its "ended" and, where it says more, its "end_reason".
+  const std::string& kind = session_.endKind();
+  const std::string& why = session_.endReason();
+  return "ended: " + kind + (why == kind ? "" : " (" + why + ")");
+}
+
+std::string SessionModel::reason() {
+  return session_.ended() ? phase() : record().paradigm.status;
+}
+
+std::vector<ui::OperatorLine> SessionModel::operatorLog() {
+  std::vector<ui::OperatorLine> out;
+  for (const session::OperatorMessage& m : session_.operatorLog().messages()) {
+    const auto severity = m.severity == session::Severity::Error     ? ui::OperatorLine::Severity::Error
+                          : m.severity == session::Severity::Warning ? ui::OperatorLine::Severity::Warning
+                                                                     : ui::OperatorLine::Severity::Info;
+    out.push_back({severity, m.t, m.text});
+  }
+  return out;
 }
 
 std::vector<ui::StageTiming> SessionModel::timing() {

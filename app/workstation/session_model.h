@@ -79,6 +79,9 @@ class SessionModel final : public ui::WorkstationModel {
   std::string eegClockLine() override;
   std::string eegSourceFault() override { return record().eeg.fault; }
   std::vector<ui::StageTiming> timing() override;
+  std::string reason() override;
+  std::vector<ui::OperatorLine> operatorLog() override;
+  size_t operatorLogSize() override { return session_.operatorLog().messages().size(); }
   std::vector<std::string> selections() override;
 
  private:

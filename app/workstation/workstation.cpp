@@ -84,7 +84,8 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     shell.addPanel(*panels.back(), entry.make.open_at_start);
     if (entry.name == "summary") summary_panel = panels.back().get();
   }
-  shell.setEmergencyStop([&] { model.emergencyStop(); });
+  shell.setEmergencyStop([&] { model.emergencyStop(); },
+                         [&] { return model.whyNot(ui::WorkstationModel::Action::EmergencyStop); });
   shell.setQuitHandler([&] { main_window.requestClose(); });
   // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
   watchInterrupts();

@@ -45,6 +45,8 @@ std::string whyNotPause(const CycleRecord& last) {
 std::string whyNotRetry(const CycleRecord& last) {
   const auto was = last.paradigm.interrupted;
   if (!was) return "nothing to retry: no emergency stop or robot fault";
+  if (*was == bci::Phase::Setup)
+    return "nothing to retry: the session had not started (Resume returns to set-up)";
   if (*was != bci::Phase::Grasping && *was != bci::Phase::Dropping) return "";
   if (!last.robot.why_not_move.empty()) return last.robot.why_not_move;
   const auto held = last.robot.holding();
@@ -55,6 +57,9 @@ std::string whyNotRetry(const CycleRecord& last) {
 
 std::string whyNotSkip(const CycleRecord& last) {
   if (!last.paradigm.interrupted) return "only after an emergency stop or a robot fault";
+  // The paradigm skips trials only (its calibration has none).
+  if (last.paradigm.trial < 1)
+    return "no trial to skip: the stop came before the first trial; Resume goes on";
   if (last.robot.busy) return "the arm is carrying out a command";
   return whyArmNotClear(last.robot);
 }
@@ -90,6 +95,11 @@ const char* toString(Action action) {
 }
 
 std::string whyNot(Action action, const CycleRecord& last, bool ended) {
+  // Once ended, the session no longer drives the arm (a simulated backend has stopped with it): a
+  // STOP from here would be logged and reach nothing that listens.
+  if (ended && (action == Action::EmergencyStop || action == Action::ResetRobot))
+    return "the session has ended and no longer drives the arm; stop a real arm at its own "
+           "emergency switch";
   if (action == Action::EmergencyStop || action == Action::ResetRobot) return "";
   if (ended) return "the session has ended";
   switch (action) {

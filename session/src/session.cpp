@@ -12,6 +12,7 @@ Session::Session(SessionConfig config, const SessionOptions& requested,
       options_(optionsFor(requested, config_)),
       clock_(options_.clock, config_.paradigm.display_hz),
       folder_(options_.folder),
+      operator_log_(options_.progress),
       timing_(1000.0 * config_.eeg.block_size / config_.eeg.rate_hz) {
   std::error_code error;
   std::filesystem::create_directories(folder_, error);
@@ -19,7 +20,7 @@ Session::Session(SessionConfig config, const SessionOptions& requested,
     throw std::runtime_error(folder_.string() + ": cannot create the session folder (" +
                              error.message() + ")");
   log_ = std::make_unique<SessionLog>(folder_ / "log.jsonl");
-  const StageServices services{clock_, *log_, options_.progress};
+  const StageServices services{clock_, *log_, operator_log_};
   AssembledStages assembled = assembleStages(config_, options_, clock_, folder_, services, display);
   stages_ = std::move(assembled.stages);
   robot_ = assembled.robot;
@@ -50,6 +51,8 @@ bool Session::request(Request request) {
     const std::string why = whyNot(*action);
     if (!why.empty()) {
       log_->write("refused", time(), {{"action", toString(*action)}, {"why", why}});
+      operator_log_.add(time(), Severity::Warning,
+                        std::string(toString(*action)) + " refused: " + why);
       return false;
     }
     if (*action == Action::Resume || *action == Action::RetryStep || *action == Action::SkipTrial)
@@ -57,6 +60,7 @@ bool Session::request(Request request) {
   }
   if (std::holds_alternative<EmergencyStopRequest>(request)) {
     log_->write("emergency_stop", time(), {{"by", "experimenter"}});
+    operator_log_.add(time(), Severity::Error, "EMERGENCY STOP by the experimenter");
     robot_->stopNow(time());  // not a frame later
   }
   queued_.push_back(std::move(request));
@@ -162,6 +166,9 @@ void Session::endRun(const std::string& reason, const std::string& kind) {
               closing.eeg_sample, clock_,         closing,       last_record};
   for (const auto& stage : stages_) stage->stop(cycle, reason);
   log_->write("session_ended", last_record.time_s, {{"reason", reason}});
+  // The terminal prints the end itself (after its status line); the window lists it here.
+  operator_log_.add(last_record.time_s, end_kind_ == "finished" ? Severity::Info : Severity::Error,
+                    "session ended: " + end_kind_ + (reason == end_kind_ ? "" : " (" + reason + ")"));
   std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
 }
 

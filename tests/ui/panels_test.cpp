@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <set>
@@ -73,7 +74,18 @@ class StandInModel final : public WorkstationModel {
   std::vector<std::string> robotLog() override { return {"connected", "finished GRASP"}; }
   void emergencyStop() override { ++calls_["estop"]; }
   std::string whyNot(Action action) override {
-    return action == Action::Pause ? "" : "only after an emergency stop or a robot fault";
+    switch (action) {
+      case Action::Pause:
+        return setup_ ? "the session has not started" : "";
+      case Action::Abort:
+      case Action::EmergencyStop:
+      case Action::EndSession:
+        return "";
+      case Action::Start:
+        return setup_ ? "" : "the session has started";
+      default:
+        return "only after an emergency stop or a robot fault";
+    }
   }
   void robotReset() override {}
   void robotHome() override {}
@@ -105,11 +117,20 @@ class StandInModel final : public WorkstationModel {
   std::vector<StageTiming> timing() override {
     return {{"eeg", 0.3, 0.4, 0.6, 0.9, 0.3}, {"tracking", 1.8, 2.2, 3.1, 4.0, 1.9}};
   }
+  std::vector<OperatorLine> operatorLog() override {
+    return {{OperatorLine::Severity::Info, 2.1, "pre-flight passed"},
+            {OperatorLine::Severity::Warning, 40.2, "12 EEG samples lost"},
+            {OperatorLine::Severity::Error, 61.0,
+             "object 10: tracking lost (pose 28.3 s old), not grasped; Retry step once it is seen "
+             "again"}};
+  }
+  size_t operatorLogSize() override { return 3; }
   std::vector<std::string> selections() override {
     return {"trial 1: object 20 (intended), cell 1,3 (intended), placed 0.3 mm off [placed]"};
   }
 
   std::map<std::string, int> calls_;
+  bool setup_ = false;  // before Start, rather than in phase 1
 
  private:
   cv::Mat camera_, binary_;
@@ -125,9 +146,10 @@ struct Drawn {
 };
 
 // The shell with `panel` alone, drawn for a few frames (ImGui settles its layout).
-Drawn draw(render::GlContext& context, Panel& panel) {
+// `layout`: an ImGui layout file to start from ("" for none).
+Drawn draw(render::GlContext& context, Panel& panel, const std::string& layout = "") {
   const render::Size size{1000, 700};
-  ImGuiLayer imgui(context, "");
+  ImGuiLayer imgui(context, layout);
   ExperimenterShell shell;
   shell.addPanel(panel);
   for (int frame = 0; frame < 3; ++frame) {
@@ -163,7 +185,8 @@ std::unique_ptr<render::GlContext> Panels::context_;
 // The buttons each panel must offer (enabled or greyed out); the panels without buttons are
 // checked by pixel probes below.
 const std::map<std::string, std::vector<std::string>> kExpectedWidgets = {
-    {"session", {"Pause", "Resume", "Abort", "EMERGENCY STOP"}},
+    {"session", {"Start", "Pause", "Resume", "Abort", "EMERGENCY STOP"}},
+    {"log", {}},
     {"robot",
      {"EMERGENCY STOP", "Reset", "Home", "Open gripper", "Retry step", "Skip trial",
       "End session"}},
@@ -203,6 +226,55 @@ TEST_F(Panels, TheSessionPanelOffersWhatThePhaseAllowsAndSaysWhyNotTheRest) {
   EXPECT_FALSE(d.widgets.at("Resume").enabled);
   EXPECT_EQ(d.widgets.at("Resume").why_disabled, "only after an emergency stop or a robot fault");
   EXPECT_TRUE(d.widgets.count("Abort"));
+}
+
+// A double click must not land on a button that took another's place: Start, Pause, Resume and
+// Abort stay where they are when the session starts.
+TEST_F(Panels, TheSessionPanelsButtonsKeepTheirPlaceWhenTheSessionStarts) {
+  model_.setup_ = true;
+  auto panel = make("session");
+  const Drawn before = draw(*context_, *panel);
+  model_.setup_ = false;
+  const Drawn after = draw(*context_, *panel);
+  EXPECT_TRUE(before.widgets.at("Start").enabled);
+  EXPECT_FALSE(after.widgets.at("Start").enabled);
+  EXPECT_TRUE(after.widgets.at("Pause").enabled);
+  for (const char* label : {"Start", "Pause", "Resume", "Abort", "EMERGENCY STOP"}) {
+    const DrawnWidget& a = before.widgets.at(label);
+    const DrawnWidget& b = after.widgets.at(label);
+    EXPECT_EQ(a.x0, b.x0) << label;
+    EXPECT_EQ(a.y0, b.y0) << label;
+  }
+}
+
+// A layout saved on a larger screen is fitted to this one: the panel and its buttons in reach.
+TEST_F(Panels, APanelSavedOutsideASmallerScreenIsFittedToIt) {
+  const std::string layout = ::testing::TempDir() + "/panels_layout.ini";
+  std::ofstream(layout) << "[Window][Robot]\nPos=1300,820\nSize=900,800\nCollapsed=0\n";
+  auto panel = make("robot");
+  const Drawn d = draw(*context_, *panel, layout);
+  for (const char* label : {"EMERGENCY STOP", "Home", "End session"}) {
+    ASSERT_TRUE(d.widgets.count(label)) << label;
+    const DrawnWidget& w = d.widgets.at(label);
+    EXPECT_GE(w.x0, 0.0f) << label;
+    EXPECT_LE(w.x1, 1000.0f) << label;
+    EXPECT_LE(w.y1, 700.0f) << label;
+  }
+}
+
+// Everything the experimenter was told, coloured by severity, filterable.
+TEST_F(Panels, TheOperatorLogListsWhatTheSessionSaid) {
+  auto panel = make("log");
+  const Drawn d = draw(*context_, *panel);
+  EXPECT_TRUE(d.windows.count("Operator log"));
+  // The error line is drawn in red somewhere in the panel.
+  int red = 0;
+  for (int y = 0; y < d.image.rows; ++y)
+    for (int x = 0; x < d.image.cols; ++x) {
+      const cv::Vec4b p = d.image.at<cv::Vec4b>(y, x);
+      red += p[0] > 200 && p[1] < 120 && p[2] < 110;
+    }
+  EXPECT_GT(red, 50);
 }
 
 TEST_F(Panels, TheRobotPanelHasTheRecoveryButtonsGreyedWithTheirReasons) {

@@ -54,6 +54,9 @@ void ExperimenterShell::drawMenuBar() {
   }
   if (ImGui::BeginMenu("Panels")) {
     for (Entry& entry : panels_) ImGui::MenuItem(entry.panel->title(), nullptr, &entry.open);
+    ImGui::Separator();
+    // Every open panel back to the default columns (the saved layout is replaced on exit).
+    if (ImGui::MenuItem("Reset layout")) reset_layout_ = true;
     ImGui::EndMenu();
   }
   if (ImGui::BeginMenu("Help")) {
@@ -62,7 +65,7 @@ void ExperimenterShell::drawMenuBar() {
   }
   if (on_stop_) {
     ImGui::SameLine(ImGui::GetWindowWidth() - 170.0f);
-    if (stopButton("EMERGENCY STOP", true)) on_stop_();
+    if (stopButton("EMERGENCY STOP", true, stop_why_not_ ? stop_why_not_() : "")) on_stop_();
   }
   ImGui::EndMainMenuBar();
 }
@@ -79,17 +82,33 @@ void ExperimenterShell::drawPanels(render::Size display, float top, float bottom
   const int rows = (count + columns - 1) / columns;
   const float width = static_cast<float>(display.width) / static_cast<float>(columns);
   const float height = (bottom - top) / static_cast<float>(rows);
+  const ImGuiCond when = reset_layout_ ? ImGuiCond_Always : ImGuiCond_FirstUseEver;
+  reset_layout_ = false;
   for (int i = 0; i < count; ++i) {
     const float x = width * static_cast<float>(i % columns);
     const float y = top + height * static_cast<float>(i / columns);
-    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowPos(ImVec2(x, y), when);
+    ImGui::SetNextWindowSize(ImVec2(width, height), when);
     if (ImGui::Begin(open[i]->panel->title(), &open[i]->open)) {
+      fitToScreen(display, top, bottom);
       detail::recordWindow(open[i]->panel->title());
       open[i]->panel->draw();
     }
     ImGui::End();
   }
+}
+
+void ExperimenterShell::fitToScreen(render::Size display, float top, float bottom) {
+  // A layout saved on a larger screen (or a window made smaller) would leave panels, and their
+  // buttons, out of reach: each is moved, then shrunk, to lie between the bars.
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  const float screen_w = static_cast<float>(display.width), area_h = bottom - top;
+  if (screen_w <= 0.0f || area_h <= 0.0f) return;
+  const ImVec2 fitted_size(std::min(size.x, screen_w), std::min(size.y, area_h));
+  const ImVec2 fitted_pos(std::clamp(pos.x, 0.0f, screen_w - fitted_size.x),
+                          std::clamp(pos.y, top, bottom - fitted_size.y));
+  if (fitted_size.x != size.x || fitted_size.y != size.y) ImGui::SetWindowSize(fitted_size);
+  if (fitted_pos.x != pos.x || fitted_pos.y != pos.y) ImGui::SetWindowPos(fitted_pos);
 }
 
 void ExperimenterShell::drawStatusBar(render::Size display, float height,

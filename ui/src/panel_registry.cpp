@@ -11,6 +11,7 @@ PanelRegistry::Entry thresholdPanel();
 PanelRegistry::Entry calibrationPanel();
 PanelRegistry::Entry trainingPanel();
 PanelRegistry::Entry summaryPanel();
+PanelRegistry::Entry operatorLogPanel();
 
 const PanelRegistry& panels() {
   static const PanelRegistry registry = [] {
@@ -22,6 +23,7 @@ const PanelRegistry& panels() {
     r.add(calibrationPanel());
     r.add(trainingPanel());
     r.add(summaryPanel());
+    r.add(operatorLogPanel());
     return r;
   }();
   return registry;

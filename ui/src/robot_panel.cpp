@@ -7,17 +7,58 @@
 namespace arbci::ui {
 
 void emergencyStopButton(WorkstationModel& model) {
-  if (stopButton("EMERGENCY STOP")) model.emergencyStop();
+  if (stopButton("EMERGENCY STOP", false, model.whyNot(WorkstationModel::Action::EmergencyStop)))
+    model.emergencyStop();
 }
 
 namespace {
+
+// End session, asked first; with an object in the gripper the dialog offers to put it back
+// before the end (once ended, the session no longer drives the arm).
+void endSessionButton(WorkstationModel& model) {
+  const auto status = model.robotStatus();
+  const int held = status ? status->holding : -1;
+  const std::string why_not = model.whyNot(WorkstationModel::Action::EndSession);
+  if (button("End session", why_not)) ImGui::OpenPopup("End session?##confirm");
+  if (!ImGui::BeginPopupModal("End session?##confirm", nullptr, ImGuiWindowFlags_AlwaysAutoResize))
+    return;
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30.0f);
+  if (held >= 0) {
+    ImGui::Text(
+        "The gripper holds object %d. Once the session ends it no longer drives the arm: put the "
+        "object back first (Open gripper puts it where it was taken from), then end.",
+        held);
+  } else {
+    ImGui::TextUnformatted("End the session now? What was recorded is kept.");
+  }
+  ImGui::PopTextWrapPos();
+  if (held >= 0) {
+    if (button("Put it back first", model.whyNot(WorkstationModel::Action::OpenGripper))) {
+      model.openGripper();
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (button("End now")) {
+      model.endSession();
+      ImGui::CloseCurrentPopup();
+    }
+  } else if (button("End now")) {
+    model.endSession();
+    ImGui::CloseCurrentPopup();
+  }
+  ImGui::SameLine();
+  if (button("Cancel")) ImGui::CloseCurrentPopup();
+  ImGui::EndPopup();
+}
 
 // After an emergency stop or a robot fault: what the experimenter can do, each button disabled
 // with the reason while it cannot go.
 void recoveryButtons(WorkstationModel& model, bool latched) {
   using Action = WorkstationModel::Action;
   heading("recovery");
-  if (button("Reset", latched ? "" : "no stop is latched")) model.robotReset();
+  const std::string why_not_reset = model.whyNot(Action::ResetRobot);
+  if (button("Reset", !why_not_reset.empty() ? why_not_reset : latched ? "" : "no stop is latched"))
+    model.robotReset();
   if (ImGui::IsItemHovered() && latched) ImGui::SetTooltip("lift the latched stop; nothing moves");
   ImGui::SameLine();
   if (button("Home", model.whyNot(Action::Home))) model.robotHome();
@@ -27,7 +68,7 @@ void recoveryButtons(WorkstationModel& model, bool latched) {
   ImGui::SameLine();
   if (button("Skip trial", model.whyNot(Action::SkipTrial))) model.skipTrial();
   ImGui::SameLine();
-  if (button("End session", model.ended() ? "the session has ended" : "")) model.endSession();
+  endSessionButton(model);
 }
 
 }  // namespace
@@ -35,13 +76,12 @@ void recoveryButtons(WorkstationModel& model, bool latched) {
 void RobotPanel::draw() {
   emergencyStopButton(model_);
   const auto status = model_.robotStatus();
+  // One line whatever the state, and the STOPPED banner below the buttons: the recovery buttons
+  // never move under the pointer when the state changes.
   if (model_.ended()) {
     // The session no longer reads the robot link: what follows is the last status it got.
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.6f, 0.2f, 1.0f));
-    ImGui::TextWrapped(
-        "session ended: the robot is no longer watched; its last status before the "
-        "end:");
-    ImGui::PopStyleColor();
+    ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f),
+                       "session ended: its last status of the robot");
   } else if (model_.robotSilent()) {
     ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "backend silent: no answer for over a second");
   } else if (!status) {
@@ -49,13 +89,13 @@ void RobotPanel::draw() {
   } else {
     ImGui::TextColored(ImVec4(0.4f, 1, 0.4f, 1), "connected");
   }
+  recoveryButtons(model_, status && !status->stop_reason.empty());
   if (status && !status->stop_reason.empty()) {
     ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "STOPPED: %s", status->stop_reason.c_str());
     ImGui::TextWrapped(
         "Check the arm and the scene. Home parks it; Open gripper puts down what it holds where "
         "it was taken from; then Retry step, Skip trial, or End session (each lifts the stop).");
   }
-  recoveryButtons(model_, status && !status->stop_reason.empty());
   if (status) {
     ImGui::Text("state: %s", robot::toString(status->state));
     if (status->current_command != robot::MessageType::Status) {

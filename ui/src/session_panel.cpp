@@ -17,24 +17,30 @@ std::string seconds(double s) {
 }  // namespace
 
 void SessionPanel::draw() {
+  using Action = WorkstationModel::Action;
   ImGui::Text("%s", model_.phase().c_str());
   ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", model_.trial(), model_.trials(),
               model_.sequence(), model_.sessionTime());
-  const bool ended = model_.ended();
-  const std::string over = ended ? "the session has ended" : "";
-  if (!model_.started()) {
-    const std::string why =
-        !over.empty() ? over : (model_.preflightRunning() ? "the pre-flight check is running" : "");
-    if (button("Start", why)) model_.start();
-  } else {
-    if (button("Pause", model_.whyNot(WorkstationModel::Action::Pause))) model_.pause();
-    ImGui::SameLine();
-    if (button("Resume", model_.whyNot(WorkstationModel::Action::Resume))) model_.resume();
-    ImGui::SameLine();
-    if (button("Abort", over)) model_.abort();
-  }
+  // Every button in its own place whatever the state (disabled with its reason where it cannot
+  // act): a double click never lands on a button that took another's place.
+  if (button("Start", model_.whyNot(Action::Start))) model_.start();
+  ImGui::SameLine();
+  if (button("Pause", model_.whyNot(Action::Pause))) model_.pause();
+  ImGui::SameLine();
+  if (button("Resume", model_.whyNot(Action::Resume))) model_.resume();
+  ImGui::SameLine();
+  if (confirmedButton("Abort", model_.whyNot(Action::Abort),
+                      "Abort the session? It ends now; what was recorded is kept.", "Yes, abort"))
+    model_.abort();
   ImGui::SameLine();
   emergencyStopButton(model_);
+  // Why the session is not going as planned (a pause, a failed training, a refused grasp), or
+  // how it ended: the same words as the operator log and the summary.
+  if (const std::string why = model_.reason(); !why.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.3f, 1.0f));
+    ImGui::TextWrapped("%s", why.c_str());
+    ImGui::PopStyleColor();
+  }
   if (const auto robot = model_.robotStatus(); robot && !robot->stop_reason.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
     ImGui::TextWrapped("robot stopped (%s): the Robot panel's recovery buttons go on from here.",
@@ -85,8 +91,12 @@ void SessionPanel::draw() {
       if (history_.size() > 300) history_.erase(history_.begin());
     }
   }
-  ImGui::PlotLines("cycle ms", history_.data(), static_cast<int>(history_.size()), 0, nullptr, 0.0f,
-                   static_cast<float>(model_.budgetMs() * 1.2), ImVec2(0, 60));
+  // The plot's scale, stated: its top is 1.2 blocks, its bottom zero.
+  const float top = static_cast<float>(model_.budgetMs() * 1.2);
+  char scale[64];
+  std::snprintf(scale, sizeof scale, "0 to %.0f ms (budget %.1f)", top, model_.budgetMs());
+  ImGui::PlotLines("cycle ms", history_.data(), static_cast<int>(history_.size()), 0, scale, 0.0f,
+                   top, ImVec2(0, 60));
   heading("selections");
   for (const std::string& line : model_.selections()) ImGui::TextUnformatted(line.c_str());
 }

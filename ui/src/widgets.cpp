@@ -54,12 +54,32 @@ bool button(const char* label, const std::string& why_not, bool small) {
   return pressed && enabled;
 }
 
-bool stopButton(const char* label, bool small) {
+bool stopButton(const char* label, bool small, const std::string& why_not) {
   ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
   ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));
-  const bool pressed = button(label, "", small);
+  const bool pressed = button(label, why_not, small);
   ImGui::PopStyleColor(2);
   return pressed;
+}
+
+bool confirmedButton(const char* label, const std::string& why_not, const std::string& question,
+                     const char* yes) {
+  const std::string popup = shownLabel(label) + "?##confirm";
+  if (button(label, why_not)) ImGui::OpenPopup(popup.c_str());
+  bool confirmed = false;
+  if (ImGui::BeginPopupModal(popup.c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30.0f);
+    ImGui::TextUnformatted(question.c_str());
+    ImGui::PopTextWrapPos();
+    if (button(yes)) {
+      confirmed = true;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (button("Cancel")) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+  }
+  return confirmed;
 }
 
 bool pathInput(const char* label, char* path, size_t size, const char* extensions,

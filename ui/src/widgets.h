@@ -22,7 +22,13 @@ inline void heading(const char* text) {
 bool button(const char* label, const std::string& why_not = "", bool small = false);
 
 // The same, in the emergency stop's red.
-bool stopButton(const char* label, bool small = false);
+bool stopButton(const char* label, bool small = false, const std::string& why_not = "");
+
+// A button whose action is asked about first: pressing it opens a dialog with `question` and
+// a button `yes` (and Cancel). Returns true when `yes` is pressed. The button stays where it is
+// whatever the state; `why_not` disables it as button() does.
+bool confirmedButton(const char* label, const std::string& why_not, const std::string& question,
+                     const char* yes);
 
 // A path typed by hand, with a Browse list of the folder's files beside it (those ending in one
 // of `extensions`, e.g. ".bdf .dat .gdf"). Returns true when the path changed.

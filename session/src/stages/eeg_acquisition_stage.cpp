@@ -119,7 +119,7 @@ void EegAcquisitionStage::noteStall(Cycle& cycle, const bci::DeliveryStall& stal
                 {"held_s", held_s},
                 {"late_s", stall.late_s},
                 {"uncertain_flashes", uncertain.size()}});
-  if (s_.progress) *s_.progress << "\nwarning: " << text << "\n";
+  s_.tell.say(cycle.time_s, Severity::Warning, text);
 }
 
 void EegAcquisitionStage::step(Cycle& cycle) {
@@ -151,15 +151,15 @@ void EegAcquisitionStage::step(Cycle& cycle) {
                   "bound): check eeg.rate_hz against the amplifier; stamps are uncertain",
                   bci::ClockModel::kMaxDriftPpm, acquisition_->info().rate_hz);
     s_.log.write("eeg_clock", cycle.time_s, {{"warning", text}});
-    if (s_.progress) *s_.progress << "\nwarning: " << text << "\n";
+    s_.tell.say(cycle.time_s, Severity::Warning, text);
     drift_warned_ = true;
   }
   if (out.lost_samples != lost_logged_) {
     s_.log.write("lost_samples", cycle.time_s,
                  {{"total", out.lost_samples}, {"new", out.lost_samples - lost_logged_}});
-    if (s_.progress)
-      *s_.progress << "\nwarning: " << out.lost_samples - lost_logged_
-                   << " EEG samples lost (see the recording's annotations)\n";
+    s_.tell.say(cycle.time_s, Severity::Warning,
+                std::to_string(out.lost_samples - lost_logged_) +
+                    " EEG samples lost (see the recording's annotations)");
     lost_logged_ = out.lost_samples;
   }
   // A live source's fault (an LSL stream gone), logged when it starts and when it ends.
@@ -171,10 +171,10 @@ void EegAcquisitionStage::step(Cycle& cycle) {
   if (out.fault != fault_logged_) {
     s_.log.write("eeg_source", cycle.time_s,
                  {{"fault", out.fault}, {"state", out.fault.empty() ? "delivering" : "fault"}});
-    if (s_.progress)
-      *s_.progress << "\n"
-                   << (out.fault.empty() ? "EEG source delivering again" : "warning: " + out.fault)
-                   << "\n";
+    if (out.fault.empty())
+      s_.tell.say(cycle.time_s, Severity::Info, "EEG source delivering again");
+    else
+      s_.tell.say(cycle.time_s, Severity::Error, "EEG source: " + out.fault);
     fault_logged_ = out.fault;
   }
   cycle.eeg_sample = cycle.record.eeg_sample = acquisition_->firstSampleAtOrAfter(cycle.host_s);

@@ -37,7 +37,7 @@ void P300Stage::setModel(const bci::P300Model& model, double time_s) {
         "the model was trained with zero-phase (offline) filters; the session filters causally, "
         "so its features lag the model's: train without --zero-phase for online use";
     s_.log.write("model_warning", time_s, {{"text", text}});
-    if (s_.progress) *s_.progress << "\nwarning: " << text << "\n";
+    s_.tell.say(time_s, Severity::Warning, text);
   }
   extractor_.emplace(model.extractor(settings_.info));
   // The online filter and window follow the model's pipeline.
@@ -150,6 +150,7 @@ void P300Stage::step(Cycle& cycle) {
                      {{"method", use->model->method}, {"provenance", use->model->provenance}});
       } catch (const std::exception& error) {
         s_.log.write("model_refused", cycle.time_s, {{"reason", error.what()}});
+        s_.tell.say(cycle.time_s, Severity::Error, std::string("model refused: ") + error.what());
         cycle.record.p300.training_error = error.what();
       }
     } else if (const auto* train = std::get_if<TrainRequest>(&request)) {

@@ -174,6 +174,7 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
   if (awaiting_p300_ && !p300.training_error.empty()) {
     awaiting_p300_ = awaiting_errp_ = false;
     s_.log.write("training_failed", time, {{"reason", p300.training_error}});
+    s_.tell.say(time, Severity::Error, "training failed: " + p300.training_error);
     status_ = "training failed: " + p300.training_error;
     paradigm_->modelTrained(false, p300.training_error);
     return;
@@ -215,9 +216,9 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
                     {"correct_feedbacks", errp_report_->other_flashes}});
     } else {
       s_.log.write("errp_training_failed", time, {{"reason", errp_failure_}});
-      if (s_.progress)
-        *s_.progress << "\nwarning: no ErrP classifier (" << errp_failure_
-                     << "): selections are executed without an ErrP check\n";
+      s_.tell.say(time, Severity::Warning,
+                  "no ErrP classifier (" + errp_failure_ +
+                      "): selections are executed without an ErrP check");
     }
   }
   chooseSelectableObjects(cycle);
@@ -344,8 +345,9 @@ void ParadigmStage::judgeFeedback(Cycle& cycle) {
     errp_counts_.correction_s += time - vetoed_since_;
     vetoed_since_ = -1.0;
   }
-  if (veto && s_.progress)
-    *s_.progress << "\n" << text << " in trial " << paradigm_->trial() << "\n";
+  if (veto)
+    s_.tell.say(time, Severity::Info,
+                std::string(text) + " in trial " + std::to_string(paradigm_->trial()));
   markVerdict(veto);
   paradigm_->errpVerdict(veto);
 }
@@ -361,9 +363,9 @@ std::set<int> ParadigmStage::attendedCodes(bool objects, const Cycle& cycle) {
   const TrialRecord& trial = currentTrial();
   std::set<int> codes = intendedCodes(objects);
   if (!codes.empty()) return codes;
-  if (s_.progress)
-    *s_.progress << "trial " << trial.trial << ": the intended object " << trial.intended_object
-                 << " is not in view, so it does not flash\n";
+  s_.tell.say(cycle.time_s, Severity::Warning,
+              "trial " + std::to_string(trial.trial) + ": the intended object " +
+                  std::to_string(trial.intended_object) + " is not in view, so it does not flash");
   s_.log.write("intended_not_in_view", cycle.time_s,
                {{"trial", trial.trial}, {"object", trial.intended_object}});
   return {};
@@ -410,9 +412,11 @@ void ParadigmStage::recordSelection(const bci::ParadigmEvent& e, Cycle& cycle) {
                                        : "cell " + std::to_string(e.cell.first) + "," +
                                              std::to_string(e.cell.second)) +
                      (correct ? " (intended)" : " (not the intended)"));
-  if (!correct && s_.progress) {
-    *s_.progress << "\nselection " << (e.objects_layout ? "of the object" : "of the cell")
-                 << " in trial " << trial.trial << " differs from the intended one; carrying on\n";
+  if (!correct) {
+    s_.tell.say(cycle.time_s, Severity::Info,
+                std::string("selection ") + (e.objects_layout ? "of the object" : "of the cell") +
+                    " in trial " + std::to_string(trial.trial) +
+                    " differs from the intended one; carrying on");
   }
 }
 
@@ -521,6 +525,7 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
                         id, seen->age(time));
           currentTrial().outcome = why;
           status_ = why;
+          s_.tell.say(time, Severity::Error, why);
           paradigm_->robotFinished(false, why);
           break;
         }
@@ -553,15 +558,15 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
           currentTrial().outcome = "returned: cell " + std::to_string(e.cell.first) + "," +
                                    std::to_string(e.cell.second) + " is taken by object " +
                                    std::to_string(*other);
-          if (s_.progress)
-            *s_.progress << "trial " << currentTrial().trial << ": " << currentTrial().outcome
-                         << "\n";
+          s_.tell.say(time, Severity::Warning,
+                      "trial " + std::to_string(currentTrial().trial) + ": " +
+                          currentTrial().outcome);
         }
         if (e.give_back) {
           currentTrial().outcome = "returned: the ErrP rejected every cell selected";
-          if (s_.progress)
-            *s_.progress << "trial " << currentTrial().trial << ": " << currentTrial().outcome
-                         << "\n";
+          s_.tell.say(time, Severity::Warning,
+                      "trial " + std::to_string(currentTrial().trial) + ": " +
+                          currentTrial().outcome);
         }
         cycle.post(
             DropRequest{currentTrial().trial, e.cell, other.has_value() || e.give_back, time});
@@ -624,8 +629,8 @@ void ParadigmStage::watchEegSource(Cycle& cycle) {
       paused_for_eeg_ = true;
       status_ = "paused: " + fault;
       s_.log.write("paused", time, {{"reason", "EEG source fault"}, {"fault", fault}});
-      if (s_.progress)
-        *s_.progress << "\npaused: " << fault << " (resumes 2 s after the EEG is back)\n";
+      s_.tell.say(time, Severity::Error,
+                  "paused: " + fault + " (resumes 2 s after the EEG is back)");
     }
     return;
   }
@@ -642,7 +647,7 @@ void ParadigmStage::watchEegSource(Cycle& cycle) {
     paused_for_eeg_ = false;
     status_.clear();
     s_.log.write("resumed", time, {{"reason", "EEG source delivering again"}});
-    if (s_.progress) *s_.progress << "\nresumed: the EEG source delivers again\n";
+    s_.tell.say(time, Severity::Info, "resumed: the EEG source delivers again");
   }
 }
 
@@ -663,7 +668,7 @@ void ParadigmStage::watchWithheldFlashes(Cycle& cycle) {
       withheld_since_ = -1.0;
       status_.clear();
       s_.log.write("resumed", time, {{"reason", "the objects are in view again"}});
-      if (s_.progress) *s_.progress << "\nresumed: the objects are in view again\n";
+      s_.tell.say(time, Severity::Info, "resumed: the objects are in view again");
     }
     return;
   }
@@ -687,7 +692,7 @@ void ParadigmStage::watchWithheldFlashes(Cycle& cycle) {
   paused_for_view_ = true;
   in_view_since_ = -1.0;
   status_ = "paused: " + reason + "; resumes once they are seen again";
-  if (s_.progress) *s_.progress << "\npaused: " << reason << "\n";
+  s_.tell.say(time, Severity::Error, "paused: " + reason);
 }
 
 void ParadigmStage::report(nlohmann::json& summary) const {

@@ -47,11 +47,8 @@ void PreflightStage::finish(Cycle& cycle, Preflight::State state) {
   } else if (state == Preflight::State::Failed) {
     s_.log.write("preflight", cycle.time_s,
                  {{"passed", false}, {"failures", preflight_.failures()}});
-    if (s_.progress) {
-      *s_.progress << "\n";
-      for (const std::string& f : preflight_.failures())
-        *s_.progress << "pre-flight failed: " << f << "\n";
-    }
+    for (const std::string& f : preflight_.failures())
+      s_.tell.say(cycle.time_s, Severity::Error, "pre-flight failed: " + f);
     // Without an experimenter nothing can be fixed: the run ends before any flash.
     if (!settings_.experimenter)
       cycle.end("pre-flight failed: " + preflight_.failures().front(), "aborted");

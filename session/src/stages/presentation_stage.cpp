@@ -1,5 +1,7 @@
 #include "stages/presentation_stage.h"
 
+#include <cstdio>
+
 namespace arbci::session {
 
 PresentationStage::PresentationStage(const PresentationSettings& settings,
@@ -68,11 +70,12 @@ void PresentationStage::warnIfDisplayTooSlow(double at) {
                 {"text",
                  "the display cannot hold display_hz: flashes are stamped as presented, "
                  "so the recorded SOA and durations are longer than configured"}});
-  if (s_.progress)
-    *s_.progress << "\nwarning: the display shows a frame every " << median << " ms, not every "
-                 << 1000.0 / settings_.paradigm.display_hz
-                 << " ms: flash onsets are stamped as presented; the SOA is longer than "
-                    "configured\n";
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "the display shows a frame every %.1f ms, not every %.1f ms: flash onsets are "
+                "stamped as presented; the SOA is longer than configured",
+                median, 1000.0 / settings_.paradigm.display_hz);
+  s_.tell.say(at, Severity::Warning, text);
 }
 
 void PresentationStage::report(nlohmann::json& summary) const {

@@ -24,6 +24,7 @@ void RobotStage::step(Cycle& cycle) {
     stepped_ = false;
     s_.log.write("robot_clock_lost", time_s,
                  {{"text", "the stepped robot backend did not answer"}});
+    s_.tell.say(time_s, Severity::Warning, "robot: the stepped backend did not answer");
   }
   client_.poll();
   handleEvents(out, time_s);
@@ -230,6 +231,10 @@ void RobotStage::handleEvents(RobotPart& out, double time_s) {
         e.sequence == 0 ? std::string(robot::toString(e.kind))
                         : std::string(robot::toString(e.kind)) + " " + robot::toString(e.command);
     messages_.push_back(what + (e.text.empty() ? "" : ": " + e.text));
+    const bool bad = e.kind == Kind::Rejected || e.kind == Kind::Failed ||
+                     e.kind == Kind::Silent ||
+                     (e.kind == Kind::Finished && e.outcome != robot::Outcome::Success);
+    if (bad) s_.tell.say(time_s, Severity::Error, "robot: " + messages_.back());
     ++messages_added_;
     if (messages_.size() > 200) messages_.erase(messages_.begin());
     handleRecoveryEvent(e, out, time_s);

@@ -21,6 +21,7 @@
 #include "arbci/session/cycle.h"
 #include "arbci/session/cycle_timing.h"
 #include "arbci/session/experimenter.h"
+#include "arbci/session/operator_log.h"
 #include "arbci/session/session_config.h"
 #include "arbci/session/session_log.h"
 #include "arbci/session/stage.h"
@@ -95,6 +96,8 @@ class Session {
   // How the run ended: "finished", "aborted", "estop" or "fault" (empty while it runs).
   const std::string& endKind() const { return end_kind_; }
   nlohmann::json summary() const;
+  // Everything the experimenter has been told so far (ends, faults, refusals, warnings).
+  const OperatorLog& operatorLog() const { return operator_log_; }
 
  private:
   void beginCycle();
@@ -107,6 +110,7 @@ class Session {
   Clock clock_;
   std::filesystem::path folder_;
   std::unique_ptr<SessionLog> log_;
+  OperatorLog operator_log_;
   CycleTiming timing_;
   std::vector<std::unique_ptr<Stage>> stages_;  // in the order they run
   RobotStage* robot_ = nullptr;                 // for the emergency stop, which cannot wait

@@ -11,21 +11,22 @@
 // (requests.h). The session times each step under the stage's name (summary.json's "cycle").
 #pragma once
 
-#include <ostream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "arbci/session/cycle.h"
+#include "arbci/session/operator_log.h"
 #include "arbci/session/session_log.h"
 
 namespace arbci::session {
 
-// What every stage may use: the session's clock, its log, and the terminal's progress stream.
+// What every stage may use: the session's clock, its log (log.jsonl), and what the experimenter
+// is told (the window's operator log and the terminal).
 struct StageServices {
   const Clock& clock;
   SessionLog& log;
-  std::ostream* progress = nullptr;
+  OperatorLog& tell;
 };
 
 class Stage {

@@ -23,8 +23,12 @@ class ExperimenterShell {
   void addPanel(Panel& panel, bool open = true);
   void show(Panel& panel);  // opens a panel added closed (e.g. the end-of-session summary)
   void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
-  // An emergency stop button in the menu bar, shown whatever panels are open.
-  void setEmergencyStop(std::function<void()> on_stop) { on_stop_ = std::move(on_stop); }
+  // An emergency stop button in the menu bar, shown whatever panels are open; `why_not` says why
+  // it cannot act now ("" when it can).
+  void setEmergencyStop(std::function<void()> on_stop, std::function<std::string()> why_not) {
+    on_stop_ = std::move(on_stop);
+    stop_why_not_ = std::move(why_not);
+  }
   // Draws the whole shell for one frame; call between ImGuiLayer::beginFrame and endFrame.
   void draw(render::Size display, const ShellStatus& status);
 
@@ -35,10 +39,13 @@ class ExperimenterShell {
   };
   void drawMenuBar();
   void drawPanels(render::Size display, float top, float bottom);
+  void fitToScreen(render::Size display, float top, float bottom);
   void drawStatusBar(render::Size display, float height, const ShellStatus& status);
   std::vector<Entry> panels_;
   std::function<void()> on_quit_, on_stop_;
+  std::function<std::string()> stop_why_not_;
   bool show_about_ = false;
+  bool reset_layout_ = false;
 };
 
 }  // namespace arbci::ui

@@ -131,6 +131,22 @@ class SummaryPanel final : public Panel {
   WorkstationModel& model_;
 };
 
+// Everything the experimenter was told (ends, faults, refusals, pauses, warnings), with its
+// session time, filtered by severity and text.
+class OperatorLogPanel final : public Panel {
+ public:
+  explicit OperatorLogPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "Operator log"; }
+  void draw() override;
+
+ private:
+  WorkstationModel& model_;
+  std::vector<OperatorLine> lines_;
+  bool show_[3] = {true, true, true};  // by OperatorLine::Severity
+  char filter_[128] = "";
+  bool scroll_to_end_ = false;
+};
+
 // The HMD view as the subject sees it (both eyes), mirrored for the experimenter.
 class HmdPanel final : public Panel {
  public:

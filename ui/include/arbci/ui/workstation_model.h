@@ -27,6 +27,13 @@ struct TrackedObject {
   double reprojection_px = 0.0;
 };
 
+// One thing the experimenter was told: an end, a fault, a refusal, a pause, a warning.
+struct OperatorLine {
+  enum class Severity { Info, Warning, Error } severity = Severity::Info;
+  double t = 0.0;  // session time, seconds
+  std::string text;
+};
+
 struct StageTiming {
   std::string stage;
   double p50_ms = 0, p90_ms = 0, p99_ms = 0, max_ms = 0, last_ms = 0;
@@ -76,7 +83,19 @@ class WorkstationModel {
   // Home parks the arm; Open gripper puts what it holds back where it was taken from; Retry step
   // asks again for the interrupted grasp or put-down; Skip trial ends the trial; End session
   // ends the run. whyNot() says why an action cannot go now ("" when it can).
-  enum class Action { Pause, Resume, Home, OpenGripper, RetryStep, SkipTrial };
+  enum class Action {
+    Start,
+    Pause,
+    Resume,
+    Abort,
+    EmergencyStop,
+    ResetRobot,
+    Home,
+    OpenGripper,
+    RetryStep,
+    SkipTrial,
+    EndSession
+  };
   virtual std::string whyNot(Action action) = 0;
   virtual void robotReset() = 0;
   virtual void robotHome() = 0;
@@ -120,6 +139,14 @@ class WorkstationModel {
   // Why a live EEG source delivers nothing now (e.g. its LSL stream is gone); empty when well.
   virtual std::string eegSourceFault() { return ""; }
   virtual std::vector<StageTiming> timing() = 0;
+  // Why the session is not going as planned now (a pause, a failed training, a grasp refused),
+  // empty when it is; once ended, how and why, in the summary's words ("estop (ended by the
+  // experimenter)").
+  virtual std::string reason() { return ""; }
+  // Everything the experimenter has been told, oldest first.
+  virtual std::vector<OperatorLine> operatorLog() { return {}; }
+  // How many lines operatorLog() holds (cheap: a panel asks every frame).
+  virtual size_t operatorLogSize() { return 0; }
   virtual std::vector<std::string> selections() = 0;  // one line per selection made
 };
 

@@ -1,0 +1,49 @@
+// What the experimenter may do in each state, and why not: the buttons' reasons come from here.
+#include <gtest/gtest.h>
+
+#include "arbci/session/experimenter.h"
+
+namespace arbci::session {
+namespace {
+
+CycleRecord stoppedIn(bci::Phase phase, int trial) {
+  CycleRecord last;
+  last.paradigm.phase = bci::Phase::EmergencyStop;
+  last.paradigm.interrupted = phase;
+  last.paradigm.trial = trial;
+  return last;
+}
+
+TEST(Experimenter, AfterAStopInSetUpRetryAndSkipSayThereIsNothingToActOn) {
+  const CycleRecord last = stoppedIn(bci::Phase::Setup, 0);
+  EXPECT_EQ(whyNot(Action::RetryStep, last, false),
+            "nothing to retry: the session had not started (Resume returns to set-up)");
+  EXPECT_EQ(whyNot(Action::SkipTrial, last, false),
+            "no trial to skip: the stop came before the first trial; Resume goes on");
+  EXPECT_EQ(whyNot(Action::Resume, last, false), "");
+}
+
+TEST(Experimenter, AStopDuringCalibrationCannotSkipATrialButCanRetry) {
+  const CycleRecord last = stoppedIn(bci::Phase::CalibrationFlashing, 0);
+  EXPECT_NE(whyNot(Action::SkipTrial, last, false), "");
+  EXPECT_EQ(whyNot(Action::RetryStep, last, false), "");
+}
+
+TEST(Experimenter, AStopInATrialCanSkipIt) {
+  const CycleRecord last = stoppedIn(bci::Phase::ObjectFlashing, 2);
+  EXPECT_EQ(whyNot(Action::SkipTrial, last, false), "");
+}
+
+TEST(Experimenter, OnceEndedTheEmergencyStopAndResetAreRefusedWithTheReason) {
+  const CycleRecord last;
+  EXPECT_EQ(whyNot(Action::EmergencyStop, last, false), "");
+  for (const Action action : {Action::EmergencyStop, Action::ResetRobot}) {
+    const std::string why = whyNot(action, last, true);
+    EXPECT_NE(why.find("the session has ended"), std::string::npos) << why;
+    EXPECT_NE(why.find("emergency switch"), std::string::npos) << why;
+  }
+  EXPECT_EQ(whyNot(Action::Abort, last, true), "the session has ended");
+}
+
+}  // namespace
+}  // namespace arbci::session
