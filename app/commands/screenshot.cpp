@@ -84,6 +84,7 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
   const auto live_limit = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   auto runUntil = [&](const std::function<bool()>& ready) {
     for (int i = 0; i < 60 * 600 && !ready() && session.step(); ++i) {
+      model.ingest();
       if (config.eeg.live() && std::chrono::steady_clock::now() > live_limit) break;
     }
   };
@@ -127,7 +128,22 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
   } else if (panel == "session") {
     runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     ui::SessionPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out, [&] { session.step(); });
+    renderPanels(*context, size, {&p}, statusLine(session), options.out, [&] {
+      session.step();
+      model.ingest();
+    });
+  } else if (panel == "eeg") {
+    // Several seconds of the calibration's flashing: traces, onsets and quality to show.
+    runUntil([&] { return phase() == bci::Phase::CalibrationFlashing && session.time() > 12.0; });
+    ui::EegPanel p(model);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out, [&] {
+      session.step();
+      model.ingest();
+    });
+  } else if (panel == "log") {
+    runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
+    ui::OperatorLogPanel p(model);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "hmd") {
     runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     // The HMD framebuffer itself, as the subject sees it.
@@ -170,9 +186,10 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
       ->add_option("--panel", options->panel,
                    "threshold, calibration, training (trained on the session's recording), "
                    "session-model (the Training panel on the model the session trained), robot, "
-                   "session or hmd (the HMD view)")
+                   "session, eeg (traces and quality), log (the operator log) or hmd (the HMD view)")
       ->check(CLI::IsMember(
-          {"threshold", "calibration", "training", "session-model", "robot", "session", "hmd"}));
+          {"threshold", "calibration", "training", "session-model", "robot", "session", "eeg", "log",
+           "hmd"}));
   command->add_option("--session", options->session,
                       "session file (default: the embedded simulated session, with a still head)");
   command->callback([options, &exit_code] {

@@ -37,6 +37,18 @@ std::string statusLine(const session::Session& session) {
   return line;
 }
 
+void SessionModel::ingest() {
+  const session::CycleRecord& last = record();
+  if (!scope_ && last.eeg.info) {
+    // Ten seconds: the longest time base the EEG panel offers.
+    scope_.emplace(*last.eeg.info, 10.0, session_.config().classifier.pipeline.filter);
+  }
+  if (!scope_) return;
+  for (const bci::Block& block : last.eeg.blocks) scope_->append(block);
+  for (const session::Presentation::Onset& onset : last.presentation.onsets)
+    scope_->markStimulus(onset.sample);
+}
+
 void SessionModel::setThreshold(const vision::ThresholdSettings& settings) {
   threshold_ = settings;
   session_.request(session::ThresholdRequest{settings});

@@ -80,6 +80,10 @@ class SessionModel final : public ui::WorkstationModel {
   std::string eegSourceFault() override { return record().eeg.fault; }
   std::vector<ui::StageTiming> timing() override;
   std::string reason() override;
+  const bci::SignalScope* eegScope() override { return scope_ ? &*scope_ : nullptr; }
+  std::string photodiodeChannel() override { return session_.config().eeg.photodiode_channel; }
+  // After each session step: the cycle's EEG and flash onsets into the EEG view's scope.
+  void ingest();
   std::vector<ui::OperatorLine> operatorLog() override;
   size_t operatorLogSize() override { return session_.operatorLog().messages().size(); }
   std::vector<std::string> selections() override;
@@ -90,6 +94,7 @@ class SessionModel final : public ui::WorkstationModel {
   session::Session& session_;
   std::vector<std::pair<std::string, std::string>> end_rows_;
   vision::ThresholdSettings threshold_;
+  std::optional<bci::SignalScope> scope_;
 };
 
 // The session's status line for the terminal and the window's status bar: time, trial, phase,

@@ -99,6 +99,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     render::WindowContext::pollEvents();
     main_window.makeCurrent();  // the simulated cameras render in it
     session.step();
+    model.ingest();
     if (session.ended() && !summary_shown) {
       if (summary_panel) shell.show(*summary_panel);  // once: the experimenter may close it
       summary_shown = true;

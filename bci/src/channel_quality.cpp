@@ -33,7 +33,7 @@ std::vector<ChannelQuality> assessChannels(const Recording& r) {
   for (const ChannelQuality& q : out) sds.push_back(q.sd_uv);
   const double typical = median(sds);
   for (ChannelQuality& q : out) {
-    q.flat = q.sd_uv < 0.5;
+    q.flat = q.sd_uv < kFlatSdUv;
     q.drifting = channels >= 3 && typical > 0.0 && q.sd_uv > 20.0 * typical;
   }
   return out;

@@ -82,7 +82,13 @@ nlohmann::json checkScreenshot(const std::filesystem::path& png,
     EXPECT_NE(std::find(shot["panels"].begin(), shot["panels"].end(), panel), shot["panels"].end())
         << png << " lacks the " << panel << " panel: " << shot["panels"];
   }
-  if (const nlohmann::json* stop = button(shot, "EMERGENCY STOP", "Robot")) {
+  if (const nlohmann::json* stop = button(shot, "EMERGENCY STOP", "Robot");
+      stop && !(*stop)["enabled"].get<bool>()) {
+    // Once the session has ended it no longer drives the arm: the button says so.
+    EXPECT_NE((*stop)["why_disabled"].get<std::string>().find("emergency switch"),
+              std::string::npos)
+        << *stop;
+  } else if (stop) {
     const auto& r = (*stop)["rect"];
     const cv::Point centre(static_cast<int>((r[0].get<double>() + r[2].get<double>()) / 2),
                            static_cast<int>((r[1].get<double>() + r[3].get<double>()) / 2 - 4));
@@ -179,6 +185,9 @@ TEST(RecoveryWindow, EndingTheSessionInAnEmergencyStopIsRecordedAsEstop) {
 click "EMERGENCY STOP"
 wait "EMERGENCY STOP"
 click "End session"
+pause 0.3
+screenshot )" + (folder / "asked.png").string() + R"(
+click "End now"
 wait "ended by the experimenter"
 screenshot )" + (folder / "ended.png").string() +
                                                 "\n");
@@ -186,8 +195,57 @@ screenshot )" + (folder / "ended.png").string() +
   const nlohmann::json summary = readJson(folder / "out/summary.json");
   EXPECT_EQ(summary["ended"], "estop");
   EXPECT_NE(summary["end_reason"].get<std::string>().find("experimenter"), std::string::npos);
+  // End session asked first, in a dialog of its own.
+  const nlohmann::json asked = checkScreenshot(folder / "asked.png", {"Robot"});
+  EXPECT_NE(button(asked, "End now", "End session?"), nullptr) << asked["buttons"];
+  EXPECT_NE(button(asked, "Cancel", "End session?"), nullptr);
   const nlohmann::json shot = checkScreenshot(folder / "ended.png", {"Session summary"});
   EXPECT_FALSE((*button(shot, "End session", "Robot"))["enabled"].get<bool>());
+  EXPECT_EQ(shot["phase"].get<std::string>().rfind("ended: estop (ended by the experimenter", 0),
+            0u)
+      << shot["phase"];
+  // After the end the E-STOP says it no longer reaches the arm, and the log says how it ended.
+  EXPECT_FALSE((*button(shot, "EMERGENCY STOP", "Robot"))["enabled"].get<bool>());
+  EXPECT_TRUE(shot["panels"].dump().find("Operator log") != std::string::npos) << shot["panels"];
+}
+
+// End session with an object in the gripper: the dialog offers to put it back first; the arm
+// does, and the session ends holding nothing.
+TEST(RecoveryWindow, EndingWithAnObjectHeldOffersToPutItBackFirst) {
+  const auto folder = kArtefacts / "recovery_held";
+  std::filesystem::remove_all(folder);
+  const ProcessResult r = runScript(folder, R"(wait "phase 2" 240
+click "EMERGENCY STOP"
+wait "EMERGENCY STOP"
+click "End session"
+pause 0.3
+screenshot )" + (folder / "held.png").string() + R"(
+click "Put it back first"
+pause 15
+click "End session"
+pause 0.3
+screenshot )" + (folder / "empty.png").string() + R"(
+click "End now"
+wait "ended" 30
+)");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  const nlohmann::json held = checkScreenshot(folder / "held.png", {"Robot"});
+  const nlohmann::json* back = button(held, "Put it back first", "End session?");
+  ASSERT_NE(back, nullptr) << held["buttons"];
+  EXPECT_TRUE((*back)["enabled"].get<bool>()) << *back;
+  // The second time the gripper is empty: no offer, only the end.
+  const nlohmann::json empty = checkScreenshot(folder / "empty.png", {"Robot"});
+  EXPECT_EQ(button(empty, "Put it back first", "End session?"), nullptr);
+  EXPECT_NE(button(empty, "End now", "End session?"), nullptr);
+  // The log: the experimenter's put-back, finished, before the end.
+  const auto log = folder / "out/log.jsonl";
+  int put_back = 0;
+  for (const nlohmann::json& c : logEvents(log, "robot_command"))
+    put_back += c.value("by", "") == "experimenter" && c["command"] != "HOME" &&
+                c["command"] != "RESET" && c["command"] != "STOP";
+  EXPECT_EQ(put_back, 1);
+  const nlohmann::json summary = readJson(folder / "out/summary.json");
+  EXPECT_EQ(summary["ended"], "estop");
 }
 
 // Ctrl+Q closes the window as the File menu says; the session ends there, its summary saved.

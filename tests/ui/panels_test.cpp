@@ -9,6 +9,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
+#include <optional>
+#include <cmath>
 #include <memory>
 #include <set>
 #include <vector>
@@ -45,6 +48,35 @@ class StandInModel final : public WorkstationModel {
     erp_.rate_hz = 256.0;
     erp_.window_start_s = 0.0;
     erp_.window_end_s = 0.8;
+    // 44 channels (over 64k vertices of traces: the GL back end must split the draw list): Fz
+    // clean, Cz flat, Pz with 30 uV of 50 Hz, the photodiode, and 40 more clean ones.
+    bci::SignalInfo info;
+    info.rate_hz = 256.0;
+    info.block_size = 16;
+    info.channels = {"Fz", "Cz", "Pz", "Photodiode"};
+    for (int c = 5; c <= 44; ++c) {
+      std::string name = "E";
+      name += std::to_string(c);
+      info.channels.push_back(name);
+    }
+    scope_.emplace(info, 10.0, bci::FilterSettings{});
+    std::mt19937 random(5);
+    std::normal_distribution<float> noise(0.0f, 8.0f);
+    for (std::int64_t first = 0; first < 6 * 256; first += 16) {
+      bci::Block block(first, info.channelCount(), 16);
+      for (int c = 0; c < info.channelCount(); ++c) {
+        for (int k = 0; k < 16; ++k) {
+          const double t = static_cast<double>(first + k) / 256.0;
+          float v = noise(random);
+          if (c == 1) v = 0.01f * v;
+          if (c == 2) v += static_cast<float>(30.0 * std::sin(2.0 * M_PI * 50.0 * t));
+          if (c == 3) v = (first / 16) % 12 < 2 ? 1000.0f : 0.0f;
+          block.at(c, k) = v;
+        }
+      }
+      scope_->append(block);
+      if ((first / 16) % 12 == 0) scope_->markStimulus(first);
+    }
   }
 
   cv::Mat cameraImage() override { return camera_; }
@@ -125,6 +157,8 @@ class StandInModel final : public WorkstationModel {
              "again"}};
   }
   size_t operatorLogSize() override { return 3; }
+  const bci::SignalScope* eegScope() override { return scope_ ? &*scope_ : nullptr; }
+  std::string photodiodeChannel() override { return "Photodiode"; }
   std::vector<std::string> selections() override {
     return {"trial 1: object 20 (intended), cell 1,3 (intended), placed 0.3 mm off [placed]"};
   }
@@ -137,6 +171,7 @@ class StandInModel final : public WorkstationModel {
   vision::DetectionResult detection_;
   robot::StatusPayload status_;
   bci::ErpCurves erp_;
+  std::optional<bci::SignalScope> scope_;
 };
 
 struct Drawn {
@@ -260,6 +295,34 @@ TEST_F(Panels, APanelSavedOutsideASmallerScreenIsFittedToIt) {
     EXPECT_LE(w.x1, 1000.0f) << label;
     EXPECT_LE(w.y1, 700.0f) << label;
   }
+}
+
+// The EEG panel: traces with each channel's quality, the flat and the noisy ones in red, the
+// finding named with its threshold in the table.
+TEST_F(Panels, TheEegPanelGradesEachChannelAndNamesTheFinding) {
+  const auto& quality = model_.eegScope()->quality();
+  ASSERT_EQ(quality.size(), 44u);
+  EXPECT_EQ(quality[0].grade, bci::Grade::Good) << quality[0].finding;
+  EXPECT_EQ(quality[1].grade, bci::Grade::Bad) << quality[1].finding;
+  EXPECT_EQ(quality[1].finding.rfind("flat", 0), 0u) << quality[1].finding;
+  EXPECT_EQ(quality[2].grade, bci::Grade::Bad) << quality[2].finding;
+  EXPECT_NE(quality[2].finding.find("line noise 50 Hz"), std::string::npos);
+  auto panel = make("eeg");
+  const Drawn d = draw(*context_, *panel);
+  EXPECT_TRUE(d.windows.count("EEG"));
+  // The grade marks left of the traces: green for Fz, red for Cz (rows from the top).
+  int green = 0, red = 0, yellow = 0;
+  for (int y = 60; y < d.image.rows; ++y) {
+    for (int x = 8; x < 16; ++x) {
+      const cv::Vec4b p = d.image.at<cv::Vec4b>(y, x);
+      green += p[1] > 150 && p[0] < 120 && p[2] < 130;
+      red += p[0] > 200 && p[1] < 100;
+      yellow += p[0] > 200 && p[1] > 180 && p[2] < 120;
+    }
+  }
+  EXPECT_GT(green, 100);
+  EXPECT_GT(red, 20);
+  EXPECT_GT(yellow, 10);
 }
 
 // Everything the experimenter was told, coloured by severity, filterable.

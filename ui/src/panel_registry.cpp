@@ -12,6 +12,7 @@ PanelRegistry::Entry calibrationPanel();
 PanelRegistry::Entry trainingPanel();
 PanelRegistry::Entry summaryPanel();
 PanelRegistry::Entry operatorLogPanel();
+PanelRegistry::Entry eegPanel();
 
 const PanelRegistry& panels() {
   static const PanelRegistry registry = [] {
@@ -19,6 +20,7 @@ const PanelRegistry& panels() {
     r.add(sessionPanel());
     r.add(hmdPanel());
     r.add(robotPanel());
+    r.add(eegPanel());
     r.add(thresholdPanel());
     r.add(calibrationPanel());
     r.add(trainingPanel());

@@ -35,6 +35,7 @@ EegAcquisitionStage::EegAcquisitionStage(const EegAcquisitionSettings& settings,
       clock.stepped() ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live,
       acquisition);
   const bci::SignalInfo& all = acquisition_->info();
+  all_info_ = std::make_shared<const bci::SignalInfo>(all);
   eeg_info_ = all;
   if (!eeg.photodiode_channel.empty()) {
     const auto found = std::find(all.channels.begin(), all.channels.end(), eeg.photodiode_channel);
@@ -85,6 +86,7 @@ bci::Block EegAcquisitionStage::eegOnly(const bci::Block& block) const {
 
 void EegAcquisitionStage::take(Cycle& cycle) {
   EegPart& out = cycle.record.eeg;
+  out.info = all_info_;
   for (bci::SampleLoss& loss : acquisition_->takeLosses()) out.losses.push_back(std::move(loss));
   for (bci::Block& block : acquisition_->take()) {
     next_sample_ = block.first_sample + block.samples;

@@ -60,6 +60,7 @@ class EegAcquisitionStage final : public Stage {
   StageServices s_;
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;
+  std::shared_ptr<const bci::SignalInfo> all_info_;
   int photodiode_ = -1;           // the photodiode's channel in the source's blocks
   std::int64_t lost_logged_ = 0;  // lost samples already in the log
   std::string fault_logged_;      // the source's fault last logged (empty: none)

@@ -11,6 +11,9 @@
 
 namespace arbci::bci {
 
+// A standard deviation below this is a flat channel, offline and live (signal_quality.h).
+inline constexpr double kFlatSdUv = 0.5;
+
 struct ChannelQuality {
   std::string channel;
   double sd_uv = 0.0;     // of the raw signal

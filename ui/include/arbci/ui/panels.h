@@ -11,6 +11,7 @@
 
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/p300_dataset.h"
+#include "arbci/ui/eeg_view.h"
 #include "arbci/ui/image_view.h"
 #include "arbci/ui/panel.h"
 #include "arbci/ui/workstation_model.h"
@@ -129,6 +130,19 @@ class SummaryPanel final : public Panel {
 
  private:
   WorkstationModel& model_;
+};
+
+// Every EEG channel scrolling (scale, time base, the session's filter on or off), the stimulus
+// onsets and the photodiode channel marked, each channel's quality graded with its finding.
+class EegPanel final : public Panel {
+ public:
+  explicit EegPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "EEG"; }
+  void draw() override;
+
+ private:
+  WorkstationModel& model_;
+  EegView view_;
 };
 
 // Everything the experimenter was told (ends, faults, refusals, pauses, warnings), with its

@@ -13,6 +13,7 @@
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/p300_model.h"
+#include "arbci/bci/signal_scope.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/vision/camera_model.h"
 #include "arbci/vision/marker.h"
@@ -136,6 +137,11 @@ class WorkstationModel {
   virtual std::string timingWarning() { return ""; }
   // The EEG time base: samples lost (gaps, overflows), the amplifier clock's drift and jitter.
   virtual std::string eegClockLine() { return ""; }
+  // The last seconds of every channel with its quality (none before the first samples).
+  virtual const bci::SignalScope* eegScope() { return nullptr; }
+  virtual std::string photodiodeChannel() { return ""; }  // "" when none
+  // Electrode impedances where the source reports them ("" when it does not).
+  virtual std::string eegImpedance() { return ""; }
   // Why a live EEG source delivers nothing now (e.g. its LSL stream is gone); empty when well.
   virtual std::string eegSourceFault() { return ""; }
   virtual std::vector<StageTiming> timing() = 0;
