@@ -11,6 +11,7 @@
 #include "arbci/render/gl_context.h"
 #include "arbci/session/session.h"
 #include "arbci/ui/experimenter_shell.h"
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panels.h"
 #include "commands/commands.h"
@@ -152,16 +153,24 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
     opened.hmd->screenshot(options.out);
   } else if (panel.empty()) {
     runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
-    ui::SessionPanel session_panel(model);
-    ui::HmdPanel hmd_panel(opened.hmd->texture(),
-                           static_cast<float>(config.hmd.width) / config.hmd.height);
-    ui::RobotPanel robot_panel(model);
-    ui::ThresholdPanel threshold_panel(model);
-    renderPanels(*context, size, {&session_panel, &hmd_panel, &robot_panel, &threshold_panel},
-                 statusLine(session), options.out, [&] { session.step(); });
+    // The panels the window opens at start, in the registry's order (as `arbci run` shows them).
+    const ui::PanelContext panel_context{model, opened.hmd->texture(),
+                                         static_cast<float>(config.hmd.width) / config.hmd.height};
+    std::vector<std::unique_ptr<ui::Panel>> owned;
+    std::vector<ui::Panel*> shown;
+    for (const auto& entry : ui::panels().entries()) {
+      if (!entry.make.open_at_start) continue;
+      owned.push_back(entry.make.make(panel_context));
+      shown.push_back(owned.back().get());
+    }
+    renderPanels(*context, size, shown, statusLine(session), options.out, [&] {
+      session.step();
+      model.ingest();
+    });
   } else {
     throw CliError(
-        "--panel must be threshold, calibration, training, session-model, robot, session or hmd");
+        "--panel must be threshold, calibration, training, session-model, robot, session, eeg, "
+        "log or hmd");
   }
   session.request(session::AbortRequest{});
   session.step();

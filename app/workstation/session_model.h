@@ -38,6 +38,9 @@ class SessionModel final : public ui::WorkstationModel {
   }
   std::optional<bci::ErpCurves> sessionErp() override;
   std::optional<bci::ErpCurves> sessionErrpErp() override;
+  std::optional<bci::EvaluationReport> sessionCalibration() override {
+    return record().paradigm.calibration;
+  }
   std::optional<double> errpThreshold() override {
     if (!session_.config().paradigm.errp) return std::nullopt;
     return session_.config().errp.threshold;

@@ -35,15 +35,14 @@ void drawErpPlots(const bci::ErpCurves& erp, const char* target, const char* oth
   ImGui::SameLine();
   ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "%s (%d)", other, erp.others);
   ImGui::SameLine();
-  ImGui::TextWrapped("difference (white); 95 %% bands; +/-%.0f uV, %.0f to %.0f ms", limit,
-                     erp.timeS(0) * 1000.0, erp.timeS(samples - 1) * 1000.0);
+  ImGui::TextWrapped("difference (white); 95 %% bands; %s", erp.filterText().c_str());
   const float width = std::max(120.0f, (ImGui::GetContentRegionAvail().x - 8.0f) / 2.0f);
-  const float height = 70.0f;
+  const float height = 70.0f, ticks = ImGui::GetFontSize() + 2.0f;  // the ms labels under it
   ImDrawList* draw = ImGui::GetWindowDrawList();
   for (int c = 0; c < channels; ++c) {
     if (c % 2 == 1) ImGui::SameLine();
     const ImVec2 origin = ImGui::GetCursorScreenPos();
-    ImGui::InvisibleButton(("erp" + std::to_string(c)).c_str(), ImVec2(width, height));
+    ImGui::InvisibleButton(("erp" + std::to_string(c)).c_str(), ImVec2(width, height + ticks));
     auto at = [&](int s, double uv) {
       return ImVec2(origin.x + width * s / (samples - 1),
                     origin.y + height * static_cast<float>(0.5 - 0.5 * uv / limit));
@@ -75,7 +74,28 @@ void drawErpPlots(const bci::ErpCurves& erp, const char* target, const char* oth
     }
     draw->AddText(ImVec2(origin.x + 4, origin.y + 2), kDifference,
                   erp.channels[static_cast<size_t>(c)].c_str());
+    // The scale: microvolts at the top and bottom edges, milliseconds every 100 (labelled every
+    // 200) under the axis.
+    char label[24];
+    std::snprintf(label, sizeof label, "+%.0f uV", limit);
+    draw->AddText(ImVec2(origin.x + width - ImGui::CalcTextSize(label).x - 3, origin.y + 1), kAxis,
+                  label);
+    std::snprintf(label, sizeof label, "-%.0f uV", limit);
+    draw->AddText(ImVec2(origin.x + width - ImGui::CalcTextSize(label).x - 3,
+                         origin.y + height - ImGui::GetFontSize() - 1),
+                  kAxis, label);
+    const int first_ms = static_cast<int>(std::ceil(erp.timeS(0) * 10.0)) * 100;
+    for (int ms = first_ms; ms <= erp.timeS(samples - 1) * 1000.0 + 1e-6; ms += 100) {
+      const ImVec2 bottom = atTime(ms / 1000.0, -limit);
+      draw->AddLine(bottom, ImVec2(bottom.x, bottom.y - 4.0f), kAxis);
+      if (ms % 200 != 0) continue;
+      std::snprintf(label, sizeof label, "%d", ms);
+      const float w = ImGui::CalcTextSize(label).x;
+      draw->AddText(ImVec2(std::clamp(bottom.x - w / 2, origin.x, origin.x + width - w), bottom.y + 1),
+                    kAxis, label);
+    }
   }
+  ImGui::TextDisabled("ms after the stimulus");
 }
 
 void drawSignedR2(const bci::ErpCurves& erp) {

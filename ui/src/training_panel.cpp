@@ -10,6 +10,7 @@
 #include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "erp_plots.h"
+#include "evaluation_plots.h"
 #include "widgets.h"
 
 namespace arbci::ui {
@@ -191,28 +192,20 @@ void TrainingPanel::draw() {
     } else {
       ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
     }
+    // How well it did on the calibration run, cross-validated, before any online selection.
+    if (const auto calibration = model_.sessionCalibration()) {
+      heading("the session's calibration run, cross-validated (before going online)");
+      drawEvaluation(*calibration);
+    }
     drawSessionErps();
     return;
   }
   const bci::TrainingResult& r = *outcome_->result;
   const bci::EvaluationReport& cv = r.cross_validation.report;
-  ImGui::TextWrapped("cross-validated (%d folds by %s): AUC %.3f (95 %% interval %.3f-%.3f)",
-                     r.cross_validation.folds, r.cross_validation.folds_by.c_str(), cv.auc,
-                     cv.auc_interval.low, cv.auc_interval.high);
-  if (cv.selection_metrics) {
-    ImGui::TextWrapped("%d selections; chance %.3f, beaten at p < 0.05 from %.3f",
-                       cv.selections_with_truth, cv.chance, cv.chance_95);
-    std::vector<float> accuracy(cv.accuracy.begin(), cv.accuracy.end()),
-        bits(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
-    ImGui::TextUnformatted("accuracy by sequences (0 to 1)");
-    ImGui::PlotLines("##accuracy", accuracy.data(), static_cast<int>(accuracy.size()), 0, nullptr,
-                     0.0f, 1.0f, ImVec2(ImGui::GetContentRegionAvail().x, 70));
-    ImGui::TextUnformatted("bits/min by sequences");
-    ImGui::PlotLines("##bits", bits.data(), static_cast<int>(bits.size()), 0, nullptr, 0.0f,
-                     FLT_MAX, ImVec2(ImGui::GetContentRegionAvail().x, 70));
-  } else {
-    ImGui::TextWrapped("no selection metrics: the stimulus codes are classes, not choices");
-  }
+  heading("cross-validated on the recordings");
+  ImGui::TextWrapped("%d folds by %s", r.cross_validation.folds,
+                     r.cross_validation.folds_by.c_str());
+  drawEvaluation(cv);
   heading("ERP averages (baseline-corrected), as arbci train --plots draws them");
   drawErpPlots(outcome_->data->erp);
   drawSignedR2(outcome_->data->erp);

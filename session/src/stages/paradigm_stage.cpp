@@ -207,6 +207,17 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
                 {"median_frame_ms", cycle.record.presentation.median_frame_ms.value_or(0.0)},
                 {"auc", calibration_report_->auc},
                 {"accuracy_by_sequences", calibration_report_->accuracy}});
+  {
+    const bci::EvaluationReport& r = *calibration_report_;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "classifier trained (%s): cross-validated AUC %.3f [%.3f, %.3f], accuracy "
+                  "%.0f %% after %zu sequences",
+                  settings_.classifier_method.c_str(), r.auc, r.auc_interval.low,
+                  r.auc_interval.high, r.accuracy.empty() ? 0.0 : 100.0 * r.accuracy.back(),
+                  r.accuracy.size());
+    s_.tell.say(time, Severity::Info, text);
+  }
   if (settings_.paradigm.errp) {
     if (errp_report_) {
       s_.log.write("errp_trained", time,
@@ -589,6 +600,8 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
         }
         last_trial_end_ = time;
         s_.log.write("trial_done", time, {{"trial", e.trial}, {"text", e.text}});
+        if (e.trial >= 1 && e.trial <= static_cast<int>(trials_.size()))
+          s_.tell.say(time, Severity::Info, selectionLine(trials_[static_cast<size_t>(e.trial - 1)]));
         break;
     }
   }

@@ -43,6 +43,7 @@ void PreflightStage::finish(Cycle& cycle, Preflight::State state) {
                  {{"passed", true},
                   {"camera_frames", preflight_.cameraFrames()},
                   {"eeg_rate_hz", preflight_.eegRateHz()}});
+    s_.tell.say(cycle.time_s, Severity::Info, "pre-flight passed");
     cycle.post(BeginRequest{});
   } else if (state == Preflight::State::Failed) {
     s_.log.write("preflight", cycle.time_s,

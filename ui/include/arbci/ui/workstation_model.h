@@ -70,6 +70,8 @@ class WorkstationModel {
   // non-target), and the ErrP block's feedback (error and correct). None before it trains.
   virtual std::optional<bci::ErpCurves> sessionErp() { return std::nullopt; }
   virtual std::optional<bci::ErpCurves> sessionErrpErp() { return std::nullopt; }
+  // The session's own model's cross-validation on its calibration run (none before it trains).
+  virtual std::optional<bci::EvaluationReport> sessionCalibration() { return std::nullopt; }
   virtual void useModel(const bci::P300Model& model) = 0;
   // The session's classifier settings, where the Training panel starts (default: the schema's).
   virtual bci::TrainingSettings trainingSettings() { return {}; }
