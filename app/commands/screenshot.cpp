@@ -141,6 +141,10 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
       session.step();
       model.ingest();
     });
+  } else if (panel == "settings") {
+    runUntil([&] { return session.frame() > 10; });
+    ui::SettingsPanel p(model);
+    renderPanels(*context, size, {&p}, statusLine(session), options.out);
   } else if (panel == "log") {
     runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
     ui::OperatorLogPanel p(model);
@@ -170,7 +174,7 @@ void renderPanel(const ScreenshotOptions& options, render::Size size) {
   } else {
     throw CliError(
         "--panel must be threshold, calibration, training, session-model, robot, session, eeg, "
-        "log or hmd");
+        "log, settings or hmd");
   }
   session.request(session::AbortRequest{});
   session.step();
@@ -195,10 +199,11 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
       ->add_option("--panel", options->panel,
                    "threshold, calibration, training (trained on the session's recording), "
                    "session-model (the Training panel on the model the session trained), robot, "
-                   "session, eeg (traces and quality), log (the operator log) or hmd (the HMD view)")
+                   "session, eeg (traces and quality), log (the operator log), settings or hmd (the HMD "
+                   "view)")
       ->check(CLI::IsMember(
           {"threshold", "calibration", "training", "session-model", "robot", "session", "eeg", "log",
-           "hmd"}));
+           "settings", "hmd"}));
   command->add_option("--session", options->session,
                       "session file (default: the embedded simulated session, with a still head)");
   command->callback([options, &exit_code] {

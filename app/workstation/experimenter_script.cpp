@@ -92,6 +92,12 @@ ExperimenterScript::ExperimenterScript(const std::filesystem::path& file) {
         throw std::runtime_error(file.string() + ": line " + std::to_string(number) +
                                  ": a key is a letter or ctrl+letter, got '" + w[1] + "'");
       c = {Kind::Key, key, 0.0, number};
+    } else if (w[0] == "type") {
+      need(2, 2);
+      c = {Kind::Type, w[1], 0.0, number};
+    } else if (w[0] == "open") {
+      need(2, 2);
+      c = {Kind::Open, w[1], 0.0, number};
     } else if (w[0] == "screenshot") {
       need(2, 2);
       if (std::filesystem::path(w[1]).extension() != ".png")
@@ -101,7 +107,7 @@ ExperimenterScript::ExperimenterScript(const std::filesystem::path& file) {
     } else {
       throw std::runtime_error(file.string() + ": line " + std::to_string(number) +
                                ": unknown command '" + w[0] +
-                               "' (wait, click, pause, key, screenshot)");
+                               "' (wait, click, pause, key, type, open, screenshot)");
     }
     commands_.push_back(c);
   }
@@ -141,6 +147,22 @@ ui::SyntheticInput ExperimenterScript::beforeFrame(double now_s, const std::stri
     case Kind::Key:
       input.ctrl = c.text.rfind("ctrl+", 0) == 0;
       input.key = std::toupper(static_cast<unsigned char>(c.text.back()));  // GLFW's letter codes
+      advance();
+      break;
+    case Kind::Type:
+      // Select all (Ctrl+A), type, Enter: one frame each.
+      if (click_stage_ == 0) {
+        input.ctrl = true;
+        input.key = 'A';
+      } else if (click_stage_ == 1) {
+        input.text = c.text;
+      } else {
+        input.key = 257;  // GLFW_KEY_ENTER
+      }
+      if (++click_stage_ > 2) advance();
+      break;
+    case Kind::Open:
+      panel_to_open_ = c.text;
       advance();
       break;
     case Kind::Click: {

@@ -9,6 +9,8 @@
 //                                (default 60 s) fails the script with the button's reason
 //   pause SECONDS                let the session run
 //   key ctrl+q                   a key press (ctrl+LETTER or LETTER)
+//   type "TEXT"                  in the field last clicked: its text replaced by TEXT, then Enter
+//   open "PANEL"                 a panel opened as from the Panels menu (by its title)
 //   screenshot FILE.png          the whole window as it is, and FILE.json: the session's phase,
 //                                the panels drawn and every button with its state and reason
 #pragma once
@@ -16,6 +18,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "arbci/render/gl_context.h"
@@ -35,12 +38,14 @@ class ExperimenterScript {
   void afterFrame(render::GlContext& context, render::Size size, const std::string& phase,
                   double session_s);
 
+  // A panel the script asked to open ("" when none), once: the window opens it.
+  std::string takePanelToOpen() { return std::exchange(panel_to_open_, ""); }
   bool done() const { return next_ >= commands_.size() || !error_.empty(); }
   const std::string& error() const { return error_; }  // non-empty: the script failed
 
  private:
   struct Command {
-    enum class Kind { Wait, Click, Pause, Key, Screenshot } kind;
+    enum class Kind { Wait, Click, Pause, Key, Type, Open, Screenshot } kind;
     std::string text;  // the phase text, the label, the key or the file
     double seconds = 0.0;
     int line = 0;
@@ -52,7 +57,8 @@ class ExperimenterScript {
   std::vector<Command> commands_;
   size_t next_ = 0;
   double started_s_ = -1.0;  // when the current command began
-  int click_stage_ = 0;      // 0: find, 1: press, 2: release, 3: confirm
+  int click_stage_ = 0;      // 0: find, 1: press, 2: release, 3: confirm; type: 0-2
+  std::string panel_to_open_;
   float click_x_ = 0, click_y_ = 0;
   std::string error_;
 };

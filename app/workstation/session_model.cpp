@@ -1,6 +1,9 @@
 #include "workstation/session_model.h"
 
 #include <cstdio>
+#include <fstream>
+
+#include "arbci/session/settings_schema.h"
 
 namespace arbci::app {
 
@@ -35,6 +38,29 @@ std::string statusLine(const session::Session& session) {
     if (!warning.empty()) line.append("  [").append(warning).append("]");
   }
   return line;
+}
+
+const core::Table* SessionModel::settingsSchema() {
+  return &session::sessionSchema();
+}
+
+std::string SessionModel::checkSettings(const nlohmann::json& settings, const std::string& file) {
+  // As `arbci run --session FILE` would read it: the schema's checks, then the files it names.
+  try {
+    const session::SessionConfig config = session::SessionConfig::parse(settings, file);
+    session::checkNamedResources(config);
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  return "";
+}
+
+std::string SessionModel::saveSettings(const nlohmann::json& settings, const std::string& file) {
+  if (const std::string why = checkSettings(settings, file); !why.empty()) return why;
+  std::ofstream out(file);
+  out << settings.dump(2) << "\n";
+  if (!out) return file + ": cannot write the session file";
+  return "saved " + file + " (arbci run --session " + file + ")";
 }
 
 void SessionModel::ingest() {

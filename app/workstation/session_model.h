@@ -83,6 +83,10 @@ class SessionModel final : public ui::WorkstationModel {
   std::string eegSourceFault() override { return record().eeg.fault; }
   std::vector<ui::StageTiming> timing() override;
   std::string reason() override;
+  const core::Table* settingsSchema() override;
+  nlohmann::json settings() override { return session_.config().toJson(); }
+  std::string checkSettings(const nlohmann::json& settings, const std::string& file) override;
+  std::string saveSettings(const nlohmann::json& settings, const std::string& file) override;
   const bci::SignalScope* eegScope() override { return scope_ ? &*scope_ : nullptr; }
   std::string photodiodeChannel() override { return session_.config().eeg.photodiode_channel; }
   // After each session step: the cycle's EEG and flash onsets into the EEG view's scope.

@@ -110,7 +110,11 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     last = now;
     const render::Size size = main_window.framebufferSize();
     ui::SyntheticInput input;
-    if (script) input = script->beforeFrame(bci::hostSeconds(), model.phase());
+    if (script) {
+      input = script->beforeFrame(bci::hostSeconds(), model.phase());
+      if (const std::string panel = script->takePanelToOpen(); !panel.empty() && !shell.show(panel))
+        std::cerr << "\nscript: no panel \"" << panel << "\" to open\n";
+    }
     imgui.beginFrame(frame_ms / 1000.0f, script ? &input : nullptr);
     shell.draw(size, {frame_ms, model.phase(), statusLine(session)});
     render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});

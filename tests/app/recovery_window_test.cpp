@@ -248,6 +248,52 @@ wait "ended" 30
   EXPECT_EQ(summary["ended"], "estop");
 }
 
+// The window as a study day starts: the EEG panel with every channel graded, the operator log,
+// and the settings edited in the window, a bad value refused with the session file's message.
+TEST(RecoveryWindow, SettingsAreEditedInTheWindowAndABadValueIsRefusedWithItsReason) {
+  const auto folder = kArtefacts / "study_day";
+  std::filesystem::remove_all(folder);
+  const ProcessResult r = runScript(folder, R"(wait "calibration" 60
+pause 3
+screenshot )" + (folder / "eeg.png").string() + R"(
+open "Settings"
+click "find a setting"
+type "min_sequences"
+click "paradigm.min_sequences"
+type "0"
+pause 0.3
+screenshot )" + (folder / "refused.png").string() + R"(
+type "3"
+pause 0.3
+screenshot )" + (folder / "fixed.png").string() + R"(
+key ctrl+q
+)");
+  EXPECT_EQ(r.exit_code, 3) << r.err;  // closed before the end
+  // The EEG panel and the operator log are there from the start; the EEG's grade marks (green)
+  // are drawn.
+  const nlohmann::json eeg = checkScreenshot(folder / "eeg.png", {"Session", "EEG", "Operator log"});
+  const cv::Mat image = cv::imread((folder / "eeg.png").string(), cv::IMREAD_COLOR);
+  int marks = 0;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+      marks += std::abs(p[2] - 70) < 12 && std::abs(p[1] - 190) < 12 && std::abs(p[0] - 90) < 12;
+    }
+  EXPECT_GT(marks, 100) << "no quality marks in the EEG panel";
+  // A bad value: Save is refused with the message a session file would get.
+  const nlohmann::json refused = checkScreenshot(folder / "refused.png", {"Settings"});
+  const nlohmann::json* save = button(refused, "Save", "Settings");
+  ASSERT_NE(save, nullptr) << refused["buttons"];
+  EXPECT_FALSE((*save)["enabled"].get<bool>());
+  const std::string why = (*save)["why_disabled"].get<std::string>();
+  EXPECT_NE(why.find("paradigm.min_sequences"), std::string::npos) << why;
+  EXPECT_NE(why.find("must"), std::string::npos) << why;
+  // Fixed, Save goes again.
+  const nlohmann::json fixed = checkScreenshot(folder / "fixed.png", {"Settings"});
+  EXPECT_TRUE((*button(fixed, "Save", "Settings"))["enabled"].get<bool>())
+      << (*button(fixed, "Save", "Settings"));
+}
+
 // Ctrl+Q closes the window as the File menu says; the session ends there, its summary saved.
 TEST(RecoveryWindow, CtrlQQuitsTheWindowAndTheSummarySaysItWasClosed) {
   const auto folder = kArtefacts / "recovery_quit";

@@ -16,13 +16,24 @@ constexpr ImGuiWindowFlags kBarFlags = ImGuiWindowFlags_NoDecoration | ImGuiWind
 }
 
 void ExperimenterShell::addPanel(Panel& panel, bool open) {
-  panels_.push_back({&panel, open});
+  panels_.push_back({&panel, open, open});
 }
 
 void ExperimenterShell::show(Panel& panel) {
   for (Entry& entry : panels_) {
     if (entry.panel == &panel) entry.open = true;
   }
+}
+
+bool ExperimenterShell::show(const std::string& title) {
+  for (Entry& entry : panels_) {
+    if (title == entry.panel->title()) {
+      entry.open = true;
+      focus_ = entry.panel;  // in front, as a menu's choice would be
+      return true;
+    }
+  }
+  return false;
 }
 
 void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
@@ -71,24 +82,39 @@ void ExperimenterShell::drawMenuBar() {
 }
 
 void ExperimenterShell::drawPanels(render::Size display, float top, float bottom) {
-  // Default layout (first run): open panels side by side in up to three columns, two rows.
+  // Default layout (first run): the panels open at start side by side in up to three columns;
+  // one opened later from the menu comes in front, large, over the middle of the window.
   std::vector<Entry*> open;
   for (Entry& entry : panels_) {
     if (entry.open) open.push_back(&entry);
   }
+  int at_start = 0;
+  for (const Entry& entry : panels_) at_start += entry.at_start;
   if (open.empty()) return;
   const int count = static_cast<int>(open.size());
-  const int columns = std::min(count, 3);
-  const int rows = (count + columns - 1) / columns;
+  const int columns = std::clamp(at_start, 1, 3);
+  const int rows = std::max(1, (at_start + columns - 1) / columns);
   const float width = static_cast<float>(display.width) / static_cast<float>(columns);
   const float height = (bottom - top) / static_cast<float>(rows);
   const ImGuiCond when = reset_layout_ ? ImGuiCond_Always : ImGuiCond_FirstUseEver;
   reset_layout_ = false;
+  int slot = 0;
   for (int i = 0; i < count; ++i) {
-    const float x = width * static_cast<float>(i % columns);
-    const float y = top + height * static_cast<float>(i / columns);
-    ImGui::SetNextWindowPos(ImVec2(x, y), when);
-    ImGui::SetNextWindowSize(ImVec2(width, height), when);
+    if (open[i]->at_start) {
+      const float x = width * static_cast<float>(slot % columns);
+      const float y = top + height * static_cast<float>(slot / columns);
+      ++slot;
+      ImGui::SetNextWindowPos(ImVec2(x, y), when);
+      ImGui::SetNextWindowSize(ImVec2(width, height), when);
+    } else {
+      const float w = static_cast<float>(display.width);
+      ImGui::SetNextWindowPos(ImVec2(w * 0.2f, top + (bottom - top) * 0.1f), when);
+      ImGui::SetNextWindowSize(ImVec2(w * 0.6f, (bottom - top) * 0.8f), when);
+    }
+    if (focus_ == open[i]->panel) {
+      ImGui::SetNextWindowFocus();
+      focus_ = nullptr;
+    }
     if (ImGui::Begin(open[i]->panel->title(), &open[i]->open)) {
       fitToScreen(display, top, bottom);
       detail::recordWindow(open[i]->panel->title());

@@ -74,6 +74,7 @@ void ImGuiLayer::beginFrame(float delta_seconds, const SyntheticInput* input) {
       io.KeysDown[input->key] = true;
       synthetic_key_ = input->key;
     }
+    if (!input->text.empty()) io.AddInputCharactersUTF8(input->text.c_str());
   }
   ImGui::NewFrame();
 }

@@ -13,6 +13,7 @@ PanelRegistry::Entry trainingPanel();
 PanelRegistry::Entry summaryPanel();
 PanelRegistry::Entry operatorLogPanel();
 PanelRegistry::Entry eegPanel();
+PanelRegistry::Entry settingsPanel();
 
 const PanelRegistry& panels() {
   static const PanelRegistry registry = [] {
@@ -24,6 +25,7 @@ const PanelRegistry& panels() {
     r.add(thresholdPanel());
     r.add(calibrationPanel());
     r.add(trainingPanel());
+    r.add(settingsPanel());
     r.add(summaryPanel());
     r.add(operatorLogPanel());
     return r;

@@ -54,6 +54,12 @@ bool button(const char* label, const std::string& why_not, bool small) {
   return pressed && enabled;
 }
 
+void recordField(const std::string& label, float width) {
+  const ImVec2 min = ImGui::GetItemRectMin(), max = ImGui::GetItemRectMax();
+  detail::recordWidget({label, currentWindowTitle(), min.x, min.y, std::min(max.x, min.x + width),
+                        max.y, true, "", ImGui::IsItemActive()});
+}
+
 bool stopButton(const char* label, bool small, const std::string& why_not) {
   ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
   ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));

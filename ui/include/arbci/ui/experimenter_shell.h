@@ -22,6 +22,7 @@ class ExperimenterShell {
   // Panels are shown in order; the shell does not own them.
   void addPanel(Panel& panel, bool open = true);
   void show(Panel& panel);  // opens a panel added closed (e.g. the end-of-session summary)
+  bool show(const std::string& title);  // by its title; false when there is none
   void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
   // An emergency stop button in the menu bar, shown whatever panels are open; `why_not` says why
   // it cannot act now ("" when it can).
@@ -36,6 +37,7 @@ class ExperimenterShell {
   struct Entry {
     Panel* panel;
     bool open;
+    bool at_start;  // open when the window opened: laid out in the columns
   };
   void drawMenuBar();
   void drawPanels(render::Size display, float top, float bottom);
@@ -46,6 +48,7 @@ class ExperimenterShell {
   std::function<std::string()> stop_why_not_;
   bool show_about_ = false;
   bool reset_layout_ = false;
+  Panel* focus_ = nullptr;  // brought to the front in the next frame
 };
 
 }  // namespace arbci::ui

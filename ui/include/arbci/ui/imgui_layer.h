@@ -9,13 +9,14 @@
 namespace arbci::ui {
 
 // Input for one frame that replaces the mouse and keyboard (a scripted experimenter): the pointer
-// at (x, y) in window pixels, the left button held or not, and a key (GLFW's code, e.g. 'Q')
-// pressed with or without Ctrl.
+// at (x, y) in window pixels, the left button held or not, a key (GLFW's code, e.g. 'Q' or 257
+// for Enter) pressed with or without Ctrl, and text typed.
 struct SyntheticInput {
   float x = -1.0f, y = -1.0f;
   bool left_down = false;
   int key = 0;
   bool ctrl = false;
+  std::string text;
 };
 
 class ImGuiLayer {

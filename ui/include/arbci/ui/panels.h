@@ -11,6 +11,7 @@
 
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/p300_dataset.h"
+#include "arbci/core/schema.h"
 #include "arbci/ui/eeg_view.h"
 #include "arbci/ui/image_view.h"
 #include "arbci/ui/panel.h"
@@ -143,6 +144,27 @@ class EegPanel final : public Panel {
  private:
   WorkstationModel& model_;
   EegView view_;
+};
+
+// The session's settings from the schema: each key with the widget of its type, its unit, range
+// and documentation; every edit checked with the session file's messages; saved to a file.
+class SettingsPanel final : public Panel {
+ public:
+  explicit SettingsPanel(WorkstationModel& model) : model_(model) {}
+  const char* title() const override { return "Settings"; }
+  void draw() override;
+
+ private:
+  void initialise();
+  void check();
+  bool editTable(const core::Table& table, nlohmann::json& object, const std::string& path);
+  bool editKey(const core::Key& key, nlohmann::json& value, const std::string& path);
+  WorkstationModel& model_;
+  bool initialised_ = false;
+  nlohmann::json document_;
+  std::string error_, message_;
+  char filter_[128] = "";
+  char save_path_[512] = "session.json";
 };
 
 // Everything the experimenter was told (ends, faults, refusals, pauses, warnings), with its

@@ -9,7 +9,10 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include "arbci/bci/erp.h"
+#include "arbci/core/schema.h"
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/p300_model.h"
@@ -76,6 +79,18 @@ class WorkstationModel {
   // The session's classifier settings, where the Training panel starts (default: the schema's).
   virtual bci::TrainingSettings trainingSettings() { return {}; }
   virtual bci::PipelineSettings pipelineSettings() { return {}; }
+
+  // Settings: the schema, this session's settings as a session file holds them, a check of an
+  // edited copy ("" when valid, else the message a file with it would get, naming `file`), and
+  // saving it ("saved FILE" or why not).
+  virtual const core::Table* settingsSchema() { return nullptr; }
+  virtual nlohmann::json settings() { return nlohmann::json::object(); }
+  virtual std::string checkSettings(const nlohmann::json& /*settings*/, const std::string& /*file*/) {
+    return "";
+  }
+  virtual std::string saveSettings(const nlohmann::json& /*settings*/, const std::string& file) {
+    return "cannot save to " + file;
+  }
 
   // Robot.
   virtual std::optional<robot::StatusPayload> robotStatus() = 0;

@@ -1,0 +1,246 @@
+// The session's settings in the window, built from the settings schema: every key with the
+// widget of its type, its unit and range, and its documentation as a tooltip; each edit checked
+// at once by the same code and with the same messages as a session file; saved to a session file
+// for the next run (a running session keeps the settings it started with).
+#include <imgui.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <sstream>
+
+#include "arbci/core/schema.h"
+#include "arbci/ui/panel_registry.h"
+#include "arbci/ui/panels.h"
+#include "widgets.h"
+
+namespace arbci::ui {
+namespace {
+
+bool matches(const std::string& text, const std::string& filter) {
+  if (filter.empty()) return true;
+  return std::search(text.begin(), text.end(), filter.begin(), filter.end(), [](char a, char b) {
+           return std::tolower(static_cast<unsigned char>(a)) ==
+                  std::tolower(static_cast<unsigned char>(b));
+         }) != text.end();
+}
+
+// "a, b, c" for a list of numbers or texts, as typed.
+std::string listText(const nlohmann::json& list) {
+  std::string out;
+  if (!list.is_array()) return list.dump();
+  for (const nlohmann::json& v : list) {
+    if (!out.empty()) out += ", ";
+    out += v.is_string() ? v.get<std::string>() : core::formatNumber(v.get<double>());
+  }
+  return out;
+}
+
+// The list typed: numbers where each item reads as one (else the item as text, which the check
+// then refuses with the schema's message), texts as they are.
+nlohmann::json parseList(const std::string& text, bool numbers) {
+  nlohmann::json out = nlohmann::json::array();
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto first = item.find_first_not_of(" \t");
+    if (first == std::string::npos) continue;
+    item = item.substr(first, item.find_last_not_of(" \t") - first + 1);
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (numbers && end && *end == '\0')
+      out.push_back(value);
+    else
+      out.push_back(item);
+  }
+  return out;
+}
+
+void keyTooltip(const core::Key& key) {
+  if (!ImGui::IsItemHovered()) return;
+  std::string text = key.doc;
+  if (!key.unit.empty()) text += "\nunit: " + key.unit;
+  if (key.type == core::Type::Number || key.type == core::Type::Integer) {
+    if (std::isfinite(key.low) || std::isfinite(key.high))
+      text += "\nallowed: " + (std::isfinite(key.low) ? core::formatNumber(key.low) : "-inf") +
+              " to " + (std::isfinite(key.high) ? core::formatNumber(key.high) : "inf");
+  }
+  if (!key.fallback.is_null()) text += "\ndefault: " + key.fallback.dump();
+  ImGui::SetTooltip("%s", text.c_str());
+}
+
+}  // namespace
+
+void SettingsPanel::initialise() {
+  if (initialised_) return;
+  initialised_ = true;
+  document_ = model_.settings();
+  check();
+}
+
+void SettingsPanel::check() {
+  error_ = model_.checkSettings(document_, save_path_);
+}
+
+// One key's widget; returns true when the value changed.
+bool SettingsPanel::editKey(const core::Key& key, nlohmann::json& value, const std::string& path) {
+  const std::string label = key.name + (key.unit.empty() ? "" : " (" + key.unit + ")");
+  ImGui::PushID(path.c_str());
+  bool changed = false;
+  const float width = std::max(120.0f, ImGui::GetContentRegionAvail().x * 0.45f);
+  ImGui::SetNextItemWidth(width);
+  switch (key.type) {
+    case core::Type::Number: {
+      double v = value.is_number() ? value.get<double>() : 0.0;
+      if (ImGui::InputDouble(label.c_str(), &v, 0.0, 0.0, "%g")) {
+        value = v;
+        changed = true;
+      }
+      break;
+    }
+    case core::Type::Integer: {
+      int v = value.is_number() ? value.get<int>() : 0;
+      if (ImGui::InputInt(label.c_str(), &v, 0, 0)) {  // typed: no step buttons
+        value = v;
+        changed = true;
+      }
+      break;
+    }
+    case core::Type::Boolean: {
+      bool v = value.is_boolean() && value.get<bool>();
+      if (ImGui::Checkbox(label.c_str(), &v)) {
+        value = v;
+        changed = true;
+      }
+      break;
+    }
+    case core::Type::Text: {
+      const std::string current = value.is_string() ? value.get<std::string>() : "";
+      const std::vector<std::string> choices = key.choices ? key.choices() : std::vector<std::string>{};
+      if (!choices.empty()) {
+        if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
+          for (const std::string& c : choices) {
+            if (ImGui::Selectable(c.c_str(), c == current)) {
+              value = c;
+              changed = true;
+            }
+          }
+          ImGui::EndCombo();
+        }
+      } else {
+        char buffer[512];
+        std::snprintf(buffer, sizeof buffer, "%s", current.c_str());
+        if (ImGui::InputText(label.c_str(), buffer, sizeof buffer)) {
+          value = std::string(buffer);
+          changed = true;
+        }
+      }
+      break;
+    }
+    case core::Type::Numbers:
+    case core::Type::Texts: {
+      char buffer[1024];
+      std::snprintf(buffer, sizeof buffer, "%s", listText(value).c_str());
+      if (ImGui::InputText(label.c_str(), buffer, sizeof buffer,
+                           ImGuiInputTextFlags_EnterReturnsTrue)) {
+        value = parseList(buffer, key.type == core::Type::Numbers);
+        changed = true;
+      }
+      break;
+    }
+    case core::Type::Section:
+    case core::Type::List:
+      break;  // drawn by editTable
+  }
+  keyTooltip(key);
+  ImGui::PopID();
+  recordField(path, width);  // a script finds the field by its dotted name
+  return changed;
+}
+
+bool SettingsPanel::editTable(const core::Table& table, nlohmann::json& object,
+                              const std::string& path) {
+  bool changed = false;
+  for (const core::Key& key : table.keys()) {
+    const std::string here = path.empty() ? key.name : path + "." + key.name;
+    nlohmann::json& value = object[key.name];
+    if (key.type == core::Type::Section && key.table) {
+      if (!value.is_object()) value = nlohmann::json::object();
+      if (filter_[0]) {
+        changed |= editTable(*key.table, value, here);
+      } else if (ImGui::TreeNode(here.c_str(), "%s", key.name.c_str())) {
+        keyTooltip(key);
+        changed |= editTable(*key.table, value, here);
+        ImGui::TreePop();
+      }
+      continue;
+    }
+    if (key.type == core::Type::List && key.table) {
+      if (!value.is_array()) continue;
+      for (size_t i = 0; i < value.size(); ++i) {
+        const std::string item = here + "[" + std::to_string(i) + "]";
+        if (filter_[0]) {
+          changed |= editTable(*key.table, value[i], item);
+        } else if (ImGui::TreeNode(item.c_str(), "%s", item.c_str())) {
+          changed |= editTable(*key.table, value[i], item);
+          ImGui::TreePop();
+        }
+      }
+      continue;
+    }
+    if (filter_[0] && !matches(here, filter_) && !matches(key.doc, filter_)) continue;
+    if (filter_[0]) ImGui::TextDisabled("%s", path.c_str());
+    changed |= editKey(key, value, here);
+  }
+  return changed;
+}
+
+void SettingsPanel::draw() {
+  initialise();
+  const core::Table* schema = model_.settingsSchema();
+  if (!schema) {
+    ImGui::TextDisabled("no settings schema");
+    return;
+  }
+  ImGui::TextWrapped(
+      "The settings this session runs with. Edits are checked as a session file is; save them "
+      "and start the next run with arbci run --session FILE (a running session keeps its own).");
+  ImGui::SetNextItemWidth(-FLT_MIN);
+  ImGui::InputTextWithHint("##find", "find a setting (name or description)", filter_,
+                           sizeof filter_);
+  recordField("find a setting", ImGui::GetItemRectSize().x);
+  if (error_.empty()) {
+    ImGui::TextColored(ImVec4(0.4f, 0.9f, 0.4f, 1.0f), "valid");
+  } else {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.35f, 0.3f, 1.0f));
+    ImGui::TextWrapped("%s", error_.c_str());
+    ImGui::PopStyleColor();
+  }
+  pathInput("session file to save", save_path_, sizeof save_path_, ".json",
+            "where Save writes these settings (a complete session file)");
+  if (button("Save", error_)) {
+    message_ = model_.saveSettings(document_, save_path_);
+  }
+  ImGui::SameLine();
+  if (button("Revert")) {
+    document_ = model_.settings();
+    check();
+    message_ = "back to the session's settings";
+  }
+  if (!message_.empty()) {
+    ImGui::SameLine();
+    ImGui::TextWrapped("%s", message_.c_str());
+  }
+  ImGui::Separator();
+  ImGui::BeginChild("settings", ImVec2(0, 0), false);
+  if (editTable(*schema, document_, "")) check();
+  ImGui::EndChild();
+}
+
+PanelRegistry::Entry settingsPanel() {
+  return {"settings",
+          "the session's settings from the schema: edited, checked as a file is, saved",
+          {[](const PanelContext& c) { return std::make_unique<SettingsPanel>(c.model); }, false}};
+}
+
+}  // namespace arbci::ui
