@@ -50,6 +50,18 @@ void printStatus(const robot::StatusPayload& s) {
 
 using Seconds = std::chrono::duration<double>;
 
+// Why the backend never bound us: its key differs (it said so), or nothing answered.
+std::string noAnswer(const robot::RobotClient& client, const robot::Endpoint& endpoint,
+                     double budget_s) {
+  if (client.keyRefused())
+    return "the backend at " + endpoint.toString() +
+           " answered that our key is not its key: give both sides the same key file "
+           "(--key-file here, arbci-robotd --key-file there)";
+  return "no answer from the backend at " + endpoint.toString() + " in " +
+         std::to_string(static_cast<int>(budget_s)) +
+         " s (is arbci-robotd running, with the same key?)";
+}
+
 robot::RobotClient connect(const RobotOptions& o, robot::Endpoint& endpoint) {
   robot::Key key;
   try {
@@ -160,9 +172,7 @@ int talk(const RobotOptions& o, robot::MessageType type) {
       if (e.kind == Kind::Failed) {
         // Commands go out only once bound to a backend run: never bound, never sent.
         if (!ever_connected)
-          throw CliError(name + " not run: no answer from the backend at " + endpoint.toString() +
-                         " in " + std::to_string(static_cast<int>(o.retry_budget_s)) +
-                         " s (is arbci-robotd running, with the same key?)");
+          throw CliError(name + " not run: " + noAnswer(client, endpoint, o.retry_budget_s));
         if (!e.may_have_run) throw CliError(e.text, 1);
         if (motion) stopUnconfirmed(client, type, sequence, e.text, restarted);
         throw CliError(name + ": unknown, it may have taken effect: " + e.text, 4);
@@ -185,9 +195,7 @@ int talk(const RobotOptions& o, robot::MessageType type) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (sequence == 0 || !client.connected())
-    throw CliError("no answer from the backend at " + endpoint.toString() + " in " +
-                   std::to_string(static_cast<int>(o.retry_budget_s)) +
-                   " s (is arbci-robotd running, with the same key?)");
+    throw CliError(noAnswer(client, endpoint, o.retry_budget_s));
   if (motion)
     stopUnconfirmed(client, type, sequence,
                     "no outcome within " + std::to_string(static_cast<int>(o.timeout_s)) + " s",

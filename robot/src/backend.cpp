@@ -262,6 +262,7 @@ struct RobotBackend::Impl {
       }
       log(toString(decoded.error),
           "ignored a datagram from " + d.from.toString() + ": " + toString(decoded.error));
+      if (decoded.error == DecodeError::BadMac) keyMismatch(d);
       return;
     }
     const Message& m = decoded.message;
@@ -341,6 +342,22 @@ struct RobotBackend::Impl {
     }
     r.text.clear();  // the reason is enough; the least sent to an address nobody bound
     const auto bytes = stamped(r);
+    if (bytes.size() < d.bytes.size() && refusal_budget.take(SteadyClock::now()))
+      socket.sendTo(bytes, d.from);
+  }
+
+  // A HELLO sealed with another key: the client is told its key is not this backend's (a wrong
+  // key file otherwise looks like no backend at all). Sealed with no key, it says nothing secret,
+  // is smaller than the HELLO and within the unbound budget.
+  void keyMismatch(const Datagram& d) {
+    const auto header = peek(d.bytes.data(), d.bytes.size());
+    if (!header || header->type != MessageType::Hello) return;
+    Message m;
+    m.type = MessageType::KeyMismatch;
+    m.session = header->session;
+    m.boot = boot;
+    m.timestamp_ms = wallClockMs();
+    const auto bytes = encode(m, kNoKey);
     if (bytes.size() < d.bytes.size() && refusal_budget.take(SteadyClock::now()))
       socket.sendTo(bytes, d.from);
   }

@@ -375,7 +375,15 @@ void RobotClient::poll() {
     if (!datagram) break;
     if (!(datagram->from == backend_)) continue;  // only the backend speaks to us
     const Decoded decoded = decode(datagram->bytes.data(), datagram->bytes.size(), key_);
-    if (decoded.ok()) handle(decoded.message);
+    if (decoded.ok()) {
+      handle(decoded.message);
+    } else if (decoded.error == DecodeError::BadMac) {
+      // A backend whose key differs says so, sealed with no key: reported, never acted on.
+      const Decoded refusal = decode(datagram->bytes.data(), datagram->bytes.size(), kNoKey);
+      if (refusal.ok() && refusal.message.type == MessageType::KeyMismatch &&
+          refusal.message.session == session_)
+        key_refused_ = true;
+    }
   }
   const auto now = Clock::now();
   // Answering a challenge: BIND until BOUND; a challenge unanswered for long may have expired

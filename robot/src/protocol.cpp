@@ -95,7 +95,7 @@ std::array<std::uint8_t, kMacBytes> mac(const std::uint8_t* data, size_t size, c
 }
 
 bool validType(std::uint8_t t) {
-  return (t >= 1 && t <= 9) || (t >= 0x81 && t <= 0x86);
+  return (t >= 1 && t <= 9) || (t >= 0x81 && t <= 0x87);
 }
 
 // A HELLO is padded to the size of the WELCOME it asks for, so that a HELLO replayed with
@@ -374,6 +374,8 @@ const char* toString(MessageType type) {
       return "REJECTED";
     case MessageType::StatusReply:
       return "STATUS reply";
+    case MessageType::KeyMismatch:
+      return "KEY MISMATCH";
   }
   return "unknown";
 }

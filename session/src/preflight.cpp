@@ -86,7 +86,11 @@ std::vector<std::string> Preflight::check(bool final) const {
     out.push_back(settings_.eeg_key + ": EEG samples arrive at " +
                   format("%.1f Hz, the source says %.1f Hz", eeg_rate_hz_, rate));
   }
-  if (!last_.robot_answered) {
+  if (!last_.robot_answered && last_.robot_key_refused) {
+    out.push_back(settings_.robot_key + ": " + settings_.robot_what +
+                  " answered that our key is not its key: give both sides the same robot.key_file "
+                  "(arbci robot keygen makes one)");
+  } else if (!last_.robot_answered) {
     out.push_back(settings_.robot_key + ": " + settings_.robot_what + " did not answer STATUS" +
                   (final ? format(" in %.1f s", last_.wall_s - first_.wall_s) : ""));
   }

@@ -263,6 +263,7 @@ click "paradigm.min_sequences"
 type "0"
 pause 0.3
 screenshot )" + (folder / "refused.png").string() + R"(
+click "paradigm.min_sequences"
 type "3"
 pause 0.3
 screenshot )" + (folder / "fixed.png").string() + R"(

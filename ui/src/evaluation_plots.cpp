@@ -37,7 +37,7 @@ void drawBySequences(const char* id, const std::vector<double>& values, double t
   if (n == 0) return;
   const float left = ImGui::CalcTextSize("100 %").x + 6.0f, below = ImGui::GetFontSize() + 4.0f;
   const float width = std::max(160.0f, ImGui::GetContentRegionAvail().x - left - 8.0f);
-  const float height = 90.0f;
+  const float height = 70.0f;
   const ImVec2 corner = ImGui::GetCursorScreenPos();
   ImGui::InvisibleButton(id, ImVec2(width + left, height + below));
   const ImVec2 origin(corner.x + left, corner.y);
@@ -93,6 +93,9 @@ void drawEvaluation(const bci::EvaluationReport& cv) {
   }
   ImGui::TextWrapped("%d selections; chance %.0f %%, beaten at p < 0.05 from %.0f %%",
                      cv.selections_with_truth, 100.0 * cv.chance, 100.0 * cv.chance_95);
+  // Accuracy and bit rate side by side: the ERPs below stay in view.
+  if (!ImGui::BeginTable("by sequences", 2, ImGuiTableFlags_SizingStretchSame)) return;
+  ImGui::TableNextColumn();
   if (!cv.accuracy.empty()) {
     ImGui::TextWrapped("accuracy by sequences: %.0f %% after %zu (95 %% bands)",
                        100.0 * cv.accuracy.back(), cv.accuracy.size());
@@ -104,13 +107,15 @@ void drawEvaluation(const bci::EvaluationReport& cv) {
     drawBySequences("##accuracy", cv.accuracy, 100.0, " %", 100.0,
                     {{cv.chance, "chance"}, {cv.chance_95, "p < 0.05"}}, low, high);
   }
+  ImGui::TableNextColumn();
   if (!cv.bits_per_minute.empty()) {
     const double best = *std::max_element(cv.bits_per_minute.begin(), cv.bits_per_minute.end());
     const double top = std::max(1.0, tickStep(best) * std::ceil(best / tickStep(best) + 1e-9));
     ImGui::TextWrapped("bits/min by sequences (the flashes only): best %.1f", best);
     drawBySequences("##bits", cv.bits_per_minute, top, "", 1.0, {});
   }
-  ImGui::TextDisabled("sequences");
+  ImGui::EndTable();
+  ImGui::TextDisabled("x: sequences");
 }
 
 }  // namespace arbci::ui

@@ -16,6 +16,7 @@ PreflightObservation PreflightStage::observe(const Cycle& cycle) const {
   o.max_pose_age_s = settings_.max_pose_age_s;
   o.eeg_samples = cycle.record.recording.samples;
   o.robot_answered = cycle.record.robot.answered;
+  o.robot_key_refused = cycle.record.robot.key_refused;
   return o;
 }
 

@@ -38,6 +38,7 @@ void RobotStage::step(Cycle& cycle) {
   out.measuring = placement_ && time_s - placement_->since_s <= 3.0;
   out.grasped = grasped_id_;
   out.answered = answered_;
+  out.key_refused = client_.keyRefused();
   out.why_not_move = whyNotMove();
   out.why_not_release = whyNotRelease();
   if (messages_added_ != messages_published_) {

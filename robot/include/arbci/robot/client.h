@@ -84,6 +84,8 @@ class RobotClient {
   // The latest status the backend sent (state, tool, gripper, world).
   const std::optional<StatusPayload>& status() const { return status_; }
   bool silent() const { return silent_; }
+  // The backend answered a HELLO that its key is not ours (KEY MISMATCH); false once bound.
+  bool keyRefused() const { return key_refused_ && !connected_; }
   bool connected() const { return connected_; }
   std::uint64_t sessionId() const { return session_; }
   // The scheduling the heartbeat thread got ("real-time (FIFO 99)", "nice -20", ...; "" before
@@ -133,6 +135,7 @@ class RobotClient {
   ClientOptions options_;
   UdpSocket socket_;
   std::uint64_t session_;
+  bool key_refused_ = false;
   std::atomic<std::uint64_t> next_sequence_{1};
   std::vector<Pending> pending_;
   std::vector<std::uint64_t> accepted_;  // recent accepted sequences (bounded)

@@ -40,6 +40,9 @@ enum class MessageType : std::uint8_t {
   StatusReply = 0x84,
   Welcome = 0x85,  // answers HELLO with a challenge; its boot field is the run's id
   Bound = 0x86,    // answers BIND: the session is bound to this run and address
+  // Answers a HELLO whose MAC failed (another key): sealed with no key (kNoKey), so anyone can
+  // forge one; it binds and moves nothing, and a client only reports it ("the key differs").
+  KeyMismatch = 0x87,
 };
 
 enum class RejectReason : std::uint8_t {
@@ -128,6 +131,8 @@ struct Message {
 };
 
 using Key = std::array<std::uint8_t, 32>;
+// The all-zero key KEY MISMATCH is sealed with: what the two sides share when their keys differ.
+inline constexpr Key kNoKey{};
 
 enum class DecodeError {
   None,

@@ -162,6 +162,7 @@ struct RobotPart {
   bool measuring = false;      // a placement still to be measured
   std::optional<int> grasped;  // the object the arm was sent to grasp in this session
   bool answered = false;       // the backend answered the last probe
+  bool key_refused = false;    // the backend answered that our key is not its key
   std::string why_not_move, why_not_release;                 // "" when the experimenter may
   std::shared_ptr<const std::vector<std::string>> messages;  // for the Robot panel
   // This cycle: what the trial's robot step came to, in the order it happened.

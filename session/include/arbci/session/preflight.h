@@ -36,6 +36,7 @@ struct PreflightObservation {
   double max_pose_age_s = 0.5;
   long long eeg_samples = 0;  // recorded so far
   bool robot_answered = false;
+  bool robot_key_refused = false;  // it answered, with KEY MISMATCH
 };
 
 class Preflight {
