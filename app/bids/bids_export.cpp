@@ -151,6 +151,41 @@ void checkBidsEntities(const BidsEntities& entities) {
   if (!entities.run.empty()) checkLabel("run", entities.run, true);
 }
 
+namespace {
+
+// Where an export goes, and the run it takes.
+struct Layout {
+  fs::path relative, eeg_dir;
+  std::string prefix;
+  std::set<int> runs;  // those already there
+  int run = 1;
+};
+
+Layout layoutOf(const fs::path& root, const BidsEntities& entities) {
+  Layout l;
+  const std::string sub = "sub-" + entities.subject;
+  const std::string ses = entities.session.empty() ? "" : "ses-" + entities.session;
+  l.relative = ses.empty() ? fs::path(sub) : fs::path(sub) / ses;
+  l.eeg_dir = root / l.relative / "eeg";
+  l.prefix = sub + (ses.empty() ? "" : "_" + ses) + "_task-" + entities.task;
+  l.runs = existingRuns(l.eeg_dir, l.prefix);
+  l.run =
+      entities.run.empty() ? (l.runs.empty() ? 1 : *l.runs.rbegin() + 1) : std::stoi(entities.run);
+  return l;
+}
+
+}  // namespace
+
+std::string bidsTarget(const fs::path& root, const BidsEntities& entities) {
+  checkBidsEntities(entities);
+  const Layout l = layoutOf(root, entities);
+  std::string text =
+      (l.relative / "eeg").string() + ", " + l.prefix + ", run " + std::to_string(l.run);
+  if (entities.run.empty()) text += " (the next free)";
+  if (l.runs.count(l.run)) text += ": already there; runs are never overwritten";
+  return text;
+}
+
 BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
                         const BidsEntities& entities) {
   checkBidsEntities(entities);
@@ -164,14 +199,11 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
   } catch (const std::exception& error) {
     throw BidsError("cannot read " + bdf.string() + ": " + error.what());
   }
-  const std::string sub = "sub-" + entities.subject;
-  const std::string ses = entities.session.empty() ? "" : "ses-" + entities.session;
-  const fs::path relative = ses.empty() ? fs::path(sub) : fs::path(sub) / ses;
-  const fs::path eeg_dir = root / relative / "eeg";
-  const std::string prefix = sub + (ses.empty() ? "" : "_" + ses) + "_task-" + entities.task;
-  const std::set<int> runs = existingRuns(eeg_dir, prefix);
-  int run =
-      entities.run.empty() ? (runs.empty() ? 1 : *runs.rbegin() + 1) : std::stoi(entities.run);
+  const Layout layout = layoutOf(root, entities);
+  const fs::path& eeg_dir = layout.eeg_dir;
+  const std::string& prefix = layout.prefix;
+  const std::set<int>& runs = layout.runs;
+  const int run = layout.run;
   if (runs.count(run))
     throw BidsError("run " + std::to_string(run) + " of " + prefix + " is already in " +
                     root.string() + "; runs are never overwritten (leave --run out for the next, " +
@@ -214,7 +246,7 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
   out.notes = events.notes;
 
   // ARBCI's own files, beside the same entities in the derivatives dataset.
-  const fs::path own = root / "derivatives" / "arbci" / relative / "eeg" / stem;
+  const fs::path own = root / "derivatives" / "arbci" / layout.relative / "eeg" / stem;
   fs::create_directories(own);
   for (const auto& entry : fs::directory_iterator(session_dir)) {
     const std::string name = entry.path().filename().string();

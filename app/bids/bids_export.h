@@ -37,6 +37,10 @@ class BidsError : public std::runtime_error {
 // cannot fail on a typo after the session).
 void checkBidsEntities(const BidsEntities& entities);
 
+// Where an export of `entities` into `root` goes: "sub-S/ses-N/eeg, run R" (R the next free run
+// when entities.run is empty). Throws BidsError for a label BIDS does not allow.
+std::string bidsTarget(const std::filesystem::path& root, const BidsEntities& entities);
+
 // Throws BidsError with a message a person can act on (not a session folder, a label BIDS does
 // not allow, a run that exists).
 BidsExport exportToBids(const std::filesystem::path& session_dir, const std::filesystem::path& root,

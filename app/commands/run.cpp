@@ -135,10 +135,15 @@ int runSession(const RunOptions& o);
 
 // The session's folder into the BIDS dataset, once it has ended; the folder stays as it is.
 int runAndExport(const RunOptions& o) {
+  const bool windowed = !o.headless && render::displayAvailable();
   if (!o.bids_root.empty()) {
-    if (o.bids.subject.empty()) throw CliError("--bids needs --subject (the BIDS subject label)");
+    // In the window the experimenter gives the subject on the start screen.
+    if (o.bids.subject.empty() && !windowed)
+      throw CliError("--bids needs --subject (the BIDS subject label)");
+    BidsEntities check = o.bids;
+    if (check.subject.empty()) check.subject = "unnamed";
     try {
-      checkBidsEntities(o.bids);
+      checkBidsEntities(check);
     } catch (const BidsError& error) {
       throw CliError(error.what());
     }
@@ -150,7 +155,16 @@ int runAndExport(const RunOptions& o) {
   const int status = runSession(run);
   if (o.bids_root.empty()) return status;
   try {
-    reportBidsExport(exportToBids(run.out, o.bids_root, o.bids));
+    // The labels the run ended with: the command line's, or what the start screen changed.
+    BidsEntities entities = o.bids;
+    std::ifstream in(std::filesystem::path(run.out) / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+    if (summary.is_object() && summary.contains("labels")) {
+      const nlohmann::json& l = summary["labels"];
+      entities = {l.value("subject", ""), l.value("session", ""), l.value("task", "arbci"),
+                  l.value("run", "")};
+    }
+    reportBidsExport(exportToBids(run.out, o.bids_root, entities));
   } catch (const std::exception& error) {
     throw CliError(std::string("the session ended, but its BIDS export failed: ") + error.what() +
                    "; the session folder " + run.out +
@@ -166,6 +180,7 @@ int runSession(const RunOptions& o) {
   options.folder = o.out.empty() ? defaultFolder() : o.out;
   FolderClaim claim(options.folder);
   if (o.trials > 0) options.trials = o.trials;
+  options.labels = {o.bids.subject, o.bids.session, o.bids.task, o.bids.run};
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
   options.fault_wait_s = o.fault_wait_s;
   options.progress = &std::cerr;
@@ -175,7 +190,8 @@ int runSession(const RunOptions& o) {
       throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
     if (!headless) {
       claim.keep();  // the window shows its own failures and offers a retry in place
-      return runWorkstation(config, options, {o.script, o.wait_for_start, o.exit_when_done});
+      return runWorkstation(config, options,
+                            {o.script, o.wait_for_start, o.exit_when_done, false, o.bids_root});
     }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped

@@ -11,8 +11,8 @@
 #include "arbci/render/gl_context.h"
 #include "arbci/session/session.h"
 #include "arbci/ui/experimenter_shell.h"
-#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/imgui_layer.h"
+#include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "commands/commands.h"
 #include "hmd/hmd_stage.h"
@@ -196,14 +196,14 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
   command->add_option("--out", options->out, "PNG file to write")->required();
   command->add_option("--size", options->size, "Image size WIDTHxHEIGHT")->capture_default_str();
   command
-      ->add_option("--panel", options->panel,
-                   "threshold, calibration, training (trained on the session's recording), "
-                   "session-model (the Training panel on the model the session trained), robot, "
-                   "session, eeg (traces and quality), log (the operator log), settings or hmd (the HMD "
-                   "view)")
-      ->check(CLI::IsMember(
-          {"threshold", "calibration", "training", "session-model", "robot", "session", "eeg", "log",
-           "settings", "hmd"}));
+      ->add_option(
+          "--panel", options->panel,
+          "threshold, calibration, training (trained on the session's recording), "
+          "session-model (the Training panel on the model the session trained), robot, "
+          "session, eeg (traces and quality), log (the operator log), settings or hmd (the HMD "
+          "view)")
+      ->check(CLI::IsMember({"threshold", "calibration", "training", "session-model", "robot",
+                             "session", "eeg", "log", "settings", "hmd"}));
   command->add_option("--session", options->session,
                       "session file (default: the embedded simulated session, with a still head)");
   command->callback([options, &exit_code] {

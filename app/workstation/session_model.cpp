@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "arbci/session/settings_schema.h"
+#include "bids/bids_export.h"
 
 namespace arbci::app {
 
@@ -38,6 +39,44 @@ std::string statusLine(const session::Session& session) {
     if (!warning.empty()) line.append("  [").append(warning).append("]");
   }
   return line;
+}
+
+namespace {
+BidsEntities entitiesOf(const core::RunLabels& l) {
+  return {l.subject, l.session, l.task.empty() ? "arbci" : l.task, l.run};
+}
+}  // namespace
+
+std::string SessionModel::setLabels(const core::RunLabels& labels) {
+  return session_.setLabels(labels);
+}
+
+std::string SessionModel::labelsProblem() {
+  const core::RunLabels& l = session_.labels();
+  if (!bids_root_.empty() && l.subject.empty())
+    return "give the subject: the run is exported to the BIDS dataset " + bids_root_.string();
+  // Without a BIDS root the subject may stay empty; a label BIDS refuses is refused anyway, so
+  // that the folder can be exported later as it is.
+  BidsEntities entities = entitiesOf(l);
+  if (entities.subject.empty()) entities.subject = "unnamed";
+  try {
+    checkBidsEntities(entities);
+  } catch (const BidsError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+std::string SessionModel::labelsTarget() {
+  if (bids_root_.empty())
+    return "recorded in " + session_.folder().string() +
+           "/summary.json (arbci bids export can file it later)";
+  if (!labelsProblem().empty()) return "";
+  try {
+    return "BIDS: " + (bids_root_ / bidsTarget(bids_root_, entitiesOf(session_.labels()))).string();
+  } catch (const BidsError& error) {
+    return error.what();
+  }
 }
 
 const core::Table* SessionModel::settingsSchema() {
@@ -271,9 +310,10 @@ std::string SessionModel::reason() {
 std::vector<ui::OperatorLine> SessionModel::operatorLog() {
   std::vector<ui::OperatorLine> out;
   for (const session::OperatorMessage& m : session_.operatorLog().messages()) {
-    const auto severity = m.severity == session::Severity::Error     ? ui::OperatorLine::Severity::Error
-                          : m.severity == session::Severity::Warning ? ui::OperatorLine::Severity::Warning
-                                                                     : ui::OperatorLine::Severity::Info;
+    const auto severity = m.severity == session::Severity::Error ? ui::OperatorLine::Severity::Error
+                          : m.severity == session::Severity::Warning
+                              ? ui::OperatorLine::Severity::Warning
+                              : ui::OperatorLine::Severity::Info;
     out.push_back({severity, m.t, m.text});
   }
   return out;

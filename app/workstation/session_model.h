@@ -2,6 +2,8 @@
 // what the last cycle's record holds, and the experimenter's actions as requests.
 #pragma once
 
+#include <filesystem>
+
 #include "arbci/session/session.h"
 #include "arbci/ui/workstation_model.h"
 
@@ -9,7 +11,9 @@ namespace arbci::app {
 
 class SessionModel final : public ui::WorkstationModel {
  public:
-  explicit SessionModel(session::Session& session) : session_(session) {}
+  // `bids_root`: where the run is exported when it ends ("" for none).
+  explicit SessionModel(session::Session& session, std::filesystem::path bids_root = {})
+      : session_(session), bids_root_(std::move(bids_root)) {}
 
   cv::Mat cameraImage() override { return record().tracking.left_image; }
   cv::Mat binaryImage() override { return record().tracking.binary; }
@@ -83,6 +87,10 @@ class SessionModel final : public ui::WorkstationModel {
   std::string eegSourceFault() override { return record().eeg.fault; }
   std::vector<ui::StageTiming> timing() override;
   std::string reason() override;
+  core::RunLabels labels() override { return session_.labels(); }
+  std::string setLabels(const core::RunLabels& labels) override;
+  std::string labelsProblem() override;
+  std::string labelsTarget() override;
   const core::Table* settingsSchema() override;
   nlohmann::json settings() override { return session_.config().toJson(); }
   std::string checkSettings(const nlohmann::json& settings, const std::string& file) override;
@@ -99,6 +107,7 @@ class SessionModel final : public ui::WorkstationModel {
   const session::CycleRecord& record() const { return session_.last(); }
   std::vector<std::pair<std::string, std::string>> summaryRows() const;
   session::Session& session_;
+  std::filesystem::path bids_root_;
   std::vector<std::pair<std::string, std::string>> end_rows_;
   vision::ThresholdSettings threshold_;
   std::optional<bci::SignalScope> scope_;

@@ -71,7 +71,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   // Unattended, the session starts itself.
   if (!workstation.wait_for_start && !workstation.unattended)
     session.request(session::StartRequest{});
-  SessionModel model(session);
+  SessionModel model(session, workstation.bids_root);
   ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;
   // Every registered panel, in the registry's order; the summary opens when the session ends.

@@ -16,6 +16,9 @@ struct WorkstationOptions {
   // Nobody at the window (the timing check): the session starts itself and a failed pre-flight
   // ends it, as headless.
   bool unattended = false;
+  // Where the run is exported when it ends (arbci run --bids): the start screen shows the run it
+  // will take.
+  std::filesystem::path bids_root;
 };
 
 int runWorkstation(const session::SessionConfig& config, session::SessionOptions options,

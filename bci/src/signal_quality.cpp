@@ -29,8 +29,7 @@ struct Finding {
   std::string text;
 };
 
-Finding graded(const char* what, double value, double poor, double bad,
-               const char* unit = "uV") {
+Finding graded(const char* what, double value, double poor, double bad, const char* unit = "uV") {
   char text[96];
   if (value > bad) {
     std::snprintf(text, sizeof text, "%s %.1f %s (bad above %g)", what, value, unit, bad);
@@ -57,8 +56,7 @@ const char* toString(Grade grade) {
   return "good";
 }
 
-SignalQuality assessSignal(const float* x, int n, double rate_hz,
-                             const QualityThresholds& t) {
+SignalQuality assessSignal(const float* x, int n, double rate_hz, const QualityThresholds& t) {
   SignalQuality q;
   if (n < 2 || rate_hz <= 0.0) {
     q.finding = "no signal yet";
@@ -111,8 +109,8 @@ SignalQuality assessSignal(const float* x, int n, double rate_hz,
   }
   const bool fifty = q.line50_uv >= q.line60_uv;
   const Finding findings[] = {
-      graded(fifty ? "line noise 50 Hz" : "line noise 60 Hz",
-             fifty ? q.line50_uv : q.line60_uv, t.line_poor_uv, t.line_bad_uv),
+      graded(fifty ? "line noise 50 Hz" : "line noise 60 Hz", fifty ? q.line50_uv : q.line60_uv,
+             t.line_poor_uv, t.line_bad_uv),
       graded("drift", std::abs(q.drift_uv_s), t.drift_poor_uv_s, t.drift_bad_uv_s, "uV/s"),
       graded("RMS", q.rms_uv, t.rms_poor_uv, t.rms_bad_uv),
   };

@@ -167,16 +167,33 @@ void Session::endRun(const std::string& reason, const std::string& kind) {
   for (const auto& stage : stages_) stage->stop(cycle, reason);
   log_->write("session_ended", last_record.time_s, {{"reason", reason}});
   // The terminal prints the end itself (after its status line); the window lists it here.
-  operator_log_.add(last_record.time_s, end_kind_ == "finished" ? Severity::Info : Severity::Error,
-                    "session ended: " + end_kind_ + (reason == end_kind_ ? "" : " (" + reason + ")"));
+  operator_log_.add(
+      last_record.time_s, end_kind_ == "finished" ? Severity::Info : Severity::Error,
+      "session ended: " + end_kind_ + (reason == end_kind_ ? "" : " (" + reason + ")"));
   std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
 }
 
+std::string Session::setLabels(const core::RunLabels& labels) {
+  if (ended_) return "the session has ended";
+  if (last().paradigm.phase != bci::Phase::Setup)
+    return "the session has started: its subject and run are fixed";
+  options_.labels = labels;
+  return "";
+}
+
 nlohmann::json Session::summary() const {
+  const core::RunLabels& l = options_.labels;
   nlohmann::json out = {
-      {"session", config_.source}, {"seed", config_.eeg.seed},       {"ended", end_kind_},
-      {"end_reason", end_reason_}, {"duration_s", last().time_s},    {"frames", frame_},
-      {"cycle", timing_.toJson()}, {"overruns", timing_.overruns()},
+      {"labels",
+       {{"subject", l.subject}, {"session", l.session}, {"task", l.task}, {"run", l.run}}},
+      {"session", config_.source},
+      {"seed", config_.eeg.seed},
+      {"ended", end_kind_},
+      {"end_reason", end_reason_},
+      {"duration_s", last().time_s},
+      {"frames", frame_},
+      {"cycle", timing_.toJson()},
+      {"overruns", timing_.overruns()},
   };
   for (const auto& stage : stages_) stage->report(out);
   return out;

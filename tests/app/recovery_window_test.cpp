@@ -33,17 +33,29 @@ void writeSession(const std::filesystem::path& file) {
 }
 
 // The window at 1280x720 (a laptop screen), its layout file in a fresh folder.
-ProcessResult runScript(const std::filesystem::path& folder, const std::string& script) {
+// `extra`: more options for arbci run; `out`: the session folder (default: FOLDER/out).
+ProcessResult runScript(const std::filesystem::path& folder, const std::string& script,
+                        const std::vector<std::string>& extra = {},
+                        const std::string& out = "out") {
   std::filesystem::create_directories(folder);
   writeSession(folder / "session.json");
   std::ofstream(folder / "script.txt") << script;
   const XvfbServer x("1280x720x24");
-  return runProcess("/usr/bin/env",
-                    {"-u", "XAUTHORITY", "DISPLAY=" + x.display(),
-                     "XDG_CONFIG_HOME=" + (folder / "config").string(), kArbci, "run", "--session",
-                     (folder / "session.json").string(), "--out", (folder / "out").string(),
-                     "--script", (folder / "script.txt").string(), "--exit-when-done"},
-                    420.0);
+  std::vector<std::string> arguments = {"-u",
+                                        "XAUTHORITY",
+                                        "DISPLAY=" + x.display(),
+                                        "XDG_CONFIG_HOME=" + (folder / "config").string(),
+                                        kArbci,
+                                        "run",
+                                        "--session",
+                                        (folder / "session.json").string(),
+                                        "--out",
+                                        (folder / out).string(),
+                                        "--script",
+                                        (folder / "script.txt").string(),
+                                        "--exit-when-done"};
+  arguments.insert(arguments.end(), extra.begin(), extra.end());
+  return runProcess("/usr/bin/env", arguments, 420.0);
 }
 
 std::vector<nlohmann::json> logEvents(const std::filesystem::path& log, const std::string& event) {
@@ -186,7 +198,8 @@ click "EMERGENCY STOP"
 wait "EMERGENCY STOP"
 click "End session"
 pause 0.3
-screenshot )" + (folder / "asked.png").string() + R"(
+screenshot )" + (folder / "asked.png").string() +
+                                                R"(
 click "End now"
 wait "ended by the experimenter"
 screenshot )" + (folder / "ended.png").string() +
@@ -224,7 +237,8 @@ click "Put it back first"
 pause 15
 click "End session"
 pause 0.3
-screenshot )" + (folder / "empty.png").string() + R"(
+screenshot )" + (folder / "empty.png").string() +
+                                                R"(
 click "End now"
 wait "ended" 30
 )");
@@ -262,17 +276,20 @@ type "min_sequences"
 click "paradigm.min_sequences"
 type "0"
 pause 0.3
-screenshot )" + (folder / "refused.png").string() + R"(
+screenshot )" + (folder / "refused.png").string() +
+                                                R"(
 click "paradigm.min_sequences"
 type "3"
 pause 0.3
-screenshot )" + (folder / "fixed.png").string() + R"(
+screenshot )" + (folder / "fixed.png").string() +
+                                                R"(
 key ctrl+q
 )");
   EXPECT_EQ(r.exit_code, 3) << r.err;  // closed before the end
   // The EEG panel and the operator log are there from the start; the EEG's grade marks (green)
   // are drawn.
-  const nlohmann::json eeg = checkScreenshot(folder / "eeg.png", {"Session", "EEG", "Operator log"});
+  const nlohmann::json eeg =
+      checkScreenshot(folder / "eeg.png", {"Session", "EEG", "Operator log"});
   const cv::Mat image = cv::imread((folder / "eeg.png").string(), cv::IMREAD_COLOR);
   int marks = 0;
   for (int y = 0; y < image.rows; ++y)
@@ -293,6 +310,54 @@ key ctrl+q
   const nlohmann::json fixed = checkScreenshot(folder / "fixed.png", {"Settings"});
   EXPECT_TRUE((*button(fixed, "Save", "Settings"))["enabled"].get<bool>())
       << (*button(fixed, "Save", "Settings"));
+}
+
+// The start screen: subject, session, task and run given in the window before Start; with a
+// BIDS root, Start waits for the subject, shows the run it will take, and runs are numbered one
+// after the other.
+TEST(RecoveryWindow, TheSubjectAndRunAreGivenOnTheStartScreenAndRunsAreNumbered) {
+  const auto folder = kArtefacts / "start_screen";
+  std::filesystem::remove_all(folder);
+  const auto root = folder / "bids";
+  const std::vector<std::string> bids = {"--wait-for-start", "--bids", root.string()};
+  const std::string script = R"(pause 1
+screenshot )" + (folder / "empty.png").string() +
+                             R"(
+click "subject"
+type "07"
+click "session"
+type "01"
+pause 0.3
+screenshot )" + (folder / "named.png").string() +
+                             R"(
+click "Start"
+wait "calibration" 60
+pause 1
+key ctrl+q
+)";
+  const ProcessResult first = runScript(folder, script, bids, "out1");
+  EXPECT_EQ(first.exit_code, 3) << first.err;  // closed during the calibration
+  // Before a subject: Start says why not; named, it shows where the run goes.
+  const nlohmann::json empty = readJson(folder / "empty.json");
+  const nlohmann::json* start = button(empty, "Start", "Session");
+  ASSERT_NE(start, nullptr);
+  EXPECT_FALSE((*start)["enabled"].get<bool>());
+  EXPECT_NE((*start)["why_disabled"].get<std::string>().find("give the subject"), std::string::npos)
+      << *start;
+  const nlohmann::json named = readJson(folder / "named.json");
+  EXPECT_TRUE((*button(named, "Start", "Session"))["enabled"].get<bool>());
+  const nlohmann::json summary = readJson(folder / "out1/summary.json");
+  EXPECT_EQ(summary["labels"]["subject"], "07");
+  EXPECT_EQ(summary["labels"]["session"], "01");
+  EXPECT_TRUE(
+      std::filesystem::exists(root / "sub-07/ses-01/eeg/sub-07_ses-01_task-arbci_run-1_eeg.bdf"))
+      << first.err;
+  // The next run of the same subject and session takes run 2.
+  const ProcessResult second = runScript(folder, script, bids, "out2");
+  EXPECT_EQ(second.exit_code, 3) << second.err;
+  EXPECT_TRUE(
+      std::filesystem::exists(root / "sub-07/ses-01/eeg/sub-07_ses-01_task-arbci_run-2_eeg.bdf"))
+      << second.err;
 }
 
 // Ctrl+Q closes the window as the File menu says; the session ends there, its summary saved.

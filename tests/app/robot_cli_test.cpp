@@ -4,11 +4,11 @@
 // run; a motion whose answer was lost is told apart from one that did not run.
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <chrono>

@@ -6,13 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
-#include <optional>
-#include <cmath>
 #include <memory>
+#include <optional>
+#include <random>
 #include <set>
 #include <vector>
 

@@ -111,9 +111,9 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
                              static_cast<int>(std::lround(kTimeBasesS[time_base_] * info.rate_hz)));
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   const float width = std::max(100.0f, ImGui::GetContentRegionAvail().x);
-  const float row = std::clamp((ImGui::GetContentRegionAvail().y * 0.6f - 20.0f) /
-                                   static_cast<float>(std::max(channels, 1)),
-                               8.0f, 60.0f);
+  const float row = std::clamp(
+      (ImGui::GetContentRegionAvail().y * 0.6f - 20.0f) / static_cast<float>(std::max(channels, 1)),
+      8.0f, 60.0f);
   const float plot_x = origin.x + kLabelWidth, plot_w = width - kLabelWidth;
   const float height = row * static_cast<float>(channels);
   ImDrawList* draw = ImGui::GetWindowDrawList();
@@ -128,8 +128,9 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
     char label[16];
     std::snprintf(label, sizeof label, s == 0 ? "now" : "-%d s", s);
     const float label_w = ImGui::CalcTextSize(label).x;
-    draw->AddText(ImVec2(std::min(x - label_w / 2, plot_x + plot_w - label_w), origin.y + height + 2.0f),
-                  IM_COL32(150, 150, 150, 255), label);
+    draw->AddText(
+        ImVec2(std::min(x - label_w / 2, plot_x + plot_w - label_w), origin.y + height + 2.0f),
+        IM_COL32(150, 150, 150, 255), label);
   }
   // Stimulus onsets: a line through every channel.
   const std::int64_t end = scope.endSample();
@@ -144,12 +145,12 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
     const float mid = origin.y + row * (static_cast<float>(c) + 0.5f);
     const bool is_photodiode = info.channels[static_cast<size_t>(c)] == photodiode;
     // The label, in its grade's colour (the photodiode is no EEG: no grade).
-    const ImU32 label_colour =
-        is_photodiode ? IM_COL32(230, 210, 90, 255)
-        : static_cast<size_t>(c) < quality.size() ? gradeColour(quality[static_cast<size_t>(c)].grade)
-                                                  : IM_COL32(150, 150, 150, 255);
-    draw->AddRectFilled(ImVec2(origin.x, mid - row / 2 + 1), ImVec2(origin.x + 8, mid + row / 2 - 1),
-                        label_colour);
+    const ImU32 label_colour = is_photodiode ? IM_COL32(230, 210, 90, 255)
+                               : static_cast<size_t>(c) < quality.size()
+                                   ? gradeColour(quality[static_cast<size_t>(c)].grade)
+                                   : IM_COL32(150, 150, 150, 255);
+    draw->AddRectFilled(ImVec2(origin.x, mid - row / 2 + 1),
+                        ImVec2(origin.x + 8, mid + row / 2 - 1), label_colour);
     // Rows lower than the text: every k-th channel named (the marks and the table name all).
     const int label_every = static_cast<int>(std::ceil(ImGui::GetFontSize() / row));
     if (c % label_every == 0)
@@ -174,7 +175,8 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
     const bool filtered = filtered_ && !is_photodiode;
     const ImU32 colour = is_photodiode ? IM_COL32(230, 210, 90, 255) : IM_COL32(200, 210, 225, 255);
     // A row out of the panel's view costs nothing (many channels in a small panel).
-    if (!ImGui::IsRectVisible(ImVec2(plot_x, mid - row / 2), ImVec2(plot_x + plot_w, mid + row / 2)))
+    if (!ImGui::IsRectVisible(ImVec2(plot_x, mid - row / 2),
+                              ImVec2(plot_x + plot_w, mid + row / 2)))
       continue;
     scope.copyLast(c, shown, filtered, samples_);
     // At most a point a pixel, and at most kPointBudget points a frame over all channels: the
@@ -187,8 +189,10 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
     if (shown > 2 * columns) {
       for (int px = 0; px < columns; ++px) {
         const int k0 = static_cast<int>((static_cast<long long>(px) * shown) / columns);
-        const int k1 = std::max(k0 + 1, static_cast<int>((static_cast<long long>(px + 1) * shown) / columns));
-        const auto [lo_it, hi_it] = std::minmax_element(samples_.begin() + k0, samples_.begin() + k1);
+        const int k1 =
+            std::max(k0 + 1, static_cast<int>((static_cast<long long>(px + 1) * shown) / columns));
+        const auto [lo_it, hi_it] =
+            std::minmax_element(samples_.begin() + k0, samples_.begin() + k1);
         const float x = plot_x + column_w * static_cast<float>(px);
         points_.push_back(ImVec2(x, y(*hi_it)));
         points_.push_back(ImVec2(x + column_w / 2.0f, y(*lo_it)));

@@ -91,8 +91,9 @@ void drawErpPlots(const bci::ErpCurves& erp, const char* target, const char* oth
       if (ms % 200 != 0) continue;
       std::snprintf(label, sizeof label, "%d", ms);
       const float w = ImGui::CalcTextSize(label).x;
-      draw->AddText(ImVec2(std::clamp(bottom.x - w / 2, origin.x, origin.x + width - w), bottom.y + 1),
-                    kAxis, label);
+      draw->AddText(
+          ImVec2(std::clamp(bottom.x - w / 2, origin.x, origin.x + width - w), bottom.y + 1), kAxis,
+          label);
     }
   }
   ImGui::TextDisabled("ms after the stimulus");

@@ -71,14 +71,15 @@ void drawBySequences(const char* id, const std::vector<double>& values, double t
   }
   if (static_cast<int>(low.size()) == n && static_cast<int>(high.size()) == n) {
     for (int k = 0; k + 1 < n; ++k)
-      draw->AddQuadFilled(at(k, high[static_cast<size_t>(k)]), at(k + 1, high[static_cast<size_t>(k + 1)]),
-                          at(k + 1, low[static_cast<size_t>(k + 1)]), at(k, low[static_cast<size_t>(k)]),
-                          kBand);
+      draw->AddQuadFilled(
+          at(k, high[static_cast<size_t>(k)]), at(k + 1, high[static_cast<size_t>(k + 1)]),
+          at(k + 1, low[static_cast<size_t>(k + 1)]), at(k, low[static_cast<size_t>(k)]), kBand);
   }
   for (int k = 0; k + 1 < n; ++k)
-    draw->AddLine(at(k, values[static_cast<size_t>(k)]), at(k + 1, values[static_cast<size_t>(k + 1)]),
-                  kLine, 1.5f);
-  for (int k = 0; k < n; ++k) draw->AddCircleFilled(at(k, values[static_cast<size_t>(k)]), 2.5f, kLine);
+    draw->AddLine(at(k, values[static_cast<size_t>(k)]),
+                  at(k + 1, values[static_cast<size_t>(k + 1)]), kLine, 1.5f);
+  for (int k = 0; k < n; ++k)
+    draw->AddCircleFilled(at(k, values[static_cast<size_t>(k)]), 2.5f, kLine);
 }
 
 }  // namespace

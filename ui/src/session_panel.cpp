@@ -23,7 +23,9 @@ void SessionPanel::draw() {
               model_.sequence(), model_.sessionTime());
   // Every button in its own place whatever the state (disabled with its reason where it cannot
   // act): a double click never lands on a button that took another's place.
-  if (button("Start", model_.whyNot(Action::Start))) model_.start();
+  const std::string labels_problem = model_.started() ? "" : model_.labelsProblem();
+  if (button("Start", !labels_problem.empty() ? labels_problem : model_.whyNot(Action::Start)))
+    model_.start();
   ImGui::SameLine();
   if (button("Pause", model_.whyNot(Action::Pause))) model_.pause();
   ImGui::SameLine();
@@ -41,6 +43,7 @@ void SessionPanel::draw() {
     ImGui::TextWrapped("%s", why.c_str());
     ImGui::PopStyleColor();
   }
+  if (!model_.started() && !model_.ended()) runLabels();
   if (const auto robot = model_.robotStatus(); robot && !robot->stop_reason.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
     ImGui::TextWrapped("robot stopped (%s): the Robot panel's recovery buttons go on from here.",
@@ -99,6 +102,50 @@ void SessionPanel::draw() {
                    top, ImVec2(0, 60));
   heading("selections");
   for (const std::string& line : model_.selections()) ImGui::TextUnformatted(line.c_str());
+}
+
+void SessionPanel::runLabels() {
+  if (!labels_read_) {
+    const core::RunLabels l = model_.labels();
+    std::snprintf(subject_, sizeof subject_, "%s", l.subject.c_str());
+    std::snprintf(visit_, sizeof visit_, "%s", l.session.c_str());
+    std::snprintf(task_, sizeof task_, "%s", l.task.c_str());
+    std::snprintf(run_, sizeof run_, "%s", l.run.c_str());
+    labels_read_ = true;
+  }
+  heading("subject and run");
+  bool changed = false;
+  const float width = std::max(60.0f, (ImGui::GetContentRegionAvail().x - 24.0f) / 4.0f);
+  struct Field {
+    const char* label;
+    const char* hint;
+    char* text;
+    size_t size;
+  };
+  const Field fields[] = {{"subject", "subject (e.g. 07)", subject_, sizeof subject_},
+                          {"session", "session (optional)", visit_, sizeof visit_},
+                          {"task", "task", task_, sizeof task_},
+                          {"run", "run: next free", run_, sizeof run_}};
+  for (size_t i = 0; i < std::size(fields); ++i) {
+    if (i > 0) ImGui::SameLine();
+    ImGui::SetNextItemWidth(width);
+    ImGui::PushID(fields[i].label);
+    changed |= ImGui::InputTextWithHint("##label", fields[i].hint, fields[i].text, fields[i].size);
+    ImGui::PopID();
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("%s (BIDS entity: letters and digits)", fields[i].hint);
+    recordField(fields[i].label, width);
+  }
+  if (changed) labels_refused_ = model_.setLabels({subject_, visit_, task_, run_});
+  if (!labels_refused_.empty()) {
+    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "%s", labels_refused_.c_str());
+  } else if (const std::string problem = model_.labelsProblem(); !problem.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.3f, 1.0f));
+    ImGui::TextWrapped("%s", problem.c_str());
+    ImGui::PopStyleColor();
+  } else {
+    ImGui::TextWrapped("%s", model_.labelsTarget().c_str());
+  }
 }
 
 void SessionPanel::trackingHealth() {

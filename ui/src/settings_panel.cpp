@@ -116,7 +116,8 @@ bool SettingsPanel::editKey(const core::Key& key, nlohmann::json& value, const s
     }
     case core::Type::Text: {
       const std::string current = value.is_string() ? value.get<std::string>() : "";
-      const std::vector<std::string> choices = key.choices ? key.choices() : std::vector<std::string>{};
+      const std::vector<std::string> choices =
+          key.choices ? key.choices() : std::vector<std::string>{};
       if (!choices.empty()) {
         if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
           for (const std::string& c : choices) {

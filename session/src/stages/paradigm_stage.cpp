@@ -569,15 +569,15 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
           currentTrial().outcome = "returned: cell " + std::to_string(e.cell.first) + "," +
                                    std::to_string(e.cell.second) + " is taken by object " +
                                    std::to_string(*other);
-          s_.tell.say(time, Severity::Warning,
-                      "trial " + std::to_string(currentTrial().trial) + ": " +
-                          currentTrial().outcome);
+          s_.tell.say(
+              time, Severity::Warning,
+              "trial " + std::to_string(currentTrial().trial) + ": " + currentTrial().outcome);
         }
         if (e.give_back) {
           currentTrial().outcome = "returned: the ErrP rejected every cell selected";
-          s_.tell.say(time, Severity::Warning,
-                      "trial " + std::to_string(currentTrial().trial) + ": " +
-                          currentTrial().outcome);
+          s_.tell.say(
+              time, Severity::Warning,
+              "trial " + std::to_string(currentTrial().trial) + ": " + currentTrial().outcome);
         }
         cycle.post(
             DropRequest{currentTrial().trial, e.cell, other.has_value() || e.give_back, time});
@@ -601,7 +601,8 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
         last_trial_end_ = time;
         s_.log.write("trial_done", time, {{"trial", e.trial}, {"text", e.text}});
         if (e.trial >= 1 && e.trial <= static_cast<int>(trials_.size()))
-          s_.tell.say(time, Severity::Info, selectionLine(trials_[static_cast<size_t>(e.trial - 1)]));
+          s_.tell.say(time, Severity::Info,
+                      selectionLine(trials_[static_cast<size_t>(e.trial - 1)]));
         break;
     }
   }

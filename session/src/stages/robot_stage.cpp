@@ -232,8 +232,7 @@ void RobotStage::handleEvents(RobotPart& out, double time_s) {
         e.sequence == 0 ? std::string(robot::toString(e.kind))
                         : std::string(robot::toString(e.kind)) + " " + robot::toString(e.command);
     messages_.push_back(what + (e.text.empty() ? "" : ": " + e.text));
-    const bool bad = e.kind == Kind::Rejected || e.kind == Kind::Failed ||
-                     e.kind == Kind::Silent ||
+    const bool bad = e.kind == Kind::Rejected || e.kind == Kind::Failed || e.kind == Kind::Silent ||
                      (e.kind == Kind::Finished && e.outcome != robot::Outcome::Success);
     if (bad) s_.tell.say(time_s, Severity::Error, "robot: " + messages_.back());
     ++messages_added_;

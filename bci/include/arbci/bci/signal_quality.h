@@ -22,7 +22,7 @@ struct QualityThresholds {
   double line_bad_uv = 20.0;
   double drift_poor_uv_s = 50.0;  // the window's linear trend
   double drift_bad_uv_s = 200.0;
-  double rms_poor_uv = 50.0;      // about the trend
+  double rms_poor_uv = 50.0;  // about the trend
   double rms_bad_uv = 100.0;
 };
 
@@ -38,6 +38,6 @@ struct SignalQuality {
 // `x`: `n` raw samples of one channel at `rate_hz` (two seconds make the 50/60 Hz amplitudes
 // exact to 0.5 Hz).
 SignalQuality assessSignal(const float* x, int n, double rate_hz,
-                             const QualityThresholds& thresholds = {});
+                           const QualityThresholds& thresholds = {});
 
 }  // namespace arbci::bci

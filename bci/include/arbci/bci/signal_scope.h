@@ -26,7 +26,7 @@ class SignalScope {
   void markStimulus(std::int64_t sample);
 
   const SignalInfo& info() const { return info_; }
-  int capacity() const { return capacity_; }  // samples kept per channel
+  int capacity() const { return capacity_; }       // samples kept per channel
   std::int64_t endSample() const { return end_; }  // one past the newest sample
   // Sample `k` samples before the newest (0: the newest) of `channel`, raw or filtered; 0 before
   // the first sample.

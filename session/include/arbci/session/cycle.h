@@ -90,7 +90,7 @@ struct Presentation {
 
 struct EegPart {
   std::shared_ptr<const bci::SignalInfo> info;  // every channel as acquired (names, rate)
-  std::vector<bci::Block> blocks;      // as acquired: every channel (the photodiode too)
+  std::vector<bci::Block> blocks;               // as acquired: every channel (the photodiode too)
   std::vector<bci::Block> eeg_blocks;  // the EEG channels only (filters, epochs, classifiers)
   std::vector<bci::SampleLoss> losses;
   std::string fault;        // why a live source delivers nothing now; empty while it does

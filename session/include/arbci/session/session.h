@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "arbci/core/run_labels.h"
 #include "arbci/session/clock.h"
 #include "arbci/session/cycle.h"
 #include "arbci/session/cycle_timing.h"
@@ -50,6 +51,8 @@ struct SessionOptions {
   // exist), one line each naming its key: the pre-flight fails with these before any flash.
   std::vector<std::string> display_failures;
   std::ostream* progress = nullptr;
+  // Who and which run (the start screen may change them until Start).
+  core::RunLabels labels;
 };
 
 // The application's display stage (the HMD's renderer), made once the other stages exist;
@@ -83,6 +86,9 @@ class Session {
   // whyNot() gives. An emergency stop goes to the arm at once.
   bool request(Request request);
   std::string whyNot(Action action) const { return session::whyNot(action, last(), ended_); }
+  // The run's labels: set until the session starts (then "" is returned), else why not.
+  std::string setLabels(const core::RunLabels& labels);
+  const core::RunLabels& labels() const { return options_.labels; }
 
   // What the last cycle produced (the panels read it).
   const CycleRecord& last() const { return records_[current_]; }

@@ -117,6 +117,11 @@ class SessionPanel final : public Panel {
  private:
   // "tracking lost" for the reference marker and each object seen too long ago.
   void trackingHealth();
+  // Before Start: subject, session, task and run, and where the run will be written.
+  void runLabels();
+  bool labels_read_ = false;
+  char subject_[64] = "", visit_[64] = "", task_[64] = "", run_[16] = "";
+  std::string labels_refused_;
   WorkstationModel& model_;
   std::vector<float> history_;
 };

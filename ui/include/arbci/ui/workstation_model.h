@@ -12,11 +12,12 @@
 #include <nlohmann/json.hpp>
 
 #include "arbci/bci/erp.h"
-#include "arbci/core/schema.h"
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/signal_scope.h"
+#include "arbci/core/run_labels.h"
+#include "arbci/core/schema.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/vision/camera_model.h"
 #include "arbci/vision/marker.h"
@@ -85,7 +86,8 @@ class WorkstationModel {
   // saving it ("saved FILE" or why not).
   virtual const core::Table* settingsSchema() { return nullptr; }
   virtual nlohmann::json settings() { return nlohmann::json::object(); }
-  virtual std::string checkSettings(const nlohmann::json& /*settings*/, const std::string& /*file*/) {
+  virtual std::string checkSettings(const nlohmann::json& /*settings*/,
+                                    const std::string& /*file*/) {
     return "";
   }
   virtual std::string saveSettings(const nlohmann::json& /*settings*/, const std::string& file) {
@@ -121,6 +123,14 @@ class WorkstationModel {
   virtual void retryStep() = 0;
   virtual void skipTrial() = 0;
   virtual void endSession() = 0;
+
+  // Who and which run: editable until Start. setLabels() takes them ("" when taken, else why
+  // not); labelsProblem() says what stops a start with them ("" when none); labelsTarget() where
+  // the run will be written ("BIDS: sub-07/eeg, ..., run 2 (the next free)", or the folder).
+  virtual core::RunLabels labels() { return {}; }
+  virtual std::string setLabels(const core::RunLabels& /*labels*/) { return "not here"; }
+  virtual std::string labelsProblem() { return ""; }
+  virtual std::string labelsTarget() { return ""; }
 
   // Session.
   virtual std::string phase() = 0;

@@ -1,0 +1,18 @@
+// Who and which run a session records: the subject, the session (a visit), the task and the run,
+// as the experimenter gives them on the start screen (or on the command line). They go into the
+// session folder's summary.json and, with a BIDS root, name the run in the dataset.
+#pragma once
+
+#include <string>
+
+namespace arbci::core {
+
+struct RunLabels {
+  std::string subject;  // letters and digits (BIDS)
+  std::string session;  // optional
+  std::string task = "arbci";
+  std::string run;  // optional: empty for the next free run
+  bool operator==(const RunLabels&) const = default;
+};
+
+}  // namespace arbci::core
