@@ -60,28 +60,29 @@ void EegView::setTimeBase(double seconds) {
     ++time_base_;
 }
 
+namespace {
+
+// A choice among `values`, each shown with `format`; `index` the chosen one.
+template <size_t N>
+void choice(const char* label, const float (&values)[N], const char* format, float width,
+            int& index) {
+  ImGui::SetNextItemWidth(width);
+  char text[32];
+  std::snprintf(text, sizeof text, format, values[index]);
+  if (!ImGui::BeginCombo(label, text)) return;
+  for (int i = 0; i < static_cast<int>(N); ++i) {
+    std::snprintf(text, sizeof text, format, values[i]);
+    if (ImGui::Selectable(text, i == index)) index = i;
+  }
+  ImGui::EndCombo();
+}
+
+}  // namespace
+
 void EegView::drawControls() {
-  ImGui::SetNextItemWidth(110.0f);
-  char scale[32];
-  std::snprintf(scale, sizeof scale, "+/-%g uV", kScalesUv[scale_]);
-  if (ImGui::BeginCombo("scale (per row)", scale)) {
-    for (int i = 0; i < static_cast<int>(std::size(kScalesUv)); ++i) {
-      std::snprintf(scale, sizeof scale, "+/-%g uV", kScalesUv[i]);
-      if (ImGui::Selectable(scale, i == scale_)) scale_ = i;
-    }
-    ImGui::EndCombo();
-  }
+  choice("scale (per row)", kScalesUv, "+/-%g uV", 110.0f, scale_);
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(80.0f);
-  char base[16];
-  std::snprintf(base, sizeof base, "%g s", kTimeBasesS[time_base_]);
-  if (ImGui::BeginCombo("time base", base)) {
-    for (int i = 0; i < static_cast<int>(std::size(kTimeBasesS)); ++i) {
-      std::snprintf(base, sizeof base, "%g s", kTimeBasesS[i]);
-      if (ImGui::Selectable(base, i == time_base_)) time_base_ = i;
-    }
-    ImGui::EndCombo();
-  }
+  choice("time base", kTimeBasesS, "%g s", 80.0f, time_base_);
   ImGui::SameLine();
   ImGui::Checkbox("filter", &filtered_);
   if (ImGui::IsItemHovered())
