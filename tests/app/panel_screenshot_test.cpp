@@ -48,6 +48,21 @@ TEST(PanelScreenshot, TheTrainingPanelPlotsTheSessionsTargetAndNonTargetAverages
   EXPECT_GT(blue, 1000);
 }
 
+// The EEG panel on the simulated subject's live signal: every channel graded (green marks), the
+// photodiode in yellow.
+TEST(PanelScreenshot, TheEegPanelShowsTheLiveChannelsWithTheirQuality) {
+  const cv::Mat image = screenshot("eeg");
+  ASSERT_FALSE(image.empty());
+  const int green = count(image, [](const cv::Vec3b& p) {
+    return std::abs(p[2] - 70) < 12 && std::abs(p[1] - 190) < 12 && std::abs(p[0] - 90) < 12;
+  });
+  const int yellow = count(image, [](const cv::Vec3b& p) {
+    return std::abs(p[2] - 230) < 15 && std::abs(p[1] - 210) < 15 && std::abs(p[0] - 90) < 15;
+  });
+  EXPECT_GT(green, 300);
+  EXPECT_GT(yellow, 100);
+}
+
 TEST(PanelScreenshot, TheHmdViewShowsBothEyesWithThePhotodiodePatchAndTheGrid) {
   const cv::Mat image = screenshot("hmd");
   ASSERT_FALSE(image.empty());
