@@ -30,6 +30,9 @@ ImGuiLayer::ImGuiLayer(render::GlContext& context, const std::string& ini_path)
     io.Fonts->AddFontDefault();
   }
   ImGui::StyleColorsDark();
+  // Opaque panels: one over another (the summary, a dialog) must not show the other's text.
+  ImGui::GetStyle().Colors[ImGuiCol_WindowBg].w = 1.0f;
+  ImGui::GetStyle().Colors[ImGuiCol_PopupBg].w = 1.0f;
   ImGui::GetStyle().WindowRounding = 3.0f;
 
   context_.makeCurrent();

@@ -18,6 +18,7 @@ std::string seconds(double s) {
 
 void SessionPanel::draw() {
   using Action = WorkstationModel::Action;
+  // One line (a narrow panel cuts it; the reason below wraps): the buttons stay where they are.
   ImGui::Text("%s", model_.phase().c_str());
   ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", model_.trial(), model_.trials(),
               model_.sequence(), model_.sessionTime());
@@ -44,7 +45,8 @@ void SessionPanel::draw() {
     ImGui::PopStyleColor();
   }
   if (!model_.started() && !model_.ended()) runLabels();
-  if (const auto robot = model_.robotStatus(); robot && !robot->stop_reason.empty()) {
+  if (const auto robot = model_.robotStatus();
+      robot && !robot->stop_reason.empty() && !model_.ended()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
     ImGui::TextWrapped("robot stopped (%s): the Robot panel's recovery buttons go on from here.",
                        robot->stop_reason.c_str());
