@@ -2,24 +2,12 @@
 // warnings), with its session time, filterable by severity and by text.
 #include <imgui.h>
 
-#include <algorithm>
-#include <cctype>
-
 #include "arbci/ui/panel_registry.h"
 #include "arbci/ui/panels.h"
 #include "widgets.h"
 
 namespace arbci::ui {
 namespace {
-
-bool containsIgnoringCase(const std::string& text, const char* needle) {
-  if (!*needle) return true;
-  const std::string n(needle);
-  return std::search(text.begin(), text.end(), n.begin(), n.end(), [](char a, char b) {
-           return std::tolower(static_cast<unsigned char>(a)) ==
-                  std::tolower(static_cast<unsigned char>(b));
-         }) != text.end();
-}
 
 ImVec4 colour(OperatorLine::Severity severity) {
   switch (severity) {

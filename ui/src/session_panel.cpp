@@ -24,7 +24,8 @@ void SessionPanel::draw() {
               model_.sequence(), model_.sessionTime());
   // Every button in its own place whatever the state (disabled with its reason where it cannot
   // act): a double click never lands on a button that took another's place.
-  const std::string labels_problem = model_.started() ? "" : model_.labelsProblem();
+  if (!labels_read_) readLabels();
+  const std::string& labels_problem = model_.started() ? std::string() : labels_problem_;
   if (button("Start", !labels_problem.empty() ? labels_problem : model_.whyNot(Action::Start)))
     model_.start();
   ImGui::SameLine();
@@ -106,15 +107,23 @@ void SessionPanel::draw() {
   for (const std::string& line : model_.selections()) ImGui::TextUnformatted(line.c_str());
 }
 
+void SessionPanel::readLabels() {
+  const core::RunLabels l = model_.labels();
+  std::snprintf(subject_, sizeof subject_, "%s", l.subject.c_str());
+  std::snprintf(visit_, sizeof visit_, "%s", l.session.c_str());
+  std::snprintf(task_, sizeof task_, "%s", l.task.c_str());
+  std::snprintf(run_, sizeof run_, "%s", l.run.c_str());
+  labels_read_ = true;
+  checkLabels();
+}
+
+void SessionPanel::checkLabels() {
+  // Once per change, not per frame: the target looks through the BIDS dataset's folders.
+  labels_problem_ = model_.labelsProblem();
+  labels_target_ = labels_problem_.empty() ? model_.labelsTarget() : "";
+}
+
 void SessionPanel::runLabels() {
-  if (!labels_read_) {
-    const core::RunLabels l = model_.labels();
-    std::snprintf(subject_, sizeof subject_, "%s", l.subject.c_str());
-    std::snprintf(visit_, sizeof visit_, "%s", l.session.c_str());
-    std::snprintf(task_, sizeof task_, "%s", l.task.c_str());
-    std::snprintf(run_, sizeof run_, "%s", l.run.c_str());
-    labels_read_ = true;
-  }
   heading("subject and run");
   bool changed = false;
   const float width = std::max(60.0f, (ImGui::GetContentRegionAvail().x - 24.0f) / 4.0f);
@@ -138,15 +147,18 @@ void SessionPanel::runLabels() {
       ImGui::SetTooltip("%s (BIDS entity: letters and digits)", fields[i].hint);
     recordField(fields[i].label, width);
   }
-  if (changed) labels_refused_ = model_.setLabels({subject_, visit_, task_, run_});
+  if (changed) {
+    labels_refused_ = model_.setLabels({subject_, visit_, task_, run_});
+    checkLabels();
+  }
   if (!labels_refused_.empty()) {
     ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "%s", labels_refused_.c_str());
-  } else if (const std::string problem = model_.labelsProblem(); !problem.empty()) {
+  } else if (!labels_problem_.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.3f, 1.0f));
-    ImGui::TextWrapped("%s", problem.c_str());
+    ImGui::TextWrapped("%s", labels_problem_.c_str());
     ImGui::PopStyleColor();
   } else {
-    ImGui::TextWrapped("%s", model_.labelsTarget().c_str());
+    ImGui::TextWrapped("%s", labels_target_.c_str());
   }
 }
 

@@ -5,7 +5,6 @@
 #include <imgui.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <sstream>
 
@@ -16,14 +15,6 @@
 
 namespace arbci::ui {
 namespace {
-
-bool matches(const std::string& text, const std::string& filter) {
-  if (filter.empty()) return true;
-  return std::search(text.begin(), text.end(), filter.begin(), filter.end(), [](char a, char b) {
-           return std::tolower(static_cast<unsigned char>(a)) ==
-                  std::tolower(static_cast<unsigned char>(b));
-         }) != text.end();
-}
 
 // "a, b, c" for a list of numbers or texts, as typed.
 std::string listText(const nlohmann::json& list) {
@@ -189,7 +180,9 @@ bool SettingsPanel::editTable(const core::Table& table, nlohmann::json& object,
       }
       continue;
     }
-    if (filter_[0] && !matches(here, filter_) && !matches(key.doc, filter_)) continue;
+    if (filter_[0] && !containsIgnoringCase(here, filter_) &&
+        !containsIgnoringCase(key.doc, filter_))
+      continue;
     if (filter_[0]) ImGui::TextDisabled("%s", path.c_str());
     changed |= editKey(key, value, here);
   }

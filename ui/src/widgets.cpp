@@ -3,6 +3,7 @@
 #include <imgui_internal.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
@@ -52,6 +53,13 @@ bool button(const char* label, const std::string& why_not, bool small) {
     ImGui::SetTooltip("%s", why_not.c_str());
   record(label, enabled, why_not, pressed && enabled);
   return pressed && enabled;
+}
+
+bool containsIgnoringCase(const std::string& text, const std::string& needle) {
+  return std::search(text.begin(), text.end(), needle.begin(), needle.end(), [](char a, char b) {
+           return std::tolower(static_cast<unsigned char>(a)) ==
+                  std::tolower(static_cast<unsigned char>(b));
+         }) != text.end();
 }
 
 void recordField(const std::string& label, float width) {

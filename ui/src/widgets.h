@@ -21,6 +21,9 @@ inline void heading(const char* text) {
 // says why not). Recorded for scripted clicks (widget_registry.h). Returns true when pressed.
 bool button(const char* label, const std::string& why_not = "", bool small = false);
 
+// Whether `text` holds `needle`, ignoring case (the panels' filter boxes); an empty needle: yes.
+bool containsIgnoringCase(const std::string& text, const std::string& needle);
+
 // Records the last item (a text or number field) under `label`, for a scripted click to find it
 // (widget_registry.h); "clicked" there means the field took the keyboard.
 // `width`: the field's own (its label beside it is not part of what a click should hit).

@@ -119,9 +119,11 @@ class SessionPanel final : public Panel {
   void trackingHealth();
   // Before Start: subject, session, task and run, and where the run will be written.
   void runLabels();
+  void readLabels();   // the model's labels into the fields, once
+  void checkLabels();  // what stops a start with them, and where the run goes
   bool labels_read_ = false;
   char subject_[64] = "", visit_[64] = "", task_[64] = "", run_[16] = "";
-  std::string labels_refused_;
+  std::string labels_refused_, labels_problem_, labels_target_;
   WorkstationModel& model_;
   std::vector<float> history_;
 };
