@@ -103,11 +103,25 @@ SimulatedWorld::Frame SimulatedWorld::capture(render::SimulatedCamera& camera, C
   return {cache.image, true};
 }
 
+void SimulatedWorld::coverAt(double t) {
+  for (size_t i = 0; i < scene_.objects.size(); ++i) {
+    const std::vector<double>& spans = settings_.world.objects[i].covered_s;
+    bool covered = false;
+    for (size_t k = 0; k + 1 < spans.size(); k += 2) covered |= t >= spans[k] && t < spans[k + 1];
+    if (scene_.objects[i].covered != covered) {
+      scene_.objects[i].covered = covered;
+      ++scene_revision_;
+    }
+  }
+}
+
 SimulatedWorld::Frame SimulatedWorld::captureLeft(double t) {
+  coverAt(t);
   return capture(*left_, left_cache_, leftCamera(t));
 }
 
 SimulatedWorld::Frame SimulatedWorld::captureRight(double t) {
+  coverAt(t);
   return capture(*right_, right_cache_, rightCamera(t));
 }
 

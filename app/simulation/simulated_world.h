@@ -35,7 +35,8 @@ class SimulatedWorld {
     bool changed = true;  // false: nothing in view moved since this camera's last frame (the same)
   };
   // One camera's frame at time `t` (the cycle renders the two on alternate frames, so no cycle
-  // pays for both). A frame is rendered again only when the head, an object or the gripper moved.
+  // pays for both). A frame is rendered again only when the head, an object, the gripper or a
+  // hand over a marker moved.
   Frame captureLeft(double t);
   Frame captureRight(double t);
   const render::Scene& scene() const { return scene_; }
@@ -56,6 +57,8 @@ class SimulatedWorld {
     cv::Mat image;
   };
   Frame capture(render::SimulatedCamera& camera, Cache& cache, const vision::Pose& pose);
+  // The hands over markers at time `t` (world.objects[].covered_s).
+  void coverAt(double t);
   std::uint64_t scene_revision_ = 1;
   int board_pose_ = 0;
   Cache left_cache_, right_cache_;

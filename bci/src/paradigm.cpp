@@ -483,6 +483,32 @@ void Paradigm::restartSequence() {
   scheduleSequence(nextFrame());
 }
 
+void Paradigm::returnToFlashing(Phase phase) {
+  if (phase == Phase::CalibrationFlashing && !awaiting_decision_) {
+    retakeCalibrationSelection();
+  } else if (phase == Phase::CalibrationFlashing || phase == Phase::ObjectFlashing ||
+             phase == Phase::CellFlashing) {
+    restartSequence();
+  }
+}
+
+void Paradigm::retakeCalibrationSelection() {
+  // Training needs whole selections: flashes on both sides of a pause (or with some withheld)
+  // would be split into pieces at the gap. The same target is cued again and flashed from the
+  // first sequence; the session leaves the interrupted flashes out of training.
+  schedule_.clear();
+  next_flash_ = 0;
+  sequence_ = 0;
+  ++calibration_retakes_;
+  phase_until_ = now_ + settings_.cue_s;
+  enter(Phase::CalibrationCue,
+        objectName(*calibration_target_) + " again (the selection was interrupted)");
+  ParadigmEvent e{ParadigmEvent::Kind::SelectionStarted};
+  e.codes = {*calibration_target_};
+  e.retake = true;
+  event(e);
+}
+
 std::optional<Phase> Paradigm::interrupted() const {
   if (phase_ != Phase::EmergencyStop && phase_ != Phase::RobotFault) return std::nullopt;
   return paused_from_;
@@ -492,11 +518,8 @@ void Paradigm::resume() {
   if (phase_ == Phase::Paused) {
     const Phase back = paused_from_;
     phase_until_ += now_;
-    enter(back, "resumed");
-    if (back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing ||
-        back == Phase::CellFlashing) {
-      restartSequence();
-    }
+    if (back != Phase::CalibrationFlashing || awaiting_decision_) enter(back, "resumed");
+    returnToFlashing(back);
     return;
   }
   const auto was = interrupted();
@@ -516,12 +539,11 @@ void Paradigm::retryStep() {
     askRobot(*was);
     return;
   }
-  enter(*was, std::string("resumed after the ") +
-                  (phase_ == Phase::EmergencyStop ? "emergency stop" : "robot fault"));
-  if (*was == Phase::CalibrationFlashing || *was == Phase::ObjectFlashing ||
-      *was == Phase::CellFlashing) {
-    restartSequence();
+  if (*was != Phase::CalibrationFlashing || awaiting_decision_) {
+    enter(*was, std::string("resumed after the ") +
+                    (phase_ == Phase::EmergencyStop ? "emergency stop" : "robot fault"));
   }
+  returnToFlashing(*was);
   // A timed phase (cue, selection shown) starts its time again.
   if (*was == Phase::CalibrationCue) phase_until_ = now_ + settings_.cue_s;
   if (*was == Phase::ObjectSelected || *was == Phase::CellSelected)

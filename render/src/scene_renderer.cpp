@@ -154,8 +154,16 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
   // test (which costs llvmpipe more than the drawing).
   const size_t flat = solid.size();
   // Objects: coloured sides, a white top carrying the marker.
-  for (const SceneObject& o : scene.objects)
+  for (const SceneObject& o : scene.objects) {
     box(solid, o.T_world_top, o.width_m, o.width_m, o.height_m, o.color, glm::vec3(0.95f));
+    if (o.covered) {
+      // A hand, flat, two centimetres above the marker and wider than it.
+      const glm::vec3 skin(0.87f, 0.68f, 0.56f);
+      vision::Pose hand = o.T_world_top;
+      hand.translation += o.T_world_top.rotation * cv::Vec3d(0.01, 0.0, 0.035);
+      box(solid, hand, o.marker.side_m * 1.8, o.marker.side_m * 1.5, 0.015, skin, skin);
+    }
+  }
   if (scene.gripper) {
     const cv::Vec3d t = scene.gripper->tool;
     const double gap = 0.02 + 0.05 * scene.gripper->opening;

@@ -147,7 +147,19 @@ const Schema<WorldObjectSettings>& objectSchema() {
         .number("width_m", &O::width_m, 0.07, 0.005, 0.6, "its width (at least the marker's)", "m")
         .number("height_m", &O::height_m, 0.06, 0.005, 0.6, "its height", "m");
     vec3(t, "color", &O::color, {0.8, 0.4, 0.3}, "its colour (red, green, blue, 0-1)");
+    t.numbers("covered_s", &O::covered_s, {}, 0, 16,
+              "simulated cameras: a hand lies over its marker from each first to each second "
+              "session time, e.g. [20, 23] (a tracking loss to rehearse; empty: never)",
+              "s");
     t.rule([](const Json& o) -> Broken {
+      const Json& covered = o["covered_s"];
+      bool ordered = covered.size() % 2 == 0;
+      for (size_t i = 0; ordered && i + 1 < covered.size(); ++i)
+        ordered = covered[i].get<double>() < covered[i + 1].get<double>();
+      if (!ordered)
+        return std::pair{"covered_s", "= " + covered.dump() +
+                                          " must be pairs of session times [from, to, ...], "
+                                          "each later than the one before"};
       if (o["width_m"].get<double>() < o["marker_m"].get<double>())
         return std::pair{"width_m", "= " + o["width_m"].dump() + " must lie in [" +
                                         o["marker_m"].dump() + ", 0.6] (at least the marker)"};

@@ -1,19 +1,23 @@
 // The pre-flight check before any flash, through the real executable headless: a camera whose
 // video does not show the reference marker, and a remote robot that never answers, each end the
 // run before the calibration run starts (exit 3), naming the session file's key; the default
-// simulated session passes it.
+// simulated session passes it. Tracking lost once the run is on: every object out of view, and a
+// marker covered during the calibration run (its selection retaken).
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "arbci/bci/recording.h"
 #include "support/run_process.h"
 #include "support/test_files.h"
 
@@ -123,6 +127,94 @@ TEST(NoObjectInView, AHeadlessRunEndsWithTheReasonAfterTheSetting) {
   for (const nlohmann::json& e : logOf(out))
     logged |= e["event"] == "paused" && e["reason"].get<std::string>() == reason;
   EXPECT_TRUE(logged);
+}
+
+// The session's defaults with a hand over object 40's marker at `covered_s` (session seconds),
+// a short calibration run and one trial.
+std::filesystem::path coveredSession(const std::filesystem::path& folder,
+                                     const std::vector<double>& covered_s, double pause_s) {
+  std::filesystem::create_directories(folder);
+  const ProcessResult settings = runProcess(kArbci, {"settings"});
+  EXPECT_EQ(settings.exit_code, 0) << settings.err;
+  nlohmann::json objects = nlohmann::json::parse(settings.out)["world"]["objects"];
+  for (auto& o : objects)
+    if (o["id"] == 40) o["covered_s"] = covered_s;
+  const auto session = folder / "session.json";
+  std::ofstream(session) << nlohmann::json{
+      {"world", {{"objects", objects}}},
+      {"paradigm",
+       {{"calibration_selections", 4},
+        {"trials", 1},
+        {"no_view_pause_s", pause_s},
+        {"intended", {{{"object", 20}, {"cell", {1, 3}}}}}}},
+      {"robot",
+       {{"speed_factor", 20}}}}.dump();
+  return session;
+}
+
+// A hand over one marker for 3 s during the calibration run (longer than a cue and its pause, so
+// it always meets flashes, and late enough for the run to have started): the selection it cuts
+// is paused, retaken with the same target once the marker is seen again, and left out of
+// training, which reports the selections it used; the run still trains on 4 whole selections.
+TEST(TrackingLoss, ACalibrationSelectionCutByACoveredMarkerIsRetakenAndLeftOutOfTraining) {
+  const auto folder = freshTempPath("preflight_test", "covered_in_calibration");
+  const auto session = coveredSession(folder, {20.0, 23.0}, 10.0);
+  const auto out = folder / "out";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 600.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["ended"], "finished");
+  const nlohmann::json& calibration = summary["calibration"];
+  ASSERT_EQ(calibration["retaken"].size(), 1u) << calibration.dump();
+  const nlohmann::json& retake = calibration["retaken"][0];
+  EXPECT_EQ(retake["reason"], "tracking lost: object 40");
+  const int cut = retake["selection"].get<int>();
+  EXPECT_EQ(retake["retaken_as"].get<int>(), cut + 1);
+  EXPECT_EQ(calibration["selections"], 4);
+  const auto used = calibration["selections_used"].get<std::vector<int>>();
+  EXPECT_EQ(used.size(), 4u);
+  EXPECT_EQ(std::count(used.begin(), used.end(), cut), 0);
+  EXPECT_EQ(std::count(used.begin(), used.end(), cut + 1), 1);
+  // The retake cues the same object; the log says why it paused, and training what it used.
+  std::map<int, int> targets;  // selection number: its cued object
+  int selection = 0;
+  bool paused = false, trained = false;
+  for (const nlohmann::json& e : logOf(out)) {
+    if (e["event"] == "calibration_target") targets[++selection] = e["object"].get<int>();
+    if (e["event"] == "paused")
+      paused |=
+          e["reason"].get<std::string>().find("object 40's flash withheld") != std::string::npos;
+    if (e["event"] == "trained")
+      trained = e["selections_used"].get<std::vector<int>>() == used &&
+                e["selections_left_out"] == nlohmann::json{cut};
+  }
+  EXPECT_TRUE(paused);
+  EXPECT_TRUE(trained);
+  EXPECT_EQ(targets.at(cut), targets.at(cut + 1));
+  EXPECT_EQ(targets.size(), 5u);
+  // The recording keeps the interrupted flashes, and says they were left out.
+  bool annotated = false;
+  for (const auto& a : bci::readRecording(out / "recording.bdf").annotations)
+    annotated |=
+        a.text.rfind("Calibration selection " + std::to_string(cut) + " interrupted", 0) == 0;
+  EXPECT_TRUE(annotated);
+}
+
+// The marker stays covered: headless, nobody can uncover it, so the run ends with the reason
+// after paradigm.no_view_pause_s.
+TEST(TrackingLoss, AMarkerCoveredForGoodInCalibrationEndsAHeadlessRunWithTheReason) {
+  const auto folder = freshTempPath("preflight_test", "covered_for_good");
+  const auto session = coveredSession(folder, {20.0, 1e6}, 4.0);
+  const auto out = folder / "out";
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 600.0);
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["ended"], "aborted");
+  EXPECT_EQ(summary["end_reason"],
+            "tracking lost: the reference marker or objects (40) lost for 4 s "
+            "(paradigm.no_view_pause_s), during calibration");
 }
 
 // A file that is not a video at all is refused as the camera opens, before the session starts.

@@ -100,6 +100,59 @@ TEST(Paradigm, CalibrationRunCuesTargetsThenAsksForTraining) {
   EXPECT_EQ(p.trial(), 1);
 }
 
+// A calibration selection interrupted part-way (a pause, an emergency stop) is retaken: the same
+// target cued again and every sequence flashed anew, so training gets whole selections; the run
+// still has its number of whole selections. One interrupted after its last flash is kept.
+TEST(Paradigm, AnInterruptedCalibrationSelectionIsRetakenWithTheSameTarget) {
+  Paradigm p(fast(), 4, 3, 3, 2);
+  std::int64_t frame = 0;
+  p.start(true);
+  p.takeEvents();
+  const int target = *p.calibrationTarget();
+  int flashes = 0;
+  auto count = [&] {
+    for (auto& e : p.takeEvents()) flashes += e.kind == Kind::Flash;
+    return flashes >= 5;
+  };
+  for (int i = 0; i < 500 && !count(); ++i) p.frame(frame++);
+  ASSERT_EQ(p.phase(), Phase::CalibrationFlashing);
+  p.pause();
+  for (int i = 0; i < 30; ++i) EXPECT_TRUE(p.frame(frame++).lit.empty());
+  p.takeEvents();
+  p.resume();
+  EXPECT_EQ(p.phase(), Phase::CalibrationCue);
+  EXPECT_EQ(p.calibrationTarget(), target);
+  EXPECT_EQ(p.calibrationRetakes(), 1);
+  auto events = p.takeEvents();
+  const auto started = std::find_if(events.begin(), events.end(), [](const ParadigmEvent& e) {
+    return e.kind == Kind::SelectionStarted;
+  });
+  ASSERT_NE(started, events.end());
+  EXPECT_TRUE(started->retake);
+  EXPECT_EQ(started->codes, std::set<int>{target});
+  // The retake flashes all three sequences from the start.
+  events = runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  EXPECT_EQ(std::count_if(events.begin(), events.end(),
+                          [](const ParadigmEvent& e) { return e.kind == Kind::Flash; }),
+            12);
+  // An emergency stop after the last flash, before the decision: nothing to retake.
+  p.emergencyStop();
+  p.retryStep();
+  EXPECT_EQ(p.phase(), Phase::CalibrationFlashing);
+  EXPECT_EQ(p.calibrationRetakes(), 1);
+  p.decide(Decision{});
+  // The second selection stopped mid-way and resumed after the emergency stop: retaken.
+  flashes = 0;
+  for (int i = 0; i < 500 && !count(); ++i) p.frame(frame++);
+  p.emergencyStop();
+  p.retryStep();
+  EXPECT_EQ(p.phase(), Phase::CalibrationCue);
+  EXPECT_EQ(p.calibrationRetakes(), 2);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(Decision{});
+  EXPECT_EQ(p.phase(), Phase::Training);  // two whole selections, as set
+}
+
 TEST(Paradigm, ATrialSelectsAnObjectGraspsItSelectsACellAndPutsItDown) {
   Paradigm p(fast(), 4, 3, 3, 3);
   std::int64_t frame = 0;

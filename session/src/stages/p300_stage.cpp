@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "arbci/bci/p300_dataset.h"
@@ -49,6 +50,20 @@ void P300Stage::setModel(const bci::P300Model& model, double time_s) {
 }
 
 void P300Stage::startSelection(const SelectionStart& selection) {
+  if (selection.retake_of && keep_signal_) {
+    // Its flashes so far are no whole selection: gone from what training sees (the recording
+    // keeps them, with the paradigm's annotation).
+    const int cut = *selection.retake_of;
+    size_t kept = 0;
+    for (size_t i = 0; i < calibration_.stimuli.size(); ++i) {
+      if (calibration_selection_[i] == cut) continue;
+      calibration_.stimuli[kept] = calibration_.stimuli[i];
+      calibration_selection_[kept++] = calibration_selection_[i];
+    }
+    calibration_.stimuli.resize(kept);
+    calibration_selection_.resize(kept);
+    left_out_.push_back(cut);
+  }
   selection_ = selection.selection;
   calibrating_ = selection.target.has_value();
   presented_ = scored_ = 0;
@@ -69,16 +84,20 @@ void P300Stage::startTraining(const std::string& method) {
   }
   bci::TrainingSettings training = settings_.training;
   training.method = method;
+  std::vector<int> trained_on = calibration_selection_;
+  trained_on.erase(std::unique(trained_on.begin(), trained_on.end()), trained_on.end());
   training_ = std::async(
-      std::launch::async, [recording = std::move(recording),
-                           pipeline = bci::withMethodRate(settings_.pipeline, method), training]() {
+      std::launch::async,
+      [recording = std::move(recording), pipeline = bci::withMethodRate(settings_.pipeline, method),
+       training, trained_on = std::move(trained_on), left_out = left_out_]() {
         // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
         // frames come first and the training takes what is left.
         ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
         const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
         bci::TrainingResult result = bci::trainModel(data, pipeline, training);
         result.model.provenance["training_files"] = {"this session's calibration run"};
-        return Outcome{std::move(result.model), result.cross_validation.report, data.erp};
+        return Outcome{std::move(result.model), result.cross_validation.report, data.erp,
+                       trained_on, left_out};
       });
 }
 
@@ -90,6 +109,8 @@ void P300Stage::takeTraining(Cycle& cycle) {
     setModel(outcome.model, cycle.time_s);
     trained_erp_ = std::make_shared<const bci::ErpCurves>(std::move(outcome.erp));
     out.trained = outcome.report;
+    out.trained_on = std::move(outcome.trained_on);
+    out.left_out = std::move(outcome.left_out);
   } catch (const std::exception& error) {
     out.training_error = error.what();
   }
@@ -162,7 +183,11 @@ void P300Stage::step(Cycle& cycle) {
   for (const Presentation::Onset& onset : cycle.record.presentation.onsets) {
     const Flash& f = onset.flash;
     const bci::StimulusEvent event{onset.sample, f.code, f.target, duration, f.known};
-    if (calibrating_ && keep_signal_) calibration_.stimuli.push_back(event);
+    const bool cut = std::find(left_out_.begin(), left_out_.end(), f.selection) != left_out_.end();
+    if (calibrating_ && keep_signal_ && !cut) {
+      calibration_.stimuli.push_back(event);
+      calibration_selection_.push_back(f.selection);
+    }
     flashes_[onset.sample] = {selection_, f.code};
     epocher_->addEvent(event);
     ++presented_;

@@ -53,6 +53,7 @@ class P300Stage final : public Stage {
     bci::P300Model model;
     bci::EvaluationReport report;
     bci::ErpCurves erp;
+    std::vector<int> trained_on, left_out;
   };
   // `why`: the request's origin, for the log.
   void setModel(const bci::P300Model& model, double time_s);
@@ -69,8 +70,11 @@ class P300Stage final : public Stage {
   std::shared_ptr<const bci::P300Model> model_;
   std::optional<bci::FeatureExtractor> extractor_;
   std::shared_ptr<const bci::ErpCurves> trained_erp_;
-  // The calibration run: its signal (sample-major while collecting) and cued flashes.
+  // The calibration run: its signal (sample-major while collecting) and cued flashes, each
+  // flash's selection beside it, and the selections interrupted and retaken (their flashes gone).
   bci::Recording calibration_;
+  std::vector<int> calibration_selection_;
+  std::vector<int> left_out_;
   bool keep_signal_ = true;
   std::future<Outcome> training_;
   std::map<std::int64_t, FlashRecord> flashes_;  // by onset sample, until epoched

@@ -100,6 +100,7 @@ void ParadigmStage::act(const Request& request, Cycle& cycle) {
     chooseSelectableObjects(cycle);
     paradigm_->start(!cycle.record.p300.model);
   } else if (std::holds_alternative<PauseRequest>(request)) {
+    stopped_because_ = "paused by the experimenter";
     paradigm_->pause();
   } else if (std::holds_alternative<ResumeRequest>(request)) {
     if (paradigm_->interrupted()) cycle.post(RobotResetIfLatchedRequest{time});
@@ -108,6 +109,7 @@ void ParadigmStage::act(const Request& request, Cycle& cycle) {
     paradigm_->abort();
   } else if (std::holds_alternative<EmergencyStopRequest>(request)) {
     // The session sent the arm its STOP already; the paradigm stops where it is.
+    stopped_because_ = "emergency stop";
     paradigm_->emergencyStop();
   } else if (std::holds_alternative<RetryStepRequest>(request)) {
     s_.log.write("recovery", time, {{"action", "retry step"}, {"trial", paradigm_->trial()}});
@@ -182,6 +184,7 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
   if (awaiting_p300_ && p300.trained) {
     awaiting_p300_ = false;
     calibration_report_ = p300.trained;
+    trained_on_ = p300.trained_on;
   }
   if (awaiting_errp_ && errp.trained) {
     awaiting_errp_ = false;
@@ -206,7 +209,9 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
                 {"longest_frame_ms", 1000.0 * watch_longest_s_},
                 {"median_frame_ms", cycle.record.presentation.median_frame_ms.value_or(0.0)},
                 {"auc", calibration_report_->auc},
-                {"accuracy_by_sequences", calibration_report_->accuracy}});
+                {"accuracy_by_sequences", calibration_report_->accuracy},
+                {"selections_used", trained_on_},
+                {"selections_left_out", p300.left_out}});
   {
     const bci::EvaluationReport& r = *calibration_report_;
     char text[200];
@@ -217,6 +222,15 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
                   r.auc_interval.high, r.accuracy.empty() ? 0.0 : 100.0 * r.accuracy.back(),
                   r.accuracy.size());
     s_.tell.say(time, Severity::Info, text);
+    if (!retakes_.empty()) {
+      std::string cut;
+      for (const Retake& r : retakes_)
+        cut += (cut.empty() ? "" : ", ") + std::to_string(r.selection) + " (" + r.reason +
+               ", retaken as " + std::to_string(r.retaken_as) + ")";
+      s_.tell.say(time, Severity::Info,
+                  "trained on " + std::to_string(trained_on_.size()) +
+                      " whole calibration selections; left out, interrupted: " + cut);
+    }
   }
   if (settings_.paradigm.errp) {
     if (errp_report_) {
@@ -447,10 +461,15 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
         selection_flashes_ = 0;
         std::set<int> attended;
         std::optional<int> target;
+        std::optional<int> retake_of;
         if (paradigm_->phase() == bci::Phase::CalibrationCue ||
             paradigm_->phase() == bci::Phase::CalibrationFlashing) {
           attended = e.codes;
           target = *e.codes.begin();
+          if (e.retake) {
+            retake_of = selection_;
+            noteRetake(*target, cycle);
+          }
           s_.log.write("calibration_target", time, {{"object", objectOfCode(*target).id}});
         } else {
           attended = attendedCodes(e.objects_layout, cycle);
@@ -459,9 +478,12 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
         selection_objects_ = e.objects_layout;
         truth_ = target ? std::set<int>{*target} : attended;
         part.selection_started =
-            SelectionStart{selection_, e.objects_layout,
+            SelectionStart{selection_,
+                           e.objects_layout,
                            e.objects_layout ? paradigm_->objectLayout() : paradigm_->gridLayout(),
-                           attended, target};
+                           attended,
+                           target,
+                           retake_of};
         break;
       }
       case Kind::Flash:
@@ -471,6 +493,8 @@ void ParadigmStage::handleEvents(Cycle& cycle) {
               "flash_withheld", time,
               {{"code", e.code}, {"object", objectOfCode(e.code).id}, {"why", "tracking lost"}});
           if (withheld_since_ < 0.0) withheld_since_ = time;
+          if (paradigm_->phase() == bci::Phase::CalibrationFlashing)
+            pauseCalibrationForView(objectOfCode(e.code).id, cycle);
           break;
         }
         withheld_since_ = -1.0;
@@ -639,6 +663,7 @@ void ParadigmStage::watchEegSource(Cycle& cycle) {
                            phase == Phase::CellFlashing || phase == Phase::ObjectSelected ||
                            phase == Phase::CellSelected;
     if (!paused_for_eeg_ && needs_eeg) {
+      stopped_because_ = "EEG source fault";
       paradigm_->pause();
       paused_for_eeg_ = true;
       status_ = "paused: " + fault;
@@ -683,30 +708,77 @@ void ParadigmStage::watchWithheldFlashes(Cycle& cycle) {
       status_.clear();
       s_.log.write("resumed", time, {{"reason", "the objects are in view again"}});
       s_.tell.say(time, Severity::Info, "resumed: the objects are in view again");
+    } else if (!settings_.experimenter &&
+               time - view_paused_at_ >= settings_.paradigm.no_view_pause_s) {
+      // Nobody can bring them back into view: the run ends, saying why.
+      const std::string reason = viewLostReason("during calibration");
+      s_.log.write("paused", time, {{"reason", reason}});
+      cycle.end(reason, "aborted");
     }
     return;
   }
   const bool flashing = phase == Phase::ObjectFlashing || phase == Phase::CalibrationFlashing;
   if (!flashing) withheld_since_ = -1.0;
   if (withheld_since_ < 0.0 || time - withheld_since_ < settings_.paradigm.no_view_pause_s) return;
-  char seconds[32];
-  std::snprintf(seconds, sizeof seconds, "%g", settings_.paradigm.no_view_pause_s);
-  std::string lost;
-  for (int id : stale_) lost += (lost.empty() ? "" : ", ") + std::to_string(id);
-  const std::string reason = std::string("no object in view: the reference marker or objects (") +
-                             lost + ") lost for " + seconds +
-                             " s (paradigm.no_view_pause_s), every flash withheld";
+  const std::string reason = viewLostReason("every flash withheld");
   s_.log.write("paused", time, {{"reason", reason}});
   if (!settings_.experimenter) {
     // Nobody can bring them back into view: the run ends, saying why.
     cycle.end(reason, "aborted");
     return;
   }
+  stopped_because_ = "no object in view";
   paradigm_->pause();
   paused_for_view_ = true;
+  view_paused_at_ = time;
   in_view_since_ = -1.0;
   status_ = "paused: " + reason + "; resumes once they are seen again";
   s_.tell.say(time, Severity::Error, "paused: " + reason);
+}
+
+std::string ParadigmStage::viewLostReason(const std::string& context) const {
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%g", settings_.paradigm.no_view_pause_s);
+  std::string lost;
+  for (int id : stale_) lost += (lost.empty() ? "" : ", ") + std::to_string(id);
+  return std::string(stale_.size() >= slots_.size() ? "no object in view" : "tracking lost") +
+         ": the reference marker or objects (" + lost + ") lost for " + seconds +
+         " s (paradigm.no_view_pause_s), " + context;
+}
+
+void ParadigmStage::pauseCalibrationForView(int object_id, Cycle& cycle) {
+  const double time = cycle.time_s;
+  stopped_because_ = "tracking lost: object " + std::to_string(object_id);
+  paradigm_->pause();
+  paused_for_view_ = true;
+  view_paused_at_ = time;
+  in_view_since_ = -1.0;
+  const std::string reason = "calibration selection " + std::to_string(selection_) + ": object " +
+                             std::to_string(object_id) +
+                             "'s flash withheld (tracking lost); the selection is retaken once "
+                             "every object has been in view for 1 s";
+  status_ = "paused: " + reason;
+  s_.log.write("paused", time, {{"reason", reason}});
+  s_.tell.say(time, Severity::Warning, "paused: " + reason);
+}
+
+void ParadigmStage::noteRetake(int target_code, Cycle& cycle) {
+  Retake r{selection_, objectOfCode(target_code).id,
+           stopped_because_.empty() ? "interrupted" : stopped_because_, selection_ + 1};
+  s_.log.write("calibration_retake", cycle.time_s,
+               {{"selection", r.selection},
+                {"object", r.object},
+                {"reason", r.reason},
+                {"retaken_as", r.retaken_as}});
+  cycle.annotate(cycle.eeg_sample, "Calibration selection " + std::to_string(r.selection) +
+                                       " interrupted (" + r.reason + "): left out of training, " +
+                                       "retaken as selection " + std::to_string(r.retaken_as));
+  s_.tell.say(cycle.time_s, Severity::Info,
+              "calibration selection " + std::to_string(r.selection) + " (object " +
+                  std::to_string(r.object) + ") interrupted (" + r.reason +
+                  "): cued again as selection " + std::to_string(r.retaken_as) +
+                  "; training leaves the interrupted flashes out");
+  retakes_.push_back(r);
 }
 
 void ParadigmStage::report(nlohmann::json& summary) const {
@@ -714,8 +786,18 @@ void ParadigmStage::report(nlohmann::json& summary) const {
   summary.update(trialsSummary(trials_, static_cast<int>(settings_.world.objects.size()), cells));
   if (calibration_report_) {
     summary["calibration"] = {{"selections", calibration_report_->selections.size()},
+                              {"selections_used", trained_on_},
                               {"auc", calibration_report_->auc},
                               {"accuracy_by_sequences", calibration_report_->accuracy}};
+  }
+  if (!retakes_.empty()) {
+    nlohmann::json& retaken = summary["calibration"]["retaken"];
+    for (const Retake& r : retakes_) {
+      retaken.push_back({{"selection", r.selection},
+                         {"object", r.object},
+                         {"reason", r.reason},
+                         {"retaken_as", r.retaken_as}});
+    }
   }
   if (!settings_.paradigm.errp) return;
   const ErrpCounts& c = errp_counts_;

@@ -62,6 +62,12 @@ class ParadigmStage final : public Stage {
   // A selection with every flash withheld for paradigm.no_view_pause_s: a pause with the reason
   // (or, with nobody at the window, the end), never a silent wait.
   void watchWithheldFlashes(Cycle& cycle);
+  // A calibration flash withheld: the selection stops there, paused until every object is in
+  // view again, and is then retaken (training needs whole selections).
+  void pauseCalibrationForView(int object_id, Cycle& cycle);
+  void noteRetake(int target_code, Cycle& cycle);
+  // "no object in view: the reference marker or objects (10, 40) lost for 10 s (...), CONTEXT"
+  std::string viewLostReason(const std::string& context) const;
   TrialRecord& currentTrial();
   // The codes the subject means in this trial's current selection (objects or cell).
   std::set<int> intendedCodes(bool objects) const;
@@ -122,7 +128,18 @@ class ParadigmStage final : public Stage {
   // a pause for that resumes once every offered object has been in view for a second.
   double withheld_since_ = -1.0;
   bool paused_for_view_ = false;
+  double view_paused_at_ = -1.0;
   double in_view_since_ = -1.0;
+  // Why the paradigm last stopped (a calibration selection interrupted there is retaken), and
+  // the retakes: the selection cut, its target, why, and its retake's number.
+  std::string stopped_because_;
+  struct Retake {
+    int selection = 0, object = 0;
+    std::string reason;
+    int retaken_as = 0;
+  };
+  std::vector<Retake> retakes_;
+  std::vector<int> trained_on_;  // the calibration selections the classifier was trained on
   std::string status_;
 };
 

@@ -105,11 +105,13 @@ struct FrameStimulus {
 
 struct ParadigmEvent {
   enum class Kind {
-    PhaseChanged,      // text: the phase
-    SelectionStarted,  // layout, target codes (calibration) in `codes`
-    Flash,             // code, onset frame
-    SelectionMade,     // codes chosen, certainty (text "runner-up" for an ErrP correction)
-    Feedback,          // a selection first shown (codes); calibration: `error` says if wrong
+    PhaseChanged,  // text: the phase
+    // Layout, target codes (calibration) in `codes`; `retake`: a calibration selection that
+    // was interrupted, cued again (its flashes so far are no whole selection to train on).
+    SelectionStarted,
+    Flash,          // code, onset frame
+    SelectionMade,  // codes chosen, certainty (text "runner-up" for an ErrP correction)
+    Feedback,       // a selection first shown (codes); calibration: `error` says if wrong
     // After a rejected selection, text: "runner-up", "repeat", "skip" (no object held yet: the
     // trial ends) or "return" (no cell accepted: the object goes back where it was taken).
     ErrpCorrection,
@@ -133,6 +135,7 @@ struct ParadigmEvent {
   int trial = 0;
   std::string text;
   std::optional<bool> error;  // Feedback in the calibration run: deliberately wrong
+  bool retake = false;        // SelectionStarted: the interrupted calibration selection again
 };
 
 class Paradigm {
@@ -146,7 +149,8 @@ class Paradigm {
   void pause();
   // Also acknowledges a robot fault or an emergency stop: an interrupted selection starts its
   // sequence again; a trial whose robot step was interrupted is over (the next one starts). The
-  // session checks first that the arm is home and holds nothing.
+  // session checks first that the arm is home and holds nothing. An interrupted calibration
+  // selection is retaken instead: its target cued again, all its sequences flashed anew.
   void resume();
   void abort();
   void emergencyStop();
@@ -186,6 +190,7 @@ class Paradigm {
   // ErrP rejections of the current selection so far.
   int corrections() const { return corrections_; }
   int sequence() const { return sequence_; }  // the current sequence of a flashing phase (1-based)
+  int calibrationRetakes() const { return calibration_retakes_; }
   bool awaitingDecision() const { return awaiting_decision_; }
   const ParadigmLayout& objectLayout() const { return object_layout_; }
   const ParadigmLayout& gridLayout() const { return grid_layout_; }
@@ -201,6 +206,10 @@ class Paradigm {
                      const std::string& text);
   void scheduleSequence(double first_onset_s);
   void restartSequence();  // an interrupted selection shows its sequence again from the start
+  // Going back to an interrupted flashing phase: the sequence again, or (calibration) the
+  // selection retaken.
+  void returnToFlashing(Phase phase);
+  void retakeCalibrationSelection();
   void nextTrial(double at_s, const std::string& why);
   void askRobot(Phase phase);  // Grasping or Dropping, with its command
   double nextFrame() const { return now_ + 1.0 / settings_.display_hz; }
@@ -232,6 +241,7 @@ class Paradigm {
   bool flashing_objects_ = true;
   bool calibrating_ = false;
   int calibration_done_ = 0;
+  int calibration_retakes_ = 0;
   std::optional<int> calibration_target_;
   int trial_ = 0;
   std::optional<int> selected_object_;

@@ -26,6 +26,7 @@ struct SceneObject {
   double width_m = 0.07;
   double height_m = 0.06;
   glm::vec3 color{0.85f, 0.35f, 0.25f};
+  bool covered = false;  // a hand lies over its marker
 };
 
 struct SceneGripper {

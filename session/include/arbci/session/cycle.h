@@ -59,6 +59,9 @@ struct SelectionStart {
   bci::ParadigmLayout layout;
   std::set<int> attended;     // the simulated subject looks there; empty: not known
   std::optional<int> target;  // the calibration run's cued code
+  // A calibration selection interrupted and cued again: the number of the one it replaces,
+  // whose flashes are no whole selection and are left out of training.
+  std::optional<int> retake_of;
 };
 
 // The last frame as the screen showed it, stamped on the EEG sample clock once presented.
@@ -115,6 +118,9 @@ struct P300Part {
   // Training ended this cycle: the model's cross-validation, or why it failed.
   std::optional<bci::EvaluationReport> trained;
   std::string training_error;
+  // With `trained`: the calibration selections (the paradigm's numbers) it was trained on, and
+  // those left out because they were interrupted and retaken.
+  std::vector<int> trained_on, left_out;
   bool training = false;  // on its worker thread
 };
 

@@ -76,6 +76,8 @@ struct WorldObjectSettings {
   cv::Vec3d position;  // top centre, robot frame
   double marker_m, width_m, height_m;
   cv::Vec3d color;
+  // Simulated cameras: a hand lies over its marker between each pair of session times (from, to).
+  std::vector<double> covered_s;
 };
 
 struct GridSettings {
