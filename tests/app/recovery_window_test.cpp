@@ -1,7 +1,8 @@
 // A study day's recovery in the real window under Xvfb, driven by a scripted experimenter
-// (arbci run --script: real mouse clicks on the panels' buttons, found by label): an emergency
-// stop during the grasp, Home, Retry step, and the session finishes; or the experimenter ends it
-// in the stop. The screenshots of each step are kept (build/test-artefacts/recovery) and checked
+// (arbci run --script: real mouse clicks on the panels' buttons, found by label): a marker
+// covered during the calibration run (the selection paused, retaken, left out of training), an
+// emergency stop during the grasp, Home, Retry step, and the session finishes; or the
+// experimenter ends it in the stop. The screenshots of each step are kept (build/test-artefacts/recovery) and checked
 // with their sidecars: the panels drawn, each button's state and the reason it is disabled.
 #include <gtest/gtest.h>
 
@@ -22,10 +23,20 @@ const std::string kArbci = ARBCI_EXECUTABLE;
 const std::filesystem::path kArtefacts = ARBCI_TEST_ARTEFACTS_DIR;
 
 // A quick session (a short calibration run, one trial) with a slow arm, so a grasp lasts long
-// enough to be stopped.
-void writeSession(const std::filesystem::path& file) {
+// enough to be stopped. `covered`: a hand over object 10's marker from 9 s to 12 s of session
+// time, during the calibration run (longer than a cue and its pause, so it meets flashes).
+void writeSession(const std::filesystem::path& file, bool covered) {
   std::ofstream(file) << R"({
-    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},)"
+                      << (covered ? R"(
+    "world": {"objects": [
+      {"id": 10, "position": [-0.27, 0.42, 0.06], "color": [0.85, 0.30, 0.25],
+       "covered_s": [9, 12]},
+      {"id": 20, "position": [-0.09, 0.42, 0.06], "color": [0.25, 0.55, 0.85]},
+      {"id": 30, "position": [0.09, 0.42, 0.06], "color": [0.30, 0.75, 0.35]},
+      {"id": 40, "position": [0.27, 0.42, 0.06], "color": [0.90, 0.75, 0.20]}]},)"
+                                  : "")
+                      << R"(
     "paradigm": {"calibration_selections": 4, "calibration_sequences": 5, "sequences": 5,
                  "min_sequences": 5, "certainty": 0.0, "trials": 1, "cue_s": 1.0, "pause_s": 0.5,
                  "intended": [{"object": 40, "cell": [3, 1]}]},
@@ -35,10 +46,10 @@ void writeSession(const std::filesystem::path& file) {
 // The window at 1280x720 (a laptop screen), its layout file in a fresh folder.
 // `extra`: more options for arbci run; `out`: the session folder (default: FOLDER/out).
 ProcessResult runScript(const std::filesystem::path& folder, const std::string& script,
-                        const std::vector<std::string>& extra = {},
-                        const std::string& out = "out") {
+                        const std::vector<std::string>& extra = {}, const std::string& out = "out",
+                        bool covered = false) {
   std::filesystem::create_directories(folder);
-  writeSession(folder / "session.json");
+  writeSession(folder / "session.json", covered);
   std::ofstream(folder / "script.txt") << script;
   const XvfbServer x("1280x720x24");
   std::vector<std::string> arguments = {"-u",
@@ -118,7 +129,15 @@ TEST(RecoveryWindow, EmergencyStopDuringTheGraspThenHomeRetryAndTheSessionFinish
   std::filesystem::remove_all(folder);
   const std::string shots = (folder / "shots").string();
   std::filesystem::create_directories(shots);
-  const ProcessResult r = runScript(folder, R"(# an emergency stop during the grasp
+  const ProcessResult r =
+      runScript(folder, R"(# a marker covered in calibration: its selection retaken
+wait "paused" 120
+pause 0.5
+screenshot )" + shots + R"(/0-covered.png
+wait "target cued" 60
+pause 0.3
+screenshot )" + shots + R"(/0-retaken.png
+# an emergency stop during the grasp
 wait "robot grasping" 240
 pause 1
 click "EMERGENCY STOP"
@@ -134,7 +153,8 @@ screenshot )" + shots + R"(/3-retried.png
 wait "finished" 240
 pause 0.5
 screenshot )" + shots + R"(/4-finished.png
-)");
+)",
+                {}, "out", true);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto out = folder / "out";
   const nlohmann::json summary = readJson(out / "summary.json");
@@ -142,6 +162,16 @@ screenshot )" + shots + R"(/4-finished.png
   ASSERT_EQ(summary["trials"].size(), 1u);
   EXPECT_EQ(summary["trials"][0]["outcome"], "placed");
   EXPECT_TRUE(summary["trials"][0]["placement_error_m"].is_number());
+  // The calibration selection the hand cut was retaken and left out of training.
+  const nlohmann::json& calibration = summary["calibration"];
+  ASSERT_EQ(calibration["retaken"].size(), 1u) << calibration.dump();
+  EXPECT_EQ(calibration["retaken"][0]["reason"], "tracking lost: object 10");
+  EXPECT_EQ(calibration["selections"], 4);
+  EXPECT_EQ(calibration["selections_used"].size(), 4u);
+  const nlohmann::json covered = checkScreenshot(folder / "shots/0-covered.png", {"Session"});
+  EXPECT_EQ(covered["phase"], "paused");
+  const nlohmann::json retaken = checkScreenshot(folder / "shots/0-retaken.png", {"Session"});
+  EXPECT_EQ(retaken["phase"], "calibration: target cued");
 
   // The log: the stop, the experimenter's HOME, the retry, and a second GRASP that succeeded.
   const auto log = out / "log.jsonl";
