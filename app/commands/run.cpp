@@ -16,6 +16,7 @@
 #include "support/headless_run.h"
 #include "support/interrupt.h"
 #include "support/session_file.h"
+#include "workstation/start_error_window.h"
 #include "workstation/workstation.h"
 
 namespace arbci::app {
@@ -132,6 +133,7 @@ void printSummary(const session::Session& session) {
 }
 
 int runSession(const RunOptions& o);
+int runSessionIn(const RunOptions& o, bool headless);
 
 // The session's folder into the BIDS dataset, once it has ended; the folder stays as it is.
 int runAndExport(const RunOptions& o) {
@@ -174,6 +176,22 @@ int runAndExport(const RunOptions& o) {
 }
 
 int runSession(const RunOptions& o) {
+  const bool headless = o.headless || !render::displayAvailable();
+  if (!o.script.empty() && headless)
+    throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
+  if (headless) return runSessionIn(o, true);
+  try {
+    return runSessionIn(o, false);
+  } catch (const CliError& error) {
+    // Started from a desktop, the terminal may be nowhere: the window says it too (and the
+    // terminal once it closes). A script that failed on it exits 4, as in the workstation.
+    if (!showStartError(error.what(), o.script) && !o.script.empty())
+      throw CliError(error.what(), 4);
+    throw;
+  }
+}
+
+int runSessionIn(const RunOptions& o, bool headless) {
   const session::SessionConfig config = loadSessionOption(o.session);
   session::SessionOptions options;
   if (!o.out.empty()) claimFolder(o.out, o.overwrite);
@@ -184,14 +202,12 @@ int runSession(const RunOptions& o) {
   if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
   options.fault_wait_s = o.fault_wait_s;
   options.progress = &std::cerr;
-  const bool headless = o.headless || !render::displayAvailable();
   try {
-    if (!o.script.empty() && headless)
-      throw CliError("--script drives the window: it needs a display (run it under xvfb-run)");
     if (!headless) {
-      claim.keep();  // the window shows its own failures and offers a retry in place
+      // Once open, the window shows the session's own failures and offers a retry in place.
       return runWorkstation(config, options,
-                            {o.script, o.wait_for_start, o.exit_when_done, false, o.bids_root});
+                            {o.script, o.wait_for_start, o.exit_when_done, false, o.bids_root,
+                             [&] { claim.keep(); }});
     }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped

@@ -65,7 +65,7 @@ int runTimingCheck(const TimingCheckOptions& o) {
       OpenedSession opened = openSession(config, options, *context);
       runHeadless(*opened.session);
     } else {
-      runWorkstation(config, options, {{}, false, true, true, {}});
+      runWorkstation(config, options, {{}, false, true, true, {}, {}});
     }
   } catch (const std::runtime_error& error) {
     throw CliError(error.what());

@@ -67,6 +67,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     main_window.makeCurrent();
   }
   OpenedSession opened = openSession(config, options, main_window);
+  if (workstation.opened) workstation.opened();
   session::Session& session = *opened.session;
   // Unattended, the session starts itself.
   if (!workstation.wait_for_start && !workstation.unattended)

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 
 #include "arbci/session/session.h"
 
@@ -19,6 +20,8 @@ struct WorkstationOptions {
   // Where the run is exported when it ends (arbci run --bids): the start screen shows the run it
   // will take.
   std::filesystem::path bids_root;
+  // Called once the session is open (its folder in use): a failure before that leaves nothing.
+  std::function<void()> opened;
 };
 
 int runWorkstation(const session::SessionConfig& config, session::SessionOptions options,

@@ -2,8 +2,9 @@
 // (arbci run --script: real mouse clicks on the panels' buttons, found by label): a marker
 // covered during the calibration run (the selection paused, retaken, left out of training), an
 // emergency stop during the grasp, Home, Retry step, and the session finishes; or the
-// experimenter ends it in the stop. The screenshots of each step are kept (build/test-artefacts/recovery) and checked
-// with their sidecars: the panels drawn, each button's state and the reason it is disabled.
+// experimenter ends it in the stop. The screenshots of each step are kept
+// (build/test-artefacts/recovery) and checked with their sidecars: the panels drawn, each button's
+// state and the reason it is disabled.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -43,13 +44,11 @@ void writeSession(const std::filesystem::path& file, bool covered) {
     "robot": {"speed_factor": 2}})";
 }
 
-// The window at 1280x720 (a laptop screen), its layout file in a fresh folder.
-// `extra`: more options for arbci run; `out`: the session folder (default: FOLDER/out).
-ProcessResult runScript(const std::filesystem::path& folder, const std::string& script,
-                        const std::vector<std::string>& extra = {}, const std::string& out = "out",
-                        bool covered = false) {
-  std::filesystem::create_directories(folder);
-  writeSession(folder / "session.json", covered);
+// The window at 1280x720 (a laptop screen), its layout file in a fresh folder: arbci run with
+// the session file FOLDER/session.json and the script, and `extra` options; `out`: the session
+// folder (FOLDER/out by default).
+ProcessResult runWindow(const std::filesystem::path& folder, const std::string& script,
+                        const std::vector<std::string>& extra, const std::string& out) {
   std::ofstream(folder / "script.txt") << script;
   const XvfbServer x("1280x720x24");
   std::vector<std::string> arguments = {"-u",
@@ -67,6 +66,15 @@ ProcessResult runScript(const std::filesystem::path& folder, const std::string& 
                                         "--exit-when-done"};
   arguments.insert(arguments.end(), extra.begin(), extra.end());
   return runProcess("/usr/bin/env", arguments, 420.0);
+}
+
+// The same with the quick session (writeSession).
+ProcessResult runScript(const std::filesystem::path& folder, const std::string& script,
+                        const std::vector<std::string>& extra = {}, const std::string& out = "out",
+                        bool covered = false) {
+  std::filesystem::create_directories(folder);
+  writeSession(folder / "session.json", covered);
+  return runWindow(folder, script, extra, out);
 }
 
 std::vector<nlohmann::json> logEvents(const std::filesystem::path& log, const std::string& event) {
@@ -400,6 +408,34 @@ TEST(RecoveryWindow, CtrlQQuitsTheWindowAndTheSummarySaysItWasClosed) {
   EXPECT_EQ(summary["ended"], "aborted");
   EXPECT_EQ(summary["end_reason"], "closed");
   EXPECT_LT(summary["duration_s"].get<double>(), 30.0);
+}
+
+// A session file the window cannot start with: the window opens anyway and says why, in the
+// same words as the terminal, with Quit; no session folder is left behind.
+TEST(RecoveryWindow, ASessionFileThatCannotStartIsShownInTheWindowWithItsReason) {
+  const auto folder = kArtefacts / "recovery_bad_file";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "session.json") << R"({"paradigm": {"min_sequences": 0}})";
+  const auto shot = folder / "cannot-start.png";
+  const ProcessResult r =
+      runWindow(folder, "pause 0.5\nscreenshot " + shot.string() + "\nclick \"Quit\"\n", {}, "out");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const std::string reason = "paradigm.min_sequences = 0 must lie in [1, 100]";
+  EXPECT_NE(r.err.find(reason), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(folder / "out"));
+  const cv::Mat image = cv::imread(shot.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  std::filesystem::path sidecar = shot;
+  const nlohmann::json drawn = readJson(sidecar.replace_extension(".json"));
+  EXPECT_EQ(drawn["phase"], "cannot start");
+  EXPECT_EQ(drawn["panels"], nlohmann::json{"The session cannot start"});
+  ASSERT_NE(button(drawn, "Quit", "The session cannot start"), nullptr);
+  // The message is drawn: red text in the window's first lines.
+  const cv::Mat top = image(cv::Rect(0, 25, 640, 25));
+  std::vector<cv::Mat> bgr;
+  cv::split(top, bgr);
+  EXPECT_GT(cv::countNonZero((bgr[2] > 180) & (bgr[1] < 140)), 100);
 }
 
 // A script that cannot go on says which line and why, and the run exits 4.
