@@ -5,6 +5,7 @@
 
 #include "arbci/session/settings_schema.h"
 #include "bids/bids_export.h"
+#include "support/session_runs.h"
 
 namespace arbci::app {
 
@@ -67,10 +68,25 @@ std::string SessionModel::labelsProblem() {
   return "";
 }
 
+void SessionModel::start() {
+  // Without a BIDS dataset, a named subject's runs are numbered among the session folders.
+  core::RunLabels labels = session_.labels();
+  if (bids_root_.empty() && !labels.subject.empty() && labels.run.empty()) {
+    labels.run = std::to_string(nextFolderRun(session_.folder(), labels));
+    session_.setLabels(labels);
+  }
+  session_.request(session::StartRequest{});
+}
+
 std::string SessionModel::labelsTarget() {
-  if (bids_root_.empty())
-    return "recorded in " + session_.folder().string() +
-           "/summary.json (arbci bids export can file it later)";
+  if (bids_root_.empty()) {
+    const core::RunLabels& l = session_.labels();
+    const std::string where = "recorded in " + session_.folder().string() +
+                              "/summary.json (arbci bids export can file it later)";
+    if (l.subject.empty() || !l.run.empty()) return where;
+    return "run " + std::to_string(nextFolderRun(session_.folder(), l)) +
+           " (the next free among the session folders beside this one), " + where;
+  }
   if (!labelsProblem().empty()) return "";
   try {
     return "BIDS: " + (bids_root_ / bidsTarget(bids_root_, entitiesOf(session_.labels()))).string();

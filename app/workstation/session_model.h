@@ -74,7 +74,9 @@ class SessionModel final : public ui::WorkstationModel {
   std::string trackingAlarm() override;
   double maxPoseAgeS() override { return session_.config().tracker.max_pose_age_s; }
   std::optional<double> referenceAgeS() override;
-  void start() override { session_.request(session::StartRequest{}); }
+  // With a subject and no run given (and no BIDS root): the next free run among the session
+  // folders first (support/session_runs.h).
+  void start() override;
   void pause() override { session_.request(session::PauseRequest{}); }
   void resume() override { session_.request(session::ResumeRequest{}); }
   void abort() override { session_.request(session::AbortRequest{}); }

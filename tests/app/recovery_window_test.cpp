@@ -398,6 +398,31 @@ key ctrl+q
       << second.err;
 }
 
+// Without a BIDS root, a subject's runs are numbered among the session folders beside one
+// another: the start screen says which run it will be, and summary.json records it.
+TEST(RecoveryWindow, WithoutABidsRootRunsAreNumberedAmongTheSessionFolders) {
+  const auto folder = kArtefacts / "start_screen_folders";
+  std::filesystem::remove_all(folder);
+  const std::string script = R"(pause 1
+click "subject"
+type "07"
+pause 0.3
+screenshot )" + (folder / "named.png").string() +
+                             R"(
+click "Start"
+wait "calibration" 60
+key ctrl+q
+)";
+  for (const char* out : {"out1", "out2"}) {
+    const ProcessResult r = runScript(folder, script, {"--wait-for-start"}, out);
+    EXPECT_EQ(r.exit_code, 3) << r.err;  // closed during the calibration
+  }
+  EXPECT_EQ(readJson(folder / "out1/summary.json")["labels"]["run"], "1");
+  const nlohmann::json second = readJson(folder / "out2/summary.json");
+  EXPECT_EQ(second["labels"]["subject"], "07");
+  EXPECT_EQ(second["labels"]["run"], "2");
+}
+
 // Ctrl+Q closes the window as the File menu says; the session ends there, its summary saved.
 TEST(RecoveryWindow, CtrlQQuitsTheWindowAndTheSummarySaysItWasClosed) {
   const auto folder = kArtefacts / "recovery_quit";
