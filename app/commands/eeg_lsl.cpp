@@ -22,6 +22,7 @@ struct LslOptions {
   std::vector<std::string> peers;
   double timeout_s = 2.0;
   std::string file, name, type = "EEG";
+  std::vector<std::string> impedance;  // per channel, into the stream's metadata
   bool wait = false, loop = false;
 };
 
@@ -88,7 +89,12 @@ void streamFile(const LslOptions& o) {
   eeg.nominal_srate = r.info.rate_hz;
   eeg.channel_format = bci::lsl::ChannelFormat::Float32;
   eeg.source_id = "arbci-eeg-stream:" + std::filesystem::path(o.file).filename().string();
-  for (const auto& label : r.info.channels) eeg.channels.push_back({label, "microvolts", "EEG"});
+  if (o.impedance.size() > r.info.channels.size())
+    throw CliError("--impedance gives " + std::to_string(o.impedance.size()) + " values for " +
+                   std::to_string(r.info.channels.size()) + " channels");
+  for (size_t c = 0; c < r.info.channels.size(); ++c)
+    eeg.channels.push_back(
+        {r.info.channels[c], "microvolts", "EEG", c < o.impedance.size() ? o.impedance[c] : ""});
   bci::lsl::StreamInfo markers;
   markers.name = name + "-Markers";
   markers.type = "Markers";
@@ -184,6 +190,12 @@ void addEegStreamCommands(CLI::App* eeg, int& exit_code) {
   stream->add_option("--name", options->name, "the stream's name (default: the file's name)");
   stream->add_option("--type", options->type, "the stream's type")->capture_default_str();
   stream->add_flag("--wait", options->wait, "start when the first consumer connects (up to 60 s)");
+  stream
+      ->add_option("--impedance", options->impedance,
+                   "each channel's impedance, in order, written into the stream's metadata "
+                   "(<desc><channels><channel><impedance>) as an amplifier's app that measures "
+                   "them does, e.g. --impedance 5,7,12")
+      ->delimiter(',');
   stream->add_flag("--loop", options->loop, "start again at the end, until interrupted");
   addScopeOptions(stream, *options);
   stream->callback([options, &exit_code] {

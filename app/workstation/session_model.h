@@ -77,6 +77,7 @@ class SessionModel final : public ui::WorkstationModel {
   // With a subject and no run given (and no BIDS root): the next free run among the session
   // folders first (support/session_runs.h).
   void start() override;
+  std::string eegImpedance() override { return record().eeg.impedance; }
   void pause() override { session_.request(session::PauseRequest{}); }
   void resume() override { session_.request(session::ResumeRequest{}); }
   void abort() override { session_.request(session::AbortRequest{}); }

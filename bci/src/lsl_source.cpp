@@ -93,6 +93,15 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
         c < static_cast<int>(full.channels.size()) ? microvoltsPer(full.channels[c].unit) : 1.0);
   name_ = full.name;
   host_ = full.hostname;
+  for (size_t c = 0; c < full.channels.size() && c < info_.channels.size(); ++c) {
+    if (full.channels[c].impedance.empty()) continue;
+    impedance_ +=
+        (impedance_.empty() ? "" : ", ") + info_.channels[c] + " " + full.channels[c].impedance;
+  }
+  if (!impedance_.empty())
+    impedance_ +=
+        " (the stream's metadata, as its app measured them when it started; LSL "
+        "states no unit)";
   pending_ = Block(0, info_.channelCount(), 0);
 }
 

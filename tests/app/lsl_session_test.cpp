@@ -43,8 +43,10 @@ TEST(LslSession, TheRecordingHoldsTheStreamedSamplesAndItsMarkersFallOnTheFlashS
   const auto session_file = folder / "lsl.json";
   std::ofstream(session_file) << session.dump(2);
 
+  // The amplifier's app states the impedances it measured in the stream's metadata.
   test::BackgroundProcess streamer(
-      kArbci, {"eeg", "stream", kEeg3, "--name", name, "--wait", "--scope", "machine"});
+      kArbci, {"eeg", "stream", kEeg3, "--name", name, "--wait", "--scope", "machine",
+               "--impedance", "4,5,6,7,8,9,10,31"});
   const auto out = folder / "session";
   test::BackgroundProcess run(
       kArbci, {"run", "--headless", "--session", session_file.string(), "--out", out.string()});
@@ -105,6 +107,12 @@ TEST(LslSession, TheRecordingHoldsTheStreamedSamplesAndItsMarkersFallOnTheFlashS
               considered, worst_samples);
   const nlohmann::json summary = test::readJson(out / "summary.json");
   EXPECT_EQ(summary["timing"]["lost_samples"], 0);
+  // The impedances the stream's metadata gave, per channel, for the EEG panel and the record.
+  const bci::Recording channels = bci::readRecording(kEeg3);
+  EXPECT_EQ(summary["eeg"]["impedance"].get<std::string>().rfind(
+                channels.info.channels[0] + " 4, " + channels.info.channels[1] + " 5, ", 0),
+            0u)
+      << summary["eeg"];
   // The stream's stamps are exact: the clock model sees no arrival jitter and no drift.
   EXPECT_LT(summary["timing"]["clock_jitter_ms"].get<double>(), 0.5);
   EXPECT_LT(std::abs(summary["timing"]["clock_drift_ppm"].get<double>()), 20.0);

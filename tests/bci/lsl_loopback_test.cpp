@@ -41,7 +41,7 @@ StreamInfo eegStream(const std::string& name, int channels, double rate, Channel
   s.channel_format = format;
   s.source_id = name + "-source";
   for (int c = 0; c < channels; ++c)
-    s.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG"});
+    s.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG", ""});
   return s;
 }
 
@@ -316,10 +316,13 @@ TEST(LslSource, AStreamAtAnotherRateThanTheSessionsIsRefused) {
   }
 }
 
+// Also: impedances in the stream's metadata (as amplifier apps that measure them write them) are
+// reported for the EEG panel, per channel, with the caveat that LSL states no unit.
 TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
   const std::string name = uniqueName("volts");
   StreamInfo info = eegStream(name, 2, 256, ChannelFormat::Double64);
   info.channels[0].unit = "V";
+  info.channels[1].impedance = "12.5";
   Outlet outlet(info, machineScope());
   LslSourceSettings settings;
   settings.name = name;
@@ -341,6 +344,8 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
   EXPECT_FLOAT_EQ(blocks[0].at(1, 3), 6.0);
   EXPECT_TRUE(source.fault().empty());
   EXPECT_NE(source.describe().find(name), std::string::npos);
+  EXPECT_EQ(source.impedance().rfind("E2 12.5 (the stream's metadata", 0), 0u)
+      << source.impedance();
 }
 
 // The check: a second process streams 64 channels at 2048 Hz for 10 minutes of

@@ -70,7 +70,8 @@ StreamInfo exampleStream() {
   s.v4data_port = 16573;
   s.v4service_port = 16572;
   s.created_at = 1234.5;
-  s.channels = {{"Fz", "microvolts", "EEG"}, {"Cz", "microvolts", "EEG"}, {"Pz", "", ""}};
+  s.channels = {
+      {"Fz", "microvolts", "EEG", "5"}, {"Cz", "microvolts", "EEG", ""}, {"Pz", "", "", ""}};
   return s;
 }
 
@@ -83,6 +84,8 @@ TEST(LslStreamInfo, TheFullDescriptionRoundTripsWithItsChannelLabels) {
   EXPECT_EQ(back.version, 110);
   EXPECT_EQ(back.v4data_port, 16573);
   EXPECT_EQ(back.channelLabels(), (std::vector<std::string>{"Fz", "Cz", "Pz"}));
+  EXPECT_EQ(back.channels[0].impedance, "5");
+  EXPECT_EQ(back.channels[1].impedance, "");
   // The short form (discovery replies) has no channels: labels default to Ch1...
   const StreamInfo brief = StreamInfo::fromXml(s.toXml(false));
   EXPECT_EQ(brief.channelLabels(), (std::vector<std::string>{"Ch1", "Ch2", "Ch3"}));

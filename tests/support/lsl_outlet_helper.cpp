@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
   info.channel_format = ChannelFormat::Float32;
   info.source_id = source_id;
   for (int c = 0; c < channels; ++c)
-    info.channels.push_back({std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG"});
+    info.channels.push_back(
+        {std::string("E").append(std::to_string(c + 1)), "microvolts", "EEG", ""});
   Outlet outlet(info, config);
   if (t0 < 0) t0 = localClock();
   std::printf("ready t0=%.9f port=%d\n", t0, outlet.info().v4data_port);

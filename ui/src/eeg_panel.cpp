@@ -98,9 +98,11 @@ void EegView::drawQualityLegend(const bci::SignalScope& scope, const std::string
       "photodiode; blue lines: stimulus onsets",
       t.flat_sd_uv, t.saturated_uv, t.line_poor_uv, t.line_bad_uv, t.drift_poor_uv_s,
       t.drift_bad_uv_s, t.rms_poor_uv, t.rms_bad_uv);
+  ImGui::TextWrapped("impedance: %s", impedance.empty()
+                                          ? "not reported by this source (LSL streams report "
+                                            "it where their metadata has it)"
+                                          : impedance.c_str());
   ImGui::PopStyleColor();
-  ImGui::TextDisabled("impedance: %s",
-                      impedance.empty() ? "not reported by this source" : impedance.c_str());
 }
 
 void EegView::drawTraces(const bci::SignalScope& scope) {

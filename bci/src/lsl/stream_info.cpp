@@ -51,6 +51,7 @@ void build(const StreamInfo& s, pugi::xml_document& doc, bool full) {
       addText(channel, "label", c.label);
       if (!c.unit.empty()) addText(channel, "unit", c.unit);
       if (!c.type.empty()) addText(channel, "type", c.type);
+      if (!c.impedance.empty()) addText(channel, "impedance", c.impedance);
     }
   }
   if (!s.parameters.empty()) {
@@ -174,7 +175,8 @@ StreamInfo StreamInfo::fromXml(const std::string& xml) {
   s.v4service_port = wholeNumber(info, "v4service_port", 0, 65535);
   for (pugi::xml_node c = info.child("desc").child("channels").child("channel"); c;
        c = c.next_sibling("channel"))
-    s.channels.push_back({c.child_value("label"), c.child_value("unit"), c.child_value("type")});
+    s.channels.push_back({c.child_value("label"), c.child_value("unit"), c.child_value("type"),
+                          c.child_value("impedance")});
   for (pugi::xml_node p : info.child("desc").child("arbci").children("parameter"))
     s.parameters.emplace_back(p.attribute("name").value(), p.child_value());
   return s;

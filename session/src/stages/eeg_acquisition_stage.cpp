@@ -168,6 +168,7 @@ void EegAcquisitionStage::step(Cycle& cycle) {
   acquisition_->withSource([&](bci::EegSource& source) {
     out.fault = source.fault();
     out.source_line = source.describe();
+    out.impedance = source.impedance();
   });
   if (const std::string fault = acquisition_->fault(); !fault.empty()) out.fault = fault;
   if (out.fault != fault_logged_) {
@@ -218,6 +219,10 @@ void EegAcquisitionStage::report(nlohmann::json& summary) const {
   summary["eeg"]["repeated_samples"] = acquisition_->repeatedSamples();
   summary["eeg"]["lost_samples"] = acquisition_->lostSamples();
   summary["eeg"]["source"] = sourceLine();
+  acquisition_->withSource([&](bci::EegSource& source) {
+    if (const std::string impedance = source.impedance(); !impedance.empty())
+      summary["eeg"]["impedance"] = impedance;
+  });
 }
 
 }  // namespace arbci::session

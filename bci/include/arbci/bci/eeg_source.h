@@ -36,6 +36,9 @@ class EegSource {
   virtual std::string fault() const { return {}; }
   // Where the signal comes from, in a line for the Session panel (empty: nothing to add).
   virtual std::string describe() const { return {}; }
+  // The electrodes' impedances as the source reports them, one line ("Fz 4.2, Cz 12"); empty
+  // when it reports none.
+  virtual std::string impedance() const { return {}; }
   // Stimuli the source itself carries (a replayed file's events) up to the samples delivered so
   // far; each is returned once.
   virtual std::vector<StimulusEvent> takeRecordedStimuli() { return {}; }

@@ -50,6 +50,8 @@ class LslSource final : public EegSource {
   std::vector<Block> poll(int max_blocks = 64) override;
   std::string fault() const override;
   std::string describe() const override;
+  // From the stream's metadata (<desc><channels><channel><impedance>), as connected.
+  std::string impedance() const override { return impedance_; }
   // Samples the stream missed while its outlet was away (as counted from the timestamps).
   std::int64_t gapSamples() const { return gap_samples_; }
 
@@ -60,7 +62,7 @@ class LslSource final : public EegSource {
   std::unique_ptr<lsl::Inlet> inlet_;
   SignalInfo info_;
   std::vector<double> scale_;  // per channel, to microvolts
-  std::string name_, host_;
+  std::string name_, host_, impedance_;
   Block pending_;
   std::int64_t next_index_ = 0;
   int connection_ = 0;

@@ -98,6 +98,7 @@ struct EegPart {
   std::vector<bci::SampleLoss> losses;
   std::string fault;        // why a live source delivers nothing now; empty while it does
   std::string source_line;  // the source's own account (an LSL stream's name, host, rates)
+  std::string impedance;    // the electrodes' impedances where the source reports them
   std::int64_t lost_samples = 0;
   double drift_ppm = 0.0, jitter_ms = 0.0;
   bool drift_reliable = false;             // see bci::ClockModel::driftReliable

@@ -34,6 +34,9 @@ constexpr double kIrregularRate = 0.0;
 
 struct ChannelDescription {
   std::string label, unit, type;
+  // <impedance>, as amplifier apps that measure it write it (g.tec's, for one); the text as
+  // given: LSL's metadata conventions state no unit for it.
+  std::string impedance;
 };
 
 struct StreamInfo {
