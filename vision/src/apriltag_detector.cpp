@@ -62,7 +62,7 @@ struct AprilTagDetector::Impl {
   }
 };
 
-AprilTagDetector::AprilTagDetector(const std::string& family, bool refine_edges)
+AprilTagDetector::AprilTagDetector(const std::string& family, bool refine_edges, int decimate)
     : impl_(std::make_unique<Impl>()) {
   impl_->family = &familyNamed(family);
   impl_->tags = impl_->family->create();
@@ -70,7 +70,7 @@ AprilTagDetector::AprilTagDetector(const std::string& family, bool refine_edges)
   if (!impl_->tags || !impl_->detector)
     throw std::runtime_error("libapriltag could not create its detector");
   apriltag_detector_add_family(impl_->detector, impl_->tags);
-  impl_->detector->quad_decimate = 1.0f;
+  impl_->detector->quad_decimate = static_cast<float>(decimate);
   impl_->detector->nthreads = 1;
   impl_->detector->refine_edges = refine_edges;
 }

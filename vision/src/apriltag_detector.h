@@ -19,13 +19,15 @@ class AprilTagDetector {
  public:
   // `family`: a libapriltag family name, or OpenCV's DICT_APRILTAG_16h5/25h9/36h10/36h11 for
   // the same families; empty: tag36h11. `refine_edges`: libapriltag's edge refinement (its
-  // default). Throws std::invalid_argument naming the accepted ones.
-  AprilTagDetector(const std::string& family, bool refine_edges);
+  // default). `decimate`: libapriltag's quad_decimate (1: quads found at full resolution, small
+  // tags count; 2: on the frame halved, the edges then refined on the frame). Throws
+  // std::invalid_argument naming the accepted ones.
+  AprilTagDetector(const std::string& family, bool refine_edges, int decimate = 1);
   ~AprilTagDetector();
   AprilTagDetector(const AprilTagDetector&) = delete;
   AprilTagDetector& operator=(const AprilTagDetector&) = delete;
 
-  // Full-resolution quads (no decimation: small tags count), one thread. Corners as every
+  // One thread. Corners as every
   // detection here: the printed tag's top-left, top-right, bottom-right, bottom-left, OpenCV
   // pixels.
   std::vector<MarkerDetection> detect(const cv::Mat& gray);

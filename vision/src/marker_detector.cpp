@@ -246,8 +246,8 @@ struct MarkerDetector::Impl {
     if (config.kind == MarkerKind::Aruco)
       dictionary = dictionaryId(config.dictionary.empty() ? "DICT_6X6_250" : config.dictionary);
     if (config.kind == MarkerKind::AprilTag)
-      apriltag =
-          std::make_unique<AprilTagDetector>(config.dictionary, config.apriltag_refine_edges);
+      apriltag = std::make_unique<AprilTagDetector>(config.dictionary, config.apriltag_refine_edges,
+                                                    config.search_decimate);
     resetThreshold();
   }
 

@@ -1,5 +1,6 @@
 #include "arbci/vision/marker_poses.h"
 
+#include <optional>
 #include <stdexcept>
 
 namespace arbci::vision {
@@ -13,14 +14,28 @@ std::map<int, PoseEstimate> MarkerPoses::estimate(const std::vector<MarkerDetect
   for (const MarkerDetection& m : markers) {
     const double side = size_of(m.id);
     if (side <= 0.0) continue;
-    std::vector<cv::Point2d> image;
-    for (const cv::Point2f& p : m.ideal_corners) image.emplace_back(p.x, p.y);
+    auto pixels = [](const std::array<cv::Point2f, 4>& corners) {
+      std::vector<cv::Point2d> image;
+      for (const cv::Point2f& p : corners) image.emplace_back(p.x, p.y);
+      return image;
+    };
     PoseOptions options = options_;
     if (const auto previous = previous_.find(m.id); previous != previous_.end())
       options.previous = previous->second;
     try {
       const auto object = markerCorners(side);
-      const PoseEstimate estimate = estimatePose(object, image, camera_matrix_, options);
+      std::optional<PoseEstimate> measured;
+      if (m.measured_ideal_corners) {
+        // Smoothed: the measured corners choose the planar solution, and bound the smoothing.
+        measured = estimatePose(object, pixels(*m.measured_ideal_corners), camera_matrix_, options);
+        options.previous = measured->pose;
+        options.ambiguity_ratio = 1e9;  // always the solution nearer the measured one
+      }
+      PoseEstimate estimate =
+          estimatePose(object, pixels(m.ideal_corners), camera_matrix_, options);
+      if (measured && rotationAngleDeg(estimate.pose.rotation, measured->pose.rotation) >
+                          options_.max_smoothing_deg)
+        estimate = *measured;
       poses[m.id] = estimate;
       previous_[m.id] = estimate.pose;
     } catch (const std::exception&) {

@@ -80,6 +80,7 @@ double MarkerTracker::OneEuro::filter(double x, double dt, const TrackerOptions&
 
 void MarkerTracker::smooth(Track& track, MarkerDetection& marker, double dt) {
   if (!options_.smooth_corners) return;
+  marker.measured_ideal_corners = marker.ideal_corners;
   for (int k = 0; k < 4; ++k) {
     const cv::Point2f before = marker.corners[k];
     marker.corners[k].x =

@@ -39,7 +39,8 @@ const core::Schema<DetectorConfig>& detectorSchema() {
                 "the black border's width as a fraction of the marker's side")
         .integer("search_decimate", &DetectorConfig::search_decimate, 1, 1, 2,
                  "1: search at full resolution; 2: on the frame averaged over 2x2 pixels, corners "
-                 "refined at full resolution (faster; markers need about 24 px a side)")
+                 "refined at full resolution (faster; markers need about 24 px a side); kind "
+                 "apriltag: libapriltag's quad_decimate")
         .boolean("apriltag_refine_edges", &DetectorConfig::apriltag_refine_edges, true,
                  "kind apriltag: libapriltag's edge refinement (the library's default); false "
                  "leaves the corners where its quad fit put them");

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,6 +26,9 @@ struct MarkerDetection {
   // The same corners undistorted (pixels of the ideal camera) when the detector has a camera
   // model; equal to `corners` otherwise. Poses are computed from these.
   std::array<cv::Point2f, 4> ideal_corners;
+  // Set by a tracker that smooths corners: `ideal_corners` as this frame measured them, before
+  // the smoothing (poses are kept near what was measured; see MarkerPoses).
+  std::optional<std::array<cv::Point2f, 4>> measured_ideal_corners;
   // ARToolKitPlus's `dir`: clockwise quarter turns from the sampled grid to the printed one.
   int orientation = 0;
   // 1.0 for a clean decode; lower for corrected bits (ARToolKitPlus's scale) or weaker matches.

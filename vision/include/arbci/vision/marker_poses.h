@@ -1,6 +1,9 @@
 // The poses of a camera's detected markers, frame after frame: each from its ideal (undistorted)
 // corners and the size of its black square, seeded with the marker's previous pose so a marker
-// seen nearly face-on does not flip between the two planar solutions. The session's tracking and
+// seen nearly face-on does not flip between the two planar solutions. Where the tracker smoothed
+// the corners, the corners as measured choose between the two solutions, and a smoothed pose
+// more than PoseOptions::max_smoothing_deg from the measured one gives way to it: smoothing
+// takes out jitter, never adds a flip. The session's tracking and
 // `arbci detect --camera` both estimate poses through it.
 #pragma once
 

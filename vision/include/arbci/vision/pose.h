@@ -41,6 +41,10 @@ struct PoseOptions {
   // the previous pose, so a marker seen nearly face-on does not flip.
   std::optional<Pose> previous;
   double ambiguity_ratio = 2.0;
+  // Smoothed corners (MarkerPoses): a pose from them that turns further than this from the pose
+  // of the corners as measured is not jitter taken out but lag, or the other planar solution
+  // (a smoothed quad is no exact view of a square): the measured pose is used instead.
+  double max_smoothing_deg = 5.0;
 };
 
 struct PoseEstimate {
