@@ -63,19 +63,21 @@ class Scorer {
       const cv::Point2d found((*corners)[c].x, (*corners)[c].y);
       outward_sum_ += (found - truth_px[c]).dot(out * (1.0 / cv::norm(out)));
       ++outward_count_;
+      corner_sq_sum_ += (found - truth_px[c]).dot(found - truth_px[c]);
     }
   }
   PoseStability result() const {
     PoseStability r = out_;
     r.outward_px = outward_count_ ? outward_sum_ / outward_count_ : 0.0;
     r.rotation_deg = rotations_ ? rotation_sum_ / rotations_ : 0.0;
+    r.corner_rms_px = outward_count_ ? std::sqrt(corner_sq_sum_ / outward_count_) : 0.0;
     return r;
   }
 
  private:
   const PoseSequence& sequence_;
   PoseStability out_;
-  double rotation_sum_ = 0.0, outward_sum_ = 0.0;
+  double rotation_sum_ = 0.0, outward_sum_ = 0.0, corner_sq_sum_ = 0.0;
   int rotations_ = 0, outward_count_ = 0;
 };
 

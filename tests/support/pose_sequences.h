@@ -39,9 +39,10 @@ cv::Mat renderSequenceFrame(const PoseSequence& sequence, MarkerFamily family, i
 // How a run's poses compare with the truth.
 struct PoseStability {
   int frames = 0, found = 0;
-  int flips = 0;              // rotation error over 15 degrees: the other planar solution
-  double outward_px = 0.0;    // mean corner offset along the diagonal, away from the centre
-  double rotation_deg = 0.0;  // mean rotation error of the frames without a flip
+  int flips = 0;               // rotation error over 15 degrees: the other planar solution
+  double outward_px = 0.0;     // mean corner offset along the diagonal, away from the centre
+  double rotation_deg = 0.0;   // mean rotation error of the frames without a flip
+  double corner_rms_px = 0.0;  // the corners' distance from the truth
 };
 
 // ARBCI: `config`'s detector, its tracker (with One-Euro corner smoothing when `smooth`) and

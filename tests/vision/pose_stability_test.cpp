@@ -16,8 +16,8 @@ namespace {
 void print(const char* sequence, const char* who, const PoseStability& r) {
   std::printf(
       "[ measured ] %-26s %-30s found %3d/%3d  flips %2d  rotation %.2f deg  corners "
-      "%+.3f px outward\n",
-      sequence, who, r.found, r.frames, r.flips, r.rotation_deg, r.outward_px);
+      "%+.3f px outward, %.3f px RMS\n",
+      sequence, who, r.found, r.frames, r.flips, r.rotation_deg, r.outward_px, r.corner_rms_px);
 }
 
 void compare(const PoseSequence& sequence) {
