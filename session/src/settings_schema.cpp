@@ -203,9 +203,13 @@ const Schema<WorldSettings>& referenceSchema() {
 
 Json defaultObjects() {
   auto object = [](int id, double x, Json color) {
-    return Json{{"id", id},         {"position", {x, 0.42, 0.06}},
-                {"marker_m", 0.05}, {"width_m", 0.07},
-                {"height_m", 0.06}, {"color", std::move(color)}};
+    return Json{{"id", id},
+                {"position", {x, 0.42, 0.06}},
+                {"marker_m", 0.05},
+                {"width_m", 0.07},
+                {"height_m", 0.06},
+                {"color", std::move(color)},
+                {"covered_s", Json::array()}};
   };
   return Json::array({object(10, -0.27, {0.85, 0.30, 0.25}), object(20, -0.09, {0.25, 0.55, 0.85}),
                       object(30, 0.09, {0.30, 0.75, 0.35}), object(40, 0.27, {0.90, 0.75, 0.20})});
