@@ -309,6 +309,7 @@ struct MarkerDetector::Impl {
     on_frame_quads.clear();
     traced.clear();
     const bool adaptive_mode = config.threshold.mode == ThresholdMode::Adaptive;
+    int occluded_tries = 0;
     for (const DarkComponent& c : labels.components()) {
       if (c.area < min_area || c.touchesBorder(width, height)) continue;
       const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
@@ -331,7 +332,18 @@ struct MarkerDetector::Impl {
       const QuadFit fit = fitQuad(contour, {c.first_x, c.first_y}, *searched, component_params);
       if (fit.quad) {
         if (!solid) quads.push_back(*fit.quad);
-      } else if (adaptive_mode && std::max(w, h) <= max_retry_side) {
+        continue;
+      }
+      if (c.holes > 0 && occluded_tries < config.occluded_corner_tries &&
+          std::min(w, h) >= 2.0f * min_side) {
+        // Ringed round light cells as a marker, but its outline is no quadrilateral: something
+        // may cover part of it (a finger over a corner). Its sides are found from their visible
+        // runs and its code read where enough cells show (BCH corrects the rest); it is still
+        // retried below as any near miss, in case it was a marker's broken border instead.
+        ++occluded_tries;
+        if (const auto quad = fitOccludedQuad(contour, *searched, params)) quads.push_back(*quad);
+      }
+      if (adaptive_mode && std::max(w, h) <= max_retry_side) {
         failed.emplace_back(c.min_x, c.min_y, w, h);
         failed_rings.push_back(c.holes > 0);
         if (fit.hull_is_quadrilateral && std::min(w, h) >= min_side * 0.5f &&
@@ -734,15 +746,19 @@ struct MarkerDetector::Impl {
   }
 
   // Samples with contrast and a dark border all round: a marker if its code decodes.
-  static bool hasMarkerBorder(const MarkerSamples& samples) {
-    return samples.contrast >= 8.0f && samples.border_light * 10 <= samples.border_samples;
+  // A quad fitted around a covered corner may show light there: a finger over a corner, a
+  // quarter of a side across, hides an eighth of the border samples (two sides' quarter each).
+  static bool hasMarkerBorder(const MarkerSamples& samples, bool occluded = false) {
+    const int light_allowed =
+        samples.border_samples / 10 + (occluded ? samples.border_samples / 8 : 0);
+    return samples.contrast >= 8.0f && samples.border_light <= light_allowed;
   }
 
   // The marker that `quad`'s samples of `image` read as, its corners in the printed order;
   // without `chase`, BCH codes are not Chase-decoded.
   std::optional<MarkerDetection> read(const cv::Mat& image, const Quad& quad,
                                       const MarkerSamples& samples, bool chase = true) const {
-    if (!hasMarkerBorder(samples)) return std::nullopt;
+    if (!hasMarkerBorder(samples, quad.occluded)) return std::nullopt;
     MarkerDetection marker;
     marker.kind = config.kind;
     if (config.kind == MarkerKind::Template) {

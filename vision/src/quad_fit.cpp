@@ -479,4 +479,90 @@ std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const 
   return quad;
 }
 
+std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const cv::Mat& image,
+                                    const QuadFitParams& params) {
+  const int n = static_cast<int>(contour.size());
+  if (n < 16) return std::nullopt;
+  // The outline as a polygon whose straight runs are the candidates for the sides. The tolerance
+  // keeps a side whole (a binarised edge wanders a pixel) and breaks a disc's arc into chords
+  // much shorter than the sides.
+  const float perimeter = perimeterOf(contour);
+  std::vector<cv::Point> polygon;
+  cv::approxPolyDP(contour, polygon, std::max(1.2, 0.012 * perimeter), true);
+  const int m = static_cast<int>(polygon.size());
+  if (m < 4 || m > 24) return std::nullopt;
+  // Each polygon vertex's index on the contour (approxPolyDP keeps contour points, in order).
+  std::vector<int> at(static_cast<size_t>(m), -1);
+  for (int v = 0, i = 0; v < m; ++v) {
+    for (int tries = 0; tries < n && contour[i] != polygon[v]; ++tries) i = (i + 1) % n;
+    if (contour[i] != polygon[v]) return std::nullopt;
+    at[v] = i;
+  }
+  struct Run {
+    int from, to;  // contour indices
+    float length;
+  };
+  std::vector<Run> runs;
+  for (int v = 0; v < m; ++v) {
+    const int w = (v + 1) % m;
+    runs.push_back({at[v], at[w], length(cv::Point2f(polygon[w] - polygon[v]))});
+  }
+  // The four longest runs, each at least a third of a quarter of the outline, in outline order.
+  std::vector<int> order(runs.size());
+  for (size_t r = 0; r < runs.size(); ++r) order[r] = static_cast<int>(r);
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return runs[a].length > runs[b].length; });
+  if (runs[order[3]].length < std::max(params.min_side * 0.5f, perimeter / 12.0f))
+    return std::nullopt;
+  std::array<int, 4> chosen{order[0], order[1], order[2], order[3]};
+  std::sort(chosen.begin(), chosen.end());
+  // Sides meet at corners that turn the same way, by 20 to 160 degrees (a square in perspective).
+  const LensMap lens{params.lens};
+  std::array<Line, 4> lines;
+  std::vector<cv::Point2f>& side_points = scratchPoints();
+  std::vector<float>& unit_weights = scratchWeights();
+  for (int k = 0; k < 4; ++k) {
+    const Run& run = runs[static_cast<size_t>(chosen[k])];
+    const int count = (run.to - run.from + n) % n;
+    const int trim = std::max(1, count / 8);
+    side_points.clear();
+    for (int j = trim; j <= count - trim; ++j)
+      side_points.push_back(lens.toIdeal(contour[(run.from + j) % n]));
+    unit_weights.assign(side_points.size(), 1.0f);
+    const auto line =
+        fitLine(side_points.data(), unit_weights.data(), static_cast<int>(side_points.size()));
+    if (!line || side_points.size() < 3) return std::nullopt;
+    lines[k] = *line;
+    // Directed along the outline, so consecutive sides turn one way.
+    if (lines[k].direction.dot(cv::Point2f(contour[run.to] - contour[run.from])) < 0.0f)
+      lines[k].direction = -lines[k].direction;
+  }
+  float turn_sign = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const cv::Point2f a = lines[k].direction, b = lines[(k + 1) % 4].direction;
+    const float cross = a.x * b.y - a.y * b.x;
+    const float angle = std::abs(std::atan2(cross, a.dot(b))) * 180.0f / 3.14159265f;
+    if (angle < 20.0f || angle > 160.0f) return std::nullopt;
+    if (turn_sign == 0.0f) turn_sign = cross;
+    if (cross * turn_sign <= 0.0f) return std::nullopt;
+  }
+  Quad quad;
+  if (!intersectLines(lines, quad.corners)) return std::nullopt;
+  // Each run covers most of its side (a covered corner shortens two sides by a quarter at most),
+  // and the corners lie near the outline: a covered one within a third of a side of it.
+  for (int k = 0; k < 4; ++k) {
+    const float side = length(quad.corners[(k + 1) % 4] - quad.corners[k]);
+    if (side < params.min_side) return std::nullopt;
+    if (runs[static_cast<size_t>(chosen[k])].length < 0.45f * side) return std::nullopt;
+    float nearest = 1e30f;
+    for (int i = 0; i < n; i += 2)
+      nearest = std::min(nearest, length(lens.toIdeal(cv::Point2f(contour[i])) - quad.corners[k]));
+    if (nearest > 2.0f + side / 3.0f) return std::nullopt;
+  }
+  if (params.refine_edges && !refineToEdges(image, lens, lines, quad.corners)) return std::nullopt;
+  if (!finishQuad(params, lens, quad)) return std::nullopt;
+  quad.occluded = true;
+  return quad;
+}
+
 }  // namespace arbci::vision

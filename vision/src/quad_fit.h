@@ -21,6 +21,9 @@ struct Quad {
   // Clockwise on screen; corner 0 lies nearest the contour point farthest from the first pixel.
   std::array<cv::Point2f, 4> corners;        // image pixels
   std::array<cv::Point2f, 4> ideal_corners;  // undistorted pixels (the same without a lens)
+  // Fitted from the visible runs of an outline partly covered (fitOccludedQuad): a corner of its
+  // border may be hidden.
+  bool occluded = false;
 };
 
 struct QuadFitParams {
@@ -56,5 +59,12 @@ QuadFit fitQuad(const std::vector<cv::Point>& contour, cv::Point first_pixel, co
 // refined sides no longer make a convex quadrilateral with sides of at least `min_side`.
 std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const cv::Mat& image,
                                const QuadFitParams& params);
+
+// A marker whose outline is no quadrilateral because something covers part of it (a finger over
+// a corner, dark or light): its four longest straight runs, in order around the outline, fitted
+// as lines and intersected, as line-based detectors find squares; nullopt unless they make a
+// convex quadrilateral that the runs mostly cover.
+std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const cv::Mat& image,
+                                    const QuadFitParams& params);
 
 }  // namespace arbci::vision

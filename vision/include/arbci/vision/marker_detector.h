@@ -44,6 +44,10 @@ struct DetectorConfig {
   // BCH only: when ARToolKitPlus's hard decoding (at most 2 corrected bits) fails, try Chase
   // decoding on the least reliable cells (recovers blurred markers; see code_decoder.h).
   bool soft_decoding = true;
+  // Square kinds: components ringed round light cells whose outline is no quadrilateral (a finger
+  // or the gripper over a corner) are fitted again from their four longest straight runs, at most
+  // this many a frame (0: never).
+  int occluded_corner_tries = 4;
   std::vector<TemplatePattern> templates;  // MarkerKind::Template
   TemplateMatchLimits template_limits;
   // The camera's lens (its calibration and an undistortion mode): sides are fitted straight in

@@ -1,0 +1,71 @@
+// A marker with one corner covered (a gripper's finger or a hand during a grasp), beside
+// libapriltag (decimate 2) on the same scenes drawn with its own tags: discs of 15-25 % of the
+// side, dark and light, over a corner, on scenes (seeds 9000-9099) that the recovery was not
+// developed on (5000-5059). The tracker must find at least as many as the peer under a dark disc,
+// and never a wrong id.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "arbci/vision/marker_detector.h"
+#include "support/marker_scoring.h"
+#include "support/occluded_markers.h"
+
+namespace arbci::test {
+namespace {
+
+constexpr int kArbciId = 1234, kAprilTagId = 123;
+
+struct Tally {
+  int found = 0, wrong = 0, frames = 0;
+};
+
+Tally count(MarkerFamily family, int id, const vision::DetectorConfig& config, Occluder occluder,
+            unsigned first_seed, int frames) {
+  vision::MarkerDetector detector(config);
+  Tally t;
+  for (int i = 0; i < frames; ++i) {
+    const OccludedFrame f = occludedMarkerFrame(family, id, occluder, 0.15, 0.25,
+                                                first_seed + static_cast<unsigned>(i));
+    std::vector<FoundMarker> found;
+    for (const vision::MarkerDetection& m : detector.detect(f.image).markers) {
+      FoundMarker fm;
+      fm.id = m.id;
+      fm.corners = m.corners;
+      found.push_back(fm);
+    }
+    const Score s = scoreFrame({id}, {f.truth}, found, true);
+    t.found += s.found;
+    t.wrong += s.wrong_id;
+    ++t.frames;
+  }
+  return t;
+}
+
+TEST(OccludedCorner, AMarkerWithACornerCoveredIsFoundBesideAprilTagAndNeverMisread) {
+  vision::DetectorConfig arbci;  // the session's defaults
+  vision::DetectorConfig apriltag;
+  apriltag.kind = vision::MarkerKind::AprilTag;
+  apriltag.search_decimate = 2;
+  for (const Occluder occluder : {Occluder::Dark, Occluder::Light}) {
+    const char* name = occluder == Occluder::Dark ? "dark" : "light";
+    const Tally ours = count(MarkerFamily::ArbciBch, kArbciId, arbci, occluder, 9000, 100);
+    const Tally peer =
+        count(MarkerFamily::AprilTag36h11, kAprilTagId, apriltag, occluder, 9000, 100);
+    std::printf(
+        "[ measured ] %s disc over a corner, 15-25 %% of the side: ARBCI %d/%d (%d wrong), "
+        "AprilTag (decimate 2) %d/%d (%d wrong)\n",
+        name, ours.found, ours.frames, ours.wrong, peer.found, peer.frames, peer.wrong);
+    EXPECT_EQ(ours.wrong, 0) << name;
+    if (occluder == Occluder::Dark) {
+      EXPECT_GE(ours.found, peer.found) << name;
+    } else {
+      // Not yet the peer's on these scenes (66 against 71): a light disc also hides the border
+      // and code cells under it, and the sides' refinement near it. This holds what was reached.
+      EXPECT_GE(ours.found * 10, peer.found * 9) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace arbci::test
