@@ -123,7 +123,8 @@ nlohmann::json datasetFacts(const bci::P300Dataset& data, const nlohmann::json& 
           {"rejected_epochs", data.rejected_epochs},
           {"reject_uv", data.reject_uv},
           {"unknown_flashes", data.unknown_flashes},
-          {"other_code_flashes", data.other_code_flashes}};
+          {"other_code_flashes", data.other_code_flashes},
+          {"interrupted_flashes", data.interrupted_flashes}};
 }
 
 void writeReportFiles(const std::string& report_path, const std::string& scores_path,
@@ -277,6 +278,10 @@ void train(TrainOptions& o) {
   if (data.other_code_flashes > 0) {
     std::cout << "; " << data.other_code_flashes << " flashes with codes beyond the paradigm's "
               << data.layout.codes() << " (a session's grid) left out";
+  }
+  if (data.interrupted_flashes > 0) {
+    std::cout << "; " << data.interrupted_flashes
+              << " flashes of calibration selections the session interrupted and retook left out";
   }
   if (data.unknown_flashes > 0) {
     std::cout << "; " << data.unknown_flashes

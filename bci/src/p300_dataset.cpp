@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -136,6 +137,43 @@ std::vector<std::pair<std::string, std::string>> layoutParameters(const Recordin
   return out;
 }
 
+// The flashes of runs (as buildDataset groups them) that a session annotated as interrupted
+// after them: "Calibration selection N interrupted ..." lies between a run's last flash and the
+// next run's first.
+static std::vector<bool> interruptedFlashes(const Recording& r, const ParadigmLayout& layout,
+                                            double gap_limit) {
+  std::vector<std::int64_t> marks;
+  for (const Annotation& a : r.annotations) {
+    if (a.text.rfind("Calibration selection ", 0) == 0 &&
+        a.text.find(" interrupted") != std::string::npos)
+      marks.push_back(a.sample);
+  }
+  std::vector<bool> out(r.stimuli.size(), false);
+  if (marks.empty()) return out;
+  std::vector<size_t> run;  // the current run's flashes
+  auto close = [&](std::int64_t next_first) {
+    if (run.empty()) return;
+    const std::int64_t last = r.stimuli[run.back()].sample;
+    for (std::int64_t m : marks) {
+      if (m > last && m <= next_first) {
+        for (size_t k : run) out[k] = true;
+        break;
+      }
+    }
+    run.clear();
+  };
+  std::int64_t previous = -1;
+  for (size_t i = 0; i < r.stimuli.size(); ++i) {
+    const StimulusEvent& e = r.stimuli[i];
+    if (!e.known || e.code > layout.codes()) continue;
+    if (previous >= 0 && e.sample - previous > gap_limit) close(e.sample);
+    run.push_back(i);
+    previous = e.sample;
+  }
+  close(std::numeric_limits<std::int64_t>::max());
+  return out;
+}
+
 P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSettings& settings,
                          const Progress& progress, const DatasetOptions& options) {
   const double reject_uv = options.reject_uv;
@@ -206,9 +244,15 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
 
     // Selections: runs of flashes separated by pauses longer than four stimulus intervals.
     const double gap_limit = std::max(1.0, 4.0 * layout.soa_s) * r.info.rate_hz;
+    const std::vector<bool> interrupted = interruptedFlashes(r, layout, gap_limit);
     std::int64_t previous = -1;
     int in_selection = 0;
-    for (const StimulusEvent& e : r.stimuli) {
+    for (size_t i = 0; i < r.stimuli.size(); ++i) {
+      const StimulusEvent& e = r.stimuli[i];
+      if (interrupted[i]) {
+        ++data.interrupted_flashes;
+        continue;
+      }
       if (!e.known) {  // an online flash of a free choice: nothing to learn from
         ++data.unknown_flashes;
         continue;

@@ -199,6 +199,16 @@ TEST(TrackingLoss, ACalibrationSelectionCutByACoveredMarkerIsRetakenAndLeftOutOf
     annotated |=
         a.text.rfind("Calibration selection " + std::to_string(cut) + " interrupted", 0) == 0;
   EXPECT_TRUE(annotated);
+  // Trained offline from the recording, the interrupted flashes are left out there too.
+  const ProcessResult train = runProcess(
+      kArbci,
+      {"train", (out / "recording.bdf").string(), "--out", (folder / "model.json").string()},
+      300.0);
+  ASSERT_EQ(train.exit_code, 0) << train.err;
+  EXPECT_NE(train.out.find("flashes of calibration selections the session interrupted and retook "
+                           "left out"),
+            std::string::npos)
+      << train.out;
 }
 
 // The marker stays covered: headless, nobody can uncover it, so the run ends with the reason

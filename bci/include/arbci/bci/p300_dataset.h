@@ -39,6 +39,9 @@ struct P300Dataset {
   int rejected_epochs = 0;     // over the amplitude limit (buildDataset's reject_uv)
   int unknown_flashes = 0;     // recorded as "U" (not known whether attended): left out
   int other_code_flashes = 0;  // codes beyond the paradigm's (a session's grid flashes): left out
+  // Flashes of calibration selections a session interrupted and retook (its annotation
+  // "Calibration selection N interrupted ..." follows them): no whole selection, left out.
+  int interrupted_flashes = 0;
   double reject_uv = 0.0;
   // Every stimulus code is always a target or never one (an oddball, or a recording coded by
   // class): the codes are the classes, not choices, so there are no selections to score.
