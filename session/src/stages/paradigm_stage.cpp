@@ -727,13 +727,17 @@ void ParadigmStage::watchWithheldFlashes(Cycle& cycle) {
     cycle.end(reason, "aborted");
     return;
   }
-  stopped_because_ = "no object in view";
+  pauseForView("no object in view", reason + "; resumes once they are seen again", time);
+  s_.tell.say(time, Severity::Error, "paused: " + reason);
+}
+
+void ParadigmStage::pauseForView(const std::string& why, const std::string& status, double time) {
+  stopped_because_ = why;
   paradigm_->pause();
   paused_for_view_ = true;
   view_paused_at_ = time;
   in_view_since_ = -1.0;
-  status_ = "paused: " + reason + "; resumes once they are seen again";
-  s_.tell.say(time, Severity::Error, "paused: " + reason);
+  status_ = "paused: " + status;
 }
 
 std::string ParadigmStage::viewLostReason(const std::string& context) const {
@@ -748,16 +752,11 @@ std::string ParadigmStage::viewLostReason(const std::string& context) const {
 
 void ParadigmStage::pauseCalibrationForView(int object_id, Cycle& cycle) {
   const double time = cycle.time_s;
-  stopped_because_ = "tracking lost: object " + std::to_string(object_id);
-  paradigm_->pause();
-  paused_for_view_ = true;
-  view_paused_at_ = time;
-  in_view_since_ = -1.0;
   const std::string reason = "calibration selection " + std::to_string(selection_) + ": object " +
                              std::to_string(object_id) +
                              "'s flash withheld (tracking lost); the selection is retaken once "
                              "every object has been in view for 1 s";
-  status_ = "paused: " + reason;
+  pauseForView("tracking lost: object " + std::to_string(object_id), reason, time);
   s_.log.write("paused", time, {{"reason", reason}});
   s_.tell.say(time, Severity::Warning, "paused: " + reason);
 }

@@ -65,6 +65,9 @@ class ParadigmStage final : public Stage {
   // A calibration flash withheld: the selection stops there, paused until every object is in
   // view again, and is then retaken (training needs whole selections).
   void pauseCalibrationForView(int object_id, Cycle& cycle);
+  // The paradigm paused until every offered object has been in view for a second; `why` names
+  // the stop for a calibration retake, `status` is the panel's reason.
+  void pauseForView(const std::string& why, const std::string& status, double time);
   void noteRetake(int target_code, Cycle& cycle);
   // "no object in view: the reference marker or objects (10, 40) lost for 10 s (...), CONTEXT"
   std::string viewLostReason(const std::string& context) const;
