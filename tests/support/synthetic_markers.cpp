@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <stdexcept>
 
 #include "arbci/vision/id_codes.h"
 
@@ -213,6 +214,21 @@ void applyCondition(cv::Mat& frame, Condition condition, std::mt19937& random) {
   }
 }
 
+// The synthetic table, or the layout's photograph under Condition::Cluttered.
+void drawTable(cv::Mat& frame, const SceneLayout& layout, Condition condition,
+               std::mt19937& random) {
+  if (condition != Condition::Cluttered) {
+    drawBackground(frame, random);
+    return;
+  }
+  if (layout.backdrop.size() != layout.size || layout.backdrop.type() != CV_8UC1) {
+    throw std::invalid_argument(
+        "the cluttered condition draws the scene over the layout's backdrop: an 8-bit grey image "
+        "of the frame's size (backdropFromPhotos)");
+  }
+  layout.backdrop.copyTo(frame);
+}
+
 void drawDecoys(cv::Mat& frame, const SceneLayout& layout) {
   for (size_t i = 0; i < layout.decoys.size(); ++i) {
     drawWarped(frame, decoyImage(layout.decoy_styles[i], 8), outerSquare(layout.decoys[i], 1));
@@ -261,6 +277,8 @@ std::string toString(Condition condition) {
       return "motion blur";
     case Condition::MotionBlurJpeg:
       return "motion+JPEG";
+    case Condition::Cluttered:
+      return "cluttered";
     case Condition::FastMotionJpeg:
       return "fast motion+J";
   }
@@ -431,7 +449,7 @@ RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condit
   std::mt19937 random(layout.seed);
   RenderedScene scene;
   scene.image.create(layout.size, CV_8UC1);
-  drawBackground(scene.image, random);
+  drawTable(scene.image, layout, condition, random);
   drawDecoys(scene.image, layout);
   const std::vector<int>& ids = usableIds(family);
   std::mt19937 id_random(layout.seed * 7919u + static_cast<std::uint32_t>(family));
@@ -447,10 +465,33 @@ RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condit
   return scene;
 }
 
+cv::Mat backdropFromPhotos(const std::vector<cv::Mat>& photos, cv::Size size, std::uint32_t seed) {
+  if (photos.empty()) throw std::invalid_argument("backdropFromPhotos: no photographs given");
+  std::mt19937 random(seed * 2654435761u + 17u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const cv::Mat& photo = photos[random() % photos.size()];
+  cv::Mat grey;
+  if (photo.channels() == 1)
+    grey = photo;
+  else
+    cv::cvtColor(photo, grey, photo.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  const double cover = std::max(static_cast<double>(size.width) / grey.cols,
+                                static_cast<double>(size.height) / grey.rows);
+  const double scale = cover * (1.0 + 0.5 * unit(random));
+  cv::Mat scaled;
+  cv::resize(grey, scaled,
+             cv::Size(std::max(size.width, static_cast<int>(std::ceil(grey.cols * scale))),
+                      std::max(size.height, static_cast<int>(std::ceil(grey.rows * scale)))),
+             0, 0, scale < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  const int x = static_cast<int>(unit(random) * (scaled.cols - size.width));
+  const int y = static_cast<int>(unit(random) * (scaled.rows - size.height));
+  return scaled(cv::Rect(x, y, size.width, size.height)).clone();
+}
+
 cv::Mat renderMarkerFree(const SceneLayout& layout, Condition condition) {
   std::mt19937 random(layout.seed);
   cv::Mat image(layout.size, CV_8UC1);
-  drawBackground(image, random);
+  drawTable(image, layout, condition, random);
   drawDecoys(image, layout);
   std::mt19937 condition_random(layout.seed * 31u + static_cast<std::uint32_t>(condition));
   applyCondition(image, condition, condition_random);

@@ -17,7 +17,9 @@ namespace arbci::test {
 enum class MarkerFamily { ArbciBch, Aruco6x6, AprilTag36h11 };
 // MotionBlur: a linear kernel 5-15 px long at a random angle (a head-mounted camera turning
 // during the exposure); MotionBlurJpeg: the same, then JPEG at quality 50 (a compressing camera);
-// FastMotionJpeg: a 9-15 px kernel (a faster head turn), then JPEG at quality 50.
+// FastMotionJpeg: a 9-15 px kernel (a faster head turn), then JPEG at quality 50. Cluttered: the
+// scene drawn over a photograph (SceneLayout::backdrop) instead of the flat synthetic table, so
+// that natural texture (grass, gravel, faces, print) surrounds the markers.
 enum class Condition {
   Clean,
   Blur,
@@ -26,7 +28,8 @@ enum class Condition {
   Combined,
   MotionBlur,
   MotionBlurJpeg,
-  FastMotionJpeg
+  FastMotionJpeg,
+  Cluttered
 };
 
 std::string toString(MarkerFamily family);
@@ -57,6 +60,8 @@ struct SceneLayout {
   std::vector<int> decoy_styles;
   int quiet_cells = 1;     // printed white margin around each marker, cells
   std::uint32_t seed = 0;  // background and lighting
+  // Condition::Cluttered's background: an 8-bit grey image of `size` (backdropFromPhotos()).
+  cv::Mat backdrop;
 };
 
 struct RenderedScene {
@@ -74,6 +79,11 @@ RenderedScene renderScene(const SceneLayout& layout, MarkerFamily family, Condit
 // Smears `frame` along a line `length` px long at `angle` radians (a box kernel on that line, drawn
 // at 4x and reduced): a camera moving during its exposure.
 void motionBlur(cv::Mat& frame, float length, float angle);
+
+// A background for Condition::Cluttered: one of `photos` (any 8-bit images, chosen by `seed`),
+// converted to grey, scaled by 1-1.5 times what covers `size` and cropped at a random place.
+// Throws std::invalid_argument when `photos` is empty.
+cv::Mat backdropFromPhotos(const std::vector<cv::Mat>& photos, cv::Size size, std::uint32_t seed);
 
 // A frame of `size` with background and decoys only (no markers), under `condition`.
 cv::Mat renderMarkerFree(const SceneLayout& layout, Condition condition);
