@@ -172,11 +172,10 @@ Reading readingOf(const std::array<float, 36>& levels) {
 
 // Sharpening overshoots, so a sharpened cell may read beyond full contrast (reliability over 1),
 // and a hard decode of a sharpened reading may overrule such a cell. Beyond twice full contrast
-// it is not trusted, and Chase judges the reading instead: on seeds 9000-9099 a motion-blurred
-// marker read as another id in another turn by overruling a cell at 4.6 (directional reading);
-// the right ids overruled cells at 2.65 at most (1.4 but once) on the motion-blurred scenes of
-// five seed sets, and under 2 in all 358 four-neighbour readings so decoded (blur and motion
-// rows of three seed sets), where the bound has refused none.
+// it is not trusted, and Chase judges the reading instead: a motion-blurred marker once read as
+// another id in another turn by overruling a cell at 4.6 (directional reading), while right
+// readings overrule cells well under that (under 2 in the four-neighbour readings, where this
+// bound refuses none).
 constexpr float kMaxOverruled = 2.0f;
 
 // The most decisively read cell a BCH decode overrules (0 when it corrected none).
@@ -230,9 +229,8 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   }
   // Motion blur smears each cell into its neighbours along one direction: sharpened against
   // those two alone, along the grid's rows, columns and diagonals (within 22.5 degrees of any
-  // direction). The amount was chosen on the bench's seeds 1000-1099; on its motion-blurred
-  // scenes nothing was tuned on (seeds 7000-7099) this read 4-6 more markers of 300 per
-  // condition with the decimated search, and no wrong id.
+  // direction). Held-out motion-blurred scenes read a few more markers in a hundred with it, and
+  // no wrong id.
   constexpr float kDirectionalAmount = 1.5f;
   constexpr std::array<CellOffset, 4> kDirections{{{0, 1}, {1, 0}, {1, 1}, {1, -1}}};
   for (const CellOffset& along : kDirections) {

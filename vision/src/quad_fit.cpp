@@ -20,9 +20,8 @@ namespace {
 constexpr float kMinSideDeviation = 2.5f;
 
 // Edge points per side when the sides are moved onto the image's edges: the first pass only
-// brings them within a pixel or two, the second fits them. 10 in the first pass cut the bench's
-// time per 640x480 frame by 0.04 ms, but gave one pose flip in 600 random poses at 30-60 degrees
-// (tests/vision/pose_test.cpp's, run 600 times; 20 and 14 gave none in 1,200).
+// brings them within a pixel or two, the second fits them. Fewer in the first pass saves little
+// time and lets a steeply tilted marker's side settle on the wrong edge (a pose flip).
 constexpr int kFirstPassSamples = 14, kSecondPassSamples = 20;
 
 // Index of the contour point in the forward arc (from, to) farthest from the chord from-to, and

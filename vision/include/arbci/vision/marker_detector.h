@@ -14,6 +14,7 @@
 
 #include "arbci/vision/marker.h"
 #include "arbci/vision/pixel_format.h"
+#include "arbci/vision/search_passes.h"
 #include "arbci/vision/template_pattern.h"
 #include "arbci/vision/threshold.h"
 #include "arbci/vision/undistortion.h"
@@ -22,8 +23,8 @@ namespace arbci::vision {
 
 enum class Smoothing { Auto, Always, Never };
 
-// kind, border and search_decimate are settings: their defaults and ranges are
-// vision::detectorSchema()'s (vision/settings.h); the rest tunes the tracker.
+// kind, border, search_decimate, apriltag_refine_edges and passes are settings: their defaults
+// and ranges are vision::detectorSchema()'s (vision/settings.h); the rest is set by the caller.
 struct DetectorConfig {
   DetectorConfig();
   MarkerKind kind;
@@ -31,9 +32,10 @@ struct DetectorConfig {
   // value in (0, 0.4] for square kinds.
   double border;
   ThresholdSettings threshold;
-  // 3x3 binomial blur before binarising: Auto smooths frames whose estimated noise exceeds 2.5
-  // grey levels (sensor noise) or that show JPEG's 8 px block edges (an MJPEG camera), and leaves
-  // other frames sharp. A frame searched at half resolution (search_decimate 2) is not smoothed.
+  // 3x3 binomial blur before binarising: Auto smooths frames whose estimated noise reaches
+  // passes.smooth_above_noise (sensor noise) or that show JPEG's 8 px block edges (an MJPEG
+  // camera), and leaves other frames sharp. A frame searched at half resolution (search_decimate
+  // 2) is not smoothed.
   Smoothing smoothing = Smoothing::Auto;
   float min_side_px = 8;  // smaller squares are ignored
   // Square kinds: 1 looks for candidates at full resolution; 2 thresholds, labels and fits quads
@@ -44,10 +46,8 @@ struct DetectorConfig {
   // BCH only: when ARToolKitPlus's hard decoding (at most 2 corrected bits) fails, try Chase
   // decoding on the least reliable cells (recovers blurred markers; see code_decoder.h).
   bool soft_decoding = true;
-  // Square kinds: components ringed round light cells whose outline is no quadrilateral (a finger
-  // or the gripper over a corner) are fitted again from their four longest straight runs, at most
-  // this many a frame (0: never).
-  int occluded_corner_tries = 4;
+  // Square kinds: the search's passes after its first (search_passes.h).
+  SearchPasses passes;
   std::vector<TemplatePattern> templates;  // MarkerKind::Template
   TemplateMatchLimits template_limits;
   // The camera's lens (its calibration and an undistortion mode): sides are fitted straight in
