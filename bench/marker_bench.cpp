@@ -136,6 +136,16 @@ int main(int argc, char** argv) {
   cli.add_option("--detections", detections_path,
                  "write every ARBCI detection (size, seed, condition, detector, id, corners) to "
                  "this file, one per line: two builds that should detect the same compare by diff");
+  std::vector<std::string> passes_off;
+  cli.add_option("--without", passes_off,
+                 "ARBCI's search without these passes (tracker.passes: occluded_corners, "
+                 "near_misses, cut_corners, fragments, thin_on_frame, mid_grey, blurred_edges), "
+                 "to measure what each catches and costs")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"occluded_corners", "near_misses", "cut_corners", "fragments",
+                             "thin_on_frame", "mid_grey", "blurred_edges"}));
+  bool peers = true;
+  cli.add_flag("!--no-peers", peers, "run ARBCI's searches alone (no AprilTag, no ArUco)");
   std::string examples_dir;
   cli.add_option("--examples", examples_dir,
                  "write the first frame of every condition and size, as ARBCI's markers are drawn, "
@@ -179,12 +189,24 @@ int main(int argc, char** argv) {
   }
   std::vector<std::unique_ptr<bench::MarkerDetectorUnderTest>> detectors;
   // ARBCI's configurations first, then the peers.
-  detectors.push_back(bench::makeArbciTracker(1));
-  detectors.push_back(bench::makeArbciTracker(2));
+  vision::SearchPasses passes;
+  for (const std::string& pass : passes_off) {
+    if (pass == "occluded_corners") passes.occluded_corners.enabled = false;
+    if (pass == "near_misses") passes.near_misses.enabled = false;
+    if (pass == "cut_corners") passes.cut_corners.enabled = false;
+    if (pass == "fragments") passes.fragments.enabled = false;
+    if (pass == "thin_on_frame") passes.thin_on_frame.enabled = false;
+    if (pass == "mid_grey") passes.mid_grey.enabled = false;
+    if (pass == "blurred_edges") passes.blurred_edges.enabled = false;
+  }
+  detectors.push_back(bench::makeArbciTracker(1, passes));
+  detectors.push_back(bench::makeArbciTracker(2, passes));
   const size_t ours = 2;
-  detectors.push_back(bench::makeAprilTag(2.0f));
-  detectors.push_back(bench::makeAprilTag(1.0f));
-  detectors.push_back(bench::makeAruco());
+  if (peers) {
+    detectors.push_back(bench::makeAprilTag(2.0f));
+    detectors.push_back(bench::makeAprilTag(1.0f));
+    detectors.push_back(bench::makeAruco());
+  }
   std::vector<test::Condition> conditions{
       test::Condition::Clean,          test::Condition::Blur,          test::Condition::Noise,
       test::Condition::UnevenLight,    test::Condition::Combined,      test::Condition::MotionBlur,
@@ -199,6 +221,11 @@ int main(int argc, char** argv) {
       max_tilt_deg,
       tilt_from == test::LayoutOptions::TiltFrom::LineOfSight ? "line of sight" : "optical axis",
       quiet_cells);
+  if (!passes_off.empty()) {
+    std::printf("ARBCI's searches without the passes:");
+    for (const std::string& pass : passes_off) std::printf(" %s", pass.c_str());
+    std::printf("\n");
+  }
   if (photos.empty())
     std::printf("(the cluttered condition is left out: give --backgrounds DIR of photographs)\n");
   else
@@ -244,8 +271,20 @@ int main(int argc, char** argv) {
                         scene.image);
           }
           Cell& cell = cells[{static_cast<int>(d), static_cast<int>(c)}];
-          cell.score.add(
-              test::scoreFrame(scene.ids, scene.markers, found, detectors[d]->orderedCorners()));
+          const test::Score frame_score =
+              test::scoreFrame(scene.ids, scene.markers, found, detectors[d]->orderedCorners());
+          cell.score.add(frame_score);
+          if (frame_score.wrong_id > 0 || frame_score.false_positive > 0) {
+            // Named, so that a wrong reading can be looked at (--examples draws the frame).
+            std::fprintf(stderr, "%s: %dx%d seed %u %s: %d wrong id, %d false positive; found",
+                         detectors[d]->name().c_str(), size.width, size.height, seed,
+                         test::toString(conditions[c]).c_str(), frame_score.wrong_id,
+                         frame_score.false_positive);
+            for (const test::FoundMarker& m : found) std::fprintf(stderr, " %d", m.id);
+            std::fprintf(stderr, "; drawn");
+            for (const int id : scene.ids) std::fprintf(stderr, " %d", id);
+            std::fprintf(stderr, "\n");
+          }
           for (size_t m = 0; m < scene.markers.size(); ++m) {
             const int bin = sideBin(scene.markers[m]);
             ++cell.truth_by_side[bin];
@@ -341,6 +380,11 @@ int main(int argc, char** argv) {
     }
     std::printf("\nmean time per frame over the %zu conditions, %dx%d:\n", conditions.size(),
                 size.width, size.height);
+    if (detectors.size() == ours) {
+      for (size_t d = 0; d < ours; ++d)
+        std::printf("  %-30s %8.3f ms\n", detectors[d]->name().c_str(), mean_ms[d]);
+      continue;
+    }
     const double fastest_peer =
         *std::min_element(mean_ms.begin() + static_cast<std::ptrdiff_t>(ours), mean_ms.end());
     for (size_t d = 0; d < detectors.size(); ++d) {

@@ -13,7 +13,8 @@ namespace {
 
 class ArbciTracker final : public MarkerDetectorUnderTest {
  public:
-  explicit ArbciTracker(int decimate) : decimate_(decimate), detector_(config(decimate)) {}
+  ArbciTracker(int decimate, const vision::SearchPasses& passes)
+      : decimate_(decimate), detector_(config(decimate, passes)) {}
   std::string name() const override {
     return decimate_ == 1 ? "ARBCI (BCH, adaptive)"
                           : "ARBCI (BCH, decimate " + std::to_string(decimate_) + ")";
@@ -47,9 +48,10 @@ class ArbciTracker final : public MarkerDetectorUnderTest {
   }
 
  private:
-  static vision::DetectorConfig config(int decimate) {
+  static vision::DetectorConfig config(int decimate, const vision::SearchPasses& passes) {
     vision::DetectorConfig c;
     c.search_decimate = decimate;
+    c.passes = passes;
     c.kind = vision::MarkerKind::Bch;
     c.border = 0.125;
     c.threshold.mode = vision::ThresholdMode::Adaptive;
@@ -132,8 +134,9 @@ class Aruco final : public MarkerDetectorUnderTest {
 
 }  // namespace
 
-std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate) {
-  return std::make_unique<ArbciTracker>(decimate);
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate,
+                                                          const vision::SearchPasses& passes) {
+  return std::make_unique<ArbciTracker>(decimate, passes);
 }
 std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate) {
   return std::make_unique<AprilTag>(decimate);

@@ -10,6 +10,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "arbci/vision/marker.h"
+#include "arbci/vision/search_passes.h"
 #include "support/marker_scoring.h"
 
 namespace arbci::bench {
@@ -36,8 +37,9 @@ class MarkerDetectorUnderTest {
   }
 };
 
-// decimate: the tracker's search_decimate (1: full resolution).
-std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate);
+// decimate: the tracker's search_decimate (1: full resolution); passes: its search's passes.
+std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate,
+                                                          const vision::SearchPasses& passes = {});
 std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate);
 std::unique_ptr<MarkerDetectorUnderTest> makeAruco();
 
