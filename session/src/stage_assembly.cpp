@@ -22,9 +22,7 @@ namespace arbci::session {
 namespace {
 
 TrackingSettings trackingSettingsOf(const SessionConfig& c, SceneSource& scene) {
-  TrackingSettings t{c.tracker.detector.kind,
-                     c.tracker.detector.border,
-                     c.tracker.detector.search_decimate,
+  TrackingSettings t{c.tracker.detector,
                      c.world.reference_id,
                      c.world.reference_size_m,
                      c.world.reference_position,

@@ -6,10 +6,7 @@ namespace arbci::session {
 namespace {
 
 vision::DetectorConfig detectorFor(const TrackingSettings& settings) {
-  vision::DetectorConfig d;
-  d.kind = settings.kind;
-  d.border = settings.border;
-  d.search_decimate = settings.search_decimate;
+  vision::DetectorConfig d = settings.detector;
   if (!settings.left_camera.distortion.empty())
     d.lens = std::make_shared<vision::Undistorter>(settings.left_camera,
                                                    vision::UndistortMode::LookupTable);

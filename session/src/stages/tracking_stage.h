@@ -18,9 +18,9 @@
 namespace arbci::session {
 
 struct TrackingSettings {
-  vision::MarkerKind kind;
-  double border;        // of the markers' black square, as a fraction of its side
-  int search_decimate;  // vision::DetectorConfig::search_decimate
+  // The session's tracker settings, whole (kind, border, search_decimate, passes, ...); the
+  // stage adds the left camera's lens.
+  vision::DetectorConfig detector;
   int reference_id;
   double reference_size_m;
   cv::Vec3d reference_position;       // robot frame
