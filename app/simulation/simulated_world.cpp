@@ -55,6 +55,19 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
     }
   }
   const cv::Vec3d tool(status.tool.x, status.tool.y, status.tool.z);
+  for (render::SceneObject& o : scene_.objects) {
+    // Coming down on an object to grasp it, the gripper's fingertip passes over a corner of its
+    // marker: from the approach height (10 cm above the top) until it holds the object.
+    const cv::Vec3d top = o.T_world_top.translation;
+    const bool over = status.current_command == robot::MessageType::Grasp &&
+                      status.holding != o.marker.id &&
+                      std::hypot(tool[0] - top[0], tool[1] - top[1]) < 0.02 &&
+                      tool[2] <= top[2] + 0.105 && tool[2] > top[2] - o.height_m;
+    if (o.gripper_over_corner != over) {
+      o.gripper_over_corner = over;
+      ++scene_revision_;
+    }
+  }
   if (!scene_.gripper || scene_.gripper->tool != tool ||
       scene_.gripper->opening != status.gripper_opening) {
     scene_.gripper = render::SceneGripper{tool, status.gripper_opening};

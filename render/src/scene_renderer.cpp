@@ -163,6 +163,16 @@ void SceneRenderer::draw(const Scene& scene, const glm::mat4& world_to_clip) {
       hand.translation += o.T_world_top.rotation * cv::Vec3d(0.01, 0.0, 0.035);
       box(solid, hand, o.marker.side_m * 1.8, o.marker.side_m * 1.5, 0.015, skin, skin);
     }
+    if (o.gripper_over_corner) {
+      // A fingertip, its rubber pad nearly black, a few millimetres above the marker's printed
+      // top-left corner: it hides 18 % of the side along both edges from that corner, and merges
+      // with the black border there (the hard case: the outline is no longer a square).
+      const glm::vec3 dark(0.06f);
+      const double h = o.marker.side_m / 2, pad = o.marker.side_m * 0.36;
+      vision::Pose tip = o.T_world_top;
+      tip.translation += o.T_world_top.rotation * cv::Vec3d(-h, h, 0.008);
+      box(solid, tip, pad, pad, 0.006, dark, dark);
+    }
   }
   if (scene.gripper) {
     const cv::Vec3d t = scene.gripper->tool;

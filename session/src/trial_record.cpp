@@ -76,24 +76,27 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
       selections.push_back(one);
     }
     wrong_robot_actions += t.wrongRobotActions();
-    trials.push_back({{"trial", t.trial},
-                      {"intended_object", t.intended_object},
-                      {"selected_object", idJson(t.acceptedObject())},
-                      {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
-                      {"selected_cell", cellJson(t.acceptedCell())},
-                      {"selections", selections},
-                      {"robot",
-                       {{"object", idJson(t.robot_object)},
-                        {"cell", cellJson(t.robot_cell)},
-                        {"returned", t.robot_returned}}},
-                      {"object_flashes", t.object_flashes},
-                      {"cell_flashes", t.cell_flashes},
-                      {"object_selection_s", t.object_selection_s},
-                      {"cell_selection_s", t.cell_selection_s},
-                      {"outcome", t.outcome},
-                      {"duration_s", t.ended_s >= 0.0 ? orNull(t.ended_s - t.started_s)
-                                                      : nlohmann::json(nullptr)},
-                      {"placement_error_m", orNull(t.placement_error_m)}});
+    trials.push_back(
+        {{"trial", t.trial},
+         {"intended_object", t.intended_object},
+         {"selected_object", idJson(t.acceptedObject())},
+         {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
+         {"selected_cell", cellJson(t.acceptedCell())},
+         {"selections", selections},
+         {"robot",
+          {{"object", idJson(t.robot_object)},
+           {"cell", cellJson(t.robot_cell)},
+           {"returned", t.robot_returned},
+           {"pose_age_max_s", t.grasp_pose_age_max_s ? nlohmann::json(*t.grasp_pose_age_max_s)
+                                                     : nlohmann::json(nullptr)}}},
+         {"object_flashes", t.object_flashes},
+         {"cell_flashes", t.cell_flashes},
+         {"object_selection_s", t.object_selection_s},
+         {"cell_selection_s", t.cell_selection_s},
+         {"outcome", t.outcome},
+         {"duration_s",
+          t.ended_s >= 0.0 ? orNull(t.ended_s - t.started_s) : nlohmann::json(nullptr)},
+         {"placement_error_m", orNull(t.placement_error_m)}});
     if (t.selected_object >= 0) {
       ++objects_made;
       objects_right += t.selected_object == t.intended_object;

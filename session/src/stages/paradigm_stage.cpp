@@ -67,6 +67,7 @@ void ParadigmStage::step(Cycle& cycle) {
   }
   for (const Request& request : cycle.record.requests) act(request, cycle);
   takeRobotNotes(cycle);
+  watchGrasp(cycle);
   collectTraining(cycle);
   stimulus_ = paradigm_->frame(cycle.frame, cycle.due_s);
   withholdStaleFlashes(cycle);
@@ -144,6 +145,20 @@ TrialRecord& ParadigmStage::currentTrial() {
     trials_.push_back(r);
   }
   return trials_[static_cast<size_t>(number - 1)];
+}
+
+void ParadigmStage::watchGrasp(Cycle& cycle) {
+  grasp_view_.observe(cycle.time_s, cycle.record.robot, cycle.record.tracking);
+  const auto sight = grasp_view_.take();
+  if (!sight) return;
+  s_.log.write("grasp_view", cycle.time_s,
+               {{"object", sight->object},
+                {"seconds", sight->seconds},
+                {"pose_age_max_s", sight->max_age_s},
+                {"never_seen", sight->never_seen}});
+  TrialRecord& trial = currentTrial();
+  if (trial.robot_object == sight->object)
+    trial.grasp_pose_age_max_s = sight->never_seen ? -1.0 : sight->max_age_s;
 }
 
 void ParadigmStage::takeRobotNotes(Cycle& cycle) {

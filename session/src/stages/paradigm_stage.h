@@ -20,6 +20,7 @@
 #include "arbci/session/session_config.h"
 #include "arbci/session/stage.h"
 #include "arbci/session/trial_record.h"
+#include "grasp_view.h"
 
 namespace arbci::session {
 
@@ -50,6 +51,8 @@ class ParadigmStage final : public Stage {
 
  private:
   void act(const Request& request, Cycle& cycle);
+  // Files how fresh the grasped object's pose stayed while the arm came down on it.
+  void watchGrasp(Cycle& cycle);
   void takeRobotNotes(Cycle& cycle);
   void collectTraining(Cycle& cycle);
   void handleEvents(Cycle& cycle);
@@ -94,6 +97,7 @@ class ParadigmStage final : public Stage {
   bci::FrameStimulus stimulus_;
   std::vector<size_t> slots_;
   std::vector<TrialRecord> trials_;
+  GraspView grasp_view_;  // the grasped object's tracking while the arm comes down on it
   std::optional<bci::EvaluationReport> calibration_report_;
   // The selection in progress: its number, its stimuli, and the codes the subject attends
   // (empty: not known) that label each flash.

@@ -27,6 +27,10 @@ struct SceneObject {
   double height_m = 0.06;
   glm::vec3 color{0.85f, 0.35f, 0.25f};
   bool covered = false;  // a hand lies over its marker
+  // The gripper's fingertip lies over a corner of its marker (the simulated arm coming down on it
+  // to grasp it): a dark pad 0.36 of the marker's side across, centred on the corner, so that it
+  // hides 18 % of the side along both edges from that corner.
+  bool gripper_over_corner = false;
 };
 
 struct SceneGripper {

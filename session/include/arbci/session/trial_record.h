@@ -38,6 +38,10 @@ struct TrialRecord {
   std::optional<int> robot_object;
   std::optional<std::pair<int, int>> robot_cell;
   bool robot_returned = false;
+  // While the arm came down on robot_object to grasp it (the gripper's fingers over its marker),
+  // the oldest its tracked pose grew, seconds; -1 when it had none at some point, nullopt when
+  // no grasp came down.
+  std::optional<double> grasp_pose_age_max_s;
   // The last object (cell) selection the ErrP classifier did not reject: what was executed.
   std::optional<int> acceptedObject() const;
   std::optional<std::pair<int, int>> acceptedCell() const;
