@@ -227,8 +227,7 @@ TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
 // marker (18 % of the side along both edges), and for the last half second its palm over the
 // whole marker. The session keeps tracking the object through the fingertip: its pose grows old
 // only under the palm (0.48 s of a 3.45 s descent at the default arm speed; 2.18 s with the
-// occluded-corner pass
-// switched off in the session file, tracker.passes.occluded_corners.enabled).
+// occluded-corner pass switched off in the session file, tracker.passes.occluded_corners).
 TEST(Session, TheGrippersFingertipOverTheGraspedObjectsMarkerDoesNotLoseIt) {
   const auto folder = fresh("fingertip");
   const auto session = folder.string() + ".json";
