@@ -223,6 +223,24 @@ TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
   EXPECT_EQ(logged_wrong, wrong);
 }
 
+// A short headless session in `folder` (seed 3): a clear responder (as steady_head.json), a
+// still head, a quick calibration, one trial per `intended` item (a JSON array of {object, cell});
+// `more` adds top-level keys (", \"robot\": {...}").
+ProcessResult runQuickSession(const std::filesystem::path& folder, const std::string& intended,
+                              const std::string& more = "") {
+  const std::string session = folder.string() + ".json";
+  const nlohmann::json trials = nlohmann::json::parse(intended);
+  std::ofstream(session) << R"({"eeg": {"erp_scale": 2.0},
+    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
+    "paradigm": {"calibration_selections": 4, "calibration_sequences": 6, "sequences": 5,
+      "certainty": 0, "cue_s": 0.5, "pause_s": 0.5, "result_s": 0.5, "trials": )"
+                         << trials.size() << R"(, "intended": )" << trials.dump() << "}" << more
+                         << "}";
+  return runProcess(
+      kArbci, {"run", "--headless", "--session", session, "--seed", "3", "--out", folder.string()},
+      300.0);
+}
+
 // As the simulated arm comes down on the object, its fingertip lies over a corner of the object's
 // marker (18 % of the side along both edges), and for the last half second its palm over the
 // whole marker. The session keeps tracking the object through the fingertip: its pose grows old
@@ -230,15 +248,7 @@ TEST(Session, WithoutAnErpSelectionsFailAndTheSessionSaysSoAndCarriesOn) {
 // occluded-corner pass switched off in the session file, tracker.passes.occluded_corners).
 TEST(Session, TheGrippersFingertipOverTheGraspedObjectsMarkerDoesNotLoseIt) {
   const auto folder = fresh("fingertip");
-  const auto session = folder.string() + ".json";
-  std::ofstream(session) << R"({"eeg": {"erp_scale": 2.0},
-    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
-    "paradigm": {"calibration_selections": 4, "calibration_sequences": 6, "sequences": 5,
-      "certainty": 0, "trials": 1, "cue_s": 0.5, "pause_s": 0.5, "result_s": 0.5,
-      "intended": [{"object": 30, "cell": [2, 2]}]}})";
-  const ProcessResult r = runProcess(
-      kArbci, {"run", "--headless", "--session", session, "--seed", "3", "--out", folder.string()},
-      300.0);
+  const ProcessResult r = runQuickSession(folder, R"([{"object": 30, "cell": [2, 2]}])");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json summary = readJson(folder / "summary.json");
   ASSERT_EQ(summary["trials"].size(), 1u);
@@ -259,18 +269,12 @@ TEST(Session, TheGrippersFingertipOverTheGraspedObjectsMarkerDoesNotLoseIt) {
 
 TEST(Session, AnObjectIsNeverPutOnAnotherAndAMovedObjectIsGraspedWhereItNowStands) {
   const auto folder = fresh("taken");
-  const auto session = folder.string() + ".json";
-  // A clear responder (as steady_head.json); the second intention is a cell already taken.
-  std::ofstream(session) << R"({"eeg": {"erp_scale": 2.0},
-    "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
-    "paradigm": {"calibration_selections": 4, "calibration_sequences": 6, "sequences": 5,
-      "certainty": 0, "trials": 3, "cue_s": 0.5, "pause_s": 0.5, "result_s": 0.5,
-      "intended": [{"object": 20, "cell": [2, 2]}, {"object": 40, "cell": [2, 2]},
-                   {"object": 20, "cell": [1, 1]}]},
-    "robot": {"speed_factor": 20}})";
-  const ProcessResult r = runProcess(
-      kArbci, {"run", "--headless", "--session", session, "--seed", "3", "--out", folder.string()},
-      300.0);
+  // The second intention is a cell already taken.
+  const ProcessResult r = runQuickSession(folder,
+                                          R"([{"object": 20, "cell": [2, 2]},
+                                              {"object": 40, "cell": [2, 2]},
+                                              {"object": 20, "cell": [1, 1]}])",
+                                          R"(, "robot": {"speed_factor": 20})");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json summary = readJson(folder / "summary.json");
   ASSERT_EQ(summary["trials"].size(), 3u);
