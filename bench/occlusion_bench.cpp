@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   for (const test::Occluder occluder : {test::Occluder::Dark, test::Occluder::Light}) {
     for (const auto& detector : detectors) {
       const int id = markerId(detector->family());
-      int found = 0, wrong = 0;
+      int found = 0, wrong = 0, with_square = 0, readable = 0;
       double seconds = 0.0;
       for (int f = 0; f < frames; ++f) {
         const test::OccludedFrame scene =
@@ -73,10 +73,22 @@ int main(int argc, char** argv) {
             test::scoreFrame({id}, {scene.truth}, seen, detector->orderedCorners());
         found += s.found;
         wrong += s.wrong_id;
+        if (s.found == 0) {
+          if (const auto miss = detector->explainMiss(scene.image, scene.truth, id)) {
+            with_square += miss->square_on_it;
+            readable += miss->readable_at_truth;
+          }
+        }
       }
-      std::printf("%-32s %-6s %5d/%-3d %6d %9.3f\n", detector->name().c_str(),
+      std::printf("%-32s %-6s %5d/%-3d %6d %9.3f", detector->name().c_str(),
                   occluder == test::Occluder::Dark ? "dark" : "light", found, frames, wrong,
                   1000.0 * seconds / frames);
+      // The tracker's misses: a square found on the marker, or its code readable at the true
+      // corners (then the search, not the reading, lost it).
+      if (detector->family() == test::MarkerFamily::ArbciBch)
+        std::printf("   misses: %d with a square on it, %d readable at the true corners",
+                    with_square, readable);
+      std::printf("\n");
     }
   }
   return 0;
