@@ -179,6 +179,15 @@ struct MarkerDetector::Impl {
     time.label += microseconds(mid, end);
   }
 
+  // A component enclosing no light region that still covers little of its hull: a marker whose
+  // border a light occluder cut open (its code's light cells then join the outside), not a solid
+  // shape, which covers nearly all of its hull.
+  static bool cutOpen(const DarkComponent& c, const std::vector<cv::Point>& contour) {
+    std::vector<cv::Point> hull;
+    cv::convexHull(contour, hull);
+    return c.area < 0.8 * cv::contourArea(hull);
+  }
+
   // The first pass: a quad fitted to the outline of every dark component of a marker's size, or,
   // for one ringed round light cells whose outline is no quadrilateral, to its visible sides
   // (passes.occluded_corners). With adaptive thresholds, the outlines that did not fit are then
@@ -224,8 +233,8 @@ struct MarkerDetector::Impl {
         if (!solid) quads.push_back(*fit.quad);
         continue;
       }
-      if (occluded.enabled && c.holes > 0 && occluded_tries < occluded.max_tries &&
-          std::min(w, h) >= 2.0f * min_side) {
+      if (occluded.enabled && occluded_tries < occluded.max_tries &&
+          std::min(w, h) >= 2.0f * min_side && (c.holes > 0 || cutOpen(c, contour))) {
         // It is still retried below as any near miss, in case it was a marker's broken border
         // instead.
         ++occluded_tries;

@@ -478,25 +478,17 @@ std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const 
   return quad;
 }
 
-std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const cv::Mat& image,
-                                    const QuadFitParams& params) {
+namespace {
+
+// The sides of an occluded outline from `polygon`, a simplification of it whose vertices are
+// contour points in contour order (`at`: their contour indices): its four longest edges, fitted on
+// the contour between their ends and intersected.
+std::optional<Quad> occludedQuadFromPolygon(const std::vector<cv::Point>& contour,
+                                            const std::vector<cv::Point>& polygon,
+                                            const std::vector<int>& at, float perimeter,
+                                            const cv::Mat& image, const QuadFitParams& params) {
   const int n = static_cast<int>(contour.size());
-  if (n < 16) return std::nullopt;
-  // The outline as a polygon whose straight runs are the candidates for the sides. The tolerance
-  // keeps a side whole (a binarised edge wanders a pixel) and breaks a disc's arc into chords
-  // much shorter than the sides.
-  const float perimeter = perimeterOf(contour);
-  std::vector<cv::Point> polygon;
-  cv::approxPolyDP(contour, polygon, std::max(1.2, 0.012 * perimeter), true);
   const int m = static_cast<int>(polygon.size());
-  if (m < 4 || m > 24) return std::nullopt;
-  // Each polygon vertex's index on the contour (approxPolyDP keeps contour points, in order).
-  std::vector<int> at(static_cast<size_t>(m), -1);
-  for (int v = 0, i = 0; v < m; ++v) {
-    for (int tries = 0; tries < n && contour[i] != polygon[v]; ++tries) i = (i + 1) % n;
-    if (contour[i] != polygon[v]) return std::nullopt;
-    at[v] = i;
-  }
   struct Run {
     int from, to;  // contour indices
     float length;
@@ -532,6 +524,15 @@ std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const
         fitLine(side_points.data(), unit_weights.data(), static_cast<int>(side_points.size()));
     if (!line || side_points.size() < 3) return std::nullopt;
     lines[k] = *line;
+    // A side is straight along its whole run: a dent in the middle of a side (a notch, a bite)
+    // is no covered corner. (The polygon's own runs are straight by construction; a run between
+    // two vertices of the outline's hull need not be.)
+    const float allowed = std::max(2.0f, 0.04f * run.length);
+    for (const cv::Point2f& p : side_points) {
+      const cv::Point2f d = p - line->point;
+      if (std::abs(d.x * line->direction.y - d.y * line->direction.x) > allowed)
+        return std::nullopt;
+    }
     // Directed along the outline, so consecutive sides turn one way.
     if (lines[k].direction.dot(cv::Point2f(contour[run.to] - contour[run.from])) < 0.0f)
       lines[k].direction = -lines[k].direction;
@@ -562,6 +563,57 @@ std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const
   if (!finishQuad(params, lens, quad)) return std::nullopt;
   quad.occluded = true;
   return quad;
+}
+
+// Each of `polygon`'s points' index on `contour`, searched forward from the last (the polygon's
+// points are contour points in contour order); empty when one is not found.
+std::vector<int> contourIndices(const std::vector<cv::Point>& contour,
+                                const std::vector<cv::Point>& polygon) {
+  const int n = static_cast<int>(contour.size());
+  std::vector<int> at(polygon.size(), -1);
+  for (size_t v = 0, i = 0; v < polygon.size(); ++v) {
+    for (int tries = 0; tries < n && contour[i] != polygon[v]; ++tries) i = (i + 1) % n;
+    if (contour[i] != polygon[v]) return {};
+    at[v] = static_cast<int>(i);
+  }
+  return at;
+}
+
+}  // namespace
+
+std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const cv::Mat& image,
+                                    const QuadFitParams& params) {
+  const int n = static_cast<int>(contour.size());
+  if (n < 16) return std::nullopt;
+  // The outline as a polygon whose straight runs are the candidates for the sides. The tolerance
+  // keeps a side whole (a binarised edge wanders a pixel) and breaks a disc's arc into chords
+  // much shorter than the sides.
+  const float perimeter = perimeterOf(contour);
+  const double tolerance = std::max(1.2, 0.012 * perimeter);
+  std::vector<cv::Point> polygon;
+  cv::approxPolyDP(contour, polygon, tolerance, true);
+  if (polygon.size() >= 4 && polygon.size() <= 24) {
+    const std::vector<int> at = contourIndices(contour, polygon);
+    if (!at.empty()) {
+      if (auto quad = occludedQuadFromPolygon(contour, polygon, at, perimeter, image, params))
+        return quad;
+    }
+  }
+  // A light occluder cuts the border open, and the outline runs in through the gap round the
+  // code cells: its polygon has too many runs, or its longest are not the sides. The outline's
+  // convex hull skips the cut (a short chord across the covered corner) and keeps the four sides.
+  std::vector<int> hull_indices;
+  cv::convexHull(contour, hull_indices, false, false);
+  if (hull_indices.size() < 4) return std::nullopt;
+  std::sort(hull_indices.begin(), hull_indices.end());
+  std::vector<cv::Point> hull;
+  for (const int i : hull_indices) hull.push_back(contour[static_cast<size_t>(i)]);
+  cv::approxPolyDP(std::vector<cv::Point>(hull), polygon, std::max(1.2, 0.012 * perimeterOf(hull)),
+                   true);
+  if (polygon.size() < 4 || polygon.size() > 24) return std::nullopt;
+  const std::vector<int> at = contourIndices(contour, polygon);
+  if (at.empty()) return std::nullopt;
+  return occludedQuadFromPolygon(contour, polygon, at, perimeterOf(hull), image, params);
 }
 
 }  // namespace arbci::vision

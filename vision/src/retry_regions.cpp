@@ -152,7 +152,7 @@ void RetryRegions::groupFragments(const std::vector<Quad>& found) {
     const cv::Point2f middle(box.x + 0.5f * box.width, box.y + 0.5f * box.height);
     bool inside_found = false;
     for (const Quad& quad : found)
-      inside_found = inside_found || insideConvex(quad.corners, middle);
+      inside_found = inside_found || (!quad.occluded && insideConvex(quad.corners, middle));
     // A thin marker broken into pieces: some of them ringed, the group's box narrow (a diagonal
     // one's box is not, and stays on the reduced image).
     const bool thin = scale_ > 1 && thin_on_frame.enabled && failed_rings_[i] > 0 &&

@@ -10,7 +10,9 @@ namespace arbci::vision {
 
 bool FoundQuads::inside(cv::Point2f p) const {
   for (const Quad& quad : searched) {
-    if (insideConvex(quad.corners, p)) return true;
+    // A quad fitted round a covered corner may be a smeared outline's guess: it does not keep a
+    // retry from finding what is really there.
+    if (!quad.occluded && insideConvex(quad.corners, p)) return true;
   }
   return false;
 }
