@@ -183,6 +183,13 @@ struct MarkerDetector::Impl {
   // border a light occluder cut open (its code's light cells then join the outside), not a solid
   // shape, which covers nearly all of its hull.
   static bool cutOpen(const DarkComponent& c, const std::vector<cv::Point>& contour) {
+    // Cut open, its outline runs in through the gap and round the code cells: much longer than
+    // its box's perimeter, where a blob's or a smear's outline is about as long (most failed
+    // outlines are those, and need no hull).
+    const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
+    if (static_cast<double>(contour.size()) < 2.4 * (w + h)) return false;
+    const double box = static_cast<double>(w) * h;
+    if (c.area >= 0.8 * box) return false;
     std::vector<cv::Point> hull;
     cv::convexHull(contour, hull);
     return c.area < 0.8 * cv::contourArea(hull);
@@ -238,7 +245,8 @@ struct MarkerDetector::Impl {
         // It is still retried below as any near miss, in case it was a marker's broken border
         // instead.
         ++occluded_tries;
-        if (const auto quad = fitOccludedQuad(contour, *searched, params)) quads.push_back(*quad);
+        if (const auto quad = fitOccludedQuad(contour, *searched, params, c.holes == 0))
+          quads.push_back(*quad);
       }
       if (adaptive_mode) retry_regions.addFailure(c, fit, labels);
     }

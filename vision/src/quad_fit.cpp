@@ -582,7 +582,7 @@ std::vector<int> contourIndices(const std::vector<cv::Point>& contour,
 }  // namespace
 
 std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const cv::Mat& image,
-                                    const QuadFitParams& params) {
+                                    const QuadFitParams& params, bool cut_open) {
   const int n = static_cast<int>(contour.size());
   if (n < 16) return std::nullopt;
   // The outline as a polygon whose straight runs are the candidates for the sides. The tolerance
@@ -602,6 +602,7 @@ std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const
   // A light occluder cuts the border open, and the outline runs in through the gap round the
   // code cells: its polygon has too many runs, or its longest are not the sides. The outline's
   // convex hull skips the cut (a short chord across the covered corner) and keeps the four sides.
+  if (!cut_open) return std::nullopt;
   std::vector<int> hull_indices;
   cv::convexHull(contour, hull_indices, false, false);
   if (hull_indices.size() < 4) return std::nullopt;

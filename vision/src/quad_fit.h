@@ -64,7 +64,9 @@ std::optional<Quad> refineQuad(const std::array<cv::Point2f, 4>& corners, const 
 // a corner, dark or light): its four longest straight runs, in order around the outline, fitted
 // as lines and intersected, as line-based detectors find squares; nullopt unless they make a
 // convex quadrilateral that the runs mostly cover.
+// `cut_open`: a light occluder may have cut the outline open (the component encloses nothing):
+// when its polygon gives no sides, the outline's convex hull, which skips the cut, is tried too.
 std::optional<Quad> fitOccludedQuad(const std::vector<cv::Point>& contour, const cv::Mat& image,
-                                    const QuadFitParams& params);
+                                    const QuadFitParams& params, bool cut_open);
 
 }  // namespace arbci::vision
