@@ -245,7 +245,8 @@ ProcessResult runQuickSession(const std::filesystem::path& folder, const std::st
 // marker (18 % of the side along both edges), and for the last half second its palm over the
 // whole marker. The session keeps tracking the object through the fingertip: its pose grows old
 // only under the palm (0.48 s of a 3.45 s descent at the default arm speed; 2.18 s with the
-// occluded-corner pass switched off in the session file, tracker.passes.occluded_corners).
+// occluded-corner pass switched off in the session file, tracker.passes.occluded_corners, which
+// must reach the session's detector).
 TEST(Session, TheGrippersFingertipOverTheGraspedObjectsMarkerDoesNotLoseIt) {
   const auto folder = fresh("fingertip");
   const ProcessResult r = runQuickSession(folder, R"([{"object": 30, "cell": [2, 2]}])");
@@ -265,6 +266,16 @@ TEST(Session, TheGrippersFingertipOverTheGraspedObjectsMarkerDoesNotLoseIt) {
     EXPECT_GT(line["seconds"].get<double>(), 2.0);  // the whole descent was watched
   }
   EXPECT_EQ(views, 1);
+  // The same with the occluded-corner pass switched off in the session file: the fingertip hides
+  // the marker, and the setting reaches the session's detector.
+  const auto without = fresh("fingertip-without-pass");
+  const ProcessResult off =
+      runQuickSession(without, R"([{"object": 30, "cell": [2, 2]}])",
+                      R"(, "tracker": {"passes": {"occluded_corners": {"enabled": false}}})");
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  const nlohmann::json off_robot = readJson(without / "summary.json")["trials"][0]["robot"];
+  ASSERT_TRUE(off_robot["pose_age_max_s"].is_number()) << off_robot.dump();
+  EXPECT_GT(off_robot["pose_age_max_s"].get<double>(), 1.5);
 }
 
 TEST(Session, AnObjectIsNeverPutOnAnotherAndAMovedObjectIsGraspedWhereItNowStands) {
