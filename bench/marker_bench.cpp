@@ -187,8 +187,6 @@ int main(int argc, char** argv) {
     }
     sizes.emplace_back(w, h);
   }
-  std::vector<std::unique_ptr<bench::MarkerDetectorUnderTest>> detectors;
-  // ARBCI's configurations first, then the peers.
   vision::SearchPasses passes;
   for (const std::string& pass : passes_off) {
     if (pass == "occluded_corners") passes.occluded_corners.enabled = false;
@@ -199,14 +197,8 @@ int main(int argc, char** argv) {
     if (pass == "mid_grey") passes.mid_grey.enabled = false;
     if (pass == "blurred_edges") passes.blurred_edges.enabled = false;
   }
-  detectors.push_back(bench::makeArbciTracker(1, passes));
-  detectors.push_back(bench::makeArbciTracker(2, passes));
-  const size_t ours = 2;
-  if (peers) {
-    detectors.push_back(bench::makeAprilTag(2.0f));
-    detectors.push_back(bench::makeAprilTag(1.0f));
-    detectors.push_back(bench::makeAruco());
-  }
+  const auto detectors = bench::detectorsUnderTest(passes, peers);
+  const size_t ours = 2;  // ARBCI's searches come first, then the peers
   std::vector<test::Condition> conditions{
       test::Condition::Clean,          test::Condition::Blur,          test::Condition::Noise,
       test::Condition::UnevenLight,    test::Condition::Combined,      test::Condition::MotionBlur,

@@ -145,4 +145,17 @@ std::unique_ptr<MarkerDetectorUnderTest> makeAruco() {
   return std::make_unique<Aruco>();
 }
 
+std::vector<std::unique_ptr<MarkerDetectorUnderTest>> detectorsUnderTest(
+    const vision::SearchPasses& passes, bool peers) {
+  std::vector<std::unique_ptr<MarkerDetectorUnderTest>> detectors;
+  detectors.push_back(makeArbciTracker(1, passes));
+  detectors.push_back(makeArbciTracker(2, passes));
+  if (peers) {
+    detectors.push_back(makeAprilTag(2.0f));
+    detectors.push_back(makeAprilTag(1.0f));
+    detectors.push_back(makeAruco());
+  }
+  return detectors;
+}
+
 }  // namespace arbci::bench

@@ -42,5 +42,9 @@ std::unique_ptr<MarkerDetectorUnderTest> makeArbciTracker(int decimate,
                                                           const vision::SearchPasses& passes = {});
 std::unique_ptr<MarkerDetectorUnderTest> makeAprilTag(float decimate);
 std::unique_ptr<MarkerDetectorUnderTest> makeAruco();
+// ARBCI's full and decimated searches (with `passes`), then, with `peers`, libapriltag (decimate 2
+// and 1) and ArUco: the detectors every marker bench compares.
+std::vector<std::unique_ptr<MarkerDetectorUnderTest>> detectorsUnderTest(
+    const vision::SearchPasses& passes = {}, bool peers = true);
 
 }  // namespace arbci::bench

@@ -46,12 +46,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "occlusion_bench: --max-radius is below --min-radius\n");
     return 2;
   }
-  std::vector<std::unique_ptr<bench::MarkerDetectorUnderTest>> detectors;
-  detectors.push_back(bench::makeArbciTracker(1));
-  detectors.push_back(bench::makeArbciTracker(2));
-  detectors.push_back(bench::makeAprilTag(2.0f));
-  detectors.push_back(bench::makeAprilTag(1.0f));
-  detectors.push_back(bench::makeAruco());
+  const auto detectors = bench::detectorsUnderTest();
   std::printf(
       "One marker per 640x480 scene (seeds %u-%u), a disc of %.0f-%.0f %% of the side over a "
       "corner.\n%-32s %-6s %9s %6s %9s\n",

@@ -277,12 +277,7 @@ int main(int argc, char** argv) {
       "steps); the smoothing's added latency is the One-Euro row's lag minus the raw row's.\n");
 
   // Detection only, every detector on the same sequence drawn with its own marker.
-  std::vector<std::unique_ptr<bench::MarkerDetectorUnderTest>> detectors;
-  detectors.push_back(bench::makeArbciTracker(1));
-  detectors.push_back(bench::makeArbciTracker(2));
-  detectors.push_back(bench::makeAprilTag(2.0f));
-  detectors.push_back(bench::makeAprilTag(1.0f));
-  detectors.push_back(bench::makeAruco());
+  auto detectors = bench::detectorsUnderTest();
   std::printf(
       "\nframes in which the marker is read (its id, centre inside the true outline), and "
       "ms per frame, one core:\n%-30s",
