@@ -178,6 +178,11 @@ Reading readingOf(const std::array<float, 36>& levels) {
 // bound refuses none).
 constexpr float kMaxOverruled = 2.0f;
 
+// Each extra reading (sharpened, then along each of four directions) is another chance for a
+// smeared code to land within 2 bits of a wrong codeword: their hard decodes may correct 1 bit,
+// and a reading 2 bits off goes to Chase decoding, which weighs the cells' reliability.
+constexpr int kMaxExtraReadingCorrections = 1;
+
 // The most decisively read cell a BCH decode overrules (0 when it corrected none).
 float strongestCorrection(const CodeDecode& decoded, const Reading& reading) {
   const Rotations& rotation = rotations();
@@ -217,7 +222,8 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   int sharpened_nearest = kBeyondHard;
   if (sharpened.cells != sampled) {
     const std::optional<CodeDecode> again = hardDecode(kind, sharpened.cells, ambiguous);
-    if (again && !ambiguous && strongestCorrection(*again, sharpened) <= kMaxOverruled)
+    if (again && !ambiguous && again->corrected_bits <= kMaxExtraReadingCorrections &&
+        strongestCorrection(*again, sharpened) <= kMaxOverruled)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.9f};
     sharpened_nearest = nearest(again);
@@ -237,7 +243,8 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
     const std::array<CellOffset, 2> ends{along, CellOffset{-along[0], -along[1]}};
     const Reading directional = readingOf(sharpenedLevels(samples, ends, kDirectionalAmount));
     const std::optional<CodeDecode> again = hardDecode(kind, directional.cells, ambiguous);
-    if (again && !ambiguous && strongestCorrection(*again, directional) <= kMaxOverruled)
+    if (again && !ambiguous && again->corrected_bits <= kMaxExtraReadingCorrections &&
+        strongestCorrection(*again, directional) <= kMaxOverruled)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.8f};
     if (!chase) continue;
