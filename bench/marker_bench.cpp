@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "arbci/vision/settings.h"
 #include "marker_peers.h"
 
 using namespace arbci;
@@ -136,14 +137,22 @@ int main(int argc, char** argv) {
   cli.add_option("--detections", detections_path,
                  "write every ARBCI detection (size, seed, condition, detector, id, corners) to "
                  "this file, one per line: two builds that should detect the same compare by diff");
+  // The passes that can be switched off: the sections of the settings schema's tracker.passes.
+  std::vector<std::string> pass_names;
+  for (const core::Key& key : vision::searchPassesSchema().keys())
+    if (key.type == core::Type::Section) pass_names.push_back(key.name);
   std::vector<std::string> passes_off;
-  cli.add_option("--without", passes_off,
-                 "ARBCI's search without these passes (tracker.passes: occluded_corners, "
-                 "near_misses, cut_corners, fragments, thin_on_frame, mid_grey, blurred_edges), "
-                 "to measure what each catches and costs")
+  cli.add_option(
+         "--without", passes_off,
+         "ARBCI's search without these passes (tracker.passes: " +
+             [&] {
+               std::string list;
+               for (const std::string& n : pass_names) list += (list.empty() ? "" : ", ") + n;
+               return list;
+             }() +
+             "), to measure what each catches and costs")
       ->delimiter(',')
-      ->check(CLI::IsMember({"occluded_corners", "near_misses", "cut_corners", "fragments",
-                             "thin_on_frame", "mid_grey", "blurred_edges"}));
+      ->check(CLI::IsMember(pass_names));
   bool peers = true;
   cli.add_flag("!--no-peers", peers, "run ARBCI's searches alone (no AprilTag, no ArUco)");
   std::string examples_dir;
@@ -188,15 +197,9 @@ int main(int argc, char** argv) {
     sizes.emplace_back(w, h);
   }
   vision::SearchPasses passes;
-  for (const std::string& pass : passes_off) {
-    if (pass == "occluded_corners") passes.occluded_corners.enabled = false;
-    if (pass == "near_misses") passes.near_misses.enabled = false;
-    if (pass == "cut_corners") passes.cut_corners.enabled = false;
-    if (pass == "fragments") passes.fragments.enabled = false;
-    if (pass == "thin_on_frame") passes.thin_on_frame.enabled = false;
-    if (pass == "mid_grey") passes.mid_grey.enabled = false;
-    if (pass == "blurred_edges") passes.blurred_edges.enabled = false;
-  }
+  nlohmann::json pass_settings = vision::searchPassesSchema().write(passes);
+  for (const std::string& pass : passes_off) pass_settings[pass]["enabled"] = false;
+  vision::searchPassesSchema().read(pass_settings, passes);
   const auto detectors = bench::detectorsUnderTest(passes, peers);
   const size_t ours = 2;  // ARBCI's searches come first, then the peers
   std::vector<test::Condition> conditions{

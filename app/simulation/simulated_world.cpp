@@ -27,6 +27,7 @@ SimulatedWorld::SimulatedWorld(const session::SceneSettings& settings) : setting
   }
   left_ = std::make_unique<render::SimulatedCamera>(camera_, settings.seed * 7 + 1);
   right_ = std::make_unique<render::SimulatedCamera>(camera_, settings.seed * 7 + 2);
+  approach_height_ = robotConfig().approach_height;
 }
 
 SimulatedWorld::~SimulatedWorld() = default;
@@ -57,12 +58,13 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
   const cv::Vec3d tool(status.tool.x, status.tool.y, status.tool.z);
   for (render::SceneObject& o : scene_.objects) {
     // Coming down on an object to grasp it, the gripper's fingertip passes over a corner of its
-    // marker: from the approach height (10 cm above the top) until it holds the object.
+    // marker: from the arm's approach height above the top until it holds the object (within
+    // 2 cm of the top's centre: the arm goes where the cameras saw the object).
     const cv::Vec3d top = o.T_world_top.translation;
     const bool over = status.current_command == robot::MessageType::Grasp &&
                       status.holding != o.marker.id &&
                       std::hypot(tool[0] - top[0], tool[1] - top[1]) < 0.02 &&
-                      tool[2] <= top[2] + 0.105 && tool[2] > top[2] - o.height_m;
+                      tool[2] <= top[2] + approach_height_ + 1e-3 && tool[2] > top[2] - o.height_m;
     if (o.gripper_over_corner != over) {
       o.gripper_over_corner = over;
       ++scene_revision_;

@@ -51,6 +51,7 @@ class SimulatedWorld {
   vision::CameraModel camera_;
   render::Scene scene_;
   std::unique_ptr<render::SimulatedCamera> left_, right_;
+  double approach_height_ = 0.0;  // the simulated arm's, above a grasp's target
   struct Cache {
     std::uint64_t scene_revision = 0;
     std::optional<vision::Pose> pose;

@@ -115,7 +115,7 @@ struct MarkerDetector::Impl {
   AdaptiveThresholder adaptive;
   LimitRows limit_rows;
   RunLabeler labels;  // the first pass's
-  std::vector<cv::Point> contour;
+  std::vector<cv::Point> contour, hull;
   // The quads found: of the searched image, and on the frame itself (thin regions of a reduced
   // image), decoded as they are.
   FoundQuads found;
@@ -179,20 +179,16 @@ struct MarkerDetector::Impl {
     time.label += microseconds(mid, end);
   }
 
-  // A component enclosing no light region that still covers little of its hull: a marker whose
-  // border a light occluder cut open (its code's light cells then join the outside), not a solid
-  // shape, which covers nearly all of its hull.
-  static bool cutOpen(const DarkComponent& c, const std::vector<cv::Point>& contour) {
-    // Cut open, its outline runs in through the gap and round the code cells: much longer than
-    // its box's perimeter, where a blob's or a smear's outline is about as long (most failed
-    // outlines are those, and need no hull).
+  // A component enclosing no light region that may be a marker whose border a light occluder cut
+  // open (search_passes.h). The outline and the box are checked first: most failed outlines are
+  // blobs and smears, and need no hull.
+  bool cutOpen(const DarkComponent& c, const std::vector<cv::Point>& outline) {
+    const SearchPasses::OccludedCorners& p = config.passes.occluded_corners;
     const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
-    if (static_cast<double>(contour.size()) < 2.4 * (w + h)) return false;
-    const double box = static_cast<double>(w) * h;
-    if (c.area >= 0.8 * box) return false;
-    std::vector<cv::Point> hull;
-    cv::convexHull(contour, hull);
-    return c.area < 0.8 * cv::contourArea(hull);
+    if (static_cast<double>(outline.size()) < p.cut_open_outline * 2.0 * (w + h)) return false;
+    if (c.area >= p.cut_open_fill * (static_cast<double>(w) * h)) return false;
+    cv::convexHull(outline, hull);
+    return c.area < p.cut_open_fill * cv::contourArea(hull);
   }
 
   // The first pass: a quad fitted to the outline of every dark component of a marker's size, or,

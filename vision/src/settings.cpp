@@ -35,7 +35,12 @@ const core::Schema<Passes::OccludedCorners>& occludedCornersSchema() {
         "gripper over a corner): its sides fitted on their visible runs and intersected");
     s.boolean("enabled", &Passes::OccludedCorners::enabled, true, "run this pass")
         .integer("max_tries", &Passes::OccludedCorners::max_tries, 4, 0, 64,
-                 "components fitted so a frame, in the order labelled");
+                 "components fitted so a frame, in the order labelled")
+        .number("cut_open_outline", &Passes::OccludedCorners::cut_open_outline, 1.2, 0.5, 10.0,
+                "a component enclosing nothing (a border a light occluder cut open) is tried when "
+                "its outline is at least this many times its box's perimeter")
+        .number("cut_open_fill", &Passes::OccludedCorners::cut_open_fill, 0.8, 0.0, 1.0,
+                "and it fills less than this fraction of its box and of its convex hull");
     return s;
   }();
   return t;

@@ -20,9 +20,15 @@ struct SearchPasses {
   // A component ringed round light cells whose outline is no quadrilateral may be a marker with
   // something over a corner (a finger, the gripper): its four sides are fitted on their visible
   // runs and intersected, and its code read where enough cells show (BCH corrects the rest).
+  // A light occluder cuts the border open: the component then encloses nothing and its outline
+  // runs in round the code cells. Such a component is tried when its outline is at least
+  // `cut_open_outline` times its box's perimeter (a blob's or a smear's is about as long) and it
+  // fills under `cut_open_fill` of its box and of its convex hull (a solid shape fills nearly all).
   struct OccludedCorners {
     bool enabled;
     int max_tries;  // components a frame, in the order labelled
+    double cut_open_outline;
+    double cut_open_fill;
   } occluded_corners;
 
   // A component whose outline did not fit a quad but whose hull is a quadrilateral with dark
