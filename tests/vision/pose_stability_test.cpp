@@ -41,5 +41,28 @@ TEST(PoseStability, AFastHandheldMarkerFlipsNoMoreThanAprilTagWithIppe) {
 TEST(PoseStability, AFarMarkerFlipsNoMoreThanAprilTagWithIppe) {
   compare(farMarkerSequence());
 }
+
+// JPEG must not move a far marker's corners: a corner 0.1 px outward on a 30 px marker puts it
+// about 4 mm nearer at 1.1 m. The same frames uncompressed are the reference (they share the
+// head motion's smear, which JPEG does not cause), and frames exposed too briefly to smear show
+// the compressed corners' own offset. Compressed frames are smoothed before the search, which
+// widens the edges; the corners must not carry that.
+TEST(PoseStability, JpegDoesNotMoveAFarMarkersCorners) {
+  const vision::DetectorConfig config;  // the session's defaults
+  const vision::PoseOptions pose;
+  const PoseSequence jpeg = farMarkerSequence();
+  PoseSequence uncompressed = jpeg;
+  uncompressed.jpeg_quality = 0;
+  PoseSequence sharp = jpeg;
+  sharp.exposure_ms = 0.0;
+  const PoseStability on_jpeg = runArbciPoses(jpeg, config, pose, false);
+  const PoseStability on_uncompressed = runArbciPoses(uncompressed, config, pose, false);
+  const PoseStability on_sharp_jpeg = runArbciPoses(sharp, config, pose, false);
+  print(jpeg.name.c_str(), "ARBCI", on_jpeg);
+  print("far, uncompressed", "ARBCI", on_uncompressed);
+  print("far, JPEG, 0 ms exposure", "ARBCI", on_sharp_jpeg);
+  EXPECT_NEAR(on_jpeg.outward_px, on_uncompressed.outward_px, 0.03);
+  EXPECT_NEAR(on_sharp_jpeg.outward_px, 0.0, 0.03);
+}
 }  // namespace
 }  // namespace arbci::test
