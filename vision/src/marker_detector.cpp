@@ -110,6 +110,9 @@ struct MarkerDetector::Impl {
   // The image candidates are searched in: `binarised`, or `half` (search_decimate 2), whose
   // pixels are `scale` of the frame's.
   const cv::Mat* searched = nullptr;
+  // Markers found on the smoothed frame are placed on the frame's own edges (placeOnFrame), unless
+  // the frame was smoothed for its noise: there the smoothed edges are the steadier.
+  bool place_on_frame = false;
   int scale = 1;
   TileThresholds tiles;
   AdaptiveThresholder adaptive;
@@ -300,8 +303,8 @@ struct MarkerDetector::Impl {
     return converted;
   }
 
-  // A marker found on the smoothed frame has its sides moved onto the frame's own edges: the
-  // smoothing widens each edge, and a wider edge meets the border's inner edge and the margin's
+  // A marker found on a frame smoothed for its compression has its sides moved onto the frame's
+  // own edges: the smoothing widens each edge, and a wider edge meets the border's inner edge and the margin's
   // outer edge sooner, which pulls its mid-level crossing inward (0.04 px on JPEG frames of a
   // 30 px marker, where the frame itself gives 0.01). That is a correction of a fraction of a
   // pixel: a side that would move further is on a smeared or noisy edge, which the smoothed frame
@@ -376,7 +379,7 @@ struct MarkerDetector::Impl {
       highest = std::max(highest, samples.highest);
       auto marker = readQuad(config, gray, quad, samples);
       if (!marker) marker = readOnBlurredEdges(config, gray, quad, samples);
-      if (marker && binarised != &gray) placeOnFrame(quad, *marker);
+      if (marker && place_on_frame) placeOnFrame(quad, *marker);
       frame_quads.push_back(quad);
       if (!marker) continue;
       decoded.emplace_back(index, *marker);
@@ -417,6 +420,7 @@ struct MarkerDetector::Impl {
     auto start = Clock::now();
     scale = config.search_decimate;
     double noise_sigma = 0.0;  // of the image searched, before any smoothing
+    place_on_frame = false;
     if (scale == 2) {
       // A 2x2 average is itself a smoothing (white noise halved): the frame is not smoothed.
       halve(gray, half);
@@ -434,6 +438,7 @@ struct MarkerDetector::Impl {
       if (smooth) smoothBinomial3(gray, smoothed);
       binarised = smooth ? &smoothed : &gray;
       searched = binarised;
+      place_on_frame = smooth && noise_sigma < config.passes.smooth_above_noise;
     }
     time.smooth = microseconds(start, Clock::now());
 
