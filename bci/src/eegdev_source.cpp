@@ -6,16 +6,10 @@
 #include <cmath>
 #include <cstring>
 
+#include "arbci/bci/units.h"
+
 namespace arbci::bci {
 namespace {
-
-double microvoltsPer(const std::string& unit) {
-  std::string u;
-  for (char c : unit) u += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (u == "v" || u == "volt" || u == "volts") return 1e6;
-  if (u == "mv" || u == "millivolt" || u == "millivolts") return 1e3;
-  return 1.0;  // uV (eegdev's usual unit), or not said
-}
 
 // The labels of a device's channels of sensor type `type`, comma-separated.
 std::string labelsOf(eegdev* device, const char* type) {

@@ -10,17 +10,10 @@
 #include "arbci/bci/lsl/inlet.h"
 #include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/lsl/resolver.h"
+#include "arbci/bci/units.h"
 
 namespace arbci::bci {
 namespace {
-
-double microvoltsPer(const std::string& unit) {
-  std::string u;
-  for (char c : unit) u += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (u == "v" || u == "volt" || u == "volts") return 1e6;
-  if (u == "mv" || u == "millivolt" || u == "millivolts") return 1e3;
-  return 1.0;  // microvolts, or not said
-}
 
 std::string describeStreams(const std::vector<lsl::StreamInfo>& streams) {
   std::string text;

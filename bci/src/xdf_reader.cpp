@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "arbci/bci/recording.h"
+#include "arbci/bci/units.h"
 #include "xdf/xdf_clock.h"
 #include "xdf/xdf_file.h"
 
@@ -22,13 +23,6 @@ namespace {
 std::string lower(std::string s) {
   for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
-}
-
-double microvoltsPer(const std::string& unit) {
-  const std::string u = lower(unit);
-  if (u == "v" || u == "volt" || u == "volts") return 1e6;
-  if (u == "mv" || u == "millivolt" || u == "millivolts") return 1e3;
-  return 1.0;
 }
 
 // ARBCI's markers ("flash <code> target|nontarget|unknown"), "<code> [target|nontarget]" or a bare

@@ -1,0 +1,14 @@
+// Voltage units as EEG sources name them (XDF channel units, LSL stream descriptions, eegdev
+// channel info): every source scales its samples to microvolts through this one table.
+#pragma once
+
+#include <string_view>
+
+namespace arbci::bci {
+
+// Microvolts per one `unit` ("V", "mV", "uV", "µV", "nV" or their spelled-out names, any case);
+// 1 for microvolts, for an empty unit and for one not in the table (EEG's usual unit: devices and
+// files that leave it out give microvolts).
+double microvoltsPer(std::string_view unit);
+
+}  // namespace arbci::bci

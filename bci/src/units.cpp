@@ -1,0 +1,17 @@
+#include "arbci/bci/units.h"
+
+#include <cctype>
+#include <string>
+
+namespace arbci::bci {
+
+double microvoltsPer(std::string_view unit) {
+  std::string u;
+  for (char c : unit) u += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (u == "v" || u == "volt" || u == "volts") return 1e6;
+  if (u == "mv" || u == "millivolt" || u == "millivolts") return 1e3;
+  if (u == "nv" || u == "nanovolt" || u == "nanovolts") return 1e-3;
+  return 1.0;
+}
+
+}  // namespace arbci::bci
