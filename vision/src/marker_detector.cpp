@@ -304,12 +304,12 @@ struct MarkerDetector::Impl {
   }
 
   // A marker found on a frame smoothed for its compression has its sides moved onto the frame's
-  // own edges: the smoothing widens each edge, and a wider edge meets the border's inner edge and the margin's
-  // outer edge sooner, which pulls its mid-level crossing inward (0.04 px on JPEG frames of a
-  // 30 px marker, where the frame itself gives 0.01). That is a correction of a fraction of a
-  // pixel: a side that would move further is on a smeared or noisy edge, which the smoothed frame
-  // places more steadily (moved there, the corners of a fast-moving marker jumped and its pose
-  // flipped). The code was read where the marker was found.
+  // own edges: the smoothing widens each edge, and a wider edge meets the border's inner edge and
+  // the margin's outer edge sooner, which pulls its mid-level crossing inward (0.04 px on JPEG
+  // frames of a 30 px marker, where the frame itself gives 0.01). That is a correction of a
+  // fraction of a pixel: a side that would move further is on a smeared or noisy edge, which the
+  // smoothed frame places more steadily (moved there, the corners of a fast-moving marker jumped
+  // and its pose flipped). The code was read where the marker was found.
   void placeOnFrame(Quad& quad, MarkerDetection& marker) const {
     constexpr float kMostMovePx = 0.3f;  // per corner
     QuadFitParams params;
