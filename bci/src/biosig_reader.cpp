@@ -16,6 +16,7 @@
 #include <mutex>
 
 #include "arbci/bci/recording.h"
+#include "arbci/bci/units.h"
 #include "bdf_layout.h"
 
 namespace arbci::bci {
@@ -236,10 +237,7 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
     const std::string unit = channel && biosig_channel_get_physdim(channel)
                                  ? trimmed(biosig_channel_get_physdim(channel))
                                  : "";
-    double scale = 1.0;
-    if (unit == "mV") scale = 1e3;
-    if (unit == "V") scale = 1e6;
-    if (unit == "nV") scale = 1e-3;
+    const double scale = microvoltsPer(unit);
     for (std::int64_t s = 0; s < samples; ++s) {
       recording.data[static_cast<size_t>(c) * samples + s] =
           static_cast<float>(data[static_cast<size_t>(c) * samples + s] * scale);

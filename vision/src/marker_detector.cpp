@@ -111,7 +111,8 @@ struct MarkerDetector::Impl {
   // pixels are `scale` of the frame's.
   const cv::Mat* searched = nullptr;
   // Markers found on the smoothed frame are placed on the frame's own edges (placeOnFrame), unless
-  // the frame was smoothed for its noise: there the smoothed edges are the steadier.
+  // the frame was smoothed for its noise: there the smoothed edges are the steadier. (A frame
+  // smoothed for its JPEG blocks, or by Smoothing::Always, is placed.)
   bool place_on_frame = false;
   int scale = 1;
   TileThresholds tiles;
@@ -303,13 +304,13 @@ struct MarkerDetector::Impl {
     return converted;
   }
 
-  // A marker found on a frame smoothed for its compression has its sides moved onto the frame's
-  // own edges: the smoothing widens each edge, and a wider edge meets the border's inner edge and
-  // the margin's outer edge sooner, which pulls its mid-level crossing inward (0.04 px on JPEG
-  // frames of a 30 px marker, where the frame itself gives 0.01). That is a correction of a
-  // fraction of a pixel: a side that would move further is on a smeared or noisy edge, which the
-  // smoothed frame places more steadily (moved there, the corners of a fast-moving marker jumped
-  // and its pose flipped). The code was read where the marker was found.
+  // A marker found on a frame smoothed other than for its noise (its JPEG blocks) has its sides
+  // moved onto the frame's own edges: the smoothing widens each edge, and a wider edge meets the
+  // border's inner edge and the margin's outer edge sooner, which pulls its mid-level crossing
+  // inward (0.04 px on JPEG frames of a 30 px marker, where the frame itself gives 0.01). That is a
+  // correction of a fraction of a pixel: a side that would move further is on a smeared or noisy
+  // edge, which the smoothed frame places more steadily (moved there, the corners of a fast-moving
+  // marker jumped and its pose flipped). The code was read where the marker was found.
   void placeOnFrame(Quad& quad, MarkerDetection& marker) const {
     constexpr float kMostMovePx = 0.3f;  // per corner
     QuadFitParams params;

@@ -1,5 +1,6 @@
 // Voltage units as EEG sources name them (XDF channel units, LSL stream descriptions, eegdev
-// channel info): every source scales its samples to microvolts through this one table.
+// channel info, GDF/EDF/BDF physical dimensions read by BioSig): every source scales its samples
+// to microvolts through this one table.
 #pragma once
 
 #include <string_view>
