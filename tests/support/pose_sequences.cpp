@@ -154,7 +154,7 @@ PoseStability runArbciPoses(const PoseSequence& s, const vision::DetectorConfig&
   const auto size_of = [&](int id) { return id == kArbciId ? s.side_m : 0.0; };
   for (int f = 0; f < s.frames(); ++f) {
     const double t = f / s.fps;
-    const cv::Mat image = renderSequenceFrame(s, MarkerFamily::ArbciBch, kArbciId, f, 1);
+    const cv::Mat image = renderSequenceFrame(s, MarkerFamily::ArbciBch, kArbciId, f, s.noise_seed);
     const vision::DetectionResult result = detector.detect(image);
     const auto markers = tracker.update(result.markers, detector.lastSquares(), t);
     const auto estimates = poses.estimate(markers, size_of);
@@ -183,7 +183,8 @@ PoseStability runAprilTagIppe(const PoseSequence& s, int decimate) {
   const auto object = vision::markerCorners(s.side_m);
   for (int f = 0; f < s.frames(); ++f) {
     const double t = f / s.fps;
-    const cv::Mat image = renderSequenceFrame(s, MarkerFamily::AprilTag36h11, kAprilTagId, f, 1);
+    const cv::Mat image =
+        renderSequenceFrame(s, MarkerFamily::AprilTag36h11, kAprilTagId, f, s.noise_seed);
     std::optional<vision::Pose> found;
     std::optional<vision::SquareCorners> corners;
     for (const vision::MarkerDetection& m : detector.detect(image).markers) {

@@ -19,8 +19,9 @@ struct PoseSequence {
   std::string name;
   std::function<vision::Pose(double t)> truth;  // T_cam_marker at time t (s)
   double seconds = 5.0, fps = 30.0, exposure_ms = 16.0, noise = 2.0;
-  int jpeg_quality = 0;  // 0: none
-  double side_m = 0.06;  // the black square
+  int jpeg_quality = 0;     // 0: none
+  unsigned noise_seed = 1;  // draws the sensor noise of every frame (renderSequenceFrame)
+  double side_m = 0.06;     // the black square
   cv::Size size{640, 480};
   cv::Matx33d k{560, 0, 319.5, 0, 560, 239.5, 0, 0, 1};
   int frames() const { return static_cast<int>(seconds * fps + 0.5); }

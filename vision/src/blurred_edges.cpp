@@ -93,56 +93,93 @@ std::optional<Line> lineOnRamps(const LensMap& lens, cv::Point2f a, cv::Point2f 
   return fitLine(points, weights, kept);
 }
 
+// A quad's ramp profiles (RampProfiles per side), sampled as they are needed.
+class SideProfiles {
+ public:
+  SideProfiles(const Quad& quad, const cv::Mat& image, const QuadFitParams& params)
+      : lens_{params.lens},
+        ideal_(quad.ideal_corners),
+        sample_(image, sidesRegion(lens_, ideal_, static_cast<float>(kRampOutside + 2))) {}
+
+  const LensMap& lens() const { return lens_; }
+  const std::array<cv::Point2f, 4>& ideal() const { return ideal_; }
+  const RampProfiles& side(int k) const { return profiles_[k]; }
+
+  // Samples profile s of side k; returns its darkest sample inside the quad.
+  float sample(int k, int s) {
+    constexpr int kFirstInside = static_cast<int>(kRampOutside / kRampStep) + 1;
+    const cv::Point2f a = ideal_[k], d = ideal_[(k + 1) % 4] - a;
+    const cv::Point2f along = d / length(d), ideal_outward(along.y, -along.x);
+    const cv::Point2f ideal_base = a + rampProfileAt(s) * d;
+    const cv::Point2f inward = -outwardInImage(lens_, ideal_base, ideal_outward);
+    const cv::Point2f from = lens_.toImage(ideal_base) - static_cast<float>(kRampOutside) * inward;
+    float* profile = profiles_[k][s];
+    sample_.line(from.x, from.y, kRampStep * inward.x, kRampStep * inward.y, kRampSamples, profile);
+    return *std::min_element(profile + kFirstInside, profile + kRampSamples);
+  }
+
+  // From the two middle profiles of each side: whether some side's edge is a ramp (a sharp edge
+  // falls from 15 % to 35 % within 0.5 px, Gaussian blur of sigma 1.5 px within 1; a 9 px smear
+  // across it in 1.8 px, at 45 degrees in 1.3). `black`: the darkest sample inside them.
+  bool smeared(float& black) {
+    constexpr int kMiddle = kRampProfiles / 2 - 1;
+    black = 255.0f;
+    for (int k = 0; k < 4; ++k)
+      black = std::min({black, sample(k, kMiddle), sample(k, kMiddle + 1)});
+    float widest = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      float mean[kRampSamples];  // of the two: half the noise
+      for (int i = 0; i < kRampSamples; ++i)
+        mean[i] = 0.5f * (profiles_[k][kMiddle][i] + profiles_[k][kMiddle + 1][i]);
+      if (const auto ramp = rampCrossings(mean, black))
+        widest = std::max(widest, (ramp->far_at - ramp->near_at) * kRampStep);
+    }
+    return widest >= kLeastSmearRamp;
+  }
+
+ private:
+  LensMap lens_;
+  std::array<cv::Point2f, 4> ideal_;
+  BilinearSampler sample_;
+  RampProfiles profiles_[4];
+};
+
+bool sidesLongEnough(const Quad& quad, const QuadFitParams& params) {
+  for (int k = 0; k < 4; ++k) {
+    if (length(quad.ideal_corners[(k + 1) % 4] - quad.ideal_corners[k]) < params.min_side)
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+bool looksSmeared(const Quad& quad, const cv::Mat& image, const QuadFitParams& params) {
+  if (!sidesLongEnough(quad, params)) return false;
+  SideProfiles profiles(quad, image, params);
+  float black = 0.0f;
+  return profiles.smeared(black);
+}
 
 std::optional<Quad> placeOnBlurredEdges(const Quad& quad, const cv::Mat& image,
                                         const QuadFitParams& params) {
-  const LensMap lens{params.lens};
-  const std::array<cv::Point2f, 4>& ideal = quad.ideal_corners;
-  const BilinearSampler sample(image,
-                               sidesRegion(lens, ideal, static_cast<float>(kRampOutside + 2)));
-  RampProfiles profiles[4];
-  constexpr int kFirstInside = static_cast<int>(kRampOutside / kRampStep) + 1;
-  // Samples profile s of side k; returns its darkest sample inside the quad.
-  auto sampleProfile = [&](int k, int s) {
-    const cv::Point2f a = ideal[k], d = ideal[(k + 1) % 4] - a;
-    const cv::Point2f along = d / length(d), ideal_outward(along.y, -along.x);
-    const cv::Point2f ideal_base = a + rampProfileAt(s) * d;
-    const cv::Point2f inward = -outwardInImage(lens, ideal_base, ideal_outward);
-    const cv::Point2f from = lens.toImage(ideal_base) - static_cast<float>(kRampOutside) * inward;
-    float* profile = profiles[k][s];
-    sample.line(from.x, from.y, kRampStep * inward.x, kRampStep * inward.y, kRampSamples, profile);
-    return *std::min_element(profile + kFirstInside, profile + kRampSamples);
-  };
-  for (int k = 0; k < 4; ++k) {
-    if (length(ideal[(k + 1) % 4] - ideal[k]) < params.min_side) return std::nullopt;
-  }
-  // First the two middle profiles of each side: unless some side's edge is a ramp (a sharp edge
-  // falls from 15 % to 35 % within 0.5 px, Gaussian blur of sigma 1.5 px within 1; a 9 px smear
-  // across it in 1.8 px, at 45 degrees in 1.3), the quad stays where it is.
-  constexpr int kMiddle = kRampProfiles / 2 - 1;
-  float black = 255.0f;
-  for (int k = 0; k < 4; ++k) {
-    black = std::min({black, sampleProfile(k, kMiddle), sampleProfile(k, kMiddle + 1)});
-  }
-  float widest = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    float mean[kRampSamples];  // of the two: half the noise
-    for (int i = 0; i < kRampSamples; ++i)
-      mean[i] = 0.5f * (profiles[k][kMiddle][i] + profiles[k][kMiddle + 1][i]);
-    if (const auto ramp = rampCrossings(mean, black))
-      widest = std::max(widest, (ramp->far_at - ramp->near_at) * kRampStep);
-  }
-  if (widest < kLeastSmearRamp) return std::nullopt;
+  if (!sidesLongEnough(quad, params)) return std::nullopt;
+  SideProfiles profiles(quad, image, params);
+  // Unless some side's edge is a ramp, the quad stays where it is.
+  float black = 0.0f;
+  if (!profiles.smeared(black)) return std::nullopt;
   // Then the rest: the black level is the darkest sample inside the quad.
+  constexpr int kMiddle = kRampProfiles / 2 - 1;
   for (int k = 0; k < 4; ++k) {
     for (int s = 0; s < kRampProfiles; ++s) {
-      if (s != kMiddle && s != kMiddle + 1) black = std::min(black, sampleProfile(k, s));
+      if (s != kMiddle && s != kMiddle + 1) black = std::min(black, profiles.sample(k, s));
     }
   }
+  const std::array<cv::Point2f, 4>& ideal = profiles.ideal();
+  const LensMap& lens = profiles.lens();
   std::array<Line, 4> lines;
   for (int k = 0; k < 4; ++k) {
-    const auto line = lineOnRamps(lens, ideal[k], ideal[(k + 1) % 4], profiles[k], black);
+    const auto line = lineOnRamps(lens, ideal[k], ideal[(k + 1) % 4], profiles.side(k), black);
     if (!line) return std::nullopt;
     lines[k] = *line;
   }

@@ -15,6 +15,7 @@
 #endif
 
 #include "apriltag_detector.h"
+#include "blurred_edges.h"
 #include "contour_trace.h"
 #include "dictionary_detector.h"
 #include "marker_sampler.h"
@@ -110,9 +111,8 @@ struct MarkerDetector::Impl {
   // The image candidates are searched in: `binarised`, or `half` (search_decimate 2), whose
   // pixels are `scale` of the frame's.
   const cv::Mat* searched = nullptr;
-  // Markers found on the smoothed frame are placed on the frame's own edges (placeOnFrame), unless
-  // the frame was smoothed for its noise: there the smoothed edges are the steadier. (A frame
-  // smoothed for its JPEG blocks, or by Smoothing::Always, is placed.)
+  // Whether this frame's markers are placed on its own edges (passes.place_on_frame): it was
+  // smoothed other than for its noise.
   bool place_on_frame = false;
   int scale = 1;
   TileThresholds tiles;
@@ -304,23 +304,19 @@ struct MarkerDetector::Impl {
     return converted;
   }
 
-  // A marker found on a frame smoothed other than for its noise (its JPEG blocks) has its sides
-  // moved onto the frame's own edges: the smoothing widens each edge, and a wider edge meets the
-  // border's inner edge and the margin's outer edge sooner, which pulls its mid-level crossing
-  // inward (0.04 px on JPEG frames of a 30 px marker, where the frame itself gives 0.01). That is a
-  // correction of a fraction of a pixel: a side that would move further is on a smeared or noisy
-  // edge, which the smoothed frame places more steadily (moved there, the corners of a fast-moving
-  // marker jumped and its pose flipped). The code was read where the marker was found.
+  // passes.place_on_frame (search_passes.h: why). The code was read where the marker was found.
   void placeOnFrame(Quad& quad, MarkerDetection& marker) const {
-    constexpr float kMostMovePx = 0.3f;  // per corner
+    const SearchPasses::PlaceOnFrame& pass = config.passes.place_on_frame;
     QuadFitParams params;
     params.min_side = config.min_side_px;
     params.lens = config.lens.get();
+    if (looksSmeared(quad, gray, params)) return;
     const auto placed = refineQuad(quad.corners, gray, params);
     if (!placed) return;
+    const float most = static_cast<float>(pass.most_move_px);
     for (int k = 0; k < 4; ++k) {
       const cv::Point2f d = placed->corners[k] - quad.corners[k];
-      if (d.dot(d) > kMostMovePx * kMostMovePx) return;
+      if (d.dot(d) > most * most) return;
     }
     quad = *placed;
     for (int k = 0; k < 4; ++k) {
@@ -439,7 +435,8 @@ struct MarkerDetector::Impl {
       if (smooth) smoothBinomial3(gray, smoothed);
       binarised = smooth ? &smoothed : &gray;
       searched = binarised;
-      place_on_frame = smooth && noise_sigma < config.passes.smooth_above_noise;
+      place_on_frame = config.passes.place_on_frame.enabled && smooth &&
+                       noise_sigma < config.passes.smooth_above_noise;
     }
     time.smooth = microseconds(start, Clock::now());
 

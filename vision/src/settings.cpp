@@ -144,6 +144,20 @@ const core::Schema<Passes::MidGrey>& midGreySchema() {
   return t;
 }
 
+const core::Schema<Passes::PlaceOnFrame>& placeOnFrameSchema() {
+  static const core::Schema<Passes::PlaceOnFrame> t = [] {
+    core::Schema<Passes::PlaceOnFrame> s(
+        "place_on_frame",
+        "a marker found on a frame smoothed for its compression, its sides moved onto the "
+        "frame's own edges (not where they are smeared)");
+    s.boolean("enabled", &Passes::PlaceOnFrame::enabled, true, "run this pass")
+        .number("most_move_px", &Passes::PlaceOnFrame::most_move_px, 0.3, 0.0, 5.0,
+                "a corner that would move further stays where it was found", "px");
+    return s;
+  }();
+  return t;
+}
+
 const core::Schema<Passes::BlurredEdges>& blurredEdgesSchema() {
   static const core::Schema<Passes::BlurredEdges> t = [] {
     core::Schema<Passes::BlurredEdges> s(
@@ -170,6 +184,7 @@ const core::Schema<SearchPasses>& searchPassesSchema() {
              "smoothing auto: a frame with at least this much estimated sensor noise is smoothed "
              "before thresholding",
              "grey levels")
+        .section("place_on_frame", &SearchPasses::place_on_frame, placeOnFrameSchema())
         .section("occluded_corners", &SearchPasses::occluded_corners, occludedCornersSchema())
         .section("near_misses", &SearchPasses::near_misses, nearMissesSchema())
         .section("cut_corners", &SearchPasses::cut_corners, cutCornersSchema())

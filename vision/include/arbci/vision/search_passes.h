@@ -17,6 +17,19 @@ struct SearchPasses {
   // small markers further.
   double smooth_above_noise;
 
+  // A marker found on a frame smoothed for its compression (its JPEG blocks; or by
+  // Smoothing::Always) has its sides moved onto the frame's own edges: the smoothing widens each
+  // edge, and a wider edge meets the border's inner edge and the margin's outer edge sooner, which
+  // pulls a small marker's corners inward. A frame smoothed for its noise keeps the smoothed edges
+  // (the steadier there), and so does a marker whose edges are smeared by motion (as
+  // blurred_edges judges a ramp): across a smear the smoothing moves little, and the frame's
+  // compression ringing more. A corner that would move more than `most_move_px` stays: the
+  // correction is a fraction of a pixel, and a larger move is noise or smear.
+  struct PlaceOnFrame {
+    bool enabled;
+    double most_move_px;
+  } place_on_frame;
+
   // A component ringed round light cells whose outline is no quadrilateral may be a marker with
   // something over a corner (a finger, the gripper): its four sides are fitted on their visible
   // runs and intersected, and its code read where enough cells show (BCH corrects the rest).
