@@ -287,7 +287,10 @@ struct MarkerDetector::Impl {
     }
     params.min_side = config.min_side_px;
     params.lens = config.lens.get();
-    return refineQuad(onFrameCoarse(start.corners), *binarised, params);
+    auto placed = refineQuad(onFrameCoarse(start.corners), *binarised, params);
+    // Still fitted from the visible runs of a covered outline: its border may show the cover.
+    if (placed) placed->occluded = coarse.occluded;
+    return placed;
   }
 
   // `image` as 8-bit luminance: itself when gray (a view; never written), else converted into
@@ -318,7 +321,8 @@ struct MarkerDetector::Impl {
       const cv::Point2f d = placed->corners[k] - quad.corners[k];
       if (d.dot(d) > most * most) return;
     }
-    quad = *placed;
+    quad.corners = placed->corners;
+    quad.ideal_corners = placed->ideal_corners;
     for (int k = 0; k < 4; ++k) {
       marker.corners[k] = quad.corners[(k + 4 - marker.orientation) % 4];
       marker.ideal_corners[k] = quad.ideal_corners[(k + 4 - marker.orientation) % 4];
