@@ -130,16 +130,26 @@ void blendRows(const std::uint8_t* __restrict near, const std::uint8_t* __restri
 
 namespace {
 
-// Each tile row expanded along x: out[tile * t + k] between tile t and its neighbour.
+// Tile t of a row expanded along x: out[tile * t + k] between tile t and its neighbour (the row's
+// end tiles have none outside: they weigh themselves).
+template <int kTileSize>
+void expandTile(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restrict out, int t) {
+  const int left = v[t > 0 ? t - 1 : 0], here = v[t], right = v[t + 1 < cols ? t + 1 : t];
+  for (int k = 0; k < kTileSize; ++k) {
+    const int far = farWeight(k, kTileSize), other = 2 * k < kTileSize ? left : right;
+    out[kTileSize * t + k] = static_cast<std::uint8_t>(((8 - far) * here + far * other + 4) >> 3);
+  }
+}
+
+// Each tile row expanded along x (expandTile), the tiles with both neighbours several at a time.
 template <int kTileSize>
 void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restrict out) {
   int t = 0;
 #ifdef __SSE2__
   if constexpr (kTileSize == 2) {
     // out[2t] = (6 v[t] + 2 v[t - 1] + 4) / 8, out[2t + 1] the same towards v[t + 1]; tiles 1 to
-    // cols - 2 here (their neighbours exist), the ends below.
-    out[0] = static_cast<std::uint8_t>((8 * v[0] + 4) >> 3);
-    out[1] = static_cast<std::uint8_t>((6 * v[0] + 2 * v[cols > 1 ? 1 : 0] + 4) >> 3);
+    // cols - 2 here (their neighbours exist), the ends by expandTile.
+    expandTile<2>(v, cols, out, 0);
     auto sixteenFrom = [&](int first) {  // tiles first .. first + 15
       const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + first));
       const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + first - 1));
@@ -158,33 +168,24 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
     }
   }
   if constexpr (kTileSize == 4) {
-    // The same four weights per tile (3, 1, 1, 3) in 16-bit lanes, eight tiles at a time: the
-    // full search expands every tile row of the frame, and this loop was a tenth of its labelling.
+    // The four weights of the far tile (3, 1, 1, 3 eighths) in 16-bit lanes, eight tiles at a
+    // time: the full search expands every tile row of the frame, and one tile at a time this was a
+    // tenth of its labelling. Tiles 1 to cols - 2 here, the ends by expandTile.
     const __m128i zero = _mm_setzero_si128(), four = _mm_set1_epi16(4);
-    const __m128i three = _mm_set1_epi16(3), five = _mm_set1_epi16(5), seven = _mm_set1_epi16(7);
+    const __m128i one = _mm_set1_epi16(1), three = _mm_set1_epi16(3);
+    const __m128i five = _mm_set1_epi16(5), seven = _mm_set1_epi16(7);
     auto load8 = [&](int first) {
       return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(v + first)), zero);
     };
+    // (near_weight h + far_weight o + 4) / 8
     auto weighted = [&](__m128i near_weight, __m128i h, __m128i far_weight, __m128i o) {
       return _mm_srli_epi16(
           _mm_add_epi16(
               _mm_add_epi16(_mm_mullo_epi16(near_weight, h), _mm_mullo_epi16(far_weight, o)), four),
           3);
     };
-    const __m128i one = _mm_set1_epi16(1);
-    // Tile 0 has no left neighbour: the scalar loop below starts it; tiles 1 .. cols - 2 here
-    // while a right neighbour exists for all eight.
-    t = 1;
-    auto scalar = [&](int tile) {
-      const int left = v[tile > 0 ? tile - 1 : 0], here = v[tile],
-                right = v[tile + 1 < cols ? tile + 1 : tile];
-      out[4 * tile + 0] = static_cast<std::uint8_t>((5 * here + 3 * left + 4) >> 3);
-      out[4 * tile + 1] = static_cast<std::uint8_t>((7 * here + left + 4) >> 3);
-      out[4 * tile + 2] = static_cast<std::uint8_t>((7 * here + right + 4) >> 3);
-      out[4 * tile + 3] = static_cast<std::uint8_t>((5 * here + 3 * right + 4) >> 3);
-    };
-    scalar(0);
-    for (; t + 9 <= cols; t += 8) {
+    expandTile<4>(v, cols, out, 0);
+    for (t = 1; t + 9 <= cols; t += 8) {
       const __m128i h = load8(t), l = load8(t - 1), r = load8(t + 1);
       const __m128i a0 = weighted(five, h, three, l), a1 = weighted(seven, h, one, l);
       const __m128i a2 = weighted(seven, h, one, r), a3 = weighted(five, h, three, r);
@@ -200,13 +201,7 @@ void expandRow(const std::uint8_t* __restrict v, int cols, std::uint8_t* __restr
     }
   }
 #endif
-  for (; t < cols; ++t) {
-    const int left = v[t > 0 ? t - 1 : 0], here = v[t], right = v[t + 1 < cols ? t + 1 : t];
-    for (int k = 0; k < kTileSize; ++k) {
-      const int far = farWeight(k, kTileSize), other = 2 * k < kTileSize ? left : right;
-      out[kTileSize * t + k] = static_cast<std::uint8_t>(((8 - far) * here + far * other + 4) >> 3);
-    }
-  }
+  for (; t < cols; ++t) expandTile<kTileSize>(v, cols, out, t);
 }
 
 }  // namespace
