@@ -9,11 +9,12 @@
 
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/gl_context.h"
+#include "arbci/session/record_text.h"
 #include "arbci/session/session.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
+#include "arbci/ui/window_state.h"
 #include "commands/commands.h"
 #include "hmd/hmd_stage.h"
 #include "hmd/open_session.h"
@@ -21,7 +22,7 @@
 #include "support/output_path.h"
 #include "support/png.h"
 #include "support/session_file.h"
-#include "workstation/session_model.h"
+#include "workstation/session_requests.h"
 
 namespace arbci::app {
 namespace {
@@ -44,18 +45,86 @@ render::Size parseSize(const std::string& text) {
   return {width, height};
 }
 
-// Draws the shell with `panels` for a few frames (ImGui settles its layout) and writes the PNG.
+// A simulated session (a still head, so it goes fast) with the window's state and request sink
+// beside it, as the workstation has them.
+class ShotSession {
+ public:
+  ShotSession(const ScreenshotOptions& options, render::GlContext& context)
+      : config_(configOf(options)),
+        folder_(std::filesystem::temp_directory_path() /
+                ("arbci-screenshot-" + std::to_string(::getpid()))),
+        opened_(open(context)),
+        requests_(*opened_.session, {}) {
+    window_.hmd_texture = opened_.hmd->texture();
+    window_.hmd_aspect = static_cast<float>(config_.hmd.width) / config_.hmd.height;
+  }
+  ~ShotSession() {
+    session().request(session::AbortRequest{});
+    session().step();
+    session().step();
+    opened_.session.reset();
+    std::error_code ignored;
+    std::filesystem::remove_all(folder_, ignored);
+  }
+  session::Session& session() { return *opened_.session; }
+  HmdStage& hmd() { return *opened_.hmd; }
+  const std::filesystem::path& folder() const { return folder_; }
+  bool step() {
+    const bool going = session().step();
+    window_.ingest(session().last(), config_);
+    return going;
+  }
+  // Steps until `ready` holds on the last record. A live amplifier runs in real time: then the
+  // picture is taken after 10 s at most, whatever the session has reached by then.
+  void runUntil(const std::function<bool(const session::CycleRecord&)>& ready) {
+    const auto live_limit = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    for (int i = 0; i < 60 * 600 && !ready(session().last()) && step(); ++i) {
+      if (config_.eeg.live() && std::chrono::steady_clock::now() > live_limit) break;
+    }
+  }
+  ui::PanelInput input() {
+    return {session().last(), config_, session().operatorLog(), window_, requests_};
+  }
+  std::string status() {
+    return session::statusLine(session().last(), config_, window_.cycleP50Ms());
+  }
+
+ private:
+  static session::SessionConfig configOf(const ScreenshotOptions& options) {
+    session::SessionConfig config = loadSessionOption(options.session);
+    if (options.session.empty()) {
+      config.cameras.head_motion_m = 0.0;
+      config.cameras.head_motion_deg = 0.0;
+      config.robot.speed_factor = 20.0;
+    }
+    return config;
+  }
+  OpenedSession open(render::GlContext& context) {
+    session::SessionOptions session_options;
+    session_options.folder = folder_;
+    session_options.trials = 1;
+    return openSession(config_, session_options, context);
+  }
+  session::SessionConfig config_;
+  std::filesystem::path folder_;
+  OpenedSession opened_;
+  SessionRequests requests_;
+  ui::WindowState window_;
+};
+
+// Draws the shell with `panels` for a few frames (ImGui settles its layout) and writes the PNG;
+// `live`: the session steps between the frames.
 void renderPanels(render::GlContext& context, render::Size size,
-                  const std::vector<ui::Panel*>& panels, const std::string& status,
-                  const std::string& out, const std::function<void()>& before_frame = {}) {
+                  const std::vector<ui::Panel*>& panels, ShotSession& shot, bool live,
+                  const std::string& out) {
   ui::ImGuiLayer imgui(context, "");
   ui::ExperimenterShell shell;
   for (ui::Panel* panel : panels) shell.addPanel(*panel);
   for (int frame = 0; frame < 3; ++frame) {
-    if (before_frame) before_frame();
+    if (live) shot.step();
     context.makeCurrent();
     imgui.beginFrame(1.0f / 60.0f);
-    shell.draw(size, {16.7f, status, "screenshot"});
+    shell.draw(size, {16.7f, shot.status(), "screenshot"}, shot.input());
     render::clearFramebuffer(context.drawFramebuffer(), size, {0.08f, 0.09f, 0.11f, 1.0f});
     imgui.endFrame();
     context.present();
@@ -63,124 +132,59 @@ void renderPanels(render::GlContext& context, render::Size size,
   writePng(out, render::readPixels(context.drawFramebuffer(), size));
 }
 
-// Runs a simulated session (a still head, so it goes fast) until `ready`, then shows a panel, or
-// (no --panel) the experimenter window as `arbci run` opens it during the grid's flashing.
+// One panel's picture by its shot (ui::panelShots()), or (no --panel) the experimenter window as
+// `arbci run` opens it during the grid's flashing.
 void renderPanel(const ScreenshotOptions& options, render::Size size) {
-  session::SessionConfig config = loadSessionOption(options.session);
-  if (options.session.empty()) {
-    config.cameras.head_motion_m = 0.0;
-    config.cameras.head_motion_deg = 0.0;
-    config.robot.speed_factor = 20.0;
-  }
   auto context = render::createHeadlessContext(size);
-  session::SessionOptions session_options;
-  session_options.folder =
-      std::filesystem::temp_directory_path() / ("arbci-screenshot-" + std::to_string(::getpid()));
-  session_options.trials = 1;
-  OpenedSession opened = openSession(config, session_options, *context);
-  session::Session& session = *opened.session;
-  SessionModel model(session);
-  // A live amplifier runs in real time: the picture is taken after 10 s at most, whatever the
-  // session has reached by then.
-  const auto live_limit = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  auto runUntil = [&](const std::function<bool()>& ready) {
-    for (int i = 0; i < 60 * 600 && !ready() && session.step(); ++i) {
-      model.ingest();
-      if (config.eeg.live() && std::chrono::steady_clock::now() > live_limit) break;
-    }
-  };
-  auto phase = [&] { return session.last().paradigm.phase; };
-  auto sequence = [&] { return session.last().paradigm.sequence; };
-  const std::string& panel = options.panel;
-  if (panel == "threshold") {
-    runUntil([&] { return session.frame() > 30; });
-    ui::ThresholdPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "calibration") {
-    ui::CalibrationPanel p(model);
-    p.holdBoard(true);
-    for (int view = 0; view < 6; ++view) {
-      const std::int64_t until = session.frame() + 4;
-      runUntil([&] { return session.frame() >= until; });
-      p.captureView();
-    }
-    p.calibrate();
-    runUntil([&] { return session.frame() % 4 == 0; });
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "training") {
-    runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
-    ui::TrainingPanel p(model);
-    p.setRecordings((session.folder() / "recording.bdf").string());
-    p.train(true);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "session-model") {
-    // The Training panel on the model the session trained after its calibration run (with
-    // ErrPs on, the ErrP classifier's averages beside the P300 one's).
-    runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
-    ui::TrainingPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "robot") {
-    runUntil([&] {
-      const auto& status = session.last().robot.status;
-      return phase() == bci::Phase::Grasping && status && status->progress > 0.3;
+  ShotSession shot(options, *context);
+  if (options.panel.empty()) {
+    shot.runUntil([](const session::CycleRecord& r) {
+      return r.paradigm.phase == bci::Phase::CellFlashing && r.paradigm.sequence >= 2;
     });
-    ui::RobotPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "session") {
-    runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
-    ui::SessionPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out, [&] {
-      session.step();
-      model.ingest();
-    });
-  } else if (panel == "eeg") {
-    // Several seconds of the calibration's flashing: traces, onsets and quality to show.
-    runUntil([&] { return phase() == bci::Phase::CalibrationFlashing && session.time() > 12.0; });
-    ui::EegPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out, [&] {
-      session.step();
-      model.ingest();
-    });
-  } else if (panel == "settings") {
-    runUntil([&] { return session.frame() > 10; });
-    ui::SettingsPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "log") {
-    runUntil([&] { return phase() == bci::Phase::ObjectFlashing; });
-    ui::OperatorLogPanel p(model);
-    renderPanels(*context, size, {&p}, statusLine(session), options.out);
-  } else if (panel == "hmd") {
-    runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
-    // The HMD framebuffer itself, as the subject sees it.
-    runUntil([&] { return session.frame() % 11 == 1; });
-    ensureWritable(options.out);
-    opened.hmd->screenshot(options.out);
-  } else if (panel.empty()) {
-    runUntil([&] { return phase() == bci::Phase::CellFlashing && sequence() >= 2; });
     // The panels the window opens at start, in the registry's order (as `arbci run` shows them).
-    const ui::PanelContext panel_context{model, opened.hmd->texture(),
-                                         static_cast<float>(config.hmd.width) / config.hmd.height};
     std::vector<std::unique_ptr<ui::Panel>> owned;
     std::vector<ui::Panel*> shown;
     for (const auto& entry : ui::panels().entries()) {
       if (!entry.make.open_at_start) continue;
-      owned.push_back(entry.make.make(panel_context));
+      owned.push_back(entry.make.make());
       shown.push_back(owned.back().get());
     }
-    renderPanels(*context, size, shown, statusLine(session), options.out, [&] {
-      session.step();
-      model.ingest();
-    });
-  } else {
-    throw CliError(
-        "--panel must be threshold, calibration, training, session-model, robot, session, eeg, "
-        "log, settings or hmd");
+    renderPanels(*context, size, shown, shot, true, options.out);
+    return;
   }
-  session.request(session::AbortRequest{});
-  session.step();
-  session.step();
-  std::error_code ignored;
-  std::filesystem::remove_all(session_options.folder, ignored);
+  for (const auto& [name, recipe] : ui::panelShots()) {
+    if (recipe->name != options.panel) continue;
+    shot.runUntil(recipe->ready);
+    if (recipe->hmd_framebuffer) {
+      ensureWritable(options.out);
+      shot.hmd().screenshot(options.out);
+      return;
+    }
+    const std::unique_ptr<ui::Panel> panel = ui::panels().at(name).make.make();
+    if (recipe->act) {
+      const ui::ShotSteps steps{[&](int frames) {
+                                  for (int i = 0; i < frames && shot.step(); ++i) {
+                                  }
+                                },
+                                [&] { return shot.input(); }, shot.folder()};
+      recipe->act(*panel, steps);
+    }
+    renderPanels(*context, size, {panel.get()}, shot, recipe->live, options.out);
+    return;
+  }
+}
+
+std::vector<std::string> shotNames() {
+  std::vector<std::string> names;
+  for (const auto& [panel, recipe] : ui::panelShots()) names.push_back(recipe->name);
+  return names;
+}
+
+std::string shotList() {
+  std::string out;
+  for (const auto& [panel, recipe] : ui::panelShots())
+    out += (out.empty() ? "" : "; ") + recipe->name + ": " + recipe->doc;
+  return out;
 }
 
 }  // namespace
@@ -196,14 +200,9 @@ void addScreenshotCommand(CLI::App& root, int& exit_code) {
   command->add_option("--out", options->out, "PNG file to write")->required();
   command->add_option("--size", options->size, "Image size WIDTHxHEIGHT")->capture_default_str();
   command
-      ->add_option(
-          "--panel", options->panel,
-          "threshold, calibration, training (trained on the session's recording), "
-          "session-model (the Training panel on the model the session trained), robot, "
-          "session, eeg (traces and quality), log (the operator log), settings or hmd (the HMD "
-          "view)")
-      ->check(CLI::IsMember({"threshold", "calibration", "training", "session-model", "robot",
-                             "session", "eeg", "log", "settings", "hmd"}));
+      ->add_option("--panel", options->panel,
+                   "one panel's picture (the panels' registry): " + shotList())
+      ->check(CLI::IsMember(shotNames()));
   command->add_option("--session", options->session,
                       "session file (default: the embedded simulated session, with a still head)");
   command->callback([options, &exit_code] {

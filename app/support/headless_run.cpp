@@ -2,11 +2,18 @@
 
 #include <iostream>
 
+#include "arbci/session/record_text.h"
 #include "support/interrupt.h"
 #include "support/status_line.h"
-#include "workstation/session_model.h"
 
 namespace arbci::app {
+
+namespace {
+std::string statusLine(const session::Session& session) {
+  return session::statusLine(session.last(), session.config(),
+                             session.timing().totalPercentiles().p50);
+}
+}  // namespace
 
 void runHeadless(session::Session& session) {
   auto show = [&session] {

@@ -8,15 +8,15 @@
 
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/window_context.h"
+#include "arbci/session/record_text.h"
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
 #include "hmd/hmd_stage.h"
 #include "hmd/open_session.h"
 #include "support/interrupt.h"
 #include "workstation/experimenter_script.h"
-#include "workstation/session_model.h"
+#include "workstation/session_requests.h"
 
 namespace arbci::app {
 namespace {
@@ -72,21 +72,24 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   // Unattended, the session starts itself.
   if (!workstation.wait_for_start && !workstation.unattended)
     session.request(session::StartRequest{});
-  SessionModel model(session, workstation.bids_root);
+  SessionRequests requests(session, workstation.bids_root);
+  ui::WindowState state([&](const core::RunLabels& labels) {
+    return describeRun(labels, session.folder(), workstation.bids_root);
+  });
+  state.hmd_texture = opened.hmd->texture();
+  state.hmd_aspect = static_cast<float>(config.hmd.width) / config.hmd.height;
+  state.ingest(session.last(), session.config());
   ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;
   // Every registered panel, in the registry's order; the summary opens when the session ends.
-  const ui::PanelContext panel_context{model, opened.hmd->texture(),
-                                       static_cast<float>(config.hmd.width) / config.hmd.height};
   std::vector<std::unique_ptr<ui::Panel>> panels;
   ui::Panel* summary_panel = nullptr;
   for (const auto& entry : ui::panels().entries()) {
-    panels.push_back(entry.make.make(panel_context));
+    panels.push_back(entry.make.make());
     shell.addPanel(*panels.back(), entry.make.open_at_start);
     if (entry.name == "summary") summary_panel = panels.back().get();
   }
-  shell.setEmergencyStop([&] { model.emergencyStop(); },
-                         [&] { return model.whyNot(ui::WorkstationModel::Action::EmergencyStop); });
+  shell.showEmergencyStop(true);
   shell.setQuitHandler([&] { main_window.requestClose(); });
   // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
   watchInterrupts();
@@ -100,7 +103,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     render::WindowContext::pollEvents();
     main_window.makeCurrent();  // the simulated cameras render in it
     session.step();
-    model.ingest();
+    state.ingest(session.last(), session.config());
     if (session.ended() && !summary_shown) {
       if (summary_panel) shell.show(*summary_panel);  // once: the experimenter may close it
       summary_shown = true;
@@ -110,18 +113,24 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     const float frame_ms = std::chrono::duration<float, std::milli>(now - last).count();
     last = now;
     const render::Size size = main_window.framebufferSize();
+    const session::CycleRecord& record = session.last();
+    const std::string phase = session::phaseText(record);
     ui::SyntheticInput input;
     if (script) {
-      input = script->beforeFrame(bci::hostSeconds(), model.phase());
+      input = script->beforeFrame(bci::hostSeconds(), phase);
       if (const std::string panel = script->takePanelToOpen(); !panel.empty() && !shell.show(panel))
         std::cerr << "\nscript: no panel \"" << panel << "\" to open\n";
     }
     imgui.beginFrame(frame_ms / 1000.0f, script ? &input : nullptr);
-    shell.draw(size, {frame_ms, model.phase(), statusLine(session)});
+    const ui::PanelInput panel_input{record, session.config(), session.operatorLog(), state,
+                                     requests};
+    shell.draw(size,
+               {frame_ms, phase, session::statusLine(record, session.config(), state.cycleP50Ms())},
+               panel_input);
     render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
     imgui.endFrame();
     if (script) {
-      script->afterFrame(main_window, size, model.phase(), session.time());
+      script->afterFrame(main_window, size, session::phaseText(session.last()), session.time());
       if (!script->error().empty()) {
         std::cerr << "\nerror: " << script->error() << "\n";
         main_window.requestClose();

@@ -94,7 +94,8 @@ const char* toString(Action action) {
   return "?";
 }
 
-std::string whyNot(Action action, const CycleRecord& last, bool ended) {
+std::string whyNot(Action action, const CycleRecord& last) {
+  const bool ended = last.ended;
   // Once ended, the session no longer drives the arm (a simulated backend has stopped with it): a
   // STOP from here would be logged and reach nothing that listens.
   if (ended && (action == Action::EmergencyStop || action == Action::ResetRobot))

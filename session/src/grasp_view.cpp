@@ -1,4 +1,4 @@
-#include "grasp_view.h"
+#include "arbci/session/grasp_view.h"
 
 #include <algorithm>
 

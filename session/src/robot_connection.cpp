@@ -1,4 +1,4 @@
-#include "robot_connection.h"
+#include "arbci/session/robot_connection.h"
 
 #include <fstream>
 

@@ -1,4 +1,4 @@
-#include "robot_process.h"
+#include "arbci/session/robot_process.h"
 
 #include <fcntl.h>
 #include <signal.h>

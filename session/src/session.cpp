@@ -2,8 +2,8 @@
 
 #include <fstream>
 
+#include "arbci/session/stages/robot_stage.h"
 #include "stage_assembly.h"
-#include "stages/robot_stage.h"
 
 namespace arbci::session {
 Session::Session(SessionConfig config, const SessionOptions& requested,
@@ -33,6 +33,7 @@ Session::Session(SessionConfig config, const SessionOptions& requested,
       {{"folder", folder_.string()}, {"session", config_.source}, {"seed", config_.eeg.seed}});
   clock_.start();
   records_[current_].host_s = clock_.hostOf(0.0);
+  records_[current_].labels = options_.labels;
   // Nobody will press Start: the pre-flight check runs from the first frame.
   if (!options_.experimenter) queued_.push_back(StartRequest{});
 }
@@ -46,6 +47,12 @@ Session::~Session() {
 }
 
 bool Session::request(Request request) {
+  if (const auto* labels = std::get_if<LabelsRequest>(&request)) {
+    const std::string why = setLabels(labels->labels);
+    if (why.empty()) return true;
+    operator_log_.add(time(), Severity::Warning, "subject and run not changed: " + why);
+    return false;
+  }
   const std::optional<Action> action = actionOf(request);
   if (action) {
     const std::string why = whyNot(*action);
@@ -77,6 +84,7 @@ void Session::beginCycle() {
   for (Request& r : queued_) record.requests.push_back(std::move(r));
   queued_.clear();
   record.frame = frame_;
+  record.labels = options_.labels;
   record.time_s = clock_.frameTime(frame_);
   record.host_s = clock_.hostOf(record.time_s);
   // When this frame will be on screen: stepped, now; in a window, a period after the last one
@@ -119,6 +127,8 @@ void Session::recordCycleTime() {
   CycleRecord& record = records_[current_];
   const double total = timing_.endCycle();
   record.stage_ms = timing_.lastCycle();
+  record.compute_ms = total;
+  record.overruns = timing_.overruns();
   const nlohmann::json fields = {
       {"frame", record.frame}, {"compute_ms", total}, {"stages", timing_.lastCycle()}};
   if (total > timing_.budgetMs()) log_->write("overrun", record.time_s, fields);
@@ -170,7 +180,14 @@ void Session::endRun(const std::string& reason, const std::string& kind) {
   operator_log_.add(
       last_record.time_s, end_kind_ == "finished" ? Severity::Info : Severity::Error,
       "session ended: " + end_kind_ + (reason == end_kind_ ? "" : " (" + reason + ")"));
-  std::ofstream(folder_ / "summary.json") << summary().dump(2) << "\n";
+  const auto summary_json = std::make_shared<const nlohmann::json>(summary());
+  std::ofstream(folder_ / "summary.json") << summary_json->dump(2) << "\n";
+  // The last record says how the run ended, for whoever reads it from now on.
+  CycleRecord& ended = records_[current_];
+  ended.ended = true;
+  ended.end_reason = reason;
+  ended.end_kind = end_kind_;
+  ended.summary = summary_json;
 }
 
 std::string Session::setLabels(const core::RunLabels& labels) {
@@ -178,6 +195,7 @@ std::string Session::setLabels(const core::RunLabels& labels) {
   if (last().paradigm.phase != bci::Phase::Setup)
     return "the session has started: its subject and run are fixed";
   options_.labels = labels;
+  records_[current_].labels = labels;
   return "";
 }
 
@@ -187,6 +205,7 @@ nlohmann::json Session::summary() const {
       {"labels",
        {{"subject", l.subject}, {"session", l.session}, {"task", l.task}, {"run", l.run}}},
       {"session", config_.source},
+      {"folder", folder_.string()},
       {"seed", config_.eeg.seed},
       {"ended", end_kind_},
       {"end_reason", end_reason_},

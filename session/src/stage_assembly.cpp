@@ -5,18 +5,18 @@
 #include <map>
 
 #include "arbci/session/scene_source.h"
-#include "stages/camera_stage.h"
-#include "stages/eeg_acquisition_stage.h"
-#include "stages/errp_stage.h"
-#include "stages/lsl_markers_stage.h"
-#include "stages/p300_stage.h"
-#include "stages/paradigm_stage.h"
-#include "stages/preflight_stage.h"
-#include "stages/presentation_stage.h"
-#include "stages/recording_stage.h"
-#include "stages/robot_stage.h"
-#include "stages/tracking_stage.h"
-#include "trial_intents.h"
+#include "arbci/session/stages/camera_stage.h"
+#include "arbci/session/stages/eeg_acquisition_stage.h"
+#include "arbci/session/stages/errp_stage.h"
+#include "arbci/session/stages/lsl_markers_stage.h"
+#include "arbci/session/stages/p300_stage.h"
+#include "arbci/session/stages/paradigm_stage.h"
+#include "arbci/session/stages/preflight_stage.h"
+#include "arbci/session/stages/presentation_stage.h"
+#include "arbci/session/stages/recording_stage.h"
+#include "arbci/session/stages/robot_stage.h"
+#include "arbci/session/stages/tracking_stage.h"
+#include "arbci/session/trial_intents.h"
 
 namespace arbci::session {
 namespace {
@@ -100,7 +100,7 @@ SessionOptions optionsFor(SessionOptions options, const SessionConfig& config) {
 
 void checkNamedResources(const SessionConfig& c) {
   SceneSettings::of(c).validate();
-  EegAcquisitionSettings{c.eeg, {}, 0.0, c.source}.validate();
+  EegAcquisitionSettings{c.eeg, 0.0, c.source}.validate();
   if (!c.classifier.model_file.empty() && !std::filesystem::exists(c.classifier.model_file))
     throw SessionConfigError(c.source + ": classifier.model = \"" + c.classifier.model_file +
                              "\": no such file");
@@ -113,8 +113,9 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   // Every stage's settings, checked before anything starts.
   checkNamedResources(c);
   const SceneSettings scene_settings = SceneSettings::of(c);
-  EegAcquisitionSettings eeg_settings{c.eeg, {}, c.paradigm.flashSeconds(), c.source};
-  if (c.eeg.live() || c.lsl.markers) eeg_settings.lsl = c.lsl.config(c.source);
+  const EegAcquisitionSettings eeg_settings{c.eeg, c.paradigm.flashSeconds(), c.source};
+  bci::lsl::LslConfig lsl;
+  if (c.eeg.live() || c.lsl.markers) lsl = c.lsl.config(c.source);
   const int camera_every =
       std::max(1, static_cast<int>(std::lround(c.paradigm.display_hz / c.cameras.rate_hz)));
 
@@ -129,7 +130,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto cameras = std::make_unique<CameraStage>(std::move(scene));
 
   // EEG: acquired on its own clock (stepped: in lock-step with the frames), recorded, classified.
-  auto eeg = std::make_unique<EegAcquisitionStage>(eeg_settings, clock, services);
+  auto eeg = std::make_unique<EegAcquisitionStage>(
+      eeg_settings, openEegSource(c.eeg, lsl, clock, c.source), clock, services);
   auto recording = std::make_unique<RecordingStage>(
       RecordingSettings{folder / "recording.bdf", eeg->info(), recordingParameters(c)}, services);
   const bci::SignalInfo& eeg_info = eeg->eegInfo();
@@ -154,7 +156,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
     const std::map<std::string, std::string> parameters = recordingParameters(c);
     markers = std::make_unique<LslMarkersStage>(
         LslMarkersSettings{c.lsl.marker_stream,
-                           eeg_settings.lsl,
+                           lsl,
                            eeg_info.rate_hz,
                            c.source,
                            {parameters.begin(), parameters.end()}},

@@ -1,4 +1,4 @@
-#include "trial_intents.h"
+#include "arbci/session/trial_intents.h"
 
 #include <map>
 #include <random>

@@ -11,6 +11,7 @@
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/system_panel.h"
+#include "support/panel_bench.h"
 #include "support/xvfb_server.h"
 
 namespace arbci::render {
@@ -48,11 +49,12 @@ TEST(WindowContext, DrawsTheExperimenterShell) {
   ui::ImGuiLayer imgui(window, "");
   ui::ExperimenterShell shell;
   shell.addPanel(panel);
+  test::PanelBench bench;
   RgbaImage image;
   for (int frame = 0; frame < 3; ++frame) {
     WindowContext::pollEvents();
     imgui.beginFrame(1.0f / 60.0f);
-    shell.draw(window.framebufferSize(), {16.7f, "test", ""});
+    shell.draw(window.framebufferSize(), {16.7f, "test", ""}, bench.input());
     clearFramebuffer(0, window.framebufferSize(), {0.0f, 0.0f, 0.0f, 1.0f});
     imgui.endFrame();
     image = readPixels(0, window.framebufferSize());

@@ -16,33 +16,34 @@ CycleRecord stoppedIn(bci::Phase phase, int trial) {
 
 TEST(Experimenter, AfterAStopInSetUpRetryAndSkipSayThereIsNothingToActOn) {
   const CycleRecord last = stoppedIn(bci::Phase::Setup, 0);
-  EXPECT_EQ(whyNot(Action::RetryStep, last, false),
+  EXPECT_EQ(whyNot(Action::RetryStep, last),
             "nothing to retry: the session had not started (Resume returns to set-up)");
-  EXPECT_EQ(whyNot(Action::SkipTrial, last, false),
+  EXPECT_EQ(whyNot(Action::SkipTrial, last),
             "no trial to skip: the stop came before the first trial; Resume goes on");
-  EXPECT_EQ(whyNot(Action::Resume, last, false), "");
+  EXPECT_EQ(whyNot(Action::Resume, last), "");
 }
 
 TEST(Experimenter, AStopDuringCalibrationCannotSkipATrialButCanRetry) {
   const CycleRecord last = stoppedIn(bci::Phase::CalibrationFlashing, 0);
-  EXPECT_NE(whyNot(Action::SkipTrial, last, false), "");
-  EXPECT_EQ(whyNot(Action::RetryStep, last, false), "");
+  EXPECT_NE(whyNot(Action::SkipTrial, last), "");
+  EXPECT_EQ(whyNot(Action::RetryStep, last), "");
 }
 
 TEST(Experimenter, AStopInATrialCanSkipIt) {
   const CycleRecord last = stoppedIn(bci::Phase::ObjectFlashing, 2);
-  EXPECT_EQ(whyNot(Action::SkipTrial, last, false), "");
+  EXPECT_EQ(whyNot(Action::SkipTrial, last), "");
 }
 
 TEST(Experimenter, OnceEndedTheEmergencyStopAndResetAreRefusedWithTheReason) {
-  const CycleRecord last;
-  EXPECT_EQ(whyNot(Action::EmergencyStop, last, false), "");
+  CycleRecord last;
+  EXPECT_EQ(whyNot(Action::EmergencyStop, last), "");
+  last.ended = true;
   for (const Action action : {Action::EmergencyStop, Action::ResetRobot}) {
-    const std::string why = whyNot(action, last, true);
+    const std::string why = whyNot(action, last);
     EXPECT_NE(why.find("the session has ended"), std::string::npos) << why;
     EXPECT_NE(why.find("emergency switch"), std::string::npos) << why;
   }
-  EXPECT_EQ(whyNot(Action::Abort, last, true), "the session has ended");
+  EXPECT_EQ(whyNot(Action::Abort, last), "the session has ended");
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
-// Every registered panel drawn in process (headless EGL, Dear ImGui) over a stand-in of the
-// session's model with known contents: each shows its window and the widgets its state calls for
-// (enabled or greyed out with the reason the model gives), and the model's figures reach the
-// picture (kept in test-artefacts/panels/) — a few milliseconds a panel, where a live simulated
-// session took seconds.
+// Every registered panel drawn in process (headless EGL, Dear ImGui) over a cycle record built by
+// hand: each shows its window and the widgets its state calls for (enabled, or greyed out with the
+// reason the record's why-not gives), the record's figures reach the picture (kept in
+// test-artefacts/panels/), and a click posts the request the button stands for — a few
+// milliseconds a panel, where a live simulated session took seconds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,153 +26,103 @@
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panel_registry.h"
 #include "arbci/ui/widget_registry.h"
+#include "support/panel_bench.h"
 
 namespace arbci::ui {
 namespace {
 
-// A session in phase 1 of trial 2: the arm idle, two markers tracked, a model trained.
-class StandInModel final : public WorkstationModel {
- public:
-  StandInModel() {
-    camera_ = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 110, 130));
-    cv::rectangle(camera_, cv::Rect(280, 200, 80, 80), cv::Scalar(0, 0, 0), cv::FILLED);
-    binary_ = cv::Mat(480, 640, CV_8UC1, cv::Scalar(255));
-    vision::MarkerDetection marker;
-    marker.id = 20;
-    marker.corners = {cv::Point2f(280, 200), cv::Point2f(360, 200), cv::Point2f(360, 280),
-                      cv::Point2f(280, 280)};
-    detection_.markers.push_back(marker);
-    status_.state = robot::RobotState::Idle;
-    status_.tool = {0.0, 0.45, 0.45};
-    erp_.channels = {"Fz", "Cz", "Pz"};
-    erp_.rate_hz = 256.0;
-    erp_.window_start_s = 0.0;
-    erp_.window_end_s = 0.8;
-    // 44 channels (over 64k vertices of traces: the GL back end must split the draw list): Fz
-    // clean, Cz flat, Pz with 30 uV of 50 Hz, the photodiode, and 40 more clean ones.
-    bci::SignalInfo info;
-    info.rate_hz = 256.0;
-    info.block_size = 16;
-    info.channels = {"Fz", "Cz", "Pz", "Photodiode"};
-    for (int c = 5; c <= 44; ++c) {
-      std::string name = "E";
-      name += std::to_string(c);
-      info.channels.push_back(name);
-    }
-    scope_.emplace(info, 10.0, bci::FilterSettings{});
-    std::mt19937 random(5);
-    std::normal_distribution<float> noise(0.0f, 8.0f);
-    for (std::int64_t first = 0; first < 6 * 256; first += 16) {
-      bci::Block block(first, info.channelCount(), 16);
-      for (int c = 0; c < info.channelCount(); ++c) {
-        for (int k = 0; k < 16; ++k) {
-          const double t = static_cast<double>(first + k) / 256.0;
-          float v = noise(random);
-          if (c == 1) v = 0.01f * v;
-          if (c == 2) v += static_cast<float>(30.0 * std::sin(2.0 * M_PI * 50.0 * t));
-          if (c == 3) v = (first / 16) % 12 < 2 ? 1000.0f : 0.0f;
-          block.at(c, k) = v;
-        }
+vision::PoseEstimate at(double x, double y) {
+  vision::PoseEstimate p;
+  p.pose = {cv::Matx33d::eye(), cv::Vec3d(x, y, 1.0)};
+  p.reprojection_rms_px = 0.4;
+  return p;
+}
+
+// 44 channels (over 64k vertices of traces: the GL back end must split the draw list): Fz clean,
+// Cz flat, Pz with 30 uV of 50 Hz, the photodiode, and 40 more clean ones; six seconds of it,
+// block by block on cycle records, a flash every twelfth block.
+void feedEeg(test::PanelBench& b) {
+  auto info = std::make_shared<bci::SignalInfo>();
+  info->rate_hz = 256.0;
+  info->block_size = 16;
+  info->channels = {"Fz", "Cz", "Pz", "Photodiode"};
+  for (int c = 5; c <= 44; ++c) {
+    std::string name = "E";  // (appended: GCC 12 warns wrongly of "E" + to_string)
+    name += std::to_string(c);
+    info->channels.push_back(name);
+  }
+  std::mt19937 random(5);
+  std::normal_distribution<float> noise(0.0f, 8.0f);
+  for (std::int64_t first = 0; first < 6 * 256; first += 16) {
+    session::CycleRecord r;
+    r.eeg.info = info;
+    bci::Block block(first, info->channelCount(), 16);
+    for (int c = 0; c < info->channelCount(); ++c) {
+      for (int k = 0; k < 16; ++k) {
+        const double t = static_cast<double>(first + k) / 256.0;
+        float v = noise(random);
+        if (c == 1) v = 0.01f * v;
+        if (c == 2) v += static_cast<float>(30.0 * std::sin(2.0 * M_PI * 50.0 * t));
+        if (c == 3) v = (first / 16) % 12 < 2 ? 1000.0f : 0.0f;
+        block.at(c, k) = v;
       }
-      scope_->append(block);
-      if ((first / 16) % 12 == 0) scope_->markStimulus(first);
     }
+    r.eeg.blocks.push_back(block);
+    if ((first / 16) % 12 == 0) r.presentation.onsets.push_back({session::Flash{}, first});
+    b.window.ingest(r, b.settings);
   }
+}
 
-  cv::Mat cameraImage() override { return camera_; }
-  cv::Mat binaryImage() override { return binary_; }
-  vision::DetectionResult detection() override { return detection_; }
-  vision::ThresholdSettings threshold() override { return {}; }
-  void setThreshold(const vision::ThresholdSettings&) override { ++calls_["threshold"]; }
-  std::vector<TrackedObject> trackedObjects() override {
-    return {{20, {-0.09, 0.42, 0.06}, 0.03, 0.4}, {40, {0.27, 0.42, 0.06}, 0.03, 0.5}};
+// A session in phase 1 of trial 2: the arm idle and home, the reference and two objects tracked,
+// the operator told three things, the cycle timed.
+void phaseOneOfTrialTwo(test::PanelBench& b) {
+  session::CycleRecord& r = b.record;
+  r.frame = 5004;
+  r.time_s = 83.4;
+  r.paradigm.phase = bci::Phase::ObjectFlashing;
+  r.paradigm.trial = 2;
+  r.paradigm.sequence = 4;
+  session::TrialRecord t;
+  t.trial = 1;
+  t.intended_object = 20;
+  t.selected_object = 20;
+  t.intended_cell = t.selected_cell = {1, 3};
+  t.outcome = "placed";
+  t.placement_error_m = 0.0003;
+  r.paradigm.trials = std::make_shared<const std::vector<session::TrialRecord>>(
+      std::vector<session::TrialRecord>{t});
+  r.preflight.lines = {"pre-flight passed"};
+  cv::Mat camera(480, 640, CV_8UC3, cv::Scalar(90, 110, 130));
+  cv::rectangle(camera, cv::Rect(280, 200, 80, 80), cv::Scalar(0, 0, 0), cv::FILLED);
+  r.tracking.left_image = camera;
+  r.tracking.binary = cv::Mat(480, 640, CV_8UC1, cv::Scalar(255));
+  vision::MarkerDetection marker;
+  marker.id = 20;
+  marker.corners = {cv::Point2f(280, 200), cv::Point2f(360, 200), cv::Point2f(360, 280),
+                    cv::Point2f(280, 280)};
+  r.tracking.detection.markers.push_back(marker);
+  vision::WorldModel world;
+  world.update(83.37, {{0, at(0.0, 0.0)}, {20, at(-0.09, -0.48)}, {40, at(0.27, -0.48)}});
+  r.tracking.world = std::make_shared<const vision::WorldModel>(world);
+  robot::StatusPayload status;
+  status.state = robot::RobotState::Idle;
+  status.tool = {0.0, 0.45, 0.45};
+  r.robot.status = status;
+  r.robot.messages = std::make_shared<const std::vector<std::string>>(
+      std::vector<std::string>{"connected", "finished GRASP"});
+  b.log.add(2.1, session::Severity::Info, "pre-flight passed");
+  b.log.add(40.2, session::Severity::Warning, "12 EEG samples lost");
+  b.log.add(61.0, session::Severity::Error,
+            "object 10: tracking lost (pose 28.3 s old), not grasped; Retry step once it is seen "
+            "again");
+  for (int cycle = 0; cycle < 31; ++cycle) {
+    session::CycleRecord timed;
+    timed.stage_ms = {{"eeg", 0.3}, {"tracking", 1.9}};
+    timed.compute_ms = 19.6;
+    b.window.ingest(timed, b.settings);
   }
-  std::string worldStatus() override { return "reference marker 0 in view"; }
-  vision::CameraModel camera() override {
-    vision::CameraModel c;
-    c.camera_matrix = cv::Matx33d(800, 0, 319.5, 0, 800, 239.5, 0, 0, 1);
-    c.image_size = {640, 480};
-    return c;
-  }
-  bool canHoldBoard() override { return true; }
-  void holdBoard(bool) override {}
-  int referenceId() override { return 0; }
-  cv::Vec3d referencePosition() override { return {0.0, 0.9, 0.0}; }
-  void setReference(int, const cv::Vec3d&) override {}
-  std::optional<bci::P300Model> model() override { return std::nullopt; }
-  void useModel(const bci::P300Model&) override {}
-  std::optional<robot::StatusPayload> robotStatus() override { return status_; }
-  bool robotSilent() override { return false; }
-  std::vector<std::string> robotLog() override { return {"connected", "finished GRASP"}; }
-  void emergencyStop() override { ++calls_["estop"]; }
-  std::string whyNot(Action action) override {
-    switch (action) {
-      case Action::Pause:
-        return setup_ ? "the session has not started" : "";
-      case Action::Abort:
-      case Action::EmergencyStop:
-      case Action::EndSession:
-        return "";
-      case Action::Start:
-        return setup_ ? "" : "the session has started";
-      default:
-        return "only after an emergency stop or a robot fault";
-    }
-  }
-  void robotReset() override {}
-  void robotHome() override {}
-  void openGripper() override {}
-  void retryStep() override {}
-  void skipTrial() override {}
-  void endSession() override {}
-  std::string phase() override { return "phase 1: objects flashing"; }
-  int trial() override { return 2; }
-  int trials() override { return 3; }
-  int sequence() override { return 4; }
-  bool started() override { return true; }
-  std::vector<std::string> preflight() override { return {"pre-flight passed"}; }
-  bool preflightRunning() override { return false; }
-  bool ended() override { return false; }
-  std::vector<std::pair<std::string, std::string>> endSummary() override {
-    return {{"ended", "finished"}, {"objects", "accuracy 100 %"}};
-  }
-  std::string trackingAlarm() override { return ""; }
-  double maxPoseAgeS() override { return 0.5; }
-  std::optional<double> referenceAgeS() override { return 0.02; }
-  void start() override {}
-  void pause() override { ++calls_["pause"]; }
-  void resume() override {}
-  void abort() override {}
-  double sessionTime() override { return 83.4; }
-  double budgetMs() override { return 58.6; }
-  int overruns() override { return 0; }
-  std::vector<StageTiming> timing() override {
-    return {{"eeg", 0.3, 0.4, 0.6, 0.9, 0.3}, {"tracking", 1.8, 2.2, 3.1, 4.0, 1.9}};
-  }
-  std::vector<OperatorLine> operatorLog() override {
-    return {{OperatorLine::Severity::Info, 2.1, "pre-flight passed"},
-            {OperatorLine::Severity::Warning, 40.2, "12 EEG samples lost"},
-            {OperatorLine::Severity::Error, 61.0,
-             "object 10: tracking lost (pose 28.3 s old), not grasped; Retry step once it is seen "
-             "again"}};
-  }
-  size_t operatorLogSize() override { return 3; }
-  const bci::SignalScope* eegScope() override { return scope_ ? &*scope_ : nullptr; }
-  std::string photodiodeChannel() override { return "Photodiode"; }
-  std::vector<std::string> selections() override {
-    return {"trial 1: object 20 (intended), cell 1,3 (intended), placed 0.3 mm off [placed]"};
-  }
-
-  std::map<std::string, int> calls_;
-  bool setup_ = false;  // before Start, rather than in phase 1
-
- private:
-  cv::Mat camera_, binary_;
-  vision::DetectionResult detection_;
-  robot::StatusPayload status_;
-  bci::ErpCurves erp_;
-  std::optional<bci::SignalScope> scope_;
-};
+  feedEeg(b);
+}
 
 struct Drawn {
   std::set<std::string> windows;
@@ -180,40 +130,78 @@ struct Drawn {
   cv::Mat image;                               // RGBA, top row first
 };
 
-// The shell with `panel` alone, drawn for a few frames (ImGui settles its layout).
-// `layout`: an ImGui layout file to start from ("" for none).
-Drawn draw(render::GlContext& context, Panel& panel, const std::string& layout = "") {
-  const render::Size size{1000, 700};
-  ImGuiLayer imgui(context, layout);
-  ExperimenterShell shell;
-  shell.addPanel(panel);
-  for (int frame = 0; frame < 3; ++frame) {
-    context.makeCurrent();
-    imgui.beginFrame(1.0f / 60.0f);
-    shell.draw(size, {16.7f, "phase 1: objects flashing", "t=83.4 s"});
-    render::clearFramebuffer(context.drawFramebuffer(), size, {0.08f, 0.09f, 0.11f, 1.0f});
-    imgui.endFrame();
-    context.present();
+constexpr render::Size kSize{1000, 700};
+
+// The shell with one panel, drawn a frame at a time (ImGui settles its layout over a few).
+class Drawer {
+ public:
+  // `layout`: an ImGui layout file to start from ("" for none).
+  Drawer(render::GlContext& context, Panel& panel, const std::string& layout = "",
+         render::Size size = kSize)
+      : context_(context), imgui_(context, layout), size_(size) {
+    shell_.addPanel(panel);
   }
-  Drawn out;
-  for (const std::string& w : drawnWindows()) out.windows.insert(w);
-  for (const DrawnWidget& w : drawnWidgets()) out.widgets[w.label] = w;
-  const render::RgbaImage pixels = render::readPixels(context.drawFramebuffer(), size);
-  out.image =
-      cv::Mat(pixels.height, pixels.width, CV_8UC4, const_cast<std::uint8_t*>(pixels.pixels.data()))
-          .clone();
-  return out;
-}
+  Drawn frames(test::PanelBench& bench, int count = 3) {
+    for (int i = 0; i < count; ++i) frame(bench, {});
+    return collect();
+  }
+  // Pointer over the button, pressed, released (ImGui's click); false when no such button.
+  bool click(test::PanelBench& bench, const std::string& label) {
+    frames(bench, 1);
+    const auto& widgets = drawnWidgets();
+    const auto found = std::find_if(widgets.begin(), widgets.end(),
+                                    [&](const DrawnWidget& w) { return w.label == label; });
+    if (found == widgets.end()) return false;
+    SyntheticInput input;
+    input.x = 0.5f * (found->x0 + found->x1);
+    input.y = 0.5f * (found->y0 + found->y1);
+    frame(bench, input);
+    input.left_down = true;
+    frame(bench, input);
+    input.left_down = false;
+    frame(bench, input);
+    return true;
+  }
+
+ private:
+  void frame(test::PanelBench& bench, const SyntheticInput& input) {
+    context_.makeCurrent();
+    imgui_.beginFrame(1.0f / 60.0f, &input);
+    shell_.draw(size_, {16.7f, "phase 1: objects flashing", "t=83.4 s"}, bench.input());
+    render::clearFramebuffer(context_.drawFramebuffer(), size_, {0.08f, 0.09f, 0.11f, 1.0f});
+    imgui_.endFrame();
+    context_.present();
+  }
+  Drawn collect() {
+    Drawn out;
+    for (const std::string& w : drawnWindows()) out.windows.insert(w);
+    for (const DrawnWidget& w : drawnWidgets()) out.widgets[w.label] = w;
+    const render::RgbaImage pixels = render::readPixels(context_.drawFramebuffer(), size_);
+    out.image = cv::Mat(pixels.height, pixels.width, CV_8UC4,
+                        const_cast<std::uint8_t*>(pixels.pixels.data()))
+                    .clone();
+    return out;
+  }
+  render::GlContext& context_;
+  ImGuiLayer imgui_;
+  render::Size size_;
+  ExperimenterShell shell_;
+};
 
 class Panels : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { context_ = render::createHeadlessContext({1000, 700}); }
+  static void SetUpTestSuite() { context_ = render::createHeadlessContext(kSize); }
   static void TearDownTestSuite() { context_.reset(); }
-  std::unique_ptr<Panel> make(const std::string& name) {
-    return panels().at(name).make.make({model_, 0, 1280.0f / 480.0f});
+  void SetUp() override {
+    phaseOneOfTrialTwo(bench_);
+    bench_.window.hmd_aspect = 1280.0f / 480.0f;
+  }
+  std::unique_ptr<Panel> make(const std::string& name) { return panels().at(name).make.make(); }
+  Drawn draw(Panel& panel, const std::string& layout = "") {
+    return Drawer(*context_, panel, layout).frames(bench_);
   }
   static std::unique_ptr<render::GlContext> context_;
-  StandInModel model_;
+  test::PanelBench bench_;
 };
 std::unique_ptr<render::GlContext> Panels::context_;
 
@@ -233,7 +221,7 @@ TEST_F(Panels, EveryRegisteredPanelDrawsItsWindowAndButtons) {
   ASSERT_GE(panels().entries().size(), 7u);
   for (const auto& entry : panels().entries()) {
     auto panel = make(entry.name);
-    const Drawn d = draw(*context_, *panel);
+    const Drawn d = draw(*panel);
     EXPECT_TRUE(d.windows.count(panel->title())) << entry.name;
     const auto expected = kExpectedWidgets.find(entry.name);
     if (expected != kExpectedWidgets.end()) {
@@ -252,25 +240,78 @@ TEST_F(Panels, EveryRegisteredPanelDrawsItsWindowAndButtons) {
   }
 }
 
+TEST_F(Panels, EveryScreenshotNameIsAPanelsShotAndNamedOnce) {
+  std::set<std::string> names;
+  for (const auto& [panel, shot] : panelShots()) {
+    EXPECT_TRUE(panels().find(panel)) << panel;
+    EXPECT_TRUE(names.insert(shot->name).second) << shot->name << " named twice";
+    EXPECT_TRUE(shot->ready) << shot->name;
+  }
+  for (const char* name : {"threshold", "calibration", "training", "session-model", "robot",
+                           "session", "eeg", "log", "settings", "hmd"})
+    EXPECT_TRUE(names.count(name)) << name;
+}
+
 TEST_F(Panels, TheSessionPanelOffersWhatThePhaseAllowsAndSaysWhyNotTheRest) {
   auto panel = make("session");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   ASSERT_TRUE(d.widgets.count("Pause"));
   EXPECT_TRUE(d.widgets.at("Pause").enabled);
   ASSERT_TRUE(d.widgets.count("Resume"));
   EXPECT_FALSE(d.widgets.at("Resume").enabled);
-  EXPECT_EQ(d.widgets.at("Resume").why_disabled, "only after an emergency stop or a robot fault");
-  EXPECT_TRUE(d.widgets.count("Abort"));
+  EXPECT_EQ(d.widgets.at("Resume").why_disabled,
+            "nothing to resume: the session is not paused or stopped");
+  EXPECT_FALSE(d.widgets.at("Start").enabled);
+  EXPECT_EQ(d.widgets.at("Start").why_disabled, "the session has started");
+}
+
+TEST_F(Panels, TheSessionPanelsButtonsPostTheirRequests) {
+  auto panel = make("session");
+  Drawer drawer(*context_, *panel);
+  ASSERT_TRUE(drawer.click(bench_, "Pause"));
+  EXPECT_EQ(bench_.requests.count<session::PauseRequest>(), 1);
+  // A disabled button posts nothing.
+  ASSERT_TRUE(drawer.click(bench_, "Resume"));
+  EXPECT_EQ(bench_.requests.count<session::ResumeRequest>(), 0);
+  ASSERT_TRUE(drawer.click(bench_, "EMERGENCY STOP"));
+  EXPECT_EQ(bench_.requests.count<session::EmergencyStopRequest>(), 1);
+}
+
+TEST_F(Panels, BeforeStartTheSessionPanelTakesTheSubjectAndPostsStart) {
+  bench_.record = session::CycleRecord{};
+  bench_.record.labels.subject = "07";
+  bench_.window = WindowState([](const core::RunLabels& l) {
+    return RunTarget{"", "run 3 of subject " + l.subject};
+  });
+  bench_.window.ingest(bench_.record, bench_.settings);
+  EXPECT_EQ(bench_.window.runTarget().target, "run 3 of subject 07");
+  auto panel = make("session");
+  Drawer drawer(*context_, *panel);
+  const Drawn d = drawer.frames(bench_);
+  EXPECT_TRUE(d.widgets.count("subject"));
+  EXPECT_TRUE(d.widgets.at("Start").enabled);
+  ASSERT_TRUE(drawer.click(bench_, "Start"));
+  EXPECT_EQ(bench_.requests.count<session::StartRequest>(), 1);
+  // What stops a start is shown on Start's button.
+  bench_.window = WindowState([](const core::RunLabels&) {
+    return RunTarget{"give the subject: the run is exported to the BIDS dataset bids", ""};
+  });
+  bench_.window.ingest(bench_.record, bench_.settings);
+  const Drawn refused = drawer.frames(bench_);
+  EXPECT_FALSE(refused.widgets.at("Start").enabled);
+  EXPECT_EQ(refused.widgets.at("Start").why_disabled,
+            "give the subject: the run is exported to the BIDS dataset bids");
 }
 
 // A double click must not land on a button that took another's place: Start, Pause, Resume and
 // Abort stay where they are when the session starts.
 TEST_F(Panels, TheSessionPanelsButtonsKeepTheirPlaceWhenTheSessionStarts) {
-  model_.setup_ = true;
+  const session::CycleRecord started = bench_.record;
+  bench_.record.paradigm.phase = bci::Phase::Setup;
   auto panel = make("session");
-  const Drawn before = draw(*context_, *panel);
-  model_.setup_ = false;
-  const Drawn after = draw(*context_, *panel);
+  const Drawn before = draw(*panel);
+  bench_.record = started;
+  const Drawn after = draw(*panel);
   EXPECT_TRUE(before.widgets.at("Start").enabled);
   EXPECT_FALSE(after.widgets.at("Start").enabled);
   EXPECT_TRUE(after.widgets.at("Pause").enabled);
@@ -287,7 +328,7 @@ TEST_F(Panels, APanelSavedOutsideASmallerScreenIsFittedToIt) {
   const std::string layout = ::testing::TempDir() + "/panels_layout.ini";
   std::ofstream(layout) << "[Window][Robot]\nPos=1300,820\nSize=900,800\nCollapsed=0\n";
   auto panel = make("robot");
-  const Drawn d = draw(*context_, *panel, layout);
+  const Drawn d = draw(*panel, layout);
   for (const char* label : {"EMERGENCY STOP", "Home", "End session"}) {
     ASSERT_TRUE(d.widgets.count(label)) << label;
     const DrawnWidget& w = d.widgets.at(label);
@@ -297,18 +338,20 @@ TEST_F(Panels, APanelSavedOutsideASmallerScreenIsFittedToIt) {
   }
 }
 
-// The EEG panel: traces with each channel's quality, the flat and the noisy ones in red, the
-// finding named with its threshold in the table.
+// The EEG panel: the window's scope, fed from the records, grades each channel; the flat and the
+// noisy ones in red, the finding named with its threshold in the table.
 TEST_F(Panels, TheEegPanelGradesEachChannelAndNamesTheFinding) {
-  const auto& quality = model_.eegScope()->quality();
+  ASSERT_NE(bench_.window.eegScope(), nullptr);
+  const auto& quality = bench_.window.eegScope()->quality();
   ASSERT_EQ(quality.size(), 44u);
   EXPECT_EQ(quality[0].grade, bci::Grade::Good) << quality[0].finding;
   EXPECT_EQ(quality[1].grade, bci::Grade::Bad) << quality[1].finding;
   EXPECT_EQ(quality[1].finding.rfind("flat", 0), 0u) << quality[1].finding;
   EXPECT_EQ(quality[2].grade, bci::Grade::Bad) << quality[2].finding;
   EXPECT_NE(quality[2].finding.find("line noise 50 Hz"), std::string::npos);
+  EXPECT_EQ(bench_.window.eegScope()->stimuli().size(), 8u);
   auto panel = make("eeg");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   EXPECT_TRUE(d.windows.count("EEG"));
   // The grade marks left of the traces: green for Fz, red for Cz (rows from the top).
   int green = 0, red = 0, yellow = 0;
@@ -325,10 +368,31 @@ TEST_F(Panels, TheEegPanelGradesEachChannelAndNamesTheFinding) {
   EXPECT_GT(yellow, 10);
 }
 
+TEST_F(Panels, TheEegPanelSaysSoBeforeTheFirstSamples) {
+  bench_.window = WindowState();
+  auto panel = make("eeg");
+  const Drawn d = draw(*panel);
+  EXPECT_TRUE(d.windows.count("EEG"));
+  EXPECT_EQ(bench_.window.eegScope(), nullptr);
+}
+
+// The window's cycle history: each stage's percentiles and the total, from the records' times.
+TEST_F(Panels, TheWindowKeepsEachStagesTimesFromTheRecords) {
+  const std::vector<StageTiming>& timing = bench_.window.timing();
+  ASSERT_EQ(timing.size(), 3u);
+  EXPECT_EQ(timing[0].stage, "eeg");
+  EXPECT_NEAR(timing[0].p50_ms, 0.3, 1e-9);
+  EXPECT_EQ(timing[1].stage, "tracking");
+  EXPECT_EQ(timing[2].stage, "total");
+  EXPECT_NEAR(timing[2].max_ms, 19.6, 1e-9);
+  EXPECT_NEAR(bench_.window.cycleP50Ms(), 19.6, 1e-9);
+  EXPECT_EQ(bench_.window.recentCycles().size(), 31u);
+}
+
 // Everything the experimenter was told, coloured by severity, filterable.
 TEST_F(Panels, TheOperatorLogListsWhatTheSessionSaid) {
   auto panel = make("log");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   EXPECT_TRUE(d.windows.count("Operator log"));
   // The error line is drawn in red somewhere in the panel.
   int red = 0;
@@ -342,17 +406,35 @@ TEST_F(Panels, TheOperatorLogListsWhatTheSessionSaid) {
 
 TEST_F(Panels, TheRobotPanelHasTheRecoveryButtonsGreyedWithTheirReasons) {
   auto panel = make("robot");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   for (const char* label : {"Home", "Open gripper", "Retry step", "Skip trial"}) {
     ASSERT_TRUE(d.widgets.count(label)) << label;
     EXPECT_FALSE(d.widgets.at(label).enabled) << label;
     EXPECT_FALSE(d.widgets.at(label).why_disabled.empty()) << label;
   }
+  EXPECT_EQ(d.widgets.at("Retry step").why_disabled,
+            "nothing to retry: no emergency stop or robot fault");
+}
+
+// After an emergency stop in a trial's flashing, with the arm home and empty: Retry step and Skip
+// trial go, each posting its request.
+TEST_F(Panels, AfterAStopTheRobotPanelsRecoveryPostsRetryAndSkip) {
+  bench_.record.paradigm.interrupted = bench_.record.paradigm.phase;
+  bench_.record.paradigm.phase = bci::Phase::EmergencyStop;
+  auto panel = make("robot");
+  Drawer drawer(*context_, *panel);
+  const Drawn d = drawer.frames(bench_);
+  EXPECT_TRUE(d.widgets.at("Retry step").enabled) << d.widgets.at("Retry step").why_disabled;
+  EXPECT_TRUE(d.widgets.at("Skip trial").enabled) << d.widgets.at("Skip trial").why_disabled;
+  ASSERT_TRUE(drawer.click(bench_, "Retry step"));
+  ASSERT_TRUE(drawer.click(bench_, "Skip trial"));
+  EXPECT_EQ(bench_.requests.count<session::RetryStepRequest>(), 1);
+  EXPECT_EQ(bench_.requests.count<session::SkipTrialRequest>(), 1);
 }
 
 TEST_F(Panels, TheThresholdPanelShowsTheCameraAndBinaryImagesSideBySide) {
   auto panel = make("threshold");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   // The camera image's grey-blue (B 90, G 110, R 130) and the black marker square are drawn.
   cv::Mat bgr;
   cv::cvtColor(d.image, bgr, cv::COLOR_RGBA2BGR);
@@ -383,28 +465,66 @@ double share(const cv::Mat& rgba, const cv::Rect& area, const cv::Vec3b& rgb, in
 
 TEST_F(Panels, TheHmdPanelShowsTheViewAtTheHmdAspectAcrossTheWindow) {
   auto panel = make("hmd");
-  const Drawn d = draw(*context_, *panel);
-  // The stand-in's view is texture 0 (black), 1280:480 wide across the 1000-pixel window: about
-  // 980 x 367 pixels below the title bar; the window's own background below it.
+  const Drawn d = draw(*panel);
+  // The view is texture 0 (black), 1280:480 wide across the 1000-pixel window: about 980 x 367
+  // pixels below the title bar; the window's own background below it.
   EXPECT_GT(share(d.image, cv::Rect(40, 80, 920, 300), {0, 0, 0}, 2), 0.99);
   EXPECT_LT(share(d.image, cv::Rect(40, 460, 920, 150), {0, 0, 0}, 2), 0.01);
 }
 
 TEST_F(Panels, TheSummaryPanelSaysTheSessionIsStillRunning) {
   auto panel = make("summary");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   // One line of grey text under the title bar, nothing below it while the session runs.
   const cv::Rect line(0, 48, 500, 16), below(0, 90, 1000, 500);
   EXPECT_LT(share(d.image, line, {15, 15, 15}, 6), 0.95);
   EXPECT_GT(share(d.image, below, {15, 15, 15}, 6), 0.99);
 }
 
+// Once ended, the last record carries the summary: one row per figure and per trial.
+TEST_F(Panels, TheSummaryPanelShowsTheEndedSessionsSummary) {
+  bench_.record.ended = true;
+  bench_.record.end_kind = bench_.record.end_reason = "finished";
+  bench_.record.summary = std::make_shared<const nlohmann::json>(nlohmann::json{
+      {"ended", "finished"},
+      {"end_reason", "finished"},
+      {"duration_s", 131.2},
+      {"folder", "arbci-session"},
+      {"objects", {{"accuracy", 1.0}, {"seconds_per_selection", 9.8}, {"bits_per_minute", 12.1}}},
+      {"trials",
+       {{{"trial", 1},
+         {"selected_object", 20},
+         {"outcome", "placed"},
+         {"placement_error_m", 0.001}},
+        {{"trial", 2}, {"selected_object", nullptr}, {"outcome", "skipped"}}}},
+      {"timing", {{"late_frames", 0}, {"lost_samples", 0}}}});
+  auto panel = make("summary");
+  const Drawn d = draw(*panel);
+  // Rows of text down the panel: the ended session's figures.
+  const cv::Rect rows(0, 48, 1000, 200);
+  EXPECT_LT(share(d.image, rows, {15, 15, 15}, 6), 0.9);
+}
+
 TEST_F(Panels, TheTrainingPanelWaitsForARecordingAndSaysSo) {
   auto panel = make("training");
-  const Drawn d = draw(*context_, *panel);
+  const Drawn d = draw(*panel);
   ASSERT_TRUE(d.widgets.count("Train"));
   EXPECT_FALSE(d.widgets.at("Train").enabled);  // no recording named yet
   EXPECT_EQ(d.widgets.at("Train").why_disabled, "name at least one recording above");
+}
+
+TEST_F(Panels, TheCalibrationPanelAppliesTheReferenceAsARequest) {
+  // A tall window: the reference's fields come below the views and the coverage map.
+  const render::Size tall{1000, 1400};
+  auto context = render::createHeadlessContext(tall);
+  auto panel = make("calibration");
+  Drawer drawer(*context, *panel, "", tall);
+  ASSERT_TRUE(drawer.click(bench_, "Apply reference"));
+  ASSERT_EQ(bench_.requests.count<session::ReferenceRequest>(), 1);
+  const auto& reference = std::get<session::ReferenceRequest>(bench_.requests.posted.back());
+  // Where the tracker has the reference now (the default: 0.90 m along the robot's y axis).
+  EXPECT_EQ(reference.id, 0);
+  EXPECT_NEAR(reference.position[1], 0.9, 1e-6);
 }
 
 }  // namespace

@@ -1,36 +1,64 @@
+// The camera Calibration panel: chessboard views with a live detection overlay, the coverage
+// map, per-view and overall reprojection error, calibrate and save, an undistortion preview, and
+// the reference marker's place in the robot frame.
 #include <imgui.h>
 
 #include <cfloat>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "arbci/ui/image_view.h"
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
+#include "arbci/vision/calibration.h"
 #include "widgets.h"
 
 namespace arbci::ui {
+namespace {
 
-CalibrationPanel::CalibrationPanel(WorkstationModel& model)
-    : model_(model), calibrator_(vision::CalibrationBoard{}) {
-  reference_id_ = model.referenceId();
-  const cv::Vec3d p = model.referencePosition();
-  for (int i = 0; i < 3; ++i) reference_position_[i] = static_cast<float>(p[i]);
-}
+class CalibrationPanel final : public Panel {
+ public:
+  CalibrationPanel() : calibrator_(vision::CalibrationBoard{}) {}
+  const char* title() const override { return "Camera calibration"; }
+  void draw(const PanelInput& in) override;
+  // What the buttons do, also for a screenshot's recipe.
+  void captureView(const PanelInput& in);
+  void calibrate();
+  void holdBoard(const PanelInput& in, bool show);
 
-void CalibrationPanel::captureView() {
-  const cv::Mat image = model_.cameraImage();
+ private:
+  void results();
+  void liveImage(const cv::Mat& image);
+  void reference(const PanelInput& in);
+  vision::IncrementalCalibrator calibrator_;
+  std::optional<vision::CalibrationResult> result_;
+  std::string last_view_, message_;
+  std::vector<cv::Point2f> last_corners_;
+  char save_path_[256] = "camera.yml";
+  bool preview_undistorted_ = false, board_ = false;
+  bool reference_read_ = false;
+  int reference_id_ = 0;
+  float reference_position_[3] = {0.0f, 0.9f, 0.0f};
+  ImageView view_, coverage_;
+};
+
+void CalibrationPanel::captureView(const PanelInput& in) {
+  const cv::Mat& image = in.record.tracking.left_image;
   if (image.empty()) return;
   const vision::ViewResult r =
       calibrator_.addView(image, "view " + std::to_string(calibrator_.viewCount() + 1));
   last_view_ = vision::toString(r.outcome) + (r.reason.empty() ? "" : ": " + r.reason);
   last_corners_ = r.corners;
-  if (board_) model_.holdBoard(true);  // the next view from another pose
+  // The next view from another pose.
+  if (board_) in.requests.post(session::HoldBoardRequest{true});
 }
 
-void CalibrationPanel::holdBoard(bool show) {
-  board_ = show && model_.canHoldBoard();
-  model_.holdBoard(board_);
+void CalibrationPanel::holdBoard(const PanelInput& in, bool show) {
+  board_ = show && in.record.cameras.can_hold_board;
+  in.requests.post(session::HoldBoardRequest{board_});
 }
 
 void CalibrationPanel::calibrate() {
@@ -42,21 +70,28 @@ void CalibrationPanel::calibrate() {
   }
 }
 
-void CalibrationPanel::draw() {
+void CalibrationPanel::draw(const PanelInput& in) {
   const vision::CalibrationBoard& board = calibrator_.board();
   ImGui::Text("board: chessboard %dx%d inner corners, %.0f mm squares", board.inner_corners.width,
               board.inner_corners.height, board.square_m * 1000);
-  if (model_.canHoldBoard()) {
-    if (ImGui::Checkbox("hold the simulated board up", &board_)) model_.holdBoard(board_);
+  if (in.record.cameras.can_hold_board) {
+    if (ImGui::Checkbox("hold the simulated board up", &board_))
+      in.requests.post(session::HoldBoardRequest{board_});
   }
-  cv::Mat image = model_.cameraImage();
-  if (button("Capture view", image.empty() ? "no camera image yet" : "")) captureView();
+  const cv::Mat& image = in.record.tracking.left_image;
+  if (button("Capture view", image.empty() ? "no camera image yet" : "")) captureView(in);
   ImGui::SameLine();
   ImGui::Text("%zu views; coverage %.0f%%", calibrator_.viewCount(),
               100.0 * calibrator_.coverageFraction());
   if (!last_view_.empty()) ImGui::Text("last view: %s", last_view_.c_str());
   if (button("Calibrate", calibrator_.viewCount() < 3 ? "capture at least 3 views first" : ""))
     calibrate();
+  results();
+  liveImage(image);
+  reference(in);
+}
+
+void CalibrationPanel::results() {
   if (result_) {
     pathInput("calibration file (.yml, .xml)", save_path_, sizeof save_path_, ".yml .yaml .xml",
               "where Save writes the camera's calibration (OpenCV YAML or XML)");
@@ -77,8 +112,11 @@ void CalibrationPanel::draw() {
     ImGui::Checkbox("preview undistorted", &preview_undistorted_);
   }
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+}
 
+void CalibrationPanel::liveImage(const cv::Mat& image) {
   // The live image with what the detector finds in it, or its undistorted preview.
+  const vision::CalibrationBoard& board = calibrator_.board();
   cv::Mat shown;
   if (!image.empty()) {
     if (preview_undistorted_ && result_) {
@@ -117,7 +155,18 @@ void CalibrationPanel::draw() {
   ImGui::TextUnformatted("coverage");
   coverage_.draw(map, ImGui::GetContentRegionAvail().x);
   ImGui::EndGroup();
+}
 
+void CalibrationPanel::reference(const PanelInput& in) {
+  if (!reference_read_) {
+    // Where the reference is now: the tracker's, else the session file's.
+    const auto& world = in.record.tracking.world;
+    reference_id_ = world ? world->reference().id : in.settings.world.reference_id;
+    const cv::Vec3d p =
+        world ? world->reference().T_robot_ref.translation : in.settings.world.reference_position;
+    for (int i = 0; i < 3; ++i) reference_position_[i] = static_cast<float>(p[i]);
+    reference_read_ = true;
+  }
   heading("reference marker (robot frame)");
   ImGui::TextUnformatted("marker id");
   ImGui::SetNextItemWidth(-FLT_MIN);
@@ -126,16 +175,33 @@ void CalibrationPanel::draw() {
   ImGui::SetNextItemWidth(-FLT_MIN);
   ImGui::InputFloat3("##position", reference_position_, "%.3f");
   if (button("Apply reference")) {
-    model_.setReference(reference_id_, cv::Vec3d(reference_position_[0], reference_position_[1],
-                                                 reference_position_[2]));
+    in.requests.post(session::ReferenceRequest{
+        reference_id_,
+        cv::Vec3d(reference_position_[0], reference_position_[1], reference_position_[2])});
   }
 }
 
+// Six views of the simulated board, four frames apart, then calibrated.
+void rehearseCalibration(Panel& panel, const ShotSteps& steps) {
+  auto& p = static_cast<CalibrationPanel&>(panel);
+  p.holdBoard(steps.input(), true);
+  for (int view = 0; view < 6; ++view) {
+    steps.step(4);
+    p.captureView(steps.input());
+  }
+  p.calibrate();
+  steps.step(4);
+}
+
+}  // namespace
+
 PanelRegistry::Entry calibrationPanel() {
-  return {
-      "calibration",
-      "camera calibration from chessboard views, and the reference marker",
-      {[](const PanelContext& c) { return std::make_unique<CalibrationPanel>(c.model); }, false}};
+  PanelParts parts{[] { return std::make_unique<CalibrationPanel>(); }, false};
+  parts.shots.push_back({"calibration", "six views of the simulated board, calibrated",
+                         [](const session::CycleRecord& r) { return r.frame >= 1; },
+                         rehearseCalibration});
+  return {"calibration", "camera calibration from chessboard views, and the reference marker",
+          parts};
 }
 
 }  // namespace arbci::ui

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arbci/session/experimenter.h"
 #include "arbci/ui/widget_registry.h"
 #include "widgets.h"
 
@@ -36,11 +37,12 @@ bool ExperimenterShell::show(const std::string& title) {
   return false;
 }
 
-void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
-  drawMenuBar();
+void ExperimenterShell::draw(render::Size display, const ShellStatus& status,
+                             const PanelInput& in) {
+  drawMenuBar(in);
   const float menu_height = ImGui::GetFrameHeight();
   const float status_height = ImGui::GetFrameHeight() + 6.0f;
-  drawPanels(display, menu_height, static_cast<float>(display.height) - status_height);
+  drawPanels(display, menu_height, static_cast<float>(display.height) - status_height, in);
   drawStatusBar(display, status_height, status);
   if (show_about_) {
     ImGui::OpenPopup("About ARBCI");
@@ -54,7 +56,7 @@ void ExperimenterShell::draw(render::Size display, const ShellStatus& status) {
   }
 }
 
-void ExperimenterShell::drawMenuBar() {
+void ExperimenterShell::drawMenuBar(const PanelInput& in) {
   // Ctrl+Q, as the menu says. This ImGui (1.86) indexes keys by the backend's codes; GLFW's for
   // letters are their upper-case ASCII codes.
   if (ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('Q', false) && on_quit_) on_quit_();
@@ -74,14 +76,17 @@ void ExperimenterShell::drawMenuBar() {
     if (ImGui::MenuItem("About")) show_about_ = true;
     ImGui::EndMenu();
   }
-  if (on_stop_) {
+  if (show_stop_) {
     ImGui::SameLine(ImGui::GetWindowWidth() - 170.0f);
-    if (stopButton("EMERGENCY STOP", true, stop_why_not_ ? stop_why_not_() : "")) on_stop_();
+    if (stopButton("EMERGENCY STOP", true,
+                   session::whyNot(session::Action::EmergencyStop, in.record)))
+      in.requests.post(session::EmergencyStopRequest{});
   }
   ImGui::EndMainMenuBar();
 }
 
-void ExperimenterShell::drawPanels(render::Size display, float top, float bottom) {
+void ExperimenterShell::drawPanels(render::Size display, float top, float bottom,
+                                   const PanelInput& in) {
   // Default layout (first run): the panels open at start side by side in up to three columns;
   // one opened later from the menu comes in front, large, over the middle of the window.
   std::vector<Entry*> open;
@@ -118,7 +123,7 @@ void ExperimenterShell::drawPanels(render::Size display, float top, float bottom
     if (ImGui::Begin(open[i]->panel->title(), &open[i]->open)) {
       fitToScreen(display, top, bottom);
       detail::recordWindow(open[i]->panel->title());
-      open[i]->panel->draw();
+      open[i]->panel->draw(in);
     }
     ImGui::End();
   }

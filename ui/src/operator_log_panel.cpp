@@ -3,30 +3,42 @@
 #include <imgui.h>
 
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
 #include "widgets.h"
 
 namespace arbci::ui {
 namespace {
 
-ImVec4 colour(OperatorLine::Severity severity) {
+using session::Severity;
+
+ImVec4 colour(Severity severity) {
   switch (severity) {
-    case OperatorLine::Severity::Error:
+    case Severity::Error:
       return {1.0f, 0.35f, 0.3f, 1.0f};
-    case OperatorLine::Severity::Warning:
+    case Severity::Warning:
       return {1.0f, 0.65f, 0.2f, 1.0f};
-    case OperatorLine::Severity::Info:
+    case Severity::Info:
       break;
   }
   return ImGui::GetStyle().Colors[ImGuiCol_Text];
 }
 
-}  // namespace
+class OperatorLogPanel final : public Panel {
+ public:
+  const char* title() const override { return "Operator log"; }
+  void draw(const PanelInput& in) override;
 
-void OperatorLogPanel::draw() {
-  // Read again only when something was said: the panel is drawn every frame.
-  if (const size_t size = model_.operatorLogSize(); size != lines_.size()) {
-    lines_ = model_.operatorLog();
+ private:
+  size_t seen_ = 0;                    // lines of the log when last drawn
+  bool show_[3] = {true, true, true};  // by session::Severity
+  char filter_[128] = "";
+  bool scroll_to_end_ = false;
+};
+
+void OperatorLogPanel::draw(const PanelInput& in) {
+  const std::vector<session::OperatorMessage>& lines = in.log.messages();
+  // Scrolled to the end when something new was said.
+  if (lines.size() != seen_) {
+    seen_ = lines.size();
     scroll_to_end_ = true;
   }
   ImGui::Checkbox("errors", &show_[2]);
@@ -39,7 +51,7 @@ void OperatorLogPanel::draw() {
   ImGui::InputTextWithHint("##filter", "filter: text to find", filter_, sizeof filter_);
   ImGui::BeginChild("operator log lines", ImVec2(0, 0), true);
   int shown = 0;
-  for (const OperatorLine& line : lines_) {
+  for (const session::OperatorMessage& line : lines) {
     if (!show_[static_cast<int>(line.severity)] || !containsIgnoringCase(line.text, filter_))
       continue;
     ++shown;
@@ -50,7 +62,7 @@ void OperatorLogPanel::draw() {
     ImGui::PopStyleColor();
   }
   if (shown == 0)
-    ImGui::TextDisabled(lines_.empty() ? "nothing to report yet" : "no line matches the filter");
+    ImGui::TextDisabled(lines.empty() ? "nothing to report yet" : "no line matches the filter");
   if (scroll_to_end_) {
     ImGui::SetScrollHereY(1.0f);
     scroll_to_end_ = false;
@@ -58,10 +70,16 @@ void OperatorLogPanel::draw() {
   ImGui::EndChild();
 }
 
+}  // namespace
+
 PanelRegistry::Entry operatorLogPanel() {
-  return {"log",
-          "the operator log: every end, fault, refusal, pause and warning with its time",
-          {[](const PanelContext& c) { return std::make_unique<OperatorLogPanel>(c.model); }}};
+  PanelParts parts{[] { return std::make_unique<OperatorLogPanel>(); }};
+  parts.shots.push_back(
+      {"log", "once the classifier is trained", [](const session::CycleRecord& r) {
+         return r.paradigm.phase == bci::Phase::ObjectFlashing;
+       }});
+  return {"log", "the operator log: every end, fault, refusal, pause and warning with its time",
+          parts};
 }
 
 }  // namespace arbci::ui

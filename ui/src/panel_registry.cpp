@@ -33,4 +33,12 @@ const PanelRegistry& panels() {
   return registry;
 }
 
+std::vector<std::pair<std::string, const PanelShot*>> panelShots() {
+  std::vector<std::pair<std::string, const PanelShot*>> out;
+  for (const auto& entry : panels().entries()) {
+    for (const PanelShot& shot : entry.make.shots) out.emplace_back(entry.name, &shot);
+  }
+  return out;
+}
+
 }  // namespace arbci::ui

@@ -1,130 +1,112 @@
+// The Session panel: the paradigm's phase, start/pause/resume/abort, the subject and run before
+// Start, the pre-flight check, tracking health, the cycle's timing per stage against the block
+// budget, and the selections made.
 #include <imgui.h>
 
-#include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
-#include "widgets.h"
-
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
+#include "arbci/session/experimenter.h"
+#include "arbci/session/record_text.h"
+#include "arbci/ui/panel_registry.h"
+#include "widgets.h"
+
 namespace arbci::ui {
 namespace {
+
+using session::Action;
+
 std::string seconds(double s) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f s", s);
   return text;
 }
-}  // namespace
 
-void SessionPanel::draw() {
-  using Action = WorkstationModel::Action;
+void colouredWrapped(const ImVec4& colour, const std::string& text) {
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+}
+
+class SessionPanel final : public Panel {
+ public:
+  const char* title() const override { return "Session"; }
+  void draw(const PanelInput& in) override;
+
+ private:
+  void buttons(const PanelInput& in);
+  // Before Start: subject, session, task and run, and where the run will be written.
+  void runLabels(const PanelInput& in);
+  // "tracking lost" for the reference marker and each object seen too long ago.
+  void trackingHealth(const PanelInput& in);
+  void timing(const PanelInput& in);
+  bool labels_read_ = false;
+  char subject_[64] = "", visit_[64] = "", task_[64] = "", run_[16] = "";
+};
+
+void SessionPanel::draw(const PanelInput& in) {
+  const session::CycleRecord& r = in.record;
+  const bool started = r.paradigm.phase != bci::Phase::Setup;
   // One line (a narrow panel cuts it; the reason below wraps): the buttons stay where they are.
-  ImGui::Text("%s", model_.phase().c_str());
-  ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", model_.trial(), model_.trials(),
-              model_.sequence(), model_.sessionTime());
-  // Every button in its own place whatever the state (disabled with its reason where it cannot
-  // act): a double click never lands on a button that took another's place.
-  if (!labels_read_) readLabels();
-  const std::string& labels_problem = model_.started() ? std::string() : labels_problem_;
-  if (button("Start", !labels_problem.empty() ? labels_problem : model_.whyNot(Action::Start)))
-    model_.start();
-  ImGui::SameLine();
-  if (button("Pause", model_.whyNot(Action::Pause))) model_.pause();
-  ImGui::SameLine();
-  if (button("Resume", model_.whyNot(Action::Resume))) model_.resume();
-  ImGui::SameLine();
-  if (confirmedButton("Abort", model_.whyNot(Action::Abort),
-                      "Abort the session? It ends now; what was recorded is kept.", "Yes, abort"))
-    model_.abort();
-  ImGui::SameLine();
-  emergencyStopButton(model_);
+  ImGui::Text("%s", session::phaseText(r).c_str());
+  ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", r.paradigm.trial,
+              in.settings.paradigm.trials, r.paradigm.sequence, r.time_s);
+  buttons(in);
   // Why the session is not going as planned (a pause, a failed training, a refused grasp), or
   // how it ended: the same words as the operator log and the summary.
-  if (const std::string why = model_.reason(); !why.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.3f, 1.0f));
-    ImGui::TextWrapped("%s", why.c_str());
-    ImGui::PopStyleColor();
+  if (const std::string why = session::reasonText(r); !why.empty())
+    colouredWrapped(ImVec4(1.0f, 0.55f, 0.3f, 1.0f), why);
+  if (!started && !r.ended) runLabels(in);
+  if (r.robot.status && !r.robot.status->stop_reason.empty() && !r.ended) {
+    colouredWrapped(ImVec4(1, 0.3f, 0.3f, 1),
+                    "robot stopped (" + r.robot.status->stop_reason +
+                        "): the Robot panel's recovery buttons go on from here.");
   }
-  if (!model_.started() && !model_.ended()) runLabels();
-  if (const auto robot = model_.robotStatus();
-      robot && !robot->stop_reason.empty() && !model_.ended()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.3f, 1));
-    ImGui::TextWrapped("robot stopped (%s): the Robot panel's recovery buttons go on from here.",
-                       robot->stop_reason.c_str());
-    ImGui::PopStyleColor();
-  }
-  for (const std::string& line : model_.preflight()) {
+  for (const std::string& line : r.preflight.lines) {
     const bool bad = line.find("FAILED") != std::string::npos || line.rfind("  ", 0) == 0;
-    if (bad && !model_.preflightRunning()) {
-      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.35f, 0.3f, 1));
-      ImGui::TextWrapped("%s", line.c_str());
-      ImGui::PopStyleColor();
+    if (bad && !r.preflight.running) {
+      colouredWrapped(ImVec4(1, 0.35f, 0.3f, 1), line);
     } else {
       ImGui::TextWrapped("%s", line.c_str());
     }
   }
-  trackingHealth();
-  const auto timing = model_.timing();
-  heading("cycle");
-  ImGui::Text("budget %.1f ms (one EEG block); overruns: %d; late frames: %lld", model_.budgetMs(),
-              model_.overruns(), model_.lateFrames());
-  if (const std::string clock = model_.eegClockLine(); !clock.empty())
-    ImGui::TextUnformatted(clock.c_str());
-  if (const std::string fault = model_.eegSourceFault(); !fault.empty())
-    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "EEG source: %s", fault.c_str());
-  if (const std::string warning = model_.timingWarning(); !warning.empty())
-    ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", warning.c_str());
-  if (ImGui::BeginTable(
-          "timing", 6,
-          ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
-    for (const char* h : {"stage", "last ms", "p50", "p90", "p99", "max"})
-      ImGui::TableSetupColumn(h);
-    ImGui::TableHeadersRow();
-    for (const StageTiming& t : timing) {
-      ImGui::TableNextRow();
-      ImGui::TableNextColumn();
-      ImGui::TextUnformatted(t.stage.c_str());
-      for (double v : {t.last_ms, t.p50_ms, t.p90_ms, t.p99_ms, t.max_ms}) {
-        ImGui::TableNextColumn();
-        ImGui::Text("%.2f", v);
-      }
-    }
-    ImGui::EndTable();
-  }
-  for (const StageTiming& t : timing) {
-    if (t.stage == "total") {
-      history_.push_back(static_cast<float>(t.last_ms));
-      if (history_.size() > 300) history_.erase(history_.begin());
-    }
-  }
-  // The plot's scale, stated: its top is 1.2 blocks, its bottom zero.
-  const float top = static_cast<float>(model_.budgetMs() * 1.2);
-  char scale[64];
-  std::snprintf(scale, sizeof scale, "0 to %.0f ms (budget %.1f)", top, model_.budgetMs());
-  ImGui::PlotLines("cycle ms", history_.data(), static_cast<int>(history_.size()), 0, scale, 0.0f,
-                   top, ImVec2(0, 60));
+  trackingHealth(in);
+  timing(in);
   heading("selections");
-  for (const std::string& line : model_.selections()) ImGui::TextUnformatted(line.c_str());
+  for (const std::string& line : session::selectionLines(r)) ImGui::TextUnformatted(line.c_str());
 }
 
-void SessionPanel::readLabels() {
-  const core::RunLabels l = model_.labels();
-  std::snprintf(subject_, sizeof subject_, "%s", l.subject.c_str());
-  std::snprintf(visit_, sizeof visit_, "%s", l.session.c_str());
-  std::snprintf(task_, sizeof task_, "%s", l.task.c_str());
-  std::snprintf(run_, sizeof run_, "%s", l.run.c_str());
-  labels_read_ = true;
-  checkLabels();
+void SessionPanel::buttons(const PanelInput& in) {
+  // Every button in its own place whatever the state (disabled with its reason where it cannot
+  // act): a double click never lands on a button that took another's place.
+  const session::CycleRecord& r = in.record;
+  const bool started = r.paradigm.phase != bci::Phase::Setup;
+  const std::string& labels_problem = started ? std::string() : in.window.runTarget().problem;
+  if (button("Start", !labels_problem.empty() ? labels_problem : whyNot(Action::Start, r)))
+    in.requests.post(session::StartRequest{});
+  ImGui::SameLine();
+  if (button("Pause", whyNot(Action::Pause, r))) in.requests.post(session::PauseRequest{});
+  ImGui::SameLine();
+  if (button("Resume", whyNot(Action::Resume, r))) in.requests.post(session::ResumeRequest{});
+  ImGui::SameLine();
+  if (confirmedButton("Abort", whyNot(Action::Abort, r),
+                      "Abort the session? It ends now; what was recorded is kept.", "Yes, abort"))
+    in.requests.post(session::AbortRequest{});
+  ImGui::SameLine();
+  emergencyStopButton(in);
 }
 
-void SessionPanel::checkLabels() {
-  // Once per change, not per frame: the target looks through the BIDS dataset's folders.
-  labels_problem_ = model_.labelsProblem();
-  labels_target_ = labels_problem_.empty() ? model_.labelsTarget() : "";
-}
-
-void SessionPanel::runLabels() {
+void SessionPanel::runLabels(const PanelInput& in) {
   heading("subject and run");
+  if (!labels_read_) {
+    const core::RunLabels& l = in.record.labels;
+    std::snprintf(subject_, sizeof subject_, "%s", l.subject.c_str());
+    std::snprintf(visit_, sizeof visit_, "%s", l.session.c_str());
+    std::snprintf(task_, sizeof task_, "%s", l.task.c_str());
+    std::snprintf(run_, sizeof run_, "%s", l.run.c_str());
+    labels_read_ = true;
+  }
   bool changed = false;
   const float width = std::max(60.0f, (ImGui::GetContentRegionAvail().x - 24.0f) / 4.0f);
   struct Field {
@@ -147,92 +129,98 @@ void SessionPanel::runLabels() {
       ImGui::SetTooltip("%s (BIDS entity: letters and digits)", fields[i].hint);
     recordField(fields[i].label, width);
   }
-  if (changed) {
-    labels_refused_ = model_.setLabels({subject_, visit_, task_, run_});
-    checkLabels();
-  }
-  if (!labels_refused_.empty()) {
-    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "%s", labels_refused_.c_str());
-  } else if (!labels_problem_.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.3f, 1.0f));
-    ImGui::TextWrapped("%s", labels_problem_.c_str());
-    ImGui::PopStyleColor();
+  if (changed) in.requests.post(session::LabelsRequest{{subject_, visit_, task_, run_}});
+  const RunTarget& target = in.window.runTarget();
+  if (!target.problem.empty()) {
+    colouredWrapped(ImVec4(1.0f, 0.55f, 0.3f, 1.0f), target.problem);
   } else {
-    ImGui::TextWrapped("%s", labels_target_.c_str());
+    ImGui::TextWrapped("%s", target.target.c_str());
   }
 }
 
-void SessionPanel::trackingHealth() {
+void SessionPanel::trackingHealth(const PanelInput& in) {
   heading("tracking");
-  const double max_age = model_.maxPoseAgeS();
+  const session::CycleRecord& r = in.record;
+  const double max_age = in.settings.tracker.max_pose_age_s;
   const ImVec4 lost(1.0f, 0.35f, 0.3f, 1.0f);
-  const auto reference = model_.referenceAgeS();
+  const auto& world = r.tracking.world;
+  const int reference_id = world ? world->reference().id : in.settings.world.reference_id;
+  const std::optional<double> reference =
+      world ? world->referenceAge(r.time_s) : std::optional<double>();
   if (!reference || *reference > max_age) {
-    ImGui::TextColored(lost, "reference %d: tracking lost%s", model_.referenceId(),
+    ImGui::TextColored(lost, "reference %d: tracking lost%s", reference_id,
                        reference ? (" (" + seconds(*reference) + ")").c_str() : " (never seen)");
   } else {
-    ImGui::Text("reference %d: seen", model_.referenceId());
+    ImGui::Text("reference %d: seen", reference_id);
   }
-  const auto robot = model_.robotStatus();
-  const int held = robot ? robot->holding : -1;
-  for (const TrackedObject& o : model_.trackedObjects()) {
+  if (!world) return;
+  const int held = r.robot.holding().value_or(-1);
+  for (const vision::ObjectState& o : world->objects()) {
     ImGui::SameLine(0.0f, 20.0f);
     if (ImGui::GetContentRegionAvail().x < 150.0f) ImGui::NewLine();
+    const double age = o.age(r.time_s);
     if (o.id == held) {
       ImGui::Text("object %d: in the gripper", o.id);
-    } else if (o.age_s > max_age) {
-      ImGui::TextColored(lost, "object %d: lost (%s)", o.id, seconds(o.age_s).c_str());
+    } else if (age > max_age) {
+      ImGui::TextColored(lost, "object %d: lost (%s)", o.id, seconds(age).c_str());
     } else {
       ImGui::Text("object %d: seen", o.id);
     }
   }
 }
 
-void HmdPanel::draw() {
-  const float width = ImGui::GetContentRegionAvail().x;
-  ImageView::drawTexture(texture_, width, width / aspect_, true);
-}
-
-}  // namespace arbci::ui
-
-namespace arbci::ui {
-
-void SummaryPanel::draw() {
-  if (!model_.ended()) {
-    ImGui::TextDisabled("the session is running; its summary appears here when it ends");
-    return;
-  }
-  if (ImGui::BeginTable("summary", 2, ImGuiTableFlags_RowBg)) {
-    ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed,
-                            ImGui::CalcTextSize("late frames  ").x);
-    ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
-    for (const auto& [label, value] : model_.endSummary()) {
+void SessionPanel::timing(const PanelInput& in) {
+  const session::CycleRecord& r = in.record;
+  const double budget = session::cycleBudgetMs(in.settings);
+  heading("cycle");
+  ImGui::Text("budget %.1f ms (one EEG block); overruns: %d; late frames: %lld", budget, r.overruns,
+              static_cast<long long>(r.presentation.late_frames));
+  ImGui::TextUnformatted(session::eegClockLine(r).c_str());
+  if (!r.eeg.fault.empty())
+    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "EEG source: %s", r.eeg.fault.c_str());
+  if (const std::string warning = session::timingWarning(r, in.settings); !warning.empty())
+    ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", warning.c_str());
+  if (ImGui::BeginTable(
+          "timing", 6,
+          ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+    for (const char* h : {"stage", "last ms", "p50", "p90", "p99", "max"})
+      ImGui::TableSetupColumn(h);
+    ImGui::TableHeadersRow();
+    for (const StageTiming& t : in.window.timing()) {
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
-      ImGui::TextDisabled("%s", label.c_str());
-      ImGui::TableNextColumn();
-      ImGui::TextWrapped("%s", value.c_str());
+      ImGui::TextUnformatted(t.stage.c_str());
+      for (double v : {t.last_ms, t.p50_ms, t.p90_ms, t.p99_ms, t.max_ms}) {
+        ImGui::TableNextColumn();
+        ImGui::Text("%.2f", v);
+      }
     }
     ImGui::EndTable();
   }
+  // The plot's scale, stated: its top is 1.2 blocks, its bottom zero.
+  const std::vector<float>& history = in.window.recentCycles();
+  const float top = static_cast<float>(budget * 1.2);
+  char scale[64];
+  std::snprintf(scale, sizeof scale, "0 to %.0f ms (budget %.1f)", top, budget);
+  ImGui::PlotLines("cycle ms", history.data(), static_cast<int>(history.size()), 0, scale, 0.0f,
+                   top, ImVec2(0, 60));
 }
+
+}  // namespace
 
 PanelRegistry::Entry sessionPanel() {
+  PanelParts parts{[] { return std::make_unique<SessionPanel>(); }};
+  parts.shots.push_back({"session",
+                         "during the grid's flashing",
+                         [](const session::CycleRecord& r) {
+                           return r.paradigm.phase == bci::Phase::CellFlashing &&
+                                  r.paradigm.sequence >= 2;
+                         },
+                         {},
+                         true});
   return {"session",
           "the phase, start/pause/resume/abort, the sequence, the selections, the cycle's timing",
-          {[](const PanelContext& c) { return std::make_unique<SessionPanel>(c.model); }}};
-}
-
-PanelRegistry::Entry hmdPanel() {
-  return {"hmd", "the HMD view as the subject sees it (both eyes)", {[](const PanelContext& c) {
-            return std::make_unique<HmdPanel>(c.hmd_texture, c.hmd_aspect);
-          }}};
-}
-
-PanelRegistry::Entry summaryPanel() {
-  return {"summary",
-          "the end-of-session summary (opened when the session ends)",
-          {[](const PanelContext& c) { return std::make_unique<SummaryPanel>(c.model); }, false}};
+          parts};
 }
 
 }  // namespace arbci::ui

@@ -5,12 +5,16 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 #include "arbci/core/schema.h"
+#include "arbci/session/session.h"
+#include "arbci/session/settings_schema.h"
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
 #include "widgets.h"
 
 namespace arbci::ui {
@@ -60,17 +64,53 @@ void keyTooltip(const core::Key& key) {
   ImGui::SetTooltip("%s", text.c_str());
 }
 
-}  // namespace
+// "" when `settings` would start a session, else the message a file with them would get, naming
+// `file`: as `arbci run --session FILE` reads it (the schema's checks, then the files it names).
+std::string checkSettings(const nlohmann::json& settings, const std::string& file) {
+  try {
+    const session::SessionConfig config = session::SessionConfig::parse(settings, file);
+    session::checkNamedResources(config);
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  return "";
+}
 
-void SettingsPanel::initialise() {
+// "saved FILE (arbci run --session FILE)", or why not.
+std::string saveSettings(const nlohmann::json& settings, const std::string& file) {
+  if (const std::string why = checkSettings(settings, file); !why.empty()) return why;
+  std::ofstream out(file);
+  out << settings.dump(2) << "\n";
+  if (!out) return file + ": cannot write the session file";
+  return "saved " + file + " (arbci run --session " + file + ")";
+}
+
+class SettingsPanel final : public Panel {
+ public:
+  const char* title() const override { return "Settings"; }
+  void draw(const PanelInput& in) override;
+
+ private:
+  void initialise(const PanelInput& in);
+  void check();
+  bool editTable(const core::Table& table, nlohmann::json& object, const std::string& path);
+  bool editKey(const core::Key& key, nlohmann::json& value, const std::string& path);
+  bool initialised_ = false;
+  nlohmann::json document_;
+  std::string error_, message_;
+  char filter_[128] = "";
+  char save_path_[512] = "session.json";
+};
+
+void SettingsPanel::initialise(const PanelInput& in) {
   if (initialised_) return;
   initialised_ = true;
-  document_ = model_.settings();
+  document_ = in.settings.toJson();
   check();
 }
 
 void SettingsPanel::check() {
-  error_ = model_.checkSettings(document_, save_path_);
+  error_ = checkSettings(document_, save_path_);
 }
 
 // One key's widget; returns true when the value changed.
@@ -189,13 +229,9 @@ bool SettingsPanel::editTable(const core::Table& table, nlohmann::json& object,
   return changed;
 }
 
-void SettingsPanel::draw() {
-  initialise();
-  const core::Table* schema = model_.settingsSchema();
-  if (!schema) {
-    ImGui::TextDisabled("no settings schema");
-    return;
-  }
+void SettingsPanel::draw(const PanelInput& in) {
+  initialise(in);
+  const core::Table& schema = session::sessionSchema();
   ImGui::TextWrapped(
       "The settings this session runs with. Edits are checked as a session file is; save them "
       "and start the next run with arbci run --session FILE (a running session keeps its own).");
@@ -213,11 +249,11 @@ void SettingsPanel::draw() {
   pathInput("session file to save", save_path_, sizeof save_path_, ".json",
             "where Save writes these settings (a complete session file)");
   if (button("Save", error_)) {
-    message_ = model_.saveSettings(document_, save_path_);
+    message_ = saveSettings(document_, save_path_);
   }
   ImGui::SameLine();
   if (button("Revert")) {
-    document_ = model_.settings();
+    document_ = in.settings.toJson();
     check();
     message_ = "back to the session's settings";
   }
@@ -227,14 +263,18 @@ void SettingsPanel::draw() {
   }
   ImGui::Separator();
   ImGui::BeginChild("settings", ImVec2(0, 0), false);
-  if (editTable(*schema, document_, "")) check();
+  if (editTable(schema, document_, "")) check();
   ImGui::EndChild();
 }
 
+}  // namespace
+
 PanelRegistry::Entry settingsPanel() {
-  return {"settings",
-          "the session's settings from the schema: edited, checked as a file is, saved",
-          {[](const PanelContext& c) { return std::make_unique<SettingsPanel>(c.model); }, false}};
+  PanelParts parts{[] { return std::make_unique<SettingsPanel>(); }, false};
+  parts.shots.push_back({"settings", "the session's settings",
+                         [](const session::CycleRecord& r) { return r.frame >= 10; }});
+  return {"settings", "the session's settings from the schema: edited, checked as a file is, saved",
+          parts};
 }
 
 }  // namespace arbci::ui

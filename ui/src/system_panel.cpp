@@ -4,7 +4,7 @@
 
 namespace arbci::ui {
 
-void SystemPanel::draw() {
+void SystemPanel::draw(const PanelInput& /*in*/) {
   if (ImGui::BeginTable("facts", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
     ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed, 140.0f);
     ImGui::TableSetupColumn("value");

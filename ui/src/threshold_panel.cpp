@@ -1,11 +1,13 @@
+// The Threshold panel: the tracker's threshold mode and value, the live binarised image beside
+// the camera image, and the markers found with ID, confidence and pose.
 #include <imgui.h>
 
 #include <cfloat>
 #include <cstdio>
 #include <string>
 
+#include "arbci/ui/image_view.h"
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
 
 namespace arbci::ui {
 namespace {
@@ -17,10 +19,19 @@ bool slider(const char* label, int* value, int low, int high) {
   return ImGui::SliderInt((std::string("##") + label).c_str(), value, low, high);
 }
 
-}  // namespace
+class ThresholdPanel final : public Panel {
+ public:
+  const char* title() const override { return "Threshold"; }
+  void draw(const PanelInput& in) override;
 
-void ThresholdPanel::draw() {
-  vision::ThresholdSettings s = model_.threshold();
+ private:
+  void markerTable(const PanelInput& in);
+  ImageView camera_, binary_;
+};
+
+void ThresholdPanel::draw(const PanelInput& in) {
+  const session::TrackingPart& tracking = in.record.tracking;
+  vision::ThresholdSettings s = tracking.threshold;
   const char* modes[] = {"constant", "automatic (median of marker pixels)",
                          "automatic (midrange, ARToolKitPlus)", "adaptive (local)"};
   int mode = static_cast<int>(s.mode);
@@ -45,15 +56,21 @@ void ThresholdPanel::draw() {
   } else {
     changed |= slider("least contrast (0: from the image noise)", &s.min_contrast, 0, 80);
   }
-  if (changed) model_.setThreshold(s);
-  const vision::DetectionResult d = model_.detection();
+  if (changed) in.requests.post(session::ThresholdRequest{s});
+  const vision::DetectionResult& d = tracking.detection;
   ImGui::TextWrapped("threshold used: %d (%s), %d candidates, %d attempt(s)", d.threshold,
                      d.threshold_mode.c_str(), d.candidates, d.threshold_attempts);
   const float width = (ImGui::GetContentRegionAvail().x - ImGui::GetStyle().ItemSpacing.x) / 2.0f;
-  camera_.draw(model_.cameraImage(), width);
+  camera_.draw(tracking.left_image, width);
   ImGui::SameLine();
-  binary_.draw(model_.binaryImage(), width);
-  ImGui::TextWrapped("%s", model_.worldStatus().c_str());
+  binary_.draw(tracking.binary, width);
+  if (tracking.world) ImGui::TextWrapped("%s", tracking.world->status(in.record.time_s).c_str());
+  markerTable(in);
+}
+
+void ThresholdPanel::markerTable(const PanelInput& in) {
+  const session::TrackingPart& tracking = in.record.tracking;
+  const double now = in.record.time_s;
   // Short headers (the panel may be narrow); the tooltip over the table says what they are.
   if (ImGui::BeginTable(
           "markers", 5,
@@ -68,8 +85,7 @@ void ThresholdPanel::draw() {
       ImGui::SetTooltip(
           "id: marker id; conf.: ID confidence; bits: bits the BCH code corrected;\n"
           "x y z: robot-frame position (mm); age: since last seen; rms: reprojection (px)");
-    const auto objects = model_.trackedObjects();
-    for (const vision::MarkerDetection& m : d.markers) {
+    for (const vision::MarkerDetection& m : tracking.detection.markers) {
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
       ImGui::Text("%d", m.id);
@@ -78,17 +94,15 @@ void ThresholdPanel::draw() {
       ImGui::TableNextColumn();
       ImGui::Text("%d", m.corrected_bits);
       ImGui::TableNextColumn();
-      const TrackedObject* found = nullptr;
-      for (const TrackedObject& o : objects) {
-        if (o.id == m.id) found = &o;
-      }
+      const auto found = tracking.world ? tracking.world->object(m.id) : std::nullopt;
       if (found) {
-        ImGui::Text("%.0f %.0f %.0f", found->position[0] * 1000, found->position[1] * 1000,
-                    found->position[2] * 1000);
+        const cv::Vec3d p = found->T_robot_object.translation;
+        ImGui::Text("%.0f %.0f %.0f", p[0] * 1000, p[1] * 1000, p[2] * 1000);
         ImGui::TableNextColumn();
-        ImGui::Text("%.2f s, %.2f px", found->age_s, found->reprojection_px);
+        ImGui::Text("%.2f s, %.2f px", found->age(now), found->reprojection_rms_px);
       } else {
-        ImGui::TextDisabled(m.id == model_.referenceId() ? "reference" : "-");
+        const bool reference = tracking.world && m.id == tracking.world->reference().id;
+        ImGui::TextDisabled(reference ? "reference" : "-");
         ImGui::TableNextColumn();
       }
     }
@@ -96,10 +110,13 @@ void ThresholdPanel::draw() {
   }
 }
 
+}  // namespace
+
 PanelRegistry::Entry thresholdPanel() {
-  return {"threshold",
-          "the tracker's threshold, the binary image and the markers found",
-          {[](const PanelContext& c) { return std::make_unique<ThresholdPanel>(c.model); }}};
+  PanelParts parts{[] { return std::make_unique<ThresholdPanel>(); }};
+  parts.shots.push_back({"threshold", "after half a second of the simulated cameras",
+                         [](const session::CycleRecord& r) { return r.frame >= 30; }});
+  return {"threshold", "the tracker's threshold, the binary image and the markers found", parts};
 }
 
 }  // namespace arbci::ui

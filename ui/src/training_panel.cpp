@@ -1,19 +1,65 @@
+// The Classifier training panel: recordings, method and parameters; training with progress on a
+// worker thread; the ERP averages and accuracy by sequences; saving the model and using it in the
+// session. Without a model trained here it shows the session's own model and what it was trained
+// on (its calibration run's averages and cross-validation).
 #include <imgui.h>
 
 #include <cfloat>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <future>
+#include <mutex>
+#include <optional>
 #include <sstream>
 
+#include "arbci/bci/evaluation.h"
+#include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/ui/panel_registry.h"
-#include "arbci/ui/panels.h"
 #include "erp_plots.h"
 #include "evaluation_plots.h"
 #include "widgets.h"
 
 namespace arbci::ui {
+namespace {
+
+class TrainingPanel final : public Panel {
+ public:
+  ~TrainingPanel() override;
+  const char* title() const override { return "Classifier training"; }
+  void draw(const PanelInput& in) override;
+  void setRecordings(const std::string& files);
+  // Trains as the button does; `wait` blocks until the result is in.
+  void train(const PanelInput& in, bool wait);
+
+ private:
+  struct Outcome {
+    std::optional<bci::TrainingResult> result;
+    std::optional<bci::P300Dataset> data;
+    std::string error;
+  };
+  void startTraining(const PanelInput& in);
+  void initialise(const PanelInput& in);
+  void controls(const PanelInput& in);
+  void collect();
+  void sessionModel(const PanelInput& in);
+  void drawSessionErps(const PanelInput& in);
+  void errpModel(const PanelInput& in);
+  void trainedHere(const PanelInput& in);
+  char files_[1024] = "";
+  char save_path_[256] = "model.json";
+  int method_ = 0;  // in bci::classifiers()
+  float window_end_ms_ = 0.0f, decimate_hz_ = 0.0f;
+  bool initialised_ = false;  // from the session's settings, on first use
+  std::atomic<double> progress_{0.0};
+  std::mutex stage_mutex_;
+  std::string stage_;
+  std::future<Outcome> training_;
+  std::optional<Outcome> outcome_;
+  std::string message_;
+};
 
 TrainingPanel::~TrainingPanel() {
   if (training_.valid()) training_.wait();
@@ -21,10 +67,10 @@ TrainingPanel::~TrainingPanel() {
 
 // The session's own settings are where the panel starts, whether it is drawn or asked to train
 // first (a screenshot trains before the first frame).
-void TrainingPanel::initialise() {
+void TrainingPanel::initialise(const PanelInput& in) {
   if (initialised_) return;
-  const bci::TrainingSettings training = model_.trainingSettings();
-  const bci::PipelineSettings pipeline = model_.pipelineSettings();
+  const bci::TrainingSettings& training = in.settings.classifier.training;
+  const bci::PipelineSettings& pipeline = in.settings.classifier.pipeline;
   const auto& entries = bci::classifiers().entries();
   for (size_t i = 0; i < entries.size(); ++i)
     if (entries[i].name == training.method) method_ = static_cast<int>(i);
@@ -33,20 +79,20 @@ void TrainingPanel::initialise() {
   initialised_ = true;
 }
 
-void TrainingPanel::startTraining() {
-  initialise();
+void TrainingPanel::startTraining(const PanelInput& in) {
+  initialise(in);
   std::vector<std::string> files;
-  std::istringstream in(files_);
+  std::istringstream named(files_);
   std::string file;
-  while (in >> file) files.push_back(file);
+  while (named >> file) files.push_back(file);
   if (files.empty()) {
     message_ = "name at least one recording (BCI2000 .dat or ARBCI .bdf)";
     return;
   }
   // The session's classifier settings, with what the panel changes.
-  bci::TrainingSettings settings = model_.trainingSettings();
+  bci::TrainingSettings settings = in.settings.classifier.training;
   settings.method = bci::classifiers().entries().at(static_cast<size_t>(method_)).name;
-  bci::PipelineSettings pipeline = model_.pipelineSettings();
+  bci::PipelineSettings pipeline = in.settings.classifier.pipeline;
   pipeline.window.end_s = window_end_ms_ / 1000.0;
   pipeline.decimate_hz = decimate_hz_;
   pipeline = bci::withMethodRate(pipeline, settings.method);
@@ -76,8 +122,8 @@ void TrainingPanel::setRecordings(const std::string& files) {
   std::snprintf(files_, sizeof files_, "%s", files.c_str());
 }
 
-void TrainingPanel::train(bool wait) {
-  startTraining();
+void TrainingPanel::train(const PanelInput& in, bool wait) {
+  startTraining(in);
   if (wait && training_.valid()) {
     training_.wait();
     collect();
@@ -93,9 +139,9 @@ void TrainingPanel::collect() {
 }
 
 // The averages the session's own classifiers were trained on, the ErrP one beside the P300 one.
-void TrainingPanel::drawSessionErps() {
-  const auto p300 = model_.sessionErp();
-  const auto errp = model_.sessionErrpErp();
+void TrainingPanel::drawSessionErps(const PanelInput& in) {
+  const auto& p300 = in.record.p300.erp;
+  const auto& errp = in.record.errp.erp;
   if (!p300 && !errp) return;
   const int columns = p300 && errp ? 2 : 1;
   if (!ImGui::BeginTable("session erps", columns, ImGuiTableFlags_SizingStretchSame)) return;
@@ -116,11 +162,21 @@ void TrainingPanel::drawSessionErps() {
   ImGui::EndTable();
 }
 
-void TrainingPanel::draw() {
+void TrainingPanel::draw(const PanelInput& in) {
+  controls(in);
+  // The session's own model when nothing was trained here.
+  if (!outcome_ || !outcome_->result) {
+    sessionModel(in);
+  } else {
+    trainedHere(in);
+  }
+}
+
+void TrainingPanel::controls(const PanelInput& in) {
   pathInput("recordings (BCI2000 .dat, GDF, EDF, BDF; several: separated by spaces)", files_,
             sizeof files_, ".dat .gdf .edf .bdf",
             "the recordings to train on; Browse picks one from the folder of the last");
-  initialise();
+  initialise(in);
   const auto& methods = bci::classifiers().entries();
   ImGui::TextUnformatted("method");
   ImGui::SetNextItemWidth(-FLT_MIN);
@@ -155,51 +211,54 @@ void TrainingPanel::draw() {
   if (button("Train", running  ? "training is running"
                       : !named ? "name at least one recording above"
                                : ""))
-    startTraining();
+    startTraining(in);
   if (running) {
     std::lock_guard lock(stage_mutex_);
     ImGui::SameLine();
     ImGui::ProgressBar(static_cast<float>(progress_.load()), ImVec2(-1, 0), stage_.c_str());
   }
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+}
 
-  // The session's own model when nothing was trained here.
-  if (!outcome_ || !outcome_->result) {
-    const auto current = model_.model();
-    if (current) {
-      ImGui::TextWrapped(
-          "session model: %s, trained on %s", current->method.c_str(),
-          current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
-      const auto threshold = model_.errpThreshold();
-      if (current->errp) {
-        std::string channels;
-        for (const auto& c : current->errp->pipeline.channels)
-          channels += (channels.empty() ? "" : ", ") + c;
-        ImGui::TextWrapped(
-            "ErrP classifier: %s on %s, %.0f-%.0f Hz, %.0f-%.0f ms after the feedback; "
-            "cross-validated AUC %.3f; a selection is rejected above a posterior of error of "
-            "%.2f",
-            current->errp->method.c_str(), channels.c_str(),
-            current->errp->pipeline.filter.highpass_hz, current->errp->pipeline.filter.lowpass_hz,
-            1000.0 * current->errp->pipeline.window.start_s,
-            1000.0 * current->errp->pipeline.window.end_s, current->errp_auc,
-            threshold.value_or(0.5));
-      } else if (threshold) {
-        ImGui::TextDisabled(
-            "ErrP classifier: none yet (trained after the calibration run's "
-            "feedback block); until then selections are executed unchecked");
-      }
-    } else {
-      ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
-    }
-    // How well it did on the calibration run, cross-validated, before any online selection.
-    if (const auto calibration = model_.sessionCalibration()) {
-      heading("the session's calibration run, cross-validated (before going online)");
-      drawEvaluation(*calibration);
-    }
-    drawSessionErps();
+void TrainingPanel::sessionModel(const PanelInput& in) {
+  const bci::P300Model* current = in.record.p300.model.get();
+  if (current) {
+    ImGui::TextWrapped(
+        "session model: %s, trained on %s", current->method.c_str(),
+        current->provenance.value("training_files", nlohmann::json::array()).dump().c_str());
+    errpModel(in);
+  } else {
+    ImGui::TextDisabled("no model yet: the session trains one after its calibration run");
+  }
+  // How well it did on the calibration run, cross-validated, before any online selection.
+  if (const auto& calibration = in.record.paradigm.calibration) {
+    heading("the session's calibration run, cross-validated (before going online)");
+    drawEvaluation(*calibration);
+  }
+  drawSessionErps(in);
+}
+
+void TrainingPanel::errpModel(const PanelInput& in) {
+  const bci::P300Model* errp = in.record.errp.model.get();
+  if (!in.settings.paradigm.errp && !errp) return;
+  if (!errp) {
+    ImGui::TextDisabled(
+        "ErrP classifier: none yet (trained after the calibration run's feedback block); until "
+        "then selections are executed unchecked");
     return;
   }
+  std::string channels;
+  for (const auto& c : errp->pipeline.channels) channels += (channels.empty() ? "" : ", ") + c;
+  const double auc = in.record.errp.auc;
+  ImGui::TextWrapped(
+      "ErrP classifier: %s on %s, %.0f-%.0f Hz, %.0f-%.0f ms after the feedback; cross-validated "
+      "AUC %.3f; a selection is rejected above a posterior of error of %.2f",
+      errp->method.c_str(), channels.c_str(), errp->pipeline.filter.highpass_hz,
+      errp->pipeline.filter.lowpass_hz, 1000.0 * errp->pipeline.window.start_s,
+      1000.0 * errp->pipeline.window.end_s, auc, in.settings.errp.threshold);
+}
+
+void TrainingPanel::trainedHere(const PanelInput& in) {
   const bci::TrainingResult& r = *outcome_->result;
   const bci::EvaluationReport& cv = r.cross_validation.report;
   heading("cross-validated on the recordings");
@@ -223,7 +282,7 @@ void TrainingPanel::draw() {
   ImGui::SameLine();
   if (button("Use in the session")) {
     try {
-      model_.useModel(r.model);
+      in.requests.post(session::UseModelRequest{std::make_shared<const bci::P300Model>(r.model)});
       message_ = "the session now uses this model";
     } catch (const std::exception& error) {
       message_ = error.what();
@@ -231,10 +290,28 @@ void TrainingPanel::draw() {
   }
 }
 
+bool onlineTrials(const session::CycleRecord& r) {
+  return r.paradigm.phase == bci::Phase::ObjectFlashing;
+}
+
+// The session's own recording, trained on in the panel as a person would.
+void rehearseTraining(Panel& panel, const ShotSteps& steps) {
+  auto& p = static_cast<TrainingPanel&>(panel);
+  p.setRecordings((steps.folder / "recording.bdf").string());
+  p.train(steps.input(), true);
+}
+
+}  // namespace
+
 PanelRegistry::Entry trainingPanel() {
-  return {"training",
-          "train a classifier on recordings; the ERPs, AUC and accuracy by sequences",
-          {[](const PanelContext& c) { return std::make_unique<TrainingPanel>(c.model); }, false}};
+  PanelParts parts{[] { return std::make_unique<TrainingPanel>(); }, false};
+  parts.shots.push_back({"training", "the session's recording trained on in the panel",
+                         onlineTrials, rehearseTraining});
+  // With ErrPs on, the ErrP classifier's averages beside the P300 one's.
+  parts.shots.push_back(
+      {"session-model", "the model the session trained after its calibration", onlineTrials});
+  return {"training", "train a classifier on recordings; the ERPs, AUC and accuracy by sequences",
+          parts};
 }
 
 }  // namespace arbci::ui

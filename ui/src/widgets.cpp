@@ -9,6 +9,8 @@
 #include <sstream>
 #include <vector>
 
+#include "arbci/session/experimenter.h"
+#include "arbci/ui/panel.h"
 #include "arbci/ui/widget_registry.h"
 
 namespace arbci::ui {
@@ -143,6 +145,12 @@ bool pathInput(const char* label, char* path, size_t size, const char* extension
   }
   ImGui::PopID();
   return changed;
+}
+
+void emergencyStopButton(const PanelInput& in) {
+  if (stopButton("EMERGENCY STOP", false,
+                 session::whyNot(session::Action::EmergencyStop, in.record)))
+    in.requests.post(session::EmergencyStopRequest{});
 }
 
 }  // namespace arbci::ui

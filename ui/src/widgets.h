@@ -7,6 +7,8 @@
 
 namespace arbci::ui {
 
+struct PanelInput;
+
 // A separator with a title under it (this ImGui has no SeparatorText).
 inline void heading(const char* text) {
   ImGui::Spacing();
@@ -31,6 +33,10 @@ void recordField(const std::string& label, float width);
 
 // The same, in the emergency stop's red.
 bool stopButton(const char* label, bool small = false, const std::string& why_not = "");
+
+// The emergency stop, as every panel that offers it shows it: posts the request (the session
+// sends the arm its STOP at once), or says why it cannot.
+void emergencyStopButton(const PanelInput& in);
 
 // A button whose action is asked about first: pressing it opens a dialog with `question` and
 // a button `yes` (and Cancel). Returns true when `yes` is pressed. The button stays where it is

@@ -2,6 +2,8 @@
 // that defines its Entry, and its line here.
 #include "arbci/session/eeg_sources.h"
 
+#include "arbci/session/clock.h"
+
 namespace arbci::session {
 
 EegSourceRegistry::Entry simulatedEegSource();
@@ -21,6 +23,22 @@ const EegSourceRegistry& eegSources() {
     return r;
   }();
   return registry;
+}
+
+OpenedEegSource openEegSource(const EegSettings& eeg, const bci::lsl::LslConfig& lsl,
+                              const Clock& clock, const std::string& session_file) {
+  const EegSourceRegistry::Entry* entry = eegSources().find(eeg.source);
+  if (!entry)
+    throw SessionConfigError(session_file + ": eeg.source = \"" + eeg.source +
+                             "\" must be one of " + eegSources().list());
+  OpenedEegSource opened;
+  opened.clock = clock.sourceClock(entry->make.transport_lag_s);
+  static const nlohmann::json none = nlohmann::json::object();
+  const auto own = eeg.sources.find(eeg.source);
+  const EegSourceContext context{eeg, own == eeg.sources.end() ? none : own->second, lsl,
+                                 opened.clock, session_file};
+  opened.source = entry->make.make(context);
+  return opened;
 }
 
 bool EegSettings::live() const {

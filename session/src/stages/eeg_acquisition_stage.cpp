@@ -1,4 +1,4 @@
-#include "stages/eeg_acquisition_stage.h"
+#include "arbci/session/stages/eeg_acquisition_stage.h"
 
 #include <algorithm>
 #include <chrono>
@@ -15,23 +15,15 @@ void EegAcquisitionSettings::validate() const {
     throw SessionConfigError(session_file + ": eeg.file = \"" + eeg.file + "\": no such file");
 }
 
-EegAcquisitionStage::EegAcquisitionStage(const EegAcquisitionSettings& settings, Clock& clock,
+EegAcquisitionStage::EegAcquisitionStage(const EegAcquisitionSettings& settings,
+                                         OpenedEegSource source, Clock& clock,
                                          const StageServices& services)
     : settings_(settings), s_(services) {
   const EegSettings& eeg = settings_.eeg;
-  const EegSourceRegistry::Entry* entry = eegSources().find(eeg.source);
-  if (!entry)
-    throw SessionConfigError(settings_.session_file + ": eeg.source = \"" + eeg.source +
-                             "\" must be one of " + eegSources().list());
-  std::shared_ptr<bci::SampleClock> source_clock = clock.sourceClock(entry->make.transport_lag_s);
-  static const nlohmann::json none = nlohmann::json::object();
-  const auto own = eeg.sources.find(eeg.source);
-  const EegSourceContext context{eeg, own == eeg.sources.end() ? none : own->second, settings_.lsl,
-                                 source_clock, settings_.session_file};
   bci::AcquisitionSettings acquisition;
   acquisition.latency_s = eeg.latency_ms / 1000.0;
   acquisition_ = std::make_unique<bci::Acquisition>(
-      entry->make.make(context), source_clock,
+      std::move(source.source), source.clock,
       clock.stepped() ? bci::Acquisition::Mode::Stepped : bci::Acquisition::Mode::Live,
       acquisition);
   const bci::SignalInfo& all = acquisition_->info();
@@ -129,7 +121,9 @@ void EegAcquisitionStage::step(Cycle& cycle) {
   if (cycle.clock.stepped()) acquisition_->advanceTo(cycle.time_s);
   take(cycle);
   EegPart& out = cycle.record.eeg;
-  const Presentation& shown = cycle.previous.presentation;
+  // This cycle's onsets (the frame the presentation stage just stamped), as the source was told:
+  // a stall taken now may have held up the samples their stamps rest on.
+  const Presentation& shown = cycle.record.presentation;
   for (const Presentation::Onset& onset : shown.onsets)
     recent_onsets_.emplace_back(shown.host_s, onset.sample);
   while (!recent_onsets_.empty() && recent_onsets_.front().first < cycle.host_s - 60.0)

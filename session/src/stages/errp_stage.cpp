@@ -1,4 +1,4 @@
-#include "stages/errp_stage.h"
+#include "arbci/session/stages/errp_stage.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -141,6 +141,7 @@ void ErrpStage::step(Cycle& cycle) {
   }
   takeTraining(cycle);
   out.model = model_;
+  out.auc = auc_;
   out.erp = trained_erp_;
   out.training = training_.valid();
   out.enabled = settings_.enabled;

@@ -1,4 +1,4 @@
-#include "stages/lsl_markers_stage.h"
+#include "arbci/session/stages/lsl_markers_stage.h"
 
 #include "arbci/bci/sample_clock.h"
 #include "arbci/session/session_config.h"

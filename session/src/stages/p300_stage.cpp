@@ -1,4 +1,4 @@
-#include "stages/p300_stage.h"
+#include "arbci/session/stages/p300_stage.h"
 
 #include <sys/resource.h>
 #include <unistd.h>

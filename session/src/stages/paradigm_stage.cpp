@@ -1,4 +1,4 @@
-#include "stages/paradigm_stage.h"
+#include "arbci/session/stages/paradigm_stage.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "stages/preflight_stage.h"
+#include "arbci/session/stages/preflight_stage.h"
 
 namespace arbci::session {
 

@@ -1,4 +1,4 @@
-#include "stages/presentation_stage.h"
+#include "arbci/session/stages/presentation_stage.h"
 
 #include <cstdio>
 

@@ -1,4 +1,4 @@
-#include "stages/recording_stage.h"
+#include "arbci/session/stages/recording_stage.h"
 
 namespace arbci::session {
 namespace {

@@ -1,4 +1,4 @@
-#include "stages/robot_stage.h"
+#include "arbci/session/stages/robot_stage.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-#include "stages/tracking_stage.h"
+#include "arbci/session/stages/tracking_stage.h"
 
 #include "arbci/vision/undistortion.h"
 
@@ -79,6 +79,7 @@ void TrackingStage::step(Cycle& cycle) {
   for (const Request& request : cycle.record.requests) {
     if (const auto* r = std::get_if<ThresholdRequest>(&request)) {
       detector_.setThreshold(r->threshold);
+      settings_.detector.threshold = r->threshold;
     } else if (const auto* r = std::get_if<ReferenceRequest>(&request)) {
       setReference(*r, cycle);
     }
@@ -101,6 +102,7 @@ void TrackingStage::publish(TrackingPart& out) const {
   out.right_camera = right_image_.empty() ? settings_.left_camera : settings_.right_camera;
   out.detection = last_;
   out.binary = detector_.lastBinaryImage();
+  out.threshold = settings_.detector.threshold;
   out.world = std::make_shared<const vision::WorldModel>(world_);
   out.max_pose_age_s = settings_.max_pose_age_s;
   out.T_cam_world_left.reset();

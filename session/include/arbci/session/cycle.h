@@ -15,12 +15,15 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include "arbci/bci/acquisition.h"
 #include "arbci/bci/decision.h"
 #include "arbci/bci/erp.h"
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/paradigm.h"
 #include "arbci/bci/signal.h"
+#include "arbci/core/run_labels.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/session/clock.h"
 #include "arbci/session/requests.h"
@@ -127,6 +130,7 @@ struct P300Part {
 
 struct ErrpPart {
   std::shared_ptr<const bci::P300Model> model;  // the ErrP classifier, once there is one
+  double auc = 0.0;                             // its cross-validated AUC (NaN: not known)
   std::shared_ptr<const bci::ErpCurves> erp;
   // The score of a feedback epoch completed this cycle: {feedback onset sample, score}.
   std::optional<std::pair<std::int64_t, double>> score;
@@ -150,8 +154,9 @@ struct TrackingPart {
   bool stereo = false;
   vision::CameraModel left_camera, right_camera;
   std::optional<vision::Pose> T_cam_world_left, T_cam_world_right;
-  vision::DetectionResult detection;  // of the latest left frame
-  cv::Mat binary;                     // the tracker's binary image of it
+  vision::DetectionResult detection;    // of the latest left frame
+  cv::Mat binary;                       // the tracker's binary image of it
+  vision::ThresholdSettings threshold;  // how the tracker thresholds (the experimenter's last)
   std::shared_ptr<const vision::WorldModel> world;
   double max_pose_age_s = 0.5;
   // The object's pose is known and no older than the allowed age at `now_s`.
@@ -234,8 +239,13 @@ struct CycleRecord {
     std::int64_t sample = 0;
   };
   std::optional<Presented> presented;
-  // Each stage's compute time this cycle (ms), by name.
+  // Each stage's compute time this cycle (ms), by name; the whole cycle's; the cycles so far whose
+  // compute time exceeded the EEG block's (the session's count).
   std::map<std::string, double> stage_ms;
+  double compute_ms = 0.0;
+  int overruns = 0;
+  // Who and which run (the start screen may change them until Start).
+  core::RunLabels labels;
 
   Presentation presentation;  // the frame presented last
   EegPart eeg;
@@ -254,8 +264,12 @@ struct CycleRecord {
   std::vector<Request> requests;
   // Requests posted this cycle, for the next.
   std::vector<Request> posted;
-  // The run should end after this cycle, and why ("" while it goes on).
+  // The run should end after this cycle, and why ("" while it goes on). Once the session has
+  // ended, its last record says so (`ended`) with the whole reason, how it ended ("finished",
+  // "aborted", "estop", "fault") and summary.json's contents.
   std::string end_reason, end_kind;
+  bool ended = false;
+  std::shared_ptr<const nlohmann::json> summary;
 };
 
 struct Cycle {

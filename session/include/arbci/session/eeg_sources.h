@@ -45,6 +45,19 @@ struct EegSourceParts {
 using EegSourceRegistry = core::Registry<EegSourceParts>;
 const EegSourceRegistry& eegSources();
 
+// A source opened for a session: the source, and the clock that paces it (stepped: the clock the
+// acquisition advances each cycle; live: the wall clock, holding blocks back by the source's
+// transport lag).
+struct OpenedEegSource {
+  std::unique_ptr<bci::EegSource> source;
+  std::shared_ptr<bci::SampleClock> clock;
+};
+class Clock;
+// Opens eeg.source from its registry entry with its own section; throws SessionConfigError
+// naming the key (session_file first) when it is unknown or cannot be opened.
+OpenedEegSource openEegSource(const EegSettings& eeg, const bci::lsl::LslConfig& lsl,
+                              const Clock& clock, const std::string& session_file);
+
 // The simulated subject a session with `eeg` (source "simulated") acquires from: its montage,
 // rate, seed and line noise, the seed's drawn profile with eeg.erp_scale and eeg.errp_scale
 // applied, and a virtual photodiode channel when one is named.

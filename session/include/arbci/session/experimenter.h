@@ -29,8 +29,9 @@ const char* toString(Action action);  // as the log's "refused" lines name it
 // threshold, the reference, a model).
 std::optional<Action> actionOf(const Request& request);
 
-// "" when `action` can go now, else why not. `ended`: the run has ended.
-std::string whyNot(Action action, const CycleRecord& last, bool ended);
+// "" when `action` can go now, else why not, from the last cycle's record (`last.ended`: the run
+// has ended).
+std::string whyNot(Action action, const CycleRecord& last);
 
 // How a run ended, for the summary: "finished" (also a timing check done), "estop" or "fault"
 // when it ends in an emergency stop or a robot fault, "aborted" otherwise.

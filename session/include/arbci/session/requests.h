@@ -13,6 +13,7 @@
 #include <opencv2/core/matx.hpp>
 
 #include "arbci/bci/p300_model.h"
+#include "arbci/core/run_labels.h"
 #include "arbci/vision/threshold.h"
 
 namespace arbci::session {
@@ -85,13 +86,19 @@ struct HoldBoardRequest {
   bool show = false;
 };
 
+// The start screen's subject, session, task and run: taken by the session at once (until Start),
+// and on the record from the next cycle.
+struct LabelsRequest {
+  core::RunLabels labels;
+};
+
 using Request =
     std::variant<StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest,
                  EmergencyStopRequest, RetryStepRequest, SkipTrialRequest, EndSessionRequest,
                  GraspRequest, DropRequest, RobotStopRequest, RobotResetRequest,
                  RobotResetIfLatchedRequest, RobotHomeRequest, RobotReleaseRequest,
                  FinishPutDownRequest, RobotProbeRequest, TrainRequest, UseModelRequest,
-                 ThresholdRequest, ReferenceRequest, HoldBoardRequest>;
+                 ThresholdRequest, ReferenceRequest, HoldBoardRequest, LabelsRequest>;
 
 // The requests of one kind among `requests`, in order.
 template <class T>

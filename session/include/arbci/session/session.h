@@ -85,7 +85,7 @@ class Session {
   // The experimenter: queued for the next cycle, or refused (and logged) with the reason
   // whyNot() gives. An emergency stop goes to the arm at once.
   bool request(Request request);
-  std::string whyNot(Action action) const { return session::whyNot(action, last(), ended_); }
+  std::string whyNot(Action action) const { return session::whyNot(action, last()); }
   // The run's labels: set until the session starts (then "" is returned), else why not.
   std::string setLabels(const core::RunLabels& labels);
   const core::RunLabels& labels() const { return options_.labels; }

@@ -24,14 +24,12 @@ class ExperimenterShell {
   void show(Panel& panel);  // opens a panel added closed (e.g. the end-of-session summary)
   bool show(const std::string& title);  // by its title; false when there is none
   void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
-  // An emergency stop button in the menu bar, shown whatever panels are open; `why_not` says why
-  // it cannot act now ("" when it can).
-  void setEmergencyStop(std::function<void()> on_stop, std::function<std::string()> why_not) {
-    on_stop_ = std::move(on_stop);
-    stop_why_not_ = std::move(why_not);
-  }
-  // Draws the whole shell for one frame; call between ImGuiLayer::beginFrame and endFrame.
-  void draw(render::Size display, const ShellStatus& status);
+  // An emergency stop button in the menu bar, shown whatever panels are open (it posts the
+  // request, or says why it cannot act now).
+  void showEmergencyStop(bool show) { show_stop_ = show; }
+  // Draws the whole shell for one frame, the panels over `in`; call between
+  // ImGuiLayer::beginFrame and endFrame.
+  void draw(render::Size display, const ShellStatus& status, const PanelInput& in);
 
  private:
   struct Entry {
@@ -39,13 +37,13 @@ class ExperimenterShell {
     bool open;
     bool at_start;  // open when the window opened: laid out in the columns
   };
-  void drawMenuBar();
-  void drawPanels(render::Size display, float top, float bottom);
+  void drawMenuBar(const PanelInput& in);
+  void drawPanels(render::Size display, float top, float bottom, const PanelInput& in);
   void fitToScreen(render::Size display, float top, float bottom);
   void drawStatusBar(render::Size display, float height, const ShellStatus& status);
   std::vector<Entry> panels_;
-  std::function<void()> on_quit_, on_stop_;
-  std::function<std::string()> stop_why_not_;
+  std::function<void()> on_quit_;
+  bool show_stop_ = false;
   bool show_about_ = false;
   bool reset_layout_ = false;
   Panel* focus_ = nullptr;  // brought to the front in the next frame

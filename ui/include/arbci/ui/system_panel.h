@@ -14,7 +14,7 @@ class SystemPanel final : public Panel {
   explicit SystemPanel(std::vector<std::pair<std::string, std::string>> facts)
       : facts_(std::move(facts)) {}
   const char* title() const override { return "System"; }
-  void draw() override;
+  void draw(const PanelInput& in) override;
 
  private:
   std::vector<std::pair<std::string, std::string>> facts_;

@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "arbci/session/robot_connection.h"
 #include "arbci/session/stage.h"
-#include "robot_connection.h"
 
 namespace arbci::session {
 

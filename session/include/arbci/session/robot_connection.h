@@ -10,8 +10,8 @@
 #include "arbci/robot/client.h"
 #include "arbci/robot/robot_config.h"
 #include "arbci/session/clock.h"
+#include "arbci/session/robot_process.h"
 #include "arbci/session/session_config.h"
-#include "robot_process.h"
 
 namespace arbci::session {
 

@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "arbci/bci/paradigm.h"
+#include "arbci/session/grasp_view.h"
 #include "arbci/session/session_config.h"
 #include "arbci/session/stage.h"
 #include "arbci/session/trial_record.h"
-#include "grasp_view.h"
 
 namespace arbci::session {
 

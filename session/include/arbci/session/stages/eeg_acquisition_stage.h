@@ -13,7 +13,7 @@
 #include <string>
 
 #include "arbci/bci/acquisition.h"
-#include "arbci/bci/lsl/config.h"
+#include "arbci/session/eeg_sources.h"
 #include "arbci/session/session_config.h"
 #include "arbci/session/stage.h"
 
@@ -21,7 +21,6 @@ namespace arbci::session {
 
 struct EegAcquisitionSettings {
   EegSettings eeg;
-  bci::lsl::LslConfig lsl;   // source "lsl": lsl_api.cfg with the session's scope and peers
   double flash_s = 0.06;     // a flash's nominal duration (the paradigm's, in whole frames)
   std::string session_file;  // for messages naming a key
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.
@@ -30,9 +29,9 @@ struct EegAcquisitionSettings {
 
 class EegAcquisitionStage final : public Stage {
  public:
-  // Opens the source and starts acquiring. Throws SessionConfigError naming the key (a source
-  // that cannot be opened, a photodiode channel it lacks).
-  EegAcquisitionStage(const EegAcquisitionSettings& settings, Clock& clock,
+  // Starts acquiring from `source` (openEegSource's). Throws SessionConfigError naming the key
+  // (a photodiode channel the source lacks).
+  EegAcquisitionStage(const EegAcquisitionSettings& settings, OpenedEegSource source, Clock& clock,
                       const StageServices& services);
   ~EegAcquisitionStage() override;
 

@@ -1,0 +1,243 @@
+// The EEG acquisition stage on hand-built records, over a scripted source: what arrived by the
+// cycle's time is taken (the photodiode split off the EEG), what the screen showed and what the
+// subject attends reach the source, lost samples are counted and told, a live source's fault is
+// named once when it starts and once when it ends, and a delivery held up marks the flash stamps
+// that rest on it — the flash the presentation stage stamped in the very cycle the stall is taken
+// among them.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+#include "arbci/session/stages/eeg_acquisition_stage.h"
+#include "support/stage_bench.h"
+
+namespace arbci::session {
+namespace {
+
+// Fz, Cz and a photodiode at 256 Hz: Fz counts the samples, the photodiode is 1000 uV. Blocks come
+// as the clock makes them available; `gap` skips that many samples once, `hold` keeps everything
+// back until released.
+class ScriptedSource final : public bci::EegSource {
+ public:
+  explicit ScriptedSource(std::shared_ptr<const bci::SampleClock> clock)
+      : clock_(std::move(clock)) {
+    info_.rate_hz = 256.0;
+    info_.block_size = 16;
+    info_.channels = {"Fz", "Cz", "Photodiode"};
+  }
+  const bci::SignalInfo& info() const override { return info_; }
+  std::vector<bci::Block> poll(int max_blocks) override {
+    std::vector<bci::Block> out;
+    if (hold) return out;
+    const std::int64_t available = clock_->available(info_.rate_hz);
+    while (next_ + 16 <= available && static_cast<int>(out.size()) < max_blocks) {
+      if (gap > 0) {
+        next_ += gap.exchange(0);
+        continue;
+      }
+      bci::Block b(next_, 3, 16);
+      for (int k = 0; k < 16; ++k) {
+        b.at(0, k) = static_cast<float>(next_ + k);
+        b.at(2, k) = 1000.0f;
+      }
+      out.push_back(std::move(b));
+      next_ += 16;
+    }
+    return out;
+  }
+  void present(const bci::StimulusEvent& e) override {
+    std::lock_guard lock(mutex);
+    presented.push_back(e);
+  }
+  void attend(const std::set<int>& codes) override {
+    std::lock_guard lock(mutex);
+    attended = codes;
+  }
+  void feedback(std::int64_t sample, const std::set<int>& codes) override {
+    std::lock_guard lock(mutex);
+    feedbacks.emplace_back(sample, codes);
+  }
+  void displayed(double, bool lit) override {
+    std::lock_guard lock(mutex);
+    patches.push_back(lit);
+  }
+  std::string fault() const override {
+    std::lock_guard lock(mutex);
+    return fault_text;
+  }
+  std::string impedance() const override { return "Fz 4.2, Cz 12"; }
+
+  std::atomic<std::int64_t> gap{0};
+  std::atomic<bool> hold{false};
+  mutable std::mutex mutex;
+  std::string fault_text;
+  std::vector<bci::StimulusEvent> presented;
+  std::set<int> attended;
+  std::vector<std::pair<std::int64_t, std::set<int>>> feedbacks;
+  std::vector<bool> patches;
+
+ private:
+  std::shared_ptr<const bci::SampleClock> clock_;
+  bci::SignalInfo info_;
+  std::int64_t next_ = 0;
+};
+
+EegAcquisitionSettings settings(const std::string& photodiode = "Photodiode") {
+  EegAcquisitionSettings s;
+  s.eeg.photodiode_channel = photodiode;
+  s.flash_s = 4.0 / 60.0;
+  s.session_file = "test.json";
+  return s;
+}
+
+struct Acquiring {
+  explicit Acquiring(test::StageBench& bench, const std::string& photodiode = "Photodiode") {
+    OpenedEegSource opened;
+    opened.clock = bench.clock().sourceClock(0.0);
+    auto own = std::make_unique<ScriptedSource>(opened.clock);
+    source = own.get();
+    opened.source = std::move(own);
+    stage = std::make_unique<EegAcquisitionStage>(settings(photodiode), std::move(opened),
+                                                  bench.clock(), bench.services());
+  }
+  ScriptedSource* source;
+  std::unique_ptr<EegAcquisitionStage> stage;
+};
+
+TEST(EegAcquisitionStage, WhatArrivedByTheCyclesTimeIsTakenWithThePhotodiodeApart) {
+  test::StageBench bench("eeg_take");
+  Acquiring eeg(bench);
+  std::int64_t samples = 0;
+  for (int frame = 0; frame < 60; ++frame) {
+    const Cycle c = bench.step(*eeg.stage);
+    for (const bci::Block& b : bench.record.eeg.blocks) {
+      EXPECT_EQ(b.channels, 3);
+      EXPECT_EQ(b.first_sample, samples);
+      samples += b.samples;
+    }
+    ASSERT_EQ(bench.record.eeg.blocks.size(), bench.record.eeg.eeg_blocks.size());
+    for (const bci::Block& b : bench.record.eeg.eeg_blocks) {
+      EXPECT_EQ(b.channels, 2);
+      EXPECT_EQ(b.at(0, 0), static_cast<float>(b.first_sample));
+    }
+    // Stepped: every block complete by the cycle's time, and the cycle stamped with its sample.
+    EXPECT_EQ(samples, static_cast<std::int64_t>(frame / 60.0 * 256.0 + 1e-9) / 16 * 16);
+    EXPECT_EQ(c.eeg_sample, bench.record.eeg_sample);
+    bench.next();
+  }
+  EXPECT_EQ(bench.previous.eeg.info->channels.size(), 3u);
+  EXPECT_EQ(bench.previous.eeg.impedance, "Fz 4.2, Cz 12");
+  EXPECT_EQ(bench.previous.eeg.lost_samples, 0);
+}
+
+TEST(EegAcquisitionStage, TheScreenAndTheSubjectsAttentionReachTheSource) {
+  test::StageBench bench("eeg_source_told");
+  Acquiring eeg(bench);
+  SelectionStart start;
+  start.attended = {2};
+  bench.previous.paradigm.selection_started = start;
+  bench.record.presentation.onsets.push_back({Flash{2, true, true, true, 1}, 40});
+  bench.record.presentation.patch = true;
+  bench.record.presentation.feedback = FeedbackShown{{3}, true, std::nullopt};
+  bench.record.presentation.sample = 44;
+  bench.step(*eeg.stage);
+  std::lock_guard lock(eeg.source->mutex);
+  EXPECT_EQ(eeg.source->attended, std::set<int>{2});
+  ASSERT_EQ(eeg.source->presented.size(), 1u);
+  EXPECT_EQ(eeg.source->presented[0].sample, 40);
+  EXPECT_TRUE(eeg.source->presented[0].target);
+  // The flash's nominal duration: 4 frames at 60 Hz, in samples.
+  EXPECT_EQ(eeg.source->presented[0].duration_samples, 17);
+  EXPECT_EQ(eeg.source->patches, std::vector<bool>{true});
+  ASSERT_EQ(eeg.source->feedbacks.size(), 1u);
+  EXPECT_EQ(eeg.source->feedbacks[0].first, 44);
+}
+
+TEST(EegAcquisitionStage, LostSamplesAreCountedLoggedAndTold) {
+  test::StageBench bench("eeg_lost");
+  Acquiring eeg(bench);
+  for (int frame = 0; frame < 30; ++frame) {
+    if (frame == 10) eeg.source->gap = 48;
+    bench.step(*eeg.stage);
+    bench.next();
+  }
+  EXPECT_EQ(bench.previous.eeg.lost_samples, 48);
+  EXPECT_EQ(bench.logged("lost_samples").size(), 1u);
+  EXPECT_TRUE(bench.toldOf("48 EEG samples lost"));
+}
+
+TEST(EegAcquisitionStage, ASourcesFaultIsNamedWhenItStartsAndWhenItEnds) {
+  test::StageBench bench("eeg_fault");
+  Acquiring eeg(bench);
+  auto fault = [&](const std::string& text) {
+    std::lock_guard lock(eeg.source->mutex);
+    eeg.source->fault_text = text;
+  };
+  for (int frame = 0; frame < 30; ++frame) {
+    if (frame == 5) fault("the LSL stream EEG is gone");
+    if (frame == 20) fault("");
+    bench.step(*eeg.stage);
+    if (frame == 10) {
+      EXPECT_EQ(bench.record.eeg.fault, "the LSL stream EEG is gone");
+    }
+    bench.next();
+  }
+  EXPECT_EQ(bench.previous.eeg.fault, "");
+  EXPECT_EQ(bench.logged("eeg_source").size(), 2u);
+  EXPECT_TRUE(bench.toldOf("EEG source: the LSL stream EEG is gone"));
+  EXPECT_TRUE(bench.toldOf("EEG source delivering again"));
+}
+
+TEST(EegAcquisitionStage, APhotodiodeChannelTheSourceLacksIsRefusedNamingTheKey) {
+  test::StageBench bench("eeg_no_photodiode");
+  try {
+    Acquiring eeg(bench, "PD");
+    FAIL() << "a photodiode channel the source lacks was taken";
+  } catch (const SessionConfigError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("eeg.photodiode_channel = \"PD\""), std::string::npos) << what;
+    EXPECT_NE(what.find("Fz, Cz, Photodiode"), std::string::npos) << what;
+  }
+}
+
+// A live source whose deliveries stop for 0.4 s: the stall is taken in the cycle whose frame the
+// presentation stage stamped inside it, and that flash's stamp is marked uncertain.
+TEST(EegAcquisitionStage, AFlashStampedInTheCycleAStallIsTakenIsMarkedUncertain) {
+  test::StageBench bench("eeg_stall", Clock::Mode::RealTime);
+  Acquiring eeg(bench);
+  auto cycle = [&] {
+    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+    bench.step(*eeg.stage);
+    bench.next();
+  };
+  for (int i = 0; i < 50; ++i) {
+    cycle();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const double held_from = bci::hostSeconds();
+  eeg.source->hold = true;
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  eeg.source->hold = false;
+  // The held-back blocks arrive at once (the acquisition polls every millisecond).
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  bench.record.presentation.shown = true;
+  bench.record.presentation.host_s = held_from + 0.2;
+  bench.record.presentation.onsets.push_back({Flash{1, true, false, true, 1}, 4321});
+  bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+  bench.step(*eeg.stage);
+  ASSERT_EQ(bench.record.eeg.stalls.size(), 1u);
+  bool marked = false;
+  for (const bci::Annotation& a : bench.record.annotations)
+    marked |= a.sample == 4321 && a.text == "stamp uncertain: EEG delivery stalled";
+  EXPECT_TRUE(marked);
+  EXPECT_TRUE(bench.toldOf("EEG delivery stalled"));
+  const auto logged = bench.logged("eeg_stall");
+  ASSERT_EQ(logged.size(), 1u);
+  EXPECT_EQ(logged[0]["uncertain_flashes"], 1);
+}
+
+}  // namespace
+}  // namespace arbci::session

@@ -1,0 +1,105 @@
+// The P300 stage on hand-built records with a simulated subject's EEG: the calibration run's
+// cued flashes kept and trained on when asked (a retaken selection left out), the next selection
+// scored and decided by the model trained, epochs that touch lost samples discarded, and a model
+// that does not fit the channels refused with the reason.
+#include <gtest/gtest.h>
+
+#include "arbci/bci/settings.h"
+#include "arbci/session/stages/p300_stage.h"
+#include "support/flash_driver.h"
+#include "support/stage_bench.h"
+
+namespace arbci::session {
+namespace {
+
+P300Settings settingsFor(const bci::SignalInfo& info) {
+  P300Settings s;
+  s.info = info;
+  s.flash_s = 4.0 / 60.0;
+  s.object_stimuli = 4;
+  s.session_file = "test.json";
+  return s;
+}
+
+class P300StageTest : public ::testing::Test {
+ protected:
+  P300StageTest()
+      : bench_("p300"), eeg_(bench_, 4), stage_(settingsFor(eeg_.info()), bench_.services()) {}
+  test::StageBench bench_;
+  test::FlashDriver eeg_;
+  P300Stage stage_;
+};
+
+TEST_F(P300StageTest, TheCalibrationIsTrainedOnWhenAskedAndTheModelDecidesTheNextSelection) {
+  // Six cued selections, the third interrupted and retaken as the fourth.
+  const int targets[] = {1, 3, 2, 2, 4, 1};
+  for (int n = 1; n <= 6; ++n) {
+    const int sequences = n == 3 ? 2 : 8;
+    eeg_.selection(stage_, n, targets[n - 1], true, sequences,
+                   n == 4 ? std::optional<int>(3) : std::nullopt);
+  }
+  EXPECT_EQ(bench_.previous.p300.model, nullptr);
+  bench_.record.requests.push_back(TrainRequest{"slda"});
+  eeg_.step(stage_);  // stepped: the training is waited for on this cycle
+  const P300Part& trained = bench_.previous.p300;
+  ASSERT_TRUE(trained.training_error.empty()) << trained.training_error;
+  ASSERT_TRUE(trained.trained.has_value());
+  ASSERT_NE(trained.model, nullptr);
+  EXPECT_EQ(trained.model->method, "slda");
+  EXPECT_EQ(trained.trained_on, (std::vector<int>{1, 2, 4, 5, 6}));
+  EXPECT_EQ(trained.left_out, (std::vector<int>{3}));
+  EXPECT_GT(trained.trained->auc, 0.75);
+  ASSERT_NE(trained.erp, nullptr);
+  // Online: nobody says which is attended; the model finds it.
+  eeg_.selection(stage_, 7, 3, false, 8);
+  const P300Part& online = bench_.previous.p300;
+  EXPECT_EQ(online.selection, 7);
+  EXPECT_EQ(online.presented, 32);
+  EXPECT_EQ(online.scored, 32);
+  EXPECT_EQ(online.sequences, 8);
+  EXPECT_EQ(online.decision.codes, std::set<int>{3});
+  EXPECT_GT(online.decision.certainty, 0.5);
+}
+
+TEST_F(P300StageTest, EpochsTouchingLostSamplesAreDiscardedNotScored) {
+  for (int n = 1; n <= 3; ++n) eeg_.selection(stage_, n, n, true, 6);
+  bench_.record.requests.push_back(TrainRequest{"slda"});
+  eeg_.step(stage_);
+  ASSERT_NE(bench_.previous.p300.model, nullptr) << bench_.previous.p300.training_error;
+  // A second lost a little after the online selection starts.
+  const std::int64_t now = static_cast<std::int64_t>(bench_.record.frame / 60.0 * 256.0);
+  bench_.record.eeg.losses.push_back({now + 128, 256, "gap in the stream"});
+  eeg_.selection(stage_, 4, 2, false, 4);
+  EXPECT_EQ(bench_.previous.p300.scored, 16);
+  EXPECT_FALSE(bench_.logged("epoch_discarded").empty());
+  nlohmann::json summary;
+  stage_.report(summary);
+  EXPECT_EQ(summary["eeg"]["discarded_epochs"].get<int>(),
+            static_cast<int>(bench_.logged("epoch_discarded").size()));
+}
+
+TEST_F(P300StageTest, AModelThatLacksTheSourcesChannelsIsRefusedWithTheReason) {
+  for (int n = 1; n <= 3; ++n) eeg_.selection(stage_, n, n, true, 6);
+  bench_.record.requests.push_back(TrainRequest{"slda"});
+  eeg_.step(stage_);
+  ASSERT_NE(bench_.previous.p300.model, nullptr);
+  ASSERT_NE(bench_.previous.p300.erp, nullptr);
+  // A model given in its place (here the same one) was not trained on this session's averages.
+  bench_.record.requests.push_back(UseModelRequest{bench_.previous.p300.model});
+  eeg_.step(stage_);
+  EXPECT_EQ(bench_.previous.p300.erp, nullptr);
+  const std::vector<std::string> kept = bench_.previous.p300.model->pipeline.channels;
+  bci::P300Model other = *bench_.previous.p300.model;
+  other.pipeline.channels = {"Fz", "Cz", "T7"};
+  bench_.record.requests.push_back(UseModelRequest{std::make_shared<const bci::P300Model>(other)});
+  eeg_.step(stage_);
+  EXPECT_NE(bench_.previous.p300.training_error.find("T7"), std::string::npos)
+      << bench_.previous.p300.training_error;
+  EXPECT_TRUE(bench_.toldOf("model refused"));
+  EXPECT_EQ(bench_.logged("model_refused").size(), 1u);
+  // The session keeps the model it had.
+  EXPECT_EQ(bench_.previous.p300.model->pipeline.channels, kept);
+}
+
+}  // namespace
+}  // namespace arbci::session

@@ -1,0 +1,168 @@
+// The robot stage on hand-built records against a real backend on 127.0.0.1 (a stepped simulated
+// arm on its own thread): the trial's grasp and put-down, noted on the record for the paradigm
+// (outcome, step finished, placement, put-down ended), the experimenter's stop and reset, the
+// pre-flight's probe, and a backend that goes silent in the middle of a grasp.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "arbci/session/stages/robot_stage.h"
+#include "support/robot_test_support.h"
+#include "support/stage_bench.h"
+
+namespace arbci::session {
+namespace {
+
+using Kind = RobotPart::Note::Kind;
+
+// The arm's world as the session's default table has it (as the simulated cameras' world makes it).
+robot::RobotConfig armFor(const WorldSettings& w) {
+  robot::RobotConfig r;
+  r.table_z = w.table_z;
+  r.workspace_min = {-0.7, 0.2, w.table_z};
+  r.workspace_max = {0.7, 1.0, w.table_z + 0.6};
+  r.speed_factor = 20.0;
+  for (const WorldObjectSettings& o : w.objects)
+    r.objects.push_back(
+        {o.id, {o.position[0], o.position[1], o.position[2]}, o.height_m, o.width_m / 2.0});
+  return r;
+}
+
+class RobotStageTest : public ::testing::Test {
+ protected:
+  RobotStageTest()
+      : bench_("robot"),
+        backend_(std::make_unique<robot::RunningBackend>(
+            std::make_unique<robot::SimulatedArm>(armFor(world_)), options())) {
+    RobotLink link;
+    link.client = std::make_unique<robot::RobotClient>(
+        robot::Endpoint::resolve("127.0.0.1", backend_->port()), robot::testKey(),
+        robot::fastClient());
+    link.stepped = true;
+    stage_ = std::make_unique<RobotStage>(RobotStageSettings{world_, 2}, std::move(link),
+                                          bench_.services());
+  }
+  static robot::BackendOptions options() {
+    robot::BackendOptions o;
+    o.stepped = true;
+    o.speed_factor = 20.0;
+    o.status_interval_s = 0.05;
+    return o;
+  }
+  // Cycles until `done` holds on a record (at most `seconds` of session time); the notes seen.
+  std::vector<RobotPart::Note> until(const std::function<bool(const RobotPart&)>& done,
+                                     double seconds = 60.0) {
+    std::vector<RobotPart::Note> notes;
+    for (int i = 0; i < seconds * 60; ++i) {
+      bench_.step(*stage_);
+      const RobotPart& r = bench_.record.robot;
+      notes.insert(notes.end(), r.notes.begin(), r.notes.end());
+      const bool finished = done(r);
+      bench_.next();
+      if (finished) break;
+    }
+    return notes;
+  }
+  static bool has(const std::vector<RobotPart::Note>& notes, Kind kind, bool success) {
+    for (const auto& n : notes)
+      if (n.kind == kind && n.success == success) return true;
+    return false;
+  }
+  WorldSettings world_;
+  test::StageBench bench_;
+  std::unique_ptr<robot::RunningBackend> backend_;
+  std::unique_ptr<RobotStage> stage_;
+};
+
+TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
+  const WorldObjectSettings& object = world_.objects.front();
+  until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
+  ASSERT_TRUE(bench_.previous.robot.status.has_value()) << "no status from the backend";
+  EXPECT_EQ(bench_.previous.robot.why_not_move, "");
+  bench_.record.requests.push_back(GraspRequest{object.id, object.position, bench_.record.time_s});
+  auto notes = until([](const RobotPart& r) {
+    for (const auto& n : r.notes)
+      if (n.kind == Kind::Finished) return true;
+    return false;
+  });
+  ASSERT_TRUE(has(notes, Kind::Finished, true));
+  EXPECT_EQ(bench_.previous.robot.holding(), object.id);
+  EXPECT_EQ(bench_.previous.robot.grasped, object.id);
+  EXPECT_FALSE(bench_.previous.robot.at_home);
+  // Put down on cell (2, 2): placed, measured, the arm home and the table seen again.
+  bench_.record.requests.push_back(DropRequest{1, {2, 2}, false, bench_.record.time_s});
+  notes = until([](const RobotPart& r) {
+    for (const auto& n : r.notes)
+      if (n.kind == Kind::PutDownEnded) return true;
+    return false;
+  });
+  EXPECT_TRUE(has(notes, Kind::Outcome, true));
+  ASSERT_TRUE(has(notes, Kind::Placement, true));
+  ASSERT_TRUE(has(notes, Kind::PutDownEnded, true));
+  for (const auto& n : notes) {
+    if (n.kind != Kind::Placement) continue;
+    EXPECT_EQ(n.trial, 1);
+    EXPECT_LT(n.error_m, 0.005);
+  }
+  EXPECT_TRUE(bench_.previous.robot.at_home);
+  EXPECT_FALSE(bench_.previous.robot.holding().has_value());
+  // What moved is unknown to tracking until a frame shows it again.
+  EXPECT_EQ(bench_.logged("placement").size(), 1u);
+}
+
+TEST_F(RobotStageTest, TheExperimentersStopLatchesAndResetLiftsIt) {
+  const WorldObjectSettings& object = world_.objects.front();
+  until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
+  bench_.record.requests.push_back(GraspRequest{object.id, object.position, bench_.record.time_s});
+  until([](const RobotPart& r) { return r.status && r.status->progress > 0.2; });
+  stage_->stopNow(bench_.record.time_s);
+  until([](const RobotPart& r) { return r.status && !r.status->stop_reason.empty(); }, 5.0);
+  ASSERT_FALSE(bench_.previous.robot.status->stop_reason.empty());
+  EXPECT_FALSE(bench_.previous.robot.busy);
+  bench_.record.requests.push_back(RobotResetRequest{bench_.record.time_s});
+  until([](const RobotPart& r) { return r.status && r.status->stop_reason.empty(); }, 5.0);
+  EXPECT_TRUE(bench_.previous.robot.status->stop_reason.empty());
+  // Home, the experimenter's recovery, goes once nothing runs.
+  bench_.record.requests.push_back(RobotHomeRequest{bench_.record.time_s});
+  until([](const RobotPart& r) { return r.at_home && !r.busy; });
+  EXPECT_TRUE(bench_.previous.robot.at_home);
+  bool stop = false, reset = false;
+  for (const auto& c : bench_.logged("robot_command")) {
+    stop |= c["command"] == "STOP";
+    reset |= c["command"] == "RESET";
+  }
+  EXPECT_TRUE(stop);
+  EXPECT_TRUE(reset);
+}
+
+TEST_F(RobotStageTest, ThePreflightsProbeIsAnswered) {
+  bench_.record.requests.push_back(RobotProbeRequest{0.0});
+  bench_.step(*stage_);
+  EXPECT_TRUE(bench_.record.robot.answered);
+}
+
+TEST_F(RobotStageTest, ABackendThatGoesSilentInAGraspIsARobotFaultOnTheRecord) {
+  const WorldObjectSettings& object = world_.objects.front();
+  until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
+  bench_.record.requests.push_back(GraspRequest{object.id, object.position, bench_.record.time_s});
+  until([](const RobotPart& r) { return r.status && r.status->progress > 0.2; });
+  backend_->halt();
+  std::vector<RobotPart::Note> notes;
+  // The link is judged silent on the wall clock: a second and more without an answer.
+  for (int i = 0; i < 400 && !has(notes, Kind::Finished, false); ++i) {
+    bench_.step(*stage_);
+    notes.insert(notes.end(), bench_.record.robot.notes.begin(), bench_.record.robot.notes.end());
+    bench_.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(has(notes, Kind::Finished, false));
+  bool said = false;
+  for (const auto& n : notes) said |= n.text == "robot fault: the backend went silent";
+  EXPECT_TRUE(said);
+  EXPECT_TRUE(bench_.previous.robot.silent);
+  EXPECT_EQ(bench_.previous.robot.why_not_move, "the robot backend does not answer");
+  EXPECT_TRUE(bench_.toldOf("robot: silent"));
+}
+
+}  // namespace
+}  // namespace arbci::session
