@@ -145,102 +145,98 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   FrameStimulus out;
   const bool flashing = phase_ == Phase::CalibrationFlashing || phase_ == Phase::ObjectFlashing ||
                         phase_ == Phase::CellFlashing;
-  if (flashing && !awaiting_decision_) {
-    // The sequence's last interval is over (and its every flash shown): another sequence, or the
-    // end of flashing.
-    if (!schedule_.empty() && next_flash_ == schedule_.size() &&
-        due_s >= schedule_.back().onset_s + settings_.soaSeconds() - kSlack) {
-      // A selection repeated after an ErrP rejection shows all its sequences.
-      const bool dynamic_stop = !calibrating_ && sequences_override_ == 0 && stop_requested_ &&
-                                sequence_ >= settings_.min_sequences;
-      const int most = calibrating_              ? settings_.calibration_sequences
-                       : sequences_override_ > 0 ? sequences_override_
-                                                 : settings_.sequences;
-      if (sequence_ < most && !dynamic_stop) {
-        scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
-      } else {
-        awaiting_decision_ = true;
-      }
-    }
+  if (flashing && !awaiting_decision_) endSequenceIfOver(due_s);
+  if (flashing && !awaiting_decision_) showFlashes(due_s, out);
+  advanceTimedPhase(due_s);
+  describe(out);
+  if (lit_last_frame_ && out.lit.empty()) last_dark_s_ = due_s;
+  lit_last_frame_ = !out.lit.empty();
+  return out;
+}
+
+void Paradigm::endSequenceIfOver(double due_s) {
+  // The sequence's last interval is over (and its every flash shown): another sequence, or the
+  // end of flashing.
+  if (schedule_.empty() || next_flash_ != schedule_.size() ||
+      due_s < schedule_.back().onset_s + settings_.soaSeconds() - kSlack)
+    return;
+  // A selection repeated after an ErrP rejection shows all its sequences.
+  const bool dynamic_stop = !calibrating_ && sequences_override_ == 0 && stop_requested_ &&
+                            sequence_ >= settings_.min_sequences;
+  const int most = calibrating_              ? settings_.calibration_sequences
+                   : sequences_override_ > 0 ? sequences_override_
+                                             : settings_.sequences;
+  if (sequence_ < most && !dynamic_stop) {
+    scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
+  } else {
+    awaiting_decision_ = true;
   }
-  if (flashing && !awaiting_decision_) {
-    for (size_t i = 0; i < schedule_.size(); ++i) {
-      ScheduledFlash& f = schedule_[i];
-      if (due_s < f.onset_s - kSlack) break;
-      if (i == next_flash_) {
-        // Never on the frame right after one that showed a flash: on a display too slow for the
-        // SOA the two would run together (one onset to the subject, one photodiode edge); it
-        // waits a frame, with the screen dark between them.
-        if (lit_last_frame_) break;
-        // Never closer than the SOA to the previous onset, nor than the dark gap (SOA less the
-        // flash, in whole frames) to the frame that ended it: after late frames the schedule
-        // slips (the selection takes longer) rather than squeezing flashes together.
-        const double soa = settings_.soaSeconds();
-        const double ready =
-            std::max(last_onset_s_ + soa, last_dark_s_ + soa - settings_.flashSeconds());
-        if (due_s < ready - kSlack) break;
-        // Its first frame. One overdue by more than a flash (the process or the display stalled)
-        // moves the rest of the sequence with it: shown one per frame, the flashes missed in a
-        // stall would follow each other closer than the SOA, their ERPs overlapping and the
-        // photodiode patch never going dark between them.
-        if (due_s > f.onset_s + settings_.flashSeconds()) {
-          const double late = due_s - f.onset_s;
-          for (size_t j = i; j < schedule_.size(); ++j) schedule_[j].onset_s += late;
-        }
-        ParadigmEvent e{ParadigmEvent::Kind::Flash};
-        e.code = f.code;
-        e.objects_layout = flashing_objects_;
-        event(e);
-        f.shown_s = due_s;
-        last_onset_s_ = due_s;
-        next_flash_ = i + 1;
-        out.lit.insert(f.code);
-        break;
-      }
-      if (i < next_flash_ && due_s < f.shown_s + settings_.flashSeconds() - kSlack)
-        out.lit.insert(f.code);
+}
+
+void Paradigm::showFlashes(double due_s, FrameStimulus& out) {
+  for (size_t i = 0; i < schedule_.size(); ++i) {
+    ScheduledFlash& f = schedule_[i];
+    if (due_s < f.onset_s - kSlack) break;
+    if (i == next_flash_) {
+      if (showNextFlash(i, due_s)) out.lit.insert(f.code);
+      break;
     }
+    if (i < next_flash_ && due_s < f.shown_s + settings_.flashSeconds() - kSlack)
+      out.lit.insert(f.code);
   }
+}
+
+bool Paradigm::showNextFlash(size_t i, double due_s) {
+  ScheduledFlash& f = schedule_[i];
+  // Never on the frame right after one that showed a flash: on a display too slow for the SOA
+  // the two would run together (one onset to the subject, one photodiode edge); it waits a
+  // frame, with the screen dark between them.
+  if (lit_last_frame_) return false;
+  // Never closer than the SOA to the previous onset, nor than the dark gap (SOA less the flash, in
+  // whole frames) to the frame that ended it: after late frames the schedule slips (the selection
+  // takes longer) rather than squeezing flashes together.
+  const double soa = settings_.soaSeconds();
+  const double ready = std::max(last_onset_s_ + soa, last_dark_s_ + soa - settings_.flashSeconds());
+  if (due_s < ready - kSlack) return false;
+  // Its first frame. One overdue by more than a flash (the process or the display stalled) moves
+  // the rest of the sequence with it: shown one per frame, the flashes missed in a stall would
+  // follow each other closer than the SOA, their ERPs overlapping and the photodiode patch never
+  // going dark between them.
+  if (due_s > f.onset_s + settings_.flashSeconds()) {
+    const double late = due_s - f.onset_s;
+    for (size_t j = i; j < schedule_.size(); ++j) schedule_[j].onset_s += late;
+  }
+  ParadigmEvent e{ParadigmEvent::Kind::Flash};
+  e.code = f.code;
+  e.objects_layout = flashing_objects_;
+  event(e);
+  f.shown_s = due_s;
+  last_onset_s_ = due_s;
+  next_flash_ = i + 1;
+  return true;
+}
+
+void Paradigm::advanceTimedPhase(double due_s) {
+  if (due_s < phase_until_ - kSlack) return;
   switch (phase_) {
     case Phase::CalibrationCue:
-      if (due_s < phase_until_ - kSlack) break;
-      if (!errp_block_) {
+      if (errp_block_) {
+        showCalibrationFeedback(due_s);
+      } else {
         startFlashing(nextFrame(), true);
-        break;
-      }
-      {
-        // The ErrP block: the cued object, or deliberately another, shown as if selected.
-        int shown = *calibration_target_;
-        const bool wrong = errp_plan_[errp_done_];
-        if (wrong) {
-          std::uniform_int_distribution<int> other(1, object_layout_.stimuli - 1);
-          shown = other(random_);
-          if (shown >= *calibration_target_) ++shown;
-        }
-        shown_codes_ = {shown};
-        shown_error_ = wrong;
-        selected_object_ = shown;
-        feedback_pending_ = true;
-        phase_until_ = due_s + settings_.result_s;
-        enter(Phase::CalibrationFeedback, objectName(shown) + (wrong ? " (wrong)" : ""));
       }
       break;
     case Phase::CalibrationFeedback:
-      if (due_s < phase_until_ - kSlack) break;
       selected_object_.reset();
       if (++errp_done_ < errp_plan_.size()) {
         cueCalibrationTarget(settings_.pause_s);
       } else {
         errp_block_ = false;
-        calibration_target_.reset();
-        calibrating_ = false;
-        enter(Phase::Training);
-        event(ParadigmEvent{ParadigmEvent::Kind::TrainModel});
+        endCalibration();
       }
       break;
     case Phase::ObjectSelected:
     case Phase::CellSelected:
-      if (due_s < phase_until_ - kSlack) break;
       if (runner_up_waiting_) {
         runner_up_waiting_ = false;
         const Decision& d = last_decision_;
@@ -253,6 +249,33 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
     default:
       break;
   }
+}
+
+void Paradigm::showCalibrationFeedback(double due_s) {
+  // The ErrP block: the cued object, or deliberately another, shown as if selected.
+  int shown = *calibration_target_;
+  const bool wrong = errp_plan_[errp_done_];
+  if (wrong) {
+    std::uniform_int_distribution<int> other(1, object_layout_.stimuli - 1);
+    shown = other(random_);
+    if (shown >= *calibration_target_) ++shown;
+  }
+  shown_codes_ = {shown};
+  shown_error_ = wrong;
+  selected_object_ = shown;
+  feedback_pending_ = true;
+  phase_until_ = due_s + settings_.result_s;
+  enter(Phase::CalibrationFeedback, objectName(shown) + (wrong ? " (wrong)" : ""));
+}
+
+void Paradigm::endCalibration() {
+  calibration_target_.reset();
+  calibrating_ = false;
+  enter(Phase::Training);
+  event(ParadigmEvent{ParadigmEvent::Kind::TrainModel});
+}
+
+void Paradigm::describe(FrameStimulus& out) {
   out.phase = phase_;
   out.grid_visible = phase_ == Phase::CellFlashing || phase_ == Phase::CellSelected ||
                      phase_ == Phase::Dropping || phase_ == Phase::Grasping;
@@ -275,9 +298,6 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   }
   if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping)
     out.selected_cell = selected_cell_;
-  if (lit_last_frame_ && out.lit.empty()) last_dark_s_ = due_s;
-  lit_last_frame_ = !out.lit.empty();
-  return out;
 }
 
 void Paradigm::askRobot(Phase phase) {
@@ -319,10 +339,7 @@ void Paradigm::decide(const Decision& decision) {
       errp_block_ = true;
       cueCalibrationTarget(settings_.pause_s);
     } else {
-      calibration_target_.reset();
-      calibrating_ = false;
-      enter(Phase::Training);
-      event(ParadigmEvent{ParadigmEvent::Kind::TrainModel});
+      endCalibration();
     }
     return;
   }

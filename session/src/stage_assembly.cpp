@@ -84,6 +84,30 @@ std::map<std::string, std::string> recordingParameters(const SessionConfig& c) {
   };
 }
 
+ErrpStageSettings errpSettingsOf(const SessionConfig& c, const bci::SignalInfo& eeg_info) {
+  ErrpStageSettings e;
+  e.enabled = c.paradigm.errp;
+  e.info = eeg_info;
+  if (c.paradigm.errp) e.pipeline = c.errp.pipeline(c.classifier.pipeline, c.eeg.montage);
+  e.training = c.errp.training();
+  e.flash_s = c.paradigm.flashSeconds();
+  e.model_file = c.classifier.model_file;
+  e.threshold = c.errp.threshold;
+  return e;
+}
+
+std::unique_ptr<LslMarkersStage> markersStageOf(const SessionConfig& c,
+                                                const bci::lsl::LslConfig& lsl, double rate_hz,
+                                                const StageServices& services) {
+  if (!c.lsl.markers) return nullptr;
+  // The stream's description says what the recording's parameters say (the layout).
+  const std::map<std::string, std::string> parameters = recordingParameters(c);
+  return std::make_unique<LslMarkersStage>(
+      LslMarkersSettings{
+          c.lsl.marker_stream, lsl, rate_hz, c.source, {parameters.begin(), parameters.end()}},
+      services);
+}
+
 }  // namespace
 
 SessionConfig configFor(SessionConfig config, const SessionOptions& options) {
@@ -140,28 +164,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
                    c.paradigm.flashSeconds(), static_cast<int>(c.world.objects.size()),
                    c.classifier.model_file, c.source},
       services);
-  ErrpStageSettings errp_settings;
-  errp_settings.enabled = c.paradigm.errp;
-  errp_settings.info = eeg_info;
-  if (c.paradigm.errp)
-    errp_settings.pipeline = c.errp.pipeline(c.classifier.pipeline, c.eeg.montage);
-  errp_settings.training = c.errp.training();
-  errp_settings.flash_s = c.paradigm.flashSeconds();
-  errp_settings.model_file = c.classifier.model_file;
-  errp_settings.threshold = c.errp.threshold;
-  auto errp = std::make_unique<ErrpStage>(errp_settings, services);
-  std::unique_ptr<LslMarkersStage> markers;
-  if (c.lsl.markers) {
-    // The stream's description says what the recording's parameters say (the layout).
-    const std::map<std::string, std::string> parameters = recordingParameters(c);
-    markers = std::make_unique<LslMarkersStage>(
-        LslMarkersSettings{c.lsl.marker_stream,
-                           lsl,
-                           eeg_info.rate_hz,
-                           c.source,
-                           {parameters.begin(), parameters.end()}},
-        services);
-  }
+  auto errp = std::make_unique<ErrpStage>(errpSettingsOf(c, eeg_info), services);
+  std::unique_ptr<LslMarkersStage> markers = markersStageOf(c, lsl, eeg_info.rate_hz, services);
   auto presentation = std::make_unique<PresentationStage>(
       PresentationSettings{c.paradigm, eeg_info.rate_hz}, services);
   auto preflight = std::make_unique<PreflightStage>(
@@ -171,7 +175,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto paradigm = std::make_unique<ParadigmStage>(
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
                             c.eeg.seed + 11, c.errp.threshold, folder / "model.json",
-                            options.experimenter},
+                            options.experimenter, c.tracker.max_pose_age_s},
       services);
   CycleRecord warm_up;
   tracking->publish(warm_up.tracking);

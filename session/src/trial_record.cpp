@@ -50,53 +50,75 @@ std::string selectionLine(const TrialRecord& t) {
   return line + " [" + t.outcome + "]";
 }
 
+namespace {
+
+nlohmann::json orNull(double v) {
+  return v >= 0.0 ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+nlohmann::json cellJson(const std::optional<std::pair<int, int>>& c) {
+  return c ? nlohmann::json{c->first, c->second} : nlohmann::json(nullptr);
+}
+nlohmann::json idJson(const std::optional<int>& id) {
+  return id ? nlohmann::json(*id) : nlohmann::json(nullptr);
+}
+
+// One trial's entry in the summary's "trials".
+nlohmann::json trialJson(const TrialRecord& t) {
+  nlohmann::json selections = nlohmann::json::array();
+  for (const SelectionMade& s : t.selections) {
+    nlohmann::json one = {{"kind", s.object ? "object" : "cell"},
+                          {"correct", s.correct},
+                          {"vetoed", s.vetoed ? nlohmann::json(*s.vetoed) : nullptr}};
+    if (s.object)
+      one["object"] = s.object_id;
+    else
+      one["cell"] = {s.cell.first, s.cell.second};
+    selections.push_back(one);
+  }
+  return {
+      {"trial", t.trial},
+      {"intended_object", t.intended_object},
+      {"selected_object", idJson(t.acceptedObject())},
+      {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
+      {"selected_cell", cellJson(t.acceptedCell())},
+      {"selections", selections},
+      {"robot",
+       {{"object", idJson(t.robot_object)},
+        {"cell", cellJson(t.robot_cell)},
+        {"returned", t.robot_returned},
+        {"pose_age_max_s", t.grasp_pose_age_max_s ? nlohmann::json(*t.grasp_pose_age_max_s)
+                                                  : nlohmann::json(nullptr)}}},
+      {"object_flashes", t.object_flashes},
+      {"cell_flashes", t.cell_flashes},
+      {"object_selection_s", t.object_selection_s},
+      {"cell_selection_s", t.cell_selection_s},
+      {"outcome", t.outcome},
+      {"duration_s", t.ended_s >= 0.0 ? orNull(t.ended_s - t.started_s) : nlohmann::json(nullptr)},
+      {"placement_error_m", orNull(t.placement_error_m)}};
+}
+
+// Accuracy, seconds per selection and bits per minute of one kind of selection (null: none made).
+nlohmann::json rate(int choices, int right, int made, double total_seconds) {
+  if (made == 0) return nlohmann::json(nullptr);
+  const double seconds = total_seconds / made;
+  return nlohmann::json{
+      {"accuracy", static_cast<double>(right) / made},
+      {"seconds_per_selection", seconds},
+      {"bits_per_minute",
+       bci::wolpawBits(choices, static_cast<double>(right) / made) * 60.0 / seconds}};
+}
+
+}  // namespace
+
 nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object_choices,
                              int cell_choices) {
   nlohmann::json trials = nlohmann::json::array();
   int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0, completed = 0;
   double object_seconds = 0, cell_seconds = 0, trial_seconds = 0;
-  auto orNull = [](double v) { return v >= 0.0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
-  auto cellJson = [](const std::optional<std::pair<int, int>>& c) {
-    return c ? nlohmann::json{c->first, c->second} : nlohmann::json(nullptr);
-  };
-  auto idJson = [](const std::optional<int>& id) {
-    return id ? nlohmann::json(*id) : nlohmann::json(nullptr);
-  };
   int wrong_robot_actions = 0;
   for (const TrialRecord& t : records) {
-    nlohmann::json selections = nlohmann::json::array();
-    for (const SelectionMade& s : t.selections) {
-      nlohmann::json one = {{"kind", s.object ? "object" : "cell"},
-                            {"correct", s.correct},
-                            {"vetoed", s.vetoed ? nlohmann::json(*s.vetoed) : nullptr}};
-      if (s.object)
-        one["object"] = s.object_id;
-      else
-        one["cell"] = {s.cell.first, s.cell.second};
-      selections.push_back(one);
-    }
     wrong_robot_actions += t.wrongRobotActions();
-    trials.push_back(
-        {{"trial", t.trial},
-         {"intended_object", t.intended_object},
-         {"selected_object", idJson(t.acceptedObject())},
-         {"intended_cell", {t.intended_cell.first, t.intended_cell.second}},
-         {"selected_cell", cellJson(t.acceptedCell())},
-         {"selections", selections},
-         {"robot",
-          {{"object", idJson(t.robot_object)},
-           {"cell", cellJson(t.robot_cell)},
-           {"returned", t.robot_returned},
-           {"pose_age_max_s", t.grasp_pose_age_max_s ? nlohmann::json(*t.grasp_pose_age_max_s)
-                                                     : nlohmann::json(nullptr)}}},
-         {"object_flashes", t.object_flashes},
-         {"cell_flashes", t.cell_flashes},
-         {"object_selection_s", t.object_selection_s},
-         {"cell_selection_s", t.cell_selection_s},
-         {"outcome", t.outcome},
-         {"duration_s",
-          t.ended_s >= 0.0 ? orNull(t.ended_s - t.started_s) : nlohmann::json(nullptr)},
-         {"placement_error_m", orNull(t.placement_error_m)}});
+    trials.push_back(trialJson(t));
     if (t.selected_object >= 0) {
       ++objects_made;
       objects_right += t.selected_object == t.intended_object;
@@ -112,15 +134,6 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
       trial_seconds += t.ended_s - t.started_s;
     }
   }
-  auto rate = [](int choices, int right, int made, double total_seconds) {
-    if (made == 0) return nlohmann::json(nullptr);
-    const double seconds = total_seconds / made;
-    return nlohmann::json{
-        {"accuracy", static_cast<double>(right) / made},
-        {"seconds_per_selection", seconds},
-        {"bits_per_minute",
-         bci::wolpawBits(choices, static_cast<double>(right) / made) * 60.0 / seconds}};
-  };
   nlohmann::json all = nullptr;
   if (completed > 0 && objects_made > 0 && cells_made > 0) {
     const double bits =

@@ -29,6 +29,7 @@ class StageBench {
         clock_(mode, display_hz),
         log_((std::filesystem::create_directories(folder_), folder_ / "log.jsonl")) {
     clock_.start();
+    record.time_s = clock_.frameTime(record.frame);
   }
   ~StageBench() {
     std::error_code ignored;
@@ -45,9 +46,9 @@ class StageBench {
   // The record this cycle writes (fresh each next()) and the last one.
   session::CycleRecord record, previous;
 
-  // This cycle, at frame `record.frame` (its session time from the clock, unless set).
+  // This cycle, at frame `record.frame` (its session time: the clock's when the record was made,
+  // unless a test set another).
   session::Cycle cycle() {
-    if (record.time_s == 0.0) record.time_s = clock_.frameTime(record.frame);
     record.host_s = clock_.hostOf(record.time_s);
     if (record.due_s == 0.0) record.due_s = record.time_s;
     return {record.frame,      record.time_s, record.due_s, record.host_s,
@@ -66,6 +67,7 @@ class StageBench {
     previous = std::move(record);
     record = session::CycleRecord{};
     record.frame = previous.frame + 1;
+    record.time_s = clock_.frameTime(record.frame);
     record.requests = std::move(previous.posted);
     previous.posted.clear();
   }

@@ -1,5 +1,7 @@
 #include "arbci/session/stages/robot_stage.h"
 
+#include <cstdio>
+
 #include <nlohmann/json.hpp>
 
 namespace arbci::session {
@@ -50,7 +52,7 @@ void RobotStage::step(Cycle& cycle) {
 
 void RobotStage::act(const Request& request, Cycle& cycle) {
   if (const auto* r = std::get_if<GraspRequest>(&request)) {
-    grasp(r->object, r->at, r->time_s);
+    grasp(*r, cycle.record.robot);
   } else if (const auto* r = std::get_if<DropRequest>(&request)) {
     drop(*r);
   } else if (const auto* r = std::get_if<RobotStopRequest>(&request)) {
@@ -83,14 +85,45 @@ void RobotStage::send(robot::MessageType type, const cv::Vec3d& target, double t
   if (type != robot::MessageType::Home) at_home_ = false;
 }
 
-void RobotStage::grasp(int object_id, const cv::Vec3d& at, double time_s) {
-  grasped_id_ = object_id;
-  grasped_from_ = at;
-  send(robot::MessageType::Grasp, at, time_s);
-  s_.log.write("robot_command", time_s,
+std::string RobotStage::whyNotGrasp(const GraspRequest& r) const {
+  if (r.at && r.pose_age_s > r.max_pose_age_s && holding() != r.object) {
+    char why[160];
+    std::snprintf(why, sizeof why,
+                  "object %d: tracking lost (pose %.1f s old), not grasped; Retry step once it is "
+                  "seen again",
+                  r.object, r.pose_age_s);
+    return why;
+  }
+  if (!r.at)
+    return "object " + std::to_string(r.object) +
+           " is not in view (never seen, or not since the robot moved it)";
+  return "";
+}
+
+void RobotStage::grasp(const GraspRequest& r, RobotPart& out) {
+  using Note = RobotPart::Note;
+  if (r.retry && holding() == r.object) {
+    // Stopped after the gripper closed: the grasp is done.
+    s_.log.write("robot_step_done", r.time_s, {{"step", "grasp"}, {"object", r.object}});
+    out.notes.push_back({Note::Kind::Finished, true, ""});
+    return;
+  }
+  if (const std::string why = whyNotGrasp(r); !why.empty()) {
+    // Never a grasp at a stale or unknown position: the experimenter retries once it is seen.
+    s_.log.write("robot_refused", r.time_s,
+                 {{"command", "GRASP"}, {"object", r.object}, {"why", why}});
+    if (r.at) s_.tell.say(r.time_s, Severity::Error, why);
+    out.notes.push_back({Note::Kind::Outcome, false, why});
+    out.notes.push_back({Note::Kind::Finished, false, why});
+    return;
+  }
+  grasped_id_ = r.object;
+  grasped_from_ = *r.at;
+  send(robot::MessageType::Grasp, *r.at, r.time_s);
+  s_.log.write("robot_command", r.time_s,
                {{"command", "GRASP"},
-                {"object", object_id},
-                {"target", {at[0], at[1], at[2]}},
+                {"object", r.object},
+                {"target", {(*r.at)[0], (*r.at)[1], (*r.at)[2]}},
                 {"sequence", *command_}});
 }
 

@@ -1,7 +1,8 @@
-// The robot stage on hand-built records against a real backend on 127.0.0.1 (a stepped simulated
-// arm on its own thread): the trial's grasp and put-down, noted on the record for the paradigm
-// (outcome, step finished, placement, put-down ended), the experimenter's stop and reset, the
-// pre-flight's probe, and a backend that goes silent in the middle of a grasp.
+// The robot stage on hand-built records against a real backend on 127.0.0.1 (a simulated arm on
+// its own thread, stepped on the session's clock or on the wall clock): the trial's grasp and
+// put-down, noted on the record for the paradigm (outcome, step finished, placement, put-down
+// ended), the experimenter's stop and reset, the pre-flight's probe, and a backend that goes silent
+// in the middle of a grasp.
 #include <gtest/gtest.h>
 
 #include <thread>
@@ -30,22 +31,24 @@ robot::RobotConfig armFor(const WorldSettings& w) {
 
 class RobotStageTest : public ::testing::Test {
  protected:
-  RobotStageTest()
-      : bench_("robot"),
-        backend_(std::make_unique<robot::RunningBackend>(
-            std::make_unique<robot::SimulatedArm>(armFor(world_)), options())) {
+  RobotStageTest() : bench_("robot") {}
+  // The backend on the session's stepped clock (reproducible), or on the wall clock as a real arm.
+  void connect(bool stepped = true) {
+    stepped_ = stepped;
+    backend_ = std::make_unique<robot::RunningBackend>(
+        std::make_unique<robot::SimulatedArm>(armFor(world_)), options(stepped));
     RobotLink link;
     link.client = std::make_unique<robot::RobotClient>(
         robot::Endpoint::resolve("127.0.0.1", backend_->port()), robot::testKey(),
         robot::fastClient());
-    link.stepped = true;
+    link.stepped = stepped;
     stage_ = std::make_unique<RobotStage>(RobotStageSettings{world_, 2}, std::move(link),
                                           bench_.services());
   }
-  static robot::BackendOptions options() {
+  static robot::BackendOptions options(bool stepped) {
     robot::BackendOptions o;
-    o.stepped = true;
-    o.speed_factor = 20.0;
+    o.stepped = stepped;
+    o.speed_factor = stepped ? 20.0 : 5.0;
     o.status_interval_s = 0.05;
     return o;
   }
@@ -60,6 +63,7 @@ class RobotStageTest : public ::testing::Test {
       const bool finished = done(r);
       bench_.next();
       if (finished) break;
+      if (!stepped_) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     return notes;
   }
@@ -69,17 +73,20 @@ class RobotStageTest : public ::testing::Test {
     return false;
   }
   WorldSettings world_;
+  bool stepped_ = true;
   test::StageBench bench_;
   std::unique_ptr<robot::RunningBackend> backend_;
   std::unique_ptr<RobotStage> stage_;
 };
 
 TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
+  connect();
   const WorldObjectSettings& object = world_.objects.front();
   until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
   ASSERT_TRUE(bench_.previous.robot.status.has_value()) << "no status from the backend";
   EXPECT_EQ(bench_.previous.robot.why_not_move, "");
-  bench_.record.requests.push_back(GraspRequest{object.id, object.position, bench_.record.time_s});
+  bench_.record.requests.push_back(
+      GraspRequest{object.id, object.position, 0.0, 0.5, false, bench_.record.frame / 60.0});
   auto notes = until([](const RobotPart& r) {
     for (const auto& n : r.notes)
       if (n.kind == Kind::Finished) return true;
@@ -90,7 +97,7 @@ TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
   EXPECT_EQ(bench_.previous.robot.grasped, object.id);
   EXPECT_FALSE(bench_.previous.robot.at_home);
   // Put down on cell (2, 2): placed, measured, the arm home and the table seen again.
-  bench_.record.requests.push_back(DropRequest{1, {2, 2}, false, bench_.record.time_s});
+  bench_.record.requests.push_back(DropRequest{1, {2, 2}, false, bench_.record.frame / 60.0});
   notes = until([](const RobotPart& r) {
     for (const auto& n : r.notes)
       if (n.kind == Kind::PutDownEnded) return true;
@@ -111,9 +118,11 @@ TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
 }
 
 TEST_F(RobotStageTest, TheExperimentersStopLatchesAndResetLiftsIt) {
+  connect(false);
   const WorldObjectSettings& object = world_.objects.front();
   until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
-  bench_.record.requests.push_back(GraspRequest{object.id, object.position, bench_.record.time_s});
+  bench_.record.requests.push_back(
+      GraspRequest{object.id, object.position, 0.0, 0.5, false, bench_.record.frame / 60.0});
   until([](const RobotPart& r) { return r.status && r.status->progress > 0.2; });
   stage_->stopNow(bench_.record.time_s);
   until([](const RobotPart& r) { return r.status && !r.status->stop_reason.empty(); }, 5.0);
@@ -136,16 +145,22 @@ TEST_F(RobotStageTest, TheExperimentersStopLatchesAndResetLiftsIt) {
 }
 
 TEST_F(RobotStageTest, ThePreflightsProbeIsAnswered) {
+  connect();
   bench_.record.requests.push_back(RobotProbeRequest{0.0});
   bench_.step(*stage_);
   EXPECT_TRUE(bench_.record.robot.answered);
 }
 
 TEST_F(RobotStageTest, ABackendThatGoesSilentInAGraspIsARobotFaultOnTheRecord) {
+  connect();
   const WorldObjectSettings& object = world_.objects.front();
   until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
-  bench_.record.requests.push_back(GraspRequest{object.id, object.position, bench_.record.time_s});
-  until([](const RobotPart& r) { return r.status && r.status->progress > 0.2; });
+  // Asked for on this cycle's frame: the arm has not moved yet when the backend goes.
+  bench_.record.requests.push_back(
+      GraspRequest{object.id, object.position, 0.0, 0.5, false, bench_.record.frame / 60.0});
+  bench_.step(*stage_);
+  ASSERT_TRUE(bench_.record.robot.busy);
+  bench_.next();
   backend_->halt();
   std::vector<RobotPart::Note> notes;
   // The link is judged silent on the wall clock: a second and more without an answer.

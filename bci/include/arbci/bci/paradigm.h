@@ -212,6 +212,16 @@ class Paradigm {
   void retakeCalibrationSelection();
   void nextTrial(double at_s, const std::string& why);
   void askRobot(Phase phase);  // Grasping or Dropping, with its command
+  // frame()'s parts: a sequence over starts the next or ends the flashing; the flash due shown
+  // (true) and those still lit; a timed phase (cue, feedback, selection shown) over moves on; what
+  // the frame shows.
+  void endSequenceIfOver(double due_s);
+  void showFlashes(double due_s, FrameStimulus& out);
+  bool showNextFlash(size_t i, double due_s);
+  void advanceTimedPhase(double due_s);
+  void showCalibrationFeedback(double due_s);
+  void endCalibration();  // the last calibration selection or feedback: training
+  void describe(FrameStimulus& out);
   double nextFrame() const { return now_ + 1.0 / settings_.display_hz; }
   void event(ParadigmEvent e);
 

@@ -31,9 +31,17 @@ struct SkipTrialRequest {};
 struct EndSessionRequest {};
 
 // To the robot stage. `time_s`: when it was asked for (a stepped arm starts it then).
+// A grasp of `object` (marker id) where the cameras last saw it: `at` (robot frame; none: never
+// seen, or not since the robot moved it), its pose then `pose_age_s` old. The robot stage never
+// grasps at an unknown pose or one older than `max_pose_age_s` (it says why on the record, as any
+// answer of the robot); `retry`: the experimenter's Retry step, done at once when the gripper
+// already holds the object.
 struct GraspRequest {
-  int object = 0;  // marker id
-  cv::Vec3d at;    // robot frame
+  int object = 0;
+  std::optional<cv::Vec3d> at;
+  double pose_age_s = 0.0;
+  double max_pose_age_s = 0.5;
+  bool retry = false;
   double time_s = 0.0;
 };
 struct DropRequest {

@@ -36,7 +36,9 @@ class RobotStage final : public Stage {
  private:
   void act(const Request& request, Cycle& cycle);
   void send(robot::MessageType type, const cv::Vec3d& target, double time_s);
-  void grasp(int object_id, const cv::Vec3d& at, double time_s);
+  void grasp(const GraspRequest& request, RobotPart& out);
+  // "" when the grasp may go, else why not (noted on the record as the robot's answer).
+  std::string whyNotGrasp(const GraspRequest& request) const;
   void drop(const DropRequest& request);
   void stop(double time_s);
   void reset(double time_s);
