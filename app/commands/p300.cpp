@@ -16,13 +16,16 @@
 #include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
+#include "arbci/bci/settings.h"
 #include "arbci/session/session_config.h"
+#include "arbci/session/settings_schema.h"
 #include "commands/commands.h"
 #include "eeg/p300_plots.h"
 #include "eeg/p300_report.h"
 #include "support/cli_error.h"
 #include "support/name_list.h"
 #include "support/output_path.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 namespace {
@@ -86,8 +89,9 @@ std::string utcNow() {
 
 struct TrainOptions {
   std::vector<std::string> files;
-  std::string out, channels, window_ms = "0,800", bci2000, plots, report, scores;
-  bci::DatasetOptions dataset;  // --reject-uv, --causal
+  std::string out, bci2000, plots, report, scores;
+  std::vector<double> window_ms;  // pipeline.window_ms
+  bci::DatasetOptions dataset;    // --reject-uv, --causal
   bool exclude_bad_channels = false;
   bci::TrainingSettings training;
   bci::PipelineSettings pipeline;
@@ -95,17 +99,18 @@ struct TrainOptions {
   bool errp = false;
   bool calibration_only = false;  // only the calibration blocks' feedbacks
   std::string p300_model;         // the ErrP classifier is written inside this P300 model
-  double errp_threshold = 0.5;
+  double errp_threshold = 0.0;    // errp.threshold
 };
 
-bci::EpochWindow parseWindow(const std::string& text) {
-  double start = 0.0, end = 0.0;
-  char comma = 0;
-  std::istringstream in(text);
-  if (!(in >> start >> comma >> end) || comma != ',' || !(end > start)) {
-    throw CliError("--window-ms '" + text + "' must be START,END in milliseconds with END > START");
+// The settings as given, checked by the schema's rules (a window that ends after it starts,
+// p_remove above p_enter): the same messages as a session file's, naming `command`.
+template <class S>
+void checkRules(const core::Schema<S>& schema, const S& settings, const std::string& command) {
+  try {
+    schema.resolve(schema.write(settings), {command, ""});
+  } catch (const core::SettingsError& error) {
+    throw CliError(error.what());
   }
-  return {start / 1000.0, end / 1000.0};
 }
 
 // Every output is checked before any work: a typo in a path costs no training.
@@ -179,7 +184,10 @@ void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
       {"--xdawn-filters",
        [&] { return std::to_string(o.training.xdawn.filters = training.xdawn.filters); }},
       {"--window-ms",
-       [&] { return o.window_ms = ms(errp.window.start_s) + "," + ms(errp.window.end_s); }},
+       [&] {
+         o.window_ms = {1000.0 * errp.window.start_s, 1000.0 * errp.window.end_s};
+         return ms(errp.window.start_s) + "," + ms(errp.window.end_s);
+       }},
       {"--decimate-hz", [&] { return text(o.pipeline.decimate_hz = errp.decimate_hz); }},
       {"--highpass-hz", [&] { return text(o.pipeline.filter.highpass_hz = errp.highpass_hz); }},
       {"--lowpass-hz", [&] { return text(o.pipeline.filter.lowpass_hz = errp.lowpass_hz); }},
@@ -194,16 +202,17 @@ void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
 }
 
 void train(TrainOptions& o) {
-  if (o.training.swlda.p_remove <= o.training.swlda.p_enter) {
-    std::ostringstream message;
-    message << "--p-remove " << o.training.swlda.p_remove << " must exceed --p-enter "
-            << o.training.swlda.p_enter << " (or a feature could enter and leave forever)";
-    throw CliError(message.str());
-  }
-  if (o.training.method == "riemann" && !o.bci2000.empty()) {
-    throw CliError(
-        "--bci2000: a riemann model is not linear in its features, so BCI2000's "
-        "LinearClassifier cannot run it (train swlda, slda or xdawn for BCI2000)");
+  o.pipeline.window = {o.window_ms[0] / 1000.0, o.window_ms[1] / 1000.0};
+  checkRules(bci::trainingSchema(), o.training, "arbci train");
+  checkRules(bci::pipelineSchema(), o.pipeline, "arbci train");
+  if (!bci::classifiers().at(o.training.method).make.linear && !o.bci2000.empty()) {
+    std::string linear;
+    for (const auto& entry : bci::classifiers().entries())
+      if (entry.make.linear) linear += (linear.empty() ? "" : ", ") + entry.name;
+    throw CliError("--bci2000: a " + o.training.method +
+                   " model is not linear in its features, so BCI2000's LinearClassifier cannot "
+                   "run it (train " +
+                   linear + " for BCI2000)");
   }
   if (o.errp && !o.bci2000.empty())
     throw CliError("--bci2000: BCI2000 has no ErrP classifier; leave out --bci2000 with --errp");
@@ -220,8 +229,6 @@ void train(TrainOptions& o) {
     }
   }
   checkOutputs(o.plots, {o.out, o.bci2000, o.report, o.scores});
-  o.pipeline.window = parseWindow(o.window_ms);
-  o.pipeline.channels = splitNameList(o.channels);
   try {
     o.pipeline = bci::withMethodRate(o.pipeline, o.training.method);
   } catch (const std::invalid_argument& error) {
@@ -335,7 +342,7 @@ struct EvaluateOptions {
   bci::DatasetOptions dataset;  // --reject-uv, --causal
   std::vector<std::string> files;
   int sequences = 0;
-  bci::StoppingRule dynamic{15, 2, 0.99};
+  bci::StoppingRule dynamic = bci::kOfflineStopping;
   std::string align = "per-file";
 };
 
@@ -421,6 +428,22 @@ void evaluate(EvaluateOptions& o) {
   }
 }
 
+// Each method with what it takes where a setting leaves it to the method (0): its features' rate
+// and its spatial filters, as its registry entry says.
+std::string methodsHelp() {
+  std::string out = "each method's own (where --decimate-hz or --xdawn-filters is 0): ";
+  bool first = true;
+  for (const auto& e : bci::classifiers().entries()) {
+    out += (first ? "" : ", ") + e.name + " " + core::formatNumber(e.make.feature_rate_hz) + " Hz";
+    if (e.make.xdawn_filters > 0)
+      out += " and " + std::to_string(e.make.xdawn_filters) + " spatial filter" +
+             (e.make.xdawn_filters > 1 ? "s" : "") + (e.name == "riemann" ? " per class" : "");
+    if (!e.make.linear) out += " (not linear: no --bci2000)";
+    first = false;
+  }
+  return out;
+}
+
 void addDatasetOptions(CLI::App& command, bci::DatasetOptions& dataset) {
   command.add_flag_function(
       "--causal",
@@ -445,50 +468,35 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       "recordings with known targets (BCI2000 .dat, ARBCI BDF+), cross-validated\n"
       "by selection. Options not given take a session's defaults (arbci settings).");
   train_cmd->add_option("FILES", t->files, "training recordings")->required();
-  train_cmd->add_option("--method", t->training.method, bci::classifiers().list(", "))
-      ->capture_default_str()
-      ->check(CLI::IsMember(bci::classifiers().names()));
+  const auto& training = bci::trainingSchema();
+  const auto& pipeline = bci::pipelineSchema();
+  schemaOption(*train_cmd, "--method", t->training.method, training.at("method"), methodsHelp());
   train_cmd->add_option("--out", t->out, "model file to write (JSON)")->required();
-  train_cmd->add_option("--channels", t->channels,
-                        "comma-separated channels to use (default: all)");
-  train_cmd->add_option("--window-ms", t->window_ms, "response window after the stimulus")
-      ->capture_default_str();
-  train_cmd
-      ->add_option("--decimate-hz", t->pipeline.decimate_hz,
-                   "feature rate after moving-average decimation (at most the signal's rate; 0: "
-                   "the method's own, which its line in --method's list gives)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10000.0));
-  train_cmd
-      ->add_option("--highpass-hz", t->pipeline.filter.highpass_hz,
-                   "Butterworth high-pass (0: none)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10000.0));
-  train_cmd
-      ->add_option("--lowpass-hz", t->pipeline.filter.lowpass_hz, "Butterworth low-pass (0: none)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10000.0));
-  train_cmd->add_option("--notch-hz", t->pipeline.filter.notch_hz, "notch (0: none)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10000.0));
-  train_cmd->add_flag("--car", t->pipeline.filter.common_average, "common average reference first");
-  train_cmd->add_flag("--zero-phase", t->pipeline.zero_phase,
-                      "filter forward and backward (no phase lag; offline only: the model says "
-                      "so, and a session filters causally)");
+  schemaOption(*train_cmd, "--channels", t->pipeline.channels, pipeline.at("channels"),
+               "comma-separated");
+  schemaOption(*train_cmd, "--window-ms", t->window_ms, pipeline.at("window_ms"),
+               "START,END after the stimulus");
+  schemaOption(*train_cmd, "--decimate-hz", t->pipeline.decimate_hz, pipeline.at("decimate_hz"),
+               "at most the signal's rate");
+  schemaOption(*train_cmd, "--highpass-hz", t->pipeline.filter.highpass_hz,
+               pipeline.at("highpass_hz"));
+  schemaOption(*train_cmd, "--lowpass-hz", t->pipeline.filter.lowpass_hz,
+               pipeline.at("lowpass_hz"));
+  schemaOption(*train_cmd, "--notch-hz", t->pipeline.filter.notch_hz, pipeline.at("notch_hz"));
+  schemaOption(*train_cmd, "--notch-q", t->pipeline.filter.notch_q, pipeline.at("notch_q"));
+  schemaOption(*train_cmd, "--filter-order", t->pipeline.filter.order, pipeline.at("filter_order"));
+  schemaFlag(*train_cmd, "--car", t->pipeline.filter.common_average, pipeline.at("common_average"));
+  schemaFlag(*train_cmd, "--zero-phase", t->pipeline.zero_phase, pipeline.at("zero_phase"),
+             "the model says so, and a session filters causally");
   addDatasetOptions(*train_cmd, t->dataset);
   train_cmd->add_flag("--exclude-bad-channels", t->exclude_bad_channels,
                       "leave out flat (SD < 0.5 uV) and drifting (SD > 20x the median channel's) "
                       "channels, which are always reported");
-  train_cmd
-      ->add_option("--folds", t->training.folds,
-                   "cross-validation folds (at most one per selection or file)")
-      ->capture_default_str()
-      ->check(CLI::Range(2, 100));
-  train_cmd
-      ->add_option("--folds-by", t->training.folds_by,
-                   "selection, block (contiguous flashes) or file; default: by selection, or by "
-                   "block for one selection or codes that are classes (an oddball)")
-      ->check(CLI::IsMember({"selection", "block", "file"}));
+  // The session's calibration folds (classifier.folds): an offline model compares with a
+  // session's own.
+  schemaOption(*train_cmd, "--folds", t->training.folds, session::classifierSchema().at("folds"),
+               "at most one per selection or file");
+  schemaOption(*train_cmd, "--folds-by", t->training.folds_by, training.at("folds_by"));
   train_cmd->add_flag("--errp", t->errp,
                       "train the error-related-potential classifier on the recordings' feedback "
                       "events (Feedback ... correct|error; a session with errp.enabled records "
@@ -500,38 +508,24 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd->add_option("--p300-model", t->p300_model,
                         "with --errp: write the ErrP classifier inside this P300 model (a session "
                         "needs both in one file) to --out");
-  train_cmd
-      ->add_option("--threshold", t->errp_threshold,
-                   "with --errp: the posterior of an error above which a selection is rejected, "
-                   "for the confusion printed")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+  schemaOption(*train_cmd, "--threshold", t->errp_threshold,
+               session::errpOwnSchema().at("threshold"), "with --errp: for the confusion printed");
   train_cmd->add_option("--report", t->report,
                         "also write the cross-validation report as JSON (everything printed)");
   train_cmd->add_option("--scores", t->scores,
                         "also write the out-of-fold score of every flash as CSV "
                         "(file,sample,code,label,score,fold)");
-  train_cmd->add_option("--p-enter", t->training.swlda.p_enter, "SWLDA: p-value to enter")
-      ->capture_default_str()
-      ->check(CLI::Range(1e-12, 1.0));
-  train_cmd
-      ->add_option("--p-remove", t->training.swlda.p_remove,
-                   "SWLDA: p-value to remove (above --p-enter)")
-      ->capture_default_str()
-      ->check(CLI::Range(1e-12, 1.0));
-  train_cmd
-      ->add_option("--max-features", t->training.swlda.max_features, "SWLDA: most features kept")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
-  train_cmd
-      ->add_option("--xdawn-filters", t->training.xdawn.filters,
-                   "xDAWN: spatial filters kept; riemann: per class (1 to the number of channels; "
-                   "0: the method's own, which its line in --method's list gives)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 256));
+  schemaOption(*train_cmd, "--p-enter", t->training.swlda.p_enter, training.at("p_enter"));
+  schemaOption(*train_cmd, "--p-remove", t->training.swlda.p_remove, training.at("p_remove"));
+  schemaOption(*train_cmd, "--max-features", t->training.swlda.max_features,
+               training.at("max_features"));
+  schemaOption(*train_cmd, "--xdawn-filters", t->training.xdawn.filters,
+               training.at("xdawn_filters"), "at most the number of channels");
+  schemaOption(*train_cmd, "--shift-ms", t->training.shift_ms, training.at("shift_ms"));
   train_cmd
       ->add_option("--certainty", t->training.dynamic.certainty,
-                   "dynamic stopping: stop at this posterior probability (0: never early)")
+                   "offline dynamic stopping (the bit rate reported with it): stop at this "
+                   "posterior probability (0: never early)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.999999));
   train_cmd->add_option("--bci2000", t->bci2000,

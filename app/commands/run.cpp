@@ -16,6 +16,7 @@
 #include "support/headless_run.h"
 #include "support/interrupt.h"
 #include "support/session_file.h"
+#include "support/session_folder.h"
 #include "workstation/start_error_window.h"
 #include "workstation/workstation.h"
 
@@ -45,62 +46,6 @@ std::string defaultFolder() {
     folder = std::string(name) + "-" + std::to_string(n);
   return folder;
 }
-
-// A session that ended in its pre-flight never started: its folder holds the reason and no data
-// (no calibration, no trial), and a retry may take its place.
-bool holdsOnlyAFailedStart(const std::filesystem::path& folder) {
-  std::ifstream in(folder / "summary.json");
-  if (!in) return false;
-  const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
-  if (summary.is_discarded() || !summary.is_object()) return false;
-  const std::string reason = summary.value("end_reason", "");
-  return reason.rfind("pre-flight failed", 0) == 0 &&
-         summary.value("trials", nlohmann::json::array()).empty();
-}
-
-// A session's data are never overwritten by accident: an existing, non-empty --out is refused
-// unless --overwrite, which empties it first, or it holds only a failed start.
-void claimFolder(const std::string& out, bool overwrite) {
-  std::error_code error;
-  if (!std::filesystem::exists(out, error) || std::filesystem::is_empty(out, error)) return;
-  if (!std::filesystem::is_directory(out))
-    throw CliError("--out " + out + ": exists and is not a folder");
-  if (!overwrite && holdsOnlyAFailedStart(out)) {
-    std::cerr << "--out " << out << ": holds a session that failed its pre-flight; replacing it\n";
-  } else if (!overwrite) {
-    throw CliError("--out " + out +
-                   ": the folder exists and is not empty (an earlier session?); choose another "
-                   "--out, leave it out for a new time-stamped folder, or add --overwrite");
-  }
-  std::filesystem::remove_all(out, error);
-  if (error) throw CliError("--out: cannot empty " + out + ": " + error.message());
-}
-
-// Until the session has opened, what this run wrote into its folder is removed again when it
-// fails (a bad setting, a missing key file): a failed start leaves nothing that blocks a retry.
-class FolderClaim {
- public:
-  explicit FolderClaim(std::filesystem::path folder)
-      : folder_(std::move(folder)), existed_(std::filesystem::exists(folder_)) {}
-  ~FolderClaim() {
-    if (kept_) return;
-    std::error_code error;
-    if (existed_) {  // claimed empty: empty it again
-      for (const auto& entry : std::filesystem::directory_iterator(folder_, error))
-        std::filesystem::remove_all(entry.path(), error);
-    } else {
-      std::filesystem::remove_all(folder_, error);
-    }
-  }
-  FolderClaim(const FolderClaim&) = delete;
-  FolderClaim& operator=(const FolderClaim&) = delete;
-  void keep() { kept_ = true; }
-
- private:
-  std::filesystem::path folder_;
-  bool existed_;
-  bool kept_ = false;
-};
 
 void printSummary(const session::Session& session) {
   std::cout << "session folder: " << session.folder().string() << "\n";

@@ -149,7 +149,10 @@ FrameStimulus Paradigm::frame(std::int64_t index, double due_s) {
   if (flashing && !awaiting_decision_) showFlashes(due_s, out);
   advanceTimedPhase(due_s);
   describe(out);
-  if (lit_last_frame_ && out.lit.empty()) last_dark_s_ = due_s;
+  if (lit_last_frame_ && out.lit.empty()) {
+    last_dark_s_ = due_s;
+    dark_frame_ = index;
+  }
   lit_last_frame_ = !out.lit.empty();
   return out;
 }
@@ -212,6 +215,7 @@ bool Paradigm::showNextFlash(size_t i, double due_s) {
   event(e);
   f.shown_s = due_s;
   last_onset_s_ = due_s;
+  onset_frame_ = frame_;
   next_flash_ = i + 1;
   return true;
 }
@@ -298,6 +302,13 @@ void Paradigm::describe(FrameStimulus& out) {
   }
   if (phase_ == Phase::CellSelected || phase_ == Phase::Dropping)
     out.selected_cell = selected_cell_;
+}
+
+void Paradigm::presented(std::int64_t index, double at_s) {
+  // A frame shown later than it was due moves what the next flash must keep its distance from:
+  // the gap and the SOA the screen really showed, not those the schedule planned.
+  if (index == onset_frame_) last_onset_s_ = std::max(last_onset_s_, at_s);
+  if (index == dark_frame_) last_dark_s_ = std::max(last_dark_s_, at_s);
 }
 
 void Paradigm::askRobot(Phase phase) {

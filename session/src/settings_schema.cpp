@@ -365,7 +365,7 @@ const Schema<SessionConfig>& paradigmSectionSchema() {
   return t;
 }
 
-const Schema<ClassifierSettings>& classifierSchema() {
+const Schema<ClassifierSettings>& classifierTable() {
   static const Schema<ClassifierSettings> t = [] {
     using C = ClassifierSettings;
     Schema<C> t("classifier", "The P300 classifier the calibration run trains");
@@ -376,7 +376,7 @@ const Schema<ClassifierSettings>& classifierSchema() {
       else
         t.adopt(bci::pipelineSchema(), key, &C::pipeline);
     }
-    for (const char* key : {"p_enter", "p_remove", "max_features", "xdawn_filters"})
+    for (const char* key : {"p_enter", "p_remove", "max_features", "xdawn_filters", "shift_ms"})
       t.adopt(bci::trainingSchema(), key, &C::training);
     // The calibration run's cross-validation, not an offline analysis's (arbci train --folds):
     // fewer folds, so the first trial starts sooner.
@@ -392,7 +392,7 @@ const Schema<ClassifierSettings>& classifierSchema() {
   return t;
 }
 
-const Schema<ErrpSettings>& errpOwnSchema() {
+const Schema<ErrpSettings>& errpTable() {
   static const Schema<ErrpSettings> t = [] {
     using E = ErrpSettings;
     Schema<E> t("errp", "The ErrP classifier");
@@ -444,8 +444,8 @@ const Schema<SessionConfig>& errpSectionSchema() {
         .adopt(p, "errp_runner_up", &SessionConfig::paradigm, "runner_up")
         .adopt(p, "errp_repeat_sequences", &SessionConfig::paradigm, "repeat_sequences")
         .adopt(p, "errp_max_corrections", &SessionConfig::paradigm, "max_corrections")
-        .merge(errpOwnSchema(), &SessionConfig::errp)
-        .rulesOf(errpOwnSchema());
+        .merge(errpTable(), &SessionConfig::errp)
+        .rulesOf(errpTable());
     return t;
   }();
   return t;
@@ -519,6 +519,14 @@ Broken crossRules(const Json& c) {
 
 }  // namespace
 
+const core::Schema<ClassifierSettings>& classifierSchema() {
+  return classifierTable();
+}
+
+const core::Schema<ErrpSettings>& errpOwnSchema() {
+  return errpTable();
+}
+
 const Schema<SessionConfig>& sessionSchema() {
   static const Schema<SessionConfig> t = [] {
     Schema<SessionConfig> t("session", "A session file: every key, its default and what it means");
@@ -532,7 +540,7 @@ const Schema<SessionConfig>& sessionSchema() {
         .section("eeg", &SessionConfig::eeg, eegSchema())
         .section("lsl", &SessionConfig::lsl, lslSchema())
         .sectionOf("paradigm", paradigmSectionSchema())
-        .section("classifier", &SessionConfig::classifier, classifierSchema())
+        .section("classifier", &SessionConfig::classifier, classifierTable())
         .sectionOf("errp", errpSectionSchema())
         .section("robot", &SessionConfig::robot, robotSchema());
     t.rule(crossRules);
@@ -569,7 +577,7 @@ LslSettings::LslSettings() {
   lslSchema().applyDefaults(*this);
 }
 ErrpSettings::ErrpSettings() {
-  errpOwnSchema().applyDefaults(*this);
+  errpTable().applyDefaults(*this);
 }
 TrialIntent::TrialIntent() : object(0) {
   intentSchema().applyDefaults(*this);

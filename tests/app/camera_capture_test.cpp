@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -71,6 +72,21 @@ TEST(CameraReader, ASessionsCaptureThreadPlaysTheFileAtItsOwnRate) {
     FAIL() << "a missing video must be refused";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("cameras.left: cannot open video"), std::string::npos)
+        << error.what();
+  }
+}
+
+// A file that is not a video at all is refused as the camera opens, naming the session file's key
+// (the session then ends before it starts: no flash, nothing recorded).
+TEST(CameraReader, AFileThatIsNotAVideoIsRefusedNamingTheKey) {
+  const auto file = freshTempPath("camera_capture_test", "camera.mp4");
+  std::ofstream(file) << "this is not a video\n";
+  try {
+    session::CameraCapture capture(-1, file.string(), "cameras.left.video");
+    FAIL() << "a file that is not a video was opened";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("cameras.left.video: cannot open video"),
+              std::string::npos)
         << error.what();
   }
 }

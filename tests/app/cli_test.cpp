@@ -59,63 +59,6 @@ TEST(Cli, UnwritableOutputGivesOneLineErrorAndNonZeroExit) {
   EXPECT_NE(result.err.find("/nonexistent-dir/shot.png"), std::string::npos) << result.err;
 }
 
-// A session folder is never overwritten by accident: the second run into it refuses and leaves
-// the first run's data as they were.
-TEST(Cli, RunRefusesAFolderThatHoldsASession) {
-  const auto folder = std::filesystem::temp_directory_path() / "arbci_cli_test_taken_session";
-  std::filesystem::remove_all(folder);
-  std::filesystem::create_directories(folder);
-  { std::ofstream(folder / "summary.json") << "{\"ended\": \"finished\"}\n"; }
-  const ProcessResult r =
-      runProcess(kArbci, {"run", "--headless", "--trials", "1", "--out", folder.string()});
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("exists and is not empty"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
-  std::ifstream in(folder / "summary.json");
-  std::string kept((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(kept, "{\"ended\": \"finished\"}\n");
-  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folder), {}), 1);
-}
-
-// A start that fails (here: the session file names a key file that is not there) leaves nothing
-// behind, and a folder holding only a session that failed its pre-flight is taken by the retry.
-TEST(Cli, AFailedStartLeavesNothingThatBlocksARetry) {
-  const auto base = std::filesystem::temp_directory_path() / "arbci_cli_test_failed_start";
-  std::filesystem::remove_all(base);
-  std::filesystem::create_directories(base);
-  const auto session = base / "missing_key.json";
-  {
-    std::ofstream(session) << "{\"robot\": {\"backend\": \"remote\", \"key_file\": \""
-                           << (base / "no.key").string() << "\"}}\n";
-  }
-  const auto fresh = base / "fresh";
-  ProcessResult r = runProcess(
-      kArbci, {"run", "--headless", "--session", session.string(), "--out", fresh.string()});
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("key_file"), std::string::npos) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(fresh));
-  // A folder given empty is left empty.
-  const auto empty = base / "empty";
-  std::filesystem::create_directories(empty);
-  r = runProcess(kArbci,
-                 {"run", "--headless", "--session", session.string(), "--out", empty.string()});
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_TRUE(std::filesystem::is_empty(empty));
-  // A failed pre-flight's folder is replaced (the run gets as far as the key file again).
-  const auto failed = base / "failed_preflight";
-  std::filesystem::create_directories(failed);
-  {
-    std::ofstream(failed / "summary.json")
-        << "{\"ended\": \"aborted\", \"end_reason\": \"pre-flight failed: robot.host, "
-           "robot.port: no answer\", \"trials\": []}\n";
-  }
-  r = runProcess(kArbci,
-                 {"run", "--headless", "--session", session.string(), "--out", failed.string()});
-  EXPECT_NE(r.err.find("failed its pre-flight; replacing it"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("key_file"), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find("exists and is not empty"), std::string::npos) << r.err;
-}
-
 // An option that cannot act is refused, not ignored.
 TEST(Cli, DetectRefusesAMarkerSetWithoutACamera) {
   const ProcessResult r = runProcess(kArbci, {"detect", "--marker-set", "set.cfg", "frame.png"});

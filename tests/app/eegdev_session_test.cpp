@@ -1,5 +1,5 @@
-// A headless session whose EEG comes through eegdev's `datafile` device, which plays a BDF file
-// as if it were an amplifier, in real time.
+// EEG through eegdev's `datafile` device, which plays a BDF file as if it were an amplifier, in
+// real time: the source as a session opens it, and its refusals.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -12,13 +12,15 @@
 
 #include "arbci/bci/eegdev_source.h"
 #include "arbci/bci/recording.h"
-#include "support/background_process.h"
+#include "arbci/session/eeg_sources.h"
+#include "arbci/session/stages/eeg_acquisition_stage.h"
+#include "arbci/session/stages/recording_stage.h"
+#include "support/stage_bench.h"
 #include "support/test_files.h"
 
 namespace arbci {
 namespace {
 
-const std::string kArbci = ARBCI_EXECUTABLE;
 const std::string kEeg3 =
     std::string(ARBCI_SHARED_DATA_DIR) + "/eeg/bci2000_samplefiles/eeg3_1.dat";
 constexpr double kRangeUv = 8000.0;
@@ -76,6 +78,9 @@ void writeBiosemiBdf(const bci::Recording& r, const std::filesystem::path& path)
       }
 }
 
+// The eegdev source as the session opens it (eeg.source "eegdev", its device string), acquired
+// in real time by the acquisition stage and written by the recording stage: the file's samples
+// arrive unchanged.
 TEST(EegdevSession, TheDatafileDeviceDeliversTheBdfIntoTheRecordingUnchanged) {
   const auto folder = test::freshTempPath("eegdev_session", "datafile");
   std::filesystem::create_directories(folder);
@@ -85,36 +90,44 @@ TEST(EegdevSession, TheDatafileDeviceDeliversTheBdfIntoTheRecordingUnchanged) {
   const bci::Recording file = bci::readRecording(bdf);  // what the file holds, quantised
   ASSERT_EQ(file.info.channels, source.info.channels);  // the reader keeps Status as events
 
-  nlohmann::json session = {{"description", "EEG through eegdev's datafile device"},
-                            {"eeg",
-                             {{"source", "eegdev"},
-                              {"rate_hz", source.info.rate_hz},
-                              {"photodiode_channel", ""},
-                              {"eegdev", {{"device", "datafile|path|" + bdf.string()}}}}}};
-  const auto session_file = folder / "eegdev.json";
-  std::ofstream(session_file) << session.dump(2);
-  const auto out = folder / "session";
-  test::BackgroundProcess run(
-      kArbci, {"run", "--headless", "--session", session_file.string(), "--out", out.string()});
-  std::this_thread::sleep_for(std::chrono::seconds(12));
-  run.signal(SIGTERM);
-  ASSERT_TRUE(run.wait(30.0)) << "the session did not end";
+  const nlohmann::json settings = {{"eeg",
+                                    {{"source", "eegdev"},
+                                     {"rate_hz", source.info.rate_hz},
+                                     {"photodiode_channel", ""},
+                                     {"eegdev", {{"device", "datafile|path|" + bdf.string()}}}}}};
+  const session::SessionConfig config = session::SessionConfig::parse(settings, "eegdev.json");
+  test::StageBench bench("eegdev", session::Clock::Mode::RealTime);
+  session::EegAcquisitionStage eeg(
+      {config.eeg, 0.06, "eegdev.json"},
+      session::openEegSource(config.eeg, {}, bench.clock(), "eegdev.json"), bench.clock(),
+      bench.services());
+  const auto path = folder / "recording.bdf";
+  session::RecordingStage recording({path, eeg.info(), {}}, bench.services());
+  // Four seconds of the file, played in real time, a cycle every 16 ms.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(4);
+  while (std::chrono::steady_clock::now() < until) {
+    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+    bench.step(eeg);
+    bench.step(recording);
+    EXPECT_EQ(bench.record.eeg.fault, "");
+    bench.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(16));
+  }
+  session::Cycle end = bench.cycle();
+  eeg.stop(end, "done");
+  recording.stop(end, "done");
 
-  const bci::Recording recorded = bci::readRecording(out / "recording.bdf");
+  const bci::Recording recorded = bci::readRecording(path);
   // The EEG channels (the Status channel is a trigger, not EEG), sample for sample from the
   // file's first, within the two files' 24-bit steps.
   ASSERT_EQ(recorded.info.channels, source.info.channels);
-  ASSERT_GT(recorded.samples, static_cast<std::int64_t>(8 * source.info.rate_hz));
+  ASSERT_GT(recorded.samples, static_cast<std::int64_t>(2 * source.info.rate_hz));
   double worst = 0;
   for (int c = 0; c < recorded.info.channelCount(); ++c)
     for (std::int64_t s = 0; s < recorded.samples; ++s)
       worst = std::max(worst, static_cast<double>(std::abs(recorded.at(c, s) - file.at(c, s))));
   EXPECT_LT(worst, 0.005) << "microvolts";
-  const nlohmann::json summary = test::readJson(out / "summary.json");
-  EXPECT_EQ(summary["timing"]["lost_samples"], 0);
-  std::printf(
-      "[ measured ] %lld samples x %d channels from eegdev datafile; worst difference %.4f uV\n",
-      static_cast<long long>(recorded.samples), recorded.info.channelCount(), worst);
+  EXPECT_EQ(bench.previous.eeg.lost_samples, 0);
 }
 
 // `seconds` of a ramp on `labels` at 256 Hz: sample s of channel c is (c + 1) * 10 + s / 100 uV.

@@ -110,8 +110,9 @@ TEST(RobotCommand, KeygenWritesAPrivateKey) {
   EXPECT_TRUE(std::filesystem::is_fifo(fifo));
 }
 
-// A wrong key file is named as such, by the command line and by a session's pre-flight, not
-// taken for a missing backend: the backend answers a HELLO it cannot verify with KEY MISMATCH.
+// A wrong key file is named as such by the command line, not taken for a missing backend: the
+// backend answers a HELLO it cannot verify with KEY MISMATCH. (A session's robot stage puts it on
+// the record and its pre-flight names it: tests/session/stages.)
 TEST(RobotCommand, AWrongKeyIsNamedAsSuchNotAsAMissingBackend) {
   const auto key = scratch("right.key"), wrong = scratch("wrong.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--force", "--out", key.string()}).exit_code, 0);
@@ -123,24 +124,6 @@ TEST(RobotCommand, AWrongKeyIsNamedAsSuchNotAsAMissingBackend) {
       runProcess(kArbci, {"robot", "--port", port, "--key-file", wrong.string(), "status"}, 60.0);
   EXPECT_EQ(cli.exit_code, 1) << cli.err;
   EXPECT_NE(cli.err.find("answered that our key is not its key"), std::string::npos) << cli.err;
-  // The session's pre-flight says the same and ends the headless run before any flash.
-  const auto session = scratch("wrong_key_session.json");
-  std::ofstream(session) << nlohmann::json{{"robot",
-                                            {{"backend", "remote"},
-                                             {"host", "127.0.0.1"},
-                                             {"port", std::stoi(port)},
-                                             {"key_file", wrong.string()}}}}
-                                .dump();
-  const auto out = scratch("wrong_key_out");
-  std::filesystem::remove_all(out);
-  const ProcessResult run = runProcess(
-      kArbci, {"run", "--headless", "--session", session.string(), "--out", out.string()}, 120.0);
-  EXPECT_EQ(run.exit_code, 3) << run.err;
-  EXPECT_NE(run.err.find("pre-flight failed: robot.host, robot.port: the robot backend at "
-                         "127.0.0.1:" +
-                         port + " answered that our key is not its key"),
-            std::string::npos)
-      << run.err;
 }
 
 TEST(RobotCommand, GraspDropAndRejectionsThroughTheBackend) {

@@ -368,6 +368,50 @@ TEST(Paradigm, OnLateFramesFlashesNeverSqueezeTheirSoaOrGap) {
   EXPECT_GT(slipped, 0);  // the late frames did make the schedule slip
 }
 
+// A frame can reach the screen later than it was due (the process or the display held up). The
+// screen's own SOA and dark gap, measured on the frames as presented, are never shorter than the
+// paradigm's: a late dark frame or onset moves the next flash with it.
+TEST(Paradigm, OnFramesPresentedLateTheScreenNeverShowsAShorterSoaOrGap) {
+  ParadigmSettings s = fast();
+  s.calibration_selections = 4;
+  Paradigm p(s, 4, 3, 3, 5);
+  p.start(true);
+  const double period = 1.0 / s.display_hz;
+  const double gap = s.soaSeconds() - s.flashSeconds();
+  std::uint32_t state = 91;
+  auto unit = [&] {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 8) / 16777216.0;
+  };
+  double clock = 0.0, last_shown = -1.0, last_onset = -1.0, last_dark = -1.0;
+  bool was_lit = false;
+  int onsets = 0, short_soa = 0, short_gap = 0;
+  for (std::int64_t frame = 0; frame < 6000 && p.phase() != Phase::Training; ++frame) {
+    // Due a period after the last frame was shown (as the window's session has it); shown then,
+    // or, one frame in five, up to three periods later.
+    clock += period;
+    const double due = last_shown < 0.0 ? clock : std::max(clock, last_shown + period);
+    const FrameStimulus shown = p.frame(frame, due);
+    if (p.awaitingDecision()) p.decide(Decision{});
+    const double at = due + (unit() < 0.2 ? period * 3.0 * unit() : 0.0);
+    p.presented(frame, at);
+    last_shown = clock = at;
+    if (!shown.lit.empty() && !was_lit) {
+      ++onsets;
+      if (last_onset >= 0.0) short_soa += at - last_onset < s.soaSeconds() - 1e-9;
+      if (last_dark >= 0.0) short_gap += at - last_dark < gap - 1e-9;
+      last_onset = at;
+    }
+    if (shown.lit.empty() && was_lit) last_dark = at;
+    was_lit = !shown.lit.empty();
+    p.takeEvents();
+  }
+  EXPECT_EQ(p.phase(), Phase::Training);
+  EXPECT_EQ(onsets, 4 * 3 * 4);
+  EXPECT_EQ(short_soa, 0);
+  EXPECT_EQ(short_gap, 0);
+}
+
 // The timing check's paradigm: cued calibration selections that go on, never to training.
 TEST(Paradigm, FlashesOnlyNeverEndsTheCalibrationRun) {
   ParadigmSettings s = fast();  // 2 calibration selections

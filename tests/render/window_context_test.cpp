@@ -24,26 +24,8 @@ void useXvfbDisplay() {
   unsetenv("XAUTHORITY");
 }
 
-TEST(WindowContext, DrawsThePatternIntoTheBackBuffer) {
-  useXvfbDisplay();
-  ASSERT_TRUE(displayAvailable()) << "no DISPLAY although Xvfb was started";
-  WindowContext window({"test", {80, 60}, true, -1, nullptr, false});
-  const Size size = window.framebufferSize();
-  ASSERT_EQ(size, (Size{80, 60}));
-  EXPECT_FALSE(window.isHeadless());
-  PrimitiveRenderer renderer;
-  clearFramebuffer(window.drawFramebuffer(), size, {0.0f, 0.0f, 0.0f, 1.0f});
-  renderer.fillPolygon(std::vector<glm::vec2>{{0, 0}, {40, 0}, {40, 30}, {0, 30}}, {1, 0, 0, 1},
-                       glm::vec2(80, 60));
-  const RgbaImage image = readPixels(0, size);
-  EXPECT_EQ(image.at(10, 10)[0], 255);
-  EXPECT_EQ(image.at(10, 10)[1], 0);
-  EXPECT_EQ(image.at(60, 50)[0], 0);
-  window.present();
-}
-
-TEST(WindowContext, DrawsTheExperimenterShell) {
-  useXvfbDisplay();
+// The experimenter shell with a panel in a window of its own: its text is drawn.
+void drawTheShell() {
   WindowContext window({"shell", {800, 500}, true, -1, nullptr, false});
   ui::SystemPanel panel({{std::string("context"), std::string("window (GLFW)")}});
   ui::ImGuiLayer imgui(window, "");
@@ -65,6 +47,29 @@ TEST(WindowContext, DrawsTheExperimenterShell) {
     for (int x = 0; x < image.width; ++x) bright += image.at(x, y)[1] > 150;
   }
   EXPECT_GT(bright, 100) << "no text drawn";
+}
+
+// One test opens the windows (a window opened is counted among the whole-window tests): a pattern
+// drawn into the back buffer, then the shell.
+TEST(WindowContext, DrawsThePatternAndTheExperimenterShell) {
+  useXvfbDisplay();
+  ASSERT_TRUE(displayAvailable()) << "no DISPLAY although Xvfb was started";
+  {
+    WindowContext window({"test", {80, 60}, true, -1, nullptr, false});
+    const Size size = window.framebufferSize();
+    ASSERT_EQ(size, (Size{80, 60}));
+    EXPECT_FALSE(window.isHeadless());
+    PrimitiveRenderer renderer;
+    clearFramebuffer(window.drawFramebuffer(), size, {0.0f, 0.0f, 0.0f, 1.0f});
+    renderer.fillPolygon(std::vector<glm::vec2>{{0, 0}, {40, 0}, {40, 30}, {0, 30}}, {1, 0, 0, 1},
+                         glm::vec2(80, 60));
+    const RgbaImage image = readPixels(0, size);
+    EXPECT_EQ(image.at(10, 10)[0], 255);
+    EXPECT_EQ(image.at(10, 10)[1], 0);
+    EXPECT_EQ(image.at(60, 50)[0], 0);
+    window.present();
+  }
+  drawTheShell();
 }
 
 }  // namespace

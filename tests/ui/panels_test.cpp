@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -25,6 +26,7 @@
 #include "arbci/ui/experimenter_shell.h"
 #include "arbci/ui/imgui_layer.h"
 #include "arbci/ui/panel_registry.h"
+#include "arbci/ui/start_error_screen.h"
 #include "arbci/ui/widget_registry.h"
 #include "support/panel_bench.h"
 
@@ -525,6 +527,130 @@ TEST_F(Panels, TheCalibrationPanelAppliesTheReferenceAsARequest) {
   // Where the tracker has the reference now (the default: 0.90 m along the robot's y axis).
   EXPECT_EQ(reference.id, 0);
   EXPECT_NEAR(reference.position[1], 0.9, 1e-6);
+}
+
+// An ERP by hand: eight channels, 0.8 s at 64 Hz, a target bump at 0.35 s over a flat other.
+std::shared_ptr<const bci::ErpCurves> handErp() {
+  auto erp = std::make_shared<bci::ErpCurves>();
+  erp->channels = {"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"};
+  erp->rate_hz = 64.0;
+  erp->window_end_s = 0.8;
+  erp->targets = 40;
+  erp->others = 120;
+  const int n = 52;
+  erp->target_mean.resize(8, n);
+  erp->other_mean.resize(8, n);
+  erp->target_se = Eigen::MatrixXd::Constant(8, n, 0.5);
+  erp->other_se = Eigen::MatrixXd::Constant(8, n, 0.3);
+  erp->signed_r2 = Eigen::MatrixXd::Zero(8, n);
+  for (int c = 0; c < 8; ++c) {
+    for (int i = 0; i < n; ++i) {
+      const double t = i / 64.0;
+      erp->target_mean(c, i) = 5.0 * std::exp(-std::pow((t - 0.35) / 0.09, 2) / 2);
+      erp->other_mean(c, i) = -0.5 * std::exp(-std::pow((t - 0.2) / 0.05, 2) / 2);
+    }
+  }
+  return erp;
+}
+
+int countPixels(const cv::Mat& rgba, const std::function<bool(const cv::Vec4b&)>& pick) {
+  int n = 0;
+  for (int y = 0; y < rgba.rows; ++y)
+    for (int x = 0; x < rgba.cols; ++x) n += pick(rgba.at<cv::Vec4b>(y, x));
+  return n;
+}
+
+// The session's own averages, on the record once it trained: the P300's target (red) and
+// non-target (blue) curves beside the ErrP's.
+TEST_F(Panels, TheTrainingPanelPlotsTheSessionsAveragesOfBothClassifiers) {
+  bench_.record.p300.erp = handErp();
+  bench_.record.errp.erp = handErp();
+  auto panel = make("training");
+  const Drawn d = draw(*panel);
+  const int red =
+      countPixels(d.image, [](const cv::Vec4b& p) { return p[0] > 170 && p[1] < 90 && p[2] < 90; });
+  const int blue =
+      countPixels(d.image, [](const cv::Vec4b& p) { return p[2] > 170 && p[0] < 120; });
+  EXPECT_GT(red, 500);
+  EXPECT_GT(blue, 500);
+}
+
+// Ending with an object in the gripper: the dialog says so and offers to put it back first.
+TEST_F(Panels, EndingWithAnObjectHeldOffersToPutItBackFirst) {
+  bench_.record.paradigm.interrupted = bci::Phase::Grasping;
+  bench_.record.paradigm.phase = bci::Phase::EmergencyStop;
+  bench_.record.robot.status->holding = 20;
+  bench_.record.robot.at_home = false;
+  auto panel = make("robot");
+  Drawer drawer(*context_, *panel);
+  ASSERT_TRUE(drawer.click(bench_, "End session"));
+  const Drawn dialog = drawer.frames(bench_, 2);
+  ASSERT_TRUE(dialog.widgets.count("Put it back first"));
+  EXPECT_TRUE(dialog.widgets.count("End now"));
+  EXPECT_TRUE(dialog.widgets.at("Put it back first").enabled)
+      << dialog.widgets.at("Put it back first").why_disabled;
+  ASSERT_TRUE(drawer.click(bench_, "Put it back first"));
+  EXPECT_EQ(bench_.requests.count<session::RobotReleaseRequest>(), 1);
+  EXPECT_EQ(bench_.requests.count<session::EndSessionRequest>(), 0);
+}
+
+// A setting out of its range: refused with the session file's message, Save disabled with it.
+TEST_F(Panels, TheSettingsPanelRefusesABadValueWithItsReason) {
+  bench_.settings.paradigm.flash_ms = 1.0;
+  auto panel = make("settings");
+  const Drawn d = draw(*panel);
+  ASSERT_TRUE(d.widgets.count("Save"));
+  EXPECT_FALSE(d.widgets.at("Save").enabled);
+  const std::string why = d.widgets.at("Save").why_disabled;
+  EXPECT_NE(why.find("paradigm.flash_ms"), std::string::npos) << why;
+}
+
+TEST(StartError, TheScreenShowsTheReasonAndQuitEndsIt) {
+  auto context = render::createHeadlessContext(kSize);
+  ImGuiLayer imgui(*context, "");
+  const std::string reason = "session.json: eeg.file = \"x.bdf\": no such file";
+  bool quit = false;
+  for (int frame = 0; frame < 6 && !quit; ++frame) {
+    SyntheticInput input;
+    if (frame >= 3) {
+      const auto& widgets = drawnWidgets();
+      const auto found = std::find_if(widgets.begin(), widgets.end(),
+                                      [](const DrawnWidget& w) { return w.label == "Quit"; });
+      ASSERT_NE(found, widgets.end());
+      input.x = 0.5f * (found->x0 + found->x1);
+      input.y = 0.5f * (found->y0 + found->y1);
+      input.left_down = frame == 4;
+    }
+    context->makeCurrent();
+    imgui.beginFrame(1.0f / 60.0f, &input);
+    quit = drawStartError(1000.0f, 700.0f, reason);
+    render::clearFramebuffer(context->drawFramebuffer(), kSize, {0.08f, 0.09f, 0.11f, 1.0f});
+    imgui.endFrame();
+    context->present();
+  }
+  EXPECT_TRUE(quit);
+}
+
+// Ctrl+Q quits as the File menu says.
+TEST_F(Panels, CtrlQQuitsTheShell) {
+  auto panel = make("log");
+  ImGuiLayer imgui(*context_, "");
+  ExperimenterShell shell;
+  shell.addPanel(*panel);
+  int quits = 0;
+  shell.setQuitHandler([&] { ++quits; });
+  for (int frame = 0; frame < 3; ++frame) {
+    SyntheticInput input;
+    if (frame == 1) {
+      input.key = 'Q';
+      input.ctrl = true;
+    }
+    context_->makeCurrent();
+    imgui.beginFrame(1.0f / 60.0f, &input);
+    shell.draw(kSize, {16.7f, "", ""}, bench_.input());
+    imgui.endFrame();
+  }
+  EXPECT_EQ(quits, 1);
 }
 
 }  // namespace

@@ -56,6 +56,8 @@ void ParadigmStage::step(Cycle& cycle) {
   takeRobotNotes(cycle);
   watchGrasp(cycle);
   collectTraining(cycle);
+  const Presentation& shown = cycle.record.presentation;
+  if (shown.shown) paradigm_.presented(shown.frame, shown.at_s);
   stimulus_ = paradigm_.frame(cycle.frame, cycle.due_s);
   view_watch_.withholdStale(cycle, slots_, paradigm_.phase(), stimulus_);
   handleEvents(cycle);

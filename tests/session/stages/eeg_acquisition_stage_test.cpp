@@ -221,22 +221,31 @@ TEST(EegAcquisitionStage, AFlashStampedInTheCycleAStallIsTakenIsMarkedUncertain)
   eeg.source->hold = true;
   std::this_thread::sleep_for(std::chrono::milliseconds(400));
   eeg.source->hold = false;
-  // The held-back blocks arrive at once (the acquisition polls every millisecond).
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  bench.record.presentation.shown = true;
-  bench.record.presentation.host_s = held_from + 0.2;
-  bench.record.presentation.onsets.push_back({Flash{1, true, false, true, 1}, 4321});
-  bench.record.time_s = bench.clock().frameTime(bench.record.frame);
-  bench.step(*eeg.stage);
-  ASSERT_EQ(bench.record.eeg.stalls.size(), 1u);
+  // The held-back blocks arrive at once, on the acquisition's thread; each cycle until the stall
+  // is taken stamps a flash presented while the deliveries were held.
+  std::int64_t marked_sample = -1;
   bool marked = false;
-  for (const bci::Annotation& a : bench.record.annotations)
-    marked |= a.sample == 4321 && a.text == "stamp uncertain: EEG delivery stalled";
+  for (int i = 0; i < 400 && marked_sample < 0; ++i) {
+    const std::int64_t sample = 4000 + i;
+    bench.record.presentation.shown = true;
+    bench.record.presentation.host_s = held_from + 0.2;
+    bench.record.presentation.onsets.push_back({Flash{1, true, false, true, 1}, sample});
+    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+    bench.step(*eeg.stage);
+    if (!bench.record.eeg.stalls.empty()) {
+      marked_sample = sample;
+      for (const bci::Annotation& a : bench.record.annotations)
+        marked |= a.sample == sample && a.text == "stamp uncertain: EEG delivery stalled";
+    }
+    bench.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_GE(marked_sample, 0) << "no stall was taken";
   EXPECT_TRUE(marked);
   EXPECT_TRUE(bench.toldOf("EEG delivery stalled"));
   const auto logged = bench.logged("eeg_stall");
   ASSERT_EQ(logged.size(), 1u);
-  EXPECT_EQ(logged[0]["uncertain_flashes"], 1);
+  EXPECT_GE(logged[0]["uncertain_flashes"].get<int>(), 1);
 }
 
 }  // namespace

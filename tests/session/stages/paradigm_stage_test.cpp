@@ -248,6 +248,63 @@ TEST_F(ParadigmStageTest, ATrialSelectsGraspsPutsDownAndEndsTheRun) {
   EXPECT_EQ(bench_.logged("selection").size(), 2u);
 }
 
+TEST_F(ParadigmStageTest, AWrongSelectionIsSaidAndTheTrialCarriesOnWithIt) {
+  model_ = trainedModel();
+  const TrialIntent intent = intendedTrials(config_)[0];
+  // Decide an object that is not the intended one.
+  for (size_t k = 0; k < config_.world.objects.size(); ++k)
+    if (config_.world.objects[k].id != intent.object) decide_ = static_cast<int>(k) + 1;
+  begin();
+  ASSERT_TRUE(until(bci::Phase::Grasping));
+  EXPECT_NE(postedOf<GraspRequest>()[0].object, intent.object);
+  EXPECT_TRUE(
+      bench_.toldOf("selection of the object in trial 1 differs from the intended one; "
+                    "carrying on"));
+  const auto selections = bench_.logged("selection");
+  ASSERT_EQ(selections.size(), 1u);
+  EXPECT_FALSE(selections[0]["correct"].get<bool>());
+}
+
+TEST_F(ParadigmStageTest, OnlyTheObjectsTheCamerasSeeAreOffered) {
+  model_ = trainedModel();
+  const int unseen = config_.world.objects[1].id;
+  hidden_ = {unseen};
+  begin();
+  const std::vector<size_t>& slots = bench_.previous.paradigm.slots;
+  EXPECT_EQ(slots.size(), config_.world.objects.size() - 1);
+  for (size_t slot : slots) EXPECT_NE(config_.world.objects[slot].id, unseen);
+  // The recording says what each code now stands for.
+  bool mapped = false;
+  for (const bci::Annotation& a : bench_.previous.annotations)
+    mapped |= a.text.rfind("StimulusCodeMap ", 0) == 0 &&
+              a.text.find("object " + std::to_string(unseen)) == std::string::npos;
+  EXPECT_TRUE(mapped);
+  EXPECT_EQ(bench_.logged("objects_in_view").size(), 1u);
+}
+
+TEST_F(ParadigmStageTest, HowFreshTheGraspedObjectsPoseStayedIsFiledWithTheTrial) {
+  model_ = trainedModel();
+  begin();
+  ASSERT_TRUE(until(bci::Phase::Grasping));
+  const int object = postedOf<GraspRequest>()[0].object;
+  // The arm comes down on it for a second while the cameras keep seeing it, then holds it.
+  robot::StatusPayload status;
+  status.current_command = robot::MessageType::Grasp;
+  robot_ = status;
+  for (int i = 0; i < 60; ++i) cycle([&](CycleRecord& r) { r.robot.grasped = object; });
+  status.holding = object;
+  robot_ = status;
+  cycle([&](CycleRecord& r) { r.robot.grasped = object; });
+  const auto sights = bench_.logged("grasp_view");
+  ASSERT_EQ(sights.size(), 1u);
+  EXPECT_EQ(sights[0]["object"], object);
+  EXPECT_NEAR(sights[0]["seconds"].get<double>(), 1.0, 0.05);
+  EXPECT_FALSE(sights[0]["never_seen"].get<bool>());
+  const TrialRecord& trial = (*bench_.previous.paradigm.trials)[0];
+  ASSERT_TRUE(trial.grasp_pose_age_max_s.has_value());
+  EXPECT_LT(*trial.grasp_pose_age_max_s, 0.05);
+}
+
 TEST_F(ParadigmStageTest, AGraspTheRobotRefusesIsAFaultWithItsReasonAndRetryAsksAgain) {
   model_ = trainedModel();
   begin();
@@ -326,6 +383,20 @@ TEST_F(HeadlessParadigmStageTest, WithNoObjectInViewARunWithoutExperimenterEndsW
   EXPECT_NE(ended.find("no object in view"), std::string::npos) << ended;
   EXPECT_NE(ended.find("paradigm.no_view_pause_s"), std::string::npos) << ended;
   EXPECT_EQ(bench_.previous.end_kind, "aborted");
+}
+
+TEST_F(HeadlessParadigmStageTest, AMarkerCoveredForGoodInCalibrationEndsTheRunWithTheReason) {
+  begin();
+  ASSERT_TRUE(until(bci::Phase::CalibrationFlashing));
+  hidden_ = {config_.world.objects[0].id};
+  std::string ended;
+  for (int i = 0; i < 60 * 10 && ended.empty(); ++i) {
+    cycle();
+    ended = bench_.previous.end_reason;
+  }
+  EXPECT_NE(ended.find("tracking lost"), std::string::npos) << ended;
+  EXPECT_NE(ended.find("during calibration"), std::string::npos) << ended;
+  EXPECT_NE(ended.find(std::to_string(config_.world.objects[0].id)), std::string::npos) << ended;
 }
 
 TEST_F(ParadigmStageTest, AnEegFaultPausesAndTwoSecondsOfSignalResume) {

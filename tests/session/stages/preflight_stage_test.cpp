@@ -127,5 +127,24 @@ TEST(PreflightStage, WithAnExperimenterAFailureIsShownAndStartCanBeTriedAgain) {
   EXPECT_EQ(begins, 1);
 }
 
+TEST(PreflightStage, ARobotThatRefusesOurKeyIsNamedAsSuch) {
+  test::StageBench bench("preflight_key");
+  PreflightStage stage(settings(false), bench.services());
+  bench.record.requests.push_back(StartRequest{});
+  std::string ended;
+  for (int i = 0; i < 20000 && ended.empty(); ++i) {
+    healthy(bench.record, false);
+    bench.record.robot.key_refused = true;
+    bench.step(stage);
+    ended = bench.record.end_reason;
+    bench.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_NE(ended.find("robot.host, robot.port: the robot backend at 10.0.0.5:5005 answered that "
+                       "our key is not its key"),
+            std::string::npos)
+      << ended;
+}
+
 }  // namespace
 }  // namespace arbci::session

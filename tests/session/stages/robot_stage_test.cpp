@@ -33,14 +33,13 @@ class RobotStageTest : public ::testing::Test {
  protected:
   RobotStageTest() : bench_("robot") {}
   // The backend on the session's stepped clock (reproducible), or on the wall clock as a real arm.
-  void connect(bool stepped = true) {
+  void connect(bool stepped = true, const robot::Key& key = robot::testKey()) {
     stepped_ = stepped;
     backend_ = std::make_unique<robot::RunningBackend>(
         std::make_unique<robot::SimulatedArm>(armFor(world_)), options(stepped));
     RobotLink link;
     link.client = std::make_unique<robot::RobotClient>(
-        robot::Endpoint::resolve("127.0.0.1", backend_->port()), robot::testKey(),
-        robot::fastClient());
+        robot::Endpoint::resolve("127.0.0.1", backend_->port()), key, robot::fastClient());
     link.stepped = stepped;
     stage_ = std::make_unique<RobotStage>(RobotStageSettings{world_, 2}, std::move(link),
                                           bench_.services());
@@ -63,9 +62,20 @@ class RobotStageTest : public ::testing::Test {
       const bool finished = done(r);
       bench_.next();
       if (finished) break;
-      if (!stepped_) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (!stepped_) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     return notes;
+  }
+  // The pre-flight's probe, as a session's first: a stepped backend answers it at once (the client
+  // waits for the answer), one on the wall clock once its status has come.
+  void probe() {
+    for (int i = 0; i < 500 && !bench_.previous.robot.answered; ++i) {
+      bench_.record.requests.push_back(RobotProbeRequest{bench_.record.time_s});
+      bench_.step(*stage_);
+      bench_.next();
+      if (!bench_.previous.robot.answered)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
   }
   static bool has(const std::vector<RobotPart::Note>& notes, Kind kind, bool success) {
     for (const auto& n : notes)
@@ -82,7 +92,7 @@ class RobotStageTest : public ::testing::Test {
 TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
   connect();
   const WorldObjectSettings& object = world_.objects.front();
-  until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
+  probe();
   ASSERT_TRUE(bench_.previous.robot.status.has_value()) << "no status from the backend";
   EXPECT_EQ(bench_.previous.robot.why_not_move, "");
   bench_.record.requests.push_back(
@@ -120,7 +130,7 @@ TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
 TEST_F(RobotStageTest, TheExperimentersStopLatchesAndResetLiftsIt) {
   connect(false);
   const WorldObjectSettings& object = world_.objects.front();
-  until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
+  probe();
   bench_.record.requests.push_back(
       GraspRequest{object.id, object.position, 0.0, 0.5, false, bench_.record.frame / 60.0});
   until([](const RobotPart& r) { return r.status && r.status->progress > 0.2; });
@@ -154,7 +164,7 @@ TEST_F(RobotStageTest, ThePreflightsProbeIsAnswered) {
 TEST_F(RobotStageTest, ABackendThatGoesSilentInAGraspIsARobotFaultOnTheRecord) {
   connect();
   const WorldObjectSettings& object = world_.objects.front();
-  until([](const RobotPart& r) { return r.status.has_value(); }, 5.0);
+  probe();
   // Asked for on this cycle's frame: the arm has not moved yet when the backend goes.
   bench_.record.requests.push_back(
       GraspRequest{object.id, object.position, 0.0, 0.5, false, bench_.record.frame / 60.0});
@@ -164,7 +174,7 @@ TEST_F(RobotStageTest, ABackendThatGoesSilentInAGraspIsARobotFaultOnTheRecord) {
   backend_->halt();
   std::vector<RobotPart::Note> notes;
   // The link is judged silent on the wall clock: a second and more without an answer.
-  for (int i = 0; i < 400 && !has(notes, Kind::Finished, false); ++i) {
+  for (int i = 0; i < 1000 && !has(notes, Kind::Finished, false); ++i) {
     bench_.step(*stage_);
     notes.insert(notes.end(), bench_.record.robot.notes.begin(), bench_.record.robot.notes.end());
     bench_.next();
@@ -177,6 +187,21 @@ TEST_F(RobotStageTest, ABackendThatGoesSilentInAGraspIsARobotFaultOnTheRecord) {
   EXPECT_TRUE(bench_.previous.robot.silent);
   EXPECT_EQ(bench_.previous.robot.why_not_move, "the robot backend does not answer");
   EXPECT_TRUE(bench_.toldOf("robot: silent"));
+}
+
+// A backend whose key is not ours answers that it is not (KEY MISMATCH): on the record for the
+// pre-flight, which names it, never taken for a missing backend.
+TEST_F(RobotStageTest, AKeyTheBackendRefusesIsOnTheRecord) {
+  robot::Key wrong = robot::testKey();
+  wrong[0] ^= 0xff;
+  connect(false, wrong);
+  for (int i = 0; i < 1000 && !bench_.previous.robot.key_refused; ++i) {
+    bench_.step(*stage_);
+    bench_.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(bench_.previous.robot.key_refused);
+  EXPECT_FALSE(bench_.previous.robot.status.has_value());
 }
 
 }  // namespace

@@ -75,6 +75,11 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
                                 const ScoreModel& model, const StoppingRule& dynamic);
 
 // Each setting's default, range and meaning: bci::trainingSchema() (bci/settings.h).
+// Offline evaluation's dynamic stopping (the bit rate `arbci train` and `arbci evaluate` report
+// with it), not the online paradigm's: up to the recordings' 15 sequences, never before 2, at a
+// posterior of 0.99.
+inline constexpr StoppingRule kOfflineStopping{15, 2, 0.99};
+
 struct TrainingSettings {
   TrainingSettings();  // the schema's defaults
   std::string method;  // a name of bci::classifiers()
@@ -86,9 +91,7 @@ struct TrainingSettings {
   // of flashes in time), "file", or "" for the default: by selection, or by block where the data
   // have fewer than 2 selections or their codes are classes.
   std::string folds_by;
-  // Offline evaluation's dynamic stopping (the bit rate `arbci evaluate` reports with it), not
-  // the online paradigm's: up to the recordings' 15 sequences.
-  StoppingRule dynamic{15, 2, 0.99};
+  StoppingRule dynamic = kOfflineStopping;
 };
 
 struct CrossValidation {

@@ -166,6 +166,10 @@ class Paradigm {
   // once per displayed frame in order. Without `due_s`: the nominal rate's time of the frame.
   FrameStimulus frame(std::int64_t index, double due_s);
   FrameStimulus frame(std::int64_t index) { return frame(index, index / settings_.display_hz); }
+  // Frame `index` reached the screen at `at_s` (the same clock as `due_s`): a late frame's flash
+  // onset or dark frame counts from when it was shown, so the SOA and the dark gap the screen
+  // shows are never shorter than the paradigm's, however late frames come.
+  void presented(std::int64_t index, double at_s);
 
   // From the cycle: the classifier may end flashing early (dynamic stopping).
   void requestStopFlashing();
@@ -236,6 +240,7 @@ class Paradigm {
   bool lit_last_frame_ = false;  // the last frame showed a flash
   // The last flash's onset, and the first frame after it that showed nothing (session seconds).
   double last_onset_s_ = -1e9, last_dark_s_ = -1e9;
+  std::int64_t onset_frame_ = -1, dark_frame_ = -1;  // the frames they were due on
   double phase_until_ = 0.0;  // timed phases end then (while paused: the time still to go)
   // Flashing: the current sequence's flashes, and when each was first shown.
   struct ScheduledFlash {

@@ -12,6 +12,9 @@
 namespace arbci::session {
 
 const core::Schema<SessionConfig>& sessionSchema();
+// Its sections that commands take options from: the calibration run's classifier, the ErrP's.
+const core::Schema<ClassifierSettings>& classifierSchema();
+const core::Schema<ErrpSettings>& errpOwnSchema();
 
 // docs/settings.md: every section's table, then the registries' members (EEG sources,
 // classifiers, marker families, camera sources, robot drivers; the application adds its panels).

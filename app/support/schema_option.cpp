@@ -1,0 +1,103 @@
+#include "support/schema_option.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace arbci::app {
+namespace {
+
+std::vector<SchemaOptionUse>& uses() {
+  static std::vector<SchemaOptionUse> all;
+  return all;
+}
+
+std::string help(const core::Key& key, const std::string& more) {
+  std::string text = key.doc;
+  if (!key.unit.empty()) text += " (" + key.unit + ")";
+  if (!more.empty()) text += "; " + more;
+  return text;
+}
+
+CLI::Option* noted(CLI::App& command, CLI::Option* option, const core::Key& key) {
+  uses().push_back({&command, option->get_name(), &key});
+  return option;
+}
+
+// The key's range, as the session file's check has it (an infinite end: unbounded).
+template <class T>
+void range(CLI::Option* option, const core::Key& key) {
+  const bool low = std::isfinite(key.low), high = std::isfinite(key.high);
+  if (!low && !high) return;
+  option->check(CLI::Range(low ? static_cast<T>(key.low) : std::numeric_limits<T>::lowest(),
+                           high ? static_cast<T>(key.high) : std::numeric_limits<T>::max()));
+}
+
+}  // namespace
+
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, double& value,
+                          const core::Key& key, const std::string& more) {
+  if (key.type != core::Type::Number)
+    throw std::logic_error(name + ": the key " + key.name + " is not a number");
+  value = key.fallback.get<double>();
+  CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
+  range<double>(option, key);
+  return noted(command, option, key);
+}
+
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, int& value,
+                          const core::Key& key, const std::string& more) {
+  if (key.type != core::Type::Integer)
+    throw std::logic_error(name + ": the key " + key.name + " is not an integer");
+  value = key.fallback.get<int>();
+  CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
+  range<int>(option, key);
+  return noted(command, option, key);
+}
+
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::string& value,
+                          const core::Key& key, const std::string& more) {
+  if (key.type != core::Type::Text)
+    throw std::logic_error(name + ": the key " + key.name + " is not a text");
+  value = key.fallback.get<std::string>();
+  CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
+  if (key.choices) option->check(CLI::IsMember(key.choices()));
+  return noted(command, option, key);
+}
+
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::vector<double>& value,
+                          const core::Key& key, const std::string& more) {
+  if (key.type != core::Type::Numbers)
+    throw std::logic_error(name + ": the key " + key.name + " is not a list of numbers");
+  value = key.fallback.get<std::vector<double>>();
+  std::string shown;
+  for (double v : value) shown += (shown.empty() ? "" : ",") + core::formatNumber(v);
+  CLI::Option* option =
+      command.add_option(name, value, help(key, more))->delimiter(',')->default_str(shown);
+  if (key.min_items == key.max_items) option->expected(static_cast<int>(key.min_items));
+  range<double>(option, key);
+  return noted(command, option, key);
+}
+
+CLI::Option* schemaOption(CLI::App& command, const std::string& name,
+                          std::vector<std::string>& value, const core::Key& key,
+                          const std::string& more) {
+  if (key.type != core::Type::Texts)
+    throw std::logic_error(name + ": the key " + key.name + " is not a list of texts");
+  value = key.fallback.get<std::vector<std::string>>();
+  CLI::Option* option = command.add_option(name, value, help(key, more))->delimiter(',');
+  return noted(command, option, key);
+}
+
+CLI::Option* schemaFlag(CLI::App& command, const std::string& name, bool& value,
+                        const core::Key& key, const std::string& more) {
+  if (key.type != core::Type::Boolean || key.fallback.get<bool>())
+    throw std::logic_error(name + ": the key " + key.name + " is not a true/false off by default");
+  value = false;
+  return noted(command, command.add_flag(name, value, help(key, more)), key);
+}
+
+const std::vector<SchemaOptionUse>& schemaOptions() {
+  return uses();
+}
+
+}  // namespace arbci::app

@@ -1,0 +1,43 @@
+// A command-line option that sets a settings key is made from the key (core/schema.h): its help is
+// the key's doc and unit, its default the key's, its check the key's range or choices. Nothing of
+// the key is written again beside the option, so `arbci train --decimate-hz` allows what
+// classifier.decimate_hz allows. Each option made so is noted (schemaOptions()), and a test walks
+// every command's options and fails on one that sets a key without going through here.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "arbci/core/schema.h"
+
+namespace arbci::app {
+
+// `value` starts at the key's default. `more`: what the command adds to the key's doc (how the
+// option differs from the session's use of it), "" for nothing.
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, double& value,
+                          const core::Key& key, const std::string& more = "");
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, int& value,
+                          const core::Key& key, const std::string& more = "");
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::string& value,
+                          const core::Key& key, const std::string& more = "");
+// A list of numbers or texts, given comma-separated ("0,800"; "Fz,Cz,Pz").
+CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::vector<double>& value,
+                          const core::Key& key, const std::string& more = "");
+CLI::Option* schemaOption(CLI::App& command, const std::string& name,
+                          std::vector<std::string>& value, const core::Key& key,
+                          const std::string& more = "");
+// A true/false key as a flag (its default must be false).
+CLI::Option* schemaFlag(CLI::App& command, const std::string& name, bool& value,
+                        const core::Key& key, const std::string& more = "");
+
+struct SchemaOptionUse {
+  const CLI::App* command;
+  std::string option;  // "--decimate-hz"
+  const core::Key* key;
+};
+// Every option made through schemaOption() or schemaFlag() so far.
+const std::vector<SchemaOptionUse>& schemaOptions();
+
+}  // namespace arbci::app
