@@ -70,7 +70,7 @@ SceneRenderer::~SceneRenderer() {
 }
 
 const Texture& SceneRenderer::markerTexture(const SceneMarker& marker) {
-  const auto key = std::make_tuple(static_cast<int>(marker.kind), marker.id,
+  const auto key = std::make_tuple(std::string(marker.kind.name), marker.id,
                                    static_cast<int>(marker.border * 1000));
   auto found = markers_.find(key);
   if (found != markers_.end()) return found->second;

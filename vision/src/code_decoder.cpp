@@ -11,10 +11,6 @@
 namespace arbci::vision {
 namespace {
 
-std::optional<DecodedId> decodeWord(MarkerKind kind, CodeWord word) {
-  return kind == MarkerKind::Simple ? SimpleIdCode::decode(word) : BchCode::decode(word);
-}
-
 // Where each cell of the sampled grid lands after `turns` clockwise quarter turns (the cell at
 // (r, c) moves to (c, 5 - r) per turn), as a bit of the turned grid's word.
 struct Rotations {
@@ -43,11 +39,11 @@ const Rotations& rotations() {
 }
 
 // ARToolKitPlus's rule: the rotation with the fewest corrected bits; a tie is ambiguous.
-std::optional<CodeDecode> hardDecode(MarkerKind kind, const CodeGrid& sampled, bool& ambiguous) {
+std::optional<CodeDecode> hardDecode(const IdCode& code, const CodeGrid& sampled, bool& ambiguous) {
   std::optional<CodeDecode> best;
   ambiguous = false;
   for (int turns = 0; turns < 4; ++turns) {
-    const auto decoded = decodeWord(kind, rotations().turned(sampled, turns));
+    const auto decoded = code.decode(rotations().turned(sampled, turns));
     if (!decoded) continue;
     if (!best || decoded->corrected_bits < best->corrected_bits) {
       best = CodeDecode{decoded->id, turns, decoded->corrected_bits, decoded->confidence};
@@ -64,7 +60,7 @@ std::optional<CodeDecode> hardDecode(MarkerKind kind, const CodeGrid& sampled, b
 // other candidate (another id or orientation) by kMinMargin. Trials are built in each turned
 // word directly (the flipped cells' bits), not as turned grids: up to 64 trials x 4 turns.
 // `nearest`: how many cells at least any codeword (in any turn) disagrees with.
-std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
+std::optional<CodeDecode> chaseDecode(const IdCode& code, const CodeGrid& sampled,
                                       const std::array<float, 36>& reliability, int nearest) {
   constexpr int kFlipped = 6;
   constexpr float kMaxReliabilityToFlip = 0.5f, kMaxWeight = 1.2f, kMinMargin = 0.6f;
@@ -97,13 +93,13 @@ std::optional<CodeDecode> chaseDecode(const CodeGrid& sampled,
     CodeWord trial = received;
     for (int step = 0; step < (1 << flippable); ++step) {
       if (step > 0) trial ^= flip[__builtin_ctz(static_cast<unsigned>(step))];
-      const auto decoded = BchCode::decode(trial);
+      const auto decoded = code.decode(trial);
       if (!decoded) continue;
       if (decoded->id == best.id && turns == best.turns) continue;
       if (decoded->id == second.id && turns == second.turns) continue;
       // The codeword against the cells as read, both in the turned orientation; the weight in
       // the sampled cells' order.
-      const CodeWord differ = BchCode::encode(decoded->id) ^ received;
+      const CodeWord differ = code.encode(decoded->id) ^ received;
       std::array<bool, 36> disagrees{};
       for (CodeWord bits = differ; bits != 0; bits &= bits - 1)
         disagrees[rotation.cell_of_bit[turns][__builtin_ctzll(bits)]] = true;
@@ -184,10 +180,10 @@ constexpr float kMaxOverruled = 2.0f;
 constexpr int kMaxExtraReadingCorrections = 1;
 
 // The most decisively read cell a BCH decode overrules (0 when it corrected none).
-float strongestCorrection(const CodeDecode& decoded, const Reading& reading) {
+float strongestCorrection(const IdCode& code, const CodeDecode& decoded, const Reading& reading) {
   const Rotations& rotation = rotations();
   const CodeWord differ =
-      BchCode::encode(decoded.id) ^ rotation.turned(reading.cells, decoded.orientation);
+      code.encode(decoded.id) ^ rotation.turned(reading.cells, decoded.orientation);
   float strongest = 0.0f;
   for (CodeWord bits = differ; bits != 0; bits &= bits - 1) {
     const int cell = rotation.cell_of_bit[decoded.orientation][__builtin_ctzll(bits)];
@@ -198,7 +194,7 @@ float strongestCorrection(const CodeDecode& decoded, const Reading& reading) {
 
 }  // namespace
 
-std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& samples,
+std::optional<CodeDecode> decodeCode(const IdCode& code, const MarkerSamples& samples,
                                      CodeReadings readings) {
   CodeGrid sampled{};
   std::array<float, 36> reliability{};
@@ -208,9 +204,9 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
     reliability[i] = std::abs(samples.cells[i] - samples.thresholds[i]) / half_contrast;
   }
   bool ambiguous = false;
-  const std::optional<CodeDecode> hard = hardDecode(kind, sampled, ambiguous);
+  const std::optional<CodeDecode> hard = hardDecode(code, sampled, ambiguous);
   if (hard && !ambiguous) return hard;
-  if (ambiguous || kind != MarkerKind::Bch || readings == CodeReadings::Plain) return std::nullopt;
+  if (ambiguous || !code.corrects_errors || readings == CodeReadings::Plain) return std::nullopt;
   const bool chase = readings == CodeReadings::SharpenedAndChase;
   // Hard decoding corrects up to 2 cells in every turn: when it found no codeword, each one
   // disagrees with 3 cells or more; when it found two equally near, nothing is known.
@@ -221,16 +217,16 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   const Reading sharpened = readingOf(sharpenedLevels(samples, kFourNeighbours, 1.0f));
   int sharpened_nearest = kBeyondHard;
   if (sharpened.cells != sampled) {
-    const std::optional<CodeDecode> again = hardDecode(kind, sharpened.cells, ambiguous);
+    const std::optional<CodeDecode> again = hardDecode(code, sharpened.cells, ambiguous);
     if (again && !ambiguous && again->corrected_bits <= kMaxExtraReadingCorrections &&
-        strongestCorrection(*again, sharpened) <= kMaxOverruled)
+        strongestCorrection(code, *again, sharpened) <= kMaxOverruled)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.9f};
     sharpened_nearest = nearest(again);
   }
   if (chase) {
-    if (auto soft = chaseDecode(sampled, reliability, kBeyondHard)) return soft;
-    if (auto soft = chaseDecode(sharpened.cells, sharpened.reliability, sharpened_nearest))
+    if (auto soft = chaseDecode(code, sampled, reliability, kBeyondHard)) return soft;
+    if (auto soft = chaseDecode(code, sharpened.cells, sharpened.reliability, sharpened_nearest))
       return soft;
   }
   // Motion blur smears each cell into its neighbours along one direction: sharpened against
@@ -243,13 +239,13 @@ std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& sampl
   for (const CellOffset& along : kDirections) {
     const std::array<CellOffset, 2> ends{along, CellOffset{-along[0], -along[1]}};
     const Reading directional = readingOf(sharpenedLevels(samples, ends, kDirectionalAmount));
-    const std::optional<CodeDecode> again = hardDecode(kind, directional.cells, ambiguous);
+    const std::optional<CodeDecode> again = hardDecode(code, directional.cells, ambiguous);
     if (again && !ambiguous && again->corrected_bits <= kMaxExtraReadingCorrections &&
-        strongestCorrection(*again, directional) <= kMaxOverruled)
+        strongestCorrection(code, *again, directional) <= kMaxOverruled)
       return CodeDecode{again->id, again->orientation, again->corrected_bits,
                         again->confidence * 0.8f};
     if (!chase) continue;
-    if (auto soft = chaseDecode(directional.cells, directional.reliability, nearest(again)))
+    if (auto soft = chaseDecode(code, directional.cells, directional.reliability, nearest(again)))
       return soft;
   }
   return std::nullopt;

@@ -10,7 +10,7 @@
 
 #include <optional>
 
-#include "arbci/vision/marker.h"
+#include "arbci/vision/marker_family.h"
 #include "marker_sampler.h"
 
 namespace arbci::vision {
@@ -22,11 +22,11 @@ struct CodeDecode {
   float confidence = 0.0f;
 };
 
-// How hard decodeCode() tries once the plain hard decoding fails (BCH only): not at all, hard
-// decoding of the sharpened readings, or those and Chase decoding.
+// How hard decodeCode() tries once the plain hard decoding fails (a code that corrects errors): not
+// at all, hard decoding of the sharpened readings, or those and Chase decoding.
 enum class CodeReadings { Plain, Sharpened, SharpenedAndChase };
 
-std::optional<CodeDecode> decodeCode(MarkerKind kind, const MarkerSamples& samples,
+std::optional<CodeDecode> decodeCode(const IdCode& code, const MarkerSamples& samples,
                                      CodeReadings readings);
 
 }  // namespace arbci::vision

@@ -10,14 +10,14 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "arbci/vision/marker_family.h"
+
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
 
-#include "apriltag_detector.h"
 #include "blurred_edges.h"
 #include "contour_trace.h"
-#include "dictionary_detector.h"
 #include "marker_sampler.h"
 #include "quad_fit.h"
 #include "quad_geometry.h"
@@ -37,17 +37,14 @@ double microseconds(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
 }
 
-bool isSquareKind(MarkerKind kind) {
-  return kind == MarkerKind::Bch || kind == MarkerKind::Simple || kind == MarkerKind::Template;
-}
-
-void validate(const DetectorConfig& config) {
-  if (isSquareKind(config.kind) && !(config.border > 0.0 && config.border <= 0.4)) {
+void validate(const DetectorConfig& config, const MarkerFamily& family) {
+  if (family.squares() && !(config.border > 0.0 && config.border <= 0.4)) {
     throw std::invalid_argument("border must be in (0, 0.4] of the marker side, got " +
                                 std::to_string(config.border));
   }
-  if (config.kind == MarkerKind::Template && config.templates.empty()) {
-    throw std::invalid_argument("the template kind needs at least one trained pattern");
+  if (family.templates && config.templates.empty()) {
+    throw std::invalid_argument("the " + toString(config.kind) +
+                                " kind needs at least one trained pattern");
   }
   const int value = config.threshold.value;
   if (value < 0 || value > 255) {
@@ -99,8 +96,8 @@ void halve(const cv::Mat& full, cv::Mat& half) {
 
 struct MarkerDetector::Impl {
   DetectorConfig config;
-  int dictionary = -1;                         // ArUco: OpenCV's dictionary
-  std::unique_ptr<AprilTagDetector> apriltag;  // AprilTag: libapriltag
+  const MarkerFamily& family;
+  std::unique_ptr<WholeImageSearch> whole_image;  // a family another library finds
   int threshold = 100;  // global threshold carried between frames (automatic modes)
   std::mt19937 random;
   // `gray` is a read-only view: of the caller's pixels for grey input, else of `converted`.
@@ -134,18 +131,14 @@ struct MarkerDetector::Impl {
   std::vector<std::pair<size_t, float>> medians;
   std::vector<Quad> frame_quads;
 
-  explicit Impl(DetectorConfig c) : config(std::move(c)) {
-    validate(config);
-    if (config.kind == MarkerKind::Aruco)
-      dictionary = dictionaryId(config.dictionary.empty() ? "DICT_6X6_250" : config.dictionary);
-    if (config.kind == MarkerKind::AprilTag)
-      apriltag = std::make_unique<AprilTagDetector>(config.dictionary, config.apriltag_refine_edges,
-                                                    config.search_decimate);
+  explicit Impl(DetectorConfig c) : config(std::move(c)), family(familyOf(config.kind)) {
+    validate(config, family);
+    if (family.whole_image) whole_image = family.whole_image(config);
     resetThreshold();
   }
 
   // ArUco and AprilTag markers are found by their own libraries, not by our stages.
-  bool external() const { return dictionary >= 0 || apriltag != nullptr; }
+  bool external() const { return whole_image != nullptr; }
 
   void resetThreshold() {
     threshold = config.threshold.value;
@@ -224,10 +217,10 @@ struct MarkerDetector::Impl {
       const int max_length = 4 * (w + h) + 64;
       traced.push_back(c);
       if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
-      // A BCH marker's outline encloses its light code cells (7 or more); a quadrilateral
-      // enclosing none is a solid shape and is dropped unrefined. One that does not fit may still
+      // A code whose every id has light cells (BCH: 7 or more): an outline that encloses none
+      // is a solid shape and is dropped unrefined. One that does not fit may still
       // be a marker whose border broke open.
-      const bool solid = c.holes == 0 && config.kind == MarkerKind::Bch;
+      const bool solid = c.holes == 0 && family.code && family.code->min_light_cells > 0;
       QuadFitParams component_params = params;
       if (solid) {
         // Dropped whether it fits or not, so held to sharp corners: fewer go on to the line fit,
@@ -365,8 +358,9 @@ struct MarkerDetector::Impl {
         if (nested) continue;
       }
       if (scale > 1 && !on_frame) {
-        // A flat code area is no BCH marker whoever refines it: not worth refining.
-        if (config.kind == MarkerKind::Bch &&
+        // A flat code area is no marker of a code whose ids all have light cells (BCH), whoever
+        // refines it: not worth refining.
+        if (family.code && family.code->min_light_cells > 0 &&
             hasFlatCodeArea(gray, onFrameCoarse(quad.corners), config.border))
           continue;
         const auto refine_start = Clock::now();
@@ -510,8 +504,7 @@ struct MarkerDetector::Impl {
       result.threshold_mode = "empty image";
     } else if (external()) {
       const auto decode_start = Clock::now();
-      result.markers = apriltag ? apriltag->detect(gray)
-                                : detectDictionaryMarkers(gray, dictionary, config.kind);
+      result.markers = whole_image->detect(gray);
       for (MarkerDetection& m : result.markers) {
         for (int k = 0; k < 4; ++k) {
           m.ideal_corners[k] =
@@ -519,9 +512,8 @@ struct MarkerDetector::Impl {
         }
       }
       time.decode = microseconds(decode_start, Clock::now());
-      // Each library thresholds the frame itself: AprilTag by its own adaptive threshold, ArUco
-      // by OpenCV's adaptive one.
-      result.threshold_mode = apriltag ? "libapriltag's own" : "opencv adaptive";
+      // Each library thresholds the frame itself.
+      result.threshold_mode = whole_image->thresholdMode();
     } else {
       result = detectSquares(time);
     }
@@ -558,7 +550,7 @@ DetectionResult MarkerDetector::detect(const ImageView& image) {
 std::optional<MarkerDetection> MarkerDetector::readAt(const cv::Mat& image,
                                                       const SquareCorners& corners) const {
   const Impl& impl = *impl_;
-  if (!isSquareKind(impl.config.kind)) {
+  if (!impl.family.squares()) {
     throw std::invalid_argument(
         "MarkerDetector::readAt reads ARToolKitPlus-style markers (BCH, simple, template); this "
         "detector finds ArUco or AprilTag markers through their own libraries");
@@ -585,7 +577,7 @@ const DetectorConfig& MarkerDetector::config() const {
 void MarkerDetector::setThreshold(const ThresholdSettings& settings) {
   DetectorConfig changed = impl_->config;
   changed.threshold = settings;
-  validate(changed);
+  validate(changed, impl_->family);
   impl_->config.threshold = settings;
   impl_->resetThreshold();
 }

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "arbci/vision/id_codes.h"
+#include "arbci/vision/marker_family.h"
 
 namespace arbci::vision {
 namespace {
@@ -107,19 +108,18 @@ std::vector<SheetSlot> layoutSheet(const std::vector<int>& ids, const Geometry& 
 cv::Mat markerCells(MarkerKind kind, int id, double border) {
   const int cells = cellsPerSide(border);
   const int offset = (cells - 6) / 2;
-  CodeWord word = 0;
-  if (kind == MarkerKind::Bch) {
-    if (id < 0 || id > BchCode::kMaxId)
-      throw std::invalid_argument("BCH ids are 0..4095, got " + std::to_string(id));
-    word = BchCode::encode(id);
-  } else if (kind == MarkerKind::Simple) {
-    if (id < 0 || id > SimpleIdCode::kMaxId)
-      throw std::invalid_argument("simple ids are 0..511, got " + std::to_string(id));
-    word = SimpleIdCode::encode(id);
-  } else {
-    throw std::invalid_argument("only bch and simple markers can be drawn, not " + toString(kind));
+  const IdCode* code = familyOf(kind).code;
+  if (!code) {
+    std::string printable;
+    for (const auto& family : markerFamilies().entries())
+      if (family.make.printable()) printable += (printable.empty() ? "" : ", ") + family.name;
+    throw std::invalid_argument("only " + printable + " markers can be drawn, not " +
+                                toString(kind));
   }
-  const CodeGrid grid = wordToGrid(word);
+  if (id < 0 || id > code->max_id)
+    throw std::invalid_argument(toString(kind) + " ids are 0.." + std::to_string(code->max_id) +
+                                ", got " + std::to_string(id));
+  const CodeGrid grid = wordToGrid(code->encode(id));
   cv::Mat image(cells, cells, CV_8UC1, cv::Scalar(0));
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 6; ++c)

@@ -7,26 +7,6 @@
 
 namespace arbci::vision {
 
-std::string toString(MarkerKind kind) {
-  switch (kind) {
-    case MarkerKind::Bch:
-      return "bch";
-    case MarkerKind::Simple:
-      return "simple";
-    case MarkerKind::Template:
-      return "template";
-    case MarkerKind::Aruco:
-      return "aruco";
-    case MarkerKind::AprilTag:
-      return "apriltag";
-  }
-  return "unknown";
-}
-
-MarkerKind markerKindFromString(const std::string& text) {
-  return markerFamilies().at(text).make.kind;
-}
-
 std::string toString(ThresholdMode mode) {
   switch (mode) {
     case ThresholdMode::Constant:

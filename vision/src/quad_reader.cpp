@@ -1,5 +1,6 @@
 #include "quad_reader.h"
 
+#include "arbci/vision/marker_family.h"
 #include "blurred_edges.h"
 #include "code_decoder.h"
 
@@ -23,7 +24,8 @@ std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const cv::
   if (!hasMarkerBorder(samples, quad.occluded)) return std::nullopt;
   MarkerDetection marker;
   marker.kind = config.kind;
-  if (config.kind == MarkerKind::Template) {
+  const MarkerFamily& family = familyOf(config.kind);
+  if (family.templates) {
     const auto match =
         matchTemplate(sampleCodeArea(image, quad, config.border, TemplatePattern::kSize),
                       config.templates, config.template_limits);
@@ -35,7 +37,7 @@ std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const cv::
     const CodeReadings readings = !config.soft_decoding ? CodeReadings::Plain
                                   : chase               ? CodeReadings::SharpenedAndChase
                                                         : CodeReadings::Sharpened;
-    const auto code = decodeCode(config.kind, samples, readings);
+    const auto code = decodeCode(*family.code, samples, readings);
     if (!code) return std::nullopt;
     marker.id = code->id;
     marker.orientation = code->orientation;

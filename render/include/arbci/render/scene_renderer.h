@@ -4,6 +4,7 @@
 
 #include <map>
 #include <memory>
+#include <string>
 #include <tuple>
 
 #include <glm/glm.hpp>
@@ -46,7 +47,7 @@ class SceneRenderer {
   ShaderProgram textured_, flat_;
   int textured_transform_ = -1, flat_transform_ = -1, sampler_location_ = -1;
   unsigned int vertex_array_ = 0, vertex_buffer_ = 0;
-  std::map<std::tuple<int, int, int>, Texture> markers_;
+  std::map<std::tuple<std::string, int, int>, Texture> markers_;
   std::map<std::pair<int, int>, Texture> boards_;
 };
 

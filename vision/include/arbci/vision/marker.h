@@ -4,6 +4,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -11,10 +12,23 @@
 
 namespace arbci::vision {
 
-enum class MarkerKind { Bch, Simple, Template, Aruco, AprilTag };
+// A marker family by its name in markerFamilies() ("bch", "apriltag"), as detections and settings
+// carry it. What the family is and how its markers are read is its registry entry
+// (marker_family.h): nothing dispatches on the name. The constants name the families code asks
+// for by name (the reference marker is BCH); a new family needs none.
+struct MarkerKind {
+  std::string_view name;
+  friend bool operator==(MarkerKind a, MarkerKind b) { return a.name == b.name; }
+  static const MarkerKind Bch, Simple, Template, Aruco, AprilTag;
+};
+inline const MarkerKind MarkerKind::Bch{"bch"};
+inline const MarkerKind MarkerKind::Simple{"simple"};
+inline const MarkerKind MarkerKind::Template{"template"};
+inline const MarkerKind MarkerKind::Aruco{"aruco"};
+inline const MarkerKind MarkerKind::AprilTag{"apriltag"};
 
 std::string toString(MarkerKind kind);
-// Parses "bch", "simple", "template", "aruco", "apriltag"; throws std::invalid_argument.
+// A family registered in markerFamilies(); throws std::invalid_argument naming those there are.
 MarkerKind markerKindFromString(const std::string& text);
 
 struct MarkerDetection {

@@ -8,18 +8,10 @@
 #include "arbci/core/schema.h"
 #include "arbci/vision/marker.h"
 #include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_family.h"
 #include "arbci/vision/search_passes.h"
 
 namespace arbci::vision {
-
-struct MarkerFamily {
-  MarkerKind kind;
-  double border;             // its usual border, as a fraction of the side
-  bool printable = false;    // `arbci marker make` draws it
-  bool in_sessions = false;  // a session can track objects by it (ids alone: no extra files)
-};
-using MarkerFamilyRegistry = core::Registry<MarkerFamily>;
-const MarkerFamilyRegistry& markerFamilies();
 
 // kind, border, search_decimate, apriltag_refine_edges and passes (the DetectorConfig's settings).
 const core::Schema<DetectorConfig>& detectorSchema();

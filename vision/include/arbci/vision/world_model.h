@@ -17,7 +17,7 @@ namespace arbci::vision {
 
 struct ReferenceMarker {
   int id = 0;
-  double size_m = 0.08;
+  double size_m = 0.0;  // its black square's side (a session's world.reference.size_m)
   // The reference marker's frame in the robot's frame: by default lying flat on the table with
   // its x and y along the robot's, 0.90 m along the robot's y axis.
   Pose T_robot_ref{cv::Matx33d::eye(), cv::Vec3d(0.0, 0.90, 0.0)};
