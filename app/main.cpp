@@ -36,18 +36,7 @@ int main(int argc, char** argv) {
   });
 
   int exit_code = 0;
-  arbci::app::addGlInfoCommand(root, exit_code);
-  arbci::app::addScreenshotCommand(root, exit_code);
-  arbci::app::addMarkerCommand(root, exit_code);
-  arbci::app::addDetectCommand(root, exit_code);
-  arbci::app::addCalibrateCommand(root, exit_code);
-  arbci::app::addEegCommand(root, exit_code);
-  arbci::app::addP300Commands(root, exit_code);
-  arbci::app::addRobotCommand(root, exit_code);
-  arbci::app::addBidsCommand(root, exit_code);
-  arbci::app::addRunCommand(root, exit_code);
-  arbci::app::addTimingCheckCommand(root, exit_code);
-  arbci::app::addSettingsCommand(root, exit_code);
+  arbci::app::addCommands(root, exit_code);
 
   try {
     root.parse(argc, argv);

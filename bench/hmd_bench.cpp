@@ -39,6 +39,8 @@ void stereoView(benchmark::State& state) {
   }
   GridLayout grid;
   grid.T_world_grid = {cv::Matx33d::eye(), cv::Vec3d(0.25, 0.7, 0)};
+  grid.rows = grid.columns = 3;
+  grid.cell_m = 0.08;
   frame.grid = grid;
   frame.grid_highlight.rows = {2};
   for (auto _ : state) {

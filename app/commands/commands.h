@@ -6,6 +6,9 @@
 
 namespace arbci::app {
 
+// Every subcommand, in the order `arbci --help` lists them.
+void addCommands(CLI::App& root, int& exit_code);
+
 void addGlInfoCommand(CLI::App& root, int& exit_code);
 void addScreenshotCommand(CLI::App& root, int& exit_code);
 void addMarkerCommand(CLI::App& root, int& exit_code);

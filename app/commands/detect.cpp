@@ -19,6 +19,7 @@
 #include "support/cli_error.h"
 #include "support/detection_json.h"
 #include "support/png.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 namespace {
@@ -29,7 +30,7 @@ struct DetectOptions {
   int device = -1;
   int frames = 0;
   std::string raw;
-  std::string kind = "bch";
+  std::string kind;
   double border = 0.0;  // 0: the kind's usual border
   std::string threshold = "adaptive";
   std::string vignetting;
@@ -40,7 +41,7 @@ struct DetectOptions {
   double min_cutoff_hz = vision::TrackerOptions{}.min_cutoff_hz;
   double beta = vision::TrackerOptions{}.beta;
   int repeat = 1;
-  int decimate = 1;
+  int decimate = 0;  // tracker.search_decimate
   std::string annotate;
   std::string camera;
   double marker_size_mm = 50.0;
@@ -303,14 +304,10 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   command->add_option("--raw", options->raw,
                       "Inputs are headerless: WIDTHxHEIGHT[:gray|rgb|bgr|rgba|bgra|abgr|rgb565]");
-  command->add_option("--kind", options->kind, vision::markerFamilies().list(", "))
-      ->check(CLI::IsMember(vision::markerFamilies().names()))
-      ->capture_default_str();
-  command
-      ->add_option("--border", options->border,
-                   "Border as a fraction of the side (default: the family's, 0.125 for bch, 0.25 "
-                   "for simple)")
-      ->check(CLI::Range(0.01, 0.4));
+  const auto& detector = vision::detectorSchema();
+  schemaOption(*command, "--kind", options->kind, detector.at("kind"));
+  schemaOptionOwnDefault(*command, "--border", options->border, detector.at("border"), 0.0,
+                         "the family's own (0.125 for bch, 0.25 for simple)");
   command
       ->add_option("--threshold", options->threshold,
                    "adaptive, auto-median, auto-midrange, or a constant 0..255")
@@ -350,14 +347,7 @@ void addDetectCommand(CLI::App& root, int& exit_code) {
           "--repeat", options->repeat,
           "Detect each frame N times; report the stage times of the run with the median total")
       ->check(CLI::Range(1, 100000));
-  command
-      ->add_option(
-          "--decimate", options->decimate,
-          "Square kinds: 1 searches candidates at full resolution; 2 on the frame averaged "
-          "over 2x2 pixels, corners then refined at full resolution (about twice as fast; "
-          "markers need about 24 px per side; docs/tracker.md)")
-      ->check(CLI::IsMember({1, 2}))
-      ->capture_default_str();
+  schemaOption(*command, "--decimate", options->decimate, detector.at("search_decimate"));
   command->add_option("--annotate", options->annotate,
                       "Write each frame with its markers drawn into this folder");
   command->add_option("--camera", options->camera,

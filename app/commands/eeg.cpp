@@ -8,10 +8,12 @@
 
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
+#include "arbci/bci/settings.h"
 #include "commands/commands.h"
 #include "eeg/simulated_recording.h"
 #include "support/cli_error.h"
 #include "support/output_path.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 namespace {
@@ -169,13 +171,11 @@ void addEegCommand(CLI::App& root, int& exit_code) {
       ->required()
       ->check(CLI::Range(1.0, 86400.0));
   sim->add_option("--out", s.out, "BDF+ file to write")->required();
-  sim->add_option("--seed", s.seed, "random seed (same seed, same recording)")
-      ->capture_default_str();
-  sim->add_option("--rate", s.rate_hz, "sampling rate in Hz")
-      ->capture_default_str()
-      ->check(CLI::Range(64.0, 4096.0));
-  sim->add_option("--montage", s.montage, "comma-separated 10-20 channel names")
-      ->capture_default_str();
+  const auto& subject = bci::subjectSchema();
+  const auto& paradigm = bci::paradigmSchema();
+  schemaOption(*sim, "--seed", s.seed, subject.at("seed"), "the same seed, the same recording");
+  schemaOption(*sim, "--rate", s.rate_hz, subject.at("rate_hz"));
+  schemaOption(*sim, "--montage", s.montage, subject.at("montage"), "comma-separated");
   sim->add_option("--stimuli", s.stimuli, "stimuli flashed one at a time (objects)")
       ->capture_default_str()
       ->check(CLI::Range(2, 64));
@@ -183,16 +183,11 @@ void addEegCommand(CLI::App& root, int& exit_code) {
                   "flash rows and columns of a ROWSxCOLUMNS matrix instead (with --columns)")
       ->check(CLI::Range(0, 32));
   sim->add_option("--columns", s.columns, "columns of the matrix")->check(CLI::Range(0, 32));
-  sim->add_option("--sequences", s.sequences, "sequences per selection")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100));
-  sim->add_option("--flash-ms", s.flash_ms, "flash duration")
-      ->capture_default_str()
-      ->check(CLI::Range(10.0, 1000.0));
-  sim->add_option("--isi-ms", s.isi_ms, "inter-stimulus interval")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 2000.0));
-  sim->add_option("--line-hz", s.line_hz, "line noise frequency (50 or 60)")->capture_default_str();
+  schemaOption(*sim, "--sequences", s.sequences, paradigm.at("calibration_sequences"),
+               "sequences per selection");
+  schemaOption(*sim, "--flash-ms", s.flash_ms, paradigm.at("flash_ms"));
+  schemaOption(*sim, "--isi-ms", s.isi_ms, paradigm.at("isi_ms"));
+  schemaOption(*sim, "--line-hz", s.line_hz, subject.at("line_hz"));
   sim->add_option("--alpha-hz", s.alpha_hz, "alpha peak frequency")
       ->capture_default_str()
       ->check(CLI::Range(6.0, 14.0));

@@ -10,9 +10,12 @@
 #include "arbci/bci/lsl/resolver.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/recording.h"
+#include "arbci/bci/settings.h"
+#include "arbci/session/settings_schema.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
 #include "support/interrupt.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 namespace {
@@ -21,7 +24,7 @@ struct LslOptions {
   std::string scope;
   std::vector<std::string> peers;
   double timeout_s = 2.0;
-  std::string file, name, type = "EEG";
+  std::string file, name, type;        // type: eeg.lsl.type, what a session looks for
   std::vector<std::string> impedance;  // per channel, into the stream's metadata
   bool wait = false, loop = false;
 };
@@ -39,12 +42,9 @@ bci::lsl::LslConfig configOf(const LslOptions& o) {
 }
 
 void addScopeOptions(CLI::App* command, LslOptions& o) {
-  command
-      ->add_option("--scope", o.scope,
-                   "where to look and serve: machine (127.0.0.1 only), link or site; default: "
-                   "lsl_api.cfg's ResolveScope ($LSLAPICFG, ./lsl_api.cfg, ~/lsl_api/, "
-                   "/etc/lsl_api/), else site")
-      ->check(CLI::IsMember({"machine", "link", "site"}));
+  schemaOption(*command, "--scope", o.scope, session::sessionKey("lsl.scope"),
+               "where to look and serve (machine: 127.0.0.1 only); lsl_api.cfg's: its "
+               "ResolveScope ($LSLAPICFG, ./lsl_api.cfg, ~/lsl_api/, /etc/lsl_api/), else site");
   command->add_option("--peer", o.peers, "a host to ask directly (repeatable; adds to KnownPeers)");
 }
 
@@ -188,7 +188,8 @@ void addEegStreamCommands(CLI::App* eeg, int& exit_code) {
       "NAME-Markers: a stand-in amplifier for demos and tests. Stops at the file's end.");
   stream->add_option("file", options->file, "the recording")->required()->check(CLI::ExistingFile);
   stream->add_option("--name", options->name, "the stream's name (default: the file's name)");
-  stream->add_option("--type", options->type, "the stream's type")->capture_default_str();
+  schemaOption(*stream, "--type", options->type, bci::lslSourceSchema().at("type"),
+               "the stream published: by default what a session looks for");
   stream->add_flag("--wait", options->wait, "start when the first consumer connects (up to 60 s)");
   stream
       ->add_option("--impedance", options->impedance,

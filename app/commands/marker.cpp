@@ -15,14 +15,16 @@
 #include "commands/commands.h"
 #include "support/cli_error.h"
 #include "support/id_list.h"
+#include "support/name_list.h"
 #include "support/output_path.h"
 #include "support/png.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 namespace {
 
 struct MakeOptions {
-  std::string kind = "bch";
+  std::string kind;  // tracker.kind
   std::string ids;
   double border = 0.0;  // 0: the kind's own (bch 0.125, simple 0.25)
   double size_mm = 80.0;
@@ -40,25 +42,23 @@ void writeText(const std::filesystem::path& path, const std::string& text) {
 
 void makeMarkers(const MakeOptions& options) {
   const auto& family = vision::markerFamilies().at(options.kind);
-  if (!family.make.printable) throw CliError("--kind " + options.kind + " is not printable here");
-  const vision::MarkerKind kind = family.make.kind;
+  const vision::IdCode* code = family.make.code;
+  if (!code) throw CliError("--kind " + options.kind + " is not printable here");
+  const vision::MarkerKind kind{family.name};
   // The kind's own border unless given: what detect --kind expects of it.
   const double border = options.border > 0.0 ? options.border : family.make.border;
-  const int max_id =
-      kind == vision::MarkerKind::Bch ? vision::BchCode::kMaxId : vision::SimpleIdCode::kMaxId;
-  const std::vector<int> ids = parseIdList(options.ids, max_id);
+  const std::vector<int> ids = parseIdList(options.ids, code->max_id);
   vision::PrintLayout layout;
   layout.size_mm = options.size_mm;
   layout.dpi = options.dpi;
   std::filesystem::path base(options.out);
   if (base.extension() == ".png" || base.extension() == ".svg") base.replace_extension();
-  if (kind == vision::MarkerKind::Bch) {
-    for (int id : ids) {
-      if (vision::BchCode::rotationMargin(id) < 5) {
-        std::cerr << "arbci: warning: BCH id " << id << " turned by 90/180/270 degrees lies within "
-                  << vision::BchCode::rotationMargin(id)
-                  << " bits of another id; prefer another id\n";
-      }
+  for (int id : ids) {
+    const int margin = code->rotation_margin ? code->rotation_margin(id) : 5;
+    if (margin < 5) {
+      std::cerr << "arbci: warning: " << options.kind << " id " << id
+                << " turned by 90/180/270 degrees lies within " << margin
+                << " bits of another id; prefer another id\n";
     }
   }
   auto write = [&](const std::filesystem::path& stem, const cv::Mat& image,
@@ -140,16 +140,15 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
       "make", "Write printable markers as PNG (at print resolution) and SVG");
   std::vector<std::string> printable;
   for (const auto& family : vision::markerFamilies().entries())
-    if (family.make.printable) printable.push_back(family.name);
-  make_command->add_option("--kind", make->kind, "bch (0..4095) or simple (0..511)")
-      ->check(CLI::IsMember(printable))
-      ->capture_default_str();
+    if (family.make.printable()) printable.push_back(family.name);
+  schemaOption(*make_command, "--kind", make->kind, vision::detectorSchema().at("kind"),
+               "printable: " + joinNames(printable) + " (bch ids 0..4095, simple 0..511)")
+      ->check(CLI::IsMember(printable));
   make_command->add_option("--id", make->ids, "Marker id, list or range: 7, 1,4,9 or 0-11")
       ->required();
-  make_command
-      ->add_option("--border", make->border,
-                   "Border width as a fraction of the side (default: the kind's, bch 0.125, "
-                   "simple 0.25, as detect --kind expects)")
+  schemaOptionOwnDefault(*make_command, "--border", make->border,
+                         vision::detectorSchema().at("border"), 0.0,
+                         "the kind's own, bch 0.125, simple 0.25, as detect --kind expects")
       ->check(CLI::IsMember({0.125, 0.25}));
   make_command->add_option("--size-mm", make->size_mm, "Side of the black square in millimetres")
       ->check(CLI::Range(1.0, 1000.0))
@@ -171,11 +170,9 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
   train_command->add_option("--image", train->image, "Image of the marker, seen face-on")
       ->required();
   train_command->add_option("--id", train->id, "Id to give the pattern")->capture_default_str();
-  train_command
-      ->add_option("--border", train->border,
-                   "Border width as a fraction of the side (default: 0.25, else 0.125, marker "
-                   "make's for bch; the one used is printed)")
-      ->check(CLI::Range(0.05, 0.4));
+  schemaOptionOwnDefault(*train_command, "--border", train->border,
+                         vision::detectorSchema().at("border"), 0.0,
+                         "0.25, else 0.125, marker make's for bch; the one used is printed");
   train_command->add_option("--out", train->out, "Pattern file to write")->required();
   train_command->callback([train, &exit_code] {
     trainPattern(*train);

@@ -102,17 +102,6 @@ struct TrainOptions {
   double errp_threshold = 0.0;    // errp.threshold
 };
 
-// The settings as given, checked by the schema's rules (a window that ends after it starts,
-// p_remove above p_enter): the same messages as a session file's, naming `command`.
-template <class S>
-void checkRules(const core::Schema<S>& schema, const S& settings, const std::string& command) {
-  try {
-    schema.resolve(schema.write(settings), {command, ""});
-  } catch (const core::SettingsError& error) {
-    throw CliError(error.what());
-  }
-}
-
 // Every output is checked before any work: a typo in a path costs no training.
 void checkOutputs(const std::string& plots, const std::vector<std::string>& files) {
   if (!plots.empty()) ensureWritableFolder(plots);
@@ -201,10 +190,10 @@ void applyErrpDefaults(TrainOptions& o, const CLI::App& cmd) {
     std::cout << "--errp: as a session's ErrP classifier where not given:" << taken << "\n";
 }
 
-void train(TrainOptions& o) {
+void train(TrainOptions& o, const CLI::App& command) {
   o.pipeline.window = {o.window_ms[0] / 1000.0, o.window_ms[1] / 1000.0};
-  checkRules(bci::trainingSchema(), o.training, "arbci train");
-  checkRules(bci::pipelineSchema(), o.pipeline, "arbci train");
+  checkSchemaRules(bci::trainingSchema(), bci::trainingSchema().write(o.training), command);
+  checkSchemaRules(bci::pipelineSchema(), bci::pipelineSchema().write(o.pipeline), command);
   if (!bci::classifiers().at(o.training.method).make.linear && !o.bci2000.empty()) {
     std::string linear;
     for (const auto& entry : bci::classifiers().entries())
@@ -444,6 +433,19 @@ std::string methodsHelp() {
   return out;
 }
 
+// Offline dynamic stopping (the bit rate reported with it): the paradigm's keys, with the
+// offline figures' own rule (bci::kOfflineStopping) as their defaults.
+void addOfflineStopping(CLI::App& command, bci::StoppingRule& rule, bool min_sequences) {
+  const std::string why = "offline stopping (bci::kOfflineStopping), not the session's";
+  schemaOptionOwnDefault(command, "--certainty", rule.certainty,
+                         session::sessionKey("paradigm.certainty"), bci::kOfflineStopping.certainty,
+                         why);
+  if (min_sequences)
+    schemaOptionOwnDefault(command, "--min-sequences", rule.min_sequences,
+                           session::sessionKey("paradigm.min_sequences"),
+                           bci::kOfflineStopping.min_sequences, why);
+}
+
 void addDatasetOptions(CLI::App& command, bci::DatasetOptions& dataset) {
   command.add_flag_function(
       "--causal",
@@ -492,9 +494,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd->add_flag("--exclude-bad-channels", t->exclude_bad_channels,
                       "leave out flat (SD < 0.5 uV) and drifting (SD > 20x the median channel's) "
                       "channels, which are always reported");
-  // The session's calibration folds (classifier.folds): an offline model compares with a
-  // session's own.
-  schemaOption(*train_cmd, "--folds", t->training.folds, session::classifierSchema().at("folds"),
+  schemaOption(*train_cmd, "--folds", t->training.folds, training.at("folds"),
                "at most one per selection or file");
   schemaOption(*train_cmd, "--folds-by", t->training.folds_by, training.at("folds_by"));
   train_cmd->add_flag("--errp", t->errp,
@@ -522,19 +522,14 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   schemaOption(*train_cmd, "--xdawn-filters", t->training.xdawn.filters,
                training.at("xdawn_filters"), "at most the number of channels");
   schemaOption(*train_cmd, "--shift-ms", t->training.shift_ms, training.at("shift_ms"));
-  train_cmd
-      ->add_option("--certainty", t->training.dynamic.certainty,
-                   "offline dynamic stopping (the bit rate reported with it): stop at this "
-                   "posterior probability (0: never early)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.999999));
+  addOfflineStopping(*train_cmd, t->training.dynamic, false);
   train_cmd->add_option("--bci2000", t->bci2000,
                         "also write the model as a BCI2000 parameter fragment (.prm)");
   train_cmd->add_option("--plots", t->plots,
                         "folder for PNG plots (ERPs; accuracy and bit rate by sequences)");
   train_cmd->callback([t, train_cmd, &exit_code] {
     if (t->errp) applyErrpDefaults(*t, *train_cmd);
-    train(*t);
+    train(*t, *train_cmd);
     exit_code = 0;
   });
 
@@ -549,16 +544,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->add_option("--sequences", e->sequences,
                    "use at most this many sequences per selection (0: all)")
       ->check(CLI::Range(0, 1000));
-  eval_cmd
-      ->add_option("--certainty", e->dynamic.certainty,
-                   "dynamic stopping: stop at this posterior probability (0: never early)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.999999));
-  eval_cmd
-      ->add_option("--min-sequences", e->dynamic.min_sequences,
-                   "dynamic stopping: never before this many sequences")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+  addOfflineStopping(*eval_cmd, e->dynamic, true);
   eval_cmd->add_option("--plots", e->plots, "folder for PNG plots");
   eval_cmd
       ->add_option("--align-scores", e->align,

@@ -14,15 +14,17 @@
 #include "arbci/robot/client.h"
 #include "arbci/robot/key_file.h"
 #include "arbci/robot/settings.h"
+#include "arbci/session/settings_schema.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 namespace {
 
 struct RobotOptions {
-  std::string host = robot::LinkSettings{}.host, key_file, out;
-  int port = robot::LinkSettings{}.port;
+  std::string host, key_file, out;  // robot.host, robot.key_file
+  int port = 0;                     // robot.port
   double timeout_s = 120.0;
   double retry_budget_s = 15.0;
   std::vector<double> xyz;
@@ -219,11 +221,9 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
       "printed when the backend can say). A motion that cannot be confirmed is followed by a\n"
       "STOP, which stays in force until `arbci robot reset`.");
   robot_cmd->require_subcommand(1);
-  robot_cmd->add_option("--host", o->host, "backend address")->capture_default_str();
-  robot_cmd->add_option("--port", o->port, "backend UDP port")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 65535));
-  robot_cmd->add_option("--key-file", o->key_file, "the shared key (arbci robot keygen)");
+  schemaOption(*robot_cmd, "--host", o->host, session::sessionKey("robot.host"));
+  schemaOption(*robot_cmd, "--port", o->port, session::sessionKey("robot.port"));
+  schemaOption(*robot_cmd, "--key-file", o->key_file, session::sessionKey("robot.key_file"));
   robot_cmd->add_option("--timeout", o->timeout_s, "seconds to wait for the outcome")
       ->capture_default_str();
   robot_cmd

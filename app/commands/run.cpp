@@ -6,15 +6,18 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "arbci/render/window_context.h"
 #include "arbci/session/session.h"
+#include "arbci/session/settings_schema.h"
 #include "commands/bids_options.h"
 #include "commands/commands.h"
 #include "hmd/open_session.h"
 #include "support/cli_error.h"
 #include "support/headless_run.h"
 #include "support/interrupt.h"
+#include "support/schema_option.h"
 #include "support/session_file.h"
 #include "support/session_folder.h"
 #include "workstation/start_error_window.h"
@@ -27,8 +30,8 @@ struct RunOptions {
   std::string session, out, script;
   bool headless = false, realtime = false, wait_for_start = false, exit_when_done = false,
        overwrite = false;
-  int trials = 0;
-  long long seed = -1;
+  std::optional<int> trials;  // paradigm.trials
+  std::optional<int> seed;    // eeg.seed
   double fault_wait_s = 5.0;
   std::string bids_root;  // --bids: export the session folder there when it ends
   BidsEntities bids;
@@ -142,9 +145,9 @@ int runSessionIn(const RunOptions& o, bool headless) {
   if (!o.out.empty()) claimFolder(o.out, o.overwrite);
   options.folder = o.out.empty() ? defaultFolder() : o.out;
   FolderClaim claim(options.folder);
-  if (o.trials > 0) options.trials = o.trials;
+  if (o.trials) options.trials = *o.trials;
   options.labels = {o.bids.subject, o.bids.session, o.bids.task, o.bids.run};
-  if (o.seed >= 0) options.seed = static_cast<std::uint64_t>(o.seed);
+  if (o.seed) options.seed = static_cast<std::uint64_t>(*o.seed);
   options.fault_wait_s = o.fault_wait_s;
   options.progress = &std::cerr;
   try {
@@ -193,10 +196,8 @@ void addRunCommand(CLI::App& root, int& exit_code) {
   run->add_option("--session", o->session,
                   "session file (JSON: the keys it changes; docs/settings.md, `arbci settings`)");
   run->add_flag("--headless", o->headless, "no window (automatic when there is no display)");
-  run->add_option("--trials", o->trials, "online trials (overrides the session file)")
-      ->check(CLI::Range(1, 1000));
-  run->add_option("--seed", o->seed, "random seed of the simulated subject and world")
-      ->check(CLI::Range(0LL, 1LL << 30));
+  schemaOverride(*run, "--trials", o->trials, session::sessionKey("paradigm.trials"));
+  schemaOverride(*run, "--seed", o->seed, session::sessionKey("eeg.seed"));
   run->add_option("--out", o->out,
                   "session folder, which must not hold a session already; one that failed its "
                   "pre-flight is replaced, and a start that fails leaves nothing in it (default: "

@@ -74,10 +74,9 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
 SimulationOptions::SimulationOptions() {
   const bci::SimulatedSubjectConfig subject;
   const bci::ParadigmSettings paradigm;
-  seed = subject.seed;
+  seed = static_cast<int>(subject.seed);
   rate_hz = subject.rate_hz;
-  for (const std::string& channel : subject.montage)
-    montage += (montage.empty() ? "" : ",") + channel;
+  montage = subject.montage;
   sequences = paradigm.calibration_sequences;
   flash_ms = paradigm.flash_ms;
   isi_ms = paradigm.isi_ms;
@@ -87,10 +86,10 @@ SimulationOptions::SimulationOptions() {
 
 SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& progress) {
   bci::SimulatedSubjectConfig config;
-  config.montage = splitNameList(o.montage);
+  config.montage = o.montage;
   if (config.montage.empty()) throw CliError("--montage names no channels");
   config.rate_hz = o.rate_hz;
-  config.seed = o.seed;
+  config.seed = static_cast<std::uint64_t>(o.seed);
   config.line_hz = o.line_hz;
   config.alpha_hz = o.alpha_hz;
   std::shared_ptr<bci::SampleClock> clock;

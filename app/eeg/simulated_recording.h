@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace arbci::app {
 
@@ -13,9 +14,9 @@ struct SimulationOptions {
   SimulationOptions();
   double seconds = 60.0;
   std::string out;
-  std::uint64_t seed;
+  int seed;
   double rate_hz;
-  std::string montage;        // comma-separated
+  std::vector<std::string> montage;
   int stimuli = 4;            // single-stimulus paradigm (objects)
   int rows = 0, columns = 0;  // row/column paradigm when both are set
   int sequences;              // a calibration selection's

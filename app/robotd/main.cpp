@@ -12,6 +12,7 @@
 #include "arbci/robot/settings.h"
 #include "arbci/robot/simulated_arm.h"
 #include "arbci/robot/thread_priority.h"
+#include "robotd/robotd_options.h"
 
 namespace {
 
@@ -31,34 +32,8 @@ int main(int argc, char** argv) {
       "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: "
       "docs/robot-protocol.md.",
       "arbci-robotd"};
-  const arbci::robot::LinkSettings link;  // the defaults a session's robot section has
-  int port = link.port;
-  std::string host = link.host, key_file, config_file, port_file, driver = "simulated";
-  double speed = 0.0;
-  bool stepped = false;
-  int watchdog_ms = link.watchdog_ms;
-  app.add_option("--port", port, "UDP port to listen on (0: any free port)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 65535));
-  app.add_option("--port-file", port_file,
-                 "write the port listened on to this file once listening");
-  app.add_option("--host", host, "address to listen on (127.0.0.1: this machine only)")
-      ->capture_default_str();
-  app.add_option("--key-file", key_file, "the shared key")->required();
-  app.add_option("--driver", driver, "the arm to drive: " + arbci::robot::robotDrivers().list(", "))
-      ->capture_default_str()
-      ->check(CLI::IsMember(arbci::robot::robotDrivers().names()));
-  app.add_option("--config", config_file,
-                 "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
-  app.add_option("--speed", speed,
-                 "simulated seconds per real second (overrides the config's speed_factor)")
-      ->check(CLI::Range(0.01, 1000.0));
-  app.add_flag("--stepped", stepped,
-               "move the arm only when a STATUS carries the client's clock (reproducible "
-               "simulations: arbci run headless starts it so), never on the wall clock");
-  app.add_option("--watchdog-ms", watchdog_ms, arbci::robot::linkSchema().at("watchdog_ms").doc)
-      ->capture_default_str()
-      ->check(CLI::Range(0, 60000));
+  arbci::app::RobotdOptions o;
+  arbci::app::addRobotdOptions(app, o);
   app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);
   app.failure_message([](const CLI::App*, const CLI::Error& error) {
     return std::string("arbci-robotd: ") + error.what() + "\n";
@@ -66,33 +41,33 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    const arbci::robot::Key key = arbci::robot::loadKey(key_file);
+    const arbci::robot::Key key = arbci::robot::loadKey(o.key_file);
     arbci::robot::RobotConfig config;
-    if (!config_file.empty()) config = arbci::robot::RobotConfig::load(config_file);
+    if (!o.config_file.empty()) config = arbci::robot::RobotConfig::load(o.config_file);
     arbci::robot::BackendOptions options;
-    options.port = port;
-    options.host = host;
-    options.speed_factor = speed > 0.0 ? speed : config.speed_factor;
+    options.port = o.port;
+    options.host = o.host;
+    options.speed_factor = o.speed > 0.0 ? o.speed : config.speed_factor;
     options.log = &std::cerr;
-    options.stepped = stepped;
-    options.watchdog_s = watchdog_ms / 1000.0;
+    options.stepped = o.stepped;
+    options.watchdog_s = o.watchdog_ms / 1000.0;
     arbci::robot::RobotBackend backend(
-        key, arbci::robot::robotDrivers().at(driver).make.make(config), options);
-    if (!port_file.empty()) {
-      std::ofstream out(port_file);
+        key, arbci::robot::robotDrivers().at(o.driver).make.make(config), options);
+    if (!o.port_file.empty()) {
+      std::ofstream out(o.port_file);
       out << backend.port() << "\n";
-      if (!out) throw std::runtime_error("cannot write " + port_file);
+      if (!out) throw std::runtime_error("cannot write " + o.port_file);
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     // A motion controller's loop: a busy PC must not delay a STOP or the watchdog's halt.
     const std::string priority = arbci::robot::raiseThreadPriority();
-    std::cerr << "arbci-robotd: listening on " << host << ":" << backend.port() << " (" << driver
-              << " arm, speed x" << options.speed_factor << ", " << config.objects.size()
-              << " objects, watchdog "
-              << (stepped           ? std::string("off (stepped)")
-                  : watchdog_ms > 0 ? std::to_string(watchdog_ms) + " ms"
-                                    : "off")
+    std::cerr << "arbci-robotd: listening on " << o.host << ":" << backend.port() << " ("
+              << o.driver << " arm, speed x" << options.speed_factor << ", "
+              << config.objects.size() << " objects, watchdog "
+              << (o.stepped           ? std::string("off (stepped)")
+                  : o.watchdog_ms > 0 ? std::to_string(o.watchdog_ms) + " ms"
+                                      : "off")
               << ", receive buffer " << backend.receiveBufferBytes() / 1024 << " KiB, scheduling "
               << priority << ")" << std::endl;
     if (backend.receiveBufferBytes() < options.receive_buffer_bytes)

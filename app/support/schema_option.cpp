@@ -1,7 +1,10 @@
 #include "support/schema_option.h"
 
 #include <cmath>
+#include <regex>
 #include <stdexcept>
+
+#include "support/cli_error.h"
 
 namespace arbci::app {
 namespace {
@@ -18,8 +21,9 @@ std::string help(const core::Key& key, const std::string& more) {
   return text;
 }
 
-CLI::Option* noted(CLI::App& command, CLI::Option* option, const core::Key& key) {
-  uses().push_back({&command, option->get_name(), &key});
+CLI::Option* noted(CLI::App& command, CLI::Option* option, const core::Key& key,
+                   bool own_default = false) {
+  uses().push_back({&command, option->get_name(), &key, own_default});
   return option;
 }
 
@@ -88,6 +92,39 @@ CLI::Option* schemaOption(CLI::App& command, const std::string& name,
   return noted(command, option, key);
 }
 
+CLI::Option* schemaOptionOwnDefault(CLI::App& command, const std::string& name, double& value,
+                                    const core::Key& key, double own, const std::string& why) {
+  if (key.type != core::Type::Number)
+    throw std::logic_error(name + ": the key " + key.name + " is not a number");
+  value = own;
+  CLI::Option* option =
+      command.add_option(name, value, help(key, "default " + core::formatNumber(own) + ": " + why));
+  range<double>(option, key);
+  return noted(command, option, key, true);
+}
+
+CLI::Option* schemaOptionOwnDefault(CLI::App& command, const std::string& name, int& value,
+                                    const core::Key& key, int own, const std::string& why) {
+  if (key.type != core::Type::Integer)
+    throw std::logic_error(name + ": the key " + key.name + " is not an integer");
+  value = own;
+  CLI::Option* option =
+      command.add_option(name, value, help(key, "default " + std::to_string(own) + ": " + why));
+  range<int>(option, key);
+  return noted(command, option, key, true);
+}
+
+CLI::Option* schemaOverride(CLI::App& command, const std::string& name, std::optional<int>& value,
+                            const core::Key& key) {
+  if (key.type != core::Type::Integer)
+    throw std::logic_error(name + ": the key " + key.name + " is not an integer");
+  value.reset();
+  CLI::Option* option =
+      command.add_option(name, value, help(key, "in place of the session file's " + key.name));
+  range<int>(option, key);
+  return noted(command, option, key, true);
+}
+
 CLI::Option* schemaFlag(CLI::App& command, const std::string& name, bool& value,
                         const core::Key& key, const std::string& more) {
   if (key.type != core::Type::Boolean || key.fallback.get<bool>())
@@ -98,6 +135,21 @@ CLI::Option* schemaFlag(CLI::App& command, const std::string& name, bool& value,
 
 const std::vector<SchemaOptionUse>& schemaOptions() {
   return uses();
+}
+
+void checkSchemaRules(const core::Table& table, const nlohmann::json& given,
+                      const CLI::App& command) {
+  try {
+    table.resolve(given, {"", ""});
+  } catch (const core::SettingsError& error) {
+    std::string message = error.what();
+    if (message.rfind(": ", 0) == 0) message.erase(0, 2);  // no file: the command line
+    for (const SchemaOptionUse& use : uses())
+      if (use.command == &command)
+        message =
+            std::regex_replace(message, std::regex("\\b" + use.key->name + "\\b"), use.option);
+    throw CliError(message);
+  }
 }
 
 }  // namespace arbci::app

@@ -10,7 +10,7 @@ FileSource::FileSource(Recording recording, std::shared_ptr<const SampleClock> c
     : recording_(std::move(recording)), clock_(std::move(clock)) {
   if (!clock_) throw std::invalid_argument("file source: no clock");
   if (block_size > 0) recording_.info.block_size = block_size;
-  if (recording_.info.block_size <= 0) recording_.info.block_size = 15;
+  if (recording_.info.block_size <= 0) recording_.info.block_size = kBlockSize;
   std::stable_sort(
       recording_.stimuli.begin(), recording_.stimuli.end(),
       [](const StimulusEvent& a, const StimulusEvent& b) { return a.sample < b.sample; });

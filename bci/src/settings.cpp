@@ -214,7 +214,7 @@ const core::Schema<SimulatedSubjectConfig>& subjectSchema() {
         .texts("montage", &S::montage, {"Fz", "Cz", "P3", "Pz", "P4", "PO7", "Oz", "PO8"}, 1,
                "the EEG channels' names (10-20); a live source's must include the model's")
         .number("rate_hz", &S::rate_hz, 256.0, 64.0, 4096.0, "the sampling rate", "Hz")
-        .integer("block_size", &S::block_size, 15, 1, 4096,
+        .integer("block_size", &S::block_size, kBlockSize, 1, 4096,
                  "samples per block the source delivers (15 at 256 Hz: one 58.6 ms cycle)")
         .number("line_hz", &S::line_hz, 50.0, 0.0, 70.0, "the power line's frequency (0: none)",
                 "Hz")

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "arbci/robot/settings.h"
+#include "arbci/robot/udp_socket.h"
 
 namespace arbci::robot {
 namespace {
@@ -94,7 +95,7 @@ const core::Schema<RobotConfig>& configSchema() {
 const core::Schema<LinkSettings>& linkSchema() {
   static const core::Schema<LinkSettings> table = [] {
     core::Schema<LinkSettings> t("link", "The robot backend's UDP address");
-    t.text("host", &LinkSettings::host, "127.0.0.1",
+    t.text("host", &LinkSettings::host, kLoopback,
            "the backend's host (arbci-robotd: the address it listens on)")
         .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port")
         // 100 ms: five heartbeats at 50 Hz. The deadline counts from each heartbeat's send time,

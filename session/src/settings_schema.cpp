@@ -4,6 +4,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "arbci/bci/classifier.h"
 #include "arbci/bci/settings.h"
@@ -400,26 +401,28 @@ const Schema<ErrpSettings>& errpTable() {
              "a selection whose posterior probability of an error exceeds it is rejected")
         .texts("channels", &E::channels, {}, 0,
                "its channels ([]: all of the montage's; those listed that the montage has)");
-    Key window{"window_ms", Type::Numbers, Json::array({0, 800}), "its epoch after each feedback",
-               "ms"};
-    window.min_items = window.max_items = 2;
-    t.custom(
-        window,
-        [](E& e, const Json& j) {
-          e.window = {j[0].get<double>() / 1000.0, j[1].get<double>() / 1000.0};
-        },
-        [](const E& e) {
-          return Json::array({e.window.start_s * 1000.0, e.window.end_s * 1000.0});
-        });
-    t.number("decimate_hz", &E::decimate_hz, 20.0, 1.0, 500.0, "its features' rate", "Hz")
-        .number("highpass_hz", &E::highpass_hz, 1.0, 0.0, 100.0, "its band's lower edge", "Hz")
-        .number("lowpass_hz", &E::lowpass_hz, 10.0, 0.0, 500.0, "its band's upper edge", "Hz")
-        .text("method", &E::method, "shift-lda", "its classifier (classifiers)",
-              [] { return bci::classifiers().names(); })
-        .integer("xdawn_filters", &E::xdawn_filters, 1, 1, 64,
-                 "xDAWN filters kept (riemann: per class)")
-        .integer("folds", &E::folds, 5, 2, 100,
-                 "its cross-validation: contiguous blocks of the feedbacks");
+    // The P300 pipeline's and training's keys (their type, unit and range), at the ErrP's own
+    // defaults: its features are slower and its band lower than the P300's.
+    const auto& pipeline = bci::pipelineSchema();
+    const auto& filter = bci::filterSchema();
+    const auto& training = bci::trainingSchema();
+    t.like(
+         pipeline.at("window_ms"), Json::array({0, 800}), "its epoch after each feedback",
+         [](E& e, const Json& j) {
+           e.window = {j[0].get<double>() / 1000.0, j[1].get<double>() / 1000.0};
+         },
+         [](const E& e) {
+           return Json::array({e.window.start_s * 1000.0, e.window.end_s * 1000.0});
+         })
+        .like(pipeline.at("decimate_hz"), &E::decimate_hz, 20.0,
+              "its features' rate (0: its method's own)")
+        .like(filter.at("highpass_hz"), &E::highpass_hz, 1.0, "its band's lower edge")
+        .like(filter.at("lowpass_hz"), &E::lowpass_hz, 10.0, "its band's upper edge")
+        .like(training.at("method"), &E::method, "shift-lda", "its classifier (classifiers)")
+        .like(training.at("xdawn_filters"), &E::xdawn_filters, 1,
+              "xDAWN filters kept (riemann: per class; 0: the method's own)")
+        .like(training.at("folds"), &E::folds, 5,
+              "its cross-validation: contiguous blocks of the feedbacks");
     t.rule([](const Json& e) -> Broken {
       const double start = e["window_ms"][0].get<double>(), end = e["window_ms"][1].get<double>();
       if (!(end > start) || start < 0.0)
@@ -627,6 +630,8 @@ bci::PipelineSettings ErrpSettings::pipeline(const bci::PipelineSettings& p300,
   out.filter.highpass_hz = highpass_hz;
   out.filter.lowpass_hz = lowpass_hz;
   out.channels.clear();
+  // decimate_hz 0: the method's own rate, as the P300's.
+  out = bci::withMethodRate(out, method);
   if (channels.empty()) {
     out.channels = montage;  // the EEG channels only, never the photodiode
     return out;
@@ -663,6 +668,19 @@ bci::lsl::LslConfig LslSettings::config(const std::string& session_file) const {
   if (!scope.empty()) c.resolve_scope = scope;
   c.known_peers.insert(c.known_peers.end(), known_peers.begin(), known_peers.end());
   return c;
+}
+
+const core::Key& sessionKey(const std::string& path) {
+  const core::Table* table = &sessionSchema();
+  const core::Key* key = nullptr;
+  std::istringstream parts(path);
+  for (std::string part; std::getline(parts, part, '.');) {
+    key = table ? table->find(part) : nullptr;
+    if (!key) throw std::logic_error("the session file has no key " + path);
+    table = key->table;
+  }
+  if (!key) throw std::logic_error("the session file has no key " + path);
+  return *key;
 }
 
 std::string settingsMarkdown() {

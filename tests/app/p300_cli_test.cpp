@@ -404,11 +404,13 @@ TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
   EXPECT_NE(r.out.find("selected with 15 sequences: 6MK?"), std::string::npos) << r.out;
   std::ifstream report_in(report);
   EXPECT_GT(nlohmann::json::parse(report_in)["auc"].get<double>(), 0.85);
-  // Not linear: no BCI2000 fragment, refused before training.
-  r = runProcess(kArbci, {"train", "--method", "riemann", eeg("eeg3_1.dat"), "--out",
-                          model.string(), "--bci2000", scratch("riemann.prm").string()});
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("not linear"), std::string::npos) << r.err;
+  // Not linear (the classifiers' entries say so): no BCI2000 fragment, refused before training.
+  for (const char* method : {"riemann", "shift-lda"}) {
+    r = runProcess(kArbci, {"train", "--method", method, eeg("eeg3_1.dat"), "--out", model.string(),
+                            "--bci2000", scratch("riemann.prm").string()});
+    EXPECT_EQ(r.exit_code, 1) << method;
+    EXPECT_NE(r.err.find("not linear"), std::string::npos) << r.err;
+  }
 }
 
 // Flat and drifting channels are reported, and left out on request; epochs over an amplitude
@@ -577,9 +579,11 @@ TEST(TrainAndEvaluate, BadInputGetsAClearError) {
        std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"--certainty", "2"}, "--certainty"},
            {{"--xdawn-filters", "-1"}, "--xdawn-filters"},
-           {{"--method", "xdawn", "--xdawn-filters", "99"}, "the features have 8 channels"},
-           {{"--decimate-hz", "1000"}, "exceeds the signal's rate 256 Hz"},
-           {{"--p-enter", "0.2", "--p-remove", "0.1"}, "must exceed --p-enter"},
+           {{"--xdawn-filters", "99"}, "--xdawn-filters"},
+           {{"--method", "xdawn", "--xdawn-filters", "20"}, "the features have 8 channels"},
+           {{"--decimate-hz", "1000"}, "--decimate-hz"},
+           {{"--decimate-hz", "400"}, "exceeds the signal's rate 256 Hz"},
+           {{"--p-enter", "0.2", "--p-remove", "0.1"}, "--p-remove = 0.1 must exceed --p-enter"},
            {{"--folds-by", "trial"}, "--folds-by"}}) {
     std::vector<std::string> args = {"train", eeg("eeg3_1.dat"), "--out",
                                      scratch("bad.json").string()};

@@ -159,7 +159,7 @@ TEST(RobotCommand, NoBackendOrWrongKeyGivesAReason) {
   const auto key = scratch("lonely.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
   // A port that is taken and never answers: a socket of the test's own, bound and never read.
-  const robot::UdpSocket silent(0);
+  const robot::UdpSocket silent(0, "127.0.0.1");
   const auto start = std::chrono::steady_clock::now();
   const ProcessResult r = runProcess(kArbci,
                                      {"robot", "--port", std::to_string(silent.port()),

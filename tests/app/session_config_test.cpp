@@ -7,6 +7,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -16,6 +18,9 @@
 #include "arbci/session/settings_schema.h"
 #include "arbci/vision/settings.h"
 #include "support/test_files.h"
+
+#include <cmath>
+#include <optional>
 
 namespace arbci::session {
 namespace {
@@ -101,6 +106,67 @@ TEST(SessionSchema, NoTwoEntriesNameTheSameKey) {
 }
 
 // docs/settings.md is generated from the schema (arbci settings --markdown): it is never stale.
+// A key's default as a literal in the sources ("0.5", "\"bch\""); none for the trivial ones (0,
+// 1, -1, true, false, ""): a member set to those is a neutral start, not a restated default.
+std::optional<std::string> literalOf(const nlohmann::json& v) {
+  if (v.is_string()) {
+    if (v.get<std::string>().empty()) return std::nullopt;
+    return std::regex_replace(v.dump(), std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)");
+  }
+  if (!v.is_number()) return std::nullopt;
+  const double x = v.get<double>();
+  if (x == 0.0 || x == 1.0 || x == -1.0) return std::nullopt;
+  if (x == std::floor(x)) return std::to_string(static_cast<long long>(x)) + R"((\.0*)?)";
+  std::string text = core::formatNumber(x);
+  return std::regex_replace(text, std::regex(R"(\.)"), R"(\.)");
+}
+
+void collectDefaults(const core::Table& table, std::map<std::string, std::set<std::string>>& out) {
+  for (const core::Key& key : table.keys()) {
+    if (key.table) collectDefaults(*key.table, out);
+    if (const auto literal = literalOf(key.fallback)) out[key.name].insert(*literal);
+  }
+}
+
+// Every default is written once, in the schema: no source writes a key's default beside its
+// name (`max_pose_age_s = 0.5`) in a struct of its own, where it could drift from the schema's.
+TEST(SessionSchema, NoSourceWritesASchemaDefaultBesideItsKeyName) {
+  std::map<std::string, std::set<std::string>> defaults;
+  collectDefaults(sessionSchema(), defaults);
+  // Names the sources also use for something else (another threshold, an id, a seed parameter).
+  const std::set<std::string> other_meanings = {"id", "threshold", "seed", "enabled"};
+  // Where the schema takes a default from (the one place it is written): tracker.border is the
+  // default marker family's own.
+  const std::map<std::string, std::string> taken_from = {
+      {"border", "vision/src/families/bch_family.cpp"}};
+  std::vector<std::string> found;
+  for (const char* folder : {"core", "vision", "bci", "robot", "session", "render", "ui", "app"}) {
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(
+             std::string(ARBCI_SOURCE_DIR) + "/" + folder)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".h" && ext != ".cpp") continue;
+      const std::string relative =
+          std::filesystem::relative(entry.path(), ARBCI_SOURCE_DIR).generic_string();
+      std::ifstream in(entry.path());
+      int number = 0;
+      for (std::string line; std::getline(in, line);) {
+        ++number;
+        line = line.substr(0, line.find("//"));
+        for (const auto& [name, literals] : defaults) {
+          if (other_meanings.count(name) || line.find(name) == std::string::npos) continue;
+          if (taken_from.count(name) && taken_from.at(name) == relative) continue;
+          for (const std::string& literal : literals) {
+            const std::regex restated("\\b" + name + R"(\s*(=|\{)\s*)" + literal + R"((?![\w.]))");
+            if (std::regex_search(line, restated))
+              found.push_back(entry.path().string() + ":" + std::to_string(number) + ": " + line);
+          }
+        }
+      }
+    }
+  }
+  for (const std::string& f : found) ADD_FAILURE() << "a schema default written again: " << f;
+}
+
 TEST(SessionSchema, DocsSettingsIsTheSchemas) {
   std::ifstream in(std::string(ARBCI_SOURCE_DIR) + "/docs/settings.md");
   std::stringstream text;
@@ -165,8 +231,9 @@ TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
   EXPECT_NE(none.find("errp.channels = [\"FC5\",\"FC6\"]: the EEG montage has none of them"),
             std::string::npos)
       << none;
-  const std::string filters = errorOf(R"({"errp": {"xdawn_filters": 0}})");
-  EXPECT_NE(filters.find("errp.xdawn_filters = 0"), std::string::npos) << filters;
+  // The training's range (0: the method's own), the ErrP's default.
+  const std::string filters = errorOf(R"({"errp": {"xdawn_filters": 65}})");
+  EXPECT_NE(filters.find("errp.xdawn_filters = 65"), std::string::npos) << filters;
 }
 
 // Before the run each stage checks what its settings name can be used, and says which key.

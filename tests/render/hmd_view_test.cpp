@@ -170,6 +170,8 @@ TEST(HmdView, UndistortedBackgroundMatchesItsRectifiedVirtualCamera) {
   Scene scene;
   SceneObject object;
   object.marker = {vision::MarkerKind::Bch, 42, 0.05, 0.125};
+  object.width_m = 0.07;
+  object.height_m = 0.06;
   object.T_world_top = {cv::Matx33d::eye(), cv::Vec3d(0.25, 0.5, 0.06)};  // towards the image edge
   scene.objects.push_back(object);
   const cv::Mat distorted = camera.render(scene, rig.left, CameraEffects{true});

@@ -20,6 +20,8 @@ Scene oneObject(int id, const vision::Pose& top) {
   Scene scene;
   SceneObject object;
   object.marker = {vision::MarkerKind::Bch, id, 0.05, 0.125};
+  object.width_m = 0.07;
+  object.height_m = 0.06;
   object.T_world_top = top;
   scene.objects.push_back(object);
   return scene;

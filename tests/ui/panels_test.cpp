@@ -106,6 +106,7 @@ void phaseOneOfTrialTwo(test::PanelBench& b) {
   vision::WorldModel world;
   world.update(83.37, {{0, at(0.0, 0.0)}, {20, at(-0.09, -0.48)}, {40, at(0.27, -0.48)}});
   r.tracking.world = std::make_shared<const vision::WorldModel>(world);
+  r.tracking.max_pose_age_s = 0.5;
   robot::StatusPayload status;
   status.state = robot::RobotState::Idle;
   status.tool = {0.0, 0.45, 0.45};

@@ -13,7 +13,8 @@ namespace {
 
 TEST(RobotFrame, ObjectsOnTheTableComeOutWithin5MillimetresThroughTheReferenceMarker) {
   const cv::Matx33d k(900, 0, 639.5, 0, 900, 359.5, 0, 0, 1);
-  const ReferenceMarker reference;  // id 0, 8 cm, at (0, 0.90, 0)
+  ReferenceMarker reference;  // id 0 at (0, 0.90, 0)
+  reference.size_m = 0.08;
   WorldModel world(reference);
   const std::map<int, cv::Vec3d> objects{
       {5, {0.12, 0.72, 0.0}}, {6, {-0.10, 0.66, 0.0}}, {7, {0.02, 0.80, 0.0}}};

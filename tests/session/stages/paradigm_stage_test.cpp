@@ -80,6 +80,7 @@ class ParadigmStageTest : public ::testing::Test {
     }
     world_.update(r.time_s, poses);
     r.tracking.world = std::make_shared<const vision::WorldModel>(world_);
+    r.tracking.max_pose_age_s = 0.5;
   }
   // One cycle: the world seen, the P300 stage's counts for the current selection (every flash
   // scored, deciding `decide` when given), the robot's `notes`; then the next.

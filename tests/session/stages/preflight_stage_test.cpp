@@ -22,6 +22,7 @@ PreflightStageSettings settings(bool experimenter) {
   s.check.robot_key = "robot.host, robot.port";
   s.check.robot_what = "the robot backend at 10.0.0.5:5005";
   s.experimenter = experimenter;
+  s.max_pose_age_s = 0.5;
   // It fails past this many seconds of session time and of the wall clock both (a robot answers
   // on the wall clock): short, so the failing tests wait little.
   s.check.timeout_s = 0.5;

@@ -29,7 +29,7 @@ class EegdevError : public std::runtime_error {
 struct EegdevSourceSettings {
   EegdevSourceSettings();
   std::string device;  // e.g. "datafile|path|/data/s01.bdf"
-  int block_size = 15;
+  int block_size = kBlockSize;
   double expected_rate_hz = 0.0;  // the session's rate: a device at another rate is refused
 };
 

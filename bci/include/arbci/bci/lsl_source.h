@@ -31,7 +31,7 @@ struct LslSourceSettings {
   std::string source_id;  // the stream's source id (empty: any): tells same-named streams apart
   std::string host;       // the host it streams from (empty: any)
   double resolve_timeout_s;
-  int block_size = 15;
+  int block_size = kBlockSize;
   double expected_rate_hz = 0.0;  // the session's rate: a stream at another rate is refused
   // Refuse a stream that answers but sends no sample within resolve_timeout_s (pre-flight).
   bool require_samples = true;

@@ -20,6 +20,10 @@ struct SignalInfo {
 };
 
 // Channel-major: sample s of channel c is data[c * samples + s].
+// Samples a block holds unless a source or the session says otherwise: 15 at 256 Hz is one 58.6 ms
+// cycle (the session's eeg.block_size, whose default this is).
+inline constexpr int kBlockSize = 15;
+
 struct Block {
   std::int64_t first_sample = 0;
   int channels = 0;

@@ -114,6 +114,14 @@ class Table {
   std::vector<Rule> rules_;
 };
 
+// `key` with another default and doc (Schema::like).
+inline Key likeKey(const Key& key, nlohmann::json fallback, std::string doc) {
+  Key k = key;
+  k.fallback = std::move(fallback);
+  k.doc = std::move(doc);
+  return k;
+}
+
 // A table bound to the struct S: each key reads and writes a member (or, for a value the file
 // holds otherwise than the struct, through a pair of functions).
 template <class S>
@@ -227,6 +235,21 @@ class Schema : public Table {
     return custom(
         std::move(k), [&other, i](S& s, const nlohmann::json& j) { other.readKey(i, j, s); },
         [&other, i](const S& s) { return other.writeKey(i, s); });
+  }
+  // A key of another table (its name, type, unit, range and choices) for another use of the same
+  // setting, with this use's own default and doc: the ErrP's decimate_hz is the pipeline's, at
+  // 20 Hz. The range stays the one declared.
+  template <class V>
+  Schema& like(const Key& other, V S::*member, nlohmann::json fallback, std::string doc) {
+    return custom(
+        likeKey(other, std::move(fallback), std::move(doc)),
+        [member](S& s, const nlohmann::json& j) { s.*member = j.get<V>(); },
+        [member](const S& s) { return nlohmann::json(s.*member); });
+  }
+  // The same for a value the struct keeps otherwise than the file.
+  Schema& like(const Key& other, nlohmann::json fallback, std::string doc, Read read, Write write) {
+    return custom(likeKey(other, std::move(fallback), std::move(doc)), std::move(read),
+                  std::move(write));
   }
   // A section of the file read into S itself (its keys bound to members of S).
   Schema& sectionOf(std::string key, const Schema<S>& table) {

@@ -35,8 +35,8 @@ struct ObjectHighlight {
 // far row (+y of the grid frame), column 1 the left one (-x).
 struct GridLayout {
   vision::Pose T_world_grid;
-  int rows = 3, columns = 3;
-  double cell_m = 0.08;
+  int rows = 0, columns = 0;  // the session's world.grid
+  double cell_m = 0.0;
   // The centre of cell (row, column), 1-based, in the world frame.
   cv::Vec3d cellCentre(int row, int column) const;
   cv::Vec3d cellCorner(double row_edge, double column_edge) const;  // edges 0..rows, 0..columns

@@ -17,14 +17,13 @@ struct SceneMarker {
   vision::MarkerKind kind = vision::MarkerKind::Bch;
   int id = 0;
   double side_m = 0.05;  // the black square
-  double border = 0.125;
+  double border = 0.0;   // of the side (the tracker's tracker.border for the session's markers)
 };
 
 struct SceneObject {
   SceneMarker marker;
-  vision::Pose T_world_top;  // the centre of the top face; z out of the face
-  double width_m = 0.07;
-  double height_m = 0.06;
+  vision::Pose T_world_top;              // the centre of the top face; z out of the face
+  double width_m = 0.0, height_m = 0.0;  // the session's world.objects[]
   glm::vec3 color{0.85f, 0.35f, 0.25f};
   bool covered = false;  // a hand lies over its marker
   // The gripper's fingertip lies over a corner of its marker (the simulated arm coming down on it

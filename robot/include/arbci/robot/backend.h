@@ -23,7 +23,7 @@ namespace arbci::robot {
 
 struct BackendOptions {
   int port = 0;  // 0: any free port (see RobotBackend::port)
-  std::string host = "127.0.0.1";
+  std::string host = LinkSettings().host;
   double speed_factor = 1.0;  // robot seconds per real second
   // Stepped: the robot moves only when a STATUS carries the requester's clock (to that time; its
   // seconds are robot seconds, speed_factor does not apply), never on the wall clock: a simulated

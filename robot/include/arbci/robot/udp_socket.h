@@ -25,6 +25,9 @@ struct Endpoint {
   static Endpoint resolve(const std::string& host, int port);
 };
 
+// This machine only: where a backend listens and sockets bind unless told otherwise.
+inline constexpr const char* kLoopback = "127.0.0.1";
+
 struct Datagram {
   std::vector<std::uint8_t> bytes;
   Endpoint from;
@@ -33,7 +36,8 @@ struct Datagram {
 class UdpSocket {
  public:
   // Bound to `port` on `host` (0: any free port). Throws SocketError with the reason.
-  explicit UdpSocket(int port = 0, const std::string& host = "127.0.0.1");
+  // `host`: the address to bind (this machine only by default).
+  explicit UdpSocket(int port = 0, const std::string& host = kLoopback);
   ~UdpSocket();
   UdpSocket(const UdpSocket&) = delete;
   UdpSocket& operator=(const UdpSocket&) = delete;

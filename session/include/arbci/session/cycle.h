@@ -158,7 +158,9 @@ struct TrackingPart {
   cv::Mat binary;                       // the tracker's binary image of it
   vision::ThresholdSettings threshold;  // how the tracker thresholds (the experimenter's last)
   std::shared_ptr<const vision::WorldModel> world;
-  double max_pose_age_s = 0.5;
+  // The tracking stage publishes tracker.max_pose_age_s here; until it does (0) every pose is
+  // stale, so a record built by hand says how old a pose may be.
+  double max_pose_age_s = 0.0;
   // The object's pose is known and no older than the allowed age at `now_s`.
   bool fresh(int id, double now_s) const;
   // "" while the reference and every object in `ids` are fresh, else "tracking lost: reference

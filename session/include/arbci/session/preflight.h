@@ -33,8 +33,8 @@ struct PreflightObservation {
   double wall_s = 0.0;  // host clock
   bool camera_frame = false;
   std::optional<double> reference_age_s;  // since the reference marker was seen
-  double max_pose_age_s = 0.5;
-  long long eeg_samples = 0;  // recorded so far
+  double max_pose_age_s = 0.0;            // the session's tracker.max_pose_age_s
+  long long eeg_samples = 0;              // recorded so far
   bool robot_answered = false;
   bool robot_key_refused = false;  // it answered, with KEY MISMATCH
 };

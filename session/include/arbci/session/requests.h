@@ -40,7 +40,7 @@ struct GraspRequest {
   int object = 0;
   std::optional<cv::Vec3d> at;
   double pose_age_s = 0.0;
-  double max_pose_age_s = 0.5;
+  double max_pose_age_s = 0.0;  // the session's tracker.max_pose_age_s
   bool retry = false;
   double time_s = 0.0;
 };

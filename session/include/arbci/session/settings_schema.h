@@ -16,6 +16,10 @@ const core::Schema<SessionConfig>& sessionSchema();
 const core::Schema<ClassifierSettings>& classifierSchema();
 const core::Schema<ErrpSettings>& errpOwnSchema();
 
+// The session file's key at a dotted path ("lsl.scope", "paradigm.trials"), for a command's
+// option made from it; std::logic_error naming the path when there is none.
+const core::Key& sessionKey(const std::string& path);
+
 // docs/settings.md: every section's table, then the registries' members (EEG sources,
 // classifiers, marker families, camera sources, robot drivers; the application adds its panels).
 std::string settingsMarkdown();

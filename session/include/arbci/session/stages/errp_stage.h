@@ -27,7 +27,7 @@ struct ErrpStageSettings {
   bci::TrainingSettings training;
   double flash_s = 0.06;   // the feedback's nominal duration (a flash's)
   std::string model_file;  // a trained P300 model whose "errp" part is used
-  double threshold = 0.5;  // for the summary
+  double threshold = 0.0;  // errp.threshold, for the summary
 };
 
 class ErrpStage final : public Stage {

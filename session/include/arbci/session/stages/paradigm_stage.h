@@ -41,7 +41,7 @@ struct ParadigmStageSettings {
   double errp_threshold = 0.5;        // ErrP: reject a selection above this posterior of error
   std::filesystem::path model_file;   // where the model trained goes
   bool experimenter = false;    // someone at the window: a wait pauses rather than ends the run
-  double max_pose_age_s = 0.5;  // an older pose is stale: never grasped at (the robot refuses)
+  double max_pose_age_s = 0.0;  // tracker.max_pose_age_s: older is stale (the robot refuses it)
 };
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;

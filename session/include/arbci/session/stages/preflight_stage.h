@@ -11,8 +11,8 @@ namespace arbci::session {
 
 struct PreflightStageSettings {
   PreflightSettings check;
-  double max_pose_age_s = 0.5;
-  bool experimenter = true;  // false: nobody can fix a failure, so the run ends
+  double max_pose_age_s = 0.0;  // the session's tracker.max_pose_age_s
+  bool experimenter = true;     // false: nobody can fix a failure, so the run ends
 };
 
 class PreflightStage final : public Stage {
