@@ -139,9 +139,6 @@ TEST(P300RealEeg, Eeg3_1ThroughXdfWithItsLayoutTrainsAsTheOriginal) {
       trainModel(buildDataset({original}, pipeline), pipeline, settings);
   EXPECT_EQ(from_xdf.cross_validation.report.selected(15), "T3OF");
   EXPECT_EQ(from_xdf.cross_validation.report.accuracy, from_dat.cross_validation.report.accuracy);
-  std::printf("[ measured ] eeg3_1 cross-validated accuracy at 15 sequences: XDF %.3f, .dat %.3f\n",
-              from_xdf.cross_validation.report.accuracy[14],
-              from_dat.cross_validation.report.accuracy[14]);
 
   // Without the layout the same file is 12 single stimuli.
   const auto bare = test::freshTempPath("p300_xdf", "eeg3_1_bare.xdf");

@@ -179,8 +179,7 @@ TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
       received_bytes += d->bytes.size();
     }
   }
-  EXPECT_LT(received_bytes, sent_bytes);
-  std::cout << "replayed " << sent_bytes << " bytes, " << received_bytes << " came back\n";
+  EXPECT_LT(received_bytes, sent_bytes) << received_bytes << " of " << sent_bytes << " bytes";
   RobotClient observer(local(port), testKey(), fastClient());
   const StatusPayload status = freshStatus(observer);
   EXPECT_EQ(status.holding, -1);
@@ -328,11 +327,6 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
   const Clock::time_point give_up = cut + 10s;
   while (*halted_at == 0 && Clock::now() < give_up) std::this_thread::sleep_for(1ms);
   ASSERT_NE(*halted_at, 0) << "the arm was not halted";
-  const double latency_ms = std::chrono::duration<double, std::milli>(
-                                Clock::time_point(Clock::duration(halted_at->load())) - cut)
-                                .count();
-  std::cout << "halt latency after the cut: " << latency_ms << " ms\n";
-  EXPECT_GT(latency_ms, 0.0);  // halted after the cut, not before
   // The watchdog, not the grasp's end, stopped it: the outcome below is "stopped", "link lost".
   // How soon is measured in bench/ (watchdog_bench, robot_link_bench), not judged here.
   relay.setCut(false);
@@ -378,11 +372,6 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsDelayed) {
   const Clock::time_point give_up = delayed + 10s;
   while (*halted_at == 0 && Clock::now() < give_up) std::this_thread::sleep_for(1ms);
   ASSERT_NE(*halted_at, 0) << "the arm was not halted";
-  std::cout << "halt latency after the link began to delay by 1.5 s: "
-            << std::chrono::duration<double, std::milli>(
-                   Clock::time_point(Clock::duration(halted_at->load())) - delayed)
-                   .count()
-            << " ms\n";
   const auto events = waitFor(client, grasp, 8s);
   ASSERT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
   EXPECT_EQ(finalEvent(events).outcome, Outcome::Stopped);
@@ -618,8 +607,6 @@ TEST(RobotLink, AStatusAfterBurstsOfJunkIsAnswered) {
   RunningBackend backend(20.0);
   RawSession raw(backend.port());
   ASSERT_TRUE(raw.hello(1));
-  std::cout << "receive buffer granted: " << backend.backend().receiveBufferBytes() / 1024
-            << " KiB\n";
   UdpSocket junk;
   const std::vector<std::uint8_t> bytes(kMaxDatagram, 0x5a);
   std::uint64_t sequence = 10;
@@ -631,10 +618,11 @@ TEST(RobotLink, AStatusAfterBurstsOfJunkIsAnswered) {
       raw.send(raw.message(MessageType::Status, sequence));
       reply = raw.answer(sequence, 50ms);
     }
-    ASSERT_TRUE(reply) << "after a burst of " << burst;
+    ASSERT_TRUE(reply) << "after a burst of " << burst << " (receive buffer "
+                       << backend.backend().receiveBufferBytes() / 1024 << " KiB, "
+                       << backend.stats().shed << " dropped unread)";
     EXPECT_EQ(reply->type, MessageType::StatusReply);
   }
-  std::cout << "junk dropped unread: " << backend.stats().shed << "\n";
 }
 
 }  // namespace

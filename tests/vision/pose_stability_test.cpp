@@ -13,11 +13,14 @@
 namespace arbci::test {
 namespace {
 
-void print(const char* sequence, const char* who, const PoseStability& r) {
-  std::printf(
-      "[ measured ] %-26s %-30s found %3d/%3d  flips %2d  rotation %.2f deg  corners "
-      "%+.3f px outward, %.3f px RMS\n",
-      sequence, who, r.found, r.frames, r.flips, r.rotation_deg, r.outward_px, r.corner_rms_px);
+// The figures, for a failure's message (bench/pose_sequence_bench prints them for every run).
+std::string figures(const char* who, const PoseStability& r) {
+  char line[200];
+  std::snprintf(line, sizeof line,
+                "%s: found %d/%d, flips %d, rotation %.2f deg, corners %+.3f px outward, "
+                "%.3f px RMS",
+                who, r.found, r.frames, r.flips, r.rotation_deg, r.outward_px, r.corner_rms_px);
+  return line;
 }
 
 void compare(const PoseSequence& sequence) {
@@ -26,12 +29,12 @@ void compare(const PoseSequence& sequence) {
   const vision::PoseOptions session_pose;
   const PoseStability raw = runArbciPoses(sequence, config, session_pose, false);
   const PoseStability smooth = runArbciPoses(sequence, config, session_pose, true);
-  print(sequence.name.c_str(), "AprilTag (decimate 2) + IPPE", peer);
-  print(sequence.name.c_str(), "ARBCI", raw);
-  print(sequence.name.c_str(), "ARBCI, corners smoothed", smooth);
-  EXPECT_GE(raw.found, peer.found * 9 / 10);
-  EXPECT_LE(raw.flips, peer.flips);
-  EXPECT_LE(smooth.flips, raw.flips);
+  const std::string all = sequence.name + "\n" + figures("AprilTag (decimate 2) + IPPE", peer) +
+                          "\n" + figures("ARBCI", raw) + "\n" +
+                          figures("ARBCI, corners smoothed", smooth);
+  EXPECT_GE(raw.found, peer.found * 9 / 10) << all;
+  EXPECT_LE(raw.flips, peer.flips) << all;
+  EXPECT_LE(smooth.flips, raw.flips) << all;
 }
 
 TEST(PoseStability, AFastHandheldMarkerFlipsNoMoreThanAprilTagWithIppe) {
@@ -58,11 +61,11 @@ TEST(PoseStability, JpegDoesNotMoveAFarMarkersCorners) {
   const PoseStability on_jpeg = runArbciPoses(jpeg, config, pose, false);
   const PoseStability on_uncompressed = runArbciPoses(uncompressed, config, pose, false);
   const PoseStability on_sharp_jpeg = runArbciPoses(sharp, config, pose, false);
-  print(jpeg.name.c_str(), "ARBCI", on_jpeg);
-  print("far, uncompressed", "ARBCI", on_uncompressed);
-  print("far, JPEG, 0 ms exposure", "ARBCI", on_sharp_jpeg);
-  EXPECT_NEAR(on_jpeg.outward_px, on_uncompressed.outward_px, 0.03);
-  EXPECT_NEAR(on_sharp_jpeg.outward_px, 0.0, 0.03);
+  const std::string all = figures("far, JPEG", on_jpeg) + "\n" +
+                          figures("far, uncompressed", on_uncompressed) + "\n" +
+                          figures("far, JPEG, 0 ms exposure", on_sharp_jpeg);
+  EXPECT_NEAR(on_jpeg.outward_px, on_uncompressed.outward_px, 0.03) << all;
+  EXPECT_NEAR(on_sharp_jpeg.outward_px, 0.0, 0.03) << all;
 }
 
 // Placing a compressed frame's markers on its own edges (passes.place_on_frame) removes the
@@ -81,8 +84,6 @@ TEST(PoseStability, PlacingOnTheFrameAddsNoFlipsToAFastMarker) {
     flips_placed += runArbciPoses(fast, placed, pose, false).flips;
     flips_unplaced += runArbciPoses(fast, unplaced, pose, false).flips;
   }
-  std::printf("[ measured ] fast, noise seeds 5 and 7: flips %d placed on the frame, %d not\n",
-              flips_placed, flips_unplaced);
   EXPECT_LE(flips_placed, flips_unplaced);
 }
 

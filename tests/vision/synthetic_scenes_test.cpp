@@ -231,9 +231,6 @@ TEST(SyntheticScenes, DecimatedSearchReadsFairScenesAsTheFullOne) {
         << test::toString(condition) << ": " << half.found << " of " << half.truth;
     // Refined on the frame's edges: corners as accurate as the full search's.
     EXPECT_LE(half.meanCornerError(), full.meanCornerError() + 0.03) << test::toString(condition);
-    std::printf("%s: full %d/%d %.3f px, decimated %d/%d %.3f px\n",
-                test::toString(condition).c_str(), full.found, full.truth, full.meanCornerError(),
-                half.found, half.truth, half.meanCornerError());
   }
 }
 
@@ -401,10 +398,6 @@ TEST(SyntheticScenes, LayoutsTiltedFromTheLineOfSightAreSeenNoMoreObliquelyThanT
       }
     }
     EXPECT_EQ(markers, 600);
-    std::printf(
-        "tilt from the %s: the most oblique of %d markers is seen %.2f deg off face-on\n",
-        tilt_from == test::LayoutOptions::TiltFrom::LineOfSight ? "line of sight" : "optical axis",
-        markers, most_oblique);
     if (tilt_from == test::LayoutOptions::TiltFrom::LineOfSight) {
       EXPECT_LE(most_oblique, options.max_tilt_deg + 0.05);
       EXPECT_GE(most_oblique, options.max_tilt_deg - 1.0);  // the tilts still reach the limit
