@@ -25,7 +25,7 @@ find_library(EDFLIB_LIBRARY NAMES libedf.a edf REQUIRED)
 if(ARBCI_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
-if(ARBCI_BUILD_BENCH)
+if(ARBCI_BENCH)
   find_package(benchmark REQUIRED)
 endif()
 # libapriltag: the tracker's AprilTag kind (vision/), the synthetic scenes' tags and the
