@@ -42,8 +42,12 @@ XvfbServer::XvfbServer(const std::string& screen) {
     dup2(null, STDOUT_FILENO);
     dup2(null, STDERR_FILENO);
     const std::string fd = std::to_string(display_pipe[1]);
+    // -noreset: an X server resets when its last client disconnects, and a connection made
+    // while it resets is refused ("Failed to open display"). A test that opens a second window
+    // after closing the first, or arbci probing the display before opening its window, would
+    // otherwise race the reset.
     execl(XVFB_EXECUTABLE, "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", screen.c_str(),
-          "-nolisten", "tcp", static_cast<char*>(nullptr));
+          "-nolisten", "tcp", "-noreset", static_cast<char*>(nullptr));
     _exit(127);
   }
   close(display_pipe[1]);
