@@ -108,11 +108,11 @@ std::vector<std::string> Preflight::lines() const {
                     format("EEG at %.1f Hz, the robot answers", eeg_rate_hz_));
       return out;
     case State::Failed:
-      out.push_back("pre-flight FAILED (Start checks again):");
+      out.emplace_back("pre-flight FAILED (Start checks again):");
       for (const std::string& f : failures_) out.push_back("  " + f);
       return out;
     case State::Running:
-      out.push_back("pre-flight: checking cameras, reference, EEG and robot ...");
+      out.emplace_back("pre-flight: checking cameras, reference, EEG and robot ...");
       for (const std::string& f : check(false)) out.push_back("  waiting: " + f);
       return out;
   }

@@ -164,7 +164,7 @@ TEST(Recording, BadFilesGiveOneLineNamingTheFileNeverACrash) {
     std::ofstream(dir / name, std::ios::binary) << bytes;
     return dir / name;
   };
-  std::string edf_garbage = "0       " + std::string(248, 'x');
+  std::string edf_garbage = std::string("0       ").append(248, 'x');
   std::string bci_lying =
       "HeaderLen= 999999 SourceCh= 8 StatevectorLen= 4\r\n[ State Vector Definition ]\r\n";
   std::string bci_no_rate =

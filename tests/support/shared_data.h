@@ -6,7 +6,8 @@
 namespace arbci::test {
 
 inline std::string sharedData(const std::string& relative) {
-  return std::string(ARBCI_SHARED_DATA_DIR) + "/" + relative;
+  std::string path = ARBCI_SHARED_DATA_DIR;
+  return path.append("/").append(relative);
 }
 
 }  // namespace arbci::test

@@ -4,6 +4,7 @@
 // what an unregularised LDA can give); the threshold midway between the class means. Compare it
 // with shrinkage LDA (slda) to see what the shrinkage buys.
 #include <Eigen/QR>
+#include <utility>
 
 #include "arbci/bci/evaluation.h"
 #include "classifiers/linear.h"
@@ -51,7 +52,7 @@ ClassifierRegistry::Entry plainLdaClassifier() {
   return {"lda",
           "plain Fisher LDA (pooled covariance, no shrinkage; its pseudo-inverse where singular): "
           "the unregularised baseline",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::bci
