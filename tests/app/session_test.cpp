@@ -108,6 +108,18 @@ TEST(Session, ThreeTrialsAllRightEachObjectWithinACentimetreAndTheSameSeedTheSam
   ASSERT_EQ(recording.info.channelCount(), 9);  // the montage and the virtual photodiode
   EXPECT_EQ(recording.info.channels.back(), "Photodiode");
   EXPECT_NEAR(recording.seconds(), summary["duration_s"].get<double>(), 0.1);
+  // The summary's timing is the recording's: the median SOA of consecutive flashes (closer than
+  // a second, so within a selection) read back from the file.
+  std::vector<double> soa_ms;
+  for (size_t i = 1; i < recording.stimuli.size(); ++i) {
+    const double gap =
+        (recording.stimuli[i].sample - recording.stimuli[i - 1].sample) * 1000.0 / 256.0;
+    if (gap < 1000.0) soa_ms.push_back(gap);
+  }
+  ASSERT_FALSE(soa_ms.empty());
+  std::nth_element(soa_ms.begin(), soa_ms.begin() + soa_ms.size() / 2, soa_ms.end());
+  EXPECT_NEAR(soa_ms[soa_ms.size() / 2], summary["timing"]["soa_ms"]["median"].get<double>(), 2.0)
+      << summary["timing"].dump(2);
   // Calibration flashes are labelled by the cue; online flashes by the trial's intention: T
   // exactly when the code stands (StimulusCodeMap) for the intended object, row or column.
   std::int64_t online_from = -1;
