@@ -44,7 +44,10 @@ void expectOnTarget(const std::filesystem::path& folder) {
   const double sample_ms = 1000.0 / 256.0;
   EXPECT_LE(std::abs(t["offset_ms"]["mean"].get<double>()), 1.0) << t.dump(2);
   EXPECT_LE(t["offset_ms"]["sd"].get<double>(), sample_ms) << t.dump(2);
-  EXPECT_GT(t["flashes"].get<int>(), 30);
+  // How many flashes fit in the check's seconds depends on how fast the machine presents them (on
+  // late frames the schedule slips, never squeezes): ten are enough to judge the offsets, and a
+  // loaded machine still shows them (18-27 in 15 s beside two busy processes, 32 on a quiet one).
+  EXPECT_GE(t["flashes"].get<int>(), 10);
   EXPECT_EQ(t["count"], t["flashes"]) << t.dump(2);
   EXPECT_EQ(t["unmatched_edges"], 0) << t.dump(2);
   // The paradigm's rules, each judged and met: one stimulus at a time, a dark frame before each,
