@@ -3,6 +3,7 @@
 #include <cmath>
 #include <regex>
 #include <stdexcept>
+#include <type_traits>
 
 #include "support/cli_error.h"
 
@@ -36,32 +37,56 @@ void range(CLI::Option* option, const core::Key& key) {
                            high ? static_cast<T>(key.high) : std::numeric_limits<T>::max()));
 }
 
+// A programming error: the option's variable is not of the key's type.
+void expectType(const std::string& name, const core::Key& key, core::Type type, const char* what) {
+  if (key.type != type) throw std::logic_error(name + ": the key " + key.name + " is not " + what);
+}
+
+// A number or an integer option: the key's type, range and doc.
+template <class T>
+void expectNumber(const std::string& name, const core::Key& key) {
+  if constexpr (std::is_same_v<T, int>)
+    expectType(name, key, core::Type::Integer, "an integer");
+  else
+    expectType(name, key, core::Type::Number, "a number");
+}
+
+template <class T>
+CLI::Option* numberOption(CLI::App& command, const std::string& name, T& value,
+                          const core::Key& key, const std::string& more) {
+  expectNumber<T>(name, key);
+  value = key.fallback.get<T>();
+  CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
+  range<T>(option, key);
+  return noted(command, option, key);
+}
+
+template <class T>
+CLI::Option* numberOptionOwnDefault(CLI::App& command, const std::string& name, T& value,
+                                    const core::Key& key, T own, const std::string& why) {
+  expectNumber<T>(name, key);
+  value = own;
+  CLI::Option* option =
+      command.add_option(name, value, help(key, "default " + core::formatNumber(own) + ": " + why));
+  range<T>(option, key);
+  return noted(command, option, key, true);
+}
+
 }  // namespace
 
 CLI::Option* schemaOption(CLI::App& command, const std::string& name, double& value,
                           const core::Key& key, const std::string& more) {
-  if (key.type != core::Type::Number)
-    throw std::logic_error(name + ": the key " + key.name + " is not a number");
-  value = key.fallback.get<double>();
-  CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
-  range<double>(option, key);
-  return noted(command, option, key);
+  return numberOption(command, name, value, key, more);
 }
 
 CLI::Option* schemaOption(CLI::App& command, const std::string& name, int& value,
                           const core::Key& key, const std::string& more) {
-  if (key.type != core::Type::Integer)
-    throw std::logic_error(name + ": the key " + key.name + " is not an integer");
-  value = key.fallback.get<int>();
-  CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
-  range<int>(option, key);
-  return noted(command, option, key);
+  return numberOption(command, name, value, key, more);
 }
 
 CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::string& value,
                           const core::Key& key, const std::string& more) {
-  if (key.type != core::Type::Text)
-    throw std::logic_error(name + ": the key " + key.name + " is not a text");
+  expectType(name, key, core::Type::Text, "a text");
   value = key.fallback.get<std::string>();
   CLI::Option* option = command.add_option(name, value, help(key, more))->capture_default_str();
   if (key.choices) option->check(CLI::IsMember(key.choices()));
@@ -70,8 +95,7 @@ CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::strin
 
 CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::vector<double>& value,
                           const core::Key& key, const std::string& more) {
-  if (key.type != core::Type::Numbers)
-    throw std::logic_error(name + ": the key " + key.name + " is not a list of numbers");
+  expectType(name, key, core::Type::Numbers, "a list of numbers");
   value = key.fallback.get<std::vector<double>>();
   std::string shown;
   for (double v : value) shown += (shown.empty() ? "" : ",") + core::formatNumber(v);
@@ -85,8 +109,7 @@ CLI::Option* schemaOption(CLI::App& command, const std::string& name, std::vecto
 CLI::Option* schemaOption(CLI::App& command, const std::string& name,
                           std::vector<std::string>& value, const core::Key& key,
                           const std::string& more) {
-  if (key.type != core::Type::Texts)
-    throw std::logic_error(name + ": the key " + key.name + " is not a list of texts");
+  expectType(name, key, core::Type::Texts, "a list of texts");
   value = key.fallback.get<std::vector<std::string>>();
   CLI::Option* option = command.add_option(name, value, help(key, more))->delimiter(',');
   return noted(command, option, key);
@@ -94,30 +117,17 @@ CLI::Option* schemaOption(CLI::App& command, const std::string& name,
 
 CLI::Option* schemaOptionOwnDefault(CLI::App& command, const std::string& name, double& value,
                                     const core::Key& key, double own, const std::string& why) {
-  if (key.type != core::Type::Number)
-    throw std::logic_error(name + ": the key " + key.name + " is not a number");
-  value = own;
-  CLI::Option* option =
-      command.add_option(name, value, help(key, "default " + core::formatNumber(own) + ": " + why));
-  range<double>(option, key);
-  return noted(command, option, key, true);
+  return numberOptionOwnDefault(command, name, value, key, own, why);
 }
 
 CLI::Option* schemaOptionOwnDefault(CLI::App& command, const std::string& name, int& value,
                                     const core::Key& key, int own, const std::string& why) {
-  if (key.type != core::Type::Integer)
-    throw std::logic_error(name + ": the key " + key.name + " is not an integer");
-  value = own;
-  CLI::Option* option =
-      command.add_option(name, value, help(key, "default " + std::to_string(own) + ": " + why));
-  range<int>(option, key);
-  return noted(command, option, key, true);
+  return numberOptionOwnDefault(command, name, value, key, own, why);
 }
 
 CLI::Option* schemaOverride(CLI::App& command, const std::string& name, std::optional<int>& value,
                             const core::Key& key) {
-  if (key.type != core::Type::Integer)
-    throw std::logic_error(name + ": the key " + key.name + " is not an integer");
+  expectType(name, key, core::Type::Integer, "an integer");
   value.reset();
   CLI::Option* option =
       command.add_option(name, value, help(key, "in place of the session file's " + key.name));

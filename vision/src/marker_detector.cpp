@@ -97,7 +97,7 @@ void halve(const cv::Mat& full, cv::Mat& half) {
 struct MarkerDetector::Impl {
   DetectorConfig config;
   const MarkerFamily& family;
-  std::unique_ptr<WholeImageSearch> whole_image;  // a family another library finds
+  std::optional<WholeImageSearch> whole_image;  // a family another library finds
   int threshold = 100;  // global threshold carried between frames (automatic modes)
   std::mt19937 random;
   // `gray` is a read-only view: of the caller's pixels for grey input, else of `converted`.
@@ -138,7 +138,7 @@ struct MarkerDetector::Impl {
   }
 
   // ArUco and AprilTag markers are found by their own libraries, not by our stages.
-  bool external() const { return whole_image != nullptr; }
+  bool external() const { return whole_image.has_value(); }
 
   void resetThreshold() {
     threshold = config.threshold.value;
@@ -513,7 +513,7 @@ struct MarkerDetector::Impl {
       }
       time.decode = microseconds(decode_start, Clock::now());
       // Each library thresholds the frame itself.
-      result.threshold_mode = whole_image->thresholdMode();
+      result.threshold_mode = whole_image->threshold_mode;
     } else {
       result = detectSquares(time);
     }

@@ -34,12 +34,10 @@ struct IdCode {
 };
 
 // Markers found in the whole frame by a library of their own (its own threshold and quads).
-class WholeImageSearch {
- public:
-  virtual ~WholeImageSearch() = default;
+struct WholeImageSearch {
   // Corners as every detection: the printed marker's TL, TR, BR, BL in OpenCV pixels.
-  virtual std::vector<MarkerDetection> detect(const cv::Mat& gray) = 0;
-  virtual std::string thresholdMode() const = 0;  // how it thresholds, for the result
+  std::function<std::vector<MarkerDetection>(const cv::Mat& gray)> detect;
+  std::string threshold_mode;  // how it thresholds, for the result
 };
 
 struct MarkerFamily {
@@ -50,7 +48,7 @@ struct MarkerFamily {
   bool templates = false;        // squares matched to DetectorConfig::templates
   // The whole frame searched by another library; throws std::invalid_argument for a
   // configuration it cannot take (an unknown dictionary).
-  std::function<std::unique_ptr<WholeImageSearch>(const DetectorConfig&)> whole_image;
+  std::function<WholeImageSearch(const DetectorConfig&)> whole_image;
 
   bool squares() const { return !whole_image; }       // found by our quad search
   bool printable() const { return code != nullptr; }  // `arbci marker make` draws it
