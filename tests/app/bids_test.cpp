@@ -44,11 +44,17 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
       << BIDS_VALIDATOR << " is missing: scripts/install-deps installs it (npm)";
   const fs::path dir = scratch();
   const fs::path root = dir / "bids";
-  const ProcessResult run = runProcess(
-      kArbci,
-      {"run", "--headless", "--trials", "1", "--seed", "3", "--out", (dir / "session").string(),
-       "--bids", root.string(), "--subject", "01", "--bids-session", "1"},
-      600.0);
+  // A short calibration run (half the default's selections, each of all its sequences: 56
+  // attended flashes with the trial's) and a quick arm: what is checked is the export.
+  std::ofstream(dir / "session.json") << R"({
+    "paradigm": {"calibration_selections": 4, "cue_s": 1.0, "pause_s": 0.5},
+    "robot": {"speed_factor": 20}})";
+  const ProcessResult run =
+      runProcess(kArbci,
+                 {"run", "--headless", "--session", (dir / "session.json").string(), "--trials",
+                  "1", "--seed", "3", "--out", (dir / "session").string(), "--bids", root.string(),
+                  "--subject", "01", "--bids-session", "1"},
+                 600.0);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("BIDS: wrote"), std::string::npos) << run.out;
   const fs::path eeg = root / "sub-01" / "ses-1" / "eeg";
