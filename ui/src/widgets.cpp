@@ -71,7 +71,10 @@ void recordField(const std::string& label, float width) {
 }
 
 bool stopButton(const char* label, bool small, const std::string& why_not) {
-  ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.75f, 0.05f, 0.05f, 1.0f));
+  // Red only while it can stop the arm: a disabled one in red (ImGui only fades it) reads as
+  // armed after the session has ended.
+  ImGui::PushStyleColor(ImGuiCol_Button, why_not.empty() ? ImVec4(0.75f, 0.05f, 0.05f, 1.0f)
+                                                         : ImVec4(0.35f, 0.22f, 0.22f, 1.0f));
   ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImVec4(0.95f, 0.1f, 0.1f, 1.0f));
   const bool pressed = button(label, why_not, small);
   ImGui::PopStyleColor(2);
