@@ -201,7 +201,7 @@ PanelRegistry::Entry calibrationPanel() {
                          [](const session::CycleRecord& r) { return r.frame >= 1; },
                          rehearseCalibration});
   return {"calibration", "camera calibration from chessboard views, and the reference marker",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

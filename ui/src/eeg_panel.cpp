@@ -41,7 +41,7 @@ PanelRegistry::Entry eegPanel() {
   return {"eeg",
           "every EEG channel scrolling, the stimuli and the photodiode marked, and each channel's "
           "quality (flat, saturated, line noise, drift, RMS)",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

@@ -31,7 +31,7 @@ PanelRegistry::Entry hmdPanel() {
                          {},
                          false,
                          true});
-  return {"hmd", "the HMD view as the subject sees it (both eyes)", parts};
+  return {"hmd", "the HMD view as the subject sees it (both eyes)", std::move(parts)};
 }
 
 }  // namespace arbci::ui

@@ -79,7 +79,7 @@ PanelRegistry::Entry operatorLogPanel() {
          return r.paradigm.phase == bci::Phase::ObjectFlashing;
        }});
   return {"log", "the operator log: every end, fault, refusal, pause and warning with its time",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

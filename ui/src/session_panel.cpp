@@ -220,7 +220,7 @@ PanelRegistry::Entry sessionPanel() {
                          true});
   return {"session",
           "the phase, start/pause/resume/abort, the sequence, the selections, the cycle's timing",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

@@ -274,7 +274,7 @@ PanelRegistry::Entry settingsPanel() {
   parts.shots.push_back({"settings", "the session's settings",
                          [](const session::CycleRecord& r) { return r.frame >= 10; }});
   return {"settings", "the session's settings from the schema: edited, checked as a file is, saved",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

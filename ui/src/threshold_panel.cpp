@@ -116,7 +116,8 @@ PanelRegistry::Entry thresholdPanel() {
   PanelParts parts{[] { return std::make_unique<ThresholdPanel>(); }};
   parts.shots.push_back({"threshold", "after half a second of the simulated cameras",
                          [](const session::CycleRecord& r) { return r.frame >= 30; }});
-  return {"threshold", "the tracker's threshold, the binary image and the markers found", parts};
+  return {"threshold", "the tracker's threshold, the binary image and the markers found",
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

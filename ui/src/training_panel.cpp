@@ -311,7 +311,7 @@ PanelRegistry::Entry trainingPanel() {
   parts.shots.push_back(
       {"session-model", "the model the session trained after its calibration", onlineTrials});
   return {"training", "train a classifier on recordings; the ERPs, AUC and accuracy by sequences",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::ui

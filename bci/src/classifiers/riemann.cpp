@@ -239,7 +239,7 @@ ClassifierRegistry::Entry riemannClassifier() {
               std::to_string(static_cast<int>(parts.feature_rate_hz)) +
               " Hz features by default, in the tangent space at their Riemannian mean, then "
               "shrinkage LDA: MOABB's best P300 pipeline; not linear (no BCI2000 export)",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::bci

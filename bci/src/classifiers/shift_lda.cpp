@@ -185,7 +185,7 @@ ClassifierRegistry::Entry shiftLdaClassifier() {
               ") spatial filters: the weights of the window's centre slid up to shift_ms each "
               "way, the centred and the best score summed (for ErrPs, whose latency varies); not "
               "linear (no BCI2000 export)",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::bci

@@ -75,7 +75,8 @@ ClassifierRegistry::Entry shrinkageLdaClassifier() {
   parts.restore = [](const nlohmann::json& json, const FeatureShape& shape) {
     return restoreLinear<ShrinkageLdaClassifier>(json, shape);
   };
-  return {"slda", "LDA with the covariance shrunk by the analytic Ledoit-Wolf intensity", parts};
+  return {"slda", "LDA with the covariance shrunk by the analytic Ledoit-Wolf intensity",
+          std::move(parts)};
 }
 
 }  // namespace arbci::bci

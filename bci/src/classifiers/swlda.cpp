@@ -194,7 +194,7 @@ ClassifierRegistry::Entry swldaClassifier() {
   return {"swlda",
           "stepwise LDA as BCI2000's P300Classifier: features enter below p_enter and leave "
           "above p_remove, at most max_features; least-squares weights",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::bci

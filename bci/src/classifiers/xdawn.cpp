@@ -81,7 +81,7 @@ ClassifierRegistry::Entry xdawnClassifier() {
           "xDAWN spatial filters (xdawn_filters kept, by default " +
               std::to_string(parts.xdawn_filters) +
               "), then shrinkage LDA: OpenViBE's P300 pipeline",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::bci

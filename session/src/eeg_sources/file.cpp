@@ -23,7 +23,7 @@ EegSourceRegistry::Entry fileEegSource() {
   };
   return {"file",
           "a recording (BDF, EDF, GDF, BCI2000, XDF) named by eeg.file, replayed in real time",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::session

@@ -34,7 +34,7 @@ EegSourceRegistry::Entry simulatedEegSource() {
   return {"simulated",
           "the simulated subject: eeg.montage at eeg.rate_hz, a P300 to the flashes it attends "
           "(eeg.erp_scale), an ErrP to wrong feedback (eeg.errp_scale), a virtual photodiode",
-          parts};
+          std::move(parts)};
 }
 
 }  // namespace arbci::session

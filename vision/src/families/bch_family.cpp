@@ -12,7 +12,7 @@ MarkerFamilyRegistry::Entry bchFamily() {
   family.in_sessions = true;
   family.code = &code;
   return {"bch", "ARToolKitPlus's BCH-coded ids 0-4095 (thin border 0.125), errors corrected",
-          family};
+          std::move(family)};
 }
 
 }  // namespace arbci::vision

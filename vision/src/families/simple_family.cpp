@@ -9,7 +9,7 @@ MarkerFamilyRegistry::Entry simpleFamily() {
   family.border = 0.25;
   family.in_sessions = true;
   family.code = &code;
-  return {"simple", "ARToolKitPlus's simple ids 0-511 (border 0.25)", family};
+  return {"simple", "ARToolKitPlus's simple ids 0-511 (border 0.25)", std::move(family)};
 }
 
 }  // namespace arbci::vision

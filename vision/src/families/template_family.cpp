@@ -7,7 +7,8 @@ MarkerFamilyRegistry::Entry templateFamily() {
   MarkerFamily family;
   family.border = 0.25;
   family.templates = true;
-  return {"template", "trained template patterns (arbci marker train; detect --pattern)", family};
+  return {"template", "trained template patterns (arbci marker train; detect --pattern)",
+          std::move(family)};
 }
 
 }  // namespace arbci::vision
