@@ -372,8 +372,8 @@ struct MarkerDetector::Impl {
       MarkerSamples samples = sampleMarker(gray, quad, config.border);
       lowest = std::min(lowest, samples.lowest);
       highest = std::max(highest, samples.highest);
-      auto marker = readQuad(config, gray, quad, samples);
-      if (!marker) marker = readOnBlurredEdges(config, gray, quad, samples);
+      auto marker = readQuad(config, family, gray, quad, samples);
+      if (!marker) marker = readOnBlurredEdges(config, family, gray, quad, samples);
       if (marker && place_on_frame) placeOnFrame(quad, *marker);
       frame_quads.push_back(quad);
       if (!marker) continue;
@@ -567,7 +567,8 @@ std::optional<MarkerDetection> MarkerDetector::readAt(const cv::Mat& image,
     quad.ideal_corners[k] =
         impl.config.lens ? toFloat(impl.config.lens->undistort(quad.corners[k])) : quad.corners[k];
   }
-  return readQuad(impl.config, gray, quad, sampleMarker(gray, quad, impl.config.border));
+  return readQuad(impl.config, impl.family, gray, quad,
+                  sampleMarker(gray, quad, impl.config.border));
 }
 
 const DetectorConfig& MarkerDetector::config() const {

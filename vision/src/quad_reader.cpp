@@ -18,13 +18,12 @@ bool hasMarkerBorder(const MarkerSamples& samples, bool occluded = false) {
 
 }  // namespace
 
-std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const cv::Mat& image,
-                                        const Quad& quad, const MarkerSamples& samples,
-                                        bool chase) {
+std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const MarkerFamily& family,
+                                        const cv::Mat& image, const Quad& quad,
+                                        const MarkerSamples& samples, bool chase) {
   if (!hasMarkerBorder(samples, quad.occluded)) return std::nullopt;
   MarkerDetection marker;
   marker.kind = config.kind;
-  const MarkerFamily& family = familyOf(config.kind);
   if (family.templates) {
     const auto match =
         matchTemplate(sampleCodeArea(image, quad, config.border, TemplatePattern::kSize),
@@ -56,7 +55,8 @@ std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const cv::
 // markers, but also decoys of marker-free frames as markers (a second reading of every failing
 // decoy doubles its chances). A quad that failed for want of contrast or a dark border is not
 // moved: none such read after the move.
-std::optional<MarkerDetection> readOnBlurredEdges(const DetectorConfig& config, const cv::Mat& gray,
+std::optional<MarkerDetection> readOnBlurredEdges(const DetectorConfig& config,
+                                                  const MarkerFamily& family, const cv::Mat& gray,
                                                   Quad& quad, MarkerSamples& samples) {
   if (!config.passes.blurred_edges.enabled || !hasMarkerBorder(samples)) return std::nullopt;
   QuadFitParams params;
@@ -73,7 +73,7 @@ std::optional<MarkerDetection> readOnBlurredEdges(const DetectorConfig& config, 
   const float least = static_cast<float>(config.passes.blurred_edges.min_move_px);
   if (moved < least * least) return std::nullopt;
   MarkerSamples placed_samples = sampleMarker(gray, *placed, config.border);
-  auto marker = readQuad(config, gray, *placed, placed_samples, /*chase=*/false);
+  auto marker = readQuad(config, family, gray, *placed, placed_samples, /*chase=*/false);
   if (marker) {
     quad = *placed;
     samples = placed_samples;

@@ -10,20 +10,23 @@
 
 #include "arbci/vision/marker.h"
 #include "arbci/vision/marker_detector.h"
+#include "arbci/vision/marker_family.h"
 #include "marker_sampler.h"
 #include "quad_fit.h"
 
 namespace arbci::vision {
 
-// The marker that `quad`'s `samples` of `image` read as, its corners in the printed order; without
-// `chase`, BCH codes are not Chase-decoded.
-std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const cv::Mat& image,
-                                        const Quad& quad, const MarkerSamples& samples,
-                                        bool chase = true);
+// The marker of `family` (config.kind's, resolved once by the detector) that `quad`'s `samples`
+// of `image` read as, its corners in the printed order; without `chase`, BCH codes are not
+// Chase-decoded.
+std::optional<MarkerDetection> readQuad(const DetectorConfig& config, const MarkerFamily& family,
+                                        const cv::Mat& image, const Quad& quad,
+                                        const MarkerSamples& samples, bool chase = true);
 
 // A quad with a marker's border whose code does not decode, its sides moved onto motion-blurred
 // edges and read again, without Chase decoding; then `quad` and `samples` are the moved quad's.
-std::optional<MarkerDetection> readOnBlurredEdges(const DetectorConfig& config, const cv::Mat& gray,
+std::optional<MarkerDetection> readOnBlurredEdges(const DetectorConfig& config,
+                                                  const MarkerFamily& family, const cv::Mat& gray,
                                                   Quad& quad, MarkerSamples& samples);
 
 }  // namespace arbci::vision
