@@ -1,13 +1,11 @@
 #include "hmd/open_session.h"
 
 #include "hmd/hmd_stage.h"
-#include "simulation/simulated_scene.h"
 
 namespace arbci::app {
 
 OpenedSession openSession(const session::SessionConfig& config,
                           const session::SessionOptions& options, render::GlContext& context) {
-  registerSimulatedScene();
   context.makeCurrent();
   OpenedSession opened;
   opened.session = std::make_unique<session::Session>(

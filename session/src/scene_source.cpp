@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "arbci/session/camera_capture.h"
+#include "simulation/simulated_scene.h"
 
 namespace arbci::session {
 namespace {
@@ -96,11 +97,7 @@ core::Registry<SceneFactory>& sceneSources() {
     r.add({"simulated",
            "the simulated world: the session's table, objects and reference marker rendered for "
            "a stereo rig at the subject's head (cameras.width ... blur_px)",
-           [](const SceneSettings&) -> std::unique_ptr<SceneSource> {
-             throw std::logic_error(
-                 "the simulated cameras render with the application's GL context: "
-                 "app::registerSimulatedScene() provides them");
-           }});
+           makeSimulatedScene});
     r.add({"devices", "camera devices (V4L2) or video files, each with its calibration",
            [](const SceneSettings& s) { return std::make_unique<DeviceScene>(s); }});
     return r;

@@ -9,12 +9,17 @@
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/gl_context.h"
 #include "arbci/render/hmd_view.h"
-#include "arbci/render/simulated_camera.h"
+#include "arbci/session/simulation/simulated_camera.h"
 #include "arbci/vision/marker_detector.h"
 #include "render/test_camera.h"
 
 namespace arbci::render {
 namespace {
+
+using session::CameraEffects;
+using session::Scene;
+using session::SceneObject;
+using session::SimulatedCamera;
 
 cv::Mat toMat(const RgbaImage& image) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.pixels.data()));

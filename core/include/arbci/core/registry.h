@@ -36,17 +36,6 @@ class Registry {
     entries_.push_back(std::move(entry));
     return *this;
   }
-  // The part registered under `name` gets its factory from the application (a part that needs
-  // what only the application has, e.g. a GL context). Throws std::logic_error when unknown.
-  void provide(const std::string& name, Factory make) {
-    for (Entry& e : entries_) {
-      if (e.name == name) {
-        e.make = std::move(make);
-        return;
-      }
-    }
-    throw std::logic_error(family_ + " '" + name + "' is not registered");
-  }
   const Entry* find(const std::string& name) const {
     const auto found = std::find_if(entries_.begin(), entries_.end(),
                                     [&](const Entry& e) { return e.name == name; });

@@ -68,8 +68,8 @@ class SceneSource {
   vision::Pose T_right_left_;
 };
 
-// The camera sources by cameras.source: "devices" (camera devices or video files) here; the
-// application adds "simulated" (the simulated world, rendered with GL). A factory throws
+// The camera sources by cameras.source: "simulated" (the simulated world, drawn on the CPU) and
+// "devices" (camera devices or video files). A factory throws
 // SessionConfigError naming the key when its cameras cannot be opened.
 using SceneFactory = std::function<std::unique_ptr<SceneSource>(const SceneSettings&)>;
 core::Registry<SceneFactory>& sceneSources();

@@ -1,6 +1,7 @@
-// A simulated camera: renders the Scene from a camera pose with the camera's calibrated
-// intrinsics (anti-aliased), then adds what real cameras add when asked: lens distortion (the
-// camera model's), blur, sensor noise and uneven lighting. Its frames go through the real tracker.
+// A simulated camera: draws the Scene from a camera pose with the camera's calibrated intrinsics
+// (anti-aliased, on the CPU: no GL context), then adds what real cameras add when asked: lens
+// distortion (the camera model's), blur, sensor noise and uneven lighting. Its frames go through
+// the real tracker.
 #pragma once
 
 #include <cstdint>
@@ -8,11 +9,12 @@
 
 #include <opencv2/core.hpp>
 
-#include "arbci/render/scene.h"
-#include "arbci/render/scene_renderer.h"
+#include "arbci/session/simulation/scene.h"
 #include "arbci/vision/camera_model.h"
 
-namespace arbci::render {
+namespace arbci::session {
+
+class ScenePainter;
 
 struct CameraEffects {
   bool distort = false;      // apply the camera model's distortion
@@ -24,8 +26,8 @@ struct CameraEffects {
 
 class SimulatedCamera {
  public:
-  // Needs a current GL context; `camera` gives the image size and intrinsics.
-  SimulatedCamera(const vision::CameraModel& camera, std::uint64_t seed = 1);
+  // `camera` gives the image size and intrinsics; `seed` the noise.
+  explicit SimulatedCamera(const vision::CameraModel& camera, std::uint64_t seed = 1);
   ~SimulatedCamera();
   SimulatedCamera(const SimulatedCamera&) = delete;
   SimulatedCamera& operator=(const SimulatedCamera&) = delete;
@@ -37,9 +39,7 @@ class SimulatedCamera {
 
  private:
   vision::CameraModel camera_;
-  SceneRenderer renderer_;
-  unsigned int multisample_fbo_ = 0, color_rb_ = 0, depth_rb_ = 0, resolve_fbo_ = 0,
-               resolve_rb_ = 0;
+  std::unique_ptr<ScenePainter> painter_;
   cv::Mat distort_map1_, distort_map2_;  // fixed-point remap tables of the lens
   cv::Mat gain_;  // uneven light (CV_16SC3, 256 = 1), for the last effects used
   double gain_vignetting_ = -1.0, gain_gradient_ = -1.0;
@@ -48,4 +48,4 @@ class SimulatedCamera {
   cv::RNG random_;
 };
 
-}  // namespace arbci::render
+}  // namespace arbci::session

@@ -2,31 +2,32 @@
 
 #include <cmath>
 
-namespace arbci::app {
+namespace arbci::session {
 
-SimulatedWorld::SimulatedWorld(const session::SceneSettings& settings) : settings_(settings) {
-  const session::CameraSettings& c = settings.cameras;
+SimulatedWorld::SimulatedWorld(const SceneSettings& settings) : settings_(settings) {
+  const CameraSettings& c = settings.cameras;
   camera_.image_size = {c.width, c.height};
   camera_.camera_matrix =
       cv::Matx33d(c.focal_px, 0, c.width / 2.0 - 0.5, 0, c.focal_px, c.height / 2.0 - 0.5, 0, 0, 1);
   camera_.distortion = c.distortion;
   camera_.source = "simulated camera";
-  const session::WorldSettings& w = settings.world;
+  const WorldSettings& w = settings.world;
   scene_.table_z = w.table_z;
   scene_.reference = {vision::MarkerKind::Bch, w.reference_id, w.reference_size_m,
                       settings.marker_border};
   scene_.T_world_reference = {cv::Matx33d::eye(), w.reference_position};
-  for (const session::WorldObjectSettings& o : w.objects) {
-    render::SceneObject object;
+  for (const WorldObjectSettings& o : w.objects) {
+    SceneObject object;
     object.marker = {settings.marker_kind, o.id, o.marker_m, settings.marker_border};
     object.T_world_top = {cv::Matx33d::eye(), o.position};
     object.width_m = o.width_m;
     object.height_m = o.height_m;
-    object.color = glm::vec3(o.color[0], o.color[1], o.color[2]);
+    object.color = cv::Vec3f(static_cast<float>(o.color[0]), static_cast<float>(o.color[1]),
+                             static_cast<float>(o.color[2]));
     scene_.objects.push_back(object);
   }
-  left_ = std::make_unique<render::SimulatedCamera>(camera_, settings.seed * 7 + 1);
-  right_ = std::make_unique<render::SimulatedCamera>(camera_, settings.seed * 7 + 2);
+  left_ = std::make_unique<SimulatedCamera>(camera_, settings.seed * 7 + 1);
+  right_ = std::make_unique<SimulatedCamera>(camera_, settings.seed * 7 + 2);
   approach_height_ = robotConfig().approach_height;
 }
 
@@ -38,7 +39,7 @@ robot::RobotConfig SimulatedWorld::robotConfig() const {
   r.workspace_min = {-0.7, 0.2, settings_.world.table_z};
   r.workspace_max = {0.7, 1.0, settings_.world.table_z + 0.6};
   r.speed_factor = settings_.robot_speed_factor;
-  for (const session::WorldObjectSettings& o : settings_.world.objects) {
+  for (const WorldObjectSettings& o : settings_.world.objects) {
     r.objects.push_back(
         {o.id, {o.position[0], o.position[1], o.position[2]}, o.height_m, o.width_m / 2.0});
   }
@@ -47,7 +48,7 @@ robot::RobotConfig SimulatedWorld::robotConfig() const {
 
 void SimulatedWorld::update(const robot::StatusPayload& status) {
   for (const robot::WorldObject& reported : status.objects) {
-    for (render::SceneObject& o : scene_.objects) {
+    for (SceneObject& o : scene_.objects) {
       const cv::Vec3d p(reported.position.x, reported.position.y, reported.position.z);
       if (o.marker.id == reported.id && p != o.T_world_top.translation) {
         o.T_world_top.translation = p;
@@ -56,7 +57,7 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
     }
   }
   const cv::Vec3d tool(status.tool.x, status.tool.y, status.tool.z);
-  for (render::SceneObject& o : scene_.objects) {
+  for (SceneObject& o : scene_.objects) {
     // Coming down on an object to grasp it, the gripper's fingertip passes over a corner of its
     // marker: from the arm's approach height above the top until it holds the object (within
     // 2 cm of the top's centre: the arm goes where the cameras saw the object).
@@ -72,13 +73,13 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
   }
   if (!scene_.gripper || scene_.gripper->tool != tool ||
       scene_.gripper->opening != status.gripper_opening) {
-    scene_.gripper = render::SceneGripper{tool, status.gripper_opening};
+    scene_.gripper = SceneGripper{tool, status.gripper_opening};
     ++scene_revision_;
   }
 }
 
 vision::Pose SimulatedWorld::leftCamera(double t) const {
-  const session::CameraSettings& c = settings_.cameras;
+  const CameraSettings& c = settings_.cameras;
   // Slow, small head motion: a few millimetres and a fraction of a degree.
   const cv::Vec3d sway(c.head_motion_m * std::sin(0.7 * t),
                        c.head_motion_m * 0.6 * std::sin(0.45 * t + 1.0),
@@ -101,13 +102,13 @@ vision::Pose SimulatedWorld::rightCamera(double t) const {
   return T_right_left() * leftCamera(t);
 }
 
-SimulatedWorld::Frame SimulatedWorld::capture(render::SimulatedCamera& camera, Cache& cache,
+SimulatedWorld::Frame SimulatedWorld::capture(SimulatedCamera& camera, Cache& cache,
                                               const vision::Pose& pose) {
   const bool moved = !cache.pose || pose.translation != cache.pose->translation ||
                      pose.rotation != cache.pose->rotation;
   if (!moved && cache.scene_revision == scene_revision_ && !cache.image.empty())
     return {cache.image, false};
-  render::CameraEffects effects;
+  CameraEffects effects;
   effects.distort = !camera_.distortion.empty();
   effects.noise_sigma = settings_.cameras.noise;
   effects.blur_sigma = settings_.cameras.blur_px;
@@ -160,16 +161,16 @@ void SimulatedWorld::holdBoard(bool show, double t) {
   // -z.
   const vision::Pose T_cam_board{tilt_x * tilt_y * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1),
                                  cv::Vec3d(p[2], p[3], p[4])};
-  render::SceneBoard board;
+  SceneBoard board;
   board.T_world_board = leftCamera(t).inverse() * T_cam_board;
   scene_.board = board;
 }
 
 std::optional<cv::Vec3d> SimulatedWorld::objectPosition(int id) const {
-  for (const render::SceneObject& o : scene_.objects) {
+  for (const SceneObject& o : scene_.objects) {
     if (o.marker.id == id) return o.T_world_top.translation;
   }
   return std::nullopt;
 }
 
-}  // namespace arbci::app
+}  // namespace arbci::session

@@ -6,12 +6,13 @@
 #include <optional>
 #include <vector>
 
-#include <glm/glm.hpp>
+#include <opencv2/core/matx.hpp>
+#include <opencv2/core/types.hpp>
 
 #include "arbci/vision/marker.h"
 #include "arbci/vision/pose.h"
 
-namespace arbci::render {
+namespace arbci::session {
 
 struct SceneMarker {
   vision::MarkerKind kind = vision::MarkerKind::Bch;
@@ -24,8 +25,8 @@ struct SceneObject {
   SceneMarker marker;
   vision::Pose T_world_top;              // the centre of the top face; z out of the face
   double width_m = 0.0, height_m = 0.0;  // the session's world.objects[]
-  glm::vec3 color{0.85f, 0.35f, 0.25f};
-  bool covered = false;  // a hand lies over its marker
+  cv::Vec3f color{0.85f, 0.35f, 0.25f};  // red, green, blue, 0-1
+  bool covered = false;                  // a hand lies over its marker
   // The gripper's fingertip lies over a corner of its marker (the simulated arm coming down on it
   // to grasp it): a dark pad 0.36 of the marker's side across, centred on the corner, so that it
   // hides 18 % of the side along both edges from that corner.
@@ -54,4 +55,4 @@ struct Scene {
   std::optional<SceneBoard> board;
 };
 
-}  // namespace arbci::render
+}  // namespace arbci::session

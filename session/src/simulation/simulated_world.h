@@ -7,17 +7,17 @@
 #include <memory>
 #include <optional>
 
-#include "arbci/render/scene.h"
-#include "arbci/render/simulated_camera.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/robot/robot_config.h"
 #include "arbci/session/scene_source.h"
+#include "arbci/session/simulation/scene.h"
+#include "arbci/session/simulation/simulated_camera.h"
 
-namespace arbci::app {
+namespace arbci::session {
 
 class SimulatedWorld {
  public:
-  explicit SimulatedWorld(const session::SceneSettings& settings);  // needs a current GL context
+  explicit SimulatedWorld(const SceneSettings& settings);
   ~SimulatedWorld();
 
   // The arbci-robotd configuration for this world (objects, table, workspace).
@@ -39,7 +39,7 @@ class SimulatedWorld {
   // hand over a marker moved.
   Frame captureLeft(double t);
   Frame captureRight(double t);
-  const render::Scene& scene() const { return scene_; }
+  const Scene& scene() const { return scene_; }
   // Holds a 9x6 chessboard (25 mm squares) up in front of the left camera, each call at the next
   // of a dozen poses (tilted, near and far, off centre), or puts it away.
   void holdBoard(bool show, double t);
@@ -47,17 +47,17 @@ class SimulatedWorld {
   std::optional<cv::Vec3d> objectPosition(int id) const;
 
  private:
-  session::SceneSettings settings_;
+  SceneSettings settings_;
   vision::CameraModel camera_;
-  render::Scene scene_;
-  std::unique_ptr<render::SimulatedCamera> left_, right_;
+  Scene scene_;
+  std::unique_ptr<SimulatedCamera> left_, right_;
   double approach_height_ = 0.0;  // the simulated arm's, above a grasp's target
   struct Cache {
     std::uint64_t scene_revision = 0;
     std::optional<vision::Pose> pose;
     cv::Mat image;
   };
-  Frame capture(render::SimulatedCamera& camera, Cache& cache, const vision::Pose& pose);
+  Frame capture(SimulatedCamera& camera, Cache& cache, const vision::Pose& pose);
   // The hands over markers at time `t` (world.objects[].covered_s).
   void coverAt(double t);
   std::uint64_t scene_revision_ = 1;
@@ -65,4 +65,4 @@ class SimulatedWorld {
   Cache left_cache_, right_cache_;
 };
 
-}  // namespace arbci::app
+}  // namespace arbci::session

@@ -2,17 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
 
 #include "simulation/simulated_world.h"
 
-namespace arbci::app {
+namespace arbci::session {
 namespace {
 
 // The simulated world's cameras, rendered on alternate display frames (no cycle pays for both).
-class SimulatedScene final : public session::SceneSource {
+class SimulatedScene final : public SceneSource {
  public:
-  explicit SimulatedScene(const session::SceneSettings& settings)
+  explicit SimulatedScene(const SceneSettings& settings)
       : world_(settings),
         camera_every_(std::max(
             1, static_cast<int>(std::lround(settings.display_hz / settings.cameras.rate_hz)))) {
@@ -53,13 +52,8 @@ class SimulatedScene final : public session::SceneSource {
 
 }  // namespace
 
-void registerSimulatedScene() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    session::sceneSources().provide("simulated", [](const session::SceneSettings& s) {
-      return std::make_unique<SimulatedScene>(s);
-    });
-  });
+std::unique_ptr<SceneSource> makeSimulatedScene(const SceneSettings& settings) {
+  return std::make_unique<SimulatedScene>(settings);
 }
 
-}  // namespace arbci::app
+}  // namespace arbci::session
