@@ -23,6 +23,13 @@ function(arbci_precompile target)
     target_precompile_headers(${target} PRIVATE ${ARGN})
   endif()
 endfunction()
+# arbci_precompile_reuse(TARGET FROM): TARGET's few files use FROM's precompiled header instead of
+# parsing the same headers again (an executable's main beside the library it calls).
+function(arbci_precompile_reuse target from)
+  if(ARBCI_PCH)
+    target_precompile_headers(${target} REUSE_FROM ${from})
+  endif()
+endfunction()
 
 # arbci_module(NAME SOURCES...): a module library with its public headers in NAME/include.
 function(arbci_module name)

@@ -88,7 +88,7 @@ void makeMarkers(const MakeOptions& options) {
   }
 }
 
-struct TrainOptions {
+struct PatternTrainOptions {
   std::string image;
   int id = 0;
   double border = 0.0;  // 0: the square's border as printed, 0.25 or 0.125 (marker make's)
@@ -96,7 +96,7 @@ struct TrainOptions {
 };
 
 // The largest square in a face-on image of the marker, sampled as a template pattern.
-void trainPattern(const TrainOptions& options) {
+void trainPattern(const PatternTrainOptions& options) {
   const cv::Mat image = cv::imread(options.image, cv::IMREAD_GRAYSCALE);
   if (image.empty()) throw CliError("cannot read image " + options.image);
   ensureWritable(options.out);
@@ -164,7 +164,7 @@ void addMarkerCommand(CLI::App& root, int& exit_code) {
     exit_code = 0;
   });
 
-  auto train = std::make_shared<TrainOptions>();
+  auto train = std::make_shared<PatternTrainOptions>();
   auto* train_command = marker->add_subcommand(
       "train", "Train a template pattern (ARToolKit .patt) from a face-on image of a marker");
   train_command->add_option("--image", train->image, "Image of the marker, seen face-on")
