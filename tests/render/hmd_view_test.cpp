@@ -11,7 +11,7 @@
 #include "arbci/render/hmd_view.h"
 #include "arbci/session/simulation/simulated_camera.h"
 #include "arbci/vision/marker_detector.h"
-#include "render/test_camera.h"
+#include "support/test_camera.h"
 
 namespace arbci::render {
 namespace {
@@ -60,7 +60,7 @@ cv::Point2d intersect(const cv::Vec4f& l1, const cv::Vec4f& l2) {
 }
 
 struct Rig {
-  vision::CameraModel camera = test::camera640();
+  vision::CameraModel camera = arbci::test::camera640();
   vision::Pose left = vision::cameraLookingAt({-0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
   vision::Pose right = vision::cameraLookingAt({0.032, 1.45, 0.45}, {0.0, 0.65, 0.0});
 };
@@ -168,7 +168,7 @@ TEST(HmdView, AScheduledFlashAppearsOnItsFramesAndNoOther) {
 
 TEST(HmdView, UndistortedBackgroundMatchesItsRectifiedVirtualCamera) {
   auto context = createHeadlessContext({1280, 480});
-  vision::CameraModel lens = test::camera640();
+  vision::CameraModel lens = arbci::test::camera640();
   lens.distortion = {-0.25, 0.08, 0.0, 0.0, 0.0};
   Rig rig;
   SimulatedCamera camera(lens);

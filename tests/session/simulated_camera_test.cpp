@@ -14,17 +14,12 @@
 #include "arbci/session/simulation/simulated_camera.h"
 #include "arbci/vision/marker_detector.h"
 #include "arbci/vision/undistortion.h"
+#include "support/test_camera.h"
 
 namespace arbci::session {
 namespace {
 
-// 640x480, 700 px focal length, no lens.
-vision::CameraModel camera640() {
-  vision::CameraModel c;
-  c.image_size = {640, 480};
-  c.camera_matrix = cv::Matx33d(700, 0, 319.5, 0, 700, 239.5, 0, 0, 1);
-  return c;
-}
+using test::camera640;
 
 Scene oneObject(int id, const vision::Pose& top) {
   Scene scene;

@@ -9,16 +9,12 @@
 #include "arbci/render/gl_context.h"
 #include "hmd/hmd_stage.h"
 #include "support/stage_bench.h"
+#include "support/test_camera.h"
 
 namespace arbci::app {
 namespace {
 
-vision::CameraModel camera640() {
-  vision::CameraModel c;
-  c.image_size = {640, 480};
-  c.camera_matrix = cv::Matx33d(700, 0, 319.5, 0, 700, 239.5, 0, 0, 1);
-  return c;
-}
+using test::camera640;
 
 // Tracking as it stands with the table in view: a grey camera image each eye (the same picture
 // from frame to frame, as tracking keeps it while nothing moves), the cameras' poses over the

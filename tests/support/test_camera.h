@@ -1,9 +1,10 @@
-// The camera the render tests draw and track with: 640x480, 700 px focal length, no lens.
+// The camera the render, HMD and simulated-camera tests draw and track with: 640x480, 700 px
+// focal length, no lens.
 #pragma once
 
 #include "arbci/vision/camera_model.h"
 
-namespace arbci::render::test {
+namespace arbci::test {
 
 inline vision::CameraModel camera640() {
   vision::CameraModel c;
@@ -12,4 +13,4 @@ inline vision::CameraModel camera640() {
   return c;
 }
 
-}  // namespace arbci::render::test
+}  // namespace arbci::test
