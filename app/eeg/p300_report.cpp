@@ -62,6 +62,15 @@ void printReport(std::ostream& out, const bci::EvaluationReport& r, const Report
     if (speller) out << "  " << r.selected(n);
     out << "\n";
   }
+  // Selections cut short count with the sequences they have: say over how many each row is.
+  if (r.fragments > 0 || r.selections_by_sequences.back() < r.selections_with_truth) {
+    out << "(selections cut short: " << r.fragments
+        << " without a whole sequence left out; the others count with what they have, so "
+           "accuracy after n sequences is over:";
+    for (int n = 1; n <= r.max_sequences; ++n)
+      out << " " << r.selections_by_sequences[static_cast<size_t>(n - 1)];
+    out << ")\n";
+  }
   out << "\ndynamic stopping (certainty >= " << std::setprecision(3) << r.dynamic_rule.certainty
       << ", " << r.dynamic_rule.min_sequences << "-" << r.dynamic_rule.max_sequences
       << " sequences): accuracy " << r.dynamic_accuracy << " "
@@ -100,6 +109,7 @@ nlohmann::json reportJson(const bci::EvaluationReport& r) {
     const size_t i = static_cast<size_t>(n - 1);
     by_sequences.push_back(
         {{"sequences", n},
+         {"selections", r.selections_by_sequences[i]},
          {"accuracy", r.accuracy[i]},
          {"accuracy_interval_95", toJson(r.accuracy_interval[i])},
          {"seconds_per_selection", r.seconds_per_selection[i]},
@@ -125,6 +135,7 @@ nlohmann::json reportJson(const bci::EvaluationReport& r) {
   out["chance"] = r.chance;
   out["chance_95"] = r.chance_95;
   out["max_sequences"] = r.max_sequences;
+  out["fragments"] = r.fragments;
   out["by_sequences"] = by_sequences;
   out["dynamic"] = {{"certainty", r.dynamic_rule.certainty},
                     {"min_sequences", r.dynamic_rule.min_sequences},

@@ -49,8 +49,8 @@ std::string EvaluationReport::selected(int sequences) const {
   std::string out;
   const bool speller = !layout.symbols.empty();
   for (const SelectionResult& s : selections) {
-    const Decision& d =
-        s.by_sequences[static_cast<size_t>(std::clamp(sequences, 1, max_sequences) - 1)];
+    const int own = static_cast<int>(s.by_sequences.size());
+    const Decision& d = s.by_sequences[static_cast<size_t>(std::clamp(sequences, 1, own) - 1)];
     if (!speller && !out.empty()) out += ", ";
     out += layout.describe(d.codes);
   }
@@ -89,23 +89,33 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     report.selection_metrics = false;
     return report;
   }
-  // Sequences every selection has.
-  report.max_sequences = std::numeric_limits<int>::max();
+  // Each selection's whole sequences.
+  auto wholeSequences = [&](const SelectionEpochs& s) {
+    if (s.epochs.empty()) return 0;
+    const int seen = data.sequence[static_cast<size_t>(s.epochs.back())] + 1;
+    return static_cast<int>(s.epochs.size()) < seen * data.layout.codes() ? seen - 1 : seen;
+  };
+  // The run's number of sequences: what at least half of its selections have, so that neither
+  // a selection cut short nor one longer than the rest (a dynamic stop that ran on) sets it.
+  std::vector<int> whole;
   for (const SelectionEpochs& s : data.selections) {
-    int complete = 0;
-    if (!s.epochs.empty()) complete = data.sequence[static_cast<size_t>(s.epochs.back())] + 1;
-    if (static_cast<int>(s.epochs.size()) < complete * data.layout.codes())
-      --complete;  // last one cut short
-    report.max_sequences = std::min(report.max_sequences, complete);
+    if (const int n = wholeSequences(s); n >= 1) whole.push_back(n);
   }
-  if (data.selections.empty() || report.max_sequences < 1)
-    throw std::invalid_argument("no selection has a whole sequence");
+  if (whole.empty()) throw std::invalid_argument("no selection has a whole sequence");
+  std::sort(whole.begin(), whole.end());
+  report.max_sequences = whole[whole.size() / 2];
   const int n_max = report.max_sequences;
   std::vector<int> correct(static_cast<size_t>(n_max), 0);
+  report.selections_by_sequences.assign(static_cast<size_t>(n_max), 0);
 
   int dynamic_correct = 0;
   double dynamic_flashes = 0.0;
   for (const SelectionEpochs& s : data.selections) {
+    const int own = std::min(wholeSequences(s), n_max);
+    if (own < 1) {
+      ++report.fragments;
+      continue;
+    }
     SelectionResult result;
     result.truth = s.target_codes;
     SelectionAccumulator fixed(data.layout, model), adaptive(data.layout, model);
@@ -113,7 +123,7 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     int sequence = 0;
     for (int row : s.epochs) {
       const size_t i = static_cast<size_t>(row);
-      if (data.sequence[i] >= n_max) break;
+      if (data.sequence[i] >= own) break;
       if (data.sequence[i] != sequence) {  // a sequence just ended
         result.by_sequences.push_back(fixed.decide());
         if (!stopped && adaptive.shouldStop(dynamic)) stopped = true;
@@ -129,9 +139,11 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
     dynamic_flashes += result.dynamic_flashes;
     if (!result.truth.empty()) {
       ++report.selections_with_truth;
-      for (int n = 0; n < n_max; ++n)
+      for (int n = 0; n < own; ++n) {
         correct[static_cast<size_t>(n)] +=
             result.by_sequences[static_cast<size_t>(n)].codes == result.truth;
+        ++report.selections_by_sequences[static_cast<size_t>(n)];
+      }
       dynamic_correct += result.dynamic.codes == result.truth;
     }
     report.selections.push_back(std::move(result));
@@ -141,16 +153,17 @@ EvaluationReport evaluateScores(const P300Dataset& data, const std::vector<doubl
   report.chance = 1.0 / choices;
   report.chance_95 = chanceLevel95(choices, report.selections_with_truth);
   for (int n = 0; n < n_max; ++n) {
-    const int right = correct[static_cast<size_t>(n)];
-    report.accuracy.push_back(static_cast<double>(right) / known);
-    report.accuracy_interval.push_back(wilsonInterval(right, report.selections_with_truth));
+    const int right = correct[static_cast<size_t>(n)],
+              counted = report.selections_by_sequences[static_cast<size_t>(n)];
+    report.accuracy.push_back(static_cast<double>(right) / std::max(1, counted));
+    report.accuracy_interval.push_back(wilsonInterval(right, counted));
     const double seconds = (n + 1) * data.layout.codes() * data.layout.soa_s;
     report.seconds_per_selection.push_back(seconds);
     report.bits_per_minute.push_back(wolpawBits(choices, report.accuracy.back()) * 60.0 / seconds);
   }
   report.dynamic_accuracy = static_cast<double>(dynamic_correct) / known;
   report.dynamic_accuracy_interval = wilsonInterval(dynamic_correct, report.selections_with_truth);
-  report.dynamic_mean_flashes = dynamic_flashes / static_cast<double>(data.selections.size());
+  report.dynamic_mean_flashes = dynamic_flashes / static_cast<double>(report.selections.size());
   report.dynamic_seconds = report.dynamic_mean_flashes * data.layout.soa_s;
   report.dynamic_bits_per_minute =
       wolpawBits(choices, report.dynamic_accuracy) * 60.0 / report.dynamic_seconds;

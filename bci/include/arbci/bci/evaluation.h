@@ -33,11 +33,17 @@ struct EvaluationReport {
   // False when the stimulus codes are classes, not choices (P300Dataset::codes_are_classes):
   // then only the single-flash figures mean anything.
   bool selection_metrics = true;
+  // The run's number of sequences: the whole sequences at least half of its selections have (a
+  // longer selection is scored up to it). A selection cut short (a retake, the end of a run)
+  // counts with the whole sequences it has and limits no other; one without a whole sequence is
+  // a fragment, left out of the selection figures (its flashes still count in the AUC).
   int max_sequences = 0;
+  int fragments = 0;
+  std::vector<int> selections_by_sequences;  // [n - 1]: with truth and at least n sequences
   double auc = 0.0;
   Interval auc_interval;  // 95 %
   int target_flashes = 0, other_flashes = 0;
-  std::vector<double> accuracy;             // [n - 1]
+  std::vector<double> accuracy;             // [n - 1], over selections_by_sequences[n - 1]
   std::vector<Interval> accuracy_interval;  // 95 % (Wilson), [n - 1]
   double chance = 0.0;                      // 1 / choices
   double chance_95 = 0.0;  // an accuracy at or above this beats guessing (p < 0.05)
