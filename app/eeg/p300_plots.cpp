@@ -367,6 +367,18 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
   bits.axes(image, "bit rate (Wolpaw)", x_step, niceStep(top, 5), "sequences", "bits/min");
   bits.curve(image, n, report.bits_per_minute, kOther, true);
   // The legend: the flashes alone, and with the recording's cues and pauses where it has them.
+  // Selections cut short count with the sequences they have: say where a point stands on fewer.
+  const std::vector<int>& counted = report.selections_by_sequences;
+  const auto fewer = std::find_if(counted.begin(), counted.end(),
+                                  [&](int c) { return c < report.selections_with_truth; });
+  if (fewer != counted.end()) {
+    text(image,
+         "from " + std::to_string(fewer - counted.begin() + 1) +
+             " sequences: " + std::to_string(counted.back()) + " of " +
+             std::to_string(report.selections_with_truth) + " selections at " +
+             std::to_string(report.max_sequences) + " (others cut short)",
+         {50, 360}, 0.38);
+  }
   cv::line(image, {540, 356}, {564, 356}, kOther, 2, cv::LINE_AA);
   text(image, "flashes only", {570, 360}, 0.38);
   if (!report.bits_per_minute_with_pauses.empty()) {
