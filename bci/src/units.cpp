@@ -5,13 +5,28 @@
 
 namespace arbci::bci {
 
-double microvoltsPer(std::string_view unit) {
+namespace {
+
+std::string lowered(std::string_view unit) {
   std::string u;
   for (char c : unit) u += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return u;
+}
+
+}  // namespace
+
+double microvoltsPer(std::string_view unit) {
+  const std::string u = lowered(unit);
   if (u == "v" || u == "volt" || u == "volts") return 1e6;
   if (u == "mv" || u == "millivolt" || u == "millivolts") return 1e3;
   if (u == "nv" || u == "nanovolt" || u == "nanovolts") return 1e-3;
   return 1.0;
+}
+
+bool isVoltageUnit(std::string_view unit) {
+  const std::string u = lowered(unit);
+  return u.empty() || microvoltsPer(u) != 1.0 || u == "uv" || u == "µv" || u == "μv" ||
+         u == "microvolt" || u == "microvolts";
 }
 
 }  // namespace arbci::bci

@@ -67,15 +67,22 @@ std::string describe(const xdf::Stream& s) {
 
 Recording readXdf(const std::filesystem::path& path, const ReadOptions& options) {
   const xdf::File file = xdf::parse(path);
-  std::string cut;
+  std::string cut, footer_note;
   if (file.cut_short) {
     cut = "cut short at byte " + std::to_string(file.whole_bytes) + " (a recording interrupted?)";
   } else {
     // LabRecorder writes each stream's footer when the recording stops: without them the file was
     // cut (at a chunk's end) before it was closed.
-    std::string missing;
-    for (const xdf::Stream& s : file.streams)
-      if (!s.footer) missing += (missing.empty() ? "" : ", ") + quoted(s);
+    // A stream that never had a sample may have no footer in a file closed properly (pyxdf
+    // reads such files): only a stream with samples and no footer says the file was cut.
+    std::string missing, empty_without;
+    for (const xdf::Stream& s : file.streams) {
+      if (s.footer) continue;
+      std::string& list = s.samples() > 0 ? missing : empty_without;
+      list += (list.empty() ? "" : ", ") + quoted(s);
+    }
+    if (missing.empty() && !empty_without.empty())
+      footer_note = "stream " + empty_without + " has no samples and no footer (read as empty)";
     if (!missing.empty())
       cut = "ends without the footer of stream " + missing +
             " (the recording was not closed: cut short at a chunk's end?)";
@@ -118,6 +125,18 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
     for (int c = 0; c < channels; ++c)
       r.data[static_cast<size_t>(c) * r.samples + s] = static_cast<float>(
           eeg->values[static_cast<size_t>(s) * channels + c] * scale[static_cast<size_t>(c)]);
+  if (!footer_note.empty()) r.notes.push_back(footer_note);
+  std::string not_voltage;
+  for (int c = 0; c < channels; ++c) {
+    const auto k = static_cast<size_t>(c);
+    if (k < eeg->units.size() && !isVoltageUnit(eeg->units[k]))
+      not_voltage +=
+          (not_voltage.empty() ? "" : ", ") + r.info.channels[k] + " (\"" + eeg->units[k] + "\")";
+  }
+  if (!not_voltage.empty())
+    r.notes.push_back("channel(s) " + not_voltage +
+                      " are not in a voltage unit: their values are kept as they are, not "
+                      "microvolts");
   r.parameters["XdfStream"] = eeg->name;
   r.parameters["XdfStreamType"] = eeg->type;
   if (!cut.empty()) {
@@ -144,8 +163,11 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
                       " break(s) in the EEG's stamps, each annotated where it falls");
 
   // Markers: each at the first EEG sample taken at or after it (as ARBCI stamps a flash); one
-  // that falls in a break goes to the first sample after it.
+  // that falls in a break goes to the first sample after it. The EEG's fitted stamps are exact
+  // to a few microseconds, not to zero: a marker stamped on a sample's time may fall a hair
+  // before or after it, so "at" allows a quarter of a period.
   const double period = 1.0 / r.info.rate_hz;
+  const double slack = period / 4.0;
   int before = 0, after = 0, marker_resets = 0;
   for (const xdf::Stream& s : file.streams) {
     if (s.numeric()) continue;
@@ -155,11 +177,11 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
     marker_resets += clock.resets;
     for (size_t k = 0; k < s.samples(); ++k) {
       const double at = times[k];
-      if (at < stamps.front() - period) {
+      if (at < stamps.front() - slack) {
         ++before;
         continue;
       }
-      const auto found = std::lower_bound(stamps.begin(), stamps.end(), at - 1e-6);
+      const auto found = std::lower_bound(stamps.begin(), stamps.end(), at - slack);
       if (found == stamps.end()) {
         ++after;
         continue;

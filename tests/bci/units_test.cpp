@@ -20,5 +20,13 @@ TEST(Units, AnUnnamedUnitIsTakenAsMicrovolts) {
   EXPECT_DOUBLE_EQ(microvoltsPer(""), 1.0);
 }
 
+// A unit that is not a voltage (an amplifier's raw counts) is not taken for one.
+TEST(Units, OnlyVoltagesAndTheEmptyUnitAreVoltages) {
+  for (const char* unit : {"", "V", "mV", "uV", "µV", "μV", "microvolts", "nV"})
+    EXPECT_TRUE(isVoltageUnit(unit)) << unit;
+  for (const char* unit : {"counts", "bits", "degC", "n/a"})
+    EXPECT_FALSE(isVoltageUnit(unit)) << unit;
+}
+
 }  // namespace
 }  // namespace arbci::bci

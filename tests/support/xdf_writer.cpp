@@ -132,7 +132,7 @@ void writeXdf(const std::filesystem::path& path, const XdfNumericStream& eeg,
   chunk(file, 6,
         withStream(2, "<?xml version=\"1.0\"?><info><sample_count>" +
                           std::to_string(markers.size()) + "</sample_count></info>"));
-  if (extras.empty_stream)
+  if (extras.empty_stream && extras.empty_stream_footer)
     chunk(file, 6,
           withStream(3,
                      "<?xml version=\"1.0\"?><info><sample_count>0</sample_count>"

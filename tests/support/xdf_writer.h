@@ -36,6 +36,7 @@ struct XdfExtras {
   std::vector<std::pair<std::string, std::string>> marker_parameters;
   bool empty_stream = false;  // a third stream (float32, 100 Hz) with a header and no sample
   bool footers = true;
+  bool empty_stream_footer = true;  // with `footers`: the empty stream's too
 };
 
 // One numeric stream (stream 1, chunks of 100 samples, each stamped) and one string Markers

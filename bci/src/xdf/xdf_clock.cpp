@@ -7,9 +7,13 @@
 namespace arbci::bci::xdf {
 namespace {
 
-// A step between two samples longer than one period by more than this is a break: LSL stamps
-// jitter by milliseconds, and 100 ms of missing EEG (25 samples at 256 Hz) is worth reporting.
-constexpr double kBreakS = 0.1;
+// A break in a regular stream: its stamps, less one period per sample, shift by at least this and
+// stay shifted (a gap in the samples, or a clock that stepped). Stamps jitter by milliseconds
+// per sample, and by tens of milliseconds where chunks are stamped as they arrive; a step alone
+// proves nothing, so a step of this size is only a candidate, kept when the median level of the
+// stamps over the half second after it differs from the half second before it by this much too.
+constexpr double kBreakS = 0.05;
+constexpr double kLevelWindowS = 0.5;
 // A clock reset: successive offsets whose collection times step back, or forward by more than
 // kResetTimeS and kResetStds spreads beyond the usual interval, while their values jump by more
 // than kResetValueS and kResetStds spreads (pyxdf's criteria, with its thresholds).
@@ -105,6 +109,32 @@ std::vector<Segment> clockSegments(const Stream& s, int& resets) {
   return out;
 }
 
+// Where a regular stream's stamps break (see kBreakS): `level` is each stamp less its index's
+// share of the nominal period, flat with jitter between breaks.
+std::vector<ClockReport::Break> breaksIn(const std::vector<double>& stamps, double period) {
+  std::vector<ClockReport::Break> out;
+  const std::size_t n = stamps.size();
+  const auto window = static_cast<std::size_t>(std::max(8.0, kLevelWindowS / period));
+  auto level = [&](std::size_t from, std::size_t to) {  // median over [from, to)
+    std::vector<double> v;
+    v.reserve(to - from);
+    for (std::size_t i = from; i < to; ++i)
+      v.push_back(stamps[i] - static_cast<double>(i) * period);
+    return median(std::move(v));
+  };
+  std::size_t stretch = 0;  // where the stretch the candidate ends began
+  for (std::size_t i = 1; i < n; ++i) {
+    const double step = stamps[i] - stamps[i - 1];
+    if (step - period <= kBreakS && step >= -kBreakS) continue;
+    const double shift =
+        level(i, std::min(n, i + window)) - level(std::max(stretch, i - std::min(i, window)), i);
+    if (std::abs(shift) < kBreakS) continue;  // a late or early stamp, not a break
+    out.push_back({i, shift});
+    stretch = i;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<double> recorderStamps(const Stream& s, ClockReport& report) {
@@ -129,21 +159,18 @@ std::vector<double> recorderStamps(const Stream& s, ClockReport& report) {
     stamps[i] = t + line.a + line.b * t;
   }
   if (s.nominal_rate <= 0.0 || stamps.size() < 2) return stamps;
+  report.breaks = breaksIn(stamps, 1.0 / s.nominal_rate);
   // Dejitter each stretch between breaks: stamps = a + b * index.
-  const double period = 1.0 / s.nominal_rate;
   std::vector<double> index(stamps.size());
   for (std::size_t i = 0; i < index.size(); ++i) index[i] = static_cast<double>(i);
   std::size_t first = 0;
-  for (std::size_t i = 1; i <= stamps.size(); ++i) {
-    const bool end = i == stamps.size();
-    const double step = end ? 0.0 : stamps[i] - stamps[i - 1];
-    if (!end && step >= 0.0 && step <= period + kBreakS) continue;
-    if (!end) report.breaks.push_back({i, step - period});
-    if (i - first >= 2) {
-      const Line line = fit(index, stamps, first, i - 1);
-      for (std::size_t k = first; k < i; ++k) stamps[k] = line.a + line.b * index[k];
+  for (std::size_t k = 0; k <= report.breaks.size(); ++k) {
+    const std::size_t end = k < report.breaks.size() ? report.breaks[k].sample : stamps.size();
+    if (end - first >= 2) {
+      const Line line = fit(index, stamps, first, end - 1);
+      for (std::size_t i = first; i < end; ++i) stamps[i] = line.a + line.b * index[i];
     }
-    first = i;
+    first = end;
   }
   return stamps;
 }

@@ -2,8 +2,10 @@
 // offsets (measured by the recorder every few seconds) fitted by a line per clock segment and
 // added to its stamps, a segment ending where the stream's clock was reset (its offsets jump in
 // both collection time and value); then, for a regular stream, the stamps of each stretch without
-// a break replaced by a straight line through them (LSL stamps chunks, not samples). A break (no
-// samples for over a second) is kept and reported, never closed up.
+// a break replaced by a straight line through them (dejittered: LSL stamps chunks as they arrive,
+// not samples as they are taken). A break (the stamps shift by 50 ms or more and stay shifted: a
+// gap in the samples, or a clock that stepped) is kept and reported, never closed up; a stamp
+// that is merely late or early, however much, is jitter.
 #pragma once
 
 #include <cstddef>

@@ -12,4 +12,8 @@ namespace arbci::bci {
 // files that leave it out give microvolts).
 double microvoltsPer(std::string_view unit);
 
+// Whether `unit` is a voltage in the table, or empty (taken as microvolts); false for anything
+// else ("counts", "bits", "degC"), whose values a reader keeps as they are and names.
+bool isVoltageUnit(std::string_view unit);
+
 }  // namespace arbci::bci
