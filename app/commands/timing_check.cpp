@@ -47,10 +47,11 @@ nlohmann::json toJson(const bci::PhotodiodeReport& r, double target_sd_ms) {
 
 int runTimingCheck(const TimingCheckOptions& o) {
   const session::SessionConfig config = loadSessionOption(o.session);
-  if (config.eeg.photodiode_channel.empty())
+  if (config.eeg.photodiode_channel.empty() && config.eeg.photodiode_marker.empty())
     throw CliError(config.source +
-                   ": eeg.photodiode_channel is empty: the timing check needs a photodiode "
-                   "channel (simulated: any name adds a virtual one)");
+                   ": eeg.photodiode_channel and eeg.photodiode_marker are empty: the timing "
+                   "check needs a photodiode channel (simulated: any name adds a virtual one) or "
+                   "the marker a photodiode on a trigger input records");
   if (std::filesystem::exists(o.out) && !std::filesystem::is_empty(o.out))
     throw CliError(o.out + ": exists and is not empty; choose a new folder");
   session::SessionOptions options;
@@ -83,8 +84,12 @@ int runTimingCheck(const TimingCheckOptions& o) {
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
   bci::PhotodiodeReport report;
   try {
-    report = bci::checkPhotodiode(recording, config.eeg.photodiode_channel,
-                                  0.5 * config.paradigm.soaSeconds());
+    // A diode on a trigger input (its marker) where the session names one, else its channel.
+    report = config.eeg.photodiode_marker.empty()
+                 ? bci::checkPhotodiode(recording, config.eeg.photodiode_channel,
+                                        0.5 * config.paradigm.soaSeconds())
+                 : bci::checkPhotodiodeMarkers(recording, config.eeg.photodiode_marker,
+                                               0.5 * config.paradigm.soaSeconds());
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
   }
@@ -148,7 +153,8 @@ void addTimingCheckCommand(CLI::App& root, int& exit_code) {
       "pairs every recorded flash onset with the photodiode channel's nearest rising edge.\n"
       "Writes DIR/timing.json (offset mean, SD, min, max in ms, count) and DIR/timing.png (a\n"
       "histogram) beside the session's files. A real photodiode goes on the patch and into the\n"
-      "amplifier channel named eeg.photodiode_channel; the simulated subject has a virtual one.\n"
+      "amplifier channel named eeg.photodiode_channel (or, on a trigger input, the marker named\n"
+      "eeg.photodiode_marker); the simulated subject has a virtual one.\n"
       "Exit status: 0 within the target (|mean| <= 1 ms, SD <= one sample, every flash paired)\n"
       "with the paradigm's rules kept (no flash while another is lit, a dark frame before each,\n"
       "no SOA or dark gap under the paradigm's); 4 when a rule broke (it is named); 1 on bad\n"

@@ -7,8 +7,12 @@
 namespace arbci::app {
 
 HmdSettings HmdSettings::of(const session::SessionConfig& config) {
-  return {config.hmd.width,     config.hmd.height, config.hmd.undistort,
-          config.world.objects, config.world.grid, !config.eeg.photodiode_channel.empty()};
+  return {config.hmd.width,
+          config.hmd.height,
+          config.hmd.undistort,
+          config.world.objects,
+          config.world.grid,
+          !config.eeg.photodiode_channel.empty() || !config.eeg.photodiode_marker.empty()};
 }
 
 HmdStage::HmdStage(const HmdSettings& settings, const std::filesystem::path& folder,

@@ -275,6 +275,9 @@ const Schema<EegSettings>& eegSchema() {
             subject.at("photodiode_channel"),
             [](E& e, const Json& j) { e.photodiode_channel = j.get<std::string>(); },
             [](const E& e) { return Json(e.photodiode_channel); })
+        .text("photodiode_marker", &E::photodiode_marker, "",
+              "a photodiode on a trigger input (an RDA marker): the marker as recorded, "
+              "\"Stimulus/S  1\"; the timing check takes its onsets as the diode's edges")
         .number("latency_ms", &E::latency_ms, 0.0, 0.0, 1000.0,
                 "the amplifier's delivery latency, as arbci timing-check measures it", "ms");
     // Each source's own section.

@@ -60,5 +60,26 @@ TEST(PhotodiodeCheck, NamesAMissingOrDeadChannel) {
   }
 }
 
+// A diode on a trigger input: the amplifier records a marker at each edge (RDA's "Stimulus/S  1"),
+// paired the same way; a marker the recording never has is named.
+TEST(PhotodiodeCheck, MarkersFromATriggerInputAreTheEdgesWhereTheDiodeHasNoChannel) {
+  Recording r = withDiode({100, 147, 194, 241, 1000}, 0, {});
+  for (std::int64_t onset : {103, 150, 197, 244, 1003, 1800})
+    r.annotations.push_back({onset, "Stimulus/S  1", 0});
+  r.annotations.push_back({500, "Response/R  8", 0});
+  const PhotodiodeReport report = checkPhotodiodeMarkers(r, "Stimulus/S  1", 0.09);
+  EXPECT_EQ(report.channel, "marker Stimulus/S  1");
+  EXPECT_EQ(report.edges, 6);
+  EXPECT_EQ(report.count, 5);
+  EXPECT_NEAR(report.mean_ms, 3 * 1000.0 / 256.0, 1e-9);
+  EXPECT_EQ(report.unmatched_edges, 1);
+  try {
+    checkPhotodiodeMarkers(r, "Stimulus/S  2", 0.09);
+    FAIL() << "a marker the recording lacks was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no marker \"Stimulus/S  2\""), std::string::npos);
+  }
+}
+
 }  // namespace
 }  // namespace arbci::bci

@@ -1,10 +1,12 @@
 // The "rda" EEG source against a small RDA server written here from BrainProducts' description of
 // Remote Data Access (the 24-byte header with the RDA GUID, the start message with the channel
 // count, sampling interval, resolutions and names, 32-bit data messages with block numbers,
-// the stop message), on 127.0.0.1 only: the samples arrive with their names, rate and
-// resolution; a lost block is filled with zeros on its samples; a server at another rate, one
-// sending 16-bit data, one that is not RDA, and a stream that stops are refused or reported,
-// each with its reason.
+// the stop message, markers inside data messages), on 127.0.0.1 only: the samples arrive with
+// their names, rate and resolution; a lost block is a gap in the sample numbers (which the
+// acquisition fills and counts); markers become annotations on their samples; a stream that
+// stops and starts again, or whose server goes and comes back, is a fault while it is away and
+// goes on after a gap; a server at another rate, one on the 16-bit port, one that is not RDA and
+// one that restarts with other channels are refused or reported, each with its reason.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -16,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "arbci/bci/acquisition.h"
 #include "arbci/session/eeg_sources.h"
 
 namespace arbci::session {
@@ -53,25 +56,64 @@ std::vector<std::uint8_t> startMessage(const std::vector<std::string>& names, do
   return message(1, body);
 }
 
+struct Marker {
+  std::uint32_t position = 0, points = 1;
+  std::string type, description;
+};
+
 // `points` samples of every channel from `first`: channel c, sample s has the raw value
-// (first + s) * 10 + c.
+// (first + s) * 10 + c; then the markers.
 std::vector<std::uint8_t> dataMessage(std::uint32_t block, std::uint32_t points, int channels,
-                                      std::int64_t first) {
+                                      std::int64_t first, const std::vector<Marker>& markers = {},
+                                      std::uint32_t type = 4) {
   std::vector<std::uint8_t> body;
   put<std::uint32_t>(body, block);
   put<std::uint32_t>(body, points);
-  put<std::uint32_t>(body, 0);  // markers
+  put<std::uint32_t>(body, static_cast<std::uint32_t>(markers.size()));
   for (std::uint32_t s = 0; s < points; ++s)
-    for (int c = 0; c < channels; ++c) put<float>(body, static_cast<float>((first + s) * 10 + c));
-  return message(4, body);
+    for (int c = 0; c < channels; ++c) {
+      if (type == 2)
+        put<std::int16_t>(body, static_cast<std::int16_t>(s));
+      else
+        put<float>(body, static_cast<float>((first + s) * 10 + c));
+    }
+  for (const Marker& m : markers) {
+    put<std::uint32_t>(
+        body, static_cast<std::uint32_t>(16 + m.type.size() + 1 + m.description.size() + 1));
+    put<std::uint32_t>(body, m.position);
+    put<std::uint32_t>(body, m.points);
+    put<std::int32_t>(body, -1);  // all channels
+    body.insert(body.end(), m.type.begin(), m.type.end());
+    body.push_back(0);
+    body.insert(body.end(), m.description.begin(), m.description.end());
+    body.push_back(0);
+  }
+  return message(type, body);
 }
 
-// A server on 127.0.0.1 (a free port) that sends `messages` to the first client, then keeps the
+// What the server does next: send a message, pause, or close the connection and take the next.
+struct Step {
+  Step(std::vector<std::uint8_t> m) : bytes(std::move(m)) {}  // NOLINT: a message is a step
+  static Step pause(int ms) {
+    Step s({});
+    s.pause_ms = ms;
+    return s;
+  }
+  static Step reconnect() {
+    Step s({});
+    s.close_and_accept = true;
+    return s;
+  }
+  std::vector<std::uint8_t> bytes;
+  int pause_ms = 0;
+  bool close_and_accept = false;
+};
+
+// A server on 127.0.0.1 (a free port) that runs `steps` with its client, then keeps the
 // connection open until destroyed.
 class RdaServer {
  public:
-  explicit RdaServer(std::vector<std::vector<std::uint8_t>> messages)
-      : messages_(std::move(messages)) {
+  explicit RdaServer(std::vector<Step> steps) : steps_(std::move(steps)) {
     listen_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     sockaddr_in address{};
     address.sin_family = AF_INET;
@@ -83,7 +125,17 @@ class RdaServer {
     ::listen(listen_, 1);
     thread_ = std::thread([this] {
       client_ = ::accept(listen_, nullptr, nullptr);
-      for (const auto& m : messages_) ::send(client_, m.data(), m.size(), MSG_NOSIGNAL);
+      for (const Step& step : steps_) {
+        if (step.close_and_accept) {
+          ::close(client_);
+          client_ = ::accept(listen_, nullptr, nullptr);
+          if (client_ < 0) return;
+        }
+        if (step.pause_ms > 0)
+          std::this_thread::sleep_for(std::chrono::milliseconds(step.pause_ms));
+        if (!step.bytes.empty())
+          ::send(client_, step.bytes.data(), step.bytes.size(), MSG_NOSIGNAL);
+      }
     });
   }
   ~RdaServer() {
@@ -95,7 +147,7 @@ class RdaServer {
   int port() const { return port_; }
 
  private:
-  std::vector<std::vector<std::uint8_t>> messages_;
+  std::vector<Step> steps_;
   int listen_ = -1, client_ = -1, port_ = 0;
   std::thread thread_;
 };
@@ -119,14 +171,15 @@ Opened openRda(int port, double rate_hz = 256.0) {
   return o;
 }
 
-// Polls until `samples` samples, or a fault and nothing left to take (at most 10 s, on a loaded
-// machine).
-std::vector<bci::Block> pollSamples(bci::EegSource& source, std::int64_t samples) {
+// Polls until `samples` samples, or (`until_fault`) a fault and nothing left to take (at most
+// 10 s, on a loaded machine).
+std::vector<bci::Block> pollSamples(bci::EegSource& source, std::int64_t samples,
+                                    bool until_fault = true) {
   std::vector<bci::Block> blocks;
   std::int64_t got = 0;
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (got < samples && std::chrono::steady_clock::now() < give_up) {
-    const bool faulty = !source.fault().empty();
+    const bool faulty = until_fault && !source.fault().empty();
     const std::vector<bci::Block> taken = source.poll(64);
     for (const bci::Block& b : taken) {
       got += b.samples;
@@ -141,7 +194,7 @@ std::vector<bci::Block> pollSamples(bci::EegSource& source, std::int64_t samples
 const std::vector<std::string> kNames = {"Fz", "Cz", "Pz", "Oz"};
 
 TEST(RdaSource, TheServersSamplesArriveWithTheirNamesRateAndResolution) {
-  std::vector<std::vector<std::uint8_t>> messages = {startMessage(kNames, 500.0, 0.1)};
+  std::vector<Step> messages = {startMessage(kNames, 500.0, 0.1)};
   for (std::uint32_t b = 0; b < 10; ++b) messages.push_back(dataMessage(b, 20, 4, b * 20));
   RdaServer server(messages);
   Opened o = openRda(server.port(), 500.0);
@@ -161,19 +214,127 @@ TEST(RdaSource, TheServersSamplesArriveWithTheirNamesRateAndResolution) {
   EXPECT_NE(o.source->describe().find("4 channels at 500 Hz"), std::string::npos);
 }
 
-TEST(RdaSource, ALostBlockIsZerosOnItsSamplesAndTheNextKeepsItsPlace) {
-  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0),
-                    dataMessage(2, 16, 4, 32), dataMessage(3, 16, 4, 48)});
+// Block 1 never came: the blocks after it keep their sample numbers, and the gap is left for the
+// acquisition to fill and count (as any source's).
+TEST(RdaSource, ALostBlockIsAGapInTheSampleNumbers) {
+  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 24, 4, 0),
+                    dataMessage(2, 24, 4, 48), dataMessage(3, 24, 4, 72)});
   Opened o = openRda(server.port());
-  const std::vector<bci::Block> blocks = pollSamples(*o.source, 64);
-  ASSERT_EQ(blocks.size(), 4u);
-  for (int s = 0; s < 16; ++s) EXPECT_EQ(blocks[1].at(0, s), 0.0f);  // block 1 never came
-  EXPECT_EQ(blocks[2].first_sample, 32);
-  EXPECT_FLOAT_EQ(blocks[2].at(3, 0), 32 * 10 + 3);
+  // (How the points are cut into blocks depends on when they are polled; where they lie does not.)
+  std::vector<std::int64_t> delivered;
+  for (const bci::Block& b : pollSamples(*o.source, 72))
+    for (int s = 0; s < b.samples; ++s) {
+      delivered.push_back(b.first_sample + s);
+      EXPECT_FLOAT_EQ(b.at(3, s), static_cast<float>((b.first_sample + s) * 10 + 3));
+    }
+  std::vector<std::int64_t> expected;
+  for (std::int64_t s = 0; s < 96; ++s)
+    if (s < 24 || s >= 48) expected.push_back(s);
+  EXPECT_EQ(delivered, expected);
+  EXPECT_NE(o.source->describe().find("1 block(s) lost"), std::string::npos)
+      << o.source->describe();
+
+  // Through the acquisition: zeros in the gap, counted and reported as a loss.
+  RdaServer again({startMessage(kNames, 256.0, 1.0), dataMessage(0, 24, 4, 0),
+                   dataMessage(2, 24, 4, 48), dataMessage(3, 24, 4, 72)});
+  Opened live = openRda(again.port());
+  bci::Acquisition acquisition(std::move(live.source), std::make_shared<bci::UnboundedClock>(),
+                               bci::Acquisition::Mode::Live);
+  acquisition.start();
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (acquisition.lostSamples() == 0 && std::chrono::steady_clock::now() < give_up) {
+    acquisition.take();
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_EQ(acquisition.lostSamples(), 24);
+  const std::vector<bci::SampleLoss> losses = acquisition.takeLosses();
+  ASSERT_EQ(losses.size(), 1u);
+  EXPECT_EQ(losses[0].first_sample, 24);
+  EXPECT_EQ(losses[0].samples, 24);
+}
+
+// Recorder's markers (a trigger box's Stimulus and Response TTLs, sent inside the data blocks)
+// become annotations "<type>/<description>" on the sample they mark.
+TEST(RdaSource, MarkersBecomeAnnotationsOnTheirSamples) {
+  RdaServer server(
+      {startMessage(kNames, 256.0, 1.0), dataMessage(0, 20, 4, 0),
+       dataMessage(1, 20, 4, 20, {{3, 1, "Stimulus", "S  1"}}),
+       dataMessage(2, 20, 4, 40, {{0, 1, "Response", "R  8"}, {19, 5, "Comment", "x"}})});
+  Opened o = openRda(server.port());
+  pollSamples(*o.source, 48);
+  std::vector<bci::Annotation> markers;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (markers.size() < 3 && std::chrono::steady_clock::now() < give_up) {
+    for (bci::Annotation& a : o.source->takeAnnotations()) markers.push_back(std::move(a));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_EQ(markers.size(), 3u);
+  EXPECT_EQ(markers[0].sample, 23);
+  EXPECT_EQ(markers[0].text, "Stimulus/S  1");
+  EXPECT_EQ(markers[1].sample, 40);
+  EXPECT_EQ(markers[1].text, "Response/R  8");
+  EXPECT_EQ(markers[2].sample, 59);
+  EXPECT_EQ(markers[2].duration_samples, 5);
+  EXPECT_TRUE(o.source->takeAnnotations().empty());  // each once
+}
+
+// Waits (at most 10 s) until the source's fault satisfies `wanted`.
+template <class Wanted>
+std::string faultWhen(bci::EegSource& source, Wanted wanted) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  std::string fault = source.fault();
+  while (!wanted(fault) && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    fault = source.fault();
+  }
+  return fault;
+}
+
+// Recorder stops (or switches to impedance mode) and starts again: a fault while it is away,
+// then the data go on after a gap at least as long as the time away (here 0.4 s).
+TEST(RdaSource, AStreamThatStopsAndStartsAgainGoesOnAfterAGap) {
+  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0), message(3, {}),
+                    Step::pause(400), startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0),
+                    dataMessage(1, 16, 4, 16)});
+  Opened o = openRda(server.port());
+  const std::string stopped = faultWhen(*o.source, [](const std::string& f) { return !f.empty(); });
+  EXPECT_NE(stopped.find("stopped the stream"), std::string::npos) << stopped;
+  EXPECT_NE(stopped.find("going on when it starts again"), std::string::npos) << stopped;
+  const std::vector<bci::Block> blocks = pollSamples(*o.source, 48, false);
+  ASSERT_EQ(blocks.size(), 3u);
+  EXPECT_EQ(blocks[0].first_sample, 0);
+  EXPECT_GE(blocks[1].first_sample, 16 + static_cast<std::int64_t>(0.4 * 256) - 16);
+  EXPECT_EQ(blocks[2].first_sample, blocks[1].first_sample + 16);  // the new counter is no loss
+  EXPECT_EQ(faultWhen(*o.source, [](const std::string& f) { return f.empty(); }), "");
+  EXPECT_NE(o.source->describe().find("1 restart(s)"), std::string::npos) << o.source->describe();
+}
+
+// The server goes away (Recorder closed) and comes back 0.4 s later: the client reconnects by
+// itself, and the time away is a gap.
+TEST(RdaSource, AServerThatGoesAndComesBackIsReconnected) {
+  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0), Step::reconnect(),
+                    Step::pause(400), startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0)});
+  Opened o = openRda(server.port());
+  const std::vector<bci::Block> blocks = pollSamples(*o.source, 32, false);
+  ASSERT_EQ(blocks.size(), 2u);
+  EXPECT_GE(blocks[1].first_sample, 16 + static_cast<std::int64_t>(0.4 * 256) - 16);
+  EXPECT_EQ(faultWhen(*o.source, [](const std::string& f) { return f.empty(); }), "");
+}
+
+// A restart with other channels cannot go on in the same recording: a fault that says so.
+TEST(RdaSource, ARestartWithOtherChannelsIsAFaultThatSaysSo) {
+  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0), message(3, {}),
+                    startMessage({"Fz", "Cz"}, 256.0, 1.0)});
+  Opened o = openRda(server.port());
+  const std::string fault = faultWhen(*o.source, [](const std::string& f) {
+    return f.find("other channels") != std::string::npos;
+  });
+  EXPECT_NE(fault.find("started again with other channels or another rate"), std::string::npos)
+      << fault;
 }
 
 TEST(RdaSource, WhatCannotBeReadIsRefusedWithItsReason) {
-  auto refusal = [](std::vector<std::vector<std::uint8_t>> messages, double rate = 256.0) {
+  auto refusal = [](std::vector<Step> messages, double rate = 256.0) {
     RdaServer server(std::move(messages));
     try {
       openRda(server.port(), rate);
@@ -185,8 +346,12 @@ TEST(RdaSource, WhatCannotBeReadIsRefusedWithItsReason) {
   const std::string rate = refusal({startMessage(kNames, 500.0, 0.1)});
   EXPECT_NE(rate.find("runs at 500 Hz, the session at 256 Hz"), std::string::npos) << rate;
   EXPECT_NE(rate.find("eeg.source = \"rda\""), std::string::npos) << rate;
-  const std::string sixteen = refusal({message(2, std::vector<std::uint8_t>(12, 0))});
-  EXPECT_NE(sixteen.find("16-bit"), std::string::npos) << sixteen;
+  // The 16-bit port sends the same start message; its first data message tells.
+  const std::string sixteen =
+      refusal({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0, {}, 2)});
+  EXPECT_NE(sixteen.find("sends 16-bit data"), std::string::npos) << sixteen;
+  EXPECT_NE(sixteen.find("set eeg.rda.port to its 32-bit port, 51244"), std::string::npos)
+      << sixteen;
   const std::string other = refusal({message(1, std::vector<std::uint8_t>(12, 0), false)});
   EXPECT_NE(other.find("does not speak RDA"), std::string::npos) << other;
   // Nobody listening: the port of a server that has gone.
@@ -205,17 +370,6 @@ TEST(RdaSource, WhatCannotBeReadIsRefusedWithItsReason) {
   }();
   EXPECT_NE(refused.find("cannot connect to the RDA server at 127.0.0.1:"), std::string::npos)
       << refused;
-}
-
-TEST(RdaSource, AStopMessageIsAFaultNotACrash) {
-  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0), message(3, {})});
-  Opened o = openRda(server.port());
-  const std::vector<bci::Block> blocks = pollSamples(*o.source, 1000);
-  EXPECT_EQ(blocks.size(), 1u);  // what came before the stop
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (o.source->fault().empty() && std::chrono::steady_clock::now() < give_up)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  EXPECT_NE(o.source->fault().find("stopped the stream"), std::string::npos) << o.source->fault();
 }
 
 }  // namespace

@@ -4,11 +4,20 @@
 // message's whole size and its type (uint32 each, little-endian). A start message (type 1) gives
 // the channel count (uint32), the sampling interval in microseconds (double), each channel's
 // resolution in microvolts per unit (double) and the channel names (zero-terminated); a data
-// message (type 4) gives its block number, points and marker count (uint32 each), the samples
-// multiplexed as float (point by point, every channel), then the markers; a stop message (type 3)
-// ends the stream. Blocks carry no time stamps: they are stamped on arrival, and a jump in the
-// block number is a loss of that many blocks' points, filled with zeros and counted. Markers are
-// left to the recording's own events.
+// message (type 4; type 2 on the 16-bit port) gives its block number, points and marker count
+// (uint32 each), the samples multiplexed as float (point by point, every channel), then the
+// markers (each: its size, position in the block, points, channel (uint32, uint32, uint32,
+// int32), then its type and description, zero-terminated); a stop message (type 3) ends the
+// stream (Recorder stopped, or switched to impedance mode).
+//
+// Blocks carry no time stamps: they are stamped on arrival. Nothing is filled in here: a jump in
+// the block number (blocks the server sent and this client never got) and the time a stopped or
+// lost stream was away are gaps in the sample numbers, which the acquisition fills with zeros,
+// counts and annotates like any source's. A stop, or a connection that closes, is a fault while
+// it lasts: the client waits for a new start message (reconnecting every second if the
+// connection went) and goes on when data returns, as an LSL source does. Markers become
+// annotations "<type>/<description>" ("Stimulus/S  1", as BrainVision's marker files name them)
+// on their sample.
 #include <arpa/inet.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -21,6 +30,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <mutex>
 #include <thread>
 
@@ -42,7 +52,7 @@ const core::Schema<RdaSettings>& rdaSchema() {
     core::Schema<RdaSettings> t("rda", "BrainVision Recorder's RDA stream (eeg.source \"rda\")");
     t.text("host", &RdaSettings::host, "127.0.0.1", "the computer running Recorder's RDA server")
         .integer("port", &RdaSettings::port, 51244, 1, 65535,
-                 "its port: 51244 for 32-bit data (16-bit data on 51234 is not read)")
+                 "its port: 51244, the 32-bit one (the 16-bit port, 51234, is refused)")
         .number("connect_timeout_s", &RdaSettings::connect_timeout_s, 5.0, 0.1, 600.0,
                 "how long to wait for the server and its start message", "s");
     return t;
@@ -75,6 +85,14 @@ class RdaError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// What a start message declares; a restart must declare the same.
+struct Layout {
+  double rate_hz = 0.0;
+  std::vector<std::string> channels;
+  std::vector<double> resolution;  // microvolts per unit, by channel
+  bool operator==(const Layout&) const = default;
+};
+
 class RdaSource final : public bci::EegSource {
  public:
   RdaSource(const RdaSettings& settings, int block_size, double expected_rate_hz)
@@ -88,17 +106,25 @@ class RdaSource final : public bci::EegSource {
         throw RdaError("no start message from the RDA server at " + where_ + " in " +
                        core::formatNumber(settings_.connect_timeout_s) + " s" +
                        (closed_ ? " (it closed the connection)" : ""));
-      if (type == kData16)
-        throw RdaError("the RDA server at " + where_ +
-                       " sends 16-bit data: connect to its 32-bit port (51244)");
+      if (type == kData16) throw RdaError(sixteenBit());
     }
-    readStart(message);
+    layout_ = readStart(message);
+    info_.rate_hz = layout_.rate_hz;
+    info_.channels = layout_.channels;
     info_.block_size = block_size;
     if (expected_rate_hz > 0.0 &&
         std::abs(info_.rate_hz - expected_rate_hz) > 1e-6 * expected_rate_hz)
       throw RdaError("the RDA stream at " + where_ + " runs at " +
                      core::formatNumber(info_.rate_hz) + " Hz, the session at " +
                      core::formatNumber(expected_rate_hz) + " Hz (eeg.rate_hz)");
+    // The 16-bit port sends the same start message: its first data message says which it is.
+    while (receive(message, type, deadline)) {
+      if (type == kData16) throw RdaError(sixteenBit());
+      if (type == kData32) {
+        readData(message);
+        break;
+      }
+    }
     reader_ = std::thread([this] { readLoop(); });
   }
   ~RdaSource() override {
@@ -112,29 +138,37 @@ class RdaSource final : public bci::EegSource {
   std::vector<bci::Block> poll(int max_blocks) override {
     std::lock_guard lock(mutex_);
     std::vector<bci::Block> out;
-    const int channels = info_.channelCount(), size = info_.block_size;
-    while (static_cast<int>(out.size()) < max_blocks &&
-           pending_.size() >= static_cast<size_t>(channels * size)) {
-      bci::Block block(next_sample_, channels, size);
-      for (int s = 0; s < size; ++s)
-        for (int c = 0; c < channels; ++c)
-          block.at(c, s) = pending_[static_cast<size_t>(s * channels + c)];
-      pending_.erase(pending_.begin(), pending_.begin() + channels * size);
-      next_sample_ += size;
-      out.push_back(std::move(block));
+    while (static_cast<int>(out.size()) < max_blocks && !ready_.empty()) {
+      out.push_back(std::move(ready_.front()));
+      ready_.pop_front();
     }
+    const int size = info_.block_size;
+    while (static_cast<int>(out.size()) < max_blocks && pendingPoints() >= size)
+      out.push_back(takePending(size));
     return out;
+  }
+  std::vector<bci::Annotation> takeAnnotations() override {
+    std::lock_guard lock(mutex_);
+    return std::exchange(markers_, {});
   }
   std::string fault() const override {
     std::lock_guard lock(mutex_);
     return fault_;
   }
   std::string describe() const override {
+    std::lock_guard lock(mutex_);
     return "RDA stream at " + where_ + ": " + std::to_string(info_.channelCount()) +
-           " channels at " + core::formatNumber(info_.rate_hz) + " Hz";
+           " channels at " + core::formatNumber(info_.rate_hz) + " Hz; " +
+           std::to_string(lost_blocks_) + " block(s) lost, " + std::to_string(restarts_) +
+           " restart(s), " + std::to_string(gap_samples_) + " samples lost to gaps";
   }
 
  private:
+  std::string sixteenBit() const {
+    return "the RDA server at " + where_ +
+           " sends 16-bit data (Recorder's port 51234): set eeg.rda.port to its 32-bit port, 51244";
+  }
+
   void connect() {
     addrinfo hints{};
     hints.ai_family = AF_INET;
@@ -148,9 +182,13 @@ class RdaSource final : public bci::EegSource {
     const int result = fd_ < 0 ? -1 : ::connect(fd_, found->ai_addr, found->ai_addrlen);
     const int error = errno;
     ::freeaddrinfo(found);
-    if (result != 0)
+    if (result != 0) {
+      if (fd_ >= 0) ::close(fd_);
+      fd_ = -1;
       throw RdaError("cannot connect to the RDA server at " + where_ + ": " + std::strerror(error) +
                      " (is Recorder's RDA enabled?)");
+    }
+    closed_ = false;
   }
 
   // Reads `count` bytes before `deadline` (host seconds); false on a timeout or a closed socket.
@@ -187,7 +225,7 @@ class RdaSource final : public bci::EegSource {
     return readBytes(body.data(), body.size(), bci::hostSeconds() + 5.0);
   }
 
-  void readStart(const std::vector<std::uint8_t>& m) {
+  Layout readStart(const std::vector<std::uint8_t>& m) const {
     if (m.size() < 12) throw RdaError("a short RDA start message from " + where_);
     const std::uint32_t channels = u32(m.data());
     const double interval_us = little<double>(m.data() + 4);
@@ -196,49 +234,146 @@ class RdaSource final : public bci::EegSource {
       throw RdaError("an RDA start message with " + std::to_string(channels) +
                      " channels and a sampling interval of " + core::formatNumber(interval_us) +
                      " us from " + where_);
-    info_.rate_hz = 1e6 / interval_us;
+    Layout layout;
+    layout.rate_hz = 1e6 / interval_us;
     for (std::uint32_t c = 0; c < channels; ++c)
-      resolution_.push_back(little<double>(m.data() + 12 + 8 * c));
+      layout.resolution.push_back(little<double>(m.data() + 12 + 8 * c));
     size_t at = 12 + 8 * size_t{channels};
     for (std::uint32_t c = 0; c < channels; ++c) {
       std::string name;
       while (at < m.size() && m[at] != 0) name.push_back(static_cast<char>(m[at++]));
       ++at;
-      info_.channels.push_back(name.empty() ? "Ch" + std::to_string(c + 1) : name);
+      layout.channels.push_back(name.empty() ? "Ch" + std::to_string(c + 1) : name);
     }
+    return layout;
+  }
+
+  int pendingPoints() const {
+    return static_cast<int>(pending_.size() / static_cast<size_t>(info_.channelCount()));
+  }
+  // The first `points` pending points as a block (channel-major).
+  bci::Block takePending(int points) {
+    const int channels = info_.channelCount();
+    bci::Block block(pending_first_, channels, points);
+    for (int s = 0; s < points; ++s)
+      for (int c = 0; c < channels; ++c)
+        block.at(c, s) = pending_[static_cast<size_t>(s * channels + c)];
+    pending_.erase(pending_.begin(),
+                   pending_.begin() + static_cast<std::ptrdiff_t>(points) * channels);
+    pending_first_ += points;
+    return block;
+  }
+  // `points` samples that never came: what is pending goes out as it is, and the next sample
+  // number moves on, so the acquisition sees the gap.
+  void skip(std::int64_t points) {
+    if (pendingPoints() > 0) ready_.push_back(takePending(pendingPoints()));
+    pending_first_ += points;
+    gap_samples_ += points;
   }
 
   void readData(const std::vector<std::uint8_t>& m) {
-    const size_t channels = resolution_.size();
+    const size_t channels = layout_.resolution.size();
     if (m.size() < 12) throw RdaError("a short RDA data message");
-    const std::uint32_t block = u32(m.data()), points = u32(m.data() + 4);
-    if (m.size() < 12 + 4 * size_t{points} * channels)
+    const std::uint32_t block = u32(m.data()), points = u32(m.data() + 4),
+                        marker_count = u32(m.data() + 8);
+    size_t at = 12 + 4 * size_t{points} * channels;
+    if (m.size() < at)
       throw RdaError("an RDA data message shorter than its " + std::to_string(points) + " points");
+    const double now = bci::hostSeconds();
     std::lock_guard lock(mutex_);
-    // Blocks the server sent and this client never got: their points are lost, as zeros.
-    if (last_block_ && block > *last_block_ + 1)
-      pending_.insert(pending_.end(), (block - *last_block_ - 1) * size_t{points} * channels, 0.0f);
+    if (resumed_) {
+      // After a stop or a lost connection: the samples the amplifier took meanwhile (the time
+      // away less this block's own) are a gap; its block numbers start again.
+      resumed_ = false;
+      const auto missing =
+          std::llround((now - last_data_host_) * info_.rate_hz) - static_cast<std::int64_t>(points);
+      if (last_data_host_ > 0.0 && missing > 0) skip(missing);
+    } else if (last_block_) {
+      // Blocks the server sent and this client never got (uint32 arithmetic: the counter wraps).
+      const std::uint32_t jump = block - *last_block_ - 1;
+      if (jump > 0 && jump < 0x80000000u) {
+        skip(static_cast<std::int64_t>(jump) * points);
+        lost_blocks_ += jump;
+      }
+    }
     last_block_ = block;
+    last_data_host_ = now;
+    const std::int64_t first = pending_first_ + pendingPoints();
     for (size_t i = 0; i < size_t{points} * channels; ++i)
       pending_.push_back(little<float>(m.data() + 12 + 4 * i) *
-                         static_cast<float>(resolution_[i % channels]));
+                         static_cast<float>(layout_.resolution[i % channels]));
+    for (std::uint32_t k = 0; k < marker_count && at + 16 <= m.size(); ++k) {
+      const std::uint32_t size = u32(m.data() + at), position = u32(m.data() + at + 4),
+                          marker_points = u32(m.data() + at + 8);
+      if (size < 16 || at + size > m.size()) break;  // a marker cut short: the rest is unusable
+      std::string type, description;
+      size_t c = at + 16;
+      while (c < at + size && m[c] != 0) type.push_back(static_cast<char>(m[c++]));
+      ++c;
+      while (c < at + size && m[c] != 0) description.push_back(static_cast<char>(m[c++]));
+      markers_.push_back({first + position, type + "/" + description,
+                          marker_points > 1 ? static_cast<int>(marker_points) : 0});
+      at += size;
+    }
+    if (!fault_.empty()) fault_.clear();
+  }
+
+  void setFault(const std::string& text) {
+    std::lock_guard lock(mutex_);
+    fault_ = text;
+  }
+
+  // Until the connection is back and has sent a start message with the same layout.
+  bool reconnect() {
+    try {
+      connect();
+    } catch (const RdaError&) {
+      return false;
+    }
+    return true;
   }
 
   void readLoop() {
     std::vector<std::uint8_t> message;
     try {
       while (!stop_) {
+        if (fd_ < 0 && !reconnect()) {
+          for (int i = 0; i < 10 && !stop_; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          continue;
+        }
         std::uint32_t type = 0;
         if (!receive(message, type, bci::hostSeconds() + 0.2)) {
-          if (closed_) throw RdaError("the RDA server at " + where_ + " closed the connection");
+          if (closed_) {
+            ::close(fd_);
+            fd_ = -1;
+            resumed_ = true;
+            setFault("the RDA server at " + where_ +
+                     " closed the connection; reconnecting when it is back");
+          }
           continue;
         }
         if (type == kData32) readData(message);
-        if (type == kStop) throw RdaError("the RDA server at " + where_ + " stopped the stream");
+        if (type == kData16) throw RdaError(sixteenBit());
+        if (type == kStop) {
+          resumed_ = true;
+          setFault("the RDA server at " + where_ +
+                   " stopped the stream (Recorder stopped, or switched to impedance mode); "
+                   "going on when it starts again");
+        }
+        if (type == kStart) {
+          const Layout layout = readStart(message);
+          if (!(layout == layout_))
+            throw RdaError("the RDA stream at " + where_ +
+                           " started again with other channels or another rate: restart the "
+                           "session to take it");
+          std::lock_guard lock(mutex_);
+          ++restarts_;
+          resumed_ = true;
+        }
       }
     } catch (const std::exception& error) {
-      std::lock_guard lock(mutex_);
-      fault_ = error.what();
+      setFault(std::string(error.what()) + " (the stream is not read any further)");
     }
   }
 
@@ -246,14 +381,20 @@ class RdaSource final : public bci::EegSource {
   std::string where_;
   int fd_ = -1;
   bool closed_ = false;
+  Layout layout_;
   bci::SignalInfo info_;
-  std::vector<double> resolution_;  // microvolts per unit, by channel
   std::thread reader_;
   std::atomic<bool> stop_{false};
   mutable std::mutex mutex_;
-  std::vector<float> pending_;  // multiplexed microvolts not yet in a block
+  std::deque<bci::Block> ready_;    // short blocks cut where a gap began
+  std::vector<float> pending_;      // multiplexed microvolts not yet in a block
+  std::int64_t pending_first_ = 0;  // the sample number of pending_'s first point
+  std::vector<bci::Annotation> markers_;
   std::optional<std::uint32_t> last_block_;
-  std::int64_t next_sample_ = 0;
+  double last_data_host_ = 0.0;
+  bool resumed_ = false;  // the next data follows a stop or a reconnection
+  std::int64_t lost_blocks_ = 0, gap_samples_ = 0;
+  int restarts_ = 0;
   std::string fault_;
 };
 

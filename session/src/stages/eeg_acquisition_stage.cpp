@@ -163,6 +163,11 @@ void EegAcquisitionStage::step(Cycle& cycle) {
     out.fault = source.fault();
     out.source_line = source.describe();
     out.impedance = source.impedance();
+    // The amplifier's own markers (trigger box, photodiode) go into the recording as they are.
+    for (bci::Annotation& marker : source.takeAnnotations()) {
+      cycle.annotate(marker.sample, std::move(marker.text));
+      ++source_markers_;
+    }
   });
   if (const std::string fault = acquisition_->fault(); !fault.empty()) out.fault = fault;
   if (out.fault != fault_logged_) {
@@ -212,6 +217,7 @@ void EegAcquisitionStage::report(nlohmann::json& summary) const {
                                      {"uncertain_flashes", stalls_.uncertain_flashes}};
   summary["eeg"]["repeated_samples"] = acquisition_->repeatedSamples();
   summary["eeg"]["lost_samples"] = acquisition_->lostSamples();
+  summary["eeg"]["source_markers"] = source_markers_;
   summary["eeg"]["source"] = sourceLine();
   acquisition_->withSource([&](bci::EegSource& source) {
     if (const std::string impedance = source.impedance(); !impedance.empty())

@@ -69,6 +69,10 @@ class ScriptedSource final : public bci::EegSource {
     return fault_text;
   }
   std::string impedance() const override { return "Fz 4.2, Cz 12"; }
+  std::vector<bci::Annotation> takeAnnotations() override {
+    std::lock_guard lock(mutex);
+    return std::exchange(markers, {});
+  }
 
   std::atomic<std::int64_t> gap{0};
   std::atomic<bool> hold{false};
@@ -78,6 +82,7 @@ class ScriptedSource final : public bci::EegSource {
   std::set<int> attended;
   std::vector<std::pair<std::int64_t, std::set<int>>> feedbacks;
   std::vector<bool> patches;
+  std::vector<bci::Annotation> markers;  // the amplifier's own, as an RDA stream carries them
 
  private:
   std::shared_ptr<const bci::SampleClock> clock_;
@@ -167,6 +172,28 @@ TEST(EegAcquisitionStage, LostSamplesAreCountedLoggedAndTold) {
   EXPECT_EQ(bench.previous.eeg.lost_samples, 48);
   EXPECT_EQ(bench.logged("lost_samples").size(), 1u);
   EXPECT_TRUE(bench.toldOf("48 EEG samples lost"));
+}
+
+// A trigger box's markers, sent by the amplifier with its data, go into the record's annotations
+// (which the recording stage writes) and are counted in the summary.
+TEST(EegAcquisitionStage, TheAmplifiersOwnMarkersBecomeTheRecordsAnnotations) {
+  test::StageBench bench("eeg_markers");
+  Acquiring eeg(bench);
+  {
+    std::lock_guard lock(eeg.source->mutex);
+    eeg.source->markers = {{20, "Stimulus/S  1", 0}, {33, "Response/R  8", 0}};
+  }
+  bench.step(*eeg.stage);
+  ASSERT_EQ(bench.record.annotations.size(), 2u);
+  EXPECT_EQ(bench.record.annotations[0].sample, 20);
+  EXPECT_EQ(bench.record.annotations[0].text, "Stimulus/S  1");
+  EXPECT_EQ(bench.record.annotations[1].text, "Response/R  8");
+  bench.next();
+  bench.step(*eeg.stage);
+  EXPECT_TRUE(bench.record.annotations.empty());  // each once
+  nlohmann::json summary;
+  eeg.stage->report(summary);
+  EXPECT_EQ(summary["eeg"]["source_markers"], 2);
 }
 
 TEST(EegAcquisitionStage, ASourcesFaultIsNamedWhenItStartsAndWhenItEnds) {

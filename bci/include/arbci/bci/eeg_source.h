@@ -42,6 +42,9 @@ class EegSource {
   // Stimuli the source itself carries (a replayed file's events) up to the samples delivered so
   // far; each is returned once.
   virtual std::vector<StimulusEvent> takeRecordedStimuli() { return {}; }
+  // Events the amplifier itself marks (a trigger box's or a photodiode's markers, sent with its
+  // data) on the samples delivered so far, as annotations; each is returned once.
+  virtual std::vector<Annotation> takeAnnotations() { return {}; }
 };
 
 }  // namespace arbci::bci

@@ -31,4 +31,10 @@ struct PhotodiodeReport {
 PhotodiodeReport checkPhotodiode(const Recording& recording, const std::string& channel,
                                  double max_offset_s);
 
+// The same check where the diode feeds a trigger input and the amplifier records a marker
+// (`marker`, an annotation's whole text, "Stimulus/S  1") at each edge. Throws
+// std::invalid_argument naming the marker when the recording has none of it.
+PhotodiodeReport checkPhotodiodeMarkers(const Recording& recording, const std::string& marker,
+                                        double max_offset_s);
+
 }  // namespace arbci::bci

@@ -118,6 +118,10 @@ struct EegSettings {
   // The channel a photodiode on the HMD's patch feeds (simulated: a virtual channel of this name
   // is added); empty: none.
   std::string photodiode_channel;
+  // An amplifier that marks the photodiode through a trigger input (BrainVision's RDA sends it as
+  // a marker): the marker as recorded ("Stimulus/S  1"), whose onsets the timing check takes as
+  // the diode's edges; empty: none.
+  std::string photodiode_marker;
   double latency_ms;  // the amplifier's delivery latency, as timing-check measured it
   // Each source's own section (eeg.lsl, eeg.eegdev, eeg.rda, ...), resolved by its schema.
   std::map<std::string, nlohmann::json> sources;

@@ -60,10 +60,11 @@ class EegAcquisitionStage final : public Stage {
   std::unique_ptr<bci::Acquisition> acquisition_;
   bci::SignalInfo eeg_info_;
   std::shared_ptr<const bci::SignalInfo> all_info_;
-  int photodiode_ = -1;           // the photodiode's channel in the source's blocks
-  std::int64_t lost_logged_ = 0;  // lost samples already in the log
-  std::string fault_logged_;      // the source's fault last logged (empty: none)
-  std::int64_t next_sample_ = 0;  // after the last block taken
+  int photodiode_ = -1;              // the photodiode's channel in the source's blocks
+  std::int64_t lost_logged_ = 0;     // lost samples already in the log
+  std::int64_t source_markers_ = 0;  // the amplifier's own markers, recorded as annotations
+  std::string fault_logged_;         // the source's fault last logged (empty: none)
+  std::int64_t next_sample_ = 0;     // after the last block taken
   // The flashes presented lately (host time, onset sample): those a stall covered are named.
   std::deque<std::pair<double, std::int64_t>> recent_onsets_;
   struct StallTotals {
