@@ -33,12 +33,30 @@ std::string lower(std::string s) {
   return s;
 }
 
-// An annotation's kind from its first word ("Phase ...", "Selected ...", "Feedback ...").
+bool endsWith(const std::string& text, const std::string& end) {
+  return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+}
+
+// An annotation's condition from its words, as "kind/level" where a reader epochs by the level
+// (MNE selects "feedback" for every "feedback/..."): "Feedback 3 error" is feedback/error.
 std::string annotationType(const std::string& text) {
   const std::string first = lower(text.substr(0, text.find(' ')));
   if (first == "selected") return "selection";
-  if (first == "phase" || first == "feedback" || first == "tracking" || first == "session")
-    return first;
+  if (first == "feedback") {
+    for (const char* level : {"correct", "error"})
+      if (endsWith(text, std::string(" ") + level)) return std::string("feedback/") + level;
+    return "feedback/unknown";
+  }
+  if (first == "errp") {
+    if (text.rfind("ErrP rejected", 0) == 0) return "errp/rejected";
+    if (text.rfind("ErrP accepted", 0) == 0) return "errp/accepted";
+  }
+  if (first == "lost") return "data_loss";
+  if (first == "phase" || first == "tracking" || first == "session") return first;
+  // An amplifier's own marker ("Stimulus/S  1", from a trigger input).
+  if (const auto slash = text.find('/');
+      slash != std::string::npos && slash > 0 && text.find(' ') > slash)
+    return "amplifier_marker";
   return "annotation";
 }
 
@@ -102,8 +120,10 @@ std::string describeLogEvent(const nlohmann::json& e) {
 }
 
 std::string logType(const std::string& event) {
-  if (event == "robot_command" || event == "robot") return "robot";
-  if (event == "errp_decision" || event == "errp_correction") return "errp";
+  if (event == "robot_command") return "robot/command";
+  if (event == "robot") return "robot/reply";
+  if (event == "errp_decision") return "errp/decision";
+  if (event == "errp_correction") return "errp/correction";
   if (event == "placement") return "placement";
   return "";
 }
@@ -119,7 +139,8 @@ BidsEvents sessionEvents(const bci::Recording& recording, const std::filesystem:
     e.sample = s.sample;
     e.onset_s = static_cast<double>(s.sample) / rate;
     e.duration_s = static_cast<double>(s.duration_samples) / rate;
-    e.trial_type = "flash";
+    // The condition a reader epochs by (target against non-target), in trial_type itself.
+    e.trial_type = !s.known ? "flash/unlabelled" : s.target ? "flash/target" : "flash/nontarget";
     e.value = std::to_string(s.code);
     const auto named = codes.find(s.code);
     e.stimulus = named != codes.end() ? named->second : "n/a";
@@ -181,17 +202,35 @@ std::string eventsSidecar() {
   j["duration"] = {{"Description", "Seconds; a flash's measured duration, 0 for instants."},
                    {"Units", "s"}};
   j["trial_type"] = {
-      {"Description", "What happened."},
+      {"Description",
+       "What happened, as kind/condition: epoch by a condition (flash/target) or by a kind "
+       "(flash, every flash; MNE selects the kind's conditions by its name)."},
       {"Levels",
-       {{"flash", "a stimulus flash (P300 paradigm): an object, a grid row or a grid column"},
+       {{"flash/target",
+         "a stimulus flash (P300 paradigm) of the attended stimulus: an object, a grid row or a "
+         "grid column"},
+        {"flash/nontarget", "a stimulus flash of a stimulus not attended"},
+        {"flash/unlabelled",
+         "a stimulus flash where nobody knows which stimulus was attended (a free choice, or the "
+         "intended object out of view): left out of training"},
         {"phase", "the session entered a phase (calibration, objects flashing, ...)"},
         {"selection", "the classifier selected an object or a cell"},
-        {"feedback", "the selection was shown to the subject (correct or error)"},
+        {"feedback/correct", "the selection shown to the subject was the intended one"},
+        {"feedback/error", "the selection shown to the subject was not the intended one"},
+        {"feedback/unknown", "a selection shown to the subject, intention unknown"},
+        {"errp/accepted", "the error-potential classifier accepted the selection shown"},
+        {"errp/rejected", "the error-potential classifier rejected the selection shown"},
+        {"errp/decision", "the error-potential classifier's scores for a verdict (from the log)"},
+        {"errp/correction", "what followed a rejection: runner-up, repeat, skip or return"},
         {"tracking", "an object's marker was lost or regained by the cameras"},
         {"session", "the session ended, with the reason"},
-        {"robot", "a command sent to the robot, or the robot's reply"},
-        {"errp", "the error-potential classifier's verdict on a feedback, or a correction"},
+        {"robot/command", "a command sent to the robot"},
+        {"robot/reply", "the robot's reply or a link event"},
         {"placement", "where the robot put the object, against the cell's centre"},
+        {"data_loss", "EEG samples lost (zeros in the recording for the duration)"},
+        {"amplifier_marker", "a marker the amplifier recorded (a trigger input), type/description"},
+        {"padding",
+         "zeros after the signal's end that complete the BDF's last record (not signal)"},
         {"annotation", "another note of the recording"}}}};
   j["value"] = {{"Description",
                  "A flash's stimulus code (1-99 objects, 100 + code grid rows and "

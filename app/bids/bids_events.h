@@ -16,8 +16,7 @@ namespace arbci::app {
 struct BidsEvent {
   double onset_s = 0.0;     // from the recording's first sample
   double duration_s = 0.0;  // 0 when instantaneous
-  std::string
-      trial_type;  // flash, phase, selection, feedback, tracking, session, robot, errp, placement
+  std::string trial_type;   // kind/condition: flash/target, feedback/error, ... (eventsSidecar)
   std::string value;        // a flash's stimulus code; "n/a" otherwise
   std::int64_t sample = 0;  // the recording's sample at the onset
   std::string stimulus;     // a flash: "object 10", "row 2", ...; "n/a" otherwise

@@ -64,20 +64,34 @@ std::set<int> existingRuns(const fs::path& eeg_dir, const std::string& stem_pref
   return runs;
 }
 
-// A dataset's dataset_description.json, when it has none.
-void describeDataset(const fs::path& dir, const std::string& name, const std::string& type) {
-  if (fs::exists(dir / "dataset_description.json")) return;
+// A dataset's dataset_description.json, when it has none; `authors` (when given) set in it
+// either way.
+void describeDataset(const fs::path& dir, const std::string& name, const std::string& type,
+                     const std::vector<std::string>& authors = {}) {
+  const fs::path file = dir / "dataset_description.json";
+  if (fs::exists(file)) {
+    if (authors.empty()) return;
+    std::ifstream in(file);
+    nlohmann::ordered_json d = nlohmann::ordered_json::parse(in, nullptr, false);
+    if (d.is_discarded() || !d.is_object())
+      throw BidsError(file.string() + " is not a JSON object: cannot set its Authors");
+    d["Authors"] = authors;
+    writeText(file, d.dump(2) + "\n");
+    return;
+  }
   fs::create_directories(dir);
   nlohmann::ordered_json d;
   d["Name"] = name;
   d["BIDSVersion"] = kBidsVersion;
   d["DatasetType"] = type;
+  if (!authors.empty()) d["Authors"] = authors;
   d["GeneratedBy"] = {{{"Name", "ARBCI"}, {"Version", ARBCI_VERSION}}};
-  writeText(dir / "dataset_description.json", d.dump(2) + "\n");
+  writeText(file, d.dump(2) + "\n");
 }
 
-void ensureDatasetFiles(const fs::path& root, const std::string& subject) {
-  describeDataset(root, "ARBCI sessions", "raw");
+void ensureDatasetFiles(const fs::path& root, const std::string& subject,
+                        const std::vector<std::string>& authors) {
+  describeDataset(root, "ARBCI sessions", "raw", authors);
   if (!fs::exists(root / "README"))
     writeText(root / "README",
               "EEG of augmented-reality P300 brain-computer interface sessions recorded with "
@@ -109,7 +123,20 @@ std::string parameter(const bci::Recording& r, const std::string& key) {
   return found == r.parameters.end() ? "" : found->second;
 }
 
-std::string eegSidecar(const bci::Recording& r, const std::string& task, int misc) {
+// The BDF's length as every reader sees it: its records, the last one completed with zeros.
+double bdfSeconds(const fs::path& bdf) {
+  std::ifstream in(bdf, std::ios::binary);
+  char header[256] = {};
+  in.read(header, sizeof header);
+  try {
+    return std::stod(std::string(header + 236, 8)) * std::stod(std::string(header + 244, 8));
+  } catch (const std::exception&) {
+    throw BidsError(bdf.string() + ": its header gives no record count and duration");
+  }
+}
+
+std::string eegSidecar(const bci::Recording& r, const std::string& task, int misc,
+                       const BidsDescription& description, double file_seconds) {
   nlohmann::ordered_json j;
   j["TaskName"] = task;
   j["TaskDescription"] =
@@ -117,7 +144,11 @@ std::string eegSidecar(const bci::Recording& r, const std::string& task, int mis
       "head-mounted display; the subject attends the object to move and the cell to put it on.";
   j["Instructions"] = "Attend the cued (calibration) or chosen object and count its flashes.";
   j["SamplingFrequency"] = r.info.rate_hz;
-  j["EEGReference"] = "n/a";
+  auto stated = [&](const std::string& given, const std::string& key) {
+    return !given.empty() ? given : !parameter(r, key).empty() ? parameter(r, key) : "";
+  };
+  const std::string reference = stated(description.reference, "EegReference");
+  j["EEGReference"] = reference.empty() ? "n/a" : reference;
   const std::string line = parameter(r, "PowerLineHz");
   double line_hz = 0.0;
   try {
@@ -131,13 +162,17 @@ std::string eegSidecar(const bci::Recording& r, const std::string& task, int mis
   }
   j["SoftwareFilters"] = "n/a";  // the recording is unfiltered; the online filter is ARBCI's own
   const std::string source = parameter(r, "EegSource");
-  j["Manufacturer"] = source == "simulated" || source.empty()
+  const std::string manufacturer = stated(description.manufacturer, "EegManufacturer");
+  j["Manufacturer"] = !manufacturer.empty() ? manufacturer
+                      : source == "simulated" || source.empty()
                           ? "n/a (ARBCI's simulated subject)"
                           : "n/a (ARBCI EEG source: " + source + ")";
   j["SoftwareVersions"] = std::string("ARBCI ") + ARBCI_VERSION;
   j["EEGChannelCount"] = r.info.channelCount() - misc;
   j["MiscChannelCount"] = misc;
-  j["RecordingDuration"] = r.seconds();
+  // The data file's length (what a reader of the BDF gets); the zeros after the signal's end are
+  // a "padding" event.
+  j["RecordingDuration"] = file_seconds;
   j["RecordingType"] = "continuous";
   return j.dump(2) + "\n";
 }
@@ -187,7 +222,7 @@ std::string bidsTarget(const fs::path& root, const BidsEntities& entities) {
 }
 
 BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
-                        const BidsEntities& entities) {
+                        const BidsEntities& entities, const BidsDescription& description) {
   checkBidsEntities(entities);
   const fs::path bdf = session_dir / "recording.bdf";
   if (!fs::exists(bdf))
@@ -208,7 +243,7 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
     throw BidsError("run " + std::to_string(run) + " of " + prefix + " is already in " +
                     root.string() + "; runs are never overwritten (leave --run out for the next, " +
                     std::to_string(*runs.rbegin() + 1) + ")");
-  ensureDatasetFiles(root, entities.subject);
+  ensureDatasetFiles(root, entities.subject, description.authors);
   fs::create_directories(eeg_dir);
   const std::string stem = prefix + "_run-" + std::to_string(run);
   BidsExport out;
@@ -216,7 +251,8 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
   out.eeg_file = eeg_dir / (stem + "_eeg.bdf");
   fs::copy_file(bdf, out.eeg_file, fs::copy_options::none);
 
-  // Channels: EEG in microvolts, the photodiode a MISC channel.
+  // Channels: EEG in microvolts, the photodiode a MISC channel (its level in the units the BDF
+  // gives every channel).
   const std::string photodiode = parameter(recording, "PhotodiodeChannel");
   std::ostringstream channels;
   channels << "name\ttype\tunits\tstatus\tstatus_description\n";
@@ -225,14 +261,28 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
     const bool is_photodiode = name == photodiode || name == "Photodiode";
     misc += is_photodiode ? 1 : 0;
     channels << cell(name) << "\t" << (is_photodiode ? "MISC" : "EEG") << "\t"
-             << (is_photodiode ? "n/a" : "uV") << "\tgood\t"
+             << "uV"
+             << "\tgood\t"
              << (is_photodiode ? "photodiode on the display: the flashes' presented onsets" : "n/a")
              << "\n";
   }
   writeText(eeg_dir / (stem + "_channels.tsv"), channels.str());
-  writeText(eeg_dir / (stem + "_eeg.json"), eegSidecar(recording, entities.task, misc));
+  const double file_seconds = bdfSeconds(out.eeg_file);
+  writeText(eeg_dir / (stem + "_eeg.json"),
+            eegSidecar(recording, entities.task, misc, description, file_seconds));
 
-  const BidsEvents events = sessionEvents(recording, session_dir / "log.jsonl");
+  BidsEvents events = sessionEvents(recording, session_dir / "log.jsonl");
+  if (const double padded = file_seconds - recording.seconds();
+      padded > 0.5 / recording.info.rate_hz) {
+    BidsEvent e;
+    e.sample = recording.samples;
+    e.onset_s = recording.seconds();
+    e.duration_s = padded;
+    e.trial_type = "padding";
+    e.value = e.stimulus = e.target = "n/a";
+    e.description = "zeros completing the BDF's last record: the signal ends here";
+    events.rows.push_back(e);
+  }
   std::ostringstream table;
   table << "onset\tduration\ttrial_type\tvalue\tsample\tstimulus\ttarget\tdescription\n";
   for (const BidsEvent& e : events.rows) {

@@ -21,6 +21,13 @@ struct BidsEntities {
   std::string run;             // optional: the next free run when empty; digits only
 };
 
+// What the sidecars say that the recording may not (one made before the session stated it).
+struct BidsDescription {
+  std::string reference;     // EEGReference; empty: the recording's (eeg.reference), else "n/a"
+  std::string manufacturer;  // Manufacturer; empty: the recording's (eeg.manufacturer)
+  std::vector<std::string> authors;  // the dataset's Authors; empty: left as they are
+};
+
 struct BidsExport {
   std::filesystem::path eeg_file;  // the BDF written
   std::string run;                 // the run number used
@@ -44,6 +51,6 @@ std::string bidsTarget(const std::filesystem::path& root, const BidsEntities& en
 // Throws BidsError with a message a person can act on (not a session folder, a label BIDS does
 // not allow, a run that exists).
 BidsExport exportToBids(const std::filesystem::path& session_dir, const std::filesystem::path& root,
-                        const BidsEntities& entities);
+                        const BidsEntities& entities, const BidsDescription& description = {});
 
 }  // namespace arbci::app

@@ -38,6 +38,7 @@ void addBidsCommand(CLI::App& root, int& exit_code) {
   struct Options {
     std::string session_dir, root;
     BidsEntities entities;
+    BidsDescription description;
   };
   auto o = std::make_shared<Options>();
   CLI::App* out = bids->add_subcommand(
@@ -53,9 +54,18 @@ void addBidsCommand(CLI::App& root, int& exit_code) {
   std::string unused;
   addBidsOptions(out, o->entities, unused, false);
   out->get_option("--subject")->required();
+  out->add_option("--reference", o->description.reference,
+                  "the EEG reference for _eeg.json (default: the session's eeg.reference, else "
+                  "n/a)");
+  out->add_option("--manufacturer", o->description.manufacturer,
+                  "the amplifier's maker for _eeg.json (default: the session's "
+                  "eeg.manufacturer)");
+  out->add_option("--author", o->description.authors,
+                  "an author of the dataset, for dataset_description.json (repeat for each, in "
+                  "order; replaces the Authors there)");
   out->callback([o, &exit_code] {
     try {
-      reportBidsExport(exportToBids(o->session_dir, o->root, o->entities));
+      reportBidsExport(exportToBids(o->session_dir, o->root, o->entities, o->description));
     } catch (const BidsError& error) {
       throw CliError(error.what());
     }

@@ -279,7 +279,13 @@ const Schema<EegSettings>& eegSchema() {
               "a photodiode on a trigger input (an RDA marker): the marker as recorded, "
               "\"Stimulus/S  1\"; the timing check takes its onsets as the diode's edges")
         .number("latency_ms", &E::latency_ms, 0.0, 0.0, 1000.0,
-                "the amplifier's delivery latency, as arbci timing-check measures it", "ms");
+                "the amplifier's delivery latency, as arbci timing-check measures it", "ms")
+        .text("reference", &E::reference, "",
+              "the electrodes' reference as the amplifier records it (\"linked mastoids\", "
+              "\"FCz\"), for the recording and a BIDS export; \"\": not stated")
+        .text("manufacturer", &E::manufacturer, "",
+              "the amplifier's maker (\"Brain Products\"), for the recording and a BIDS "
+              "export; \"\": not stated");
     // Each source's own section.
     for (const auto& source : eegSources().entries()) {
       if (!source.settings) continue;

@@ -80,6 +80,8 @@ std::map<std::string, std::string> recordingParameters(const SessionConfig& c) {
       // For the recording's description (a BIDS export's _eeg.json): where the EEG came from
       // and the power line the online filter notched.
       {"EegSource", c.eeg.source},
+      {"EegReference", c.eeg.reference},
+      {"EegManufacturer", c.eeg.manufacturer},
       {"PowerLineHz", std::to_string(c.classifier.pipeline.filter.notch_hz)},
   };
 }

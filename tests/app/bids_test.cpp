@@ -71,9 +71,11 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
   const std::string events = read(eeg / (stem + "_events.tsv"));
   EXPECT_EQ(events.substr(0, events.find('\n')),
             "onset\tduration\ttrial_type\tvalue\tsample\tstimulus\ttarget\tdescription");
-  EXPECT_NE(events.find("\tflash\t"), std::string::npos);
+  EXPECT_NE(events.find("\tflash/target\t"), std::string::npos);
+  EXPECT_NE(events.find("\tflash/nontarget\t"), std::string::npos);
   EXPECT_NE(events.find("\tT\tflash of object"), std::string::npos);
-  EXPECT_NE(events.find("\trobot\t"), std::string::npos);
+  EXPECT_NE(events.find("\trobot/command\t"), std::string::npos);
+  EXPECT_NE(events.find("\tfeedback/"), std::string::npos);
   EXPECT_NE(events.find("sent GRASP"), std::string::npos);
   EXPECT_NE(events.find("\tselection\t"), std::string::npos);
 

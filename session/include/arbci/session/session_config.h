@@ -123,6 +123,8 @@ struct EegSettings {
   // the diode's edges; empty: none.
   std::string photodiode_marker;
   double latency_ms;  // the amplifier's delivery latency, as timing-check measured it
+  // What the recording says of the amplifier (a BIDS export's EEGReference and Manufacturer).
+  std::string reference, manufacturer;
   // Each source's own section (eeg.lsl, eeg.eegdev, eeg.rda, ...), resolved by its schema.
   std::map<std::string, nlohmann::json> sources;
   // A source that runs on its own clock in real time (an amplifier): the session cannot step it.

@@ -1,0 +1,136 @@
+// The BIDS export on a session folder made here (a recording with known events, a log with a
+// robot command), in process: trial_type carries each event's condition (flash/target,
+// flash/nontarget, feedback/error, ...), the photodiode's unit is the BDF's, RecordingDuration
+// is the BDF's length with the zeros after the signal an event of their own, and the reference,
+// manufacturer and authors are the session's or the command's. (The validator and MNE read a
+// whole session's export in tests/app/bids_test.cpp.)
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "arbci/bci/recording_writer.h"
+#include "bids/bids_export.h"
+#include "support/test_files.h"
+
+namespace arbci::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// 10.1 s at 256 Hz (2,585 samples: the last 0.25 s record is padded), Cz and a photodiode.
+fs::path sessionFolder(const std::string& name, const std::string& reference) {
+  const fs::path dir = test::freshTempPath("bids_export", name);
+  fs::create_directories(dir);
+  bci::SignalInfo info;
+  info.rate_hz = 256.0;
+  info.channels = {"Cz", "Photodiode"};
+  {
+    bci::RecordingWriter writer(dir / "recording.bdf", info,
+                                {{"PhotodiodeChannel", "Photodiode"},
+                                 {"EegSource", "rda"},
+                                 {"EegReference", reference},
+                                 {"StimulusCodeMap", "1=object 10;2=object 20"}});
+    bci::Block block(0, 2, 2585);
+    writer.write(block);
+    writer.addStimulus({256, 1, true, 17, true});
+    writer.addStimulus({307, 2, false, 17, true});
+    writer.addStimulus({358, 2, false, 17, false});
+    writer.addAnnotation({10, "Phase calibration", 0});
+    writer.addAnnotation({600, "Feedback 2 error", 0});
+    writer.addAnnotation({700, "ErrP rejected the selection (posterior of error 0.91)", 0});
+    writer.addAnnotation({800, "Stimulus/S  1", 0});
+    writer.addAnnotation({900, "Lost 24 samples: gap in the source's samples", 24});
+  }
+  std::ofstream(dir / "log.jsonl") << R"({"t": 0.04, "event": "phase", "phase": "calibration"})"
+                                   << "\n"
+                                   << R"({"t": 3.0, "event": "robot_command", "command": "GRASP",)"
+                                   << R"( "object": 10, "sequence": 1})"
+                                   << "\n";
+  return dir;
+}
+
+std::map<std::string, int> trialTypes(const std::string& events) {
+  std::map<std::string, int> out;
+  std::istringstream in(events);
+  std::string line;
+  std::getline(in, line);  // the header
+  while (std::getline(in, line)) {
+    std::istringstream cells(line);
+    std::string onset, duration, type;
+    std::getline(cells, onset, '\t');
+    std::getline(cells, duration, '\t');
+    std::getline(cells, type, '\t');
+    ++out[type];
+  }
+  return out;
+}
+
+TEST(BidsExport, TrialTypeCarriesEachEventsCondition) {
+  const fs::path dir = sessionFolder("conditions", "FCz");
+  const fs::path root = dir / "bids";
+  const BidsExport done = exportToBids(dir, root, {"01", "", "arbci", ""});
+  const std::string events =
+      read(done.eeg_file.parent_path() / "sub-01_task-arbci_run-1_events.tsv");
+  const std::map<std::string, int> expected{
+      {"flash/target", 1},   {"flash/nontarget", 1}, {"flash/unlabelled", 1}, {"phase", 1},
+      {"feedback/error", 1}, {"errp/rejected", 1},   {"amplifier_marker", 1}, {"data_loss", 1},
+      {"robot/command", 1},  {"padding", 1}};
+  EXPECT_EQ(trialTypes(events), expected) << events;
+  // Each level is described in the sidecar.
+  const nlohmann::json sidecar = nlohmann::json::parse(
+      read(done.eeg_file.parent_path() / "sub-01_task-arbci_run-1_events.json"));
+  for (const auto& [level, count] : expected)
+    EXPECT_TRUE(sidecar["trial_type"]["Levels"].contains(level)) << level;
+}
+
+TEST(BidsExport, TheDurationIsTheFilesAndThePaddingIsAnEvent) {
+  const fs::path dir = sessionFolder("duration", "");
+  const BidsExport done = exportToBids(dir, dir / "bids", {"01", "", "arbci", ""});
+  const fs::path eeg = done.eeg_file.parent_path();
+  const nlohmann::json sidecar =
+      nlohmann::json::parse(read(eeg / "sub-01_task-arbci_run-1_eeg.json"));
+  EXPECT_DOUBLE_EQ(sidecar["RecordingDuration"].get<double>(), 10.25);  // 41 records of 0.25 s
+  EXPECT_EQ(sidecar["EEGReference"], "n/a");
+  EXPECT_EQ(sidecar["Manufacturer"], "n/a (ARBCI EEG source: rda)");
+  const std::string events = read(eeg / "sub-01_task-arbci_run-1_events.tsv");
+  EXPECT_NE(events.find("\t0.15234375\tpadding\tn/a\t2585\t"), std::string::npos) << events;
+  const std::string channels = read(eeg / "sub-01_task-arbci_run-1_channels.tsv");
+  EXPECT_NE(channels.find("Photodiode\tMISC\tuV\t"), std::string::npos) << channels;
+}
+
+TEST(BidsExport, ReferenceManufacturerAndAuthorsFromTheSessionOrTheCommand) {
+  const fs::path dir = sessionFolder("described", "linked mastoids");
+  const fs::path root = dir / "bids";
+  BidsDescription described;
+  described.manufacturer = "Brain Products";
+  described.authors = {"Ada Lovelace", "Alan Turing"};
+  const BidsExport done = exportToBids(dir, root, {"01", "", "arbci", ""}, described);
+  const nlohmann::json sidecar =
+      nlohmann::json::parse(read(done.eeg_file.parent_path() / "sub-01_task-arbci_run-1_eeg.json"));
+  EXPECT_EQ(sidecar["EEGReference"], "linked mastoids");  // the session's
+  EXPECT_EQ(sidecar["Manufacturer"], "Brain Products");   // the command's
+  nlohmann::json dataset = nlohmann::json::parse(read(root / "dataset_description.json"));
+  EXPECT_EQ(dataset["Authors"], nlohmann::json::array({"Ada Lovelace", "Alan Turing"}));
+  // A later export with other authors replaces them; one without leaves them.
+  described.authors = {"Grace Hopper"};
+  exportToBids(dir, root, {"01", "", "arbci", ""}, described);
+  exportToBids(dir, root, {"01", "", "arbci", ""});
+  dataset = nlohmann::json::parse(read(root / "dataset_description.json"));
+  EXPECT_EQ(dataset["Authors"], nlohmann::json::array({"Grace Hopper"}));
+  EXPECT_EQ(dataset["Name"], "ARBCI sessions");
+}
+
+}  // namespace
+}  // namespace arbci::app
