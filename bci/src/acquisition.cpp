@@ -123,6 +123,7 @@ ClockModel::Observation Acquisition::deliver(const Block& delivered, double host
     const std::int64_t missing = block->first_sample - next_sample_;
     losses_.push_back({next_sample_, missing, "gap in the source's samples"});
     lost_ += missing;
+    model_.startAgain();
     for (std::int64_t from = next_sample_; from < block->first_sample;) {
       const int n = static_cast<int>(std::min<std::int64_t>(block->first_sample - from, 4096));
       ring_.write(Block(from, block->channels, n));

@@ -83,6 +83,13 @@ ClockModel::Observation ClockModel::observe(std::int64_t end_sample, double host
   return out;
 }
 
+void ClockModel::startAgain() {
+  points_.clear();
+  stalled_.clear();
+  have_arrival_ = false;
+  drift_se_ppm_ = 0.0;
+}
+
 void ClockModel::restart() {
   points_ = std::move(stalled_);
   stalled_.clear();

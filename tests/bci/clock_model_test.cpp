@@ -192,6 +192,36 @@ class GappySource final : public EegSource {
   int blocks_ = 0;
 };
 
+// An amplifier 62 ppm fast, 60 s, then a gap whose length was counted one sample long (a
+// reconnected LSL stream counts it from the stamps either side): the samples after it sit one
+// sample off the old line. Fitted across the step, the drift is far off and looks sure of itself;
+// started again at the gap, it is unreliable at first, then right.
+TEST(ClockModel, AGapStartsTheFitAgainSoAStepInTheCountCannotBendTheDrift) {
+  auto run = [](bool start_again) {
+    ClockModel model(256.0, 120.0);
+    const double rate = 256.0 * (1.0 + 62e-6);
+    std::int64_t end = 0;
+    double off = 0.0;  // samples the count is ahead of the truth
+    auto deliver = [&] {
+      end += 16;
+      model.observe(end, (static_cast<double>(end) - off) / rate);
+    };
+    for (int k = 0; k < 960; ++k) deliver();  // 60 s
+    end += 256 * 5;  // 5 s away; the count says one sample more than was missed
+    off = 1.0;
+    if (start_again) model.startAgain();
+    deliver();
+    const bool reliable_at_once = model.driftReliable();
+    for (int k = 0; k < 480; ++k) deliver();  // 30 s more
+    return std::make_pair(reliable_at_once, model.driftPpm());
+  };
+  const auto [bent_reliable, bent] = run(false);
+  EXPECT_GT(std::abs(bent - 62.0), 10.0) << bent;  // what a step does to a fit across it
+  const auto [reliable_at_once, drift] = run(true);
+  EXPECT_FALSE(reliable_at_once);
+  EXPECT_NEAR(drift, 62.0, 1.0);
+}
+
 TEST(Acquisition, AGapIsFilledWithZerosCountedAndNamed) {
   auto clock = std::make_shared<ManualClock>();
   Acquisition acquisition(std::make_unique<GappySource>(clock), clock, Acquisition::Mode::Stepped);

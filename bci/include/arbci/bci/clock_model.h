@@ -50,6 +50,11 @@ class ClockModel {
   // been a stall, the delivery path has changed for good (a reconnect, a new buffer): the model
   // starts again from the arrivals since.
   Observation observe(std::int64_t end_sample, double host_s);
+  // The samples stepped over a gap (lost, their count taken from the other side's stamps or from
+  // the time away): a count off by a sample or two is a step in the line that would bend the
+  // drift for the whole window, so the fit starts again from the next arrival (the drift is
+  // unreliable until the new span is long enough). The mapping holds meanwhile.
+  void startAgain();
 
   // True once two deliveries have been observed (before that, the nominal rate).
   bool fitted() const { return points_.size() >= 2; }
