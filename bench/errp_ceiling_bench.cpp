@@ -31,18 +31,25 @@ namespace {
 
 constexpr double kFeedbackPeriodS = 3.5;  // cue 1.5 s + result 1 s + pause 1 s
 
-// A calibration block of `feedbacks` feedbacks (a quarter wrong) by the simulated subject of
-// `eeg` with `seed`, as a recording whose stimuli are the feedbacks coded by class.
-bci::Recording calibrationBlock(session::EegSettings eeg, std::uint64_t seed, int feedbacks) {
+// `blocks` calibration blocks of `feedbacks` feedbacks each (a quarter of each block wrong, in
+// random order within it, as a session's calibration plans them) by the simulated subject of
+// `eeg` with `seed`, as one recording whose stimuli are the feedbacks coded by class.
+bci::Recording calibrationBlocks(session::EegSettings eeg, std::uint64_t seed, int feedbacks,
+                                 int blocks) {
   eeg.seed = seed;
   eeg.photodiode_channel.clear();  // the ErrP pipeline's channels only
   const bci::SimulatedSubjectConfig config = session::simulatedSubjectOf(eeg);
   bci::SimulatedSubject subject(config, std::make_shared<bci::UnboundedClock>());
 
   std::mt19937 random(static_cast<std::uint32_t>(seed * 7919 + 17));
-  std::vector<bool> wrong(static_cast<size_t>(feedbacks), false);
-  std::fill_n(wrong.begin(), feedbacks / 4, true);
-  std::shuffle(wrong.begin(), wrong.end(), random);
+  std::vector<bool> wrong;
+  for (int b = 0; b < blocks; ++b) {
+    std::vector<bool> block(static_cast<size_t>(feedbacks), false);
+    std::fill_n(block.begin(), feedbacks / 4, true);
+    std::shuffle(block.begin(), block.end(), random);
+    wrong.insert(wrong.end(), block.begin(), block.end());
+  }
+  feedbacks *= blocks;
 
   const int channels = static_cast<int>(config.montage.size());
   const auto period = static_cast<std::int64_t>(kFeedbackPeriodS * config.rate_hz);
@@ -172,8 +179,8 @@ int main(int argc, char** argv) {
       pipeline.channels.size(), config.errp.xdawn_filters, "seed", "feedbacks", "method", "AUC");
   for (const int seed : seeds) {
     for (const int size : sizes) {
-      const bci::Recording recording = calibrationBlock(
-          config.eeg, static_cast<std::uint64_t>(seed), size * std::max(1, blocks));
+      const bci::Recording recording = calibrationBlocks(
+          config.eeg, static_cast<std::uint64_t>(seed), size, std::max(1, blocks));
       const bci::P300Dataset whole = bci::buildDataset({recording}, pipeline);
       for (const std::string& method : methods) {
         bci::TrainingSettings training = config.errp.training();
@@ -181,23 +188,38 @@ int main(int argc, char** argv) {
         if (shift_ms >= 0.0) training.shift_ms = shift_ms;
         if (xdawn_filters > 0) training.xdawn.filters = xdawn_filters;
         if (blocks == 0) {
-          const bci::CrossValidation cv = bci::crossValidate(whole, training);
-          std::printf("%6d %9d %-9s %.3f [%.3f, %.3f]\n", seed, size, method.c_str(), cv.report.auc,
-                      cv.report.auc_interval.low, cv.report.auc_interval.high);
-        } else {
-          std::vector<double> aucs;
-          for (int b = 0; b < blocks; ++b) {
-            const bci::CrossValidation cv =
-                bci::crossValidate(epochRange(whole, b * size, (b + 1) * size), training);
-            aucs.push_back(cv.report.auc);
+          try {
+            const bci::CrossValidation cv = bci::crossValidate(whole, training);
+            std::printf("%6d %9d %-9s %.3f [%.3f, %.3f]\n", seed, size, method.c_str(),
+                        cv.report.auc, cv.report.auc_interval.low, cv.report.auc_interval.high);
+          } catch (const std::invalid_argument& error) {
+            std::printf("%6d %9d %-9s untrainable: %s\n", seed, size, method.c_str(), error.what());
           }
+        } else {
+          // A block a fold cannot train on is reported and left out of the mean, never an abort.
+          std::vector<double> aucs;
+          std::string untrainable;
+          for (int b = 0; b < blocks; ++b) {
+            try {
+              const bci::CrossValidation cv =
+                  bci::crossValidate(epochRange(whole, b * size, (b + 1) * size), training);
+              aucs.push_back(cv.report.auc);
+            } catch (const std::invalid_argument& error) {
+              untrainable += " block " + std::to_string(b + 1) + ": " + error.what() + ";";
+            }
+          }
+          const int n = static_cast<int>(aucs.size());
           double mean = 0.0, spread = 0.0;
-          for (const double a : aucs) mean += a / blocks;
-          for (const double a : aucs) spread += (a - mean) * (a - mean) / (blocks - 1);
-          std::printf("%6d %9d %-9s mean %.3f SD %.3f range %.3f-%.3f over %d blocks\n", seed, size,
-                      method.c_str(), mean, std::sqrt(spread),
-                      *std::min_element(aucs.begin(), aucs.end()),
-                      *std::max_element(aucs.begin(), aucs.end()), blocks);
+          for (const double a : aucs) mean += a / std::max(1, n);
+          for (const double a : aucs) spread += (a - mean) * (a - mean) / std::max(1, n - 1);
+          if (n > 0)
+            std::printf("%6d %9d %-9s mean %.3f SD %.3f range %.3f-%.3f over %d of %d blocks\n",
+                        seed, size, method.c_str(), mean, std::sqrt(spread),
+                        *std::min_element(aucs.begin(), aucs.end()),
+                        *std::max_element(aucs.begin(), aucs.end()), n, blocks);
+          if (!untrainable.empty())
+            std::printf("%6d %9d %-9s untrainable:%s\n", seed, size, method.c_str(),
+                        untrainable.c_str());
         }
         std::fflush(stdout);
       }

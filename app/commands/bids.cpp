@@ -3,10 +3,12 @@
 // same at the end of a run.
 #include <iostream>
 
+#include "arbci/session/settings_schema.h"
 #include "bids/bids_export.h"
 #include "commands/bids_options.h"
 #include "commands/commands.h"
 #include "support/cli_error.h"
+#include "support/schema_option.h"
 
 namespace arbci::app {
 
@@ -54,12 +56,11 @@ void addBidsCommand(CLI::App& root, int& exit_code) {
   std::string unused;
   addBidsOptions(out, o->entities, unused, false);
   out->get_option("--subject")->required();
-  out->add_option("--reference", o->description.reference,
-                  "the EEG reference for _eeg.json (default: the session's eeg.reference, else "
-                  "n/a)");
-  out->add_option("--manufacturer", o->description.manufacturer,
-                  "the amplifier's maker for _eeg.json (default: the session's "
-                  "eeg.manufacturer)");
+  schemaOption(*out, "--reference", o->description.reference, session::sessionKey("eeg.reference"),
+               "for _eeg.json's EEGReference; not given: what the session recorded, else n/a");
+  schemaOption(*out, "--manufacturer", o->description.manufacturer,
+               session::sessionKey("eeg.manufacturer"),
+               "for _eeg.json's Manufacturer; not given: what the session recorded");
   out->add_option("--author", o->description.authors,
                   "an author of the dataset, for dataset_description.json (repeat for each, in "
                   "order; replaces the Authors there)");

@@ -69,6 +69,39 @@ nlohmann::json checkChannels(std::vector<bci::Recording>& recordings, bool exclu
   return {{"flat", flat}, {"drifting", drifting}, {"excluded", exclude && !bad.empty()}};
 }
 
+// The channels checkChannels left out, with why, for the figures and erp.json.
+void noteExcluded(bci::ErpCurves& erp, const nlohmann::json& quality) {
+  if (!quality.value("excluded", false)) return;
+  for (const char* why : {"flat", "drifting"})
+    for (const auto& name : quality[why]) erp.excluded.emplace_back(name.get<std::string>(), why);
+}
+
+// --scalp-window-ms and --scalp-ms: where the scalp map is drawn (bci::ScalpTime's defaults).
+struct ScalpOptions {
+  std::vector<double> window_ms{bci::ScalpTime{}.from_s * 1000.0, bci::ScalpTime{}.to_s * 1000.0};
+  std::optional<double> at_ms;
+  bci::ScalpTime time() const {
+    bci::ScalpTime t;
+    t.from_s = window_ms[0] / 1000.0;
+    t.to_s = window_ms[1] / 1000.0;
+    if (at_ms) t.at_s = *at_ms / 1000.0;
+    return t;
+  }
+};
+
+void addScalpOptions(CLI::App& command, ScalpOptions& o) {
+  command
+      .add_option("--scalp-window-ms", o.window_ms,
+                  "the scalp map's search window: it is drawn where the target - non-target "
+                  "difference peaks inside it (FROM,TO after the stimulus)")
+      ->expected(2)
+      ->delimiter(',')
+      ->capture_default_str()
+      ->check(CLI::Range(-2000.0, 5000.0));
+  command.add_option("--scalp-ms", o.at_ms,
+                     "draw the scalp map at this time after the stimulus instead (ms)");
+}
+
 void printPlots(const std::vector<std::filesystem::path>& written) {
   bool scalp = false;
   for (const auto& file : written) {
@@ -93,6 +126,7 @@ struct TrainOptions {
   std::vector<double> window_ms;  // pipeline.window_ms
   bci::DatasetOptions dataset;    // --reject-uv, --causal
   bool exclude_bad_channels = false;
+  ScalpOptions scalp;
   bci::TrainingSettings training;
   bci::PipelineSettings pipeline;
   // ErrP: the recordings' feedback events instead of their flashes.
@@ -239,6 +273,7 @@ void train(TrainOptions& o, const CLI::App& command) {
     }
     quality = checkChannels(recordings, o.exclude_bad_channels);
     data = bci::buildDataset(recordings, o.pipeline, progress, o.dataset);
+    noteExcluded(data.erp, quality);
     result = bci::trainModel(data, o.pipeline, o.training, progress);
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
@@ -317,9 +352,9 @@ void train(TrainOptions& o, const CLI::App& command) {
                 {"zero_phase", o.pipeline.zero_phase}});
   writeReportFiles(o.report, o.scores, cv.report, facts, data, cv.scores, cv.fold);
   if (!o.plots.empty()) {
-    const auto written = writeP300Plots(o.plots, data, result.cross_validation.report,
-                                        "cross-validated " + o.training.method,
-                                        o.errp ? ClassNames{"error", "correct"} : ClassNames{});
+    const auto written = writeP300Plots(
+        o.plots, data, result.cross_validation.report, "cross-validated " + o.training.method,
+        o.errp ? ClassNames{"error", "correct"} : ClassNames{}, o.scalp.time());
     printPlots(written);
   }
   std::cout << "model: " << o.out << "\n";
@@ -333,6 +368,7 @@ struct EvaluateOptions {
   int sequences = 0;
   bci::StoppingRule dynamic = bci::kOfflineStopping;
   std::string align = "per-file";
+  ScalpOptions scalp;
 };
 
 void evaluate(EvaluateOptions& o) {
@@ -410,7 +446,8 @@ void evaluate(EvaluateOptions& o) {
                   {"zero_phase", model.pipeline.zero_phase}});
     writeReportFiles(o.report, o.scores, report, facts, data, scores, {});
     if (!o.plots.empty()) {
-      printPlots(writeP300Plots(o.plots, data, report, "evaluated " + model.method));
+      printPlots(
+          writeP300Plots(o.plots, data, report, "evaluated " + model.method, {}, o.scalp.time()));
     }
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
@@ -527,6 +564,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
                         "also write the model as a BCI2000 parameter fragment (.prm)");
   train_cmd->add_option("--plots", t->plots,
                         "folder for PNG plots (ERPs; accuracy and bit rate by sequences)");
+  addScalpOptions(*train_cmd, t->scalp);
   train_cmd->callback([t, train_cmd, &exit_code] {
     if (t->errp) applyErrpDefaults(*t, *train_cmd);
     train(*t, *train_cmd);
@@ -546,6 +584,7 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->check(CLI::Range(0, 1000));
   addOfflineStopping(*eval_cmd, e->dynamic, true);
   eval_cmd->add_option("--plots", e->plots, "folder for PNG plots");
+  addScalpOptions(*eval_cmd, e->scalp);
   eval_cmd
       ->add_option("--align-scores", e->align,
                    "per-file: shift each file's scores so their median is the training scores' "

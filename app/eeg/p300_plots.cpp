@@ -130,6 +130,23 @@ void colourBar(cv::Mat& image, const cv::Rect& area, double limit, const std::st
   text(image, unit, {area.x - 4, area.y - 8}, 0.35);
 }
 
+// What the averages went through, on every figure: the filter, the reference and the channels
+// left out.
+std::string methodText(const bci::ErpCurves& erp) {
+  std::string out = "filter: " + erp.filterText() + "; reference: " + erp.referenceText();
+  for (size_t i = 0; i < erp.excluded.size(); ++i)
+    out += (i == 0 ? "; left out: " : ", ") + erp.excluded[i].first + " (" +
+           erp.excluded[i].second + ")";
+  return out;
+}
+
+// "96 target, 283 non-target epochs from 8 selections".
+std::string epochsText(const bci::ErpCurves& erp, const ClassNames& names) {
+  return std::to_string(erp.targets) + " " + names.target + ", " + std::to_string(erp.others) +
+         " " + names.other + " epochs" +
+         (erp.selections > 0 ? " from " + std::to_string(erp.selections) + " selections" : "");
+}
+
 // Signed r^2 per channel (rows) and time (columns).
 std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const bci::ErpCurves& erp,
                                     const ClassNames& names) {
@@ -139,10 +156,9 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const b
   cv::Mat image(top + channels * row_h + 70, left + width + 120, CV_8UC3, kWhite);
   text(image,
        "signed r^2 (" + names.target + " vs " + names.other +
-           ") per channel and time: " + std::to_string(erp.targets) + " " + names.target + ", " +
-           std::to_string(erp.others) + " " + names.other + " epochs",
+           ") per channel and time: " + epochsText(erp, names),
        {left, 24}, 0.5);
-  text(image, "filter: " + erp.filterText(), {left, 44}, 0.4);
+  text(image, methodText(erp), {left, 44}, 0.4);
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
   const int label_every = (14 + row_h - 1) / row_h;
   const double t0 = erp.timeS(0) * 1000.0, t1 = erp.timeS(samples - 1) * 1000.0;
@@ -172,12 +188,13 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const b
 
 // The difference wave at its peak on a head map, where the channels' 10-20 positions are known.
 std::filesystem::path writeScalpMap(const std::filesystem::path& folder, const bci::ErpCurves& erp,
-                                    const ClassNames& names) {
-  const std::optional<bci::ScalpMap> map = bci::scalpMapAtPeak(erp);
+                                    const ClassNames& names, const bci::ScalpTime& when) {
+  const std::optional<bci::ScalpMap> map = bci::scalpMapAt(erp, when);
   if (!map) return {};
   const int size = 360, margin = 50;
-  cv::Mat image(size + 2 * margin + 40, size + 2 * margin + 90, CV_8UC3, kWhite);
-  const cv::Point centre(margin + size / 2, margin + 30 + size / 2);
+  const int header = 50;  // four lines of text above the head
+  cv::Mat image(size + 2 * margin + 40 + header, size + 2 * margin + 90, CV_8UC3, kWhite);
+  const cv::Point centre(margin + size / 2, margin + 30 + header + size / 2);
   const double radius = size / 2.0, head = 0.55;  // the map's edge, in position units
   for (int y = -size / 2; y <= size / 2; ++y) {
     for (int x = -size / 2; x <= size / 2; ++x) {
@@ -199,13 +216,17 @@ std::filesystem::path writeScalpMap(const std::filesystem::path& folder, const b
     cv::circle(image, p, 3, kBlack, cv::FILLED, cv::LINE_AA);
     text(image, e.name, p + cv::Point(5, -4), 0.35);
   }
+  text(image, names.target + " - " + names.other + " at " + format(map->time_s * 1000.0, 0) + " ms",
+       {10, 22}, 0.5);
   text(image,
-       names.target + " - " + names.other + " at " + format(map->time_s * 1000.0, 0) +
-           " ms (the difference's peak over channels)",
-       {10, 24}, 0.45);
-  text(image, "filter: " + erp.filterText(), {10, 44}, 0.4);
-  colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40, 16, size - 40), map->limit_uv,
-            "uV", 1);
+       when.at_s ? std::string("(as given)")
+                 : "(the difference's peak over channels in " + format(when.from_s * 1000.0, 0) +
+                       "-" + format(when.to_s * 1000.0, 0) + " ms)",
+       {10, 42}, 0.4);
+  text(image, "filter: " + erp.filterText(), {10, 62}, 0.35);
+  text(image, methodText(erp).substr(methodText(erp).find("reference:")), {10, 82}, 0.35);
+  colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40 + header, 16, size - 40),
+            map->limit_uv, "uV", 1);
   const std::filesystem::path path = folder / "scalp.png";
   save(path, image);
   return path;
@@ -225,10 +246,9 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const 
   text(image,
        "ERP averages (mean +/- 1.96 SE over epochs, baseline " + format(erp.start_s * 1000.0, 0) +
            " to " + format((erp.start_s + erp.baseline_s) * 1000.0, 0) +
-           " ms subtracted): " + std::to_string(erp.targets) + " " + names.target + ", " +
-           std::to_string(erp.others) + " " + names.other + " epochs",
+           " ms subtracted): " + epochsText(erp, names),
        {left, 26}, 0.5);
-  text(image, "filter: " + erp.filterText(), {left, 46}, 0.45);
+  text(image, methodText(erp), {left, 46}, 0.45);
   // Legend.
   const std::pair<std::string, cv::Scalar> legend[] = {
       {names.target, kTarget}, {names.other, kOther}, {"difference", kBlack}};
@@ -278,7 +298,7 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const 
 
 }  // namespace
 
-nlohmann::json erpJson(const bci::ErpCurves& erp) {
+nlohmann::json erpJson(const bci::ErpCurves& erp, const bci::ScalpTime& when) {
   const Eigen::MatrixXd difference = erp.difference();
   std::vector<double> ms(static_cast<size_t>(erp.samples()));
   for (int s = 0; s < erp.samples(); ++s) ms[static_cast<size_t>(s)] = erp.timeS(s) * 1000.0;
@@ -293,27 +313,42 @@ nlohmann::json erpJson(const bci::ErpCurves& erp) {
                         {"non_target_se", bci::ErpCurves::row(erp.other_se, c)},
                         {"signed_r2", bci::ErpCurves::row(erp.signed_r2, c)}});
   }
+  nlohmann::json filter = {{"type", erp.filtered() ? "butterworth" : "none"},
+                           {"order", erp.filtered() ? erp.filter_order : 0},
+                           {"highpass_hz", erp.highpass_hz},
+                           {"lowpass_hz", erp.lowpass_hz},
+                           {"notch_hz", erp.notch_hz},
+                           {"notch_q", erp.notch_hz > 0.0 ? erp.notch_q : 0.0},
+                           {"zero_phase", erp.filtered() && erp.zero_phase},
+                           {"text", erp.filterText()}};
+  nlohmann::json excluded = nlohmann::json::array();
+  for (const auto& [name, why] : erp.excluded) excluded.push_back({{"name", name}, {"why", why}});
+  nlohmann::json scalp = {{"time_ms", erp.timeS(bci::scalpSample(erp, when)) * 1000.0}};
+  if (when.at_s)
+    scalp["given_ms"] = *when.at_s * 1000.0;
+  else
+    scalp["search_ms"] = {when.from_s * 1000.0, when.to_s * 1000.0};
   return {{"units", "uV"},
           {"rate_hz", erp.rate_hz},
+          {"reference", erp.common_average ? "common_average" : "as_recorded"},
           {"baseline_ms", {erp.start_s * 1000.0, (erp.start_s + erp.baseline_s) * 1000.0}},
+          {"epoch_ms", {erp.timeS(0) * 1000.0, erp.timeS(std::max(0, erp.samples() - 1)) * 1000.0}},
           {"window_ms", {erp.window_start_s * 1000.0, erp.window_end_s * 1000.0}},
-          {"filter",
-           {{"highpass_hz", erp.highpass_hz},
-            {"lowpass_hz", erp.lowpass_hz},
-            {"notch_hz", erp.notch_hz},
-            {"zero_phase", erp.zero_phase},
-            {"text", erp.filterText()}}},
+          {"filter", filter},
+          {"excluded_channels", excluded},
+          {"selections", erp.selections},
           {"target_epochs", erp.targets},
           {"non_target_epochs", erp.others},
           {"peak_ms", erp.samples() > 0 ? erp.timeS(erp.peakSample()) * 1000.0 : 0.0},
+          {"scalp_map", scalp},
           {"channels", channels}};
 }
 
 std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,
                                                   const bci::P300Dataset& data,
                                                   const bci::EvaluationReport& report,
-                                                  const std::string& title,
-                                                  const ClassNames& names) {
+                                                  const std::string& title, const ClassNames& names,
+                                                  const bci::ScalpTime& when) {
   std::error_code error;
   std::filesystem::create_directories(folder, error);
   if (error)
@@ -324,11 +359,11 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
   if (!erp_png.empty()) {
     written.push_back(erp_png);
     for (const auto& extra :
-         {writeR2Figure(folder, data.erp, names), writeScalpMap(folder, data.erp, names)})
+         {writeR2Figure(folder, data.erp, names), writeScalpMap(folder, data.erp, names, when)})
       if (!extra.empty()) written.push_back(extra);
     written.push_back(folder / "erp.json");
     std::ofstream out(written.back());
-    out << erpJson(data.erp).dump() << "\n";
+    out << erpJson(data.erp, when).dump() << "\n";
     if (!out) throw CliError("cannot write " + written.back().string());
   }
 
@@ -345,7 +380,11 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
   const double x1 = std::max(2.0, static_cast<double>(report.max_sequences));
   const double x_step = niceStep(x1 - 1.0, 10) < 1.0 ? 1.0 : niceStep(x1 - 1.0, 10);
   const Panel accuracy{{90, 70, 320, 230}, 1.0, x1, 0.0, 100.0};
-  accuracy.axes(image, "accuracy (95 % intervals)", x_step, 20.0, "sequences", "accuracy (%)");
+  // How many selections the accuracy rests on: with a handful, the intervals are wide.
+  accuracy.axes(
+      image,
+      "accuracy, " + std::to_string(report.selections_with_truth) + " selections (95 % intervals)",
+      x_step, 20.0, "sequences", "accuracy (%)");
   // Guessing: the chance level, and the accuracy that beats it at p < 0.05 (dashed).
   cv::line(image, accuracy.map(1.0, 100.0 * report.chance), accuracy.map(x1, 100.0 * report.chance),
            kGrey, 1);

@@ -25,10 +25,13 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
                                                   const bci::P300Dataset& data,
                                                   const bci::EvaluationReport& report,
                                                   const std::string& title,
-                                                  const ClassNames& names = {});
+                                                  const ClassNames& names = {},
+                                                  const bci::ScalpTime& when = {});
 
 // erp.json: per channel the time axis (ms), the target and non-target averages, their difference
-// and standard errors (uV), with the baseline, the analysis window and the epoch counts.
-nlohmann::json erpJson(const bci::ErpCurves& erp);
+// and standard errors (uV), with what was done: the reference, the filter (type, order, band,
+// notch and its Q, zero-phase or causal), the epoch, baseline and analysis window, the channels
+// left out and why, the selections and epochs behind it, and the scalp map's time.
+nlohmann::json erpJson(const bci::ErpCurves& erp, const bci::ScalpTime& when = {});
 
 }  // namespace arbci::app

@@ -46,17 +46,25 @@ std::string ErpCurves::filterText() const {
     std::snprintf(text, sizeof text, "%g", v);
     return std::string(text);
   };
+  if (!filtered()) return "unfiltered";
   std::string band;
+  const std::string butterworth =
+      (filter_order > 0 ? std::to_string(filter_order) + "th-order " : std::string()) +
+      "Butterworth ";
   if (highpass_hz > 0.0 && lowpass_hz > 0.0)
-    band = hz(highpass_hz) + "-" + hz(lowpass_hz) + " Hz band-pass";
+    band = butterworth + hz(highpass_hz) + "-" + hz(lowpass_hz) + " Hz band-pass";
   else if (highpass_hz > 0.0)
-    band = hz(highpass_hz) + " Hz high-pass";
+    band = butterworth + hz(highpass_hz) + " Hz high-pass";
   else if (lowpass_hz > 0.0)
-    band = hz(lowpass_hz) + " Hz low-pass";
-  else
-    return "unfiltered";
-  if (notch_hz > 0.0) band += ", " + hz(notch_hz) + " Hz notch";
+    band = butterworth + hz(lowpass_hz) + " Hz low-pass";
+  if (notch_hz > 0.0)
+    band += (band.empty() ? "" : ", ") + hz(notch_hz) + " Hz notch" +
+            (notch_q > 0.0 ? " (Q " + hz(notch_q) + ")" : std::string());
   return band + (zero_phase ? ", zero-phase" : ", causal (as online)");
+}
+
+std::string ErpCurves::referenceText() const {
+  return common_average ? "common average" : "as recorded";
 }
 
 int ErpCurves::peakSample() const {
@@ -83,9 +91,37 @@ double ScalpMap::at(double x, double y) const {
   return weights > 0.0 ? weighted / weights : 0.0;
 }
 
-std::optional<ScalpMap> scalpMapAtPeak(const ErpCurves& erp) {
+int scalpSample(const ErpCurves& erp, const ScalpTime& when) {
+  const int n = erp.samples();
+  if (n == 0) return 0;
+  auto sampleAt = [&](double t) {
+    return std::clamp(static_cast<int>(std::lround((t - erp.start_s) * erp.rate_hz)), 0, n - 1);
+  };
+  if (when.at_s) return sampleAt(*when.at_s);
+  int from = sampleAt(when.from_s), to = sampleAt(when.to_s);
+  if (erp.timeS(to) < when.from_s || erp.timeS(from) > when.to_s) {
+    from = 0;  // the window lies outside the epoch: its whole length
+    to = n - 1;
+  }
+  // A peak: the largest local maximum inside the window (a difference still falling from an
+  // earlier peak is largest at the window's first sample, which is no peak); failing one, the
+  // window's largest value.
+  const Eigen::VectorXd power = erp.difference().colwise().squaredNorm().transpose();
+  int best = -1;
+  for (int s = from; s <= to; ++s) {
+    const bool local =
+        (s == 0 || power(s) >= power(s - 1)) && (s == n - 1 || power(s) >= power(s + 1));
+    if (local && (best < 0 || power(s) > power(best))) best = s;
+  }
+  if (best >= 0) return best;
+  Eigen::Index peak = 0;
+  power.segment(from, to - from + 1).maxCoeff(&peak);
+  return from + static_cast<int>(peak);
+}
+
+std::optional<ScalpMap> scalpMapAt(const ErpCurves& erp, const ScalpTime& when) {
   if (erp.samples() == 0) return std::nullopt;
-  const int peak = erp.peakSample();
+  const int peak = scalpSample(erp, when);
   const Eigen::MatrixXd difference = erp.difference();
   ScalpMap map;
   map.time_s = erp.timeS(peak);

@@ -2,8 +2,11 @@
 
 #include "arbci/bci/paradigm.h"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "arbci/bci/classifier.h"
 
 namespace arbci::bci {
 
@@ -67,6 +70,44 @@ FeedbackRecording feedbackRecording(const Recording& session, FeedbackPart part)
         "model); leave out --calibration-only");
   }
   return out;
+}
+
+namespace {
+
+double logChoose(int n, int k) {
+  return std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0);
+}
+
+// P(X > limit) for X ~ Hypergeometric(population n, successes e, draws b).
+double upperTail(int n, int e, int b, int limit) {
+  double p = 0.0;
+  for (int x = std::max(limit + 1, 0); x <= std::min(e, b); ++x)
+    if (b - x <= n - e) p += std::exp(logChoose(e, x) + logChoose(n - e, b - x) - logChoose(n, b));
+  return p;
+}
+
+// The chance that some fold's training part has fewer than kMinimumTargets of a class.
+double foldFailure(int n, int wrong, int folds) {
+  double p = 0.0;
+  for (int f = 0; f < folds; ++f) {
+    const int b = static_cast<int>(std::lround(static_cast<double>(f + 1) * n / folds)) -
+                  static_cast<int>(std::lround(static_cast<double>(f) * n / folds));
+    p += upperTail(n, wrong, b, wrong - kMinimumTargets);          // too few errors left
+    p += upperTail(n, n - wrong, b, n - wrong - kMinimumTargets);  // too few correct left
+  }
+  return p;
+}
+
+}  // namespace
+
+int minimumCalibrationFeedbacks(double wrong_rate, int folds) {
+  constexpr double kAcceptedFailure = 0.01;
+  for (int n = 2 * kMinimumTargets; n <= 100000; ++n) {
+    const int wrong = static_cast<int>(std::lround(wrong_rate * n));
+    if (wrong < kMinimumTargets || n - wrong < kMinimumTargets) continue;
+    if (foldFailure(n, wrong, folds) <= kAcceptedFailure) return n;
+  }
+  return 0;
 }
 
 }  // namespace arbci::bci

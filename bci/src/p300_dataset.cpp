@@ -332,6 +332,10 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   data.erp.highpass_hz = settings.filter.highpass_hz;
   data.erp.lowpass_hz = settings.filter.lowpass_hz;
   data.erp.notch_hz = settings.filter.notch_hz;
+  data.erp.filter_order = settings.filter.order;
+  data.erp.notch_q = settings.filter.notch_q;
+  data.erp.common_average = settings.filter.common_average;
+  data.erp.selections = static_cast<int>(data.selections.size());
   data.erp.zero_phase = settings.zero_phase || erp_own_pass;
   if (progress) progress(1.0, "epochs ready");
   return data;

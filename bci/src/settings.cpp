@@ -120,7 +120,9 @@ const core::Schema<PipelineSettings>& pipelineSchema() {
         .number("decimate_hz", &P::decimate_hz, 0.0, 0.0, 500.0,
                 "the features' rate: the epoch is averaged in bins to it (0: the method's own, " +
                     std::to_string(static_cast<int>(ClassifierParts{}.feature_rate_hz)) +
-                    " Hz as BCI2000 unless its line in the classifiers' list says otherwise)",
+                    " Hz as BCI2000 for most; arbci train --method's help and docs/settings.md's "
+                    "classifiers "
+                    "give each method's own)",
                 "Hz")
         .texts("channels", &P::channels, {}, 0, "the feature channels ([]: every EEG channel)")
         .boolean("zero_phase", &P::zero_phase, false,
@@ -167,8 +169,8 @@ const core::Schema<TrainingSettings>& trainingSchema() {
     Key filters{"xdawn_filters",
                 Type::Integer,
                 0,
-                "xDAWN spatial filters kept (riemann: per class; 0: the method's own, as its "
-                "line in the classifiers' list says)",
+                "xDAWN spatial filters kept (riemann: per class; 0: the method's own, which arbci "
+                "train --method's help and docs/settings.md's classifiers give)",
                 "",
                 0,
                 64};

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "arbci/bci/classifier.h"
+#include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/settings.h"
 #include "arbci/robot/settings.h"
 #include "arbci/session/eeg_sources.h"
@@ -514,6 +515,22 @@ Broken crossRules(const Json& c) {
     if (row < 1 || row > rows || column < 1 || column > columns)
       return std::pair{at + ".cell", "lies outside the " + std::to_string(rows) + "x" +
                                          std::to_string(columns) + " grid"};
+  }
+  if (const Json& errp = c["errp"]; errp["enabled"].get<bool>()) {
+    // Too few calibration feedbacks leave a fold (or the whole block) without enough errors to
+    // train on: refused now, not found out after the calibration run.
+    const int given = errp["calibration_feedbacks"].get<int>(), folds = errp["folds"].get<int>();
+    const double rate = errp["wrong_feedback_rate"].get<double>();
+    const int least = bci::minimumCalibrationFeedbacks(rate, folds);
+    if (given > 0 && given < least)
+      return std::pair{"errp.calibration_feedbacks",
+                       "= " + std::to_string(given) +
+                           " is too few to train the ErrP classifier "
+                           "with errp.folds = " +
+                           std::to_string(folds) + " and a wrong share of " +
+                           core::formatNumber(rate) + ": at least " + std::to_string(least) +
+                           " (every fold keeps " + std::to_string(bci::kMinimumTargets) +
+                           " errors to train on), or more folds (smaller held-out blocks)"};
   }
   if (c["errp"]["enabled"].get<bool>() && !c["errp"]["channels"].empty()) {
     const auto montage = c["eeg"]["montage"].get<std::vector<std::string>>();

@@ -66,6 +66,14 @@ TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
   EXPECT_NE(r.out.find("plot: " + (plots / "r2.png").string()), std::string::npos) << r.out;
   std::ifstream in(plots / "erp.json");
   const nlohmann::json erp = nlohmann::json::parse(in);
+  // What was done, stated: unfiltered (so not "zero-phase"), the amplifier's reference, the
+  // scalp map inside the P300's window.
+  EXPECT_EQ(erp["reference"], "as_recorded");
+  EXPECT_EQ(erp["filter"]["type"], "none");
+  EXPECT_EQ(erp["filter"]["zero_phase"], false);
+  EXPECT_GE(erp["scalp_map"]["time_ms"].get<double>(), 250.0);
+  EXPECT_LE(erp["scalp_map"]["time_ms"].get<double>(), 600.0);
+  EXPECT_GT(erp["selections"].get<int>(), 0);
 
   const bci::Recording raw = bci::readRecording(eeg("eeg3_1.dat"));
   const int channels = raw.info.channelCount();
@@ -177,6 +185,10 @@ TEST(TrainAndEvaluate, DefaultErpFigureShowsTheParietalP300AndStatesItsFilter) {
     EXPECT_EQ(erp[causal]["filter"]["highpass_hz"], 0.5);
     EXPECT_EQ(erp[causal]["filter"]["lowpass_hz"], 20.0);
     EXPECT_EQ(erp[causal]["filter"]["zero_phase"], !causal);
+    EXPECT_EQ(erp[causal]["filter"]["type"], "butterworth");
+    EXPECT_GT(erp[causal]["filter"]["order"].get<int>(), 0);
+    EXPECT_EQ(erp[causal]["filter"]["notch_hz"], 50.0);
+    EXPECT_GT(erp[causal]["filter"]["notch_q"].get<double>(), 0.0);
     // The window the features use: 15 bins of 13 samples at 256 Hz, 0-762 ms (not 800).
     EXPECT_NEAR(erp[causal]["window_ms"][1].get<double>(), 15 * 13 * 1000.0 / 256.0, 1e-6);
   }
@@ -427,8 +439,11 @@ TEST(TrainAndEvaluate, BadChannelsAndLargeEpochsAreReportedAndLeftOutOnRequest) 
   }
   write(damaged, broken);
   const auto model = scratch("artifacts.json"), report = scratch("artifacts_report.json");
-  ProcessResult r =
-      runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out", model.string()});
+  const auto plain_plots = scratch("artifacts_plots"), car_plots = scratch("artifacts_car_plots");
+  std::filesystem::remove_all(plain_plots);
+  std::filesystem::remove_all(car_plots);
+  ProcessResult r = runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out",
+                                        model.string(), "--plots", plain_plots.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("channels: flat " + flat + "; drifting " + drifting +
                        ": used (--exclude-bad-channels to leave them out)"),
@@ -436,8 +451,21 @@ TEST(TrainAndEvaluate, BadChannelsAndLargeEpochsAreReportedAndLeftOutOnRequest) 
       << r.out;
   r = runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out", model.string(),
                           "--exclude-bad-channels", "--reject-uv", "60", "--zero-phase", "--report",
-                          report.string()});
+                          report.string(), "--car", "--plots", car_plots.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The figures' numbers say what was done: the reference, and the channels left out and why.
+  auto erpOf = [](const std::filesystem::path& plots) {
+    std::ifstream in(plots / "erp.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json plain = erpOf(plain_plots), car = erpOf(car_plots);
+  EXPECT_EQ(plain["reference"], "as_recorded");
+  EXPECT_EQ(plain["excluded_channels"], nlohmann::json::array());
+  EXPECT_EQ(car["reference"], "common_average");
+  EXPECT_EQ(
+      car["excluded_channels"],
+      nlohmann::json::parse("[{\"name\": \"" + flat + "\", \"why\": \"flat\"}, {\"name\": \"" +
+                            drifting + "\", \"why\": \"drifting\"}]"));
   EXPECT_NE(r.out.find(": excluded"), std::string::npos) << r.out;
   std::ifstream model_in(model);
   const nlohmann::json m = nlohmann::json::parse(model_in);

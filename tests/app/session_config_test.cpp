@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/settings.h"
 #include "arbci/session/session.h"
 #include "arbci/session/session_config.h"
@@ -234,6 +235,25 @@ TEST(SessionConfig, ErrpChannelsAreTheMontageOrThoseOfTheListItHas) {
   // The training's range (0: the method's own), the ErrP's default.
   const std::string filters = errorOf(R"({"errp": {"xdawn_filters": 65}})");
   EXPECT_NE(filters.find("errp.xdawn_filters = 65"), std::string::npos) << filters;
+}
+
+// An ErrP calibration block too small for its folds is refused at load with the minimum, not
+// found out after the whole calibration run; the default block (100) trains.
+TEST(SessionConfig, AnErrpCalibrationTooSmallForItsFoldsIsRefusedWithTheMinimum) {
+  const int least = bci::minimumCalibrationFeedbacks(0.25, 5);
+  EXPECT_GT(least, 40);
+  EXPECT_LE(least, 100);
+  const std::string small = errorOf(R"({"errp": {"enabled": true, "calibration_feedbacks": 40}})");
+  EXPECT_NE(small.find("errp.calibration_feedbacks = 40 is too few to train the ErrP classifier "
+                       "with errp.folds = 5 and a wrong share of 0.25: at least " +
+                       std::to_string(least)),
+            std::string::npos)
+      << small;
+  EXPECT_NO_THROW(
+      SessionConfig::load(sessionFile("errp_enough", R"({"errp": {"enabled": true}})")));
+  // With fewer folds each held-out block is larger, so more feedbacks are needed.
+  EXPECT_GE(bci::minimumCalibrationFeedbacks(0.25, 2), least);
+  EXPECT_LE(bci::minimumCalibrationFeedbacks(0.25, 10), least);
 }
 
 // Before the run each stage checks what its settings name can be used, and says which key.

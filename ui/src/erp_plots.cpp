@@ -35,7 +35,8 @@ void drawErpPlots(const bci::ErpCurves& erp, const char* target, const char* oth
   ImGui::SameLine();
   ImGui::TextColored(ImVec4(0.16f, 0.43f, 0.78f, 1.0f), "%s (%d)", other, erp.others);
   ImGui::SameLine();
-  ImGui::TextWrapped("difference (white); 95 %% bands; %s", erp.filterText().c_str());
+  ImGui::TextWrapped("difference (white); 95 %% bands; %s; reference %s", erp.filterText().c_str(),
+                     erp.referenceText().c_str());
   const float width = std::max(120.0f, (ImGui::GetContentRegionAvail().x - 8.0f) / 2.0f);
   const float height = 70.0f, ticks = ImGui::GetFontSize() + 2.0f;  // the ms labels under it
   ImDrawList* draw = ImGui::GetWindowDrawList();
@@ -133,13 +134,15 @@ void drawSignedR2(const bci::ErpCurves& erp) {
 }
 
 void drawScalpMap(const bci::ErpCurves& erp) {
-  const std::optional<bci::ScalpMap> map = bci::scalpMapAtPeak(erp);
+  const std::optional<bci::ScalpMap> map = bci::scalpMapAt(erp, bci::ScalpTime{});
   if (!map) {
     ImGui::TextDisabled("no scalp map: fewer than 3 channels have 10-20 names");
     return;
   }
-  ImGui::TextWrapped("target - non-target at %.0f ms (the difference's peak), +/-%.1f uV",
-                     map->time_s * 1000.0, map->limit_uv);
+  const bci::ScalpTime when;
+  ImGui::TextWrapped(
+      "target - non-target at %.0f ms (the difference's peak in %.0f-%.0f ms), +/-%.1f uV",
+      map->time_s * 1000.0, when.from_s * 1000.0, when.to_s * 1000.0, map->limit_uv);
   const float size = 180.0f, head = 0.55f;
   const ImVec2 corner = ImGui::GetCursorScreenPos();
   ImGui::InvisibleButton("scalp", ImVec2(size, size));

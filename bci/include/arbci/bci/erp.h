@@ -21,9 +21,19 @@ struct ErpCurves {
   // The filter the averaged signal went through, stated on every figure: a figure's filter
   // changes the ERP's shape (a causal band-pass delays and rings), so it is part of the result.
   double highpass_hz = 0.0, lowpass_hz = 0.0, notch_hz = 0.0;  // 0: none
-  bool zero_phase = false;         // forward and backward (no lag) rather than causal (as online)
-  std::string filterText() const;  // "0.5-20 Hz band-pass, zero-phase"
-  int targets = 0, others = 0;     // epochs averaged
+  int filter_order = 0;     // of each Butterworth half (high-pass, low-pass)
+  double notch_q = 0.0;     // the notch's quality factor
+  bool zero_phase = false;  // forward and backward (no lag) rather than causal (as online)
+  bool filtered() const { return highpass_hz > 0.0 || lowpass_hz > 0.0 || notch_hz > 0.0; }
+  // "4th-order Butterworth 0.5-20 Hz band-pass, 50 Hz notch (Q 30), zero-phase", or "unfiltered".
+  std::string filterText() const;
+  // The reference the averages are on: the common average (subtracted first) or the amplifier's.
+  bool common_average = false;
+  std::string referenceText() const;  // "common average" or "as recorded"
+  // Channels left out of the recordings before averaging, each with its reason ("flat").
+  std::vector<std::pair<std::string, std::string>> excluded;
+  int selections = 0;           // the selections the epochs come from (0: no selections)
+  int targets = 0, others = 0;  // epochs averaged
   // Channels (rows) x samples (columns), microvolts.
   Eigen::MatrixXd target_mean, other_mean, target_se, other_se;
   // Signed r^2 (the point-biserial correlation of amplitude with target/non-target, squared,
@@ -55,8 +65,19 @@ struct ScalpMap {
   double limit_uv = 0.0;  // the largest |value| (>= 1e-6)
   double at(double x, double y) const;
 };
+// Where the scalp map is drawn: the difference's peak (root mean square over channels) inside a
+// search window (the P300's, by default), or a time given.
+struct ScalpTime {
+  double from_s = 0.25, to_s = 0.6;  // the search window, after the stimulus
+  std::optional<double> at_s;        // a time given: the sample nearest it
+};
+// The sample the scalp map is drawn at: the largest local peak of the difference (root mean
+// square over channels) inside the window, clipped to the epoch (the whole epoch when the window
+// holds none of it); the window's largest value where it holds no peak. Never an edge merely
+// because drift grows there or an earlier peak is still falling.
+int scalpSample(const ErpCurves& erp, const ScalpTime& when);
 // None when fewer than 3 channels have known positions.
-std::optional<ScalpMap> scalpMapAtPeak(const ErpCurves& erp);
+std::optional<ScalpMap> scalpMapAt(const ErpCurves& erp, const ScalpTime& when = {});
 
 // Sums epochs of `channels` x `samples` (channel-major: channel c's samples at c * samples).
 class ErpAccumulator {

@@ -38,4 +38,11 @@ struct FeedbackRecording {
 FeedbackRecording feedbackRecording(const Recording& session,
                                     FeedbackPart part = FeedbackPart::Both);
 
+// The fewest calibration feedbacks (a share `wrong_rate` of them wrong, in random order) that
+// train the ErrP classifier with `folds` contiguous cross-validation folds: every fold's
+// training part keeps kMinimumTargets of each class with a probability of at least 99 % (the
+// union of each held-out block's hypergeometric tails), and so does the whole block. 0 when no
+// number up to 100,000 does (a rate of 0 or 1).
+int minimumCalibrationFeedbacks(double wrong_rate, int folds);
+
 }  // namespace arbci::bci
