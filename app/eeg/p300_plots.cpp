@@ -154,9 +154,7 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const b
   if (channels == 0 || samples < 2) return {};
   const int left = 80, top = 60, row_h = std::clamp(320 / channels, 6, 28), width = 720;
   cv::Mat image(top + channels * row_h + 70, left + width + 120, CV_8UC3, kWhite);
-  text(image,
-       "signed r^2 (" + names.target + " vs " + names.other +
-           ") per channel and time: " + epochsText(erp, names),
+  text(image, "signed r^2, " + names.target + " vs " + names.other + ": " + epochsText(erp, names),
        {left, 24}, 0.5);
   text(image, methodText(erp), {left, 44}, 0.4);
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
