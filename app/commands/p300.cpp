@@ -531,8 +531,10 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   train_cmd->add_flag("--exclude-bad-channels", t->exclude_bad_channels,
                       "leave out flat (SD < 0.5 uV) and drifting (SD > 20x the median channel's) "
                       "channels, which are always reported");
-  schemaOption(*train_cmd, "--folds", t->training.folds, training.at("folds"),
-               "at most one per selection or file");
+  // The session's calibration folds (classifier.folds), as "options not given take a session's
+  // defaults" says; an offline analysis may ask for more.
+  schemaOption(*train_cmd, "--folds", t->training.folds, session::sessionKey("classifier.folds"),
+               "here: any recordings' cross-validation; at most one per selection or file");
   schemaOption(*train_cmd, "--folds-by", t->training.folds_by, training.at("folds_by"));
   train_cmd->add_flag("--errp", t->errp,
                       "train the error-related-potential classifier on the recordings' feedback "

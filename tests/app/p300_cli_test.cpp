@@ -316,7 +316,8 @@ TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
       runProcess(kArbci, {"train", "--method", "slda", by_class.string(), "--out",
                           scratch("by_class.json").string(), "--report", report.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("10 folds by block (the default here"), std::string::npos) << r.out;
+  // The session's folds (classifier.folds), by block.
+  EXPECT_NE(r.out.find("4 folds by block (the default here"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("no selection metrics"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("bits/min"), std::string::npos) << r.out;
   std::ifstream in(report);
