@@ -148,6 +148,9 @@ void checkOutputs(const std::string& plots, const std::vector<std::string>& file
 nlohmann::json datasetFacts(const bci::P300Dataset& data, const nlohmann::json& channels) {
   return {{"files", data.sources},
           {"channels", channels},
+          // What the averages went through (the features' filter differs only in being causal
+          // where zero_phase is false).
+          {"averages", analysisJson(data.erp)},
           {"rejected_epochs", data.rejected_epochs},
           {"reject_uv", data.reject_uv},
           {"unknown_flashes", data.unknown_flashes},
@@ -306,6 +309,7 @@ void train(TrainOptions& o, const CLI::App& command) {
               << " uV peak-to-peak rejected";
   }
   if (o.pipeline.zero_phase) std::cout << "; zero-phase filters (offline only)";
+  std::cout << "\nthe averages (figures, erp.json): " << analysisText(data.erp);
   if (data.other_code_flashes > 0) {
     std::cout << "; " << data.other_code_flashes << " flashes with codes beyond the paradigm's "
               << data.layout.codes() << " (a session's grid) left out";
@@ -437,6 +441,7 @@ void evaluate(EvaluateOptions& o) {
       std::cout.unsetf(std::ios::fixed);
       std::cout << "\n";
     }
+    std::cout << "the averages (figures, erp.json): " << analysisText(data.erp) << "\n";
     printReport(std::cout, report);
     nlohmann::json facts = datasetFacts(data, quality);
     facts.update({{"command", "evaluate"},

@@ -130,15 +130,39 @@ void colourBar(cv::Mat& image, const cv::Rect& area, double limit, const std::st
   text(image, unit, {area.x - 4, area.y - 8}, 0.35);
 }
 
-// What the averages went through, on every figure: the filter, the reference and the channels
-// left out.
-std::string methodText(const bci::ErpCurves& erp) {
+}  // namespace
+
+std::string analysisText(const bci::ErpCurves& erp) {
   std::string out = "filter: " + erp.filterText() + "; reference: " + erp.referenceText();
   for (size_t i = 0; i < erp.excluded.size(); ++i)
     out += (i == 0 ? "; left out: " : ", ") + erp.excluded[i].first + " (" +
            erp.excluded[i].second + ")";
   return out;
 }
+
+nlohmann::json analysisJson(const bci::ErpCurves& erp) {
+  nlohmann::json filter = {{"type", erp.filtered() ? "butterworth" : "none"},
+                           {"order", erp.filtered() ? erp.filter_order : 0},
+                           {"highpass_hz", erp.highpass_hz},
+                           {"lowpass_hz", erp.lowpass_hz},
+                           {"notch_hz", erp.notch_hz},
+                           {"notch_q", erp.notch_hz > 0.0 ? erp.notch_q : 0.0},
+                           {"zero_phase", erp.filtered() && erp.zero_phase},
+                           {"text", erp.filterText()}};
+  nlohmann::json excluded = nlohmann::json::array();
+  for (const auto& [name, why] : erp.excluded) excluded.push_back({{"name", name}, {"why", why}});
+  return {{"reference", erp.common_average ? "common_average" : "as_recorded"},
+          {"filter", filter},
+          {"baseline_ms", {erp.start_s * 1000.0, (erp.start_s + erp.baseline_s) * 1000.0}},
+          {"epoch_ms", {erp.timeS(0) * 1000.0, erp.timeS(std::max(0, erp.samples() - 1)) * 1000.0}},
+          {"window_ms", {erp.window_start_s * 1000.0, erp.window_end_s * 1000.0}},
+          {"excluded_channels", excluded},
+          {"selections", erp.selections},
+          {"target_epochs", erp.targets},
+          {"non_target_epochs", erp.others}};
+}
+
+namespace {
 
 // "96 target, 283 non-target epochs from 8 selections".
 std::string epochsText(const bci::ErpCurves& erp, const ClassNames& names) {
@@ -156,7 +180,7 @@ std::filesystem::path writeR2Figure(const std::filesystem::path& folder, const b
   cv::Mat image(top + channels * row_h + 70, left + width + 120, CV_8UC3, kWhite);
   text(image, "signed r^2, " + names.target + " vs " + names.other + ": " + epochsText(erp, names),
        {left, 24}, 0.5);
-  text(image, methodText(erp), {left, 44}, 0.4);
+  text(image, analysisText(erp), {left, 44}, 0.4);
   const double limit = std::max(1e-6, erp.signed_r2.cwiseAbs().maxCoeff());
   const int label_every = (14 + row_h - 1) / row_h;
   const double t0 = erp.timeS(0) * 1000.0, t1 = erp.timeS(samples - 1) * 1000.0;
@@ -222,7 +246,7 @@ std::filesystem::path writeScalpMap(const std::filesystem::path& folder, const b
                        "-" + format(when.to_s * 1000.0, 0) + " ms)",
        {10, 42}, 0.4);
   text(image, "filter: " + erp.filterText(), {10, 62}, 0.35);
-  text(image, methodText(erp).substr(methodText(erp).find("reference:")), {10, 82}, 0.35);
+  text(image, analysisText(erp).substr(analysisText(erp).find("reference:")), {10, 82}, 0.35);
   colourBar(image, cv::Rect(size + 2 * margin + 10, margin + 40 + header, 16, size - 40),
             map->limit_uv, "uV", 1);
   const std::filesystem::path path = folder / "scalp.png";
@@ -246,7 +270,7 @@ std::filesystem::path writeErpFigure(const std::filesystem::path& folder, const 
            " to " + format((erp.start_s + erp.baseline_s) * 1000.0, 0) +
            " ms subtracted): " + epochsText(erp, names),
        {left, 26}, 0.5);
-  text(image, methodText(erp), {left, 46}, 0.45);
+  text(image, analysisText(erp), {left, 46}, 0.45);
   // Legend.
   const std::pair<std::string, cv::Scalar> legend[] = {
       {names.target, kTarget}, {names.other, kOther}, {"difference", kBlack}};
@@ -311,35 +335,18 @@ nlohmann::json erpJson(const bci::ErpCurves& erp, const bci::ScalpTime& when) {
                         {"non_target_se", bci::ErpCurves::row(erp.other_se, c)},
                         {"signed_r2", bci::ErpCurves::row(erp.signed_r2, c)}});
   }
-  nlohmann::json filter = {{"type", erp.filtered() ? "butterworth" : "none"},
-                           {"order", erp.filtered() ? erp.filter_order : 0},
-                           {"highpass_hz", erp.highpass_hz},
-                           {"lowpass_hz", erp.lowpass_hz},
-                           {"notch_hz", erp.notch_hz},
-                           {"notch_q", erp.notch_hz > 0.0 ? erp.notch_q : 0.0},
-                           {"zero_phase", erp.filtered() && erp.zero_phase},
-                           {"text", erp.filterText()}};
-  nlohmann::json excluded = nlohmann::json::array();
-  for (const auto& [name, why] : erp.excluded) excluded.push_back({{"name", name}, {"why", why}});
   nlohmann::json scalp = {{"time_ms", erp.timeS(bci::scalpSample(erp, when)) * 1000.0}};
   if (when.at_s)
     scalp["given_ms"] = *when.at_s * 1000.0;
   else
     scalp["search_ms"] = {when.from_s * 1000.0, when.to_s * 1000.0};
-  return {{"units", "uV"},
-          {"rate_hz", erp.rate_hz},
-          {"reference", erp.common_average ? "common_average" : "as_recorded"},
-          {"baseline_ms", {erp.start_s * 1000.0, (erp.start_s + erp.baseline_s) * 1000.0}},
-          {"epoch_ms", {erp.timeS(0) * 1000.0, erp.timeS(std::max(0, erp.samples() - 1)) * 1000.0}},
-          {"window_ms", {erp.window_start_s * 1000.0, erp.window_end_s * 1000.0}},
-          {"filter", filter},
-          {"excluded_channels", excluded},
-          {"selections", erp.selections},
-          {"target_epochs", erp.targets},
-          {"non_target_epochs", erp.others},
-          {"peak_ms", erp.samples() > 0 ? erp.timeS(erp.peakSample()) * 1000.0 : 0.0},
-          {"scalp_map", scalp},
-          {"channels", channels}};
+  nlohmann::json out = analysisJson(erp);
+  out.update({{"units", "uV"},
+              {"rate_hz", erp.rate_hz},
+              {"peak_ms", erp.samples() > 0 ? erp.timeS(erp.peakSample()) * 1000.0 : 0.0},
+              {"scalp_map", scalp},
+              {"channels", channels}});
+  return out;
 }
 
 std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& folder,

@@ -28,6 +28,13 @@ std::vector<std::filesystem::path> writeP300Plots(const std::filesystem::path& f
                                                   const ClassNames& names = {},
                                                   const bci::ScalpTime& when = {});
 
+// What the averages (and the classifier's epochs) went through, in a line ("filter: 4th-order
+// Butterworth 0.5-20 Hz band-pass, 50 Hz notch (Q 25), zero-phase; reference: as recorded; left
+// out: Fz (flat)") and as data (reference, filter, baseline, epoch and window, the channels left
+// out and why, the selections and epochs): every figure, erp.json and the report carry them.
+std::string analysisText(const bci::ErpCurves& erp);
+nlohmann::json analysisJson(const bci::ErpCurves& erp);
+
 // erp.json: per channel the time axis (ms), the target and non-target averages, their difference
 // and standard errors (uV), with what was done: the reference, the filter (type, order, band,
 // notch and its Q, zero-phase or causal), the epoch, baseline and analysis window, the channels
