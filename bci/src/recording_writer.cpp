@@ -166,6 +166,17 @@ struct RecordingWriter::State {
       if (dirty.exchange(false)) ::fdatasync(file.get());
     }
   }
+  void stopSyncing() {
+    {
+      std::lock_guard lock(sync_mutex);
+      stop_sync = true;
+    }
+    sync_wake.notify_all();
+    if (syncer.joinable()) syncer.join();
+  }
+  // Whatever failed (a full disk in the last record), the syncing thread ends with the state: a
+  // joinable thread destroyed would terminate the whole session.
+  ~State() { stopSyncing(); }
 };
 
 RecordingWriter::RecordingWriter(const std::filesystem::path& path, const SignalInfo& info,
@@ -258,16 +269,11 @@ void RecordingWriter::close() {
     s.annotations.push_back(
         s.tal(end, padded_end - end, std::string(bdf::kEndMarker) + std::to_string(true_samples)));
     do {
-      s.writeRecord();
+      s.writeRecord();  // throws on a full disk; ~State stops the syncing thread then
     } while (!s.annotations.empty());
     s.padded = s.records * s.record_samples - true_samples;
   }
-  {
-    std::lock_guard lock(s.sync_mutex);
-    s.stop_sync = true;
-  }
-  s.sync_wake.notify_all();
-  s.syncer.join();
+  s.stopSyncing();
   ::fdatasync(s.file.get());
 }
 

@@ -3,7 +3,9 @@
 // a file cut short is refused with a reason or salvaged up to its last complete record.
 #include <edflib.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 
@@ -11,6 +13,7 @@
 #include "arbci/bci/recording_writer.h"
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
+#include "support/test_files.h"
 
 namespace arbci::bci {
 namespace {
@@ -155,6 +158,45 @@ TEST(Recording, UnwritablePathNamesTheFile) {
   } catch (const RecordingError& error) {
     EXPECT_NE(std::string(error.what()).find("/nonexistent-folder/x.bdf"), std::string::npos);
   }
+}
+
+// A disk that fills during a session (here: a file-size limit, which fails writes as a full disk
+// does): the write that fails throws an error naming the file, and the writer then closes and
+// goes away without terminating the process (its syncing thread ends with it).
+TEST(Recording, AFullDiskIsAnErrorNamingTheFileNotATerminate) {
+  const auto path = test::freshTempPath("recording", "full.bdf");
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  struct Restore {
+    rlimit limit;
+    void (*handler)(int);
+    ~Restore() {
+      ::setrlimit(RLIMIT_FSIZE, &limit);
+      std::signal(SIGXFSZ, handler);
+    }
+  } restore{old, old_handler};
+  SignalInfo info;
+  info.rate_hz = 256.0;
+  info.channels = {"Cz", "Pz"};
+  std::string error;
+  {
+    RecordingWriter writer(path, info);
+    rlimit small = old;
+    small.rlim_cur = 64 * 1024;
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    try {
+      for (int b = 0; b < 1000; ++b) {
+        Block block(b * 256, 2, 256);
+        writer.write(block);
+        writer.addAnnotation({b * 256, "a note", 0});
+      }
+    } catch (const RecordingError& e) {
+      error = e.what();
+    }
+  }  // destroyed with a record it cannot write: no std::terminate
+  EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("write failed"), std::string::npos) << error;
 }
 
 TEST(Recording, BadFilesGiveOneLineNamingTheFileNeverACrash) {
