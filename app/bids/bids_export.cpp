@@ -144,8 +144,9 @@ std::string eegSidecar(const bci::Recording& r, const std::string& task, int mis
       "head-mounted display; the subject attends the object to move and the cell to put it on.";
   j["Instructions"] = "Attend the cued (calibration) or chosen object and count its flashes.";
   j["SamplingFrequency"] = r.info.rate_hz;
+  // What the export was given, else what the session recorded.
   auto stated = [&](const std::string& given, const std::string& key) {
-    return !given.empty() ? given : !parameter(r, key).empty() ? parameter(r, key) : "";
+    return given.empty() ? parameter(r, key) : given;
   };
   const std::string reference = stated(description.reference, "EegReference");
   j["EEGReference"] = reference.empty() ? "n/a" : reference;

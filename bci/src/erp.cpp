@@ -48,9 +48,17 @@ std::string ErpCurves::filterText() const {
   };
   if (!filtered()) return "unfiltered";
   std::string band;
+  const auto ordinal = [](int n) {
+    const int tens = n % 100, ones = n % 10;
+    const char* suffix = tens >= 11 && tens <= 13 ? "th"
+                         : ones == 1              ? "st"
+                         : ones == 2              ? "nd"
+                         : ones == 3              ? "rd"
+                                                  : "th";
+    return std::to_string(n) + suffix;
+  };
   const std::string butterworth =
-      (filter_order > 0 ? std::to_string(filter_order) + "th-order " : std::string()) +
-      "Butterworth ";
+      (filter_order > 0 ? ordinal(filter_order) + "-order " : std::string()) + "Butterworth ";
   if (highpass_hz > 0.0 && lowpass_hz > 0.0)
     band = butterworth + hz(highpass_hz) + "-" + hz(lowpass_hz) + " Hz band-pass";
   else if (highpass_hz > 0.0)

@@ -59,6 +59,9 @@ TEST(ErpCurves, TheFilterAndTheReferenceAreStatedInFull) {
   EXPECT_EQ(erp.filterText(),
             "4th-order Butterworth 0.5-20 Hz band-pass, 50 Hz notch (Q 30), zero-phase");
   EXPECT_EQ(erp.referenceText(), "common average");
+  erp.filter_order = 2;
+  erp.notch_hz = 0.0;
+  EXPECT_EQ(erp.filterText(), "2nd-order Butterworth 0.5-20 Hz band-pass, zero-phase");
 }
 
 }  // namespace

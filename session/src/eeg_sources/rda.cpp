@@ -323,7 +323,7 @@ class RdaSource final : public bci::EegSource {
     fault_ = text;
   }
 
-  // Until the connection is back and has sent a start message with the same layout.
+  // One attempt to connect again (the read loop then waits for the start message).
   bool reconnect() {
     try {
       connect();

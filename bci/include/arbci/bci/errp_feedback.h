@@ -39,10 +39,11 @@ FeedbackRecording feedbackRecording(const Recording& session,
                                     FeedbackPart part = FeedbackPart::Both);
 
 // The fewest calibration feedbacks (a share `wrong_rate` of them wrong, in random order) that
-// train the ErrP classifier with `folds` contiguous cross-validation folds: every fold's
-// training part keeps kMinimumTargets of each class with a probability of at least 99 % (the
-// union of each held-out block's hypergeometric tails), and so does the whole block. 0 when no
-// number up to 100,000 does (a rate of 0 or 1).
+// train the ErrP classifier with `folds` contiguous cross-validation folds. The wrong ones fall at
+// random, so a held-out block may take more than its share of them; the block is big enough when
+// every fold's training part keeps kMinimumTargets of each class with a chance of 99 % or more
+// (bounded by summing each held-out block's hypergeometric tail). 0 when no size up to 100,000
+// is big enough.
 int minimumCalibrationFeedbacks(double wrong_rate, int folds);
 
 }  // namespace arbci::bci
