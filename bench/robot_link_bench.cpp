@@ -6,7 +6,11 @@
 //   2. a link that starts delaying everything by 1.5 s: the same (a delayed heartbeat is stale);
 //   3. a lossy link: how often the watchdog halts a grasp (its price on a bad network);
 //   4. a flood of forged datagrams (40,000 a second by default): STOP to ACCEPTED latency and
-//      false watchdog halts of live motions, with and without the flood.
+//      false watchdog halts of live motions, with and without the flood; a STOP from a fresh
+//      client (a new address, as `arbci robot stop` from another shell) from its first HELLO;
+//   5. fresh clients that send their motion at once, as the CLI does (halts of healthy motions),
+//      and a fresh client through a link already known to be slow (refused, never moved).
+// `--flood-port P --flood-seconds S` only floods a running arbci-robotd, for timing the real CLI.
 // Run it alone and under load (two busy processes, as bench/under-load) for the docs' tables.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -61,7 +65,7 @@ double percentile(std::vector<double> v, double p) {
 
 struct Latencies {
   std::vector<double> from_event, from_heartbeat;
-  int not_halted = 0;
+  int not_halted = 0, halted_before = 0;  // the latter: halted before the fault (not counted)
 };
 
 // Grasps through the relay; `fault` is applied at a random heartbeat phase; the halt is awaited.
@@ -80,6 +84,10 @@ Latencies halts(int runs, unsigned seed, Fault fault) {
       continue;
     }
     robot::pollFor(client, std::chrono::milliseconds(100 + random() % 300));
+    if (*rig.halted_at != 0) {
+      ++out.halted_before;  // a halt of a healthy link is not the fault's
+      continue;
+    }
     const auto at = Clock::now();
     fault(relay);
     const std::int64_t heartbeat_us = relay.lastHeartbeatForwardedUs();
@@ -98,9 +106,9 @@ Latencies halts(int runs, unsigned seed, Fault fault) {
 
 void printHalts(const char* what, int runs, const Latencies& l) {
   std::printf(
-      "| %s | %d | %zu | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f |\n", what, runs,
-      l.from_event.size(), percentile(l.from_event, 0.5), percentile(l.from_event, 0.95),
-      percentile(l.from_event, 0.99),
+      "| %s | %d | %d | %zu | %.1f / %.1f / %.1f / %.1f | %.1f / %.1f / %.1f / %.1f |\n", what,
+      runs, l.halted_before, l.from_event.size(), percentile(l.from_event, 0.5),
+      percentile(l.from_event, 0.95), percentile(l.from_event, 0.99),
       l.from_event.empty() ? 0.0 : *std::max_element(l.from_event.begin(), l.from_event.end()),
       percentile(l.from_heartbeat, 0.5), percentile(l.from_heartbeat, 0.95),
       percentile(l.from_heartbeat, 0.99),
@@ -205,6 +213,83 @@ FloodRow floodRow(double rate, int stops, int motions) {
   return row;
 }
 
+// STOPs from fresh clients (each a new socket, so a new source address, as `arbci robot stop`
+// from another shell) while the session's bound client is there and the flood runs: ms from the
+// client's creation (its first HELLO) to the STOP's acceptance.
+std::vector<double> freshStops(double rate, int tries) {
+  robot::RunningBackend backend(std::make_unique<robot::SimulatedArm>(robot::twoObjects()),
+                                benchOptions(8.0));
+  robot::RobotClient session(robot::Endpoint::resolve("127.0.0.1", backend.port()),
+                             robot::testKey());
+  const auto bound_by = Clock::now() + 5s;
+  while (!session.connected() && Clock::now() < bound_by) robot::pollFor(session, 5ms);
+  Flood flood(backend.port(), session.sessionId(), rate);
+  std::this_thread::sleep_for(300ms);
+  std::vector<double> ms;
+  for (int i = 0; i < tries; ++i) {
+    const auto start = Clock::now();
+    robot::RobotClient fresh(robot::Endpoint::resolve("127.0.0.1", backend.port()),
+                             robot::testKey());
+    const auto stop = fresh.send(robot::MessageType::Stop);
+    bool accepted = false;
+    while (!accepted && Clock::now() - start < 20s) {
+      fresh.poll();
+      accepted = fresh.accepted(stop);
+      if (!accepted) std::this_thread::sleep_for(100us);
+    }
+    ms.push_back(accepted ? std::chrono::duration<double, std::milli>(Clock::now() - start).count()
+                          : 1e9);
+    robot::waitFor(session, session.send(robot::MessageType::Reset), 5s);
+  }
+  return ms;
+}
+
+// Fresh clients, each sending its motion at once (as the CLI does) at real speed: how many of
+// these healthy motions the watchdog halted, and how many finished.
+std::pair<int, int> freshMotions(int motions) {
+  robot::RunningBackend backend(std::make_unique<robot::SimulatedArm>(robot::twoObjects()),
+                                benchOptions(4.0));
+  int finished = 0;
+  for (int i = 0; i < motions; ++i) {
+    robot::RobotClient fresh(robot::Endpoint::resolve("127.0.0.1", backend.port()),
+                             robot::testKey());
+    const auto events =
+        robot::waitFor(fresh, i % 2 == 0 ? fresh.send(robot::MessageType::Grasp, {0.10, 0.60, 0.06})
+                                         : fresh.send(robot::MessageType::Drop, {0.10, 0.60, 0.0}));
+    const robot::RobotEvent& last = robot::finalEvent(events);
+    if (last.kind == robot::RobotEvent::Kind::Finished && last.outcome == robot::Outcome::Success)
+      ++finished;
+    if (backend.stats().watchdog_halts > 0) {
+      robot::RobotClient reset(robot::Endpoint::resolve("127.0.0.1", backend.port()),
+                               robot::testKey());
+      robot::waitFor(reset, reset.send(robot::MessageType::Reset), 5s);
+    }
+  }
+  return {static_cast<int>(backend.stats().watchdog_halts), finished};
+}
+
+// A fresh client's HOME through a link that delays 1.5 s (both ways, or towards the backend
+// only): what became of it (refused with the reason, or ran).
+std::string slowFreshHome(bool one_way) {
+  Rig rig;
+  test::UdpRelay relay(rig.backend.port(), robot::testKey());
+  relay.setDelay(1500ms, one_way);
+  robot::RobotClient fresh(robot::Endpoint::resolve("127.0.0.1", relay.port()), robot::testKey());
+  const auto events = robot::waitFor(fresh, fresh.send(robot::MessageType::Home), 30s);
+  const robot::RobotEvent& last = robot::finalEvent(events);
+  if (rig.backend.stats().executed > 0) return "ran: " + last.text;
+  return std::string(robot::toString(last.kind)) + ": " + last.text;
+}
+
+// Only the flood, at a running backend, for timing the real `arbci robot stop` beside it.
+int floodOnly(int port, double rate, double seconds) {
+  Flood flood(port, 1, rate);
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  std::printf("sent %llu forged datagrams to port %d\n",
+              static_cast<unsigned long long>(flood.sent()), port);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -225,16 +310,27 @@ int main(int argc, char** argv) {
   app.add_option("--watchdog-ms", watchdog_ms, "the backend's watchdog")->capture_default_str();
   bool log = false;
   app.add_flag("--log", log, "print the backends' log (every halt with its cause) to stderr");
+  int fresh_stops = 20, fresh_motions = 100, flood_port = 0;
+  double flood_seconds = 60.0;
+  app.add_option("--fresh-stops", fresh_stops, "STOPs from fresh clients under the flood")
+      ->capture_default_str();
+  app.add_option("--fresh-motions", fresh_motions, "motions each from a fresh client (0: skip)")
+      ->capture_default_str();
+  app.add_option("--flood-port", flood_port, "only flood the backend at this port, then exit");
+  app.add_option("--flood-seconds", flood_seconds, "how long --flood-port floods")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (flood_port > 0) return floodOnly(flood_port, flood_rate, flood_seconds);
   if (log) g_log = &std::cerr;
   g_watchdog_s = watchdog_ms / 1000.0;
   std::printf(
-      "Watchdog halts during a grasp (watchdog %.0f ms, heartbeat 50 Hz); ms as "
-      "median / p95 / p99 / max\n",
-      watchdog_ms);
+      "Watchdog halts during a grasp (watchdog %.0f ms, %d heartbeats per watchdog period); ms "
+      "as median / p95 / p99 / max\n",
+      watchdog_ms, robot::ClientOptions{}.heartbeats_per_watchdog);
   std::printf(
-      "| fault | runs | halted | from the fault | from the last heartbeat's send time |\n"
-      "|---|---|---|---|---|\n");
+      "| fault | runs | halted before the fault | halted | from the fault | from the last "
+      "heartbeat's send time |\n"
+      "|---|---|---|---|---|---|\n");
   const Latencies cut = halts(cuts, 1, [](test::UdpRelay& r) { r.setCut(true); });
   printHalts("link cut", cuts, cut);
   const Latencies delayed = halts(cuts, 101, [](test::UdpRelay& r) { r.setDelay(1500ms); });
@@ -286,6 +382,30 @@ int main(int argc, char** argv) {
   }
   std::printf(
       "target: with 40,000 forged datagrams a second, STOP to ACCEPTED p99 <= 20 ms and "
-      "0 false halts\n");
+      "0 false halts\n\n");
+
+  if (fresh_stops > 0) {
+    const std::vector<double> ms = freshStops(flood_rate, fresh_stops);
+    const auto within = std::count_if(ms.begin(), ms.end(), [](double v) { return v <= 500.0; });
+    std::printf(
+        "A STOP from a fresh client (new address, from its first HELLO) under %.0f forged "
+        "datagrams a second\n| tries | accepted within 500 ms | median / p95 / max ms |\n"
+        "|---|---|---|\n| %d | %td | %.1f / %.1f / %.1f |\ntarget: 20 of 20 within 500 ms\n\n",
+        flood_rate, fresh_stops, within, percentile(ms, 0.5), percentile(ms, 0.95),
+        *std::max_element(ms.begin(), ms.end()));
+    if (within < fresh_stops) status = 1;
+  }
+  if (fresh_motions > 0) {
+    const auto [halts, finished] = freshMotions(fresh_motions);
+    std::printf(
+        "Healthy motions, each from a fresh client that sends it at once (as the CLI does)\n"
+        "| motions | finished | halted by the watchdog |\n|---|---|---|\n| %d | %d | %d |\n"
+        "target: 0 halted\n\n",
+        fresh_motions, finished, halts);
+    if (halts > 0) status = 1;
+  }
+  std::printf("A fresh client's HOME through a link that delays 1.5 s\n");
+  std::printf("- both ways: %s\n", slowFreshHome(false).c_str());
+  std::printf("- towards the backend only: %s\n", slowFreshHome(true).c_str());
   return status;
 }

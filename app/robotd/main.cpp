@@ -26,8 +26,8 @@ void onSignal(int) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "arbci-robotd: the ARBCI robot backend. Accepts HELLO, GRASP, DROP, HOME, STOP, RESET, "
-      "HEARTBEAT and STATUS over UDP,\n"
+      "arbci-robotd: the ARBCI robot backend. Accepts HELLO, BIND, GRASP, DROP, HOME, STOP, "
+      "RESET, HEARTBEAT and STATUS over UDP,\n"
       "authenticated with the shared key (make one with `arbci robot keygen`), and drives a\n"
       "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: "
       "docs/robot-protocol.md.",

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <mutex>
 #include <set>
+#include <utility>
 
 #include "arbci/robot/thread_priority.h"
 
@@ -15,7 +16,6 @@ namespace arbci::robot {
 namespace {
 
 using SteadyClock = std::chrono::steady_clock;
-constexpr std::uint64_t kReplayWindow = 1024;
 constexpr size_t kCachedReplies = 256;
 constexpr auto kSessionLifetime = std::chrono::minutes(5);
 // A WELCOME's challenge must be answered within this long; a session keeps this many open (a
@@ -26,6 +26,8 @@ constexpr size_t kMaxChallenges = 256;
 // The watchdog looks this much before its deadline, so that waking from the socket wait (tens of
 // microseconds, more on a busy machine) does not carry the halt past the watchdog time.
 constexpr std::int64_t kWakeMarginUs = 1000;
+// Source addresses whose unbound budget is remembered; the least recently heard is forgotten.
+constexpr size_t kBudgetedSources = 1024;
 
 std::uint64_t randomId() {
   std::uint64_t id = 0;
@@ -54,6 +56,39 @@ class TokenBucket {
  private:
   double rate_, tokens_;
   SteadyClock::time_point last_ = SteadyClock::now();
+};
+
+// The unbound budget, one per source address: a flood from one address (or a few) spends its own
+// and never the budget of a new client's HELLO, BIND or STOP from another.
+class SourceBudgets {
+ public:
+  explicit SourceBudgets(double rate) : rate_(rate) {}
+  bool take(const Endpoint& from, SteadyClock::time_point now) {
+    const std::uint64_t key = (std::uint64_t{from.address.sin_addr.s_addr} << 16) |
+                              from.address.sin_port;  // address and port, as received
+    auto found = budgets_.find(key);
+    if (found == budgets_.end()) {
+      if (budgets_.size() >= kBudgetedSources) forgetOldest();
+      found = budgets_.emplace(key, Entry{TokenBucket(rate_), now}).first;
+    }
+    found->second.heard = now;
+    return found->second.bucket.take(now);
+  }
+
+ private:
+  struct Entry {
+    TokenBucket bucket;
+    SteadyClock::time_point heard;
+  };
+  void forgetOldest() {
+    auto oldest = budgets_.begin();
+    for (auto it = budgets_.begin(); it != budgets_.end(); ++it) {
+      if (it->second.heard < oldest->second.heard) oldest = it;
+    }
+    budgets_.erase(oldest);
+  }
+  double rate_;
+  std::map<std::uint64_t, Entry> budgets_;
 };
 
 }  // namespace
@@ -87,6 +122,10 @@ struct RobotBackend::Impl {
     // address is answered again (its BOUND may have been lost).
     std::uint64_t bound_challenge = 0, bind_sequence = 0;
     SteadyClock::time_point active;
+    // A motion that came before any heartbeat (when, on this backend's clock): it starts when the
+    // first heartbeat arrives fresh, and is refused when that arrives stale or not at all.
+    std::optional<Message> held;
+    std::int64_t held_us = 0;
   };
   std::map<std::uint64_t, Session> sessions;
 
@@ -106,7 +145,8 @@ struct RobotBackend::Impl {
   std::string stop_reason;              // a latched stop: motion commands are refused until a RESET
   std::optional<double> stepped_clock;  // stepped: the clock the robot has reached
   SteadyClock::time_point last_step = SteadyClock::now(), last_push = SteadyClock::now();
-  TokenBucket unbound_budget, refusal_budget;
+  SourceBudgets unbound_budget;
+  TokenBucket refusal_budget;
   BackendStats stats;
   mutable std::mutex stats_mutex;
   std::string priority;
@@ -170,7 +210,10 @@ struct RobotBackend::Impl {
     m.sequence = sequence;
     const DriverStatus d = driver->status();
     StatusPayload& s = m.status;
-    s.state = stop_reason.empty() ? d.state : RobotState::Stopped;
+    // Stopped is the latch: once a RESET lifts it, an arm that stands still is idle.
+    s.state = !stop_reason.empty()                                     ? RobotState::Stopped
+              : d.state == RobotState::Stopped && !running.has_value() ? RobotState::Idle
+                                                                       : d.state;
     s.stop_reason = stop_reason;
     s.stop_epoch = stop_epoch;
     s.tool = d.tool;
@@ -220,6 +263,12 @@ struct RobotBackend::Impl {
     const std::string what = halted ? toString(running->type) + std::string(" halted") : "";
     driver->stop();
     finish(Outcome::Stopped, outcome_text);
+    for (auto& [id, session] : sessions) {
+      if (!session.held) continue;
+      const Message held = *std::exchange(session.held, std::nullopt);
+      reject(held, session.peer, RejectReason::Stopped,
+             "the robot was stopped (" + reason + ") before the command could start");
+    }
     const bool latched = stop_reason.empty();
     if (latched) stop_reason = reason;
     if (halted || latched) {
@@ -231,14 +280,15 @@ struct RobotBackend::Impl {
   }
 
   // Whether a datagram deserves a MAC check: from a bound session's own address always (the
-  // real client's STOP and heartbeats are never crowded out); anything else within the unbound
-  // budget, so a flood of forgeries costs a header read each.
+  // real client's STOP and heartbeats are never crowded out); anything else within its source
+  // address's budget, so a flood of forgeries costs a header read each and a new client's
+  // datagrams from another address are still read.
   bool worthVerifying(const Datagram& d, bool from_bound_peer, SteadyClock::time_point now) {
-    if (from_bound_peer || unbound_budget.take(now)) return true;
+    if (from_bound_peer || unbound_budget.take(d.from, now)) return true;
     count(&BackendStats::shed);
     log("shed", "dropped datagrams unread (not from a bound client, over " +
                     std::to_string(static_cast<int>(options.unbound_per_s)) +
-                    " a second), e.g. from " + d.from.toString());
+                    " a second from one address), e.g. from " + d.from.toString());
     return false;
   }
 
@@ -303,6 +353,7 @@ struct RobotBackend::Impl {
       return;
     }
     if (s.seen.count(m.sequence)) {
+      if (s.held && s.held->sequence == m.sequence) return;  // still waiting for a heartbeat
       const auto cached = s.replies.find(m.sequence);
       if (cached != s.replies.end()) {
         count(&BackendStats::duplicates);
@@ -329,21 +380,28 @@ struct RobotBackend::Impl {
   // amplify traffic towards a forged sender address.
   void stale(const Message& m, const Datagram& d, RejectReason reason, const std::string& text) {
     count(&BackendStats::replayed);
-    log(toString(reason),
-        std::string("refused ") + toString(m.type) + " from " + d.from.toString() + ": " + text);
-    const auto found = sessions.find(m.session);
-    if (m.type == MessageType::Heartbeat || m.type == MessageType::Bind) return;
+    const bool answered = answerStale(m, d, reason, text);
+    log(toString(reason), std::string(answered ? "refused " : "ignored (not answered) ") +
+                              toString(m.type) + " from " + d.from.toString() + ": " + text);
+  }
+
+  // Whether a refusal was sent (see stale()).
+  bool answerStale(const Message& m, const Datagram& d, RejectReason reason,
+                   const std::string& text) {
+    if (m.type == MessageType::Heartbeat || m.type == MessageType::Bind) return false;
     Message r = reply(m, MessageType::Rejected);
     r.reason = reason;
     r.text = text;
-    if (found != sessions.end()) {
-      if (refusal_budget.take(SteadyClock::now())) send(r, found->second.peer);
-      return;
+    if (const auto found = sessions.find(m.session); found != sessions.end()) {
+      if (!refusal_budget.take(SteadyClock::now())) return false;
+      send(r, found->second.peer);
+      return true;
     }
     r.text.clear();  // the reason is enough; the least sent to an address nobody bound
     const auto bytes = stamped(r);
-    if (bytes.size() < d.bytes.size() && refusal_budget.take(SteadyClock::now()))
-      socket.sendTo(bytes, d.from);
+    if (bytes.size() >= d.bytes.size() || !refusal_budget.take(SteadyClock::now())) return false;
+    socket.sendTo(bytes, d.from);
+    return true;
   }
 
   // A HELLO sealed with another key: the client is told its key is not this backend's (a wrong
@@ -480,6 +538,8 @@ struct RobotBackend::Impl {
     if (running && running->session == m.session && running->sequence < s.abandon_below)
       latchStop("halted: the client gave up on the command",
                 "halted: the client gave up on the command");
+    // The link has now shown how old its heartbeats arrive: a held motion starts or is refused.
+    if (s.held) motion(*std::exchange(s.held, std::nullopt), s);
   }
 
   void process(const Message& m, Session& s) {
@@ -510,6 +570,22 @@ struct RobotBackend::Impl {
     }
   }
 
+  // Why a motion's stop epoch is not this run's (reason 11).
+  std::string wrongEpoch(const Message& m) const {
+    const std::string command = std::string(toString(m.type)) + " " + std::to_string(m.sequence);
+    const std::string now = " (epoch now " + std::to_string(stop_epoch) + ")";
+    if (m.stop_epoch == 0)
+      return command + " carries no stop epoch (0)" + now +
+             ": a motion must carry the epoch of the WELCOME, BOUND or ACCEPTED last received; it "
+             "never runs";
+    if (m.stop_epoch > stop_epoch)
+      return command + " carries stop epoch " + std::to_string(m.stop_epoch) +
+             ", which this backend run has not reached" + now + ": it never runs";
+    return command + " was made in stop epoch " + std::to_string(m.stop_epoch) +
+           ", before the STOP that a RESET lifted" + now +
+           ": it never runs; send it again if it is still wanted";
+  }
+
   void motion(const Message& m, Session& s) {
     if (!stop_reason.empty()) {
       reject(m, s.peer, RejectReason::Stopped,
@@ -517,16 +593,18 @@ struct RobotBackend::Impl {
       return;
     }
     if (m.stop_epoch != stop_epoch) {
-      reject(m, s.peer, RejectReason::BeforeStop,
-             std::string(toString(m.type)) + " " + std::to_string(m.sequence) +
-                 " was made in stop epoch " + std::to_string(m.stop_epoch) + ", before the STOP " +
-                 "that a RESET lifted (epoch now " + std::to_string(stop_epoch) +
-                 "): it never runs; send it again if it is still wanted");
+      reject(m, s.peer, RejectReason::BeforeStop, wrongEpoch(m));
       return;
     }
     if (m.sequence < s.abandon_below) {
       reject(m, s.peer, RejectReason::Cancelled,
              "sequence " + std::to_string(m.sequence) + " was given up by the client");
+      return;
+    }
+    if (s.held) {
+      reject(m, s.peer, RejectReason::Busy,
+             std::string("busy: ") + toString(s.held->type) + " " +
+                 std::to_string(s.held->sequence) + " waits for the client's first heartbeat");
       return;
     }
     if (running) {
@@ -536,6 +614,12 @@ struct RobotBackend::Impl {
       return;
     }
     const std::int64_t now_us = steadyMicros();
+    if (watchdogActive() && !s.heartbeat_us) {
+      // No heartbeat yet: nothing shows that the watchdog could halt this motion in time.
+      s.held = m;
+      s.held_us = now_us;
+      return;
+    }
     if (watchdogActive() && s.last_heartbeat_age_us > watchdogMicros()) {
       // The link delays the heartbeats past the watchdog: it could not halt the arm in time.
       reject(m, s.peer, RejectReason::Unreachable,
@@ -619,6 +703,15 @@ struct RobotBackend::Impl {
       last_push = now;
       const auto found = sessions.find(running->session);
       if (found != sessions.end()) send(statusFor(running->session, 0), found->second.peer);
+    }
+    for (auto& [id, s] : sessions) {
+      const std::int64_t wait_us = std::llround(options.first_heartbeat_wait_s * 1e6);
+      if (!s.held || steadyMicros() - s.held_us < wait_us) continue;
+      const Message held = *std::exchange(s.held, std::nullopt);
+      reject(held, s.peer, RejectReason::Unreachable,
+             "no heartbeat came from the client within " + std::to_string(wait_us / 1000) +
+                 " ms of its " + toString(held.type) +
+                 ": the link has not shown that the watchdog could halt the arm in time");
     }
     std::erase_if(sessions, [&](const auto& entry) {
       return now - entry.second.active > kSessionLifetime &&

@@ -36,6 +36,11 @@ std::uint64_t randomNonce() {
 // Offset samples kept (about 6 s of statuses at 5 a second): long enough to hold one taken on a
 // quiet link, short enough that clock drift between machines does not matter.
 constexpr size_t kOffsetSamples = 32;
+// Heartbeats are ~100 bytes each; 200 a second keeps the backend's replay window (4,096
+// sequences) longer than a command's 15 s of retransmission.
+constexpr double kMaxHeartbeatHz = 200.0;
+// With no watchdog (a stepped backend) heartbeats only carry the abandon-below mark.
+constexpr double kHeartbeatHzWithoutWatchdog = 10.0;
 
 }  // namespace
 
@@ -66,7 +71,7 @@ RobotClient::RobotClient(const Endpoint& backend, const Key& key, const ClientOp
   RAND_bytes(reinterpret_cast<unsigned char*>(&session_), sizeof session_);
   created_ = last_heard_ = next_status_ = Clock::now();
   sendHello();
-  if (options_.heartbeat_hz > 0.0) heartbeat_ = std::thread([this] { heartbeatLoop(); });
+  if (options_.heartbeats_per_watchdog > 0) heartbeat_ = std::thread([this] { heartbeatLoop(); });
 }
 
 RobotClient::~RobotClient() {
@@ -89,15 +94,21 @@ void RobotClient::heartbeatLoop() {
     std::lock_guard lock(priority_mutex_);
     heartbeat_priority_ = priority;
   }
-  const auto period = seconds(1.0 / options_.heartbeat_hz);
   std::unique_lock lock(heartbeat_mutex_);
-  while (!heartbeat_wake_.wait_for(lock, period, [this] { return stopping_; })) {
-    if (!connected_ || !offset_known_) continue;
-    Message m = fresh(MessageType::Heartbeat, next_sequence_++);
-    m.abandon_below = abandon_below_;
-    m.time_us = steadyMicros() + offset_us_.load();
-    socket_.sendTo(encode(m, key_), backend_);
+  while (!heartbeat_wake_.wait_for(lock, std::chrono::microseconds(heartbeat_period_us_.load()),
+                                   [this] { return stopping_; })) {
+    if (connected_ && offset_known_) sendHeartbeat();
   }
+}
+
+// Stamped with its send time on the backend's clock. From the heartbeat thread, and once from
+// the cycle's thread as the client binds: the backend holds a motion until a heartbeat shows
+// the link fresh, so the first one must not wait for the thread's next turn.
+void RobotClient::sendHeartbeat() {
+  Message m = fresh(MessageType::Heartbeat, next_sequence_++);
+  m.abandon_below = abandon_below_;
+  m.time_us = steadyMicros() + offset_us_.load();
+  socket_.sendTo(encode(m, key_), backend_);
 }
 
 std::optional<std::int64_t> RobotClient::clockOffsetUs() const {
@@ -263,6 +274,11 @@ bool RobotClient::welcome(const Message& m) {
   bind_started_ = Clock::now();
   bind_interval_ = options_.first_retransmit_s;
   watchdog_ms_ = m.watchdog_ms;
+  const double hz =
+      m.watchdog_ms == 0
+          ? kHeartbeatHzWithoutWatchdog
+          : std::min(kMaxHeartbeatHz, options_.heartbeats_per_watchdog * 1000.0 / m.watchdog_ms);
+  heartbeat_period_us_ = std::llround(1e6 / hz);
   sendBind();
   return true;
 }
@@ -289,6 +305,8 @@ void RobotClient::bound(const Message& m) {
       "bound to backend run " + std::to_string(m.boot) +
           (watchdog_ms_ ? ", watchdog " + std::to_string(watchdog_ms_) + " ms" : ", no watchdog")));
   next_status_ = Clock::now();
+  // Before any command: the backend holds a motion until a heartbeat has come.
+  if (options_.heartbeats_per_watchdog > 0) sendHeartbeat();
   for (Pending& p : pending_) transmit(p);
 }
 

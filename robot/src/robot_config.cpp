@@ -98,10 +98,11 @@ const core::Schema<LinkSettings>& linkSchema() {
     t.text("host", &LinkSettings::host, kLoopback,
            "the backend's host (arbci-robotd: the address it listens on)")
         .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port")
-        // 100 ms: five heartbeats at 50 Hz. The deadline counts from each heartbeat's send time,
-        // so a delayed link halts as a dead one does; a busy PC only delays the heartbeat
-        // thread (the highest priority the process may take), which sleeps between beats and is
-        // woken promptly even at normal priority (docs/robot.md has the false-halt counts).
+        // 100 ms: the client sends 20 heartbeats in it (every 5 ms), so only 19 or more lost in
+        // a row halt the arm. The deadline counts from each heartbeat's send time, so a delayed
+        // link halts as a dead one does; a busy PC only delays the heartbeat thread (the highest
+        // priority the process may take), which sleeps between beats and is woken promptly even
+        // at normal priority (docs/robot.md has the loss model and the false-halt counts).
         .integer("watchdog_ms", &LinkSettings::watchdog_ms, 100, 0, 60000,
                  "the backend halts a running motion (and latches the stop) this long after the "
                  "send time of the commanding client's newest heartbeat (a heartbeat the link "

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "support/halt_recording_arm.h"
+#include "support/raw_robot_session.h"
 #include "support/robot_test_support.h"
 #include "support/udp_relay.h"
 
@@ -73,73 +74,6 @@ bool has(const std::vector<RobotEvent>& events, RobotEvent::Kind kind) {
   return std::any_of(events.begin(), events.end(),
                      [&](const RobotEvent& e) { return e.kind == kind; });
 }
-
-// Speaks the protocol by hand, byte for byte as a client would, to probe the backend's edges.
-class RawSession {
- public:
-  explicit RawSession(int backend_port) : backend_(local(backend_port)) {}
-  Message message(MessageType type, std::uint64_t sequence) const {
-    Message m;
-    m.type = type;
-    m.session = kSession;
-    m.sequence = sequence;
-    m.timestamp_ms = wallClockMs();
-    m.boot = type == MessageType::Hello ? 0 : boot_;
-    m.stop_epoch = epoch_;
-    return m;
-  }
-  void send(const Message& m) { send(m, socket); }
-  void send(const Message& m, UdpSocket& from) { from.sendTo(encode(m, testKey()), backend_); }
-  // The next message for this session arriving on `on` within `timeout`.
-  std::optional<Message> receive(std::chrono::milliseconds timeout, UdpSocket& on) {
-    const auto end = Clock::now() + timeout;
-    while (Clock::now() < end) {
-      on.wait(2);
-      while (auto d = on.receive()) {
-        const Decoded decoded = decode(d->bytes.data(), d->bytes.size(), testKey());
-        if (decoded.ok() && decoded.message.session == kSession) return decoded.message;
-      }
-    }
-    return std::nullopt;
-  }
-  std::optional<Message> receive(std::chrono::milliseconds timeout) {
-    return receive(timeout, socket);
-  }
-  // The next reply answering `sequence` (status pushes answer 0).
-  std::optional<Message> answer(std::uint64_t sequence, std::chrono::milliseconds timeout = 2s) {
-    const auto end = Clock::now() + timeout;
-    while (Clock::now() < end) {
-      const auto m =
-          receive(std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now() + 1ms));
-      if (m && m->sequence == sequence) return m;
-    }
-    return std::nullopt;
-  }
-  // The whole handshake: HELLO with a nonce, the WELCOME echoing it, BIND with its challenge
-  // (sequence + 1), BOUND.
-  bool hello(std::uint64_t sequence) {
-    Message hello = message(MessageType::Hello, sequence);
-    hello.nonce = 0x1234 + sequence;
-    send(hello);
-    const auto welcome = answer(sequence);
-    if (!welcome || welcome->type != MessageType::Welcome || welcome->nonce != hello.nonce)
-      return false;
-    boot_ = welcome->boot;
-    Message bind = message(MessageType::Bind, sequence + 1);
-    bind.challenge = welcome->challenge;
-    send(bind);
-    const auto bound = answer(sequence + 1);
-    if (!bound || bound->type != MessageType::Bound) return false;
-    epoch_ = bound->stop_epoch;
-    return true;
-  }
-  UdpSocket socket;
-
- private:
-  static constexpr std::uint64_t kSession = 4242;
-  Endpoint backend_;
-  std::uint64_t boot_ = 0, epoch_ = 0;
-};
 
 TEST(RobotLink, ACapturedCommandReplayedToARestartedBackendIsRejected) {
   auto first = std::make_unique<RunningBackend>(20.0);
@@ -447,8 +381,12 @@ TEST(RobotLink, TheReplayWindowHoldsAtTheTopOfTheSequenceRange) {
   RunningBackend backend(50.0);
   RawSession raw(backend.port());
   constexpr std::uint64_t kTop = std::numeric_limits<std::uint64_t>::max();
-  ASSERT_TRUE(raw.hello(kTop - 2000));
-  // A command at the very top runs once, however many copies arrive.
+  ASSERT_TRUE(raw.hello(kTop - 2 * kReplayWindow));
+  // The link proven (a motion waits for the session's first heartbeat; both clocks are this
+  // machine's), a command at the very top runs once, however many copies arrive.
+  Message heartbeat = raw.message(MessageType::Heartbeat, kTop - 1);
+  heartbeat.time_us = steadyMicros();
+  raw.send(heartbeat);
   const Message home = raw.message(MessageType::Home, kTop);
   for (int i = 0; i < 3; ++i) raw.send(home);
   const auto accepted = raw.answer(kTop);
@@ -459,13 +397,13 @@ TEST(RobotLink, TheReplayWindowHoldsAtTheTopOfTheSequenceRange) {
   ASSERT_TRUE(waitUntil([&] { return backend.stats().duplicates >= 5; }));
   EXPECT_EQ(backend.stats().executed, 1u);
   // A whole window below the highest: refused as a replay; just inside it: a new command.
-  raw.send(raw.message(MessageType::Status, kTop - 1024));
-  const auto old = raw.answer(kTop - 1024);
+  raw.send(raw.message(MessageType::Status, kTop - kReplayWindow));
+  const auto old = raw.answer(kTop - kReplayWindow);
   ASSERT_TRUE(old);
   EXPECT_EQ(old->type, MessageType::Rejected);
   EXPECT_EQ(old->reason, RejectReason::Replayed);
-  raw.send(raw.message(MessageType::Status, kTop - 1023));
-  const auto inside = raw.answer(kTop - 1023, 2s);
+  raw.send(raw.message(MessageType::Status, kTop - kReplayWindow + 1));
+  const auto inside = raw.answer(kTop - kReplayWindow + 1, 2s);
   EXPECT_FALSE(inside && inside->type == MessageType::Rejected);
 }
 

@@ -23,14 +23,15 @@ void UdpRelay::setCut(bool cut) {
   cut_ = cut;
 }
 
-void UdpRelay::setDelay(std::chrono::milliseconds delay) {
+void UdpRelay::setDelay(std::chrono::milliseconds delay, bool to_backend_only) {
   std::lock_guard lock(mutex_);
   delay_ = delay;
+  delay_to_backend_only_ = to_backend_only;
 }
 
 // Called with the mutex held.
 void UdpRelay::forward(Bytes bytes, bool to_backend) {
-  if (delay_.count() > 0) {
+  if (delay_.count() > 0 && (to_backend || !delay_to_backend_only_)) {
     delayed_.push_back({std::chrono::steady_clock::now() + delay_, std::move(bytes), to_backend});
   } else if (to_backend) {
     back_.sendTo(bytes, backend_);

@@ -31,9 +31,9 @@ class UdpRelay {
   void setLoss(double to_backend, double to_client);
   // Everything, both ways, is dropped while cut.
   void setCut(bool cut);
-  // Everything forwarded from now on, both ways, arrives this much later (a congested or
-  // stalled link).
-  void setDelay(std::chrono::milliseconds delay);
+  // Everything forwarded from now on, both ways (or only towards the backend), arrives this much
+  // later (a congested or stalled link; one way: an asymmetric path).
+  void setDelay(std::chrono::milliseconds delay, bool to_backend_only = false);
   // Commands of this type from the client are held back from now on until release().
   void hold(robot::MessageType command);
   // Sends the held copies of command `sequence` to the backend (in arrival order).
@@ -67,6 +67,7 @@ class UdpRelay {
   double loss_to_backend_ = 0.0, loss_to_client_ = 0.0;
   bool cut_ = false;
   std::chrono::milliseconds delay_{0};
+  bool delay_to_backend_only_ = false;
   struct Delayed {
     std::chrono::steady_clock::time_point due;
     Bytes bytes;

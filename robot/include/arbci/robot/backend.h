@@ -5,7 +5,8 @@
 // watchdog, when the commanding client's heartbeats stop arriving fresh during a motion)
 // latches: motion commands are refused until a RESET, and commands made before it never run.
 // A flood costs little: datagrams from the bound address of a known session are verified and
-// handled first; everything else is sorted by its header and verified only within a budget.
+// handled first; everything else is sorted by its header and verified only within a budget of
+// its source address's. A motion waits for its session's first fresh heartbeat.
 #pragma once
 
 #include <atomic>
@@ -36,12 +37,17 @@ struct BackendOptions {
   // backend's clock): a delayed link halts as a dead one does. 0 turns it off. A stepped backend
   // needs none: its arm moves only when the client's clock says so.
   double watchdog_s = LinkSettings().watchdog_ms / 1000.0;
+  // With the watchdog on, a motion from a session that has sent no heartbeat yet is held until
+  // the first one arrives (started if it arrives fresh, refused `unreachable` if stale) and
+  // refused after this long without one: until then nothing shows the watchdog could halt it.
+  double first_heartbeat_wait_s = 1.0;
   // Asked of the kernel for the socket (it grants at most net.core.rmem_max, times 2). Sized for
   // latency, not throughput: a flood that outruns the backend is dropped by the kernel rather
   // than queued in front of a STOP (256 KiB hold about 110 full-size datagrams).
   int receive_buffer_bytes = 256 << 10;
   // Datagrams not from a bound session's address (HELLO, BIND, strays, forgeries) are verified
-  // at most this many a second; the rest are dropped unread. Bound sessions are never limited.
+  // at most this many a second from each source address (a flood from one address never spends
+  // another's budget); the rest are dropped unread. Bound sessions are never limited.
   double unbound_per_s = 200.0;
   // Refusals sent to an address that is not a bound session's (a stale or unknown command), at
   // most this many a second, and only when smaller than the datagram refused.

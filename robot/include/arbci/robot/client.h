@@ -31,9 +31,12 @@ struct ClientOptions {
   double first_retransmit_s = 0.05;
   double max_retransmit_s = 0.4;
   double status_interval_s = 0.2;
-  double silence_s = 1.0;      // no answer for this long: the backend is reported silent
-  double give_up_s = 15.0;     // a command nobody accepted in this long fails
-  double heartbeat_hz = 50.0;  // while connected; 0: none (a test of the watchdog)
+  double silence_s = 1.0;   // no answer for this long: the backend is reported silent
+  double give_up_s = 15.0;  // a command nobody accepted in this long fails
+  // Heartbeats sent per watchdog period of the bound backend (at most 200 a second): the
+  // watchdog halts only when this many in a row are lost or late, so the rate sets what
+  // independent loss a link survives (docs/robot.md). 0: none (a test of the watchdog).
+  int heartbeats_per_watchdog = 20;
 };
 
 struct RobotEvent {
@@ -129,6 +132,7 @@ class RobotClient {
   void markAccepted(Pending& p);
   void updateAbandonFloor();
   void heartbeatLoop();
+  void sendHeartbeat();
 
   Endpoint backend_;
   Key key_;
@@ -147,6 +151,7 @@ class RobotClient {
   std::atomic<std::uint64_t> abandon_below_{1};
   std::atomic<std::int64_t> offset_us_{0};
   std::atomic<bool> offset_known_{false};
+  std::atomic<std::int64_t> heartbeat_period_us_{5'000};  // from the bound run's watchdog
   std::uint64_t epoch_ = 0;
   // HELLOs awaiting their WELCOME: nonce and send time (this clock); the BIND awaiting ACCEPTED.
   std::vector<std::pair<std::uint64_t, std::int64_t>> hellos_;

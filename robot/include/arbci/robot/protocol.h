@@ -21,6 +21,10 @@ constexpr size_t kHeaderBytes = 42;
 constexpr size_t kMacBytes = 32;
 constexpr size_t kMaxDatagram = 1400;
 constexpr int kMaxWorldObjects = 32;
+// A sequence this far below a session's highest is refused as a replay. Wide enough that a
+// command retransmitted until the client gives up (15 s) stays inside it while heartbeats (at
+// most 200 a second) and statuses (5) advance the highest.
+constexpr std::uint64_t kReplayWindow = 4096;
 
 enum class MessageType : std::uint8_t {
   // Commands (client to backend).
