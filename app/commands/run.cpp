@@ -78,6 +78,9 @@ void printSummary(const session::Session& session) {
   std::cout << "ended: " << session.endKind();
   if (session.endReason() != session.endKind()) std::cout << " (" << session.endReason() << ")";
   std::cout << "\n";
+  if (!std::filesystem::exists(session.folder() / "summary.json"))
+    std::cout << "summary.json could not be written (a full disk?): the figures above are the "
+                 "run's summary\n";
 }
 
 int runSession(const RunOptions& o);

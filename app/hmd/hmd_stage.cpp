@@ -12,15 +12,18 @@ HmdSettings HmdSettings::of(const session::SessionConfig& config) {
           config.hmd.undistort,
           config.world.objects,
           config.world.grid,
-          !config.eeg.photodiode_channel.empty() || !config.eeg.photodiode_marker.empty()};
+          !config.eeg.photodiode_channel.empty() || !config.eeg.photodiode_marker.empty(),
+          config.hmd.screenshots};
 }
 
 HmdStage::HmdStage(const HmdSettings& settings, const std::filesystem::path& folder,
-                   render::GlContext& context, const session::CycleRecord& warm_up)
+                   render::GlContext& context, const session::CycleRecord& warm_up,
+                   const session::StageServices& services)
     : settings_(settings),
+      s_(services),
       grid_(gridLayoutOf(settings.grid)),
       context_(context),
-      screenshots_(folder) {
+      screenshots_(folder, settings.screenshots) {
   context_.makeCurrent();
   fbo_ = std::make_unique<render::Framebuffer>(render::Size{settings.width, settings.height});
   view_ = std::make_unique<render::HmdView>();
@@ -72,11 +75,30 @@ void HmdStage::step(session::Cycle& cycle) {
     out.patch_lit = render::readGrey(fbo_->id(), fbo_->size(), middle, middle) > 127;
   }
   if (const auto path = screenshots_.take(stimulus)) screenshot(*path);
+  reportImageFailures(cycle);
   if (context_.isHeadless()) context_.present();  // a window is presented by its owner
 }
 
-void HmdStage::stop(session::Cycle&, const std::string&) {
+void HmdStage::stop(session::Cycle& cycle, const std::string&) {
   images_.flush();
+  reportImageFailures(cycle);
+}
+
+// A screenshot that could not be written (a full disk) is said once, with the reason; the run
+// goes on (the recording is what must not be lost, and its own writes end the run).
+void HmdStage::reportImageFailures(session::Cycle& cycle) {
+  const auto failure = images_.failure();
+  if (!failure || *failure == reported_failure_) return;
+  reported_failure_ = *failure;
+  s_.log.write("screenshot_failed", cycle.time_s, {{"text", *failure}});
+  s_.tell.say(cycle.time_s, session::Severity::Warning, "screenshot not written: " + *failure);
+}
+
+void HmdStage::report(nlohmann::json& summary) const {
+  summary["screenshots"] = {{"kept", settings_.screenshots},
+                            {"written", images_.written()},
+                            {"failed", images_.failed()}};
+  if (const auto failure = images_.failure()) summary["screenshots"]["failure"] = *failure;
 }
 
 void HmdStage::screenshot(const std::filesystem::path& path) {

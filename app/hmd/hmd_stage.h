@@ -25,7 +25,8 @@ struct HmdSettings {
   bool undistort;     // the camera images, before the overlays
   std::vector<session::WorldObjectSettings> objects;
   session::GridSettings grid;
-  bool photodiode = false;  // the frame carries the photodiode patch
+  bool photodiode = false;             // the frame carries the photodiode patch
+  std::string screenshots;  // hmd.screenshots
   static HmdSettings of(const session::SessionConfig& config);
 };
 
@@ -35,11 +36,13 @@ class HmdStage final : public session::Stage {
   // `warm_up` (the tracked warm-up frames), so Mesa compiles its shader variants before the cycle
   // is timed.
   HmdStage(const HmdSettings& settings, const std::filesystem::path& folder,
-           render::GlContext& context, const session::CycleRecord& warm_up);
+           render::GlContext& context, const session::CycleRecord& warm_up,
+           const session::StageServices& services);
 
   const char* name() const override { return "render"; }
   void step(session::Cycle& cycle) override;
   void stop(session::Cycle& cycle, const std::string& reason) override;
+  void report(nlohmann::json& summary) const override;
 
   unsigned int texture() const { return fbo_->colorTexture(); }
   render::Size size() const { return fbo_->size(); }
@@ -48,8 +51,11 @@ class HmdStage final : public session::Stage {
 
  private:
   bool draw(const bci::FrameStimulus& stimulus, const session::CycleRecord& record, double now_s);
+  void reportImageFailures(session::Cycle& cycle);
 
   HmdSettings settings_;
+  session::StageServices s_;
+  std::string reported_failure_;  // the screenshot failure last told
   render::GridLayout grid_;
   render::GlContext& context_;
   std::unique_ptr<render::Framebuffer> fbo_;

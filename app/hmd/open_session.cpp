@@ -9,9 +9,10 @@ OpenedSession openSession(const session::SessionConfig& config,
   context.makeCurrent();
   OpenedSession opened;
   opened.session = std::make_unique<session::Session>(
-      config, options, [&](const session::StageServices&, const session::CycleRecord& warm_up) {
-        auto hmd =
-            std::make_unique<HmdStage>(HmdSettings::of(config), options.folder, context, warm_up);
+      config, options,
+      [&](const session::StageServices& services, const session::CycleRecord& warm_up) {
+        auto hmd = std::make_unique<HmdStage>(HmdSettings::of(config), options.folder, context,
+                                              warm_up, services);
         opened.hmd = hmd.get();
         return hmd;
       });

@@ -34,7 +34,12 @@ std::string phaseSlug(bci::Phase phase) {
 
 void PhaseScreenshots::phaseEntered(bci::Phase phase, int trial) {
   const std::string slug = phaseSlug(phase);
-  if (slug.empty()) return;
+  if (slug.empty() || kept_ == "none") return;
+  const bool ending = phase == bci::Phase::Finished || phase == bci::Phase::RobotFault;
+  const bool in_trial = !ending && phase != bci::Phase::CalibrationFlashing &&
+                        phase != bci::Phase::CalibrationFeedback;
+  if (kept_ == "end" && !ending) return;
+  if (kept_ == "first_trial" && in_trial && trial != 1) return;
   // The calibration run's phases recur with every target: the first of each is kept.
   const bool once = phase == bci::Phase::CalibrationFlashing ||
                     phase == bci::Phase::CalibrationFeedback || phase == bci::Phase::Finished ||

@@ -86,6 +86,13 @@ std::vector<std::string> Preflight::check(bool final) const {
     out.push_back(settings_.eeg_key + ": EEG samples arrive at " +
                   format("%.1f Hz, the source says %.1f Hz", eeg_rate_hz_, rate));
   }
+  if (settings_.disk_needed > 0 && last_.disk_free && *last_.disk_free < settings_.disk_needed) {
+    out.push_back("--out: the disk holding " + settings_.folder + " has " +
+                  format("%.0f MB free; this run needs ", std::floor(*last_.disk_free / 1e6)) +
+                  settings_.disk_what +
+                  ": free some space, choose another folder, or keep fewer "
+                  "screenshots (hmd.screenshots)");
+  }
   if (!last_.robot_answered && last_.robot_key_refused) {
     out.push_back(settings_.robot_key + ": " + settings_.robot_what +
                   " answered that our key is not its key: give both sides the same robot.key_file "

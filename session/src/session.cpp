@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include "arbci/core/whole_file.h"
 #include "arbci/session/stages/robot_stage.h"
 #include "stage_assembly.h"
 
@@ -181,7 +182,13 @@ void Session::endRun(const std::string& reason, const std::string& kind) {
       last_record.time_s, end_kind_ == "finished" ? Severity::Info : Severity::Error,
       "session ended: " + end_kind_ + (reason == end_kind_ ? "" : " (" + reason + ")"));
   const auto summary_json = std::make_shared<const nlohmann::json>(summary());
-  std::ofstream(folder_ / "summary.json") << summary_json->dump(2) << "\n";
+  // Whole or not at all: on a full disk a cut summary would read as a broken run.
+  if (const std::string why =
+          core::writeWholeFile(folder_ / "summary.json", summary_json->dump(2) + "\n");
+      !why.empty()) {
+    log_->write("summary_not_written", last_record.time_s, {{"text", why}});
+    operator_log_.add(last_record.time_s, Severity::Error, "summary.json not written: " + why);
+  }
   // The last record says how the run ended, for whoever reads it from now on.
   CycleRecord& ended = records_[current_];
   ended.ended = true;

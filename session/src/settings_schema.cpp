@@ -48,7 +48,16 @@ const Schema<HmdConfig>& hmdSchema() {
         .boolean("undistort", &HmdConfig::undistort, true,
                  "the camera images undistorted before the overlays")
         .integer("mirror_monitor", &HmdConfig::mirror_monitor, -1, -1, 15,
-                 "the monitor (0-based) the HMD's view is shown on full screen (-1: none)");
+                 "the monitor (0-based) the HMD's view is shown on full screen (-1: none)")
+        // PNG of the whole HMD frame, about 760 kB each at 1280x480 (camera images barely
+        // compress): "phases" keeps 6 a trial, ~270 MB over a 60-trial day.
+        .text("screenshots", &HmdConfig::screenshots, "phases",
+              "the HMD frames kept as PNG (~760 kB each at 1280x480): phases (the calibration's, "
+              "each trial phase's, the end's and a robot fault's), first_trial (the same for trial "
+              "1 only), end (the end's and a robot fault's), none",
+              [] {
+                return std::vector<std::string>{"phases", "first_trial", "end", "none"};
+              });
     return t;
   }();
   return t;

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <map>
 
+#include "arbci/session/disk_estimate.h"
 #include "arbci/session/scene_source.h"
 #include "arbci/session/stages/camera_stage.h"
 #include "arbci/session/stages/eeg_acquisition_stage.h"
@@ -37,9 +38,13 @@ TrackingSettings trackingSettingsOf(const SessionConfig& c, SceneSource& scene) 
 }
 
 PreflightSettings preflightSettingsOf(const SessionConfig& c, const SessionOptions& options,
-                                      double eeg_rate_hz) {
+                                      const bci::SignalInfo& eeg) {
   PreflightSettings p;
-  p.eeg_rate_hz = eeg_rate_hz;
+  p.eeg_rate_hz = eeg.rate_hz;
+  const DiskEstimate disk = plannedRunBytes(c, eeg.channelCount(), eeg.rate_hz);
+  p.disk_needed = disk.bytes;
+  p.disk_what = disk.what;
+  p.folder = options.folder.string();
   p.known_failures = options.display_failures;
   if (c.cameras.source == "simulated") {
     p.camera_key = "cameras.source";
@@ -171,8 +176,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto presentation = std::make_unique<PresentationStage>(
       PresentationSettings{c.paradigm, eeg_info.rate_hz}, services);
   auto preflight = std::make_unique<PreflightStage>(
-      PreflightStageSettings{preflightSettingsOf(c, options, eeg_info.rate_hz),
-                             c.tracker.max_pose_age_s, options.experimenter},
+      PreflightStageSettings{preflightSettingsOf(c, options, eeg_info), c.tracker.max_pose_age_s,
+                             options.experimenter},
       services);
   auto paradigm = std::make_unique<ParadigmStage>(
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),

@@ -2,12 +2,13 @@
 // session is the point. The default world through three trials with given intentions (a
 // calibration run, training, the robot grasping and putting down, every object within a
 // centimetre), run twice with one seed (the same recording, byte for byte); and a TERM signal that
-// ends a run with its summary saved. Every other behaviour of a session is tested at its own
-// level: each stage on hand-built records (tests/session/stages), the panels on hand-built records
-// (tests/ui), the application's parts in process (tests/app/unit).
+// ends a run with its summary saved, as does a disk that fills mid-run. Every other behaviour of a
+// session is tested at its own level: each stage on hand-built records (tests/session/stages), the
+// panels on hand-built records (tests/ui), the application's parts in process (tests/app/unit).
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -205,6 +206,47 @@ TEST(Session, ATermSignalEndsAHeadlessRunWithItsSummarySaved) {
   const nlohmann::json summary = readJson(folder / "summary.json");
   EXPECT_EQ(summary["ended"], "aborted");
   EXPECT_GT(bci::readRecording(folder / "recording.bdf").samples, 0);
+}
+
+// A disk that fills mid-run (a file-size limit on the process fails its writes as a full disk
+// does): the run ends as a fault with the file and the system's reason on the terminal and in
+// the summary, every sample written before it reads back, screenshots that could not be written
+// are counted, and the process exits, never aborts.
+TEST(Session, ADiskThatFillsMidRunEndsItWithTheReasonAndKeepsTheRecording) {
+  const auto folder = fresh("full_disk");
+  const auto out = fresh("full_disk_terminal.txt");
+  const pid_t child = fork();
+  if (child == 0) {
+    const int terminal = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(terminal, STDOUT_FILENO);
+    dup2(terminal, STDERR_FILENO);
+    ::signal(SIGXFSZ, SIG_IGN);  // kept across exec: the write fails instead
+    rlimit limit{};
+    ::getrlimit(RLIMIT_FSIZE, &limit);
+    limit.rlim_cur = 120 * 1024;
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    execl(kArbci.c_str(), kArbci.c_str(), "run", "--headless", "--session",
+          (kSessions + "/steady_head.json").c_str(), "--out", folder.c_str(), nullptr);
+    _exit(127);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  std::ifstream in(out);
+  const std::string terminal((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+  ASSERT_TRUE(WIFEXITED(status)) << terminal;
+  EXPECT_EQ(WEXITSTATUS(status), 3) << terminal;
+  EXPECT_NE(terminal.find("ended: fault (the recording failed: " +
+                          (folder / "recording.bdf").string() + ": write failed: File too large"),
+            std::string::npos)
+      << terminal;
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "fault");
+  EXPECT_NE(summary["eeg"]["recording_error"].get<std::string>().find("write failed"),
+            std::string::npos);
+  EXPECT_GT(summary["screenshots"]["failed"].get<int>(), 0);
+  const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
+  EXPECT_GT(recording.samples, 256 * 5);
 }
 
 }  // namespace

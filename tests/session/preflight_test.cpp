@@ -2,6 +2,8 @@
 // a failure known before the check (the display's) fails it on its first frame, naming the key.
 #include "arbci/session/preflight.h"
 
+#include "arbci/session/disk_estimate.h"
+
 #include <gtest/gtest.h>
 
 namespace arbci::session {
@@ -51,6 +53,52 @@ TEST(Preflight, AFailureTheDisplayFoundFailsOnTheFirstFrameNamingItsKey) {
   EXPECT_EQ(p.failures().front(), "hmd.mirror_monitor = 3: there is no such monitor");
   ASSERT_GE(p.lines().size(), 2u);
   EXPECT_NE(p.lines()[1].find("hmd.mirror_monitor = 3"), std::string::npos);
+}
+
+TEST(Preflight, ADiskThatCannotHoldThePlannedRunFailsSayingHowMuchIsNeeded) {
+  PreflightSettings s = settings();
+  s.disk_needed = 85'000'000;
+  s.folder = "/data/day1";
+  s.disk_what = "about 85 MB: twice the 26 min planned";
+  Preflight p(s);
+  p.begin(healthy(0));
+  Preflight::State state = Preflight::State::Running;
+  for (int frame = 1; frame < 600 && state == Preflight::State::Running; ++frame) {
+    PreflightObservation o = healthy(frame);
+    o.disk_free = 12'400'000;
+    state = p.update(o);
+  }
+  ASSERT_EQ(state, Preflight::State::Failed);
+  ASSERT_EQ(p.failures().size(), 1u);
+  EXPECT_EQ(p.failures().front(),
+            "--out: the disk holding /data/day1 has 12 MB free; this run needs about 85 MB: "
+            "twice the 26 min planned: free some space, choose another folder, or keep fewer "
+            "screenshots (hmd.screenshots)");
+  // With the space there, the same set-up passes.
+  Preflight enough(s);
+  enough.begin(healthy(0));
+  state = Preflight::State::Running;
+  for (int frame = 1; frame < 600 && state == Preflight::State::Running; ++frame) {
+    PreflightObservation o = healthy(frame);
+    o.disk_free = 200'000'000;
+    state = enough.update(o);
+  }
+  EXPECT_EQ(state, Preflight::State::Passed);
+}
+
+// The estimate grows with the trials, the channels and the screenshots kept, and says so.
+TEST(DiskEstimate, TheRunsFilesFromItsSettings) {
+  SessionConfig c;
+  const DiskEstimate base = plannedRunBytes(c, 9, 256.0);
+  EXPECT_GT(base.planned_s, 60.0);
+  EXPECT_NE(base.what.find("hmd.screenshots \"phases\""), std::string::npos) << base.what;
+  c.paradigm.trials *= 10;
+  const DiskEstimate longer = plannedRunBytes(c, 9, 256.0);
+  EXPECT_GT(longer.bytes, 5 * base.bytes);
+  c.hmd.screenshots = "none";
+  const DiskEstimate fewer = plannedRunBytes(c, 9, 256.0);
+  EXPECT_LT(fewer.bytes, longer.bytes / 2);
+  EXPECT_GT(plannedRunBytes(c, 64, 2048.0).bytes, 20 * fewer.bytes);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "arbci/session/stages/preflight_stage.h"
 
+#include <filesystem>
+
 namespace arbci::session {
 
 PreflightStage::PreflightStage(const PreflightStageSettings& settings,
@@ -17,6 +19,11 @@ PreflightObservation PreflightStage::observe(const Cycle& cycle) const {
   o.eeg_samples = cycle.record.recording.samples;
   o.robot_answered = cycle.record.robot.answered;
   o.robot_key_refused = cycle.record.robot.key_refused;
+  if (settings_.check.disk_needed > 0) {
+    std::error_code error;
+    const auto space = std::filesystem::space(settings_.check.folder, error);
+    if (!error) o.disk_free = space.available;
+  }
   return o;
 }
 

@@ -35,22 +35,40 @@ void RecordingStage::record(Cycle& cycle) {
   cycle.record.recording.samples = writer_->samplesWritten();
 }
 
+// A write that fails (a full disk, an I/O error) ends the run: data that cannot be kept must not
+// be collected. Every record written before it stays readable (the header counts whole records).
 void RecordingStage::step(Cycle& cycle) {
-  record(cycle);
+  if (!failed_.empty()) return;
+  try {
+    record(cycle);
+  } catch (const bci::RecordingError& error) {
+    failed_ = error.what();
+    s_.log.write("recording_failed", cycle.time_s,
+                 {{"text", failed_}, {"samples", writer_->samplesWritten()}});
+    cycle.end("the recording failed: " + failed_ + " (the samples before it are kept)", "fault");
+  }
 }
 
 void RecordingStage::stop(Cycle& cycle, const std::string& reason) {
-  record(cycle);
-  writer_->addAnnotation({cycle.clock.sampleAt(cycle.host_s), "Session ended: " + reason, 0});
-  for (const auto& [sample, flash] : unrecorded_)
-    writer_->addStimulus(stimulusOf(sample, flash, 0));
-  unrecorded_.clear();
-  writer_->close();
+  if (!failed_.empty()) return;  // nothing more can be written; what was written is whole
+  try {
+    record(cycle);
+    writer_->addAnnotation({cycle.clock.sampleAt(cycle.host_s), "Session ended: " + reason, 0});
+    for (const auto& [sample, flash] : unrecorded_)
+      writer_->addStimulus(stimulusOf(sample, flash, 0));
+    unrecorded_.clear();
+    writer_->close();
+  } catch (const bci::RecordingError& error) {
+    failed_ = error.what();
+    s_.log.write("recording_failed", cycle.time_s,
+                 {{"text", failed_}, {"samples", writer_->samplesWritten()}});
+  }
 }
 
 void RecordingStage::report(nlohmann::json& summary) const {
   summary["eeg"]["recording"] = writer_->path().filename().string();
   summary["eeg"]["samples"] = writer_->samplesWritten();
+  if (!failed_.empty()) summary["eeg"]["recording_error"] = failed_;
 }
 
 }  // namespace arbci::session

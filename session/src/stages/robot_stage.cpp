@@ -150,6 +150,13 @@ void RobotStage::stop(double time_s) {
   s_.log.write("robot_command", time_s, {{"command", "STOP"}, {"sequence", sequence}});
 }
 
+void RobotStage::stop(Cycle& cycle, const std::string& reason) {
+  if (!busy() || stopped_) return;
+  s_.log.write("robot_stopped_at_end", cycle.time_s, {{"reason", reason}});
+  stop(cycle.time_s);
+  client_.poll();
+}
+
 void RobotStage::stopNow(double time_s) {
   stop(time_s);
 }

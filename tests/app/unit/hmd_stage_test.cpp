@@ -39,7 +39,8 @@ class HmdStageTest : public ::testing::Test {
     session::CycleRecord warm_up;
     tracked(warm_up);
     stage_ =
-        std::make_unique<HmdStage>(HmdSettings::of(config), bench_.folder(), *context_, warm_up);
+        std::make_unique<HmdStage>(HmdSettings::of(config), bench_.folder(), *context_, warm_up,
+                                   bench_.services());
   }
   test::StageBench bench_;
   std::unique_ptr<render::GlContext> context_;

@@ -5,6 +5,7 @@
 
 #include "arbci/bci/recording.h"
 #include "arbci/session/stages/recording_stage.h"
+#include "support/file_size_limit.h"
 #include "support/stage_bench.h"
 
 namespace arbci::session {
@@ -119,6 +120,38 @@ TEST(RecordingStage, AFileThatCannotBeCreatedIsRefusedNamingIt) {
     FAIL() << "a recording in a missing folder was created";
   } catch (const std::exception& error) {
     EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+  }
+}
+
+// A disk that fills mid-run (a file-size limit fails the writes as a full disk does): the run
+// ends as a fault naming the file and the system's reason, nothing more is written, the stop does
+// not throw, and every second written before the failure reads back exactly.
+TEST_F(RecordingStageTest, AWriteThatFailsEndsTheRunAndKeepsWhatWasWritten) {
+  std::int64_t first = 0;
+  {
+    test::FileSizeLimit limit(40 * 1024);
+    for (int second = 0; second < 60 && bench_.record.end_reason.empty(); ++second) {
+      for (int i = 0; i < 16; ++i) bench_.record.eeg.blocks.push_back(block(first + 16 * i));
+      first += 256;
+      bench_.step(*stage_);
+      if (bench_.record.end_reason.empty()) bench_.next();
+    }
+    EXPECT_EQ(bench_.record.end_kind, "fault");
+    EXPECT_NE(bench_.record.end_reason.find("recording.bdf: write failed"), std::string::npos)
+        << bench_.record.end_reason;
+    Cycle c = bench_.cycle();
+    stage_->stop(c, bench_.record.end_reason);  // writes nothing more, throws nothing
+  }
+  nlohmann::json summary;
+  stage_->report(summary);
+  EXPECT_NE(summary["eeg"]["recording_error"].get<std::string>().find("write failed"),
+            std::string::npos);
+  const bci::Recording r = bci::readRecording(path_);
+  EXPECT_GT(r.samples, 256 * 5);
+  EXPECT_LT(r.samples, first);
+  for (std::int64_t s = 0; s < r.samples; s += 97) {
+    EXPECT_NEAR(r.at(0, s), static_cast<float>(s), 0.05) << s;
+    EXPECT_NEAR(r.at(1, s), -static_cast<float>(s), 0.05) << s;
   }
 }
 

@@ -5,6 +5,7 @@
 // each failure naming the session file's key to look at.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +23,10 @@ struct PreflightSettings {
   std::string eeg_key;
   int reference_id = 0;
   std::string robot_key, robot_what;
+  // The session folder's disk must have this much free (0: not checked); `disk_what` says how
+  // it was reckoned.
+  std::uintmax_t disk_needed = 0;
+  std::string folder, disk_what;
   // Failures known before the check begins (the display's: a missing HMD monitor); any fails
   // the pre-flight on its first frame.
   std::vector<std::string> known_failures;
@@ -36,7 +41,8 @@ struct PreflightObservation {
   double max_pose_age_s = 0.0;            // the session's tracker.max_pose_age_s
   long long eeg_samples = 0;              // recorded so far
   bool robot_answered = false;
-  bool robot_key_refused = false;  // it answered, with KEY MISMATCH
+  bool robot_key_refused = false;           // it answered, with KEY MISMATCH
+  std::optional<std::uintmax_t> disk_free;  // on the session folder's disk (unknown: unchecked)
 };
 
 class Preflight {

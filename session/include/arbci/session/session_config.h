@@ -33,7 +33,8 @@ struct HmdConfig {
   HmdConfig();
   int width, height;  // both eyes side by side
   bool undistort;
-  int mirror_monitor;  // -1: no mirror window
+  int mirror_monitor;       // -1: no mirror window
+  std::string screenshots;  // which HMD frames are kept: "phases", "first_trial", "end", "none"
 };
 
 struct CameraSource {

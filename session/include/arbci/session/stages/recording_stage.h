@@ -2,7 +2,8 @@
 // in the order they happened — the notes the stages made last cycle (phases, selections,
 // tracking, robot steps), each flash with its label (Stim <code> T|N|U, grid codes as 100 + code)
 // and measured duration once its last frame has passed, the feedback shown, and every stretch of
-// lost samples.
+// lost samples. A write that fails (a full disk) ends the run as a fault, naming the file and the
+// system's reason; what was written before stays readable.
 #pragma once
 
 #include <filesystem>
@@ -36,6 +37,7 @@ class RecordingStage final : public Stage {
   StageServices s_;
   std::unique_ptr<bci::RecordingWriter> writer_;
   std::map<std::int64_t, Flash> unrecorded_;  // by onset sample, until its duration is known
+  std::string failed_;  // why a write failed (the run ended there); "" while all is written
 };
 
 }  // namespace arbci::session

@@ -29,6 +29,9 @@ class RobotStage final : public Stage {
   RobotStage(const RobotStageSettings& settings, RobotLink link, const StageServices& services);
   const char* name() const override { return "robot"; }
   void step(Cycle& cycle) override;
+  // The run ends (a fault, an abort, a full disk): a motion still in flight is STOPped, so the
+  // arm never runs on unsupervised (the watchdog would halt it too, once heartbeats stop).
+  void stop(Cycle& cycle, const std::string& reason) override;
   // STOP now, not a frame later (the experimenter's emergency stop); the paradigm is told on the
   // record next cycle.
   void stopNow(double time_s);
