@@ -132,12 +132,15 @@ TEST(OpenCvDictionaries, ArucoTutorialPhotosGiveTheirIds) {
 
 // AprilTag through libapriltag: every tag of the library's own regression images, at its
 // reference corners (libapriltag's pixel centres sit +0.5 from OpenCV's). The references were
-// made without edge refinement, so it is off here; with it (the default) each corner moves by a
-// fraction of a pixel.
-TEST(AprilTags, EveryReferenceTagOfTheLibrarysTestImagesAtItsCorners) {
+// made without edge refinement: off, each corner lies within a pixel of its reference; with it
+// (the default, ARBCI's refinement after decoding) the corners move onto the edges, by a third
+// of a pixel typically and up to 3.5 px on the most oblique tags (libapriltag's own refinement
+// moves those 2.4 px), and no tag may be lost (libapriltag's refinement before decoding lost the
+// 12-pixel tag near (702, 114)).
+void expectEveryReferenceTag(bool refine_edges, float tolerance_px) {
   DetectorConfig config;
   config.kind = MarkerKind::AprilTag;
-  config.apriltag_refine_edges = false;
+  config.apriltag_refine_edges = refine_edges;
   MarkerDetector detector(config);
   int reference_tags = 0, found_tags = 0;
   for (const char* name :
@@ -168,19 +171,27 @@ TEST(AprilTags, EveryReferenceTagOfTheLibrarysTestImagesAtItsCorners) {
       EXPECT_EQ(m.kind, MarkerKind::AprilTag);
     }
     // Each reference tag has a detection whose corners (libapriltag's p[3], p[2], p[1], p[0] as
-    // top-left, top-right, bottom-right, bottom-left) lie within a pixel of it.
+    // top-left, top-right, bottom-right, bottom-left) lie within the tolerance of it.
     for (const auto& ref : reference) {
       const bool found = std::any_of(markers.begin(), markers.end(), [&](const auto& m) {
         for (int k = 0; k < 4; ++k)
-          if (cv::norm(m.corners[k] - ref[3 - k]) > 1.0) return false;
+          if (cv::norm(m.corners[k] - ref[3 - k]) > tolerance_px) return false;
         return true;
       });
       found_tags += found;
-      EXPECT_TRUE(found) << name << ": a reference tag at " << ref[0];
+      EXPECT_TRUE(found) << name << ": the reference tag at " << ref[0] << " was lost";
     }
   }
   EXPECT_EQ(reference_tags, 47);
   EXPECT_EQ(found_tags, 47);
+}
+
+TEST(AprilTags, EveryReferenceTagOfTheLibrarysTestImagesAtItsCorners) {
+  expectEveryReferenceTag(false, 1.0f);
+}
+
+TEST(AprilTags, EveryReferenceTagWithEdgeRefinementTheDefault) {
+  expectEveryReferenceTag(true, 4.0f);
 }
 
 // OpenCV's AprilTag dictionary names choose the same family. OpenCV's aruco module reads these

@@ -13,6 +13,8 @@
 
 #include <stdexcept>
 
+#include "quad_fit.h"
+
 namespace arbci::vision {
 namespace {
 
@@ -56,6 +58,7 @@ struct AprilTagDetector::Impl {
   const Family* family = nullptr;
   apriltag_family_t* tags = nullptr;
   apriltag_detector_t* detector = nullptr;
+  bool refine_edges = true;
   ~Impl() {
     if (detector) apriltag_detector_destroy(detector);
     if (tags) family->destroy(tags);
@@ -72,7 +75,8 @@ AprilTagDetector::AprilTagDetector(const std::string& family, bool refine_edges,
   apriltag_detector_add_family(impl_->detector, impl_->tags);
   impl_->detector->quad_decimate = static_cast<float>(decimate);
   impl_->detector->nthreads = 1;
-  impl_->detector->refine_edges = refine_edges;
+  impl_->detector->refine_edges = false;  // see the header: refined after decoding instead
+  impl_->refine_edges = refine_edges;
 }
 
 AprilTagDetector::~AprilTagDetector() = default;
@@ -96,6 +100,12 @@ std::vector<MarkerDetection> AprilTagDetector::detect(const cv::Mat& gray) {
     for (int k = 0; k < 4; ++k) {
       const double* p = d->p[3 - k];
       m.corners[k] = cv::Point2f(static_cast<float>(p[0] - 0.5), static_cast<float>(p[1] - 0.5));
+    }
+    if (impl_->refine_edges) {
+      QuadFitParams params;
+      params.min_side = 4.0f;
+      // Kept as libapriltag placed them when the sides cannot be moved onto edges.
+      if (const auto refined = refineQuad(m.corners, gray, params)) m.corners = refined->corners;
     }
     m.ideal_corners = m.corners;
     m.corrected_bits = d->hamming;

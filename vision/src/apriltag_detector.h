@@ -18,10 +18,12 @@ std::string aprilTagFamilies();
 class AprilTagDetector {
  public:
   // `family`: a libapriltag family name, or OpenCV's DICT_APRILTAG_16h5/25h9/36h10/36h11 for
-  // the same families; empty: tag36h11. `refine_edges`: libapriltag's edge refinement (its
-  // default). `decimate`: libapriltag's quad_decimate (1: quads found at full resolution, small
-  // tags count; 2: on the frame halved, the edges then refined on the frame). Throws
-  // std::invalid_argument naming the accepted ones.
+  // the same families; empty: tag36h11. `refine_edges`: each detection's sides moved onto the
+  // frame's edges by ARBCI's own refinement (quad_fit's), not libapriltag's: libapriltag refines
+  // before it decodes, and on a tag of a dozen pixels its refined outline no longer decodes (one
+  // of its own 47 regression tags is lost). `decimate`: libapriltag's quad_decimate (1: quads found
+  // at full resolution, small tags count; 2: on the frame halved, the edges then refined on the
+  // frame). Throws std::invalid_argument naming the accepted ones.
   AprilTagDetector(const std::string& family, bool refine_edges, int decimate = 1);
   ~AprilTagDetector();
   AprilTagDetector(const AprilTagDetector&) = delete;
