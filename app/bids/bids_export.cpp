@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -29,10 +31,12 @@ void checkLabel(const std::string& what, const std::string& label, bool digits_o
         (digits_only ? "digits only (e.g. 1)" : "letters and digits only (e.g. 01, P3)"));
 }
 
+// Checked after the flush: a full disk shows only when the buffer reaches it.
 void writeText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
-  if (!out) throw BidsError("cannot write " + path.string());
+  out.close();
+  if (!out) throw BidsError("cannot write " + path.string() + ": " + std::strerror(errno));
 }
 
 std::string number(double value) {
@@ -113,7 +117,9 @@ void ensureDatasetFiles(const fs::path& root, const std::string& subject,
   if (!known.count("sub-" + subject)) {
     std::ofstream out(participants, std::ios::app);
     out << "sub-" << subject << "\n";
-    if (!out) throw BidsError("cannot write " + participants.string());
+    out.close();
+    if (!out)
+      throw BidsError("cannot write " + participants.string() + ": " + std::strerror(errno));
   }
   describeDataset(root / "derivatives" / "arbci", "ARBCI session files", "derivative");
 }
@@ -222,6 +228,10 @@ std::string bidsTarget(const fs::path& root, const BidsEntities& entities) {
   return text;
 }
 
+BidsExport exportRun(const bci::Recording& recording, const fs::path& session_dir,
+                     const fs::path& root, const Layout& layout, const std::string& stem,
+                     const BidsEntities& entities, const BidsDescription& description);
+
 BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
                         const BidsEntities& entities, const BidsDescription& description) {
   checkBidsEntities(entities);
@@ -247,6 +257,29 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
   ensureDatasetFiles(root, entities.subject, description.authors);
   fs::create_directories(eeg_dir);
   const std::string stem = prefix + "_run-" + std::to_string(run);
+  try {
+    return exportRun(recording, session_dir, root, layout, stem, entities, description);
+  } catch (const std::exception& error) {
+    // A run half exported (a full disk) would block its own export later ("already in"): what
+    // was written of it goes, so that the same command can be run again once there is room.
+    std::error_code ignored;
+    for (const auto& entry : fs::directory_iterator(eeg_dir, ignored)) {
+      if (entry.path().filename().string().rfind(stem + "_", 0) == 0)
+        fs::remove(entry.path(), ignored);
+    }
+    fs::remove_all(root / "derivatives" / "arbci" / layout.relative / "eeg" / stem, ignored);
+    throw BidsError(std::string(error.what()) + "; nothing of run " + std::to_string(run) +
+                    " was left in " + root.string() + ": make room and export it again");
+  }
+}
+
+// The run's files, once its layout is settled; throws on the first that cannot be written.
+BidsExport exportRun(const bci::Recording& recording, const fs::path& session_dir,
+                     const fs::path& root, const Layout& layout, const std::string& stem,
+                     const BidsEntities& entities, const BidsDescription& description) {
+  const fs::path& eeg_dir = layout.eeg_dir;
+  const fs::path bdf = session_dir / "recording.bdf";
+  const int run = layout.run;
   BidsExport out;
   out.run = std::to_string(run);
   out.eeg_file = eeg_dir / (stem + "_eeg.bdf");

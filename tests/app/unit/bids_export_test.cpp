@@ -15,6 +15,7 @@
 
 #include "arbci/bci/recording_writer.h"
 #include "bids/bids_export.h"
+#include "support/file_size_limit.h"
 #include "support/test_files.h"
 
 namespace arbci::app {
@@ -130,6 +131,29 @@ TEST(BidsExport, ReferenceManufacturerAndAuthorsFromTheSessionOrTheCommand) {
   dataset = nlohmann::json::parse(read(root / "dataset_description.json"));
   EXPECT_EQ(dataset["Authors"], nlohmann::json::array({"Grace Hopper"}));
   EXPECT_EQ(dataset["Name"], "ARBCI sessions");
+}
+
+// A disk that fills during the export (a file-size limit fails the copy as a full disk does):
+// the error says so, nothing of the run is left to block its export later, and the same export
+// runs once there is room.
+TEST(BidsExport, AFullDiskLeavesNoHalfRunAndTheSameExportWorksOnceThereIsRoom) {
+  const fs::path dir = sessionFolder("full_disk", "");
+  const fs::path root = dir / "bids";
+  {
+    test::FileSizeLimit limit(20 * 1024);
+    try {
+      exportToBids(dir, root, {"01", "", "arbci", ""});
+      ADD_FAILURE() << "exported past the file-size limit";
+    } catch (const BidsError& error) {
+      EXPECT_NE(std::string(error.what()).find("nothing of run 1 was left in"), std::string::npos)
+          << error.what();
+    }
+  }
+  for (const auto& entry : fs::recursive_directory_iterator(root))
+    EXPECT_EQ(entry.path().filename().string().find("run-1"), std::string::npos) << entry.path();
+  const BidsExport done = exportToBids(dir, root, {"01", "", "arbci", ""});
+  EXPECT_EQ(done.run, "1");
+  EXPECT_TRUE(fs::exists(done.eeg_file));
 }
 
 }  // namespace
