@@ -55,8 +55,8 @@ TEST(DetectCommand, PrintsOneJsonObjectPerFrameWithMarkersAndStageTimes) {
     EXPECT_GT(marker["confidence"].get<double>(), 0.9);
     // Every stage, and (--repeat reports one whole run, the median's) they add up to the total.
     double parts = 0.0;
-    for (const char* stage : {"convert", "smooth", "threshold", "label", "quads", "retry", "refine",
-                              "decode", "other"}) {
+    for (const char* stage : {"convert", "smooth", "threshold", "label", "quads", "retry", "edges",
+                              "refine", "decode", "other"}) {
       ASSERT_TRUE(frame["timing_us"].contains(stage)) << stage;
       parts += frame["timing_us"][stage].get<double>();
     }

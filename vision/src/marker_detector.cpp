@@ -18,6 +18,7 @@
 
 #include "blurred_edges.h"
 #include "contour_trace.h"
+#include "edge_quads.h"
 #include "marker_sampler.h"
 #include "quad_fit.h"
 #include "quad_geometry.h"
@@ -103,7 +104,7 @@ struct MarkerDetector::Impl {
   // `gray` is a read-only view: of the caller's pixels for grey input, else of `converted`.
   // `converted` and `smoothed` are written only by this detector and never shared with callers,
   // so reusing their buffers can never write into a caller's image.
-  cv::Mat gray, converted, smoothed, half;
+  cv::Mat gray, converted, smoothed, half, edges_image;
   const cv::Mat* binarised = nullptr;  // `gray` or `smoothed`
   // The image candidates are searched in: `binarised`, or `half` (search_decimate 2), whose
   // pixels are `scale` of the frame's.
@@ -252,6 +253,98 @@ struct MarkerDetector::Impl {
       time.retry += microseconds(retry_start, Clock::now());
     }
     time.quads += microseconds(start, Clock::now()) - time.retry;
+  }
+
+  // passes.edge_segments, after the outline search's quads were decoded: as the other later
+  // passes, with adaptive thresholds only (a constant or automatic threshold is the
+  // experimenter's choice of what counts as dark), and, where the caller said which ids to
+  // expect, only when one of them was not read.
+  void searchEdges(StageTimes& time, std::vector<MarkerDetection>& markers) {
+    const SearchPasses::EdgeSegments& pass = config.passes.edge_segments;
+    if (config.threshold.mode != ThresholdMode::Adaptive || !pass.enabled || pass.max_quads <= 0)
+      return;
+    if (!config.expected_ids.empty()) {
+      std::set<int> missing = config.expected_ids;
+      for (const MarkerDetection& m : markers) missing.erase(m.id);
+      if (missing.empty()) return;
+    }
+    const auto start = Clock::now();
+    std::vector<Quad> first;
+    first.swap(found.searched);  // the frame's quads already looked at
+    found.on_frame.clear();
+    QuadFitParams params;
+    params.min_side = std::max(4.0f, config.min_side_px / static_cast<float>(scale));
+    params.lens = scale == 1 ? config.lens.get() : nullptr;
+    addEdgeSegmentQuads(params, markers, first);
+    time.edges += microseconds(start, Clock::now());
+    std::vector<MarkerDetection> more;
+    float lowest = 255.0f, highest = 0.0f, median = -1.0f;
+    decode(time, more, lowest, highest, median);
+    for (const MarkerDetection& m : more) markers.push_back(m);
+    first.insert(first.end(), found.searched.begin(), found.searched.end());
+    found.searched.swap(first);
+  }
+
+  // passes.edge_segments (search_passes.h: why). On half the searched resolution when the search
+  // is at full: the segment detector's cost goes with the pixels, and a marker large enough to
+  // read has sides long enough at half. Its quads join the searched image's, refined on it.
+  void addEdgeSegmentQuads(const QuadFitParams& params, const std::vector<MarkerDetection>& markers,
+                           const std::vector<Quad>& looked_at) {
+    const SearchPasses::EdgeSegments& pass = config.passes.edge_segments;
+    const bool reduce = scale == 1;
+    if (reduce) cv::resize(*searched, edges_image, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    const cv::Mat& image = reduce ? edges_image : *searched;
+    EdgeQuadParams edges;
+    edges.min_side = std::max(4.0f, params.min_side / (reduce ? 2.0f : 1.0f));
+    edges.min_contrast = static_cast<float>(pass.min_contrast);
+    edges.max_corner_gap = static_cast<float>(pass.max_corner_gap);
+    edges.max_covered_gap = static_cast<float>(pass.max_covered_gap);
+    edges.max_quads = pass.max_quads;
+    // The markers already read, in the segment image's pixels (half the frame's: a reduced
+    // pixel's centre is the middle of the two it averages). Other quads of the outline search
+    // are no reason to skip a place: one may be a failed fit over the very marker sought.
+    std::vector<Quad> known;
+    for (const MarkerDetection& m : markers) {
+      Quad q;
+      for (int k = 0; k < 4; ++k) q.corners[k] = (m.corners[k] - cv::Point2f(0.5f, 0.5f)) * 0.5f;
+      // Either turn: the markers' corners follow the printed order, clockwise on screen unless
+      // seen from behind.
+      if (signedQuadArea(q.corners) < 0.0f) std::reverse(q.corners.begin(), q.corners.end());
+      known.push_back(q);
+    }
+    // A solid dark quadrilateral is no marker of a code whose every id has light cells (BCH).
+    const bool needs_light_cells = family.code && family.code->min_light_cells > 0;
+    // A quad the outline search already read (in vain) at the same corners is not read again.
+    auto readBefore = [&](const std::array<cv::Point2f, 4>& corners) {
+      const float near = 2.0f * static_cast<float>(scale);
+      return std::any_of(looked_at.begin(), looked_at.end(), [&](const Quad& q) {
+        for (int k = 0; k < 4; ++k) {
+          bool matched = false;
+          for (int j = 0; j < 4 && !matched; ++j)
+            matched = cv::norm(q.corners[j] - corners[k]) <= near;
+          if (!matched) return false;
+        }
+        return true;
+      });
+    };
+    for (Quad quad : edgeSegmentQuads(image, known, edges)) {
+      if (!reduce) {
+        const auto on_frame = onFrameCoarse(quad.corners);
+        if (readBefore(on_frame) ||
+            (needs_light_cells && hasFlatCodeArea(gray, on_frame, config.border)))
+          continue;
+        found.searched.push_back(quad);  // refined on the frame when decoded
+        continue;
+      }
+      for (cv::Point2f& c : quad.corners) c = c * 2.0f + cv::Point2f(0.5f, 0.5f);
+      auto refined = refineQuad(quad.corners, *searched, params);
+      if (!refined) continue;
+      if (readBefore(refined->corners) ||
+          (needs_light_cells && hasFlatCodeArea(gray, refined->corners, config.border)))
+        continue;
+      refined->occluded = quad.occluded;
+      found.searched.push_back(*refined);
+    }
   }
 
   // A reduced image's point in frame pixels: a reduced pixel's centre is the middle of the frame
@@ -448,6 +541,7 @@ struct MarkerDetector::Impl {
       float lowest = 255.0f, highest = 0.0f, marker_median = -1.0f;
       result.markers.clear();
       decode(time, result.markers, lowest, highest, marker_median);
+      searchEdges(time, result.markers);
       result.candidates = static_cast<int>(found.searched.size());
       result.threshold_attempts = attempt + 1;
       if (!automatic) break;

@@ -54,6 +54,26 @@ const core::Schema<Passes::NearMisses>& nearMissesSchema() {
   return t;
 }
 
+const core::Schema<Passes::EdgeSegments>& edgeSegmentsSchema() {
+  static const core::Schema<Passes::EdgeSegments> t = [] {
+    core::Schema<Passes::EdgeSegments> s(
+        "edge_segments",
+        "quads assembled from straight edge segments (LSD at half resolution): a marker whose "
+        "covered corner joined its border to the background");
+    s.boolean("enabled", &Passes::EdgeSegments::enabled, true, "run this pass")
+        .number("min_contrast", &Passes::EdgeSegments::min_contrast, 16.0, 1.0, 255.0,
+                "grey levels between a segment's dark and light sides")
+        .number("max_corner_gap", &Passes::EdgeSegments::max_corner_gap, 0.12, 0.0, 0.5,
+                "a side's segment ends this near its corner, as a fraction of the side")
+        .number("max_covered_gap", &Passes::EdgeSegments::max_covered_gap, 0.45, 0.0, 0.9,
+                "at one covered corner, this near, as a fraction of the side")
+        .integer("max_quads", &Passes::EdgeSegments::max_quads, 16, 0, 200,
+                 "candidates read a frame, from the longest sides");
+    return s;
+  }();
+  return t;
+}
+
 const core::Schema<Passes::CutCorners>& cutCornersSchema() {
   static const core::Schema<Passes::CutCorners> t = [] {
     core::Schema<Passes::CutCorners> s(
@@ -170,7 +190,8 @@ const core::Schema<SearchPasses>& searchPassesSchema() {
         .section("fragments", &SearchPasses::fragments, fragmentsSchema())
         .section("thin_on_frame", &SearchPasses::thin_on_frame, thinOnFrameSchema())
         .section("mid_grey", &SearchPasses::mid_grey, midGreySchema())
-        .section("blurred_edges", &SearchPasses::blurred_edges, blurredEdgesSchema());
+        .section("blurred_edges", &SearchPasses::blurred_edges, blurredEdgesSchema())
+        .section("edge_segments", &SearchPasses::edge_segments, edgeSegmentsSchema());
     return t;
   }();
   return table;

@@ -7,6 +7,9 @@ namespace {
 
 vision::DetectorConfig detectorFor(const TrackingSettings& settings) {
   vision::DetectorConfig d = settings.detector;
+  // The markers the session looks for: the costliest search pass runs only when one is missed.
+  d.expected_ids = {settings.reference_id};
+  for (const auto& [id, size] : settings.marker_size) d.expected_ids.insert(id);
   if (!settings.left_camera.distortion.empty())
     d.lens = std::make_shared<vision::Undistorter>(settings.left_camera,
                                                    vision::UndistortMode::LookupTable);

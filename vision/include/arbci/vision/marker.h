@@ -53,22 +53,24 @@ struct MarkerDetection {
 };
 
 // Microseconds spent in each stage of one frame: quads is the quad search on the image searched,
-// retry the re-binarised near misses and fragments, refine the decimated search's quads moved
-// onto the frame's edges, other the work between the timed stages. The parts add up to total.
+// retry the re-binarised near misses and fragments, edges the quads assembled from edge segments,
+// refine the decimated search's quads moved onto the frame's edges, other the work between the
+// timed stages. The parts add up to total.
 struct StageTimes {
-  double convert = 0, smooth = 0, threshold = 0, label = 0, quads = 0, retry = 0, refine = 0,
-         decode = 0, other = 0, total = 0;
+  double convert = 0, smooth = 0, threshold = 0, label = 0, quads = 0, retry = 0, edges = 0,
+         refine = 0, decode = 0, other = 0, total = 0;
   StageTimes& operator+=(const StageTimes& more);
 };
 
 // Every part of StageTimes with its name, in pipeline order (total is not a part).
-inline constexpr std::array<std::pair<const char*, double StageTimes::*>, 9> kStageParts{{
+inline constexpr std::array<std::pair<const char*, double StageTimes::*>, 10> kStageParts{{
     {"convert", &StageTimes::convert},
     {"smooth", &StageTimes::smooth},
     {"threshold", &StageTimes::threshold},
     {"label", &StageTimes::label},
     {"quads", &StageTimes::quads},
     {"retry", &StageTimes::retry},
+    {"edges", &StageTimes::edges},
     {"refine", &StageTimes::refine},
     {"decode", &StageTimes::decode},
     {"other", &StageTimes::other},

@@ -7,6 +7,7 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,10 @@ struct DetectorConfig {
   // 2) is not smoothed.
   Smoothing smoothing = Smoothing::Auto;
   float min_side_px = 8;  // smaller squares are ignored
+  // The ids the caller expects in view (a session: its reference and objects); empty: unknown.
+  // The edge-segment pass (passes.edge_segments, the costliest) then runs only on frames where
+  // the outline search missed one of them, e.g. an object whose corner a hand covers.
+  std::set<int> expected_ids;
   // Square kinds: 1 looks for candidates at full resolution; 2 thresholds, labels and fits quads
   // on the frame averaged over 2x2 pixels (a quarter of the pixels), then moves every side onto
   // the full-resolution edge, as AprilTag's quad_decimate. About twice as fast; markers need about

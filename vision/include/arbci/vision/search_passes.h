@@ -114,6 +114,21 @@ struct SearchPasses {
     bool enabled;
     double min_move_px;
   } blurred_edges;
+
+  // A finger over a corner that also reaches the background joins the border's dark component to
+  // the background's: no outline of the marker is left to fit. Quads are then assembled from
+  // straight edge segments (OpenCV's LSD on the frame at half resolution, as AprilTag 3 fits its
+  // quads to edge points): four segments dark on their inner side that follow one another
+  // turning right, each ending within `max_corner_gap` of its side from the next corner, except
+  // at one covered corner (within `max_covered_gap`). Segments whose sides differ by less than
+  // `min_contrast` grey levels are left out. At most `max_quads` candidates a frame are read.
+  struct EdgeSegments {
+    bool enabled;
+    double min_contrast;
+    double max_corner_gap;
+    double max_covered_gap;
+    int max_quads;
+  } edge_segments;
 };
 
 }  // namespace arbci::vision
