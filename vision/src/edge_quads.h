@@ -16,14 +16,15 @@
 
 namespace arbci::vision {
 
+// As tracker.passes.edge_segments (search_passes.h), in the image's pixels.
 struct EdgeQuadParams {
-  float min_side = 8.0f;       // px on the image given
-  float min_contrast = 16.0f;  // grey levels between a segment's dark and light sides
+  float min_side = 0.0f;      // px on the image given
+  float min_contrast = 0.0f;  // grey levels between a segment's dark and light sides
   // A side's segment ends within this fraction of its side of the corner (at least 2 px), except
   // at one covered corner, where the gap may be up to `max_covered_gap` of the side.
-  float max_corner_gap = 0.12f;
-  float max_covered_gap = 0.45f;
-  int max_quads = 16;  // candidates a frame, the longest sides first
+  float max_corner_gap = 0.0f;
+  float max_covered_gap = 0.0f;
+  int max_quads = 0;  // candidates a frame, the longest sides first
 };
 
 // Quads on `half` (an image at half the searched resolution or the searched image itself), their
