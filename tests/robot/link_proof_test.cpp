@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <string>
 #include <thread>
 
 #include "support/raw_robot_session.h"
@@ -37,11 +38,34 @@ BackendOptions withWatchdog(double first_heartbeat_wait_s) {
   return options;
 }
 
+// The answer to command `sequence` is a refusal for `reason` whose text says `says`.
+void expectRefused(RawSession& raw, std::uint64_t sequence, RejectReason reason,
+                   const std::string& says, std::chrono::milliseconds wait = 2s) {
+  const auto refused = raw.answer(sequence, wait);
+  ASSERT_TRUE(refused) << "no answer to " << sequence;
+  EXPECT_EQ(refused->type, MessageType::Rejected);
+  EXPECT_EQ(refused->reason, reason);
+  EXPECT_NE(refused->text.find(says), std::string::npos) << refused->text;
+}
+
+// A session bound by hand that has sent HOME 102 and no heartbeat yet.
+struct WaitingHome {
+  explicit WaitingHome(double first_heartbeat_wait_s)
+      : backend(std::make_unique<SimulatedArm>(twoObjects()), withWatchdog(first_heartbeat_wait_s)),
+        raw(backend.port()),
+        bound(raw.hello(100)) {
+    raw.send(raw.message(MessageType::Home, 102));
+  }
+  RunningBackend backend;
+  RawSession raw;
+  bool bound;
+};
+
 TEST(RobotLinkProof, AMotionWaitsForTheSessionsFirstHeartbeatAndThenRuns) {
-  RunningBackend backend(std::make_unique<SimulatedArm>(twoObjects()), withWatchdog(60.0));
-  RawSession raw(backend.port());
-  ASSERT_TRUE(raw.hello(100));
-  raw.send(raw.message(MessageType::Home, 102));
+  WaitingHome w(60.0);
+  ASSERT_TRUE(w.bound);
+  RunningBackend& backend = w.backend;
+  RawSession& raw = w.raw;
   raw.send(raw.message(MessageType::Home, 102));  // a retransmission while it waits
   std::this_thread::sleep_for(100ms);
   EXPECT_EQ(backend.stats().executed, 0u);
@@ -53,38 +77,29 @@ TEST(RobotLinkProof, AMotionWaitsForTheSessionsFirstHeartbeatAndThenRuns) {
 }
 
 TEST(RobotLinkProof, AMotionWithNoHeartbeatIsRefusedAsUnreachable) {
-  RunningBackend backend(std::make_unique<SimulatedArm>(twoObjects()), withWatchdog(0.2));
-  RawSession raw(backend.port());
-  ASSERT_TRUE(raw.hello(100));
-  raw.send(raw.message(MessageType::Home, 102));
-  const auto refused = raw.answer(102, 5s);
-  ASSERT_TRUE(refused);
-  EXPECT_EQ(refused->type, MessageType::Rejected);
-  EXPECT_EQ(refused->reason, RejectReason::Unreachable);
-  EXPECT_NE(refused->text.find("no heartbeat came from the client"), std::string::npos)
-      << refused->text;
+  WaitingHome w(0.2);
+  ASSERT_TRUE(w.bound);
+  RunningBackend& backend = w.backend;
+  RawSession& raw = w.raw;
+  expectRefused(raw, 102, RejectReason::Unreachable, "no heartbeat came from the client", 5s);
   EXPECT_EQ(backend.stats().executed, 0u);
 }
 
 TEST(RobotLinkProof, AStaleFirstHeartbeatRefusesTheWaitingMotion) {
-  RunningBackend backend(std::make_unique<SimulatedArm>(twoObjects()), withWatchdog(60.0));
-  RawSession raw(backend.port());
-  ASSERT_TRUE(raw.hello(100));
-  raw.send(raw.message(MessageType::Home, 102));
+  WaitingHome w(60.0);
+  ASSERT_TRUE(w.bound);
+  RunningBackend& backend = w.backend;
+  RawSession& raw = w.raw;
   raw.heartbeat(103, 750ms);  // what a slow link's heartbeat looks like on arrival
-  const auto refused = raw.answer(102);
-  ASSERT_TRUE(refused);
-  EXPECT_EQ(refused->type, MessageType::Rejected);
-  EXPECT_EQ(refused->reason, RejectReason::Unreachable);
-  EXPECT_NE(refused->text.find("too slow to move safely"), std::string::npos) << refused->text;
+  expectRefused(raw, 102, RejectReason::Unreachable, "too slow to move safely");
   EXPECT_EQ(backend.stats().executed, 0u);
 }
 
 TEST(RobotLinkProof, AStopWhileAMotionWaitsRefusesIt) {
-  RunningBackend backend(std::make_unique<SimulatedArm>(twoObjects()), withWatchdog(60.0));
-  RawSession raw(backend.port());
-  ASSERT_TRUE(raw.hello(100));
-  raw.send(raw.message(MessageType::Home, 102));
+  WaitingHome w(60.0);
+  ASSERT_TRUE(w.bound);
+  RunningBackend& backend = w.backend;
+  RawSession& raw = w.raw;
   std::this_thread::sleep_for(50ms);
   raw.send(raw.message(MessageType::Stop, 103));
   const auto refused = raw.answer(102);
@@ -153,17 +168,11 @@ TEST(RobotLinkProof, AMotionWithoutAStopEpochOrWithAFutureOneIsRefusedSayingWhic
   Message none = raw.message(MessageType::Home, 103);
   none.stop_epoch = 0;
   raw.send(none);
-  const auto no_epoch = raw.answer(103);
-  ASSERT_TRUE(no_epoch);
-  EXPECT_EQ(no_epoch->reason, RejectReason::BeforeStop);
-  EXPECT_NE(no_epoch->text.find("carries no stop epoch (0)"), std::string::npos) << no_epoch->text;
+  expectRefused(raw, 103, RejectReason::BeforeStop, "carries no stop epoch (0)");
   Message future = raw.message(MessageType::Home, 104);
   future.stop_epoch = 7;
   raw.send(future);
-  const auto ahead = raw.answer(104);
-  ASSERT_TRUE(ahead);
-  EXPECT_EQ(ahead->reason, RejectReason::BeforeStop);
-  EXPECT_NE(ahead->text.find("has not reached (epoch now 1)"), std::string::npos) << ahead->text;
+  expectRefused(raw, 104, RejectReason::BeforeStop, "has not reached (epoch now 1)");
 }
 
 }  // namespace
