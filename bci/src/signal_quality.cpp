@@ -24,6 +24,20 @@ double amplitudeAt(const std::vector<double>& y, double hz, double rate_hz) {
   return 2.0 * std::hypot(re, im) / window_sum;
 }
 
+// Line noise is a peak: the amplitude at the line frequency at least this many times the mean of
+// its neighbours 2 to 6 Hz either side. Broadband noise (a loose electrode, muscle) is as strong
+// at 50 or 60 Hz as beside them and is graded by its RMS instead (one frequency of white noise
+// stands four times above the mean of ten others about once in a hundred thousand).
+constexpr double kLinePeakRatio = 4.0;
+
+bool isPeak(const std::vector<double>& y, double hz, double rate_hz) {
+  double beside = 0.0;
+  for (const double d : {2.0, 3.0, 4.0, 5.0, 6.0}) {
+    beside += (amplitudeAt(y, hz - d, rate_hz) + amplitudeAt(y, hz + d, rate_hz)) / 10.0;
+  }
+  return amplitudeAt(y, hz, rate_hz) >= kLinePeakRatio * beside;
+}
+
 struct Finding {
   Grade grade;
   std::string text;
@@ -91,6 +105,7 @@ SignalQuality assessSignal(const float* x, int n, double rate_hz, const QualityT
   q.rms_uv = std::sqrt(sum_sq / n);
   q.line50_uv = amplitudeAt(detrended, 50.0, rate_hz);
   q.line60_uv = amplitudeAt(detrended, 60.0, rate_hz);
+  const bool peak50 = isPeak(detrended, 50.0, rate_hz), peak60 = isPeak(detrended, 60.0, rate_hz);
   q.flat = q.sd_uv < t.flat_sd_uv;
   q.saturated = peak >= t.saturated_uv;
 
@@ -107,9 +122,11 @@ SignalQuality assessSignal(const float* x, int n, double rate_hz, const QualityT
     q.finding = text;
     return q;
   }
-  const bool fifty = q.line50_uv >= q.line60_uv;
+  // The stronger of the two lines that stand out from their neighbours; none when neither does.
+  const double line50 = peak50 ? q.line50_uv : 0.0, line60 = peak60 ? q.line60_uv : 0.0;
+  const bool fifty = line50 >= line60;
   const Finding findings[] = {
-      graded(fifty ? "line noise 50 Hz" : "line noise 60 Hz", fifty ? q.line50_uv : q.line60_uv,
+      graded(fifty ? "line noise 50 Hz" : "line noise 60 Hz", fifty ? line50 : line60,
              t.line_poor_uv, t.line_bad_uv),
       graded("drift", std::abs(q.drift_uv_s), t.drift_poor_uv_s, t.drift_bad_uv_s, "uV/s"),
       graded("RMS", q.rms_uv, t.rms_poor_uv, t.rms_bad_uv),

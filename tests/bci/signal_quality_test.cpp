@@ -55,6 +55,19 @@ TEST(SignalQuality, LineNoiseIsMeasuredAt50And60HzAndGradedWithItsThreshold) {
   EXPECT_NE(sixty.finding.find("line noise 60 Hz"), std::string::npos) << sixty.finding;
 }
 
+// Broadband noise (a loose electrode) is as strong at 50 and 60 Hz as beside them: graded by its
+// RMS, never as line noise; a line on top of it is still named.
+TEST(SignalQuality, BroadbandNoiseIsNotLineNoise) {
+  for (unsigned seed = 1; seed <= 100; ++seed) {
+    const SignalQuality broadband = assess(signal(144.0, 0.0, 50.0, 0.0, seed));
+    EXPECT_EQ(broadband.grade, Grade::Bad) << broadband.finding;
+    EXPECT_EQ(broadband.finding.rfind("RMS", 0), 0u)
+        << "seed " << seed << ": " << broadband.finding;
+  }
+  const SignalQuality with_line = assess(signal(40.0, 60.0, 50.0));
+  EXPECT_NE(with_line.finding.find("line noise 50 Hz"), std::string::npos) << with_line.finding;
+}
+
 TEST(SignalQuality, FlatSaturatedAndDriftingChannelsAreNamed) {
   const SignalQuality flat = assess(signal(0.1));
   EXPECT_TRUE(flat.flat);
