@@ -1,19 +1,19 @@
 #include "hmd/image_writer.h"
 
-#include <fcntl.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <cerrno>
-#include <cstring>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "arbci/core/whole_file.h"
+
 namespace arbci::app {
 namespace {
 
-// "" when the image is on disk; else why not, with the system's reason (a full disk).
+// "" when the image is on disk; else why not, with the system's reason (a full disk). Written
+// whole or not at all: no half image is left to be taken for a whole one.
 std::string encodeAndWrite(const std::filesystem::path& path, const cv::Mat& image) {
   std::vector<std::uint8_t> bytes;
   try {
@@ -21,20 +21,7 @@ std::string encodeAndWrite(const std::filesystem::path& path, const cv::Mat& ima
   } catch (const cv::Exception& error) {
     return std::string("cannot encode: ") + error.what();
   }
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return "cannot create " + path.string() + ": " + std::strerror(errno);
-  size_t done = 0;
-  std::string why;
-  while (done < bytes.size() && why.empty()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno != EINTR)
-      why = "cannot write " + path.string() + ": " + std::strerror(errno);
-    if (n > 0) done += static_cast<size_t>(n);
-  }
-  if (::close(fd) != 0 && why.empty())
-    why = "cannot write " + path.string() + ": " + std::strerror(errno);
-  if (!why.empty()) ::unlink(path.c_str());  // no half image left to be taken for a whole one
-  return why;
+  return core::writeWholeFile(path, std::string(bytes.begin(), bytes.end()));
 }
 
 }  // namespace

@@ -86,7 +86,9 @@ double upperTail(int n, int e, int b, int limit) {
   return p;
 }
 
-// The chance that some fold's training part has fewer than kMinimumTargets of a class.
+// The chance that some fold's training part has fewer than kMinimumTargets of a class, bounded
+// above by the sum over folds of the held-out block's hypergeometric tail (a union bound: the
+// size it gives is never too small).
 double foldFailure(int n, int wrong, int folds) {
   double p = 0.0;
   for (int f = 0; f < folds; ++f) {

@@ -26,7 +26,7 @@ constexpr size_t kMaxChallenges = 256;
 // The watchdog looks this much before its deadline, so that waking from the socket wait (tens of
 // microseconds, more on a busy machine) does not carry the halt past the watchdog time.
 constexpr std::int64_t kWakeMarginUs = 1000;
-// Source addresses whose unbound budget is remembered; the least recently heard is forgotten.
+// Source addresses whose unbound budget is remembered at once (see SourceBudgets::forgetQuiet).
 constexpr size_t kBudgetedSources = 1024;
 
 std::uint64_t randomId() {
@@ -68,7 +68,7 @@ class SourceBudgets {
                               from.address.sin_port;  // address and port, as received
     auto found = budgets_.find(key);
     if (found == budgets_.end()) {
-      if (budgets_.size() >= kBudgetedSources) forgetOldest();
+      if (budgets_.size() >= kBudgetedSources) forgetQuiet(now);
       found = budgets_.emplace(key, Entry{TokenBucket(rate_), now}).first;
     }
     found->second.heard = now;
@@ -80,12 +80,15 @@ class SourceBudgets {
     TokenBucket bucket;
     SteadyClock::time_point heard;
   };
-  void forgetOldest() {
-    auto oldest = budgets_.begin();
-    for (auto it = budgets_.begin(); it != budgets_.end(); ++it) {
-      if (it->second.heard < oldest->second.heard) oldest = it;
-    }
-    budgets_.erase(oldest);
+  // Addresses quiet for a second have a full budget again: forgetting them changes nothing. When
+  // every one spoke within the second (a flood forging a new address each time), all are
+  // forgotten: each new address starts with a full budget either way. Once per kBudgetedSources
+  // new addresses at most, so a flood of new addresses costs no scan per datagram.
+  void forgetQuiet(SteadyClock::time_point now) {
+    std::erase_if(budgets_, [&](const auto& entry) {
+      return now - entry.second.heard >= std::chrono::seconds(1);
+    });
+    if (budgets_.size() >= kBudgetedSources) budgets_.clear();
   }
   double rate_;
   std::map<std::uint64_t, Entry> budgets_;

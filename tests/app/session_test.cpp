@@ -8,7 +8,6 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +22,7 @@
 #include <thread>
 
 #include "arbci/bci/recording.h"
+#include "support/file_size_limit.h"
 #include "support/run_process.h"
 #include "support/shared_data.h"
 #include "support/test_files.h"
@@ -220,11 +220,7 @@ TEST(Session, ADiskThatFillsMidRunEndsItWithTheReasonAndKeepsTheRecording) {
     const int terminal = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(terminal, STDOUT_FILENO);
     dup2(terminal, STDERR_FILENO);
-    ::signal(SIGXFSZ, SIG_IGN);  // kept across exec: the write fails instead
-    rlimit limit{};
-    ::getrlimit(RLIMIT_FSIZE, &limit);
-    limit.rlim_cur = 120 * 1024;
-    ::setrlimit(RLIMIT_FSIZE, &limit);
+    const FileSizeLimit limit(120 * 1024);  // kept across exec (SIGXFSZ ignored with it)
     execl(kArbci.c_str(), kArbci.c_str(), "run", "--headless", "--session",
           (kSessions + "/steady_head.json").c_str(), "--out", folder.c_str(), nullptr);
     _exit(127);

@@ -3,16 +3,16 @@
 // a file cut short is refused with a reason or salvaged up to its last complete record.
 #include <edflib.h>
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
-#include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
+#include "support/file_size_limit.h"
 #include "support/test_files.h"
 
 namespace arbci::bci {
@@ -165,26 +165,14 @@ TEST(Recording, UnwritablePathNamesTheFile) {
 // goes away without terminating the process (its syncing thread ends with it).
 TEST(Recording, AFullDiskIsAnErrorNamingTheFileNotATerminate) {
   const auto path = test::freshTempPath("recording", "full.bdf");
-  rlimit old{};
-  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
-  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
-  struct Restore {
-    rlimit limit;
-    void (*handler)(int);
-    ~Restore() {
-      ::setrlimit(RLIMIT_FSIZE, &limit);
-      std::signal(SIGXFSZ, handler);
-    }
-  } restore{old, old_handler};
   SignalInfo info;
   info.rate_hz = 256.0;
   info.channels = {"Cz", "Pz"};
   std::string error;
+  std::optional<test::FileSizeLimit> limit;  // lifted after the writer has gone
   {
     RecordingWriter writer(path, info);
-    rlimit small = old;
-    small.rlim_cur = 64 * 1024;
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    limit.emplace(64 * 1024);
     try {
       for (int b = 0; b < 1000; ++b) {
         Block block(b * 256, 2, 256);

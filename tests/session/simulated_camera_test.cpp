@@ -94,10 +94,9 @@ TEST(SimulatedCamera, ThroughADistortingLensWithNoiseAndBlur) {
 // marker (SimulatedWorld during a grasp). Seen from the subject's head, as the session's cameras
 // are, an object on the near half of the table (57 places) is still found, by its sides, with its
 // pose; without the occluded-corner and edge-segment passes none is, so the fingertip (18 % of the
-// side along both edges, nearly black) really hides the corner. The pass does not find every place
-// (measured here: 56 of 57; the GL renderer this one replaced, 125 of 126 over a similar set), and
-// a hidden corner costs accuracy that depends on the place (median 1.6 mm, worst 2.3 cm; GL: 2.0 mm
-// and 1.9 cm), so both are asserted over the set, not place by place.
+// side along both edges, nearly black) really hides the corner. The passes need not find every
+// place, and a hidden corner costs accuracy that depends on the place, so both are asserted over
+// the set, not place by place.
 TEST(SimulatedCamera, TheGrippersFingertipOverACornerLeavesTheObjectsPoseTracked) {
   const vision::CameraModel camera = camera640();
   SimulatedCamera simulated(camera, 3);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "quad_geometry.h"
+
 namespace arbci::vision {
 namespace {
 
@@ -72,13 +74,6 @@ int link(const Segment& a, const Segment& b, const EdgeQuadParams& p) {
   return 0;
 }
 
-bool insideConvex(const std::array<cv::Point2f, 4>& q, cv::Point2f p) {
-  for (int k = 0; k < 4; ++k) {
-    if (cross(q[(k + 1) % 4] - q[k], p - q[k]) < 0.0f) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 std::vector<Quad> edgeSegmentQuads(const cv::Mat& half, const std::vector<Quad>& known,
@@ -141,9 +136,7 @@ std::vector<Quad> edgeSegmentQuads(const cv::Mat& half, const std::vector<Quad>&
             ok = side >= params.min_side && sides[k]->length >= 0.45f * side;
           }
           if (!ok) continue;
-          const cv::Point2f middle =
-              0.25f * (quad.corners[0] + quad.corners[1] + quad.corners[2] + quad.corners[3]);
-          if (!insideConvex(quad.corners, middle) || taken(middle)) continue;
+          if (signedQuadArea(quad.corners) <= 0.0f || taken(centre(quad.corners))) continue;
           quad.ideal_corners = quad.corners;
           quad.occluded = gaps == 1;
           quads.push_back(quad);

@@ -307,9 +307,6 @@ struct MarkerDetector::Impl {
     for (const MarkerDetection& m : markers) {
       Quad q;
       for (int k = 0; k < 4; ++k) q.corners[k] = (m.corners[k] - cv::Point2f(0.5f, 0.5f)) * 0.5f;
-      // Either turn: the markers' corners follow the printed order, clockwise on screen unless
-      // seen from behind.
-      if (signedQuadArea(q.corners) < 0.0f) std::reverse(q.corners.begin(), q.corners.end());
       known.push_back(q);
     }
     // A solid dark quadrilateral is no marker of a code whose every id has light cells (BCH).

@@ -19,11 +19,7 @@ PreflightObservation PreflightStage::observe(const Cycle& cycle) const {
   o.eeg_samples = cycle.record.recording.samples;
   o.robot_answered = cycle.record.robot.answered;
   o.robot_key_refused = cycle.record.robot.key_refused;
-  if (settings_.check.disk_needed > 0) {
-    std::error_code error;
-    const auto space = std::filesystem::space(settings_.check.folder, error);
-    if (!error) o.disk_free = space.available;
-  }
+  o.disk_free = disk_free_;
   return o;
 }
 
@@ -33,6 +29,13 @@ void PreflightStage::step(Cycle& cycle) {
                      preflight_.state() != Preflight::State::Running;
   if (begin) {
     s_.log.write("preflight_started", cycle.time_s, {});
+    // Once a check: the disk does not fill in the seconds it lasts.
+    disk_free_.reset();
+    if (settings_.check.disk_needed > 0) {
+      std::error_code error;
+      const auto space = std::filesystem::space(settings_.check.folder, error);
+      if (!error) disk_free_ = space.available;
+    }
     preflight_.begin(observe(cycle));
   }
   if (preflight_.state() == Preflight::State::Running) {

@@ -39,11 +39,10 @@ FeedbackRecording feedbackRecording(const Recording& session,
                                     FeedbackPart part = FeedbackPart::Both);
 
 // The fewest calibration feedbacks (a share `wrong_rate` of them wrong, in random order) that
-// train the ErrP classifier with `folds` contiguous cross-validation folds. The wrong ones fall at
-// random, so a held-out block may take more than its share of them; the block is big enough when
-// every fold's training part keeps kMinimumTargets of each class with a chance of 99 % or more
-// (bounded by summing each held-out block's hypergeometric tail). 0 when no size up to 100,000
-// is big enough.
+// train the ErrP classifier with `folds` contiguous cross-validation folds: every fold's training
+// part must keep kMinimumTargets of each class with a chance of 99 % or more, because the wrong
+// ones fall at random and a held-out block may take more than its share. 0 when no size up to
+// 100,000 is enough.
 int minimumCalibrationFeedbacks(double wrong_rate, int folds);
 
 }  // namespace arbci::bci

@@ -4,6 +4,9 @@
 // terminal and in the panel, and a run without an experimenter ends there.
 #pragma once
 
+#include <cstdint>
+#include <optional>
+
 #include "arbci/session/preflight.h"
 #include "arbci/session/stage.h"
 
@@ -27,6 +30,7 @@ class PreflightStage final : public Stage {
   PreflightStageSettings settings_;
   StageServices s_;
   Preflight preflight_;
+  std::optional<std::uintmax_t> disk_free_;  // on the session folder's disk, at the check's start
 };
 
 }  // namespace arbci::session
