@@ -10,6 +10,13 @@ find_package(nlohmann_json 3 REQUIRED)
 find_package(OpenSSL REQUIRED)
 find_package(ZLIB REQUIRED)
 find_package(orocos_kdl REQUIRED)
+# MuJoCo (libmujoco-dev): found by hand, because Debian 12's mujocoConfig.cmake names an include
+# folder (libqhull_r) that no package installs, which stops CMake's generate step.
+find_path(MUJOCO_INCLUDE_DIR mujoco/mujoco.h REQUIRED)
+find_library(MUJOCO_LIBRARY mujoco REQUIRED)
+add_library(arbci_mujoco INTERFACE)
+target_include_directories(arbci_mujoco SYSTEM INTERFACE ${MUJOCO_INCLUDE_DIR})
+target_link_libraries(arbci_mujoco INTERFACE ${MUJOCO_LIBRARY})
 # LSL stream descriptions are XML and discovery queries are XPath: pugixml evaluates them as
 # liblsl does (Debian libpugixml-dev).
 find_package(pugixml REQUIRED)

@@ -25,13 +25,13 @@ void onSignal(int) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  const std::string about =
       "arbci-robotd: the ARBCI robot backend. Accepts HELLO, BIND, GRASP, DROP, HOME, STOP, "
-      "RESET, HEARTBEAT and STATUS over UDP,\n"
-      "authenticated with the shared key (make one with `arbci robot keygen`), and drives a\n"
-      "simulated six-joint arm (UR10 kinematics) over a simulated table. Protocol: "
-      "docs/robot-protocol.md.",
-      "arbci-robotd"};
+      "RESET, HEARTBEAT and STATUS over UDP,\nauthenticated with the shared key (make one with "
+      "`arbci robot keygen`), and drives an arm (--driver):\n" +
+      arbci::robot::robotDrivers().describe() +
+      "Protocol: docs/robot-protocol.md; the drivers and the physics arm's model: docs/robot.md.";
+  CLI::App app{about, "arbci-robotd"};
   arbci::app::RobotdOptions o;
   arbci::app::addRobotdOptions(app, o);
   app.set_version_flag("--version", std::string("arbci-robotd ") + ARBCI_VERSION);
@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
     const arbci::robot::Key key = arbci::robot::loadKey(o.key_file);
     arbci::robot::RobotConfig config;
     if (!o.config_file.empty()) config = arbci::robot::RobotConfig::load(o.config_file);
+    if (!o.model.empty()) config.model = o.model;
     arbci::robot::BackendOptions options;
     options.port = o.port;
     options.host = o.host;

@@ -17,9 +17,9 @@ void addRobotdOptions(CLI::App& app, RobotdOptions& o) {
                  "write the port listened on to this file once listening");
   schemaOption(app, "--host", o.host, link.at("host"), "the address to listen on");
   app.add_option("--key-file", o.key_file, "the shared key")->required();
-  app.add_option("--driver", o.driver, "the arm to drive: " + robot::robotDrivers().list(", "))
-      ->capture_default_str()
-      ->check(CLI::IsMember(robot::robotDrivers().names()));
+  schemaOption(app, "--driver", o.driver, link.at("driver"));
+  schemaOption(app, "--model", o.model, robot::configSchema().at("model"),
+               "in place of the config's model");
   app.add_option("--config", o.config_file,
                  "ROBOT.json: workspace, table, motion, simulated objects (defaults if omitted)");
   schemaOptionOwnDefault(app, "--speed", o.speed, robot::configSchema().at("speed_factor"), 0.0,

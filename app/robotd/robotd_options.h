@@ -10,7 +10,8 @@ namespace arbci::app {
 
 struct RobotdOptions {
   int port = 0;  // robot.port
-  std::string host, key_file, config_file, port_file, driver = "simulated";
+  std::string host, key_file, config_file, port_file, model;
+  std::string driver;  // robot.driver
   double speed = 0.0;  // 0: the config's speed_factor
   bool stepped = false;
   int watchdog_ms = 0;  // robot.watchdog_ms

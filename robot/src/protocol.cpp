@@ -4,6 +4,7 @@
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -170,6 +171,8 @@ void writePayload(Writer& w, const Message& m) {
         w.integer(s.objects[i].id);
         w.vec(s.objects[i].position);
         w.integer(static_cast<std::uint8_t>(s.objects[i].held ? 1 : 0));
+        for (double q : s.objects[i].orientation)
+          w.integer(static_cast<std::int16_t>(std::lround(std::clamp(q, -1.0, 1.0) * 32767.0)));
       }
       break;
     }
@@ -262,6 +265,13 @@ bool readPayload(Reader& r, Message& m) {
         o.id = r.integer<std::int32_t>();
         o.position = r.vec();
         o.held = r.integer<std::uint8_t>() != 0;
+        double norm = 0.0;
+        for (double& q : o.orientation) {
+          q = r.integer<std::int16_t>() / 32767.0;
+          norm += q * q;
+        }
+        if (norm < 0.25) return false;  // not a rotation
+        for (double& q : o.orientation) q /= std::sqrt(norm);
         s.objects.push_back(o);
       }
       return !r.failed && finite(s.tool);

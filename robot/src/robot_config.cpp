@@ -32,20 +32,6 @@ core::Schema<S>& point(core::Schema<S>& t, const std::string& name, Vec3 S::*mem
 
 constexpr double kTiny = 1e-6;  // "positive": above it
 
-const core::Schema<SimulatedObject>& objectSchema() {
-  static const core::Schema<SimulatedObject> table = [] {
-    core::Schema<SimulatedObject> t("object", "An object of the simulated world");
-    t.required(Key{"id", Type::Integer, nullptr, "its marker id", "", 0, 1 << 30},
-               &SimulatedObject::id);
-    point(t, "position", &SimulatedObject::position, nullptr, "the centre of its top face", true);
-    t.number("height", &SimulatedObject::height, 0.06, kTiny, 10.0, "its height", "m")
-        .number("radius", &SimulatedObject::radius, 0.03, kTiny, 10.0,
-                "its footprint's radius, for contact and grasping", "m");
-    return t;
-  }();
-  return table;
-}
-
 const core::Schema<RobotConfig>& workspaceSchema() {
   static const core::Schema<RobotConfig> table = [] {
     core::Schema<RobotConfig> t("workspace", "The box the tool may reach (robot frame)");
@@ -64,6 +50,25 @@ const core::Schema<RobotConfig>& workspaceSchema() {
 }
 
 }  // namespace
+
+const core::Schema<SimulatedObject>& objectSchema() {
+  static const core::Schema<SimulatedObject> table = [] {
+    core::Schema<SimulatedObject> t("object", "An object of the simulated world");
+    t.required(core::Key{"id", Type::Integer, nullptr, "its marker id", "", 0, 1 << 30},
+               &SimulatedObject::id);
+    point(t, "position", &SimulatedObject::position, nullptr, "the centre of its top face", true);
+    t.number("height", &SimulatedObject::height, 0.06, kTiny, 10.0, "its height", "m")
+        .number("radius", &SimulatedObject::radius, 0.03, kTiny, 10.0,
+                "its footprint's radius, for contact and grasping (the mujoco driver: half the "
+                "side of its square footprint)",
+                "m")
+        .number("mass", &SimulatedObject::mass, 0.15, 0.001, 20.0, "mujoco driver: its mass", "kg")
+        .number("friction", &SimulatedObject::friction, 0.8, 0.05, 3.0,
+                "mujoco driver: its sliding friction coefficient");
+    return t;
+  }();
+  return table;
+}
 
 const core::Schema<RobotConfig>& configSchema() {
   static const core::Schema<RobotConfig> table = [] {
@@ -85,6 +90,13 @@ const core::Schema<RobotConfig>& configSchema() {
         .number("gripper_seconds", &R::gripper_seconds, 0.5, kTiny, 60.0,
                 "how long the gripper takes to open or close", "s");
     point(t, "home", &R::home, {0.0, 0.45, 0.45}, "where HOME parks the tool");
+    t.text("model", &R::model, "",
+           "mujoco driver: the arm's MJCF file, or arm6 or arm7, the project's 6- and 7-axis "
+           "arms (\"\": arm6); docs/robot.md names what a model must provide")
+        .number("grip_force", &R::grip_force, 15.0, 0.5, 500.0,
+                "mujoco driver: the gripper closes until each finger presses this hard", "N")
+        .number("contact_force", &R::contact_force, 3.0, 0.1, 500.0,
+                "mujoco driver: a descent ends when the wrist's force changes this much", "N");
     t.list("objects", &R::objects, objectSchema(), Json::array(), 0,
            "the simulated world's objects (none: a real arm's world is its own)");
     return t;
@@ -94,7 +106,7 @@ const core::Schema<RobotConfig>& configSchema() {
 
 const core::Schema<LinkSettings>& linkSchema() {
   static const core::Schema<LinkSettings> table = [] {
-    core::Schema<LinkSettings> t("link", "The robot backend's UDP address");
+    core::Schema<LinkSettings> t("link", "The robot backend: its UDP address and its arm");
     t.text("host", &LinkSettings::host, kLoopback,
            "the backend's host (arbci-robotd: the address it listens on)")
         .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port")
@@ -108,7 +120,12 @@ const core::Schema<LinkSettings>& linkSchema() {
                  "send time of the commanding client's newest heartbeat (a heartbeat the link "
                  "delayed counts as missing); 0: off (not for a real arm); raise it on a lossy "
                  "link",
-                 "ms");
+                 "ms")
+        // The kinematic arm by default: it puts an object exactly where it was sent, so the
+        // default session measures the tracker and the classifier, not the grasp.
+        .text("driver", &LinkSettings::driver, "simulated",
+              "the arm arbci-robotd drives: " + robotDrivers().list(", "),
+              [] { return robotDrivers().names(); });
     return t;
   }();
   return table;

@@ -27,8 +27,8 @@ RobotLink connectRobot(const RobotSettings& settings, const robot::RobotConfig& 
   // A simulated clock steps the arm too (the robot follows the session, frame by frame).
   link.stepped = clock.stepped();
   link.backend = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder / "robot.json",
-                                                settings.speed_factor, settings.watchdog_ms, folder,
-                                                link.stepped);
+                                                settings.driver, settings.speed_factor,
+                                                settings.watchdog_ms, folder, link.stepped);
   std::ofstream(folder / "robotd.pid") << link.backend->pid() << "\n";
   link.client = std::make_unique<robot::RobotClient>(
       robot::Endpoint::resolve("127.0.0.1", link.backend->port()), key);

@@ -30,8 +30,9 @@ std::filesystem::path robotdNextToMe() {
 
 RobotProcess::RobotProcess(const std::filesystem::path& executable,
                            const std::filesystem::path& key_file,
-                           const std::filesystem::path& config_file, double speed_factor,
-                           int watchdog_ms, const std::filesystem::path& folder, bool stepped) {
+                           const std::filesystem::path& config_file, const std::string& driver,
+                           double speed_factor, int watchdog_ms,
+                           const std::filesystem::path& folder, bool stepped) {
   if (!std::filesystem::exists(executable))
     throw std::runtime_error(executable.string() +
                              ": the robot backend is not there (build arbci-robotd)");
@@ -50,8 +51,9 @@ RobotProcess::RobotProcess(const std::filesystem::path& executable,
       dup2(log, STDOUT_FILENO);
     }
     execl(executable.c_str(), executable.c_str(), "--port", "0", "--port-file", port_file.c_str(),
-          "--key-file", key_file.c_str(), "--config", config_file.c_str(), "--speed", speed.c_str(),
-          "--watchdog-ms", watchdog.c_str(), stepped ? "--stepped" : nullptr, nullptr);
+          "--key-file", key_file.c_str(), "--config", config_file.c_str(), "--driver",
+          driver.c_str(), "--speed", speed.c_str(), "--watchdog-ms", watchdog.c_str(),
+          stepped ? "--stepped" : nullptr, nullptr);
     _exit(127);
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);

@@ -148,6 +148,12 @@ const Schema<TrackerSettings>& trackerSchema() {
   return t;
 }
 
+// Another module's key under this file's name for it (its unit in the name, as the others here).
+Key renamed(Key key, std::string name) {
+  key.name = std::move(name);
+  return key;
+}
+
 const Schema<WorldObjectSettings>& objectSchema() {
   static const Schema<WorldObjectSettings> t = [] {
     using O = WorldObjectSettings;
@@ -156,7 +162,15 @@ const Schema<WorldObjectSettings>& objectSchema() {
     vec3(t, "position", &O::position, nullptr, "[x, y, z] of the top centre in metres", true);
     t.number("marker_m", &O::marker_m, 0.05, 0.005, 0.5, "its marker's side", "m")
         .number("width_m", &O::width_m, 0.07, 0.005, 0.6, "its width (at least the marker's)", "m")
-        .number("height_m", &O::height_m, 0.06, 0.005, 0.6, "its height", "m");
+        .number("height_m", &O::height_m, 0.06, 0.005, 0.6, "its height", "m")
+        .custom(
+            renamed(robot::objectSchema().at("mass"), "mass_kg"),
+            [](O& o, const Json& j) { o.mass_kg = j.get<double>(); },
+            [](const O& o) { return Json(o.mass_kg); })
+        .custom(
+            robot::objectSchema().at("friction"),
+            [](O& o, const Json& j) { o.friction = j.get<double>(); },
+            [](const O& o) { return Json(o.friction); });
     vec3(t, "color", &O::color, {0.8, 0.4, 0.3}, "its colour (red, green, blue, 0-1)");
     t.numbers("covered_s", &O::covered_s, {}, 0, 16,
               "simulated cameras: a hand lies over its marker from each first to each second "
@@ -219,6 +233,8 @@ Json defaultObjects() {
                 {"marker_m", 0.05},
                 {"width_m", 0.07},
                 {"height_m", 0.06},
+                {"mass_kg", robot::SimulatedObject().mass},
+                {"friction", robot::SimulatedObject().friction},
                 {"color", std::move(color)},
                 {"covered_s", Json::array()}};
   };
@@ -482,6 +498,10 @@ const Schema<RobotSettings>& robotSchema() {
            [] {
              return std::vector<std::string>{"simulated", "remote"};
            })
+        .custom(
+            robot::linkSchema().at("driver"),
+            [](R& r, const Json& j) { r.driver = j.get<std::string>(); },
+            [](const R& r) { return Json(r.driver); })
         .number("speed_factor", &R::speed_factor, 8.0, 0.1, 100.0,
                 "simulated: the arm's seconds per second of the session")
         .custom(

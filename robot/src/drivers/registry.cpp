@@ -5,11 +5,13 @@
 namespace arbci::robot {
 
 DriverRegistry::Entry simulatedArmDriver();
+DriverRegistry::Entry mujocoArmDriver();
 
 const DriverRegistry& robotDrivers() {
   static const DriverRegistry registry = [] {
     DriverRegistry r("robot driver", "arbci-robotd --driver");
     r.add(simulatedArmDriver());
+    r.add(mujocoArmDriver());
     return r;
   }();
   return registry;

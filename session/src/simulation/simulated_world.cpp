@@ -3,6 +3,17 @@
 #include <cmath>
 
 namespace arbci::session {
+namespace {
+
+// A unit quaternion (w, x, y, z) as a rotation matrix.
+cv::Matx33d rotationOf(const std::array<double, 4>& q) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+}
+
+}  // namespace
 
 SimulatedWorld::SimulatedWorld(const SceneSettings& settings) : settings_(settings) {
   const CameraSettings& c = settings.cameras;
@@ -40,8 +51,11 @@ robot::RobotConfig SimulatedWorld::robotConfig() const {
   r.workspace_max = {0.7, 1.0, settings_.world.table_z + 0.6};
   r.speed_factor = settings_.robot_speed_factor;
   for (const WorldObjectSettings& o : settings_.world.objects) {
-    r.objects.push_back(
-        {o.id, {o.position[0], o.position[1], o.position[2]}, o.height_m, o.width_m / 2.0});
+    robot::SimulatedObject object(o.id, {o.position[0], o.position[1], o.position[2]}, o.height_m,
+                                  o.width_m / 2.0);
+    object.mass = o.mass_kg;
+    object.friction = o.friction;
+    r.objects.push_back(object);
   }
   return r;
 }
@@ -50,8 +64,10 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
   for (const robot::WorldObject& reported : status.objects) {
     for (SceneObject& o : scene_.objects) {
       const cv::Vec3d p(reported.position.x, reported.position.y, reported.position.z);
-      if (o.marker.id == reported.id && p != o.T_world_top.translation) {
-        o.T_world_top.translation = p;
+      const cv::Matx33d r = rotationOf(reported.orientation);
+      if (o.marker.id == reported.id &&
+          (p != o.T_world_top.translation || r != o.T_world_top.rotation)) {
+        o.T_world_top = {r, p};
         ++scene_revision_;
       }
     }

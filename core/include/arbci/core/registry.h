@@ -58,6 +58,12 @@ class Registry {
     for (const Entry& e : entries_) out += (out.empty() ? "" : separator) + e.name;
     return out;
   }
+  // One line per entry, "  name: doc\n", for a --help text.
+  std::string describe() const {
+    std::string out;
+    for (const Entry& e : entries_) out += "  " + e.name + ": " + e.doc + "\n";
+    return out;
+  }
   const std::vector<Entry>& entries() const { return entries_; }
   const std::string& family() const { return family_; }
   const std::string& key() const { return key_; }

@@ -16,7 +16,7 @@
 
 namespace arbci::robot {
 
-constexpr std::uint8_t kProtocolVersion = 3;
+constexpr std::uint8_t kProtocolVersion = 4;
 constexpr size_t kHeaderBytes = 42;
 constexpr size_t kMacBytes = 32;
 constexpr size_t kMaxDatagram = 1400;
@@ -77,6 +77,9 @@ struct WorldObject {
   std::int32_t id = 0;
   Vec3 position;  // the centre of its top face, robot frame, metres
   bool held = false;
+  // Its orientation (w, x, y, z; identity: upright, axes along the robot's), sent to 1/32767: a
+  // physics driver's object can turn or topple.
+  std::array<double, 4> orientation{1.0, 0.0, 0.0, 0.0};
 };
 
 struct StatusPayload {

@@ -20,11 +20,18 @@ class ConfigError : public std::runtime_error {
 struct SimulatedObject {
   SimulatedObject();  // the schema's defaults
   SimulatedObject(int object_id, Vec3 top, double object_height, double object_radius)
-      : id(object_id), position(top), height(object_height), radius(object_radius) {}
+      : SimulatedObject() {
+    id = object_id;
+    position = top;
+    height = object_height;
+    radius = object_radius;
+  }
   int id;
   Vec3 position;  // the centre of its top face
   double height;
-  double radius;  // of its footprint, for contact and grasping
+  double radius;    // of its footprint, for contact and grasping
+  double mass;      // kg (the physics driver's)
+  double friction;  // sliding friction coefficient (the physics driver's)
 };
 
 struct RobotConfig {
@@ -40,6 +47,11 @@ struct RobotConfig {
   double max_joint_speed;  // rad/s
   double gripper_seconds;
   Vec3 home;
+  // The mujoco driver: its arm's MJCF ("": the project's 6-axis arm), the grip it closes to and
+  // the contact force that ends a descent.
+  std::string model;
+  double grip_force;     // N
+  double contact_force;  // N
   std::vector<SimulatedObject> objects;
 
   // Throws ConfigError naming the file and the field.

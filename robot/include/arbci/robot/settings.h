@@ -16,6 +16,8 @@
 namespace arbci::robot {
 
 const core::Schema<RobotConfig>& configSchema();
+// An object of the simulated world (configSchema()'s objects[]).
+const core::Schema<SimulatedObject>& objectSchema();
 
 // Where a backend listens and a client finds it.
 struct LinkSettings {
@@ -23,6 +25,7 @@ struct LinkSettings {
   std::string host;
   int port;
   int watchdog_ms;
+  std::string driver;  // the arm arbci-robotd drives: robotDrivers()'s name
 };
 const core::Schema<LinkSettings>& linkSchema();
 

@@ -14,8 +14,9 @@ class RobotProcess {
   // Starts `executable` and waits (at most 10 s) until it listens. Throws std::runtime_error
   // with the reason (and the end of its log) when it does not come up.
   RobotProcess(const std::filesystem::path& executable, const std::filesystem::path& key_file,
-               const std::filesystem::path& config_file, double speed_factor, int watchdog_ms,
-               const std::filesystem::path& folder, bool stepped = false);
+               const std::filesystem::path& config_file, const std::string& driver,
+               double speed_factor, int watchdog_ms, const std::filesystem::path& folder,
+               bool stepped = false);
   ~RobotProcess();  // SIGTERM, then SIGKILL after 2 s
   RobotProcess(const RobotProcess&) = delete;
   RobotProcess& operator=(const RobotProcess&) = delete;

@@ -76,6 +76,7 @@ struct WorldObjectSettings {
   int id;              // its marker's BCH id
   cv::Vec3d position;  // top centre, robot frame
   double marker_m, width_m, height_m;
+  double mass_kg, friction;  // the physics driver's body
   cv::Vec3d color;
   // Simulated cameras: a hand lies over its marker between each pair of session times (from, to).
   std::vector<double> covered_s;
@@ -187,6 +188,7 @@ struct TrialIntent {
 struct RobotSettings {
   RobotSettings();
   std::string backend;  // "simulated" (arbci-robotd here) or "remote"
+  std::string driver;   // simulated: the arm arbci-robotd drives (robot::robotDrivers())
   double speed_factor;  // the simulated arm's
   std::string host;
   int port;
