@@ -361,7 +361,7 @@ MujocoArm::MujocoArm(const RobotConfig& config) : impl_(std::make_unique<Impl>()
     what = config.model;
     folder = std::filesystem::absolute(config.model).parent_path();
   }
-  m.model = mujoco::compile(mujoco::composeScene(arm_xml, folder, config), what);
+  m.model = mujoco::compile(mujoco::composeScene(arm_xml, folder, config, what), what);
   m.data.reset(mj_makeData(m.model.get()));
   m.contract = mujoco::findContract(*m.model, config, what);
   m.kinematics = std::make_unique<mujoco::ArmKinematics>(*m.model, m.contract);

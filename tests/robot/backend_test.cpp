@@ -11,6 +11,7 @@
 #include <random>
 #include <thread>
 
+#include "arbci/robot/mujoco_arm.h"
 #include "support/robot_test_support.h"
 #include "support/udp_relay.h"
 
@@ -78,13 +79,17 @@ TEST(RobotBackend, GraspThenDropMovesTheObjectToTheDropPointWithin5mm) {
   EXPECT_EQ(backend.stats().executed, 2u);
 }
 
-TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
-  RunningBackend backend(50.0);
+// Exactly once through a lossy link, for any driver.
+void eachCommandRunsOnceThroughLoss(std::unique_ptr<RobotDriver> arm, int commands) {
+  BackendOptions options;
+  options.speed_factor = 50.0;
+  options.status_interval_s = 0.05;
+  RunningBackend backend(std::move(arm), options);
   test::UdpRelay relay(backend.port(), testKey());
   relay.setLoss(0.30, 0.30);
   RobotClient client(Endpoint::resolve("127.0.0.1", relay.port()), testKey(), fastClient());
   int finished = 0;
-  for (int i = 0; i < 100; ++i) {
+  for (int i = 0; i < commands; ++i) {
     const auto sequence = client.send(MessageType::Home);
     const auto events = waitFor(client, sequence, 10s);
     ASSERT_FALSE(events.empty()) << "command " << i;
@@ -92,11 +97,19 @@ TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
         << "command " << i << ": " << finalEvent(events).text;
     ++finished;
   }
-  EXPECT_EQ(finished, 100);
+  EXPECT_EQ(finished, commands);
   const BackendStats stats = backend.stats();
-  EXPECT_EQ(stats.executed, 100u);  // each exactly once
+  EXPECT_EQ(stats.executed, static_cast<std::uint64_t>(commands));  // each exactly once
   EXPECT_GT(stats.duplicates, 0u);  // although copies did arrive
-  EXPECT_GT(relay.dropped(), 50u);
+  EXPECT_GT(relay.dropped(), static_cast<std::uint64_t>(commands / 2));
+}
+
+TEST(RobotBackend, Through30PercentLossEachOf100CommandsRunsExactlyOnce) {
+  eachCommandRunsOnceThroughLoss(std::make_unique<SimulatedArm>(twoObjects()), 100);
+}
+
+TEST(RobotBackend, Through30PercentLossEachOf30MujocoCommandsRunsExactlyOnce) {
+  eachCommandRunsOnceThroughLoss(std::make_unique<MujocoArm>(twoObjects()), 30);
 }
 
 TEST(RobotBackend, TenThousandBadDatagramsChangeNothing) {
@@ -197,8 +210,12 @@ TEST(RobotBackend, OutsideTheWorkspaceIsRejectedWithTheReason) {
   EXPECT_EQ(backend.stats().executed, 0u);
 }
 
-TEST(RobotBackend, StopHaltsAMotionAtOnce) {
-  RunningBackend backend(1.0);  // real time: the grasp takes seconds
+// The STOP latch, for any driver.
+void stopHaltsAMotionAtOnce(std::unique_ptr<RobotDriver> arm) {
+  BackendOptions options;
+  options.speed_factor = 1.0;  // real time: the grasp takes seconds
+  options.status_interval_s = 0.05;
+  RunningBackend backend(std::move(arm), options);
   RobotClient client(Endpoint::resolve("127.0.0.1", backend.port()), testKey(), fastClient());
   const auto grasp = client.send(MessageType::Grasp, {0.10, 0.60, 0.06});
   ASSERT_TRUE(waitUntilAccepted(client, grasp));
@@ -231,6 +248,14 @@ TEST(RobotBackend, StopHaltsAMotionAtOnce) {
   events = waitFor(client, client.send(MessageType::Home), 15s);
   EXPECT_EQ(finalEvent(events).kind, RobotEvent::Kind::Finished);
   EXPECT_EQ(finalEvent(events).outcome, Outcome::Success);
+}
+
+TEST(RobotBackend, StopHaltsAMotionAtOnce) {
+  stopHaltsAMotionAtOnce(std::make_unique<SimulatedArm>(twoObjects()));
+}
+
+TEST(RobotBackend, StopHaltsAMujocoMotionAtOnce) {
+  stopHaltsAMotionAtOnce(std::make_unique<MujocoArm>(twoObjects()));
 }
 
 TEST(RobotBackend, ARestartMidCommandIsReportedAsAFailureNeverSuccess) {

@@ -13,6 +13,7 @@
 #include <limits>
 #include <sstream>
 
+#include "arbci/robot/mujoco_arm.h"
 #include "support/halt_recording_arm.h"
 #include "support/raw_robot_session.h"
 #include "support/robot_test_support.h"
@@ -244,11 +245,12 @@ TEST(RobotLink, AnotherClientsCommandMadeBeforeAStopNeverRunsAfterTheReset) {
   EXPECT_EQ(backend.stats().executed, 1u);
 }
 
-TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
+// The watchdog's proof, for any driver: a cut link halts the arm and latches the stop.
+void watchdogHaltsWhenTheLinkIsCut(std::unique_ptr<RobotDriver> arm) {
   auto halted_at = std::make_shared<std::atomic<Clock::rep>>(0);
   BackendOptions options = realTime();
   ASSERT_DOUBLE_EQ(options.watchdog_s, 0.1);  // the default (robot.watchdog_ms)
-  RunningBackend backend(std::make_unique<test::HaltRecordingArm>(twoObjects(), halted_at),
+  RunningBackend backend(std::make_unique<test::HaltRecordingArm>(std::move(arm), halted_at),
                          options);
   test::UdpRelay relay(backend.port(), testKey());
   RobotClient client(local(relay.port()), testKey(), fastClient());
@@ -284,6 +286,14 @@ TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
   next = waitFor(client, client.send(MessageType::Home), 15s);
   EXPECT_EQ(finalEvent(next).kind, RobotEvent::Kind::Finished);
   EXPECT_EQ(finalEvent(next).outcome, Outcome::Success);
+}
+
+TEST(RobotLink, TheWatchdogHaltsTheArmWhenTheLinkIsCut) {
+  watchdogHaltsWhenTheLinkIsCut(std::make_unique<SimulatedArm>(twoObjects()));
+}
+
+TEST(RobotLink, TheWatchdogHaltsTheMujocoArmWhenTheLinkIsCut) {
+  watchdogHaltsWhenTheLinkIsCut(std::make_unique<MujocoArm>(twoObjects()));
 }
 
 // A link that starts delaying everything by 1.5 s mid-grasp halts the arm as a cut one does:

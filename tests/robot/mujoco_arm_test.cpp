@@ -1,8 +1,11 @@
 // The mujoco driver in process (no sockets): grasp, carry and put down by forces, a release above
-// the table, an off-centre grasp, reproducibility and the 7-axis arm.
+// the table, an off-centre grasp, reproducibility, the stop, the 7-axis arm and a model that lacks
+// a part of the contract.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "arbci/robot/mujoco_arm.h"
 
@@ -50,6 +53,135 @@ TEST(MujocoArm, GraspsCarriesAndPutsDownWhereAsked) {
   EXPECT_NEAR(placed.position.z, 0.06, 0.002);  // resting on the table, upright
   const DriverResult home = runToEnd(arm, {MessageType::Home, {}});
   EXPECT_EQ(home.outcome, Outcome::Success) << home.text;
+}
+
+TEST(MujocoArm, AnObjectReleasedAboveTheTableFallsAndRestsOnIt) {
+  MujocoArm arm(twoObjects());
+  ASSERT_EQ(runToEnd(arm, {MessageType::Grasp, {-0.09, 0.42, 0.06}}).outcome, Outcome::Success);
+  // Let go with its base 0.2 m above the table.
+  const DriverResult drop = runToEnd(arm, {MessageType::Drop, {0.0, 0.66, 0.2}});
+  EXPECT_EQ(drop.outcome, Outcome::Success) << drop.text;
+  const WorldObject o = objectNamed(arm, 10);
+  EXPECT_FALSE(o.held);
+  // Resting on the table, upright or not: its top face's centre at its height when upright, at
+  // half its width when on its side.
+  const double upright = 1 - 2 * (o.orientation[1] * o.orientation[1] + o.orientation[2] * o.orientation[2]);
+  if (upright > 0.99)
+    EXPECT_NEAR(o.position.z, 0.06, 0.002);
+  else
+    EXPECT_NEAR(o.position.z, 0.035, 0.002);
+  // It fell, so did not land farther than a few centimetres from under the release.
+  EXPECT_LT(std::hypot(o.position.x - 0.0, o.position.y - 0.66), 0.05);
+}
+
+// Off the object's centre by 60 % of its half-width: along the fingers' closing direction a finger
+// lands on its top; across it the fingers close on its edge. Either way the verdict is what
+// physics did: success only with the object lifted, else a failed grasp and the object on the
+// table.
+TEST(MujocoArm, AnOffCentreGraspSucceedsOnlyWhenTheObjectIsLifted) {
+  for (const Vec3& offset : {Vec3{0.021, 0, 0}, Vec3{-0.021, 0, 0}, Vec3{0, 0.021, 0},
+                             Vec3{0, -0.021, 0}}) {
+    MujocoArm arm(twoObjects());
+    const DriverResult grasp =
+        runToEnd(arm, {MessageType::Grasp, {-0.09 + offset.x, 0.42 + offset.y, 0.06}});
+    const WorldObject o = objectNamed(arm, 10);
+    if (grasp.outcome == Outcome::Success) {
+      EXPECT_EQ(arm.status().holding, 10);
+      EXPECT_GT(o.position.z, 0.15) << "held but not lifted, offset " << offset.x << ", " << offset.y;
+    } else {
+      EXPECT_EQ(arm.status().holding, -1);
+      EXPECT_LT(o.position.z, 0.07) << grasp.text;
+      EXPECT_FALSE(grasp.text.empty());
+    }
+  }
+}
+
+TEST(MujocoArm, AGraspOverNothingFails) {
+  MujocoArm arm(twoObjects());
+  const DriverResult grasp = runToEnd(arm, {MessageType::Grasp, {0.0, 0.42, 0.06}});
+  EXPECT_EQ(grasp.outcome, Outcome::Failed);
+  EXPECT_NE(grasp.text.find("closed on nothing"), std::string::npos) << grasp.text;
+  EXPECT_EQ(arm.status().holding, -1);
+  // Nothing to put down.
+  const auto refused = arm.check({MessageType::Drop, {0.0, 0.66, 0.0}});
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->reason, RejectReason::InvalidState);
+}
+
+TEST(MujocoArm, APointBeyondTheArmsReachIsRefused) {
+  MujocoArm arm(twoObjects());
+  const auto refused = arm.check({MessageType::Grasp, {0.0, 0.99, 0.06}});
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->reason, RejectReason::Unreachable);
+}
+
+// The same steps give the same world, to the bit.
+TEST(MujocoArm, TheSameStepsGiveTheSameWorld) {
+  auto run = [] {
+    MujocoArm arm(twoObjects());
+    arm.start({MessageType::Grasp, {-0.09, 0.42, 0.06}});
+    for (int i = 0; i < 200; ++i) arm.step(0.0371);  // steps that do not divide the timestep
+    arm.start({MessageType::Drop, {0.1, 0.7, 0.15}});
+    for (int i = 0; i < 200; ++i) arm.step(0.0371);
+    return arm.world();
+  };
+  const auto a = run(), b = run();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].position.x, b[i].position.x);
+    EXPECT_EQ(a[i].position.y, b[i].position.y);
+    EXPECT_EQ(a[i].position.z, b[i].position.z);
+    EXPECT_EQ(a[i].orientation, b[i].orientation);
+  }
+}
+
+TEST(MujocoArm, AStopHoldsTheArmWhereItIs) {
+  MujocoArm arm(twoObjects());
+  arm.start({MessageType::Grasp, {-0.09, 0.42, 0.06}});
+  for (int i = 0; i < 10; ++i) arm.step(0.05);
+  arm.stop();
+  const Vec3 at = arm.status().tool;
+  EXPECT_EQ(arm.status().state, RobotState::Stopped);
+  EXPECT_FALSE(arm.step(1.0));  // a stopped arm does not move on
+  EXPECT_EQ(arm.status().tool.x, at.x);
+  EXPECT_EQ(arm.status().tool.z, at.z);
+  // A new command starts from there.
+  const DriverResult home = runToEnd(arm, {MessageType::Home, {}});
+  EXPECT_EQ(home.outcome, Outcome::Success) << home.text;
+}
+
+TEST(MujocoArm, TheSevenAxisArmGraspsAndPutsDown) {
+  MujocoArm arm(twoObjects("arm7"));
+  EXPECT_EQ(arm.armJoints(), 7);
+  ASSERT_EQ(runToEnd(arm, {MessageType::Grasp, {0.09, 0.42, 0.06}}).outcome, Outcome::Success);
+  ASSERT_EQ(runToEnd(arm, {MessageType::Drop, {-0.09, 0.75, 0.0}}).outcome, Outcome::Success);
+  const WorldObject placed = objectNamed(arm, 20);
+  EXPECT_NEAR(placed.position.x, -0.09, 0.01);
+  EXPECT_NEAR(placed.position.y, 0.75, 0.01);
+}
+
+TEST(MujocoArm, AModelWithoutThePartsItNeedsIsRefusedByName) {
+  const auto folder = std::filesystem::temp_directory_path() / "arbci_mujoco_model_test";
+  std::filesystem::create_directories(folder);
+  std::string arm = builtInArm("arm6");
+  const std::string sensor = "<force name=\"wrist_force\" site=\"wrist\"/>";
+  arm.erase(arm.find(sensor), sensor.size());
+  std::ofstream(folder / "arm.xml") << arm;
+  RobotConfig c = twoObjects((folder / "arm.xml").string());
+  try {
+    MujocoArm refused(c);
+    ADD_FAILURE() << "a model without a wrist force sensor was loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("wrist_force"), std::string::npos) << e.what();
+  }
+  std::ofstream(folder / "arm.xml") << "<mujoco><worldbody><body></mujoco>";
+  try {
+    MujocoArm refused(c);
+    ADD_FAILURE() << "a broken file was loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("arm.xml"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace

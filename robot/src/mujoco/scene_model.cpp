@@ -63,14 +63,14 @@ int named(const mjModel& m, mjtObj type, const std::string& name) {
 }  // namespace
 
 std::string composeScene(const std::string& arm_xml, const std::filesystem::path& folder,
-                         const RobotConfig& config) {
+                         const RobotConfig& config, const std::string& what) {
   pugi::xml_document doc;
   const pugi::xml_parse_result parsed = doc.load_string(arm_xml.c_str());
   if (!parsed)
-    throw ConfigError(std::string("the arm's MJCF is not XML: ") + parsed.description() +
-                      " at offset " + std::to_string(parsed.offset));
+    throw ConfigError(what + " is not XML: " + parsed.description() + " at byte " +
+                      std::to_string(parsed.offset));
   pugi::xml_node root = doc.child("mujoco");
-  if (!root) throw ConfigError("the arm's MJCF has no <mujoco> element");
+  if (!root) throw ConfigError(what + " has no <mujoco> element (is it MJCF?)");
   if (!folder.empty()) {
     pugi::xml_node compiler = root.child("compiler");
     if (!compiler) compiler = root.prepend_child("compiler");

@@ -16,8 +16,9 @@ namespace arbci::robot::mujoco {
 
 // The arm's MJCF text (its file's, or the embedded default arm's) with the table and `objects`
 // added to its worldbody. Mesh and texture folders given relative to `folder` are made absolute.
+// `what` names the model in errors (its file).
 std::string composeScene(const std::string& arm_xml, const std::filesystem::path& folder,
-                         const RobotConfig& config);
+                         const RobotConfig& config, const std::string& what);
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }

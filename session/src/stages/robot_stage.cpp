@@ -30,8 +30,9 @@ void RobotStage::step(Cycle& cycle) {
   }
   client_.poll();
   handleEvents(out, time_s);
-  measurePlacement(out, time_s);
-  endPutDownOnceInView(out, cycle.frame);
+  noteReportedPlacement(time_s);
+  // The robot acts before tracking in the cycle: the cameras' view is the last cycle's.
+  endPutDownOnceInView(out, cycle.previous.tracking, time_s, cycle.frame);
 
   out.status = client_.status();
   out.silent = client_.silent();
@@ -288,7 +289,7 @@ void RobotStage::handleEvents(RobotPart& out, double time_s) {
       if (success && command_type_ == robot::MessageType::Drop) {
         if (!giving_back_ && drop_) {
           out.notes.push_back({Note::Kind::Outcome, true, "placed"});
-          placement_ = Placement{drop_->trial, drop_->cell, e.sequence, time_s};
+          placement_ = Placement{drop_->trial, drop_->cell, e.sequence, time_s, std::nullopt};
         }
         out.moved.push_back(*grasped_id_);
         // The arm parked over the table hides objects from the cameras: it goes home before the
@@ -324,34 +325,68 @@ void RobotStage::handleEvents(RobotPart& out, double time_s) {
   }
 }
 
-void RobotStage::measurePlacement(RobotPart& out, double time_s) {
+double RobotStage::objectHeight(int id) const {
+  for (const auto& s : settings_.world.objects) {
+    if (s.id == id) return s.height_m;
+  }
+  return 0.0;
+}
+
+void RobotStage::noteReportedPlacement(double time_s) {
   const auto& status = client_.status();
-  // Only a status that knows the drop finished shows where the object stands.
-  if (!placement_ || !status || status->last_finished_sequence < placement_->command) return;
+  // Only a status that knows the drop finished shows where the robot let the object go.
+  if (!placement_ || placement_->reported || !grasped_id_ || !status ||
+      status->last_finished_sequence < placement_->command)
+    return;
   for (const robot::WorldObject& o : status->objects) {
-    if (!grasped_id_ || o.id != *grasped_id_) continue;
-    double height = 0.0;
-    for (const auto& s : settings_.world.objects) {
-      if (s.id == o.id) height = s.height_m;
-    }
-    const cv::Vec3d centre =
-        settings_.world.grid.cellCentre(placement_->cell.first, placement_->cell.second);
-    const double error =
-        cv::norm(cv::Vec3d(o.position.x, o.position.y, o.position.z - height) - centre);
-    RobotPart::Note note{RobotPart::Note::Kind::Placement, true, ""};
-    note.trial = placement_->trial;
-    note.error_m = error;
-    out.notes.push_back(note);
-    s_.log.write("placement", time_s,
+    if (o.id != *grasped_id_) continue;
+    placement_->reported = cv::Vec3d(o.position.x, o.position.y, o.position.z - objectHeight(o.id));
+    s_.log.write("placement_reported", time_s,
                  {{"trial", placement_->trial},
                   {"object", o.id},
-                  {"error_m", error},
-                  {"position", {o.position.x, o.position.y, o.position.z - height}}});
+                  {"position", {(*placement_->reported)[0], (*placement_->reported)[1],
+                                (*placement_->reported)[2]}}});
   }
+}
+
+void RobotStage::measurePlacement(RobotPart& out, const TrackingPart& tracking, double time_s) {
+  if (!placement_ || !grasped_id_) return;
+  const int id = *grasped_id_;
+  const cv::Vec3d centre =
+      settings_.world.grid.cellCentre(placement_->cell.first, placement_->cell.second);
+  RobotPart::Note note{RobotPart::Note::Kind::Placement, true, ""};
+  note.trial = placement_->trial;
+  note.error_m = -1.0;  // not seen
+  nlohmann::json fields = {{"trial", placement_->trial}, {"object", id}};
+  // The object's top as the cameras saw it after the drop (the tracker forgot it when the robot
+  // moved it, so any pose it has now is a new sighting).
+  const auto seen = tracking.world ? tracking.world->object(id) : std::nullopt;
+  if (seen && seen->seen_at_s >= placement_->since_s) {
+    const cv::Vec3d top = seen->T_robot_object.translation;
+    const cv::Vec3d base(top[0], top[1], top[2] - objectHeight(id));
+    note.error_m = cv::norm(base - centre);
+    fields["error_m"] = note.error_m;
+    fields["position"] = {base[0], base[1], base[2]};
+    fields["seen_at"] = seen->seen_at_s;
+  } else {
+    fields["error_m"] = nullptr;
+    fields["why"] = "the cameras have not seen the object since the drop";
+  }
+  if (placement_->reported) {
+    const cv::Vec3d r = *placement_->reported;
+    fields["robot_reported"] = {r[0], r[1], r[2]};
+    if (seen && fields.contains("position")) {
+      const cv::Vec3d base(fields["position"][0], fields["position"][1], fields["position"][2]);
+      fields["robot_vs_cameras_m"] = cv::norm(r - base);
+    }
+  }
+  out.notes.push_back(note);
+  s_.log.write("placement", time_s, fields);
   placement_.reset();
 }
 
-void RobotStage::endPutDownOnceInView(RobotPart& out, std::int64_t frame) {
+void RobotStage::endPutDownOnceInView(RobotPart& out, const TrackingPart& tracking,
+                                      double time_s, std::int64_t frame) {
   if (!homed_) return;
   if (!clear_view_frame_) {
     // The scene follows the robot's status: once it shows the arm home, two camera frames.
@@ -363,6 +398,7 @@ void RobotStage::endPutDownOnceInView(RobotPart& out, std::int64_t frame) {
   if (frame < *clear_view_frame_) return;
   homed_.reset();
   clear_view_frame_.reset();
+  measurePlacement(out, tracking, time_s);
   out.notes.push_back({RobotPart::Note::Kind::PutDownEnded, true, ""});
 }
 

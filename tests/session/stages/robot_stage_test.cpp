@@ -56,6 +56,7 @@ class RobotStageTest : public ::testing::Test {
                                      double seconds = 60.0) {
     std::vector<RobotPart::Note> notes;
     for (int i = 0; i < seconds * 60; ++i) {
+      if (cameras_) cameras_(bench_.record);
       bench_.step(*stage_);
       const RobotPart& r = bench_.record.robot;
       notes.insert(notes.end(), r.notes.begin(), r.notes.end());
@@ -82,6 +83,23 @@ class RobotStageTest : public ::testing::Test {
       if (n.kind == kind && n.success == success) return true;
     return false;
   }
+  // The tracking stage's part of each record (what the cameras see), when set: the robot stage
+  // reads it on the next cycle's previous record, as in a session (tracking runs after it).
+  std::function<void(CycleRecord&)> cameras_;
+  // Cameras that see `id`'s top at `top` (robot frame) in every frame, with the reference.
+  void camerasSee(int id, const cv::Vec3d& top) {
+    auto world = std::make_shared<vision::WorldModel>(
+        vision::ReferenceMarker{world_.reference_id, world_.reference_size_m,
+                                {cv::Matx33d::eye(), world_.reference_position}});
+    cameras_ = [this, world, id, top](CycleRecord& r) {
+      // The camera at the robot's origin, axes along the robot's.
+      vision::PoseEstimate reference, object;
+      reference.pose = {cv::Matx33d::eye(), world_.reference_position};
+      object.pose = {cv::Matx33d::eye(), top};
+      world->update(r.time_s, {{world_.reference_id, reference}, {id, object}});
+      r.tracking.world = std::make_shared<const vision::WorldModel>(*world);
+    };
+  }
   WorldSettings world_;
   bool stepped_ = true;
   test::StageBench bench_;
@@ -106,7 +124,11 @@ TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
   EXPECT_EQ(bench_.previous.robot.holding(), object.id);
   EXPECT_EQ(bench_.previous.robot.grasped, object.id);
   EXPECT_FALSE(bench_.previous.robot.at_home);
-  // Put down on cell (2, 2): placed, measured, the arm home and the table seen again.
+  // Put down on cell (2, 2): placed, measured, the arm home and the table seen again. The
+  // cameras see the object 3 mm beside the cell's centre: the placement is theirs, not the arm's
+  // report (the kinematic arm lets go exactly over the centre).
+  const cv::Vec3d centre = world_.grid.cellCentre(2, 2);
+  camerasSee(object.id, centre + cv::Vec3d(0.003, 0.0, object.height_m));
   bench_.record.requests.push_back(DropRequest{1, {2, 2}, false, bench_.record.frame / 60.0});
   notes = until([](const RobotPart& r) {
     for (const auto& n : r.notes)
@@ -119,12 +141,46 @@ TEST_F(RobotStageTest, AGraspAndAPutDownAreNotedOnTheRecordWithThePlacement) {
   for (const auto& n : notes) {
     if (n.kind != Kind::Placement) continue;
     EXPECT_EQ(n.trial, 1);
-    EXPECT_LT(n.error_m, 0.005);
+    EXPECT_NEAR(n.error_m, 0.003, 1e-6);
   }
   EXPECT_TRUE(bench_.previous.robot.at_home);
   EXPECT_FALSE(bench_.previous.robot.holding().has_value());
-  // What moved is unknown to tracking until a frame shows it again.
-  EXPECT_EQ(bench_.logged("placement").size(), 1u);
+  const auto logged = bench_.logged("placement");
+  ASSERT_EQ(logged.size(), 1u);
+  EXPECT_NEAR(logged[0]["error_m"].get<double>(), 0.003, 1e-6);
+  // The arm's own report of where it let go, beside the cameras' view.
+  EXPECT_NEAR(logged[0]["robot_vs_cameras_m"].get<double>(), 0.003, 1e-3);
+}
+
+TEST_F(RobotStageTest, APlacementTheCamerasDidNotSeeHasNoError) {
+  connect();
+  const WorldObjectSettings& object = world_.objects.front();
+  probe();
+  bench_.record.requests.push_back(
+      GraspRequest{object.id, object.position, 0.0, 0.5, false, bench_.record.frame / 60.0});
+  until([](const RobotPart& r) {
+    for (const auto& n : r.notes)
+      if (n.kind == Kind::Finished) return true;
+    return false;
+  });
+  bench_.record.requests.push_back(DropRequest{1, {1, 1}, false, bench_.record.frame / 60.0});
+  const auto notes = until([](const RobotPart& r) {
+    for (const auto& n : r.notes)
+      if (n.kind == Kind::PutDownEnded) return true;
+    return false;
+  });
+  bool measured = false;
+  for (const auto& n : notes) {
+    if (n.kind != Kind::Placement) continue;
+    measured = true;
+    EXPECT_LT(n.error_m, 0.0) << "an error the cameras never saw";
+  }
+  EXPECT_TRUE(measured);
+  const auto logged = bench_.logged("placement");
+  ASSERT_EQ(logged.size(), 1u);
+  EXPECT_TRUE(logged[0]["error_m"].is_null());
+  EXPECT_EQ(logged[0]["why"], "the cameras have not seen the object since the drop");
+  EXPECT_TRUE(logged[0].contains("robot_reported"));
 }
 
 TEST_F(RobotStageTest, TheExperimentersStopLatchesAndResetLiftsIt) {

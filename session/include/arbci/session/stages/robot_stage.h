@@ -53,8 +53,11 @@ class RobotStage final : public Stage {
                     double time_s);
   void handleRecoveryEvent(const robot::RobotEvent& e, RobotPart& out, double time_s);
   void handleEvents(RobotPart& out, double time_s);
-  void measurePlacement(RobotPart& out, double time_s);
-  void endPutDownOnceInView(RobotPart& out, std::int64_t frame);
+  double objectHeight(int id) const;
+  void noteReportedPlacement(double time_s);
+  void measurePlacement(RobotPart& out, const TrackingPart& tracking, double time_s);
+  void endPutDownOnceInView(RobotPart& out, const TrackingPart& tracking, double time_s,
+                            std::int64_t frame);
   bool busy() const { return command_.has_value() || recovery_.has_value(); }
   std::optional<int> holding() const;
   std::string whyNotMove() const;
@@ -73,12 +76,14 @@ class RobotStage final : public Stage {
   std::optional<int> grasped_id_;
   cv::Vec3d grasped_from_;  // where the object in the gripper was taken from
   bool giving_back_ = false;
-  // A placement to measure once the robot reports the world after the drop.
+  // A placement to measure: the cameras' view of the object once the arm has left the table
+  // (the robot's own report of where it let go is logged beside it, not used as the result).
   struct Placement {
     int trial = 0;
     std::pair<int, int> cell;
     std::uint64_t command = 0;
     double since_s = 0.0;
+    std::optional<cv::Vec3d> reported;  // the object's base as the robot's status has it
   };
   std::optional<Placement> placement_;
   std::optional<DropRequest> drop_;  // the put-down in progress
