@@ -41,7 +41,8 @@ Figures measure(RobotDriver& arm, int trials) {
     const Vec3 object = {-0.27 + 0.18 * k, 0.42, 0.06};
     const Vec3 cell = cells[t % 3];
     // Out to the cell and back, so the table is the same for the next trial.
-    const DriverCommand commands[] = {{MessageType::Grasp, object}, {MessageType::Drop, cell},
+    const DriverCommand commands[] = {{MessageType::Grasp, object},
+                                      {MessageType::Drop, cell},
                                       {MessageType::Grasp, {cell.x, cell.y, 0.06}},
                                       {MessageType::Drop, {object.x, object.y, 0.0}},
                                       {MessageType::Home, {}}};

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "arbci/assets.h"
+#include "arbci/robot/workspace_check.h"
 #include "mujoco/arm_kinematics.h"
 #include "mujoco/scene_model.h"
 
@@ -23,12 +24,6 @@ constexpr double kResting = 0.005;     // m/s: a released object slower than thi
 constexpr double kRestingFor = 0.1;    // s
 constexpr double kLiftedClear = 0.02;  // m: a held object's base this far above the table
 constexpr double kForceBaselineSeconds = 0.2;
-
-std::string where(const Vec3& p) {
-  char text[96];
-  std::snprintf(text, sizeof text, "(%.3f, %.3f, %.3f)", p.x, p.y, p.z);
-  return text;
-}
 
 double distance(const Vec3& a, const Vec3& b) {
   return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
@@ -268,7 +263,7 @@ struct MujocoArm::Impl {
     switch (s.kind) {
       case Segment::Kind::Move: {
         if (!advancePath(s.to, config.cartesian_speed, dt)) {
-          fault = "no joint motion reaches " + where(path) + " (joint limit or singularity)";
+          fault = "no joint motion reaches " + pointText(path) + " (joint limit or singularity)";
           return true;
         }
         physicsStep();
@@ -291,7 +286,7 @@ struct MujocoArm::Impl {
           return true;
         }
         if (!advancePath({s.to.x, s.to.y, s.to.z}, config.descend_speed, dt)) {
-          fault = "no joint motion reaches " + where(path) + " (joint limit or singularity)";
+          fault = "no joint motion reaches " + pointText(path) + " (joint limit or singularity)";
           return true;
         }
         physicsStep();
@@ -303,7 +298,7 @@ struct MujocoArm::Impl {
                               sensors[contract.right_force] >= config.grip_force;
         if (gripping || grip >= grip_closed) {
           if (!gripping && held() < 0) {
-            failure = "the gripper closed on nothing at " + where(tool());
+            failure = "the gripper closed on nothing at " + pointText(tool());
           }
           return true;
         }
@@ -329,9 +324,10 @@ struct MujocoArm::Impl {
         // Held is what physics holds: between both fingers and clear of the table.
         const auto* o = object(held());
         if (failure.empty() && (!o || bottom(*o) < config.table_z + kLiftedClear)) {
-          failure = grasped >= 0 ? "object " + std::to_string(grasped) +
-                                       " slipped out of the gripper during the lift"
-                                 : "nothing between the fingers after the lift at " + where(tool());
+          failure = grasped >= 0
+                        ? "object " + std::to_string(grasped) +
+                              " slipped out of the gripper during the lift"
+                        : "nothing between the fingers after the lift at " + pointText(tool());
         }
         return true;
       }
@@ -371,7 +367,7 @@ MujocoArm::MujocoArm(const RobotConfig& config) : impl_(std::make_unique<Impl>()
   m.grip = m.grip_open;
   const auto home = m.kinematics->solveAnywhere(config.home);
   if (!home)
-    throw ConfigError(what + ": the home position " + where(config.home) +
+    throw ConfigError(what + ": the home position " + pointText(config.home) +
                       " is not reachable pointing down");
   for (size_t k = 0; k < home->size(); ++k) m.data->qpos[m.contract.qpos[k]] = (*home)[k];
   m.q_des = *home;
@@ -402,17 +398,10 @@ std::optional<Rejection> MujocoArm::check(const DriverCommand& c) const {
   const RobotConfig& cfg = m.config;
   if (c.type == MessageType::Grasp || c.type == MessageType::Drop) {
     const Vec3& p = c.target;
-    const bool inside = p.x >= cfg.workspace_min.x && p.x <= cfg.workspace_max.x &&
-                        p.y >= cfg.workspace_min.y && p.y <= cfg.workspace_max.y &&
-                        p.z >= cfg.workspace_min.z && p.z <= cfg.workspace_max.z;
-    if (!inside)
-      return Rejection{RejectReason::OutsideWorkspace, where(p) + " lies outside the workspace"};
-    if (p.z < cfg.table_z - 0.001)
-      return Rejection{RejectReason::OutsideWorkspace, where(p) + " lies below the table"};
-    const Vec3 above{p.x, p.y, std::max(p.z + cfg.approach_height, cfg.table_z + cfg.lift_height)};
-    for (const Vec3& point : {p, above}) {
+    if (auto outside = outsideWorkspace(cfg, p)) return outside;
+    for (const Vec3& point : {p, approachPoint(cfg, p)}) {
       if (!m.kinematics->solve(point, m.q_des) && !m.kinematics->solveAnywhere(point))
-        return Rejection{RejectReason::Unreachable, where(p) + " is out of the arm's reach"};
+        return Rejection{RejectReason::Unreachable, pointText(p) + " is out of the arm's reach"};
     }
     const int holding = m.held();
     if (c.type == MessageType::Grasp && holding >= 0)
@@ -473,9 +462,9 @@ std::optional<DriverResult> MujocoArm::step(double seconds) {
     case MessageType::Grasp:
       return DriverResult{Outcome::Success, "holding object " + std::to_string(m.held())};
     case MessageType::Drop:
-      return DriverResult{Outcome::Success, "released at " + where(m.tool())};
+      return DriverResult{Outcome::Success, "released at " + pointText(m.tool())};
     default:
-      return DriverResult{Outcome::Success, "at home " + where(m.tool())};
+      return DriverResult{Outcome::Success, "at home " + pointText(m.tool())};
   }
 }
 

@@ -1,4 +1,5 @@
 #include "arbci/robot/simulated_arm.h"
+#include "arbci/robot/workspace_check.h"
 
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
@@ -254,21 +255,9 @@ std::optional<Rejection> SimulatedArm::check(const DriverCommand& c) const {
   const RobotConfig& cfg = m.config;
   if (c.type == MessageType::Grasp || c.type == MessageType::Drop) {
     const Vec3& p = c.target;
-    const bool inside = p.x >= cfg.workspace_min.x && p.x <= cfg.workspace_max.x &&
-                        p.y >= cfg.workspace_min.y && p.y <= cfg.workspace_max.y &&
-                        p.z >= cfg.workspace_min.z && p.z <= cfg.workspace_max.z;
-    char where[96];
-    std::snprintf(where, sizeof where, "(%.3f, %.3f, %.3f)", p.x, p.y, p.z);
-    if (!inside)
-      return Rejection{RejectReason::OutsideWorkspace,
-                       std::string(where) + " lies outside the workspace"};
-    if (p.z < cfg.table_z - 0.001)
-      return Rejection{RejectReason::OutsideWorkspace,
-                       std::string(where) + " lies below the table"};
-    const Vec3 above{p.x, p.y, std::max(p.z + cfg.approach_height, cfg.table_z + cfg.lift_height)};
-    if (!reachable(p) || !reachable(above))
-      return Rejection{RejectReason::Unreachable,
-                       std::string(where) + " is out of the arm's reach"};
+    if (auto outside = outsideWorkspace(cfg, p)) return outside;
+    if (!reachable(p) || !reachable(approachPoint(cfg, p)))
+      return Rejection{RejectReason::Unreachable, pointText(p) + " is out of the arm's reach"};
     if (c.type == MessageType::Grasp && m.holding >= 0) {
       return Rejection{RejectReason::InvalidState,
                        "already holding object " + std::to_string(m.holding)};

@@ -23,7 +23,9 @@ RobotLink connectRobot(const RobotSettings& settings, const robot::RobotConfig& 
   const robot::Key key = robot::generateKey();
   const auto key_file = folder / "robot.key";
   robot::saveKey(key_file, key);
-  std::ofstream(folder / "robot.json") << simulated_world.toJson();
+  robot::RobotConfig config = simulated_world;
+  config.model = settings.model;
+  std::ofstream(folder / "robot.json") << config.toJson();
   // A simulated clock steps the arm too (the robot follows the session, frame by frame).
   link.stepped = clock.stepped();
   link.backend = std::make_unique<RobotProcess>(robotdNextToMe(), key_file, folder / "robot.json",

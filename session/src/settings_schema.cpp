@@ -502,6 +502,10 @@ const Schema<RobotSettings>& robotSchema() {
             robot::linkSchema().at("driver"),
             [](R& r, const Json& j) { r.driver = j.get<std::string>(); },
             [](const R& r) { return Json(r.driver); })
+        .custom(
+            robot::configSchema().at("model"),
+            [](R& r, const Json& j) { r.model = j.get<std::string>(); },
+            [](const R& r) { return Json(r.model); })
         .number("speed_factor", &R::speed_factor, 8.0, 0.1, 100.0,
                 "simulated: the arm's seconds per second of the session")
         .custom(

@@ -1,7 +1,8 @@
 // The simulated session end to end, headless, through the real executables: where the whole
 // session is the point. The default world through three trials with given intentions (a
 // calibration run, training, the robot grasping and putting down, every object within a
-// centimetre), run twice with one seed (the same recording, byte for byte); and a TERM signal that
+// centimetre), run twice with one seed (the same recording, byte for byte); the same with the arm
+// in the physics engine (6 and 7 axes); and a TERM signal that
 // ends a run with its summary saved, as does a disk that fills mid-run. Every other behaviour of a
 // session is tested at its own level: each stage on hand-built records (tests/session/stages), the
 // panels on hand-built records (tests/ui), the application's parts in process (tests/app/unit).
@@ -179,6 +180,71 @@ TEST(Session, ThreeTrialsAllRightEachObjectWithinACentimetreAndTheSameSeedTheSam
 
 // Ctrl+C or a TERM ends a headless run like an abort: the summary is written, the recording
 // closed, and the exit status says it did not finish.
+// The placements of a run as log.jsonl has them: the cameras' view and the robot's report.
+std::vector<nlohmann::json> placements(const std::filesystem::path& folder) {
+  std::vector<nlohmann::json> out;
+  for (const auto& line : readLog(folder / "log.jsonl"))
+    if (line["event"] == "placement") out.push_back(line);
+  return out;
+}
+
+// The arm in the physics engine (robot.driver mujoco): three of three objects placed, each within
+// 10 mm of its cell as the tracker sees it, and the same seed the same run (recording and
+// placements) again.
+TEST(Session, ThePhysicsArmPlacesThreeOfThreeAsTheCamerasSeeAndTheSameSeedTheSameRun) {
+  auto run = [](const std::string& name) {
+    const auto folder = fresh(name);
+    const ProcessResult r = runProcess(kArbci,
+                                       {"run", "--headless", "--session",
+                                        kSessions + "/physics_arm.json", "--out", folder.string()},
+                                       600.0);
+    EXPECT_EQ(r.exit_code, 0) << r.err << r.out;
+    return folder;
+  };
+  const auto folder = run("physics");
+  const auto again = run("physics_again");
+  EXPECT_TRUE(dataRecords(folder / "recording.bdf") == dataRecords(again / "recording.bdf"))
+      << "the same seed gave different data records";
+  const auto placed = placements(folder);
+  EXPECT_EQ(placed, placements(again));
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "finished");
+  ASSERT_EQ(summary["trials"].size(), 3u);
+  for (const auto& t : summary["trials"]) {
+    EXPECT_EQ(t["outcome"], "placed") << t.dump();
+    ASSERT_TRUE(t["placement_error_m"].is_number()) << t.dump();
+    EXPECT_LT(t["placement_error_m"].get<double>(), 0.010) << t.dump();
+  }
+  ASSERT_EQ(placed.size(), 3u);
+  for (const auto& p : placed) {
+    // Measured by the cameras, with the arm's own report beside it.
+    EXPECT_TRUE(p["error_m"].is_number()) << p.dump();
+    EXPECT_TRUE(p.contains("robot_reported")) << p.dump();
+  }
+}
+
+// The project's second arm (7 axes, robot.model arm7) runs the same session.
+TEST(Session, TheSevenAxisPhysicsArmRunsTheSession) {
+  const auto folder = fresh("physics_arm7");
+  const auto settings = folder.parent_path() / "physics_arm7.json";
+  std::filesystem::create_directories(folder.parent_path());
+  std::ifstream in(kSessions + "/physics_arm.json");
+  nlohmann::json file = nlohmann::json::parse(in);
+  file["robot"]["model"] = "arm7";
+  std::ofstream(settings) << file.dump();
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", settings.string(), "--out", folder.string()},
+      600.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  ASSERT_EQ(summary["trials"].size(), 3u);
+  for (const auto& t : summary["trials"]) {
+    EXPECT_EQ(t["outcome"], "placed") << t.dump();
+    ASSERT_TRUE(t["placement_error_m"].is_number()) << t.dump();
+    EXPECT_LT(t["placement_error_m"].get<double>(), 0.010) << t.dump();
+  }
+}
+
 TEST(Session, ATermSignalEndsAHeadlessRunWithItsSummarySaved) {
   const auto folder = fresh("term");
   const pid_t child = fork();

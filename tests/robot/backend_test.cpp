@@ -100,7 +100,7 @@ void eachCommandRunsOnceThroughLoss(std::unique_ptr<RobotDriver> arm, int comman
   EXPECT_EQ(finished, commands);
   const BackendStats stats = backend.stats();
   EXPECT_EQ(stats.executed, static_cast<std::uint64_t>(commands));  // each exactly once
-  EXPECT_GT(stats.duplicates, 0u);  // although copies did arrive
+  EXPECT_GT(stats.duplicates, 0u);                                  // although copies did arrive
   EXPECT_GT(relay.dropped(), static_cast<std::uint64_t>(commands / 2));
 }
 

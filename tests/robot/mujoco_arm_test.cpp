@@ -65,7 +65,8 @@ TEST(MujocoArm, AnObjectReleasedAboveTheTableFallsAndRestsOnIt) {
   EXPECT_FALSE(o.held);
   // Resting on the table, upright or not: its top face's centre at its height when upright, at
   // half its width when on its side.
-  const double upright = 1 - 2 * (o.orientation[1] * o.orientation[1] + o.orientation[2] * o.orientation[2]);
+  const double upright =
+      1 - 2 * (o.orientation[1] * o.orientation[1] + o.orientation[2] * o.orientation[2]);
   if (upright > 0.99)
     EXPECT_NEAR(o.position.z, 0.06, 0.002);
   else
@@ -79,15 +80,16 @@ TEST(MujocoArm, AnObjectReleasedAboveTheTableFallsAndRestsOnIt) {
 // physics did: success only with the object lifted, else a failed grasp and the object on the
 // table.
 TEST(MujocoArm, AnOffCentreGraspSucceedsOnlyWhenTheObjectIsLifted) {
-  for (const Vec3& offset : {Vec3{0.021, 0, 0}, Vec3{-0.021, 0, 0}, Vec3{0, 0.021, 0},
-                             Vec3{0, -0.021, 0}}) {
+  for (const Vec3& offset :
+       {Vec3{0.021, 0, 0}, Vec3{-0.021, 0, 0}, Vec3{0, 0.021, 0}, Vec3{0, -0.021, 0}}) {
     MujocoArm arm(twoObjects());
     const DriverResult grasp =
         runToEnd(arm, {MessageType::Grasp, {-0.09 + offset.x, 0.42 + offset.y, 0.06}});
     const WorldObject o = objectNamed(arm, 10);
     if (grasp.outcome == Outcome::Success) {
       EXPECT_EQ(arm.status().holding, 10);
-      EXPECT_GT(o.position.z, 0.15) << "held but not lifted, offset " << offset.x << ", " << offset.y;
+      EXPECT_GT(o.position.z, 0.15)
+          << "held but not lifted, offset " << offset.x << ", " << offset.y;
     } else {
       EXPECT_EQ(arm.status().holding, -1);
       EXPECT_LT(o.position.z, 0.07) << grasp.text;

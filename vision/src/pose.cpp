@@ -30,6 +30,13 @@ cv::Vec3d Pose::rotationVector() const {
   return rvec;
 }
 
+cv::Matx33d rotationFromQuaternion(const std::array<double, 4>& q) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+}
+
 double rotationAngleDeg(const cv::Matx33d& a, const cv::Matx33d& b) {
   const cv::Matx33d d = a.t() * b;
   const double c = std::clamp((d(0, 0) + d(1, 1) + d(2, 2) - 1.0) / 2.0, -1.0, 1.0);

@@ -3,17 +3,6 @@
 #include <cmath>
 
 namespace arbci::session {
-namespace {
-
-// A unit quaternion (w, x, y, z) as a rotation matrix.
-cv::Matx33d rotationOf(const std::array<double, 4>& q) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-}
-
-}  // namespace
 
 SimulatedWorld::SimulatedWorld(const SceneSettings& settings) : settings_(settings) {
   const CameraSettings& c = settings.cameras;
@@ -64,7 +53,7 @@ void SimulatedWorld::update(const robot::StatusPayload& status) {
   for (const robot::WorldObject& reported : status.objects) {
     for (SceneObject& o : scene_.objects) {
       const cv::Vec3d p(reported.position.x, reported.position.y, reported.position.z);
-      const cv::Matx33d r = rotationOf(reported.orientation);
+      const cv::Matx33d r = vision::rotationFromQuaternion(reported.orientation);
       if (o.marker.id == reported.id &&
           (p != o.T_world_top.translation || r != o.T_world_top.rotation)) {
         o.T_world_top = {r, p};

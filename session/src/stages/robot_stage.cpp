@@ -341,11 +341,12 @@ void RobotStage::noteReportedPlacement(double time_s) {
   for (const robot::WorldObject& o : status->objects) {
     if (o.id != *grasped_id_) continue;
     placement_->reported = cv::Vec3d(o.position.x, o.position.y, o.position.z - objectHeight(o.id));
-    s_.log.write("placement_reported", time_s,
-                 {{"trial", placement_->trial},
-                  {"object", o.id},
-                  {"position", {(*placement_->reported)[0], (*placement_->reported)[1],
-                                (*placement_->reported)[2]}}});
+    s_.log.write(
+        "placement_reported", time_s,
+        {{"trial", placement_->trial},
+         {"object", o.id},
+         {"position",
+          {(*placement_->reported)[0], (*placement_->reported)[1], (*placement_->reported)[2]}}});
   }
 }
 
@@ -385,8 +386,8 @@ void RobotStage::measurePlacement(RobotPart& out, const TrackingPart& tracking, 
   placement_.reset();
 }
 
-void RobotStage::endPutDownOnceInView(RobotPart& out, const TrackingPart& tracking,
-                                      double time_s, std::int64_t frame) {
+void RobotStage::endPutDownOnceInView(RobotPart& out, const TrackingPart& tracking, double time_s,
+                                      std::int64_t frame) {
   if (!homed_) return;
   if (!clear_view_frame_) {
     // The scene follows the robot's status: once it shows the arm home, two camera frames.

@@ -189,6 +189,7 @@ struct RobotSettings {
   RobotSettings();
   std::string backend;  // "simulated" (arbci-robotd here) or "remote"
   std::string driver;   // simulated: the arm arbci-robotd drives (robot::robotDrivers())
+  std::string model;    // simulated, mujoco driver: its arm's MJCF (robot::RobotConfig::model)
   double speed_factor;  // the simulated arm's
   std::string host;
   int port;

@@ -29,6 +29,8 @@ struct Pose {
 
 // The angle in degrees of the rotation between two poses' orientations.
 double rotationAngleDeg(const cv::Matx33d& a, const cv::Matx33d& b);
+// The rotation of a unit quaternion (w, x, y, z), as the robot's status reports an object's.
+cv::Matx33d rotationFromQuaternion(const std::array<double, 4>& wxyz);
 
 enum class PoseMethod { Rpp, Ippe, Iterative };
 std::string toString(PoseMethod method);
