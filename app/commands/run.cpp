@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "arbci/core/whole_file.h"
 #include "arbci/render/window_context.h"
 #include "arbci/session/session.h"
 #include "arbci/session/settings_schema.h"
@@ -117,7 +118,19 @@ int runAndExport(const RunOptions& o) {
       entities = {l.value("subject", ""), l.value("session", ""), l.value("task", "arbci"),
                   l.value("run", "")};
     }
-    reportBidsExport(exportToBids(run.out, o.bids_root, entities));
+    const BidsExport done = exportToBids(run.out, o.bids_root, entities);
+    reportBidsExport(done);
+    // The run number is the export's choice, made after the session wrote its summary: the
+    // summary names it too, and where the run went.
+    if (summary.is_object()) {
+      nlohmann::json updated = summary;
+      updated["labels"]["run"] = done.run;
+      updated["bids"] = {{"root", o.bids_root}, {"eeg_file", done.eeg_file.string()}};
+      if (const std::string why = core::writeWholeFile(
+              std::filesystem::path(run.out) / "summary.json", updated.dump(2) + "\n");
+          !why.empty())
+        std::cerr << "arbci run: summary.json not updated with the BIDS run: " << why << "\n";
+    }
   } catch (const std::exception& error) {
     throw CliError(std::string("the session ended, but its BIDS export failed: ") + error.what() +
                    "; the session folder " + run.out +

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
@@ -115,6 +116,15 @@ struct SimulatedSubject::Generator {
     shared.settle(random, normal);
   }
 };
+
+std::string SimulatedSubject::describe() const {
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "simulated subject (seed %llu: P3 %.1f uV at %.0f ms), %zu channels at %.0f Hz",
+                static_cast<unsigned long long>(config_.seed), profile_.p3_amplitude_uv,
+                profile_.p3_latency_s * 1000.0, config_.montage.size(), config_.rate_hz);
+  return text;
+}
 
 SimulatedSubject::SimulatedSubject(const SimulatedSubjectConfig& config,
                                    std::shared_ptr<const SampleClock> clock)

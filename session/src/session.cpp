@@ -154,7 +154,13 @@ void Session::endIfDone() {
   }
   // The last placement is measured before the run ends (a status after the drop, or 3 s).
   if (phase == bci::Phase::Finished && !record.robot.measuring) endRun("finished");
-  if (phase == bci::Phase::Aborted) endRun("aborted");
+  if (phase == bci::Phase::Aborted) {
+    // The whole reason (who or what aborted it), not the word alone.
+    std::string reason = "aborted";
+    for (const PhaseChange& change : record.paradigm.phase_changes)
+      if (change.phase == bci::Phase::Aborted && !change.text.empty()) reason = change.text;
+    endRun(reason, "aborted");
+  }
   if (options_.flashes_only_s > 0.0 && time >= options_.flashes_only_s) endRun("timing check done");
   if (!options_.experimenter && time > options_.max_session_s)
     endRun("the session ran past its time limit");

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -66,6 +67,13 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
                          "summary.json"));
   EXPECT_FALSE(fs::exists(root / "derivatives" / "arbci" / "sub-01" / "ses-1" / "eeg" / stem /
                           "robot.key"));  // the secret stays behind
+  // The session folder's summary names the run the export chose, and the simulated subject.
+  const auto summary = nlohmann::json::parse(read(dir / "session" / "summary.json"));
+  EXPECT_EQ(summary["labels"]["run"], "1") << summary["labels"].dump();
+  EXPECT_EQ(summary["bids"]["eeg_file"], (eeg / (stem + "_eeg.bdf")).string());
+  EXPECT_NE(summary["eeg"]["source"].get<std::string>().find("simulated subject (seed "),
+            std::string::npos)
+      << summary["eeg"]["source"];
 
   // The events: every flash with T or N, and the robot's commands placed on the recording.
   const std::string events = read(eeg / (stem + "_events.tsv"));

@@ -162,10 +162,13 @@ TEST(MujocoArm, TheSevenAxisArmGraspsAndPutsDown) {
   EXPECT_NEAR(placed.position.y, 0.75, 0.01);
 }
 
-TEST(MujocoArm, AModelWithoutThePartsItNeedsIsRefusedByName) {
+TEST(MujocoArm, ALabsModelFileLoadsAndOneWithoutThePartsItNeedsIsRefusedByName) {
   const auto folder = std::filesystem::temp_directory_path() / "arbci_mujoco_model_test";
   std::filesystem::create_directories(folder);
   std::string arm = builtInArm("arm6");
+  // A lab's file that keeps the contract loads.
+  std::ofstream(folder / "arm.xml") << arm;
+  EXPECT_EQ(MujocoArm(twoObjects((folder / "arm.xml").string())).armJoints(), 6);
   const std::string sensor = "<force name=\"wrist_force\" site=\"wrist\"/>";
   arm.erase(arm.find(sensor), sensor.size());
   std::ofstream(folder / "arm.xml") << arm;

@@ -52,7 +52,7 @@ void ParadigmStage::onPhaseChanged(const bci::ParadigmEvent& e, Cycle& cycle) {
   s_.log.write("phase", cycle.time_s,
                {{"phase", bci::toString(e.phase)}, {"text", e.text}, {"trial", e.trial}});
   cycle.annotate(cycle.eeg_sample, bci::kPhaseAnnotation + e.text);
-  cycle.record.paradigm.phase_changes.push_back({e.phase, e.trial});
+  cycle.record.paradigm.phase_changes.push_back({e.phase, e.trial, e.text});
 }
 
 void ParadigmStage::onSelectionStarted(const bci::ParadigmEvent& e, Cycle& cycle) {

@@ -38,9 +38,8 @@ class HmdStageTest : public ::testing::Test {
     config.eeg.photodiode_channel = "Photodiode";
     session::CycleRecord warm_up;
     tracked(warm_up);
-    stage_ =
-        std::make_unique<HmdStage>(HmdSettings::of(config), bench_.folder(), *context_, warm_up,
-                                   bench_.services());
+    stage_ = std::make_unique<HmdStage>(HmdSettings::of(config), bench_.folder(), *context_,
+                                        warm_up, bench_.services());
   }
   test::StageBench bench_;
   std::unique_ptr<render::GlContext> context_;
@@ -49,7 +48,7 @@ class HmdStageTest : public ::testing::Test {
 
 TEST_F(HmdStageTest, AFlashOnTheGridLightsThePatchInBothEyesAndIsReadBack) {
   tracked(bench_.record);
-  bench_.record.paradigm.phase_changes.push_back({bci::Phase::CellFlashing, 1});
+  bench_.record.paradigm.phase_changes.push_back({bci::Phase::CellFlashing, 1, ""});
   bci::FrameStimulus& shown = bench_.record.paradigm.stimulus;
   shown.phase = bci::Phase::CellFlashing;
   shown.grid_visible = true;

@@ -198,6 +198,7 @@ struct RobotPart {
 struct PhaseChange {
   bci::Phase phase;
   int trial = 0;
+  std::string text;  // the paradigm's words: "aborted: training failed: ..."
 };
 
 struct ParadigmPart {
