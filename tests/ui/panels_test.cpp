@@ -165,6 +165,15 @@ class Drawer {
     frame(bench, input);
     return true;
   }
+  // A key pressed with Ctrl (a shortcut), over one frame.
+  void ctrlKey(test::PanelBench& bench, char key) {
+    SyntheticInput input;
+    input.key = key;
+    input.ctrl = true;
+    frame(bench, input);
+    frames(bench, 2);
+  }
+  ExperimenterShell& shell() { return shell_; }
 
  private:
   void frame(test::PanelBench& bench, const SyntheticInput& input) {
@@ -632,9 +641,10 @@ TEST(StartError, TheScreenShowsTheReasonAndQuitEndsIt) {
   EXPECT_TRUE(quit);
 }
 
-// Ctrl+Q quits as the File menu says.
+// Ctrl+Q quits as the File menu says: before a session starts, at once.
 TEST_F(Panels, CtrlQQuitsTheShell) {
   auto panel = make("log");
+  bench_.record.paradigm.phase = bci::Phase::Setup;
   ImGuiLayer imgui(*context_, "");
   ExperimenterShell shell;
   shell.addPanel(*panel);
@@ -651,6 +661,22 @@ TEST_F(Panels, CtrlQQuitsTheShell) {
     shell.draw(kSize, {16.7f, "", ""}, bench_.input());
     imgui.endFrame();
   }
+  EXPECT_EQ(quits, 1);
+}
+
+// While a session runs, Ctrl+Q asks the question Abort asks before it ends anything.
+TEST_F(Panels, CtrlQInARunningSessionAsksFirst) {
+  auto panel = make("log");
+  Drawer drawer(*context_, *panel);
+  int quits = 0;
+  drawer.shell().setQuitHandler([&] { ++quits; });
+  bench_.record.paradigm.phase = bci::Phase::CalibrationFlashing;
+  drawer.ctrlKey(bench_, 'Q');
+  EXPECT_EQ(quits, 0) << "quit without asking";
+  ASSERT_TRUE(drawer.click(bench_, "Cancel"));
+  EXPECT_EQ(quits, 0);
+  drawer.ctrlKey(bench_, 'Q');
+  ASSERT_TRUE(drawer.click(bench_, "Yes, quit"));
   EXPECT_EQ(quits, 1);
 }
 

@@ -48,6 +48,7 @@ void ExperimenterShell::draw(render::Size display, const ShellStatus& status,
     ImGui::OpenPopup("About ARBCI");
     show_about_ = false;
   }
+  drawQuit(in);
   if (ImGui::BeginPopupModal("About ARBCI", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::Text("ARBCI %s", ARBCI_VERSION);
     ImGui::TextUnformatted("Augmented-reality BCI experimenter workstation.");
@@ -56,13 +57,41 @@ void ExperimenterShell::draw(render::Size display, const ShellStatus& status,
   }
 }
 
+// Quitting ends a running session as Abort does: it asks the same question first. Before the
+// start or after the end there is nothing to lose, and it quits at once.
+void ExperimenterShell::drawQuit(const PanelInput& in) {
+  if (quit_asked_) {
+    quit_asked_ = false;
+    const bool running = in.record.paradigm.phase != bci::Phase::Setup && !in.record.ended;
+    if (!running) {
+      if (on_quit_) on_quit_();
+      return;
+    }
+    ImGui::OpenPopup("Quit ARBCI?##confirm");
+  }
+  if (!ImGui::BeginPopupModal("Quit ARBCI?##confirm", nullptr, ImGuiWindowFlags_AlwaysAutoResize))
+    return;
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30.0f);
+  ImGui::TextUnformatted(
+      "The session is running. Quitting ends it now (as Abort does); what was recorded is kept.");
+  ImGui::PopTextWrapPos();
+  if (button("Yes, quit")) {
+    ImGui::CloseCurrentPopup();
+    if (on_quit_) on_quit_();
+  }
+  ImGui::SameLine();
+  if (button("Cancel")) ImGui::CloseCurrentPopup();
+  ImGui::EndPopup();
+}
+
 void ExperimenterShell::drawMenuBar(const PanelInput& in) {
   // Ctrl+Q, as the menu says. This ImGui (1.86) indexes keys by the backend's codes; GLFW's for
   // letters are their upper-case ASCII codes.
-  if (ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('Q', false) && on_quit_) on_quit_();
+  const bool quit = ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('Q', false);
+  if (quit) quit_asked_ = true;
   if (!ImGui::BeginMainMenuBar()) return;
   if (ImGui::BeginMenu("File")) {
-    if (ImGui::MenuItem("Quit", "Ctrl+Q") && on_quit_) on_quit_();
+    if (ImGui::MenuItem("Quit", "Ctrl+Q")) quit_asked_ = true;
     ImGui::EndMenu();
   }
   if (ImGui::BeginMenu("Panels")) {

@@ -30,8 +30,15 @@ void endSessionButton(const PanelInput& in) {
     ImGui::TextUnformatted("End the session now? What was recorded is kept.");
   }
   ImGui::PopTextWrapPos();
+  const std::string why_not_release = whyNot(Action::OpenGripper, r);
+  if (held >= 0 && !why_not_release.empty()) {
+    // Said here, not only on the disabled button's tooltip: what comes first.
+    colouredWrapped(ImVec4(1.0f, 0.7f, 0.3f, 1.0f),
+                    "Put it back first is not possible now (" + why_not_release +
+                        "): press E-STOP to stop the trial, then put it back.");
+  }
   if (held >= 0) {
-    if (button("Put it back first", whyNot(Action::OpenGripper, r))) {
+    if (button("Put it back first", why_not_release)) {
       in.requests.post(session::RobotReleaseRequest{r.time_s});
       ImGui::CloseCurrentPopup();
     }

@@ -23,12 +23,6 @@ std::string seconds(double s) {
   return text;
 }
 
-void colouredWrapped(const ImVec4& colour, const std::string& text) {
-  ImGui::PushStyleColor(ImGuiCol_Text, colour);
-  ImGui::TextWrapped("%s", text.c_str());
-  ImGui::PopStyleColor();
-}
-
 class SessionPanel final : public Panel {
  public:
   const char* title() const override { return "Session"; }
@@ -50,8 +44,18 @@ void SessionPanel::draw(const PanelInput& in) {
   const bool started = r.paradigm.phase != bci::Phase::Setup;
   // One line (a narrow panel cuts it; the reason below wraps): the buttons stay where they are.
   ImGui::Text("%s", session::phaseText(r).c_str());
-  ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", r.paradigm.trial,
-              in.settings.paradigm.trials, r.paradigm.sequence, r.time_s);
+  // The calibration run counts its own selections (the trials come after it).
+  if (const auto& c = r.paradigm.calibration_selection) {
+    ImGui::Text("calibration selection %d of %d%s, sequence %d, session time %.1f s", c->first,
+                c->second,
+                r.paradigm.calibration_retakes > 0
+                    ? (" (" + std::to_string(r.paradigm.calibration_retakes) + " retaken)").c_str()
+                    : "",
+                r.paradigm.sequence, r.time_s);
+  } else {
+    ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", r.paradigm.trial,
+                in.settings.paradigm.trials, r.paradigm.sequence, r.time_s);
+  }
   buttons(in);
   // Why the session is not going as planned (a pause, a failed training, a refused grasp), or
   // how it ended: the same words as the operator log and the summary.

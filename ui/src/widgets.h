@@ -18,6 +18,13 @@ inline void heading(const char* text) {
   ImGui::PopStyleColor();
 }
 
+// Wrapped text in a colour (a warning, a reason).
+inline void colouredWrapped(const ImVec4& colour, const std::string& text) {
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+}
+
 // A button that says why it cannot be pressed: with `why_not` non-empty it is drawn disabled and
 // hovering it shows the reason. Every press leaves visible feedback this way (it acts, or it
 // says why not). Recorded for scripted clicks (widget_registry.h). Returns true when pressed.

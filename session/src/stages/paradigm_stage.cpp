@@ -74,6 +74,11 @@ void ParadigmStage::publish(Cycle& cycle) {
   part.interrupted = paradigm_.interrupted();
   part.trial = paradigm_.trial();
   part.sequence = paradigm_.sequence();
+  if (paradigm_.calibrating())
+    part.calibration_selection = {
+        std::min(paradigm_.calibrationDone() + 1, settings_.paradigm.calibration_selections),
+        settings_.paradigm.calibration_selections};
+  part.calibration_retakes = paradigm_.calibrationRetakes();
   part.errp_awaited = paradigm_.awaitingErrpVerdict();
   part.stimulus = stimulus_;
   part.slots = slots_;

@@ -195,6 +195,9 @@ class Paradigm {
   int corrections() const { return corrections_; }
   int sequence() const { return sequence_; }  // the current sequence of a flashing phase (1-based)
   int calibrationRetakes() const { return calibration_retakes_; }
+  // Calibration selections done so far (the one under way is this plus one).
+  int calibrationDone() const { return calibration_done_; }
+  bool calibrating() const { return calibrating_; }
   bool awaitingDecision() const { return awaiting_decision_; }
   const ParadigmLayout& objectLayout() const { return object_layout_; }
   const ParadigmLayout& gridLayout() const { return grid_layout_; }

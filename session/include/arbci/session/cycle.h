@@ -205,6 +205,9 @@ struct ParadigmPart {
   bci::Phase phase = bci::Phase::Setup;
   std::optional<bci::Phase> interrupted;
   int trial = 0, sequence = 0;
+  // In the calibration run: the selection under way (1-based) of how many, and retakes so far.
+  std::optional<std::pair<int, int>> calibration_selection;
+  int calibration_retakes = 0;
   bool errp_awaited = false;
   bci::FrameStimulus stimulus;            // what this frame shows
   std::vector<Flash> first_shown;         // flashes this frame shows for the first time

@@ -38,6 +38,7 @@ class ExperimenterShell {
     bool at_start;  // open when the window opened: laid out in the columns
   };
   void drawMenuBar(const PanelInput& in);
+  void drawQuit(const PanelInput& in);
   void drawPanels(render::Size display, float top, float bottom, const PanelInput& in);
   void fitToScreen(render::Size display, float top, float bottom);
   void drawStatusBar(render::Size display, float height, const ShellStatus& status);
@@ -45,6 +46,7 @@ class ExperimenterShell {
   std::function<void()> on_quit_;
   bool show_stop_ = false;
   bool show_about_ = false;
+  bool quit_asked_ = false;  // Ctrl+Q or File > Quit, to be confirmed while a session runs
   bool reset_layout_ = false;
   Panel* focus_ = nullptr;  // brought to the front in the next frame
 };
