@@ -75,6 +75,12 @@ StimulusTiming::Frame StimulusTiming::presented(double due_s, double presented_s
 
 void StimulusTiming::startSelection() {
   selection_onsets_.clear();
+  selection_interrupted_s_ = 0.0;
+}
+
+void StimulusTiming::interrupted(double seconds) {
+  // Before the first onset the span has not begun: nothing to take out of it.
+  if (!selection_onsets_.empty()) selection_interrupted_s_ += seconds;
 }
 
 double StimulusTiming::medianSoaS() const {
@@ -84,8 +90,9 @@ double StimulusTiming::medianSoaS() const {
 
 double StimulusTiming::selectionSeconds() const {
   if (selection_onsets_.empty()) return 0.0;
-  return static_cast<double>(selection_onsets_.back() - selection_onsets_.front()) / rate_hz_ +
-         medianSoaS();
+  const double span =
+      static_cast<double>(selection_onsets_.back() - selection_onsets_.front()) / rate_hz_;
+  return std::max(0.0, span - selection_interrupted_s_) + medianSoaS();
 }
 
 std::optional<double> StimulusTiming::medianFrameIntervalMs() const {

@@ -52,6 +52,17 @@ std::string selectionLine(const TrialRecord& t) {
 
 namespace {
 
+nlohmann::json interruptionsJson(const std::vector<TrialRecord::Interruption>& all) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& i : all) {
+    out.push_back({{"kind", i.kind},
+                   {"at_s", i.at_s},
+                   {"resumed_s",
+                    i.resumed_s >= 0.0 ? nlohmann::json(i.resumed_s) : nlohmann::json(nullptr)}});
+  }
+  return out;
+}
+
 nlohmann::json orNull(double v) {
   return v >= 0.0 ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
@@ -92,6 +103,9 @@ nlohmann::json trialJson(const TrialRecord& t) {
       {"cell_flashes", t.cell_flashes},
       {"object_selection_s", t.object_selection_s},
       {"cell_selection_s", t.cell_selection_s},
+      {"object_interrupted_s", t.object_interrupted_s},
+      {"cell_interrupted_s", t.cell_interrupted_s},
+      {"interruptions", interruptionsJson(t.interruptions)},
       {"outcome", t.outcome},
       {"duration_s", t.ended_s >= 0.0 ? orNull(t.ended_s - t.started_s) : nlohmann::json(nullptr)},
       {"placement_error_m", orNull(t.placement_error_m)}};

@@ -506,7 +506,11 @@ TEST_F(Panels, TheSummaryPanelShowsTheEndedSessionsSummary) {
       {"trials",
        {{{"trial", 1},
          {"selected_object", 20},
+         {"intended_object", 20},
+         {"selected_cell", {1, 1}},
+         {"intended_cell", {3, 1}},
          {"outcome", "placed"},
+         {"interruptions", {{{"kind", "emergency stop"}, {"at_s", 80.2}, {"resumed_s", 89.0}}}},
          {"placement_error_m", 0.001}},
         {{"trial", 2}, {"selected_object", nullptr}, {"outcome", "skipped"}}}},
       {"timing", {{"late_frames", 0}, {"lost_samples", 0}}}});

@@ -39,23 +39,49 @@ void addRates(const nlohmann::json& s, Rows& rows) {
                           number(s["all_inclusive"]["bits_per_minute"], "%.1f bits/min"));
 }
 
+// "cell 1,1 (intended 3,1: wrong)", or "cell 3,1" when it was the intended one.
+std::string choice(const char* what, const nlohmann::json& selected, const nlohmann::json& intended,
+                   bool& wrong) {
+  auto text = [](const nlohmann::json& v) {
+    if (v.is_array() && v.size() == 2) return v[0].dump() + "," + v[1].dump();
+    return v.dump();
+  };
+  // null: no selection was accepted (none made, or every one rejected by the ErrP).
+  if (selected.is_null()) return std::string("no ") + what;
+  std::string out = std::string(what) + " " + text(selected);
+  if (!intended.is_null() && selected != intended) {
+    wrong = true;
+    out += " (intended " + text(intended) + ": wrong)";
+  }
+  return out;
+}
+
 void addTrials(const nlohmann::json& s, Rows& rows) {
-  int placed = 0;
+  int placed = 0, placed_right = 0;
   const nlohmann::json trials = s.value("trials", nlohmann::json::array());
   for (const nlohmann::json& t : trials) {
-    const std::string outcome = t.value("outcome", "");
-    // null: no object selection was accepted (none made, or every one rejected by the ErrP).
-    const nlohmann::json object = t.value("selected_object", nlohmann::json());
-    std::string line = (object.is_number() ? "object " + object.dump() : std::string("no object")) +
-                       ": " + outcome;
+    bool wrong = false;
+    std::string line = choice("object", t.value("selected_object", nlohmann::json()),
+                              t.value("intended_object", nlohmann::json()), wrong) +
+                       ", " +
+                       choice("cell", t.value("selected_cell", nlohmann::json()),
+                              t.value("intended_cell", nlohmann::json()), wrong) +
+                       ": " + t.value("outcome", "");
     if (t.contains("placement_error_m") && t["placement_error_m"].is_number()) {
       ++placed;
+      placed_right += wrong ? 0 : 1;
       line += ", " + number(t["placement_error_m"], "%.1f mm off", 1000.0);
     }
+    const nlohmann::json interruptions = t.value("interruptions", nlohmann::json::array());
+    if (!interruptions.empty())
+      line += "; interrupted " + std::to_string(interruptions.size()) + " time" +
+              (interruptions.size() == 1 ? "" : "s") + " (" + interruptions[0].value("kind", "") +
+              (interruptions.size() > 1 ? ", ..." : "") + ")";
     rows.emplace_back("trial " + std::to_string(t.value("trial", 0)), line);
   }
-  rows.emplace_back("placements",
-                    std::to_string(placed) + " of " + std::to_string(trials.size()) + " trials");
+  rows.emplace_back("placements", std::to_string(placed) + " of " + std::to_string(trials.size()) +
+                                      " trials, " + std::to_string(placed_right) +
+                                      " where intended");
 }
 
 void addTiming(const nlohmann::json& s, Rows& rows) {

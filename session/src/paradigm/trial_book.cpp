@@ -33,11 +33,13 @@ bool TrialBook::recordSelection(int number, const SelectionDecided& s) {
     trial.object_certainty = s.certainty;
     trial.object_flashes = s.flashes;
     trial.object_selection_s = s.selection_s;
+    trial.object_interrupted_s = s.selection_interrupted_s;
   } else {
     trial.selected_cell = s.cell;
     trial.cell_certainty = s.certainty;
     trial.cell_flashes = s.flashes;
     trial.cell_selection_s = s.selection_s;
+    trial.cell_interrupted_s = s.selection_interrupted_s;
   }
   const bool correct = s.objects ? trial.selected_object == trial.intended_object
                                  : trial.selected_cell == trial.intended_cell;

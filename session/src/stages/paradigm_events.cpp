@@ -53,6 +53,26 @@ void ParadigmStage::onPhaseChanged(const bci::ParadigmEvent& e, Cycle& cycle) {
                {{"phase", bci::toString(e.phase)}, {"text", e.text}, {"trial", e.trial}});
   cycle.annotate(cycle.eeg_sample, bci::kPhaseAnnotation + e.text);
   cycle.record.paradigm.phase_changes.push_back({e.phase, e.trial, e.text});
+  noteInterruption(e, cycle.time_s);
+}
+
+// Every pause, E-STOP and robot fault of an online trial, and when it went on, for the summary.
+void ParadigmStage::noteInterruption(const bci::ParadigmEvent& e, double time_s) {
+  const auto kind = [](bci::Phase p) -> const char* {
+    if (p == bci::Phase::Paused) return "paused";
+    if (p == bci::Phase::EmergencyStop) return "emergency stop";
+    if (p == bci::Phase::RobotFault) return "robot fault";
+    return nullptr;
+  };
+  TrialRecord* trial = trials_.find(e.trial);
+  if (!trial) return;
+  auto& list = trial->interruptions;
+  const char* now = kind(e.phase);
+  if (!list.empty() && list.back().resumed_s < 0.0) {
+    if (now && list.back().kind == now) return;  // the same one goes on
+    list.back().resumed_s = time_s;              // resumed, or another took over
+  }
+  if (now) list.push_back({now, time_s, -1.0});
 }
 
 void ParadigmStage::onSelectionStarted(const bci::ParadigmEvent& e, Cycle& cycle) {
@@ -110,6 +130,7 @@ void ParadigmStage::onSelectionMade(const bci::ParadigmEvent& e, Cycle& cycle) {
   decided.certainty = e.certainty;
   decided.flashes = selection_flashes_;
   decided.selection_s = cycle.record.presentation.selection_s;
+  decided.selection_interrupted_s = cycle.record.presentation.selection_interrupted_s;
   const bool correct = trials_.recordSelection(number, decided);
   const TrialRecord& trial = trials_.at(number);
   nlohmann::json fields = {{"trial", trial.trial},

@@ -14,6 +14,12 @@ void PresentationStage::step(Cycle& cycle) {
   out = Presentation{};
   // A new selection's SOA is measured among its own flashes.
   if (drawn.paradigm.selection_started) timing_.startSelection();
+  // Time the session stood interrupted is not selection time (bit rates count the subject's).
+  const bci::Phase phase = drawn.paradigm.phase;
+  if (last_time_s_ && (phase == bci::Phase::Paused || phase == bci::Phase::EmergencyStop ||
+                       phase == bci::Phase::RobotFault))
+    timing_.interrupted(cycle.time_s - *last_time_s_);
+  last_time_s_ = cycle.time_s;
   if (drawn.presented) {
     out.shown = true;
     out.host_s = drawn.presented->host_s;
@@ -49,6 +55,7 @@ void PresentationStage::step(Cycle& cycle) {
     warnIfDisplayTooSlow(out.at_s);
   }
   out.selection_s = timing_.selectionSeconds();
+  out.selection_interrupted_s = timing_.selectionInterruptedSeconds();
   out.median_frame_ms = timing_.medianFrameIntervalMs();
   out.late_frames = timing_.lateFrames();
   out.display_too_slow = timing_.displayTooSlow();

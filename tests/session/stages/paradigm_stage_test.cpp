@@ -327,6 +327,11 @@ TEST_F(ParadigmStageTest, AGraspTheRobotRefusesIsAFaultWithItsReasonAndRetryAsks
   EXPECT_EQ(postedOf<RobotResetIfLatchedRequest>().size(), 1u);
   EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Grasping);
   EXPECT_EQ(bench_.previous.paradigm.status, "");
+  // The fault is on the trial's record, from when it came to when the retry went on.
+  const auto& interruptions = (*bench_.previous.paradigm.trials)[0].interruptions;
+  ASSERT_EQ(interruptions.size(), 1u);
+  EXPECT_EQ(interruptions[0].kind, "robot fault");
+  EXPECT_GT(interruptions[0].resumed_s, interruptions[0].at_s);
 }
 
 TEST_F(ParadigmStageTest, AnObjectOutOfViewIsNotFlashedAndTheCalibrationSelectionIsRetaken) {
@@ -455,6 +460,10 @@ TEST_F(ParadigmStageTest, TheEmergencyStopPostsARobotStopAndEndSessionEndsWithTh
   EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::EmergencyStop);
   EXPECT_EQ(bench_.previous.paradigm.interrupted, bci::Phase::Grasping);
   EXPECT_EQ(postedOf<RobotStopRequest>().size(), 1u);
+  const auto& interruptions = (*bench_.previous.paradigm.trials)[0].interruptions;
+  ASSERT_EQ(interruptions.size(), 1u);
+  EXPECT_EQ(interruptions[0].kind, "emergency stop");
+  EXPECT_LT(interruptions[0].resumed_s, 0.0);  // not over
   bench_.record.requests.push_back(EndSessionRequest{});
   cycle();
   EXPECT_EQ(bench_.previous.end_reason, "ended by the experimenter in: EMERGENCY STOP");

@@ -55,6 +55,30 @@ TEST_F(PresentationStageTest, AFlashIsStampedAtItsFirstFrameAndLastsUntilTheFirs
   EXPECT_EQ(shown().ended[0].duration_samples, 17);
 }
 
+// A selection whose flashing stood still for an E-STOP: its time is its flashes' (first onset to
+// last, plus one SOA) without the stop, which is reported apart.
+TEST_F(PresentationStageTest, TimeInterruptedIsLeftOutOfTheSelectionsTime) {
+  auto frameAt = [&](bool flash, bci::Phase phase) {
+    CycleRecord& p = bench_.previous;
+    p.paradigm.phase = phase;
+    const std::int64_t sample = std::llround(p.frame / 60.0 * 256.0);
+    if (flash) {
+      drawn({1}, {1}, sample);
+    } else {
+      drawn({}, {}, sample);
+    }
+    step();
+  };
+  bench_.previous.paradigm.selection_started = SelectionStart{};
+  // Flashes every 12 frames (200 ms), three of them; 120 frames (2 s) stopped; two more.
+  for (int f = 0; f < 36; ++f) frameAt(f % 12 == 0, bci::Phase::ObjectFlashing);
+  for (int f = 0; f < 120; ++f) frameAt(false, bci::Phase::EmergencyStop);
+  for (int f = 0; f < 13; ++f) frameAt(f % 12 == 0, bci::Phase::ObjectFlashing);
+  EXPECT_NEAR(shown().selection_interrupted_s, 2.0, 0.05);
+  // Five flashes: four intervals and one SOA, 1.0 s, whatever the stop's length.
+  EXPECT_NEAR(shown().selection_s, 1.0, 0.05);
+}
+
 TEST_F(PresentationStageTest, NothingIsStampedForAFrameNotYetPresented) {
   bench_.previous.paradigm.first_shown.push_back({3, true, false, true, 1});
   bench_.previous.paradigm.stimulus.lit = {3};

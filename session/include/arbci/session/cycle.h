@@ -87,8 +87,10 @@ struct Presentation {
   std::optional<FeedbackShown> feedback;
   std::optional<bool> patch;  // the photodiode patch changed to lit (true) or dark on this frame
   bool late = false;
-  // The current selection's duration from its onsets as presented (first to last, plus one SOA).
+  // The current selection's duration from its onsets as presented (first to last, plus one SOA),
+  // without the time it spent interrupted (paused, E-STOP, robot fault), which is apart.
   double selection_s = 0.0;
+  double selection_interrupted_s = 0.0;
   std::optional<double> median_frame_ms;  // once 60 frames were presented
   std::int64_t late_frames = 0;
   bool display_too_slow = false;

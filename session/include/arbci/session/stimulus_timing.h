@@ -41,8 +41,13 @@ class StimulusTiming {
                   const std::vector<int>& first_shown);
   // A new selection starts (its SOA is measured among its own flashes).
   void startSelection();
-  // The current selection's duration from its flash onsets: first onset to last, plus one SOA.
+  // The current selection's duration from its flash onsets: first onset to last, plus one SOA,
+  // less the time it was interrupted (a pause, an E-STOP, a robot fault) once its flashes began.
   double selectionSeconds() const;
+  // That interrupted time, counted by interrupted() since startSelection().
+  double selectionInterruptedSeconds() const { return selection_interrupted_s_; }
+  // `seconds` of the current selection passed with the session interrupted.
+  void interrupted(double seconds);
 
   std::int64_t lateFrames() const { return late_frames_; }
   std::int64_t framesPresented() const { return frames_; }
@@ -73,6 +78,7 @@ class StimulusTiming {
   std::optional<std::int64_t> last_end_sample_;
   std::vector<double> gap_samples_;
   std::vector<std::int64_t> selection_onsets_;
+  double selection_interrupted_s_ = 0.0;
 };
 
 }  // namespace arbci::session

@@ -29,6 +29,15 @@ struct TrialRecord {
   double object_certainty = 0.0, cell_certainty = 0.0;
   int object_flashes = 0, cell_flashes = 0;
   double object_selection_s = 0.0, cell_selection_s = 0.0;  // from the presented onsets
+  // Within each selection, the time the session stood interrupted (not in the times above).
+  double object_interrupted_s = 0.0, cell_interrupted_s = 0.0;
+  // Each pause, E-STOP and robot fault in the trial: what, when, and when it ended (resumed, or
+  // another took over; -1: never).
+  struct Interruption {
+    std::string kind;  // "paused", "emergency stop", "robot fault"
+    double at_s = 0.0, resumed_s = -1.0;
+  };
+  std::vector<Interruption> interruptions;
   double started_s = 0.0, ended_s = -1.0;  // session time: after the last trial, its put-down
   double placement_error_m = -1.0;
   std::string outcome = "incomplete";

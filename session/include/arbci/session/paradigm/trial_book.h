@@ -21,7 +21,8 @@ struct SelectionDecided {
   std::pair<int, int> cell{0, 0};  // else: the cell
   double certainty = 0.0;
   int flashes = 0;
-  double selection_s = 0.0;  // from its onsets as presented
+  double selection_s = 0.0;              // from its onsets as presented, without interruptions
+  double selection_interrupted_s = 0.0;  // the time it stood interrupted
 };
 
 class TrialBook {

@@ -69,6 +69,7 @@ class ParadigmStage final : public Stage {
   // The paradigm's events, each to its handler.
   void handleEvents(Cycle& cycle);
   void onPhaseChanged(const bci::ParadigmEvent& e, Cycle& cycle);
+  void noteInterruption(const bci::ParadigmEvent& e, double time_s);
   void onSelectionStarted(const bci::ParadigmEvent& e, Cycle& cycle);
   void onFlash(const bci::ParadigmEvent& e, Cycle& cycle);
   void onSelectionMade(const bci::ParadigmEvent& e, Cycle& cycle);

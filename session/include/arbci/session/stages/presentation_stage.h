@@ -32,6 +32,7 @@ class PresentationStage final : public Stage {
   StimulusTiming timing_;
   bool patch_lit_ = false;  // as the last presented frame showed it
   bool warned_slow_display_ = false;
+  std::optional<double> last_time_s_;  // the last cycle's session time
 };
 
 }  // namespace arbci::session
