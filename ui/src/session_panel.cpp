@@ -157,18 +157,22 @@ void SessionPanel::trackingHealth(const PanelInput& in) {
   } else {
     ImGui::Text("reference %d: seen", reference_id);
   }
-  if (!world) return;
   const int held = r.robot.holding().value_or(-1);
-  for (const vision::ObjectState& o : world->objects()) {
+  // Every object of the session, the ones the cameras never saw (or not since the robot moved
+  // them) too: an empty table is named object by object.
+  for (const session::WorldObjectSettings& object : in.settings.world.objects) {
+    const int id = object.id;
     ImGui::SameLine(0.0f, 20.0f);
     if (ImGui::GetContentRegionAvail().x < 150.0f) ImGui::NewLine();
-    const double age = o.age(r.time_s);
-    if (o.id == held) {
-      ImGui::Text("object %d: in the gripper", o.id);
-    } else if (age > max_age) {
-      ImGui::TextColored(lost, "object %d: lost (%s)", o.id, seconds(age).c_str());
+    const auto o = world ? world->object(id) : std::nullopt;
+    if (id == held) {
+      ImGui::Text("object %d: in the gripper", id);
+    } else if (!o) {
+      ImGui::TextColored(lost, "object %d: not seen", id);
+    } else if (const double age = o->age(r.time_s); age > max_age) {
+      ImGui::TextColored(lost, "object %d: lost (%s)", id, seconds(age).c_str());
     } else {
-      ImGui::Text("object %d: seen", o.id);
+      ImGui::Text("object %d: seen", id);
     }
   }
 }
