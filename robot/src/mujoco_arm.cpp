@@ -24,6 +24,7 @@ constexpr double kResting = 0.005;     // m/s: a released object slower than thi
 constexpr double kRestingFor = 0.1;    // s
 constexpr double kLiftedClear = 0.02;  // m: a held object's base this far above the table
 constexpr double kForceBaselineSeconds = 0.2;
+constexpr int kCheckIterations = 60;  // a reachable point converges in far fewer from either seed
 
 double distance(const Vec3& a, const Vec3& b) {
   return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
@@ -52,6 +53,7 @@ struct MujocoArm::Impl {
   std::unique_ptr<mujoco::ArmKinematics> kinematics;
   std::vector<double> q_des;     // the joints' set points
   std::vector<double> q_before;  // ... at the last step
+  std::vector<double> q_home;    // the joints at home, the posture the arm starts in
   Vec3 path;                     // where the tool's path is now
   double speed = 0.0;            // along the path
   double grip = 0.0;             // the gripper's set point (ctrlrange low: open)
@@ -371,6 +373,7 @@ MujocoArm::MujocoArm(const RobotConfig& config) : impl_(std::make_unique<Impl>()
                       " is not reachable pointing down");
   for (size_t k = 0; k < home->size(); ++k) m.data->qpos[m.contract.qpos[k]] = (*home)[k];
   m.q_des = *home;
+  m.q_home = *home;
   m.q_before = *home;
   mj_forward(m.model.get(), m.data.get());
   m.path = m.tool();
@@ -400,7 +403,10 @@ std::optional<Rejection> MujocoArm::check(const DriverCommand& c) const {
     const Vec3& p = c.target;
     if (auto outside = outsideWorkspace(cfg, p)) return outside;
     for (const Vec3& point : {p, approachPoint(cfg, p)}) {
-      if (!m.kinematics->solve(point, m.q_des) && !m.kinematics->solveAnywhere(point))
+      // From where the arm is, then from its home posture: a few milliseconds at most, as the
+      // backend's loop (the watchdog's) waits for check (the many-start search is for start-up).
+      if (!m.kinematics->solve(point, m.q_des, kCheckIterations) &&
+          !m.kinematics->solve(point, m.q_home, kCheckIterations))
         return Rejection{RejectReason::Unreachable, pointText(p) + " is out of the arm's reach"};
     }
     const int holding = m.held();
