@@ -29,8 +29,8 @@ namespace {
 
 struct RunOptions {
   std::string session, out, script;
-  bool headless = false, realtime = false, wait_for_start = false, exit_when_done = false,
-       overwrite = false;
+  bool headless = false, realtime = false, start_now = false, wait_for_start = false,
+       exit_when_done = false, overwrite = false;
   std::optional<int> trials;  // paradigm.trials
   std::optional<int> seed;    // eeg.seed
   double fault_wait_s = 5.0;
@@ -170,7 +170,7 @@ int runSessionIn(const RunOptions& o, bool headless) {
     if (!headless) {
       // Once open, the window shows the session's own failures and offers a retry in place.
       return runWorkstation(config, options,
-                            {o.script, o.wait_for_start, o.exit_when_done, false, o.bids_root,
+                            {o.script, !o.start_now, o.exit_when_done, false, o.bids_root,
                              [&] { claim.keep(); }});
     }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
@@ -229,8 +229,12 @@ void addRunCommand(CLI::App& root, int& exit_code) {
                   "panels' buttons (wait \"PHASE\", click \"LABEL\", pause S, key ctrl+q,\n"
                   "screenshot F.png; see docs/render-ui.md). Exit status 4 when it fails")
       ->check(CLI::ExistingFile);
+  run->add_flag("--start-now", o->start_now,
+                "windowed: start at once, without the start screen's subject, session and run\n"
+                "(headless runs always start at once)");
+  // The start screen became the default; the old flag still parses, so lab scripts keep working.
   run->add_flag("--wait-for-start", o->wait_for_start,
-                "windowed: wait for the experimenter to press Start");
+                "windowed: the start screen waits for Start (the default; kept for old scripts)");
   run->add_option("--fault-wait", o->fault_wait_s,
                   "headless: seconds to wait for an experimenter after a robot fault")
       ->capture_default_str();

@@ -12,7 +12,7 @@ namespace arbci::app {
 struct WorkstationOptions {
   // A scripted experimenter (workstation/experimenter_script.h); exit status 4 when it fails.
   std::filesystem::path script;
-  bool wait_for_start = false;    // the experimenter presses Start (else it runs at once)
+  bool wait_for_start = true;     // the experimenter presses Start (else it runs at once)
   bool close_when_ended = false;  // the window closes once the session has ended
   // Nobody at the window (the timing check): the session starts itself and a failed pre-flight
   // ends it, as headless.

@@ -152,7 +152,7 @@ wait "finished" 240
 pause 0.5
 screenshot )" + shots + R"(/4-finished.png
 )",
-                                    {"--wait-for-start"}, "out");
+                                    {}, "out");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto out = folder / "out";
   const nlohmann::json summary = readJson(out / "summary.json");
