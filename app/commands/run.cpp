@@ -169,9 +169,9 @@ int runSessionIn(const RunOptions& o, bool headless) {
   try {
     if (!headless) {
       // Once open, the window shows the session's own failures and offers a retry in place.
-      return runWorkstation(config, options,
-                            {o.script, !o.start_now, o.exit_when_done, false, o.bids_root,
-                             [&] { claim.keep(); }});
+      return runWorkstation(
+          config, options,
+          {o.script, !o.start_now, o.exit_when_done, false, o.bids_root, [&] { claim.keep(); }});
     }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped

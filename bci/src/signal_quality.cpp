@@ -123,7 +123,10 @@ SignalQuality assessSignal(const float* x, int n, double rate_hz, const QualityT
     return q;
   }
   // The stronger of the two lines that stand out from their neighbours; none when neither does.
-  const double line50 = peak50 ? q.line50_uv : 0.0, line60 = peak60 ? q.line60_uv : 0.0;
+  const bool grade50 = t.line_hz == 0.0 || std::abs(t.line_hz - 50.0) < 1.0;
+  const bool grade60 = t.line_hz == 0.0 || std::abs(t.line_hz - 60.0) < 1.0;
+  const double line50 = peak50 && grade50 ? q.line50_uv : 0.0;
+  const double line60 = peak60 && grade60 ? q.line60_uv : 0.0;
   const bool fifty = line50 >= line60;
   const Finding findings[] = {
       graded(fifty ? "line noise 50 Hz" : "line noise 60 Hz", fifty ? line50 : line60,

@@ -45,3 +45,30 @@ std::string TrackingPart::alarm(const std::vector<int>& ids, double now_s) const
 }
 
 }  // namespace arbci::session
+
+namespace arbci::session {
+
+std::vector<std::string> QualityPart::bad() const {
+  std::vector<std::string> out;
+  for (size_t c = 0; c < quality.size() && c < channels.size(); ++c)
+    if (quality[c].grade == bci::Grade::Bad) out.push_back(channels[c] + ": " + quality[c].finding);
+  return out;
+}
+
+nlohmann::json QualityPart::toJson() const {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t c = 0; c < quality.size() && c < channels.size(); ++c) {
+    const bci::SignalQuality& q = quality[c];
+    out.push_back({{"channel", channels[c]},
+                   {"grade", bci::toString(q.grade)},
+                   {"finding", q.finding},
+                   {"rms_uv", q.rms_uv},
+                   {"sd_uv", q.sd_uv},
+                   {"line50_uv", q.line50_uv},
+                   {"line60_uv", q.line60_uv},
+                   {"drift_uv_s", q.drift_uv_s}});
+  }
+  return out;
+}
+
+}  // namespace arbci::session

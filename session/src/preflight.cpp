@@ -14,8 +14,9 @@ std::string format(const char* pattern, double a, double b = 0.0) {
 
 }  // namespace
 
-void Preflight::begin(const PreflightObservation& now) {
+void Preflight::begin(const PreflightObservation& now, bool quality_accepted) {
   state_ = State::Running;
+  quality_accepted_ = quality_accepted;
   first_ = last_ = now;
   camera_frames_ = 0;
   reference_seen_ = false;
@@ -93,6 +94,7 @@ std::vector<std::string> Preflight::check(bool final) const {
                   ": free some space, choose another folder, or keep fewer "
                   "screenshots (hmd.screenshots)");
   }
+  if (std::string quality = qualityFailure(); !quality.empty()) out.push_back(std::move(quality));
   if (!last_.robot_answered && last_.robot_key_refused) {
     out.push_back(settings_.robot_key + ": " + settings_.robot_what +
                   " answered that our key is not its key: give both sides the same robot.key_file "
@@ -102,6 +104,36 @@ std::vector<std::string> Preflight::check(bool final) const {
                   (final ? format(" in %.1f s", last_.wall_s - first_.wall_s) : ""));
   }
   return out;
+}
+
+std::string Preflight::qualityFailure() const {
+  if (settings_.quality_gate == "off" || quality_accepted_) return "";
+  if (!last_.bad_channels)
+    return settings_.eeg_key + ": the channels' quality is not known yet (it needs 2 s of signal)";
+  const auto& bad = *last_.bad_channels;
+  if (static_cast<int>(bad.size()) <= settings_.bad_channels_allowed) return "";
+  std::string text = "gates.signal_quality: " + std::to_string(bad.size()) + " of " +
+                     std::to_string(last_.channels) + " EEG channels bad (";
+  for (size_t i = 0; i < bad.size(); ++i) text += (i ? "; " : "") + bad[i];
+  text += "): check the electrodes in the EEG panel";
+  if (settings_.quality_gate == "ask") text += ", or start anyway";
+  return text;
+}
+
+bool Preflight::questioned() const {
+  if (state_ != State::Failed || settings_.quality_gate != "ask" || quality_accepted_) return false;
+  // The quality is the only failure: everything else passed.
+  return failures_.size() == 1 && failures_.front().rfind("gates.signal_quality", 0) == 0;
+}
+
+std::string Preflight::qualityVerdict() const {
+  if (settings_.quality_gate == "off") return "not checked";
+  if (quality_accepted_) return "accepted by the experimenter";
+  if (state_ == State::Passed) return "passed";
+  for (const std::string& f : failures_)
+    if (f.rfind("gates.signal_quality", 0) == 0)
+      return settings_.quality_gate == "ask" ? "questioned" : "refused";
+  return last_.bad_channels ? "passed" : "not assessed";
 }
 
 std::vector<std::string> Preflight::lines() const {
@@ -115,7 +147,10 @@ std::vector<std::string> Preflight::lines() const {
                     format("EEG at %.1f Hz, the robot answers", eeg_rate_hz_));
       return out;
     case State::Failed:
-      out.emplace_back("pre-flight FAILED (Start checks again):");
+      out.emplace_back(questioned()
+                           ? "pre-flight: all passed but the EEG's quality (Start checks again; "
+                             "Start anyway accepts it):"
+                           : "pre-flight FAILED (Start checks again):");
       for (const std::string& f : failures_) out.push_back("  " + f);
       return out;
     case State::Running:

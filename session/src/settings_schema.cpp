@@ -9,6 +9,7 @@
 #include "arbci/bci/classifier.h"
 #include "arbci/bci/errp_feedback.h"
 #include "arbci/bci/settings.h"
+#include "arbci/bci/signal_quality.h"
 #include "arbci/robot/settings.h"
 #include "arbci/session/eeg_sources.h"
 #include "arbci/session/scene_source.h"
@@ -589,6 +590,65 @@ const core::Schema<ErrpSettings>& errpOwnSchema() {
   return errpTable();
 }
 
+const Schema<GateSettings>& gateSchema() {
+  static const Schema<GateSettings> t = [] {
+    using G = GateSettings;
+    Schema<G> t("gates",
+                "What a run must pass: the EEG's quality at Start, the calibration's review "
+                "before going online, the flashes' timing during the run");
+    t.text("signal_quality", &G::signal_quality, "ask",
+           "at Start, EEG channels graded bad over the last 2 s (flat, saturated, line noise at "
+           "classifier.notch_hz, drift, RMS): ask the experimenter to start anyway or not (a run "
+           "without one is refused), refuse, or off (logged only)",
+           [] {
+             return std::vector<std::string>{"ask", "refuse", "off"};
+           })
+        .integer("bad_channels_allowed", &G::bad_channels_allowed, 0, 0, 256,
+                 "bad channels that pass the quality gate")
+        .number("flat_sd_uv", &G::flat_sd_uv, bci::kFlatSdUv, 0.0, 100.0,
+                "a channel whose standard deviation is below this is flat (bad)", "uV")
+        .number("line_bad_uv", &G::line_bad_uv, bci::kLineBadUv, 0.1, 1e4,
+                "line noise at the notch frequency above this amplitude is bad", "uV")
+        .number("drift_bad_uv_s", &G::drift_bad_uv_s, bci::kDriftBadUvS, 0.1, 1e5,
+                "a linear drift faster than this is bad", "uV/s")
+        .number("rms_bad_uv", &G::rms_bad_uv, bci::kRmsBadUv, 1.0, 1e5,
+                "an RMS about the trend above this is bad", "uV")
+        .boolean("review", &G::review, true,
+                 "windowed: after training, the calibration's ERP, AUC and accuracy wait for the "
+                 "experimenter's Go online or Recalibrate")
+        .number("min_auc", &G::min_auc, 0.0, 0.0, 1.0,
+                "a calibration whose cross-validated AUC is below this does not go online "
+                "unattended: the experimenter decides, and a run without one ends (0: none)")
+        .text("timing", &G::timing, "pause",
+              "flashes off the timing limits: each annotated in the recording, and past "
+              "max_off_share or max_late_share the run pauses with the reason (pause), only "
+              "annotated (annotate), or not checked (off); a run without an experimenter never "
+              "pauses",
+              [] {
+                return std::vector<std::string>{"pause", "annotate", "off"};
+              })
+        .number("max_flash_ms", &G::max_flash_ms, 0.0, 0.0, 10000.0,
+                "a flash shown longer is off limits (0: twice paradigm.flash_ms as the display "
+                "shows it)",
+                "ms")
+        .number("min_gap_ms", &G::min_gap_ms, 0.0, 0.0, 10000.0,
+                "a dark gap before a flash shorter than this is off limits (0: half the "
+                "configured gap)",
+                "ms")
+        .number("min_soa_ms", &G::min_soa_ms, 0.0, 0.0, 10000.0,
+                "an onset-to-onset interval shorter than this is off limits (0: the configured "
+                "SOA less one display frame)",
+                "ms")
+        .number("max_off_share", &G::max_off_share, 0.1, 0.0, 1.0,
+                "the share of a selection's flashes (after its first 12) off limits that pauses "
+                "the run")
+        .number("max_late_share", &G::max_late_share, 0.5, 0.0, 1.0,
+                "the share of the last 120 presented frames presented late that pauses the run");
+    return t;
+  }();
+  return t;
+}
+
 const Schema<SessionConfig>& sessionSchema() {
   static const Schema<SessionConfig> t = [] {
     Schema<SessionConfig> t("session", "A session file: every key, its default and what it means");
@@ -604,7 +664,8 @@ const Schema<SessionConfig>& sessionSchema() {
         .sectionOf("paradigm", paradigmSectionSchema())
         .section("classifier", &SessionConfig::classifier, classifierTable())
         .sectionOf("errp", errpSectionSchema())
-        .section("robot", &SessionConfig::robot, robotSchema());
+        .section("robot", &SessionConfig::robot, robotSchema())
+        .section("gates", &SessionConfig::gates, gateSchema());
     t.rule(crossRules);
     return t;
   }();
@@ -646,6 +707,22 @@ TrialIntent::TrialIntent() : object(0) {
 }
 RobotSettings::RobotSettings() {
   robotSchema().applyDefaults(*this);
+}
+GateSettings::GateSettings() {
+  gateSchema().applyDefaults(*this);
+}
+bci::QualityThresholds GateSettings::thresholds(double line_hz) const {
+  bci::QualityThresholds t;
+  t.flat_sd_uv = flat_sd_uv;
+  t.line_bad_uv = line_bad_uv;
+  t.drift_bad_uv_s = drift_bad_uv_s;
+  t.rms_bad_uv = rms_bad_uv;
+  // A poor grade stays below the bad one however the bad threshold is set.
+  t.line_poor_uv = std::min(t.line_poor_uv, line_bad_uv);
+  t.drift_poor_uv_s = std::min(t.drift_poor_uv_s, drift_bad_uv_s);
+  t.rms_poor_uv = std::min(t.rms_poor_uv, rms_bad_uv);
+  t.line_hz = line_hz;
+  return t;
 }
 SessionConfig::SessionConfig() {
   sessionSchema().applyDefaults(*this);

@@ -16,6 +16,7 @@
 #include "arbci/session/stages/presentation_stage.h"
 #include "arbci/session/stages/recording_stage.h"
 #include "arbci/session/stages/robot_stage.h"
+#include "arbci/session/stages/signal_quality_stage.h"
 #include "arbci/session/stages/tracking_stage.h"
 #include "arbci/session/trial_intents.h"
 
@@ -58,6 +59,8 @@ PreflightSettings preflightSettingsOf(const SessionConfig& c, const SessionOptio
   }
   p.eeg_key = c.eeg.source == "file" ? "eeg.file" : "eeg.rate_hz";
   p.reference_id = c.world.reference_id;
+  p.quality_gate = c.gates.signal_quality;
+  p.bad_channels_allowed = c.gates.bad_channels_allowed;
   if (c.robot.backend == "simulated") {
     p.robot_key = "robot.backend";
     p.robot_what = "the simulated arm (arbci-robotd)";
@@ -166,6 +169,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto recording = std::make_unique<RecordingStage>(
       RecordingSettings{folder / "recording.bdf", eeg->info(), recordingParameters(c)}, services);
   const bci::SignalInfo& eeg_info = eeg->eegInfo();
+  auto quality = std::make_unique<SignalQualityStage>(
+      SignalQualitySettings{eeg_info, c.gates.thresholds(c.classifier.pipeline.filter.notch_hz)});
   auto p300 = std::make_unique<P300Stage>(
       P300Settings{eeg_info, c.classifier.pipeline, c.classifier.training,
                    c.paradigm.flashSeconds(), static_cast<int>(c.world.objects.size()),
@@ -193,6 +198,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   out.stages.push_back(std::move(presentation));
   out.stages.push_back(std::move(eeg));
   out.stages.push_back(std::move(recording));
+  out.stages.push_back(std::move(quality));
   out.stages.push_back(std::move(p300));
   out.stages.push_back(std::move(errp));
   if (markers) out.stages.push_back(std::move(markers));

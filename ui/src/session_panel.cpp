@@ -75,6 +75,11 @@ void SessionPanel::draw(const PanelInput& in) {
       ImGui::TextWrapped("%s", line.c_str());
     }
   }
+  // The quality gate asked: the experimenter may start with the channels as they are (the log,
+  // the recording and the summary say so).
+  if (!r.preflight.questioned.empty() && !started &&
+      button("Start anyway, with these channels", ""))
+    in.requests.post(session::StartRequest{true});
   trackingHealth(in);
   timing(in);
   heading("selections");

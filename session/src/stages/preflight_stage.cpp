@@ -20,14 +20,19 @@ PreflightObservation PreflightStage::observe(const Cycle& cycle) const {
   o.robot_answered = cycle.record.robot.answered;
   o.robot_key_refused = cycle.record.robot.key_refused;
   o.disk_free = disk_free_;
+  const QualityPart& quality = cycle.record.quality;
+  o.channels = static_cast<int>(quality.channels.size());
+  if (!quality.quality.empty()) o.bad_channels = quality.bad();
   return o;
 }
 
 void PreflightStage::step(Cycle& cycle) {
-  const bool begin = !requestsOf<StartRequest>(cycle.record.requests).empty() &&
-                     cycle.previous.paradigm.phase == bci::Phase::Setup &&
+  const auto starts = requestsOf<StartRequest>(cycle.record.requests);
+  const bool begin = !starts.empty() && cycle.previous.paradigm.phase == bci::Phase::Setup &&
                      preflight_.state() != Preflight::State::Running;
   if (begin) {
+    // Accepting the quality is the experimenter's answer to the question just asked, no other.
+    const bool accepted = starts.back()->despite_quality && preflight_.questioned();
     s_.log.write("preflight_started", cycle.time_s, {});
     // Once a check: the disk does not fill in the seconds it lasts.
     disk_free_.reset();
@@ -36,7 +41,7 @@ void PreflightStage::step(Cycle& cycle) {
       const auto space = std::filesystem::space(settings_.check.folder, error);
       if (!error) disk_free_ = space.available;
     }
-    preflight_.begin(observe(cycle));
+    preflight_.begin(observe(cycle), accepted);
   }
   if (preflight_.state() == Preflight::State::Running) {
     finish(cycle, preflight_.update(observe(cycle)));
@@ -46,9 +51,32 @@ void PreflightStage::step(Cycle& cycle) {
   }
   cycle.record.preflight.running = preflight_.state() == Preflight::State::Running;
   cycle.record.preflight.lines = preflight_.lines();
+  if (preflight_.questioned()) cycle.record.preflight.questioned = cycle.record.quality.bad();
+}
+
+void PreflightStage::logQuality(Cycle& cycle) {
+  const QualityPart& quality = cycle.record.quality;
+  const std::string verdict = preflight_.qualityVerdict();
+  const std::vector<std::string> bad = quality.bad();
+  quality_ = {{"verdict", verdict},
+              {"gate", settings_.check.quality_gate},
+              {"bad_channels", bad.size()},
+              {"channels", quality.toJson()}};
+  s_.log.write("signal_quality", cycle.time_s, quality_);
+  // The recording (and a BIDS export's events) says what the channels were like at Start.
+  std::string note = "Signal quality at Start: " + verdict + ", " + std::to_string(bad.size()) +
+                     " of " + std::to_string(quality.channels.size()) + " channels bad";
+  for (size_t i = 0; i < bad.size(); ++i) note += (i ? "; " : " (") + bad[i];
+  if (!bad.empty()) note += ")";
+  cycle.annotate(cycle.eeg_sample, note);
+}
+
+void PreflightStage::report(nlohmann::json& summary) const {
+  summary["signal_quality"] = quality_.empty() ? nlohmann::json{{"verdict", "no Start"}} : quality_;
 }
 
 void PreflightStage::finish(Cycle& cycle, Preflight::State state) {
+  if (state != Preflight::State::Running) logQuality(cycle);
   if (state == Preflight::State::Passed) {
     s_.log.write("preflight", cycle.time_s,
                  {{"passed", true},
@@ -58,7 +86,15 @@ void PreflightStage::finish(Cycle& cycle, Preflight::State state) {
     cycle.post(BeginRequest{});
   } else if (state == Preflight::State::Failed) {
     s_.log.write("preflight", cycle.time_s,
-                 {{"passed", false}, {"failures", preflight_.failures()}});
+                 {{"passed", false},
+                  {"failures", preflight_.failures()},
+                  {"questioned", preflight_.questioned()}});
+    if (preflight_.questioned() && settings_.experimenter) {
+      s_.tell.say(cycle.time_s, Severity::Warning,
+                  "pre-flight: " + preflight_.failures().front() +
+                      " (Start anyway, or fix them and Start)");
+      return;
+    }
     for (const std::string& f : preflight_.failures())
       s_.tell.say(cycle.time_s, Severity::Error, "pre-flight failed: " + f);
     // Without an experimenter nothing can be fixed: the run ends before any flash.

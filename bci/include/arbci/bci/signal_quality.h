@@ -13,17 +13,23 @@ namespace arbci::bci {
 enum class Grade { Good, Poor, Bad };
 const char* toString(Grade grade);  // "good", "poor", "bad"
 
+// Where a line, a drift and an RMS turn bad: the EEG panel's grading and the session's quality gate
+// (gates.*, whose defaults these are).
+inline constexpr double kLineBadUv = 20.0, kDriftBadUvS = 200.0, kRmsBadUv = 100.0;
+
 // Where a finding turns poor (amber) and bad (red). Scalp EEG is tens of microvolts: a channel
 // far above that carries an artefact or a loose electrode.
 struct QualityThresholds {
   double flat_sd_uv = kFlatSdUv;  // standard deviation below this: flat (bad)
   double saturated_uv = 5000.0;   // a sample this far from zero: the amplifier's range (bad)
   double line_poor_uv = 5.0;      // amplitude at 50 or 60 Hz
-  double line_bad_uv = 20.0;
+  double line_bad_uv = kLineBadUv;
   double drift_poor_uv_s = 50.0;  // the window's linear trend
-  double drift_bad_uv_s = 200.0;
+  double drift_bad_uv_s = kDriftBadUvS;
   double rms_poor_uv = 50.0;  // about the trend
-  double rms_bad_uv = 100.0;
+  double rms_bad_uv = kRmsBadUv;
+  // The lab's power line (the notch's frequency): only its line is graded; 0: 50 and 60 Hz both.
+  double line_hz = 0.0;
 };
 
 struct SignalQuality {

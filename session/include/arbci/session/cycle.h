@@ -23,6 +23,7 @@
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/paradigm.h"
 #include "arbci/bci/signal.h"
+#include "arbci/bci/signal_quality.h"
 #include "arbci/core/run_labels.h"
 #include "arbci/robot/protocol.h"
 #include "arbci/session/clock.h"
@@ -108,6 +109,16 @@ struct EegPart {
   double drift_ppm = 0.0, jitter_ms = 0.0;
   bool drift_reliable = false;             // see bci::ClockModel::driftReliable
   std::vector<bci::DeliveryStall> stalls;  // deliveries held up, taken this cycle
+};
+
+// Each EEG channel's quality over the last 2 s of raw signal, graded as the EEG panel grades it
+// (the quality gate at Start reads it; signal_quality_stage.h).
+struct QualityPart {
+  std::vector<std::string> channels;
+  std::vector<bci::SignalQuality> quality;  // one per channel; empty until 2 s were seen
+  // "C3: flat: SD 0.10 uV (bad below 0.5)" for each channel graded bad.
+  std::vector<std::string> bad() const;
+  nlohmann::json toJson() const;  // [{channel, grade, finding, rms_uv, ...}]
 };
 
 struct RecordingPart {
@@ -233,6 +244,9 @@ struct DisplayPart {
 struct PreflightPart {
   bool running = false;
   std::vector<std::string> lines;
+  // The check passed but for the EEG's quality (gates.signal_quality "ask"): the bad channels,
+  // which the experimenter may accept with StartRequest{despite_quality}.
+  std::vector<std::string> questioned;
 };
 
 struct CycleRecord {
@@ -257,6 +271,7 @@ struct CycleRecord {
 
   Presentation presentation;  // the frame presented last
   EegPart eeg;
+  QualityPart quality;
   RecordingPart recording;
   P300Part p300;
   ErrpPart errp;

@@ -1,5 +1,6 @@
 // The pre-flight check before the calibration run: camera frames arrive and show the reference
-// marker, the EEG flows at its rate, and the robot answers STATUS. It watches the cycle for at
+// marker, the EEG flows at its rate and its channels are not graded bad (gates.signal_quality),
+// and the robot answers STATUS. It watches the cycle for at
 // least `min_s` and passes once all hold; past `timeout_s` (of session time and of the wall
 // clock both: a robot answers on the wall clock even when the session's is simulated) it fails,
 // each failure naming the session file's key to look at.
@@ -27,6 +28,10 @@ struct PreflightSettings {
   // it was reckoned.
   std::uintmax_t disk_needed = 0;
   std::string folder, disk_what;
+  // gates.signal_quality: "ask" (a failure the experimenter may override), "refuse" or "off";
+  // more bad channels than `bad_channels_allowed` fail it.
+  std::string quality_gate = "off";
+  int bad_channels_allowed = 0;
   // Failures known before the check begins (the display's: a missing HMD monitor); any fails
   // the pre-flight on its first frame.
   std::vector<std::string> known_failures;
@@ -43,6 +48,9 @@ struct PreflightObservation {
   bool robot_answered = false;
   bool robot_key_refused = false;           // it answered, with KEY MISMATCH
   std::optional<std::uintmax_t> disk_free;  // on the session folder's disk (unknown: unchecked)
+  // The EEG channels graded bad ("C3: flat: ..."), of how many; none: not assessed yet.
+  std::optional<std::vector<std::string>> bad_channels;
+  int channels = 0;
 };
 
 class Preflight {
@@ -50,7 +58,8 @@ class Preflight {
   enum class State { Idle, Running, Passed, Failed };
   explicit Preflight(PreflightSettings settings) : settings_(std::move(settings)) {}
 
-  void begin(const PreflightObservation& now);
+  // `quality_accepted`: the experimenter chose to start despite bad channels (the gate "ask").
+  void begin(const PreflightObservation& now, bool quality_accepted = false);
   // Running: updates the state from this frame's observation.
   State update(const PreflightObservation& now);
   State state() const { return state_; }
@@ -58,11 +67,18 @@ class Preflight {
   const std::vector<std::string>& failures() const { return failures_; }
   // For the panel: one line per check with what was measured so far.
   std::vector<std::string> lines() const;
+  // Failed on the signal's quality alone, which the experimenter may accept (the gate "ask").
+  bool questioned() const;
+  // The quality verdict once the check ended: "passed", "refused", "questioned", "accepted by the
+  // experimenter" or "not checked".
+  std::string qualityVerdict() const;
   double eegRateHz() const { return eeg_rate_hz_; }
   int cameraFrames() const { return camera_frames_; }
 
  private:
   std::vector<std::string> check(bool final) const;
+  // "" when the channels pass the gate, else its failure.
+  std::string qualityFailure() const;
   PreflightSettings settings_;
   State state_ = State::Idle;
   PreflightObservation first_, last_;
@@ -77,6 +93,7 @@ class Preflight {
   std::optional<PreflightObservation> eeg_from_;  // where the rate is counted from
   PreflightObservation eeg_last_;                 // the last frame on which samples arrived
   std::vector<std::string> failures_;
+  bool quality_accepted_ = false;
 };
 
 }  // namespace arbci::session

@@ -19,7 +19,10 @@
 namespace arbci::session {
 
 // The experimenter's Start, to the pre-flight check; the check passed, to the paradigm.
-struct StartRequest {};
+// `despite_quality`: the experimenter starts although the pre-flight questioned the EEG's quality.
+struct StartRequest {
+  bool despite_quality = false;
+};
 struct BeginRequest {};
 // The experimenter, to the paradigm.
 struct PauseRequest {};

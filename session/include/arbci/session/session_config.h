@@ -20,6 +20,7 @@
 #include "arbci/bci/features.h"
 #include "arbci/bci/lsl/config.h"
 #include "arbci/bci/paradigm.h"
+#include "arbci/bci/signal_quality.h"
 #include "arbci/vision/marker_detector.h"
 
 namespace arbci::session {
@@ -197,6 +198,23 @@ struct RobotSettings {
   std::string key_file;
 };
 
+// The gates a run passes (docs/session.md, "Gates"): the signal's quality at Start, the
+// calibration's review before the first online trial, and the flashes' timing during the run.
+struct GateSettings {
+  GateSettings();
+  std::string signal_quality;  // "ask", "refuse" or "off"
+  int bad_channels_allowed;
+  double flat_sd_uv, line_bad_uv, drift_bad_uv_s, rms_bad_uv;  // a channel graded bad
+  bool review;         // windowed: the experimenter accepts the calibration before going online
+  double min_auc;      // below it the session does not go online unattended (0: no minimum)
+  std::string timing;  // "pause", "annotate" or "off"
+  double max_flash_ms, min_gap_ms, min_soa_ms;  // 0: derived from the paradigm's settings
+  double max_off_share;                         // of a selection's flashes, then it pauses
+  double max_late_share;                        // of the last 120 frames, then it pauses
+  // How a channel is graded, at Start and in the EEG panel alike; `line_hz`: the notch's.
+  bci::QualityThresholds thresholds(double line_hz) const;
+};
+
 struct SessionConfig {
   SessionConfig();                          // the schema's defaults: the embedded simulated session
   std::string source = "embedded default";  // the file it was read from (not a setting)
@@ -212,6 +230,7 @@ struct SessionConfig {
   ClassifierSettings classifier;
   ErrpSettings errp;
   RobotSettings robot;
+  GateSettings gates;
 
   double displayHz() const { return paradigm.display_hz; }
   // The defaults, or `path` over the defaults. Throws SessionConfigError naming the key.
