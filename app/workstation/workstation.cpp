@@ -84,10 +84,13 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   // Every registered panel, in the registry's order; the summary opens when the session ends.
   std::vector<std::unique_ptr<ui::Panel>> panels;
   ui::Panel* summary_panel = nullptr;
+  ui::Panel* training_panel = nullptr;  // the calibration review is there
+  bool reviewing = false;
   for (const auto& entry : ui::panels().entries()) {
     panels.push_back(entry.make.make());
     shell.addPanel(*panels.back(), entry.make.open_at_start);
     if (entry.name == "summary") summary_panel = panels.back().get();
+    if (entry.name == "training") training_panel = panels.back().get();
   }
   shell.showEmergencyStop(true);
   shell.setQuitHandler([&] { main_window.requestClose(); });
@@ -104,6 +107,10 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     main_window.makeCurrent();  // the simulated cameras render in it
     session.step();
     state.ingest(session.last(), session.config());
+    // The calibration waits for the experimenter: its review opens in front (once per review).
+    const bool review = session.last().paradigm.review.has_value();
+    if (review && !reviewing && training_panel) shell.show(*training_panel);
+    reviewing = review;
     if (session.ended() && !summary_shown) {
       if (summary_panel) shell.show(*summary_panel);  // once: the experimenter may close it
       summary_shown = true;

@@ -454,6 +454,16 @@ void Paradigm::modelTrained(bool ok, const std::string& text) {
   startFlashing(nextFrame(), true);
 }
 
+void Paradigm::recalibrate() {
+  if (phase_ != Phase::Training) return;
+  calibration_done_ = 0;
+  errp_block_ = false;
+  errp_done_ = 0;
+  errp_plan_.clear();
+  calibrating_ = true;
+  cueCalibrationTarget(settings_.pause_s);
+}
+
 void Paradigm::robotFinished(bool success, const std::string& text) {
   if (phase_ != Phase::Grasping && phase_ != Phase::Dropping) return;
   if (!success) {

@@ -6,6 +6,7 @@
 namespace arbci::session {
 
 std::string phaseText(const CycleRecord& record) {
+  if (!record.ended && record.paradigm.review) return "calibration review";
   if (!record.ended) return bci::toString(record.paradigm.phase);
   const std::string& kind = record.end_kind;
   const std::string& why = record.end_reason;

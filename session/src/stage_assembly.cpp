@@ -187,7 +187,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto paradigm = std::make_unique<ParadigmStage>(
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
                             c.eeg.seed + 11, c.errp.threshold, folder / "model.json",
-                            options.experimenter, c.tracker.max_pose_age_s},
+                            options.experimenter, c.tracker.max_pose_age_s, c.gates.review,
+                            c.gates.min_auc},
       services);
   CycleRecord warm_up;
   tracking->publish(warm_up.tracking);

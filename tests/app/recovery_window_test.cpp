@@ -135,6 +135,11 @@ click "subject"
 type "07"
 pause 0.3
 click "Start"
+# the calibration review: the experimenter goes online
+wait "calibration review" 240
+pause 0.5
+screenshot )" + shots + R"(/0-review.png
+click "Go online"
 # an emergency stop during the grasp
 wait "robot grasping" 240
 pause 1

@@ -45,6 +45,7 @@ class TrainingPanel final : public Panel {
   void controls(const PanelInput& in);
   void collect();
   void sessionModel(const PanelInput& in);
+  void review(const PanelInput& in, const session::ParadigmPart::Review& review);
   void drawSessionErps(const PanelInput& in);
   void errpModel(const PanelInput& in);
   void trainedHere(const PanelInput& in);
@@ -163,6 +164,8 @@ void TrainingPanel::drawSessionErps(const PanelInput& in) {
 }
 
 void TrainingPanel::draw(const PanelInput& in) {
+  // The session waits on the review: it comes first.
+  if (const auto& r = in.record.paradigm.review) review(in, *r);
   controls(in);
   // The session's own model when nothing was trained here.
   if (!outcome_ || !outcome_->result) {
@@ -218,6 +221,31 @@ void TrainingPanel::controls(const PanelInput& in) {
     ImGui::ProgressBar(static_cast<float>(progress_.load()), ImVec2(-1, 0), stage_.c_str());
   }
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+}
+
+// The calibration review: what the model does on the calibration run (below: its ERP and
+// cross-validation), and the experimenter's decision before any online trial.
+void TrainingPanel::review(const PanelInput& in, const session::ParadigmPart::Review& r) {
+  heading("calibration review: go online with this model?");
+  const ImVec4 colour = r.below ? ImVec4(1.0f, 0.45f, 0.3f, 1.0f) : ImVec4(0.5f, 0.9f, 0.5f, 1.0f);
+  char text[240];
+  if (r.below) {
+    std::snprintf(text, sizeof text,
+                  "calibration run %d: cross-validated AUC %.3f, below the minimum %.3f "
+                  "(gates.min_auc). Recalibrate, or go online on your own judgement.",
+                  r.round, r.auc, r.min_auc);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "calibration run %d: cross-validated AUC %.3f. The ERP and the accuracy by "
+                  "sequences are below.",
+                  r.round, r.auc);
+  }
+  colouredWrapped(colour, text);
+  if (button(r.below ? "Go online anyway" : "Go online"))
+    in.requests.post(session::GoOnlineRequest{});
+  ImGui::SameLine();
+  if (button("Recalibrate")) in.requests.post(session::RecalibrateRequest{});
+  ImGui::Separator();
 }
 
 void TrainingPanel::sessionModel(const PanelInput& in) {

@@ -130,12 +130,26 @@ void CalibrationRun::logErrp(const Cycle& cycle, const StageServices& s) const {
       "no ErrP classifier (" + errp_failure_ + "): selections are executed without an ErrP check");
 }
 
+void CalibrationRun::reviewed(const std::string& decision, double auc, double time_s) {
+  reviews_.push_back({{"decision", decision}, {"auc", auc}, {"at_s", time_s}});
+}
+
+void CalibrationRun::restart() {
+  report_.reset();
+  errp_report_.reset();
+  trained_on_.clear();
+  error_.clear();
+  errp_failure_.clear();
+  awaiting_p300_ = awaiting_errp_ = false;
+}
+
 void CalibrationRun::summarise(nlohmann::json& summary) const {
+  if (!reviews_.empty()) summary["calibration"]["reviews"] = reviews_;
   if (report_) {
-    summary["calibration"] = {{"selections", report_->selections.size()},
-                              {"selections_used", trained_on_},
-                              {"auc", report_->auc},
-                              {"accuracy_by_sequences", report_->accuracy}};
+    summary["calibration"].update({{"selections", report_->selections.size()},
+                                   {"selections_used", trained_on_},
+                                   {"auc", report_->auc},
+                                   {"accuracy_by_sequences", report_->accuracy}});
   }
   if (retakes_.empty()) return;
   nlohmann::json& retaken = summary["calibration"]["retaken"];

@@ -27,10 +27,12 @@ ErrpStage::~ErrpStage() {
   if (training_.valid()) training_.wait();
 }
 
-void ErrpStage::setModel(std::shared_ptr<const bci::P300Model> errp) {
-  keep_signal_ = false;
-  signal_.clear();
-  signal_.shrink_to_fit();
+void ErrpStage::setModel(std::shared_ptr<const bci::P300Model> errp, bool calibrated) {
+  if (!calibrated) {
+    keep_signal_ = false;
+    signal_.clear();
+    signal_.shrink_to_fit();
+  }
   model_ = std::move(errp);
   filters_.reset();
   epocher_.reset();
@@ -61,9 +63,6 @@ void ErrpStage::startTraining() {
           signal_[static_cast<size_t>(s * channels + c)];
     }
   }
-  keep_signal_ = false;
-  signal_.clear();
-  signal_.shrink_to_fit();
   training_ = std::async(
       std::launch::async, [recording = std::move(recording), pipeline = settings_.pipeline,
                            training = settings_.training]() {
@@ -81,7 +80,7 @@ void ErrpStage::takeTraining(Cycle& cycle) {
   ErrpPart& out = cycle.record.errp;
   try {
     Outcome outcome = training_.get();
-    setModel(std::make_shared<const bci::P300Model>(std::move(outcome.model)));
+    setModel(std::make_shared<const bci::P300Model>(std::move(outcome.model)), true);
     trained_erp_ = std::make_shared<const bci::ErpCurves>(std::move(outcome.erp));
     auc_ = outcome.report.auc;
     out.trained = outcome.report;
@@ -92,8 +91,15 @@ void ErrpStage::takeTraining(Cycle& cycle) {
 
 void ErrpStage::step(Cycle& cycle) {
   ErrpPart& out = cycle.record.errp;
-  if (const auto& started = cycle.previous.paradigm.selection_started)
+  if (const auto& started = cycle.previous.paradigm.selection_started) {
     calibrating_ = started->target.has_value();
+    if (!calibrating_ && keep_signal_) {
+      // Online: the feedback block's signal is no longer needed.
+      keep_signal_ = false;
+      signal_.clear();
+      signal_.shrink_to_fit();
+    }
+  }
   for (const Request& request : cycle.record.requests) {
     if (const auto* use = std::get_if<UseModelRequest>(&request)) {
       try {
@@ -105,6 +111,11 @@ void ErrpStage::step(Cycle& cycle) {
       }
     } else if (std::holds_alternative<TrainRequest>(request) && settings_.enabled) {
       startTraining();
+    } else if (std::holds_alternative<RecalibrateRequest>(request) &&
+               cycle.previous.paradigm.review && keep_signal_) {
+      // A new feedback block comes: the classifier is trained on it alone.
+      setModel(nullptr, true);
+      feedbacks_.clear();
     }
   }
   const Presentation& shown = cycle.record.presentation;

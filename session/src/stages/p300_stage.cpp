@@ -29,7 +29,7 @@ P300Stage::~P300Stage() {
   if (training_.valid()) training_.wait();
 }
 
-void P300Stage::setModel(const bci::P300Model& model, double time_s) {
+void P300Stage::setModel(const bci::P300Model& model, double time_s, bool calibrated) {
   model.checkCompatible(settings_.info, "the EEG source");
   trained_erp_.reset();  // the averages belong to the model this session trained, not this one
   if (model.pipeline.zero_phase) {
@@ -44,12 +44,30 @@ void P300Stage::setModel(const bci::P300Model& model, double time_s) {
   // The online filter and window follow the model's pipeline.
   filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, settings_.info);
   model_ = std::make_shared<const bci::P300Model>(model);
+  if (calibrated) return;
   keep_signal_ = false;
   calibration_.data.clear();
   calibration_.data.shrink_to_fit();
 }
 
+void P300Stage::recalibrate() {
+  // The calibration run starts over: no model until it is trained again, on the new run's
+  // selections only (the signal is kept whole: the new flashes index into it).
+  model_.reset();
+  extractor_.reset();
+  accumulator_.reset();
+  trained_erp_.reset();
+  calibration_.stimuli.clear();
+  calibration_selection_.clear();
+}
+
 void P300Stage::startSelection(const SelectionStart& selection) {
+  if (!selection.target && keep_signal_ && model_) {
+    // Online: the calibration signal is no longer needed.
+    keep_signal_ = false;
+    calibration_.data.clear();
+    calibration_.data.shrink_to_fit();
+  }
   if (selection.retake_of && keep_signal_) {
     // Its flashes so far are no whole selection: gone from what training sees (the recording
     // keeps them, with the paradigm's annotation).
@@ -106,7 +124,7 @@ void P300Stage::takeTraining(Cycle& cycle) {
   if (!cycle.clock.ready(training_)) return;
   try {
     Outcome outcome = training_.get();  // rethrows the worker's error
-    setModel(outcome.model, cycle.time_s);
+    setModel(outcome.model, cycle.time_s, true);
     trained_erp_ = std::make_shared<const bci::ErpCurves>(std::move(outcome.erp));
     out.trained = outcome.report;
     out.trained_on = std::move(outcome.trained_on);
@@ -176,6 +194,9 @@ void P300Stage::step(Cycle& cycle) {
       }
     } else if (const auto* train = std::get_if<TrainRequest>(&request)) {
       startTraining(train->method);
+    } else if (std::holds_alternative<RecalibrateRequest>(request) &&
+               cycle.previous.paradigm.review && keep_signal_) {
+      recalibrate();
     }
   }
   // The flashes the last frame showed for the first time.

@@ -86,6 +86,7 @@ void ParadigmStage::publish(Cycle& cycle) {
   if (trial && trial->selected_object > 0) part.selected_object = trial->selected_object;
   part.trials = std::make_shared<const std::vector<TrialRecord>>(trials_.trials());
   part.calibration = calibration_.report();
+  part.review = review_;
   part.status = reasons_.status;
 }
 
@@ -122,6 +123,10 @@ void ParadigmStage::act(const Request& request, Cycle& cycle) {
     reasons_.status.clear();
     paradigm_.skipTrial();
     handleEvents(cycle);
+  } else if (std::holds_alternative<GoOnlineRequest>(request)) {
+    answerReview(true, cycle);
+  } else if (std::holds_alternative<RecalibrateRequest>(request)) {
+    answerReview(false, cycle);
   } else if (std::holds_alternative<EndSessionRequest>(request)) {
     const bci::Phase phase = paradigm_.phase();
     s_.log.write("recovery", time, {{"action", "end session"}});
@@ -179,11 +184,76 @@ void ParadigmStage::collectTraining(Cycle& cycle) {
       paradigm_.modelTrained(false, calibration_.error());
       return;
     case CalibrationRun::Outcome::Trained:
-      chooseSelectableObjects(cycle);
-      trials_.nextStartsAt(cycle.time_s);  // the first trial's time counts from here
-      paradigm_.modelTrained(true, "");
+      reviewCalibration(cycle);
       return;
   }
+}
+
+void ParadigmStage::reviewCalibration(Cycle& cycle) {
+  const double auc = calibration_.report() ? calibration_.report()->auc : 0.0;
+  const double minimum = settings_.min_auc;
+  // A NaN AUC (one class missing) is below any minimum.
+  const bool below = minimum > 0.0 && !(auc >= minimum);
+  char text[200];
+  std::snprintf(text, sizeof text, "calibration AUC %.3f%s", auc,
+                below ? " below gates.min_auc" : "");
+  std::string words = text;
+  if (below) {
+    std::snprintf(text, sizeof text, " %.3f", minimum);
+    words += text;
+  }
+  if (below && !settings_.experimenter) {
+    // Nobody to decide: the run does not go online on a calibration below the lab's minimum.
+    const std::string reason = words + ": not going online unattended";
+    s_.log.write("calibration_review", cycle.time_s,
+                 {{"auc", auc}, {"min_auc", minimum}, {"decision", "end: nobody to ask"}});
+    calibration_.reviewed("ended unattended", auc, cycle.time_s);
+    cycle.end(reason, "aborted");
+    paradigm_.abort();
+    return;
+  }
+  if (!below && !(settings_.review && settings_.experimenter)) {
+    goOnline(cycle);
+    return;
+  }
+  review_ = ParadigmPart::Review{auc, minimum, below, calibration_round_};
+  reasons_.status = "calibration review: " + words +
+                    "; Go online or Recalibrate (Classifier training panel: ERP, AUC, accuracy)";
+  s_.log.write("calibration_review", cycle.time_s,
+               {{"auc", auc}, {"min_auc", minimum}, {"below", below}, {"decision", "asked"}});
+  s_.tell.say(cycle.time_s, below ? Severity::Warning : Severity::Info, reasons_.status);
+}
+
+void ParadigmStage::goOnline(Cycle& cycle) {
+  review_.reset();
+  chooseSelectableObjects(cycle);
+  trials_.nextStartsAt(cycle.time_s);  // the first trial's time counts from here
+  paradigm_.modelTrained(true, "");
+}
+
+void ParadigmStage::answerReview(bool go_online, Cycle& cycle) {
+  if (!review_) return;
+  const double auc = review_->auc;
+  const char* decision = go_online ? "go online" : "recalibrate";
+  s_.log.write("calibration_review", cycle.time_s,
+               {{"auc", auc}, {"below", review_->below}, {"decision", decision}});
+  char text[160];
+  std::snprintf(text, sizeof text, "Calibration review: %s (AUC %.3f%s)", decision, auc,
+                review_->below ? ", below the minimum" : "");
+  cycle.annotate(cycle.eeg_sample, text);
+  calibration_.reviewed(decision, auc, cycle.time_s);
+  reasons_.status.clear();
+  if (go_online) {
+    goOnline(cycle);
+    return;
+  }
+  review_.reset();
+  ++calibration_round_;
+  s_.tell.say(cycle.time_s, Severity::Info,
+              "recalibrating: a new calibration run; training will use its selections only");
+  calibration_.restart();
+  paradigm_.recalibrate();
+  handleEvents(cycle);
 }
 
 const WorldObjectSettings& ParadigmStage::objectOfCode(int code) const {

@@ -61,6 +61,28 @@ TEST_F(P300StageTest, TheCalibrationIsTrainedOnWhenAskedAndTheModelDecidesTheNex
   EXPECT_GT(online.decision.certainty, 0.5);
 }
 
+TEST_F(P300StageTest, RecalibrateAtTheReviewTrainsOnTheNewRunAlone) {
+  for (int n = 1; n <= 3; ++n) eeg_.selection(stage_, n, n, true, 6);
+  bench_.record.requests.push_back(TrainRequest{"slda"});
+  eeg_.step(stage_);
+  ASSERT_NE(bench_.previous.p300.model, nullptr) << bench_.previous.p300.training_error;
+  // The review asked; the experimenter recalibrates: no model until the new run is trained.
+  bench_.previous.paradigm.review = ParadigmPart::Review{};
+  bench_.record.requests.push_back(RecalibrateRequest{});
+  eeg_.step(stage_);
+  EXPECT_EQ(bench_.previous.p300.model, nullptr);
+  for (int n = 4; n <= 7; ++n) eeg_.selection(stage_, n, n - 3, true, 6);
+  bench_.record.requests.push_back(TrainRequest{"slda"});
+  eeg_.step(stage_);
+  const P300Part& trained = bench_.previous.p300;
+  ASSERT_NE(trained.model, nullptr) << trained.training_error;
+  EXPECT_EQ(trained.trained_on, (std::vector<int>{4, 5, 6, 7}));
+  EXPECT_GT(trained.trained->auc, 0.75);
+  // Online, the new model decides.
+  eeg_.selection(stage_, 8, 2, false, 8);
+  EXPECT_EQ(bench_.previous.p300.decision.codes, std::set<int>{2});
+}
+
 TEST_F(P300StageTest, EpochsTouchingLostSamplesAreDiscardedNotScored) {
   for (int n = 1; n <= 3; ++n) eeg_.selection(stage_, n, n, true, 6);
   bench_.record.requests.push_back(TrainRequest{"slda"});

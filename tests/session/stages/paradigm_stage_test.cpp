@@ -9,6 +9,7 @@
 
 #include <functional>
 
+#include "arbci/session/record_text.h"
 #include "arbci/session/stages/p300_stage.h"
 #include "arbci/session/stages/paradigm_stage.h"
 #include "arbci/session/trial_intents.h"
@@ -40,6 +41,7 @@ std::shared_ptr<const bci::P300Model> trainedModel() {
 
 SessionConfig shortSession() {
   SessionConfig c;
+  c.gates.review = false;  // the review has its own tests
   bci::ParadigmSettings& p = c.paradigm;
   p.calibration_selections = 2;
   p.calibration_sequences = 1;
@@ -60,7 +62,8 @@ class ParadigmStageTest : public ::testing::Test {
         bench_("paradigm"),
         stage_(
             ParadigmStageSettings{config_.paradigm, config_.world, "slda", intendedTrials(config_),
-                                  11, 0.5, bench_.folder() / "model.json", experimenter, 0.5},
+                                  11, 0.5, bench_.folder() / "model.json", experimenter, 0.5,
+                                  config_.gates.review && experimenter, config_.gates.min_auc},
             bench_.services()) {}
 
   // The objects the cameras see now (all but `hidden`), at their places; the reference seen.
@@ -514,6 +517,118 @@ TEST_F(ErrpParadigmStageTest, AFeedbackTheErrpRejectsIsNotExecutedAndTheRunnerUp
   nlohmann::json summary;
   stage_.report(summary);
   EXPECT_EQ(summary["errp"]["decisions"], 1);
+}
+
+}  // namespace
+}  // namespace arbci::session
+
+namespace arbci::session {
+namespace {
+
+// The calibration review (gates.review, gates.min_auc) on hand-built training results.
+class ReviewParadigmStageTest : public ParadigmStageTest {
+ protected:
+  static SessionConfig gated(bool review, double min_auc) {
+    SessionConfig c = shortSession();
+    c.gates.review = review;
+    c.gates.min_auc = min_auc;
+    return c;
+  }
+  explicit ReviewParadigmStageTest(bool review = true, double min_auc = 0.0,
+                                   bool experimenter = true)
+      : ParadigmStageTest(gated(review, min_auc), experimenter) {}
+  // Through the calibration run to its training result, AUC `auc`.
+  void trainedAt(double auc) {
+    begin();
+    ASSERT_TRUE(until(bci::Phase::Training));
+    cycle();
+    model_ = trainedModel();
+    cycle([auc](CycleRecord& r) {
+      r.p300.trained = bci::EvaluationReport{};
+      r.p300.trained->auc = auc;
+      r.p300.trained_on = {1, 2};
+    });
+  }
+};
+
+TEST_F(ReviewParadigmStageTest, TheTrainedCalibrationWaitsForGoOnline) {
+  trainedAt(0.9);
+  // Held in training, for as long as the experimenter looks.
+  for (int i = 0; i < 120; ++i) cycle();
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Training);
+  ASSERT_TRUE(bench_.previous.paradigm.review.has_value());
+  EXPECT_DOUBLE_EQ(bench_.previous.paradigm.review->auc, 0.9);
+  EXPECT_FALSE(bench_.previous.paradigm.review->below);
+  EXPECT_EQ(phaseText(bench_.previous), "calibration review");
+  bench_.record.requests.push_back(GoOnlineRequest{});
+  cycle();
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectFlashing);
+  EXPECT_FALSE(bench_.previous.paradigm.review.has_value());
+  bool noted = false;
+  for (const bci::Annotation& a : bench_.previous.annotations)
+    noted |= a.text.rfind("Calibration review: go online (AUC 0.900)", 0) == 0;
+  EXPECT_TRUE(noted);
+  nlohmann::json summary;
+  stage_.report(summary);
+  ASSERT_EQ(summary["calibration"]["reviews"].size(), 1u) << summary["calibration"].dump();
+  EXPECT_EQ(summary["calibration"]["reviews"][0]["decision"], "go online");
+}
+
+TEST_F(ReviewParadigmStageTest, RecalibrateRunsTheCalibrationAgainAndTrainsAgain) {
+  trainedAt(0.6);
+  const int selections = selection_;
+  bench_.record.requests.push_back(RecalibrateRequest{});
+  cycle();
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::CalibrationCue);
+  ASSERT_TRUE(bench_.previous.paradigm.calibration_selection.has_value());
+  EXPECT_EQ(bench_.previous.paradigm.calibration_selection->first, 1);
+  model_.reset();
+  ASSERT_TRUE(until(bci::Phase::Training));
+  cycle();
+  EXPECT_EQ(postedOf<TrainRequest>().size(), 2u);
+  EXPECT_GE(selection_, selections + 2);  // the new run's own selections
+  model_ = trainedModel();
+  cycle([](CycleRecord& r) {
+    r.p300.trained = bci::EvaluationReport{};
+    r.p300.trained->auc = 0.9;
+    r.p300.trained_on = {3, 4};
+  });
+  ASSERT_TRUE(bench_.previous.paradigm.review.has_value());
+  EXPECT_EQ(bench_.previous.paradigm.review->round, 2);
+}
+
+class MinimumAucTest : public ReviewParadigmStageTest {
+ protected:
+  MinimumAucTest() : ReviewParadigmStageTest(false, 0.95) {}
+};
+
+TEST_F(MinimumAucTest, BelowTheMinimumTheExperimenterDecidesEvenWithoutAReview) {
+  trainedAt(0.9);
+  ASSERT_TRUE(bench_.previous.paradigm.review.has_value());
+  EXPECT_TRUE(bench_.previous.paradigm.review->below);
+  EXPECT_NE(bench_.previous.paradigm.status.find("calibration AUC 0.900 below gates.min_auc 0.950"),
+            std::string::npos)
+      << bench_.previous.paradigm.status;
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Training);
+}
+
+class UnattendedMinimumAucTest : public ReviewParadigmStageTest {
+ protected:
+  UnattendedMinimumAucTest() : ReviewParadigmStageTest(true, 0.95, false) {}
+};
+
+TEST_F(UnattendedMinimumAucTest, BelowTheMinimumARunWithoutExperimenterEndsWithTheReason) {
+  trainedAt(0.9);
+  EXPECT_EQ(bench_.previous.end_reason,
+            "calibration AUC 0.900 below gates.min_auc 0.950: not going online unattended");
+  EXPECT_EQ(bench_.previous.end_kind, "aborted");
+  EXPECT_NE(bench_.previous.paradigm.phase, bci::Phase::ObjectFlashing);
+}
+
+TEST_F(UnattendedMinimumAucTest, AboveTheMinimumItGoesOnlineWithoutAReview) {
+  trainedAt(0.97);
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectFlashing);
+  EXPECT_FALSE(bench_.previous.paradigm.review.has_value());
 }
 
 }  // namespace

@@ -180,6 +180,9 @@ class Paradigm {
   void errpVerdict(bool error);
   bool awaitingErrpVerdict() const;
   void modelTrained(bool ok, const std::string& text);
+  // From Training (the experimenter's Recalibrate at the review): the calibration run again, from
+  // its first selection (and its ErrP block, where there is one).
+  void recalibrate();
   void robotFinished(bool success, const std::string& text);
   // The number of objects that can be selected from the next trial on (those tracked).
   void setObjectCount(int objects);

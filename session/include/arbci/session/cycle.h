@@ -231,6 +231,14 @@ struct ParadigmPart {
   std::optional<int> selected_object;      // the marker id selected in this trial
   std::shared_ptr<const std::vector<TrialRecord>> trials;
   std::optional<bci::EvaluationReport> calibration;
+  // Trained, before the first online trial: the calibration waits for the experimenter's Go
+  // online or Recalibrate (gates.review, or its AUC below gates.min_auc).
+  struct Review {
+    double auc = 0.0, min_auc = 0.0;
+    bool below = false;  // under gates.min_auc
+    int round = 1;       // the calibration run's number (a recalibration is the second)
+  };
+  std::optional<Review> review;
   std::string status;  // the last reason given: a fault, a pause, a failed training
 };
 

@@ -32,6 +32,10 @@ struct EmergencyStopRequest {};  // the arm was already told to stop by the sess
 struct RetryStepRequest {};
 struct SkipTrialRequest {};
 struct EndSessionRequest {};
+// The experimenter's answer to the calibration review (to the paradigm, and to the P300 and ErrP
+// stages, which start their calibration data over on Recalibrate).
+struct GoOnlineRequest {};
+struct RecalibrateRequest {};
 
 // To the robot stage. `time_s`: when it was asked for (a stepped arm starts it then).
 // A grasp of `object` (marker id) where the cameras last saw it: `at` (robot frame; none: never
@@ -103,13 +107,12 @@ struct LabelsRequest {
   core::RunLabels labels;
 };
 
-using Request =
-    std::variant<StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest,
-                 EmergencyStopRequest, RetryStepRequest, SkipTrialRequest, EndSessionRequest,
-                 GraspRequest, DropRequest, RobotStopRequest, RobotResetRequest,
-                 RobotResetIfLatchedRequest, RobotHomeRequest, RobotReleaseRequest,
-                 FinishPutDownRequest, RobotProbeRequest, TrainRequest, UseModelRequest,
-                 ThresholdRequest, ReferenceRequest, HoldBoardRequest, LabelsRequest>;
+using Request = std::variant<
+    StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest, EmergencyStopRequest,
+    RetryStepRequest, SkipTrialRequest, EndSessionRequest, GoOnlineRequest, RecalibrateRequest,
+    GraspRequest, DropRequest, RobotStopRequest, RobotResetRequest, RobotResetIfLatchedRequest,
+    RobotHomeRequest, RobotReleaseRequest, FinishPutDownRequest, RobotProbeRequest, TrainRequest,
+    UseModelRequest, ThresholdRequest, ReferenceRequest, HoldBoardRequest, LabelsRequest>;
 
 // The requests of one kind among `requests`, in order.
 template <class T>

@@ -42,7 +42,13 @@ class CalibrationRun {
   const std::string& error() const { return error_; }
   const std::optional<bci::EvaluationReport>& report() const { return report_; }
 
-  // summary.json's "calibration" (selections, those used, AUC, accuracy, the retaken ones).
+  // The experimenter's (or the gate's) decision on the trained calibration, for the summary.
+  void reviewed(const std::string& decision, double auc, double time_s);
+  // A recalibration: the next training is awaited afresh (retakes and reviews stay listed).
+  void restart();
+
+  // summary.json's "calibration" (selections, those used, AUC, accuracy, the retaken ones, the
+  // reviews).
   void summarise(nlohmann::json& summary) const;
 
  private:
@@ -59,6 +65,7 @@ class CalibrationRun {
     int retaken_as = 0;
   };
   std::vector<Retake> retakes_;
+  nlohmann::json reviews_ = nlohmann::json::array();
   double since_ = 0.0;
   bool awaiting_p300_ = false, awaiting_errp_ = false;
   std::optional<bci::EvaluationReport> report_, errp_report_;

@@ -44,7 +44,9 @@ class ErrpStage final : public Stage {
     bci::EvaluationReport report;
     bci::ErpCurves erp;
   };
-  void setModel(std::shared_ptr<const bci::P300Model> errp);
+  // `calibrated`: trained on this session's feedback block, whose signal is kept until the first
+  // online selection (a recalibration at the review starts from it).
+  void setModel(std::shared_ptr<const bci::P300Model> errp, bool calibrated = false);
   void startTraining();
   void takeTraining(Cycle& cycle);
 

@@ -56,7 +56,11 @@ class P300Stage final : public Stage {
     std::vector<int> trained_on, left_out;
   };
   // `why`: the request's origin, for the log.
-  void setModel(const bci::P300Model& model, double time_s);
+  // `calibrated`: trained on this session's calibration run, whose signal is kept until the first
+  // online selection (a recalibration at the review starts from it); else a model from elsewhere,
+  // and there is no calibration signal to keep.
+  void setModel(const bci::P300Model& model, double time_s, bool calibrated = false);
+  void recalibrate();
   void startSelection(const SelectionStart& selection);
   void startTraining(const std::string& method);
   void takeTraining(Cycle& cycle);

@@ -42,6 +42,8 @@ struct ParadigmStageSettings {
   std::filesystem::path model_file;   // where the model trained goes
   bool experimenter = false;    // someone at the window: a wait pauses rather than ends the run
   double max_pose_age_s = 0.0;  // tracker.max_pose_age_s: older is stale (the robot refuses it)
+  bool review = false;          // gates.review: the experimenter accepts the calibration
+  double min_auc = 0.0;         // gates.min_auc (0: none)
 };
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
@@ -64,6 +66,11 @@ class ParadigmStage final : public Stage {
   void takeRobotNotes(Cycle& cycle);
   void watchGrasp(Cycle& cycle);
   void collectTraining(Cycle& cycle);
+  // Trained: online at once, or the review first (or, below the minimum AUC with nobody to ask,
+  // the end of the run).
+  void reviewCalibration(Cycle& cycle);
+  void goOnline(Cycle& cycle);
+  void answerReview(bool go_online, Cycle& cycle);
   void decideIfReady(const Cycle& cycle);
   void judgeFeedback(Cycle& cycle);
   // The paradigm's events, each to its handler.
@@ -110,6 +117,8 @@ class ParadigmStage final : public Stage {
   std::set<int> truth_;
   int selection_flashes_ = 0;
   bool retrying_ = false;  // the experimenter's Retry step is being carried out
+  std::optional<ParadigmPart::Review> review_;  // the calibration awaiting the experimenter
+  int calibration_round_ = 1;
 };
 
 }  // namespace arbci::session
