@@ -85,7 +85,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   std::vector<std::unique_ptr<ui::Panel>> panels;
   ui::Panel* summary_panel = nullptr;
   ui::Panel* training_panel = nullptr;  // the calibration review is there
-  bool reviewing = false;
+  bool reviewing = false, opened_for_review = false;
   for (const auto& entry : ui::panels().entries()) {
     panels.push_back(entry.make.make());
     shell.addPanel(*panels.back(), entry.make.open_at_start);
@@ -109,7 +109,12 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     state.ingest(session.last(), session.config());
     // The calibration waits for the experimenter: its review opens in front (once per review).
     const bool review = session.last().paradigm.review.has_value();
-    if (review && !reviewing && training_panel) shell.show(*training_panel);
+    // Opened for it, it closes once answered: it would cover the panels the trials need.
+    if (review && !reviewing && training_panel) {
+      opened_for_review = !shell.isOpen(*training_panel);
+      shell.show(*training_panel);
+    }
+    if (!review && reviewing && opened_for_review && training_panel) shell.hide(*training_panel);
     reviewing = review;
     if (session.ended() && !summary_shown) {
       if (summary_panel) shell.show(*summary_panel);  // once: the experimenter may close it

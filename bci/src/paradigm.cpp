@@ -570,6 +570,16 @@ void Paradigm::resume() {
   retryStep();
 }
 
+void Paradigm::resumeHeld() {
+  if (phase_ != Phase::Paused) return;
+  const Phase back = paused_from_;
+  phase_until_ += now_;
+  enter(back, "resumed after a stall");
+  if (back == Phase::CalibrationFlashing || back == Phase::ObjectFlashing ||
+      back == Phase::CellFlashing)
+    restartSequence();
+}
+
 void Paradigm::retryStep() {
   const auto was = interrupted();
   if (!was) return;

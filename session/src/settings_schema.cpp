@@ -619,6 +619,10 @@ const Schema<GateSettings>& gateSchema() {
         .number("min_auc", &G::min_auc, 0.0, 0.0, 1.0,
                 "a calibration whose cross-validated AUC is below this does not go online "
                 "unattended: the experimenter decides, and a run without one ends (0: none)")
+        .integer("max_retakes", &G::max_retakes, 8, 1, 1000,
+                 "calibration selections retaken (tracking lost) before the run pauses to ask the "
+                 "experimenter (a run without one ends); a stall of the machine (every marker lost "
+                 "at once) holds the flashes instead and is no retake")
         .text("timing", &G::timing, "pause",
               "flashes off the timing limits: each annotated in the recording, and past "
               "max_off_share or max_late_share the run pauses with the reason (pause), only "

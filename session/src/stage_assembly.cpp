@@ -17,6 +17,7 @@
 #include "arbci/session/stages/recording_stage.h"
 #include "arbci/session/stages/robot_stage.h"
 #include "arbci/session/stages/signal_quality_stage.h"
+#include "arbci/session/stages/timing_gate_stage.h"
 #include "arbci/session/stages/tracking_stage.h"
 #include "arbci/session/trial_intents.h"
 
@@ -180,6 +181,13 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   std::unique_ptr<LslMarkersStage> markers = markersStageOf(c, lsl, eeg_info.rate_hz, services);
   auto presentation = std::make_unique<PresentationStage>(
       PresentationSettings{c.paradigm, eeg_info.rate_hz}, services);
+  const GateSettings& g = c.gates;
+  auto timing_gate = std::make_unique<TimingGateStage>(
+      TimingGateSettings{g.timing,
+                         timingLimitsOf(g.max_flash_ms, g.min_gap_ms, g.min_soa_ms, g.max_off_share,
+                                        g.max_late_share, c.paradigm),
+                         eeg_info.rate_hz, options.experimenter},
+      services);
   auto preflight = std::make_unique<PreflightStage>(
       PreflightStageSettings{preflightSettingsOf(c, options, eeg_info), c.tracker.max_pose_age_s,
                              options.experimenter},
@@ -188,7 +196,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
                             c.eeg.seed + 11, c.errp.threshold, folder / "model.json",
                             options.experimenter, c.tracker.max_pose_age_s, c.gates.review,
-                            c.gates.min_auc},
+                            c.gates.min_auc, c.gates.max_retakes},
       services);
   CycleRecord warm_up;
   tracking->publish(warm_up.tracking);
@@ -200,6 +208,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   out.stages.push_back(std::move(eeg));
   out.stages.push_back(std::move(recording));
   out.stages.push_back(std::move(quality));
+  out.stages.push_back(std::move(timing_gate));
   out.stages.push_back(std::move(p300));
   out.stages.push_back(std::move(errp));
   if (markers) out.stages.push_back(std::move(markers));

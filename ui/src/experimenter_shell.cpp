@@ -26,6 +26,19 @@ void ExperimenterShell::show(Panel& panel) {
   }
 }
 
+void ExperimenterShell::hide(Panel& panel) {
+  for (Entry& entry : panels_) {
+    if (entry.panel == &panel) entry.open = false;
+  }
+}
+
+bool ExperimenterShell::isOpen(const Panel& panel) const {
+  for (const Entry& entry : panels_) {
+    if (entry.panel == &panel) return entry.open;
+  }
+  return false;
+}
+
 bool ExperimenterShell::show(const std::string& title) {
   for (Entry& entry : panels_) {
     if (title == entry.panel->title()) {

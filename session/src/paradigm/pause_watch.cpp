@@ -1,5 +1,6 @@
 #include "arbci/session/paradigm/pause_watch.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace arbci::session {
@@ -57,6 +58,8 @@ void ViewWatch::withholdStale(Cycle& cycle, const std::vector<size_t>& slots, bc
     if (!tracking.fresh(id, cycle.time_s)) stale.insert(id);
     if (objects && stale.count(id)) stimulus.lit.erase(static_cast<int>(k) + 1);
   }
+  all_lost_ = !stale.empty() && stale.size() == slots.size() &&
+              !tracking.fresh(world_.reference_id, cycle.time_s);
   // The recording says when an offered object's tracking is lost and regained (once started).
   if (phase != bci::Phase::Setup) {
     for (int id : stale)
@@ -74,6 +77,29 @@ void ViewWatch::flashWithheld(int object_id, int selection, Cycle& cycle, bci::P
   const double time = cycle.time_s;
   if (withheld_since_ < 0.0) withheld_since_ = time;
   if (paradigm.phase() != bci::Phase::CalibrationFlashing) return;
+  if (all_lost_) {
+    hold(cycle, paradigm, reasons, s);
+    return;
+  }
+  if (paradigm.calibrationRetakes() >= max_retakes_) {
+    // Retakes that keep coming: the experimenter looks before the run loops on.
+    std::string reason = "calibration selections retaken " +
+                         std::to_string(paradigm.calibrationRetakes()) +
+                         " times (gates.max_retakes): object " + std::to_string(object_id) +
+                         " keeps leaving the cameras' view";
+    if (!stalls_.empty())
+      reason += ", and the PC stalled " + std::to_string(stalls_.size()) + " times";
+    s.log.write("paused", time, {{"reason", reason}});
+    if (!experimenter_) {
+      cycle.end(reason, "aborted");
+      return;
+    }
+    pause("too many retakes", reason + "; check the markers and cameras, then Resume", time,
+          paradigm, reasons);
+    asked_retakes_ = true;
+    s.tell.say(time, Severity::Error, "paused: " + reason);
+    return;
+  }
   // A calibration flash withheld: the selection stops there, paused until every object is in
   // view again, and is then retaken (training needs whole selections).
   const std::string reason = "calibration selection " + std::to_string(selection) + ": object " +
@@ -90,12 +116,23 @@ void ViewWatch::watch(Cycle& cycle, bci::Paradigm& paradigm, size_t offered, Sto
   using bci::Phase;
   const Phase phase = paradigm.phase();
   const double time = cycle.time_s;
+  if (held_) {
+    if (phase != Phase::Paused) {
+      held_ = false;  // the experimenter resumed or ended it
+      return;
+    }
+    // The markers back: the flashes go on (no second's wait: nothing moved).
+    if (!all_lost_ && stale_.empty()) endHold(cycle, paradigm, reasons, s);
+    return;
+  }
   if (paused_) {
     if (phase != Phase::Paused) {
       paused_ = false;  // the experimenter resumed or ended it
       withheld_since_ = -1.0;
       return;
     }
+    // Asked about the retakes: only the experimenter goes on from here.
+    if (asked_retakes_) return;
     in_view_since_ = stale_.empty() ? (in_view_since_ < 0.0 ? time : in_view_since_) : -1.0;
     if (in_view_since_ >= 0.0 && time - in_view_since_ >= 1.0) {
       paradigm.resume();
@@ -125,6 +162,53 @@ void ViewWatch::watch(Cycle& cycle, bci::Paradigm& paradigm, size_t offered, Sto
   pause("no object in view", reason + "; resumes once they are seen again", time, paradigm,
         reasons);
   s.tell.say(time, Severity::Error, "paused: " + reason);
+}
+
+void ViewWatch::hold(Cycle& cycle, bci::Paradigm& paradigm, StopReasons& reasons,
+                     const StageServices& s) {
+  const double time = cycle.time_s;
+  held_ = true;
+  held_at_ = time;
+  stalls_.push_back(time);
+  reasons.stopped_because = "stall";
+  reasons.status =
+      "held: every marker vanished at once, the reference too (the machine stalled, not "
+      "tracking); the flashes go on when the markers are back";
+  paradigm.pause();
+  s.log.write("stall", time, {{"what", "every marker lost at once"}, {"held", true}});
+  cycle.annotate(cycle.eeg_sample, "Stall: every marker lost at once; flashes held");
+}
+
+void ViewWatch::endHold(Cycle& cycle, bci::Paradigm& paradigm, StopReasons& reasons,
+                        const StageServices& s) {
+  const double time = cycle.time_s, seconds = time - held_at_;
+  held_ = false;
+  longest_stall_s_ = std::max(longest_stall_s_, seconds);
+  withheld_since_ = -1.0;
+  reasons.status.clear();
+  paradigm.resumeHeld();
+  s.log.write("stall_ended", time, {{"seconds", seconds}});
+  cycle.annotate(cycle.eeg_sample, "Stall ended: flashes go on");
+  // Stalls that keep coming: the PC cannot hold the session's pace.
+  int recent = 0;
+  for (double at : stalls_) recent += at >= time - kSlowWindowS;
+  if (recent < kSlowStalls || (too_slow_told_ > 0 && recent % kSlowStalls != 0)) return;
+  ++too_slow_told_;
+  char text[240];
+  std::snprintf(text, sizeof text,
+                "the PC is too slow for this session: %d stalls in the last %.0f s (the longest "
+                "%.0f ms) froze the cameras and the screen; close other programs, or run the "
+                "EEG panel and the mirror window less (each stall is held and annotated)",
+                recent, kSlowWindowS, 1000.0 * longest_stall_s_);
+  s.log.write("pc_too_slow", time,
+              {{"stalls", recent}, {"window_s", kSlowWindowS}, {"longest_s", longest_stall_s_}});
+  s.tell.say(time, Severity::Error, text);
+}
+
+void ViewWatch::report(nlohmann::json& summary) const {
+  summary["stalls"] = {{"count", stalls_.size()},
+                       {"longest_s", longest_stall_s_},
+                       {"pc_too_slow_warnings", too_slow_told_}};
 }
 
 void ViewWatch::pause(const std::string& why, const std::string& status, double time,

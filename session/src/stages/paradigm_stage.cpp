@@ -36,7 +36,8 @@ ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const StageS
       trials_(settings_.intended),
       errp_(settings_.errp_threshold),
       calibration_(settings_.classifier_method, settings_.model_file, settings_.paradigm.errp),
-      view_watch_(settings_.world, settings_.paradigm.no_view_pause_s, settings_.experimenter) {
+      view_watch_(settings_.world, settings_.paradigm.no_view_pause_s, settings_.experimenter,
+                  settings_.max_retakes) {
   nameObjects();
 }
 
@@ -96,8 +97,12 @@ void ParadigmStage::act(const Request& request, Cycle& cycle) {
     if (paradigm_.phase() != bci::Phase::Setup) return;
     chooseSelectableObjects(cycle);
     paradigm_.start(!cycle.record.p300.model);
-  } else if (std::holds_alternative<PauseRequest>(request)) {
-    reasons_.stopped_because = "paused by the experimenter";
+  } else if (const auto* pause = std::get_if<PauseRequest>(&request)) {
+    reasons_.stopped_because = pause->reason.empty() ? "paused by the experimenter" : pause->reason;
+    if (!pause->reason.empty()) {
+      reasons_.status = "paused: " + pause->reason;
+      s_.log.write("paused", time, {{"reason", pause->reason}});
+    }
     paradigm_.pause();
   } else if (std::holds_alternative<ResumeRequest>(request)) {
     if (paradigm_.interrupted()) cycle.post(RobotResetIfLatchedRequest{time});
@@ -381,6 +386,7 @@ void ParadigmStage::report(nlohmann::json& summary) const {
   summary.update(
       trialsSummary(trials_.trials(), static_cast<int>(settings_.world.objects.size()), cells));
   calibration_.summarise(summary);
+  view_watch_.report(summary);
   if (settings_.paradigm.errp) errp_.report(summary["errp"]);
 }
 

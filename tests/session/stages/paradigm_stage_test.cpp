@@ -63,7 +63,8 @@ class ParadigmStageTest : public ::testing::Test {
         stage_(
             ParadigmStageSettings{config_.paradigm, config_.world, "slda", intendedTrials(config_),
                                   11, 0.5, bench_.folder() / "model.json", experimenter, 0.5,
-                                  config_.gates.review && experimenter, config_.gates.min_auc},
+                                  config_.gates.review && experimenter, config_.gates.min_auc,
+                                  config_.gates.max_retakes},
             bench_.services()) {}
 
   // The objects the cameras see now (all but `hidden`), at their places; the reference seen.
@@ -73,7 +74,7 @@ class ParadigmStageTest : public ::testing::Test {
     vision::PoseEstimate reference;
     // The camera 1 m above the reference (its default place: (0, 0.90, 0) in the robot's frame).
     reference.pose = {cv::Matx33d::eye(), cv::Vec3d(0.0, 0.0, 1.0)};
-    poses[0] = reference;
+    if (!reference_hidden_) poses[0] = reference;
     for (const WorldObjectSettings& o : config_.world.objects) {
       if (hidden_.count(o.id)) continue;
       vision::PoseEstimate p;
@@ -139,6 +140,7 @@ class ParadigmStageTest : public ::testing::Test {
   ParadigmStage stage_;
   vision::WorldModel world_;
   std::set<int> hidden_;
+  bool reference_hidden_ = false;
   std::shared_ptr<const bci::P300Model> model_, errp_model_;
   std::optional<robot::StatusPayload> robot_;
   int selection_ = 0, flashes_ = 0, decide_ = 1;
@@ -373,6 +375,67 @@ TEST_F(ParadigmStageTest, AnObjectOutOfViewIsNotFlashedAndTheCalibrationSelectio
   EXPECT_TRUE(annotated("Tracking regained object"));
   EXPECT_TRUE(annotated("Calibration selection " + std::to_string(first) + " interrupted"));
   EXPECT_EQ(bench_.logged("calibration_retake").size(), 1u);
+}
+
+TEST_F(ParadigmStageTest, EveryMarkerLostAtOnceIsAStallThatHoldsTheFlashesWithoutARetake) {
+  begin();
+  ASSERT_TRUE(until(bci::Phase::CalibrationFlashing));
+  const int first = selection_;
+  // The machine stalls: the reference and every object gone together.
+  for (const WorldObjectSettings& o : config_.world.objects) hidden_.insert(o.id);
+  reference_hidden_ = true;
+  ASSERT_TRUE(until(bci::Phase::Paused, 2.0));
+  EXPECT_NE(bench_.previous.paradigm.status.find("held: every marker vanished at once"),
+            std::string::npos)
+      << bench_.previous.paradigm.status;
+  // Back: the flashes go on at once, in the same selection.
+  hidden_.clear();
+  reference_hidden_ = false;
+  bool retaken = false;
+  for (int i = 0; i < 10 && bench_.previous.paradigm.phase != bci::Phase::CalibrationFlashing;
+       ++i) {
+    cycle();
+    retaken |= bench_.previous.paradigm.selection_started.has_value();
+  }
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::CalibrationFlashing);
+  EXPECT_FALSE(retaken);
+  EXPECT_EQ(selection_, first);
+  EXPECT_EQ(bench_.previous.paradigm.calibration_retakes, 0);
+  EXPECT_EQ(bench_.logged("stall_ended").size(), 1u);
+  nlohmann::json summary;
+  stage_.report(summary);
+  EXPECT_EQ(summary["stalls"]["count"], 1);
+}
+
+class RetakeCapTest : public ParadigmStageTest {
+ protected:
+  static SessionConfig capped() {
+    SessionConfig c = shortSession();
+    c.gates.max_retakes = 1;
+    c.paradigm.calibration_selections = 8;
+    return c;
+  }
+  RetakeCapTest() : ParadigmStageTest(capped()) {}
+};
+
+TEST_F(RetakeCapTest, PastTheRetakesAllowedTheExperimenterIsAskedInsteadOfLooping) {
+  begin();
+  // Object 1 leaves the view, comes back (a retake), and leaves again.
+  for (int round = 0; round < 2; ++round) {
+    ASSERT_TRUE(until(bci::Phase::CalibrationFlashing));
+    hidden_ = {config_.world.objects[0].id};
+    ASSERT_TRUE(until(bci::Phase::Paused, 5.0));
+    hidden_.clear();
+  }
+  EXPECT_NE(bench_.previous.paradigm.status.find("retaken 1 times (gates.max_retakes)"),
+            std::string::npos)
+      << bench_.previous.paradigm.status;
+  // In view again, it waits for the experimenter's Resume.
+  for (int i = 0; i < 180; ++i) cycle();
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Paused);
+  bench_.record.requests.push_back(ResumeRequest{});
+  cycle();
+  EXPECT_NE(bench_.previous.paradigm.phase, bci::Phase::Paused);
 }
 
 class HeadlessParadigmStageTest : public ParadigmStageTest {

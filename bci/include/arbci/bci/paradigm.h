@@ -152,6 +152,9 @@ class Paradigm {
   // session checks first that the arm is home and holds nothing. An interrupted calibration
   // selection is retaken instead: its target cued again, all its sequences flashed anew.
   void resume();
+  // After a hold (a stall of the machine, not of the subject): the paused flashing goes on with
+  // its current sequence again, a calibration selection included (not retaken).
+  void resumeHeld();
   void abort();
   void emergencyStop();
   // The experimenter's recovery after an emergency stop or a robot fault. Retry: the interrupted

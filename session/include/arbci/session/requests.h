@@ -25,7 +25,10 @@ struct StartRequest {
 };
 struct BeginRequest {};
 // The experimenter, to the paradigm.
-struct PauseRequest {};
+// `reason`: why, when not the experimenter's own (a stage that pauses the run says why).
+struct PauseRequest {
+  std::string reason;
+};
 struct ResumeRequest {};
 struct AbortRequest {};
 struct EmergencyStopRequest {};  // the arm was already told to stop by the session

@@ -207,6 +207,7 @@ struct GateSettings {
   double flat_sd_uv, line_bad_uv, drift_bad_uv_s, rms_bad_uv;  // a channel graded bad
   bool review;         // windowed: the experimenter accepts the calibration before going online
   double min_auc;      // below it the session does not go online unattended (0: no minimum)
+  int max_retakes;     // calibration selections retaken before the experimenter is asked
   std::string timing;  // "pause", "annotate" or "off"
   double max_flash_ms, min_gap_ms, min_soa_ms;  // 0: derived from the paradigm's settings
   double max_off_share;                         // of a selection's flashes, then it pauses

@@ -23,6 +23,8 @@ class ExperimenterShell {
   void addPanel(Panel& panel, bool open = true);
   void show(Panel& panel);  // opens a panel added closed (e.g. the end-of-session summary)
   bool show(const std::string& title);  // by its title; false when there is none
+  void hide(Panel& panel);                // closes it, as its window's close button does
+  bool isOpen(const Panel& panel) const;
   void setQuitHandler(std::function<void()> on_quit) { on_quit_ = std::move(on_quit); }
   // An emergency stop button in the menu bar, shown whatever panels are open (it posts the
   // request, or says why it cannot act now).

@@ -39,10 +39,18 @@ class EegFaultWatch {
 // regained); a calibration flash withheld pauses the selection until every object has been in
 // view for a second, and it is then retaken; a selection whose every flash is withheld for
 // paradigm.no_view_pause_s pauses the session (or, with nobody at the window, ends it).
+// Every marker lost at once, the reference with the objects, is a stall of the machine (the
+// process or the cameras held up), not of tracking: the flashes are held and go on with the
+// sequence once the markers are back, the selection not retaken; stalls that keep coming are
+// named (the PC is too slow, with the figures). After gates.max_retakes retakes of calibration
+// selections the experimenter is asked (the run paused; without one, it ends) instead of looping.
 class ViewWatch {
  public:
-  ViewWatch(const WorldSettings& world, double no_view_pause_s, bool experimenter)
-      : world_(world), no_view_pause_s_(no_view_pause_s), experimenter_(experimenter) {}
+  ViewWatch(const WorldSettings& world, double no_view_pause_s, bool experimenter, int max_retakes)
+      : world_(world),
+        no_view_pause_s_(no_view_pause_s),
+        experimenter_(experimenter),
+        max_retakes_(max_retakes) {}
 
   // This frame's stimulus without the flashes of offered objects (slots: world.objects by code)
   // whose pose is stale at the cycle's time.
@@ -52,6 +60,12 @@ class ViewWatch {
   void flashWithheld(int object_id, int selection, Cycle& cycle, bci::Paradigm& paradigm,
                      StopReasons& reasons, const StageServices& s);
   void flashShown() { withheld_since_ = -1.0; }
+  // summary.json's "stalls" (count, longest, the PC-too-slow warnings).
+  void report(nlohmann::json& summary) const;
+
+  // Stalls this many times within kSlowWindowS: the PC is too slow for the session.
+  static constexpr int kSlowStalls = 5;
+  static constexpr double kSlowWindowS = 60.0;
   // The pause for view: resumed once the objects have been in view for a second; a selection
   // withheld too long paused (or the run ended).
   void watch(Cycle& cycle, bci::Paradigm& paradigm, size_t offered, StopReasons& reasons,
@@ -60,13 +74,23 @@ class ViewWatch {
  private:
   void pause(const std::string& why, const std::string& status, double time,
              bci::Paradigm& paradigm, StopReasons& reasons);
+  void hold(Cycle& cycle, bci::Paradigm& paradigm, StopReasons& reasons, const StageServices& s);
+  void endHold(Cycle& cycle, bci::Paradigm& paradigm, StopReasons& reasons, const StageServices& s);
   // "no object in view: the reference marker or objects (10, 40) lost for 10 s (...), CONTEXT"
   std::string lostReason(const std::string& context, size_t offered) const;
 
   WorldSettings world_;
   double no_view_pause_s_;
   bool experimenter_;
-  std::set<int> stale_;  // offered objects whose pose is stale (marker ids)
+  int max_retakes_;
+  std::set<int> stale_;    // offered objects whose pose is stale (marker ids)
+  bool all_lost_ = false;  // the reference and every offered object stale together
+  // Stalls: held now (since when), when each began, the longest, the warnings given.
+  bool held_ = false;
+  double held_at_ = 0.0, longest_stall_s_ = 0.0;
+  std::vector<double> stalls_;
+  int too_slow_told_ = 0;
+  bool asked_retakes_ = false;
   // Since when every flash of the selection has been withheld (-1: a flash was shown since).
   double withheld_since_ = -1.0;
   bool paused_ = false;

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <set>
@@ -44,6 +45,7 @@ struct ParadigmStageSettings {
   double max_pose_age_s = 0.0;  // tracker.max_pose_age_s: older is stale (the robot refuses it)
   bool review = false;          // gates.review: the experimenter accepts the calibration
   double min_auc = 0.0;         // gates.min_auc (0: none)
+  int max_retakes = std::numeric_limits<int>::max();  // gates.max_retakes (none unless given)
 };
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
