@@ -169,9 +169,13 @@ int runSessionIn(const RunOptions& o, bool headless) {
   try {
     if (!headless) {
       // Once open, the window shows the session's own failures and offers a retry in place.
-      return runWorkstation(
-          config, options,
-          {o.script, !o.start_now, o.exit_when_done, false, o.bids_root, [&] { claim.keep(); }});
+      return runWorkstation(config, options,
+                            {o.script, !o.start_now, o.exit_when_done,
+                             // Started at once and closed at the end, with no script: a batch
+                             // run in a window, which nobody watches. What would wait for an
+                             // experimenter (a failed pre-flight, objects out of view) ends it.
+                             o.start_now && o.exit_when_done && o.script.empty(), o.bids_root,
+                             [&] { claim.keep(); }});
     }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped
@@ -223,7 +227,9 @@ void addRunCommand(CLI::App& root, int& exit_code) {
                 "headless: the EEG, the frames and the arm on the wall clock (not reproducible)\n"
                 "instead of a simulated clock as fast as the machine allows");
   run->add_flag("--exit-when-done", o->exit_when_done,
-                "windowed: close the window once the session has ended (scripted runs)");
+                "windowed: close the window once the session has ended (scripted runs); with\n"
+                "--start-now and no --script nobody is expected at the window: what would wait\n"
+                "for the experimenter (a failed pre-flight, objects out of view) ends the run");
   run->add_option("--script", o->script,
                   "windowed: a scripted experimenter replays FILE with real clicks on the\n"
                   "panels' buttons (wait \"PHASE\", click \"LABEL\", pause S, key ctrl+q,\n"

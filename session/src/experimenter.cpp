@@ -13,6 +13,8 @@ std::string whyArmNotClear(const RobotPart& robot) {
 
 std::string whyNotResume(const CycleRecord& last) {
   const ParadigmPart& p = last.paradigm;
+  if (p.phase == bci::Phase::Paused && !p.waiting_for.empty())
+    return "it resumes by itself once " + p.waiting_for + ", in the same selection";
   if (p.phase == bci::Phase::Paused) return "";
   if (!p.interrupted) return "nothing to resume: the session is not paused or stopped";
   if (*p.interrupted != bci::Phase::Grasping && *p.interrupted != bci::Phase::Dropping) return "";

@@ -20,6 +20,7 @@ void Preflight::begin(const PreflightObservation& now, bool quality_accepted) {
   first_ = last_ = now;
   camera_frames_ = 0;
   reference_seen_ = false;
+  objects_seen_.clear();
   eeg_rate_hz_ = 0.0;
   eeg_from_.reset();
   first_eeg_s_.reset();
@@ -37,6 +38,7 @@ Preflight::State Preflight::update(const PreflightObservation& now) {
   }
   camera_frames_ += now.camera_frame;
   reference_seen_ |= now.reference_age_s && *now.reference_age_s <= now.max_pose_age_s;
+  objects_seen_.insert(now.objects_seen.begin(), now.objects_seen.end());
   const double elapsed = now.time_s - first_.time_s;
   // The rate is counted from a moment after the first samples arrived: a source's first
   // deliveries carry what it buffered before the session asked (a start-up backlog), which would
@@ -76,6 +78,16 @@ std::vector<std::string> Preflight::check(bool final) const {
                   std::to_string(settings_.reference_id) + " was not seen in " +
                   std::to_string(camera_frames_) +
                   " camera frames (in view? the right id? see the Threshold panel)");
+  }
+  // Fewer than two objects in view: nothing to select between (the paradigm would wait forever).
+  if (reference_seen_ && settings_.object_ids.size() >= 2 && objects_seen_.size() < 2) {
+    std::string missing;
+    for (int id : settings_.object_ids)
+      if (!objects_seen_.count(id)) missing += (missing.empty() ? "" : ", ") + std::to_string(id);
+    out.push_back("world.objects: " + std::to_string(objects_seen_.size()) + " of the " +
+                  std::to_string(settings_.object_ids.size()) + " objects seen in " +
+                  std::to_string(camera_frames_) + " camera frames (not seen: " + missing +
+                  "); at least 2 must be on the table and in view");
   }
   const double rate = settings_.eeg_rate_hz;
   const double silent = last_.time_s - eeg_last_.time_s;
@@ -143,7 +155,9 @@ std::vector<std::string> Preflight::lines() const {
       return out;
     case State::Passed:
       out.push_back("pre-flight passed: " + std::to_string(camera_frames_) +
-                    " camera frames with the reference, " +
+                    " camera frames with the reference and " +
+                    std::to_string(objects_seen_.size()) + " of " +
+                    std::to_string(settings_.object_ids.size()) + " objects, " +
                     format("EEG at %.1f Hz, the robot answers", eeg_rate_hz_));
       return out;
     case State::Failed:

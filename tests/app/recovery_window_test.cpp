@@ -26,14 +26,16 @@ const std::string kArbci = ARBCI_EXECUTABLE;
 const std::filesystem::path kArtefacts = ARBCI_TEST_ARTEFACTS_DIR;
 
 // A quick session (a short calibration run, one trial) with a slow arm, so a grasp lasts long
-// enough to be stopped.
+// enough to be stopped. Under Xvfb on a loaded machine most frames come late: the timing gate
+// would pause the run (gates.timing "pause", its own tests' subject); here flashes are annotated.
 void writeSession(const std::filesystem::path& file) {
   std::ofstream(file) << R"({
     "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
     "paradigm": {"calibration_selections": 4, "calibration_sequences": 5, "sequences": 5,
                  "min_sequences": 5, "certainty": 0.0, "trials": 1, "cue_s": 1.0, "pause_s": 0.5,
                  "intended": [{"object": 40, "cell": [3, 1]}]},
-    "robot": {"speed_factor": 2}})";
+    "robot": {"speed_factor": 2},
+    "gates": {"timing": "annotate"}})";
 }
 
 // The window at 1280x720 (a laptop screen), its layout file in a fresh folder: arbci run with

@@ -48,3 +48,20 @@ TEST(Experimenter, OnceEndedTheEmergencyStopAndResetAreRefusedWithTheReason) {
 
 }  // namespace
 }  // namespace arbci::session
+
+namespace arbci::session {
+namespace {
+
+TEST(Experimenter, APauseTheSessionMadeForViewResumesByItselfNotByResume) {
+  CycleRecord last;
+  last.paradigm.phase = bci::Phase::Paused;
+  last.paradigm.waiting_for = "every object in view for 1 s (not seen: 10, 20)";
+  EXPECT_EQ(whyNot(Action::Resume, last),
+            "it resumes by itself once every object in view for 1 s (not seen: 10, 20), in the "
+            "same selection");
+  last.paradigm.waiting_for.clear();  // the experimenter's own pause
+  EXPECT_EQ(whyNot(Action::Resume, last), "");
+}
+
+}  // namespace
+}  // namespace arbci::session

@@ -55,6 +55,35 @@ TEST(Preflight, AFailureTheDisplayFoundFailsOnTheFirstFrameNamingItsKey) {
   EXPECT_NE(p.lines()[1].find("hmd.mirror_monitor = 3"), std::string::npos);
 }
 
+TEST(Preflight, FewerThanTwoObjectsInViewFailNamingThoseNotSeen) {
+  PreflightSettings s = settings();
+  s.object_ids = {10, 20, 30, 40};
+  s.timeout_s = 2.0;
+  Preflight p(s);
+  p.begin(healthy(0));
+  Preflight::State state = Preflight::State::Running;
+  for (int frame = 1; frame < 600 && state == Preflight::State::Running; ++frame) {
+    PreflightObservation o = healthy(frame);
+    o.objects_seen = {20};  // the others off the table
+    state = p.update(o);
+  }
+  ASSERT_EQ(state, Preflight::State::Failed);
+  ASSERT_EQ(p.failures().size(), 1u);
+  EXPECT_EQ(p.failures()[0].rfind("world.objects: 1 of the 4 objects seen", 0), 0u)
+      << p.failures()[0];
+  EXPECT_NE(p.failures()[0].find("not seen: 10, 30, 40"), std::string::npos);
+  // Two seen (at some time during the check) are enough.
+  Preflight again(s);
+  again.begin(healthy(0));
+  state = Preflight::State::Running;
+  for (int frame = 1; frame < 600 && state == Preflight::State::Running; ++frame) {
+    PreflightObservation o = healthy(frame);
+    o.objects_seen = {frame % 2 ? 20 : 40};
+    state = again.update(o);
+  }
+  EXPECT_EQ(state, Preflight::State::Passed);
+}
+
 TEST(Preflight, ADiskThatCannotHoldThePlannedRunFailsSayingHowMuchIsNeeded) {
   PreflightSettings s = settings();
   s.disk_needed = 85'000'000;

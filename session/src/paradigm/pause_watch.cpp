@@ -205,6 +205,14 @@ void ViewWatch::endHold(Cycle& cycle, bci::Paradigm& paradigm, StopReasons& reas
   s.tell.say(time, Severity::Error, text);
 }
 
+std::string ViewWatch::waitingFor() const {
+  if (held_) return "the markers to come back after the stall";
+  if (!paused_ || asked_retakes_) return "";
+  std::string lost;
+  for (int id : stale_) lost += (lost.empty() ? "" : ", ") + std::to_string(id);
+  return "every object in view for 1 s" + (lost.empty() ? "" : " (not seen: " + lost + ")");
+}
+
 void ViewWatch::report(nlohmann::json& summary) const {
   summary["stalls"] = {{"count", stalls_.size()},
                        {"longest_s", longest_stall_s_},

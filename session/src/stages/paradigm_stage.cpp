@@ -88,6 +88,7 @@ void ParadigmStage::publish(Cycle& cycle) {
   part.trials = std::make_shared<const std::vector<TrialRecord>>(trials_.trials());
   part.calibration = calibration_.report();
   part.review = review_;
+  if (part.phase == bci::Phase::Paused) part.waiting_for = view_watch_.waitingFor();
   part.status = reasons_.status;
 }
 

@@ -16,6 +16,11 @@ PreflightObservation PreflightStage::observe(const Cycle& cycle) const {
   if (const auto& world = cycle.record.tracking.world)
     o.reference_age_s = world->referenceAge(cycle.time_s);
   o.max_pose_age_s = settings_.max_pose_age_s;
+  for (int id : settings_.check.object_ids) {
+    const auto& world = cycle.record.tracking.world;
+    const auto state = world ? world->object(id) : std::nullopt;
+    if (state && state->age(cycle.time_s) <= settings_.max_pose_age_s) o.objects_seen.push_back(id);
+  }
   o.eeg_samples = cycle.record.recording.samples;
   o.robot_answered = cycle.record.robot.answered;
   o.robot_key_refused = cycle.record.robot.key_refused;

@@ -239,6 +239,9 @@ struct ParadigmPart {
     int round = 1;       // the calibration run's number (a recalibration is the second)
   };
   std::optional<Review> review;
+  // Paused by the session itself until something comes back ("every object in view for 1 s"):
+  // it resumes by itself, so Resume is not the experimenter's to press. Empty otherwise.
+  std::string waiting_for;
   std::string status;  // the last reason given: a fault, a pause, a failed training
 };
 

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,8 @@ struct PreflightSettings {
   std::string camera_key, camera_what;
   std::string eeg_key;
   int reference_id = 0;
+  // The objects the session offers (marker ids): at least two must be seen to select between.
+  std::vector<int> object_ids;
   std::string robot_key, robot_what;
   // The session folder's disk must have this much free (0: not checked); `disk_what` says how
   // it was reckoned.
@@ -43,6 +46,7 @@ struct PreflightObservation {
   double wall_s = 0.0;  // host clock
   bool camera_frame = false;
   std::optional<double> reference_age_s;  // since the reference marker was seen
+  std::vector<int> objects_seen;          // offered objects whose pose is fresh now
   double max_pose_age_s = 0.0;            // the session's tracker.max_pose_age_s
   long long eeg_samples = 0;              // recorded so far
   bool robot_answered = false;
@@ -84,6 +88,7 @@ class Preflight {
   PreflightObservation first_, last_;
   int camera_frames_ = 0;
   bool reference_seen_ = false;
+  std::set<int> objects_seen_;
   double eeg_rate_hz_ = 0.0;
   // The EEG's start-up backlog drains within this long of the first samples arriving.
   static constexpr double kSettleS = 0.25;

@@ -60,6 +60,8 @@ class ViewWatch {
   void flashWithheld(int object_id, int selection, Cycle& cycle, bci::Paradigm& paradigm,
                      StopReasons& reasons, const StageServices& s);
   void flashShown() { withheld_since_ = -1.0; }
+  // What a pause it made waits for before it resumes by itself ("" when none does).
+  std::string waitingFor() const;
   // summary.json's "stalls" (count, longest, the PC-too-slow warnings).
   void report(nlohmann::json& summary) const;
 
