@@ -20,6 +20,13 @@ render::HmdFrame composeHmdFrame(const bci::FrameStimulus& stimulus, const HmdSc
   render::HmdFrame frame;
   frame.left = {tracking.left_image, tracking.left_camera, tracking.T_cam_world_left};
   frame.right = {tracking.right_image, tracking.right_camera, tracking.T_cam_world_right};
+  if (!scene.rest.empty()) {
+    // Nothing overlaid: the instruction alone (the photodiode patch stays dark).
+    frame.left.image = frame.right.image = scene.rest;
+    frame.left.T_cam_world = frame.right.T_cam_world = std::nullopt;
+    if (scene.photodiode_patch) frame.photodiode_patch = false;
+    return frame;
+  }
   const bool objects_phase = stimulus.phase == bci::Phase::ObjectFlashing ||
                              stimulus.phase == bci::Phase::CalibrationFlashing;
   const auto& objects = scene.objects;

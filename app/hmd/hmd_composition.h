@@ -23,6 +23,8 @@ struct HmdScene {
   render::GridLayout grid;
   bool photodiode_patch = false;
   double now_s = 0.0;  // the frame's time: objects with an older pose than allowed are greyed
+  // A rest screen instead of the scene (rest_screen.h): each eye's image; empty: the scene.
+  cv::Mat rest;
 };
 
 // The session file's grid as the renderer draws it (on the table, in the robot frame).

@@ -45,13 +45,17 @@ HmdStage::HmdStage(const HmdSettings& settings, const std::filesystem::path& fol
 bool HmdStage::draw(const bci::FrameStimulus& stimulus, const session::CycleRecord& record,
                     double now_s) {
   const auto& status = record.robot.status;
-  const HmdScene scene{settings_.objects,
-                       record.tracking,
-                       record.paradigm.slots,
-                       status ? status->holding : -1,
-                       grid_,
-                       settings_.photodiode,
-                       now_s};
+  HmdScene scene{settings_.objects,
+                 record.tracking,
+                 record.paradigm.slots,
+                 status ? status->holding : -1,
+                 grid_,
+                 settings_.photodiode,
+                 now_s,
+                 {}};
+  const cv::Mat& eye = record.tracking.left_image;
+  if (const std::string text = restText(stimulus.phase); !text.empty() && !eye.empty())
+    scene.rest = rest_.image(eye.size(), text);
   const render::HmdFrame frame = composeHmdFrame(stimulus, scene);
   // What this frame shows; unchanged, the framebuffer already holds it.
   const std::string signature = hmdFrameSignature(frame);

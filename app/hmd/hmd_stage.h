@@ -16,6 +16,7 @@
 #include "arbci/session/stage.h"
 #include "hmd/image_writer.h"
 #include "hmd/phase_screenshots.h"
+#include "hmd/rest_screen.h"
 
 namespace arbci::app {
 
@@ -25,7 +26,7 @@ struct HmdSettings {
   bool undistort;     // the camera images, before the overlays
   std::vector<session::WorldObjectSettings> objects;
   session::GridSettings grid;
-  bool photodiode = false;             // the frame carries the photodiode patch
+  bool photodiode = false;  // the frame carries the photodiode patch
   std::string screenshots;  // hmd.screenshots
   static HmdSettings of(const session::SessionConfig& config);
 };
@@ -61,6 +62,7 @@ class HmdStage final : public session::Stage {
   std::unique_ptr<render::Framebuffer> fbo_;
   std::unique_ptr<render::HmdView> view_;
   PhaseScreenshots screenshots_;
+  RestScreen rest_;
   ImageWriter images_;
   // The last frame drawn: an identical frame is not drawn again (the framebuffer still holds it).
   std::string last_signature_;

@@ -35,7 +35,9 @@ class SessionPanel final : public Panel {
   // "tracking lost" for the reference marker and each object seen too long ago.
   void trackingHealth(const PanelInput& in);
   void timing(const PanelInput& in);
+  void notes(const PanelInput& in);
   bool labels_read_ = false;
+  char note_[256] = "";
   char subject_[64] = "", visit_[64] = "", task_[64] = "", run_[16] = "";
 };
 
@@ -80,10 +82,26 @@ void SessionPanel::draw(const PanelInput& in) {
   if (!r.preflight.questioned.empty() && !started &&
       button("Start anyway, with these channels", ""))
     in.requests.post(session::StartRequest{true});
+  notes(in);
   trackingHealth(in);
   timing(in);
   heading("selections");
   for (const std::string& line : session::selectionLines(r)) ImGui::TextUnformatted(line.c_str());
+}
+
+// A note the experimenter types goes into the recording at this moment ("Note: ..."), and into
+// the log: what happened in the room belongs beside the EEG it explains.
+void SessionPanel::notes(const PanelInput& in) {
+  if (in.record.ended) return;
+  ImGui::SetNextItemWidth(std::max(120.0f, ImGui::GetContentRegionAvail().x - 110.0f));
+  const bool entered = ImGui::InputTextWithHint("##note", "a note for the recording", note_,
+                                                sizeof note_, ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  const bool empty = note_[0] == '\0';
+  if ((button("Add note", empty ? "type the note first" : "") || entered) && !empty) {
+    in.requests.post(session::NoteRequest{note_});
+    note_[0] = '\0';
+  }
 }
 
 void SessionPanel::buttons(const PanelInput& in) {

@@ -38,6 +38,11 @@ void RecordingStage::record(Cycle& cycle) {
 // A write that fails (a full disk, an I/O error) ends the run: data that cannot be kept must not
 // be collected. Every record written before it stays readable (the header counts whole records).
 void RecordingStage::step(Cycle& cycle) {
+  for (const NoteRequest* note : requestsOf<NoteRequest>(cycle.record.requests)) {
+    s_.log.write("note", cycle.time_s, {{"text", note->text}, {"sample", cycle.eeg_sample}});
+    s_.tell.say(cycle.time_s, Severity::Info, "note: " + note->text);
+    cycle.annotate(cycle.eeg_sample, "Note: " + note->text);
+  }
   if (!failed_.empty()) return;
   try {
     record(cycle);

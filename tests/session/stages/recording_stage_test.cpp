@@ -103,6 +103,23 @@ TEST_F(RecordingStageTest, NotesLossesAndFeedbackAreRecordedAndTheEndSaysWhy) {
   EXPECT_TRUE(has("Session ended: aborted (by the experimenter)"));
 }
 
+TEST_F(RecordingStageTest, TheExperimentersNoteGoesIntoTheRecordingAndTheLog) {
+  cycleWith(0, 8);
+  bench_.record.eeg_sample = 128;
+  bench_.record.requests.push_back(NoteRequest{"Cz re-gelled, subject yawned"});
+  cycleWith(128, 8);
+  cycleWith(256, 16);
+  const bci::Recording r = closeAndRead();
+  bool noted = false;
+  for (const bci::Annotation& a : r.annotations)
+    noted |= a.text == "Note: Cz re-gelled, subject yawned" && a.sample == 128;
+  EXPECT_TRUE(noted);
+  const auto logged = bench_.logged("note");
+  ASSERT_EQ(logged.size(), 1u);
+  EXPECT_EQ(logged[0]["text"], "Cz re-gelled, subject yawned");
+  EXPECT_TRUE(bench_.toldOf("note: Cz re-gelled"));
+}
+
 TEST_F(RecordingStageTest, AFlashStillLitAtTheEndIsRecordedWithoutADuration) {
   bench_.record.presentation.onsets.push_back({Flash{4, true, false, true, 1}, 200});
   cycleWith(0, 16);

@@ -104,18 +104,26 @@ struct HoldBoardRequest {
   bool show = false;
 };
 
+// The experimenter's note, typed in the window: into the recording (and the LSL Markers stream)
+// as "Note: TEXT" at the moment it was made, and into the log (to the recording stage).
+struct NoteRequest {
+  std::string text;
+};
+
 // The start screen's subject, session, task and run: taken by the session at once (until Start),
 // and on the record from the next cycle.
 struct LabelsRequest {
   core::RunLabels labels;
 };
 
-using Request = std::variant<
-    StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest, EmergencyStopRequest,
-    RetryStepRequest, SkipTrialRequest, EndSessionRequest, GoOnlineRequest, RecalibrateRequest,
-    GraspRequest, DropRequest, RobotStopRequest, RobotResetRequest, RobotResetIfLatchedRequest,
-    RobotHomeRequest, RobotReleaseRequest, FinishPutDownRequest, RobotProbeRequest, TrainRequest,
-    UseModelRequest, ThresholdRequest, ReferenceRequest, HoldBoardRequest, LabelsRequest>;
+using Request =
+    std::variant<StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest,
+                 EmergencyStopRequest, RetryStepRequest, SkipTrialRequest, EndSessionRequest,
+                 GoOnlineRequest, RecalibrateRequest, GraspRequest, DropRequest, RobotStopRequest,
+                 RobotResetRequest, RobotResetIfLatchedRequest, RobotHomeRequest,
+                 RobotReleaseRequest, FinishPutDownRequest, RobotProbeRequest, TrainRequest,
+                 UseModelRequest, ThresholdRequest, ReferenceRequest, HoldBoardRequest,
+                 LabelsRequest, NoteRequest>;
 
 // The requests of one kind among `requests`, in order.
 template <class T>

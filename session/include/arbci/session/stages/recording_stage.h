@@ -2,8 +2,9 @@
 // in the order they happened — the notes the stages made last cycle (phases, selections,
 // tracking, robot steps), each flash with its label (Stim <code> T|N|U, grid codes as 100 + code)
 // and measured duration once its last frame has passed, the feedback shown, and every stretch of
-// lost samples. A write that fails (a full disk) ends the run as a fault, naming the file and the
-// system's reason; what was written before stays readable.
+// lost samples; and the experimenter's notes (NoteRequest; also to the log). A write that fails
+// (a full disk) ends the run as a fault, naming the file and the system's reason; what was
+// written before stays readable.
 #pragma once
 
 #include <filesystem>
