@@ -6,6 +6,8 @@
 #include <iostream>
 #include <optional>
 
+#include <imgui.h>
+
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/window_context.h"
 #include "arbci/session/record_text.h"
@@ -19,6 +21,36 @@
 #include "workstation/session_requests.h"
 
 namespace arbci::app {
+namespace {
+
+// Opening can take seconds (an LSL stream looked for until its timeout, an amplifier connected):
+// the window and the terminal say what it waits for instead of a black window.
+void showOpening(render::WindowContext& window, ui::ImGuiLayer& imgui,
+                 const session::SessionConfig& config) {
+  const std::string text =
+      config.eeg.source == "lsl"
+          ? "Opening the session: looking for the EEG stream on the Lab Streaming Layer "
+            "(eeg.lsl; it waits up to its resolve timeout, then says what it found)"
+          : "Opening the session: starting the EEG source (" + config.eeg.source +
+                "), the cameras and the robot";
+  std::cerr << text << "\n";
+  render::WindowContext::pollEvents();
+  window.makeCurrent();
+  const render::Size size = window.framebufferSize();
+  imgui.beginFrame(1.0f / 60.0f);
+  ImGui::SetNextWindowPos(ImVec2(20.0f, 40.0f));
+  ImGui::Begin("Opening", nullptr,
+               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse |
+                   ImGuiWindowFlags_NoSavedSettings);
+  ImGui::TextUnformatted(text.c_str());
+  ImGui::End();
+  render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
+  imgui.endFrame();
+  window.present();
+}
+
+}  // namespace
+
 namespace {
 
 // Where the panel layout is kept between runs.
@@ -66,6 +98,8 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     mirror = std::make_unique<render::WindowContext>(m);
     main_window.makeCurrent();
   }
+  ui::ImGuiLayer imgui(main_window, layoutFile());
+  showOpening(main_window, imgui, config);
   OpenedSession opened = openSession(config, options, main_window);
   if (workstation.opened) workstation.opened();
   session::Session& session = *opened.session;
@@ -79,7 +113,6 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   state.hmd_texture = opened.hmd->texture();
   state.hmd_aspect = static_cast<float>(config.hmd.width) / config.hmd.height;
   state.ingest(session.last(), session.config());
-  ui::ImGuiLayer imgui(main_window, layoutFile());
   ui::ExperimenterShell shell;
   // Every registered panel, in the registry's order; the summary opens when the session ends.
   std::vector<std::unique_ptr<ui::Panel>> panels;

@@ -65,9 +65,11 @@ void SessionPanel::draw(const PanelInput& in) {
     colouredWrapped(ImVec4(1.0f, 0.55f, 0.3f, 1.0f), why);
   if (!started && !r.ended) runLabels(in);
   if (r.robot.status && !r.robot.status->stop_reason.empty() && !r.ended) {
-    colouredWrapped(ImVec4(1, 0.3f, 0.3f, 1),
-                    "robot stopped (" + r.robot.status->stop_reason +
-                        "): the Robot panel's recovery buttons go on from here.");
+    colouredWrapped(
+        ImVec4(1, 0.3f, 0.3f, 1),
+        "robot stopped (" + r.robot.status->stop_reason +
+            "): Resume here, or Retry step / Skip trial in the Robot panel, resets it and goes on "
+            "(Home and Open gripper there first where the arm must be cleared).");
   }
   for (const std::string& line : r.preflight.lines) {
     const bool bad = line.find("FAILED") != std::string::npos || line.rfind("  ", 0) == 0;
