@@ -127,7 +127,12 @@ void TimingGateStage::pauseIfPastLimits(Cycle& cycle) {
   off_ = flashes_ = 0;
   late_.clear();
   if (settings_.policy != "pause" || !settings_.experimenter) {
-    s_.tell.say(cycle.time_s, Severity::Warning, why);
+    // Not paused, the same warning would come every few seconds: once a minute is enough.
+    if (!told_at_ || cycle.time_s - *told_at_ >= kTellEveryS) {
+      s_.tell.say(cycle.time_s, Severity::Warning,
+                  std::string(why) + " (the run goes on; told at most once a minute)");
+      told_at_ = cycle.time_s;
+    }
     return;
   }
   ++pauses_;

@@ -45,6 +45,8 @@ class TimingGateStage final : public Stage {
   static constexpr int kMinFlashes = 12;
   // The late frames' share is taken over this many presented frames.
   static constexpr int kLateWindow = 120;
+  // A run that is not paused for timing is told of it at most this often.
+  static constexpr double kTellEveryS = 60.0;
 
  private:
   void offLimits(Cycle& cycle, const char* what, double value_ms, double limit_ms,
@@ -59,6 +61,7 @@ class TimingGateStage final : public Stage {
   std::optional<std::int64_t> last_onset_, last_end_;
   std::deque<bool> late_;  // the last frames presented: late or not
   bool paused_ = false;    // asked for a pause that has not been resumed yet
+  std::optional<double> told_at_;
   // For the summary.
   int long_flashes_ = 0, short_gaps_ = 0, short_soas_ = 0, pauses_ = 0;
   double longest_flash_ms_ = 0.0;
