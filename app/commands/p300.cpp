@@ -17,6 +17,7 @@
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/settings.h"
+#include "arbci/bci/unsupervised.h"
 #include "arbci/session/session_config.h"
 #include "arbci/session/settings_schema.h"
 #include "commands/commands.h"
@@ -134,7 +135,39 @@ struct TrainOptions {
   bool calibration_only = false;  // only the calibration blocks' feedbacks
   std::string p300_model;         // the ErrP classifier is written inside this P300 model
   double errp_threshold = 0.0;    // errp.threshold
+  bool unsupervised = false;      // learn without the recordings' labels (bci/unsupervised.h)
 };
+
+// What learning without labels found, and, where the recordings carry labels (never read by it),
+// how it compares: post-hoc accuracy, the learning curve, and its AUC beside the supervised one.
+void learnWithoutLabels(const TrainOptions& o, bci::P300Dataset& data) {
+  const bci::UnsupervisedReport u = bci::evaluateWithoutLabels(data);
+  const int n = static_cast<int>(data.selections.size());
+  std::cout << "unsupervised (EM over each selection's one attended choice; the labels not read): "
+            << u.fit.agreeing << " of " << u.fit.restarts << " starts agree on the decoding kept\n";
+  if (u.labelled) {
+    std::cout << "post hoc, against the recordings' labels: " << u.right << " of " << n
+              << " selections right\n";
+  }
+  std::cout << "learning curve (selection k decoded by the fit on selections 1..k; starts "
+               "agreeing):";
+  for (const auto& p : u.curve) {
+    std::cout << " " << p.selection << (u.labelled ? (p.right ? " right" : " wrong") : "") << " ("
+              << p.agreeing << ")";
+    if (&p != &u.curve.back()) std::cout << ",";
+  }
+  std::cout << "\n";
+  if (u.labelled && n >= 2) {
+    bci::TrainingResult supervised = bci::trainModel(data, o.pipeline, o.training);
+    std::cout << "AUC against the labels, each selection scored by the fit on the others: "
+              << u.cross_validated_auc << " (unsupervised) vs "
+              << supervised.cross_validation.report.auc << " (" << o.training.method
+              << " on the labels, cross-validated)\n";
+  }
+  data = bci::withLabelsFound(data, u.fit);
+  std::cout << "the model below is " << o.training.method
+            << " trained on the labels found (its cross-validation is against them)\n\n";
+}
 
 // Every output is checked before any work: a typo in a path costs no training.
 void checkOutputs(const std::string& plots, const std::vector<std::string>& files) {
@@ -240,6 +273,10 @@ void train(TrainOptions& o, const CLI::App& command) {
                    "run it (train " +
                    linear + " for BCI2000)");
   }
+  if (o.errp && o.unsupervised)
+    throw CliError(
+        "--unsupervised learns the P300 from its one attended choice per selection; "
+        "an ErrP classifier (--errp) has no such choice");
   if (o.errp && !o.bci2000.empty())
     throw CliError("--bci2000: BCI2000 has no ErrP classifier; leave out --bci2000 with --errp");
   if (!o.errp && !o.p300_model.empty())
@@ -277,7 +314,10 @@ void train(TrainOptions& o, const CLI::App& command) {
     quality = checkChannels(recordings, o.exclude_bad_channels);
     data = bci::buildDataset(recordings, o.pipeline, progress, o.dataset);
     noteExcluded(data.erp, quality);
+    if (o.unsupervised) learnWithoutLabels(o, data);
     result = bci::trainModel(data, o.pipeline, o.training, progress);
+    if (o.unsupervised)
+      result.model.provenance["labels"] = "found without labels (arbci train --unsupervised)";
   } catch (const std::invalid_argument& error) {
     throw CliError(error.what());
   }
@@ -541,6 +581,10 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   schemaOption(*train_cmd, "--folds", t->training.folds, session::sessionKey("classifier.folds"),
                "here: any recordings' cross-validation; at most one per selection or file");
   schemaOption(*train_cmd, "--folds-by", t->training.folds_by, training.at("folds_by"));
+  train_cmd->add_flag("--unsupervised", t->unsupervised,
+                      "learn without the recordings' target labels: EM over each selection's one "
+                      "attended choice (docs/classification.md); reports post-hoc accuracy, the "
+                      "learning curve and the AUC beside the supervised one where labels exist");
   train_cmd->add_flag("--errp", t->errp,
                       "train the error-related-potential classifier on the recordings' feedback "
                       "events (Feedback ... correct|error; a session with errp.enabled records "

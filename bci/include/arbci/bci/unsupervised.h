@@ -1,0 +1,64 @@
+// A P300 classifier learnt without labels (Kindermans et al., PLoS ONE 2012): every selection has
+// exactly one attended choice (an object, or a cell: its row and its column), unknown.
+// Expectation-maximisation over that latent choice: given a projection w, each epoch's log-odds of
+// being a target (a one-dimensional Gaussian model of w.x per class) summed over the epochs of
+// each choice give the posterior of each choice; given the posteriors, each epoch's probability of
+// being a target weights the class means, and w = S^-1 (mean_target - mean_other) with S the
+// covariance of all epochs, which needs no label (shrunk by the Ledoit-Wolf intensity). Several
+// starts from random projections; the decoding most of them reach is kept, and how many agree is
+// the measure of trust. Labels in the data are never read.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "arbci/bci/p300_dataset.h"
+
+namespace arbci::bci {
+
+struct UnsupervisedOptions {
+  int restarts = 12;
+  int max_iterations = 100;
+  std::uint64_t seed = 1;
+};
+
+struct UnsupervisedFit {
+  std::vector<int> selections;     // the dataset's selections fitted (indices into selections)
+  std::vector<int> choice;         // per fitted selection: the choice decoded (0-based)
+  std::vector<double> posterior;   // its posterior
+  Eigen::VectorXd weights;         // the kept start's projection (target scores higher)
+  int restarts = 0, agreeing = 0;  // starts, and those that reached the kept decoding
+  int iterations = 0;              // the kept start's
+};
+
+// Fits `selections` of `data` (every one if empty). Throws std::invalid_argument when a selection
+// has no choice of the layout among its codes (no single attended stimulus to find).
+UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selections = {},
+                                 const UnsupervisedOptions& options = {});
+
+// `data` with each epoch's label replaced by what the fit decoded (a target: its code belongs to
+// its selection's decoded choice), for a supervised classifier to be trained on.
+P300Dataset withLabelsFound(const P300Dataset& data, const UnsupervisedFit& fit);
+
+// How the fit does, measured against the recordings' own labels where they carry them (the fit
+// never reads them).
+struct UnsupervisedReport {
+  UnsupervisedFit fit;
+  bool labelled = false;  // every selection's target is known
+  int right = 0;          // post hoc: selections decoded right by the fit on all of them
+  // The learning curve: selection k decoded by the fit on selections 1..k, as online.
+  struct Point {
+    int selection = 0;  // 1-based
+    bool right = false;
+    int agreeing = 0;  // starts that reached that fit's decoding
+  };
+  std::vector<Point> curve;
+  // Each selection's epochs scored by the fit on the others: the AUC against the true labels.
+  double cross_validated_auc = 0.0;
+};
+UnsupervisedReport evaluateWithoutLabels(const P300Dataset& data,
+                                         const UnsupervisedOptions& options = {});
+
+}  // namespace arbci::bci
