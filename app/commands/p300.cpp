@@ -292,6 +292,8 @@ void train(TrainOptions& o, const CLI::App& command) {
     }
   }
   checkOutputs(o.plots, {o.out, o.bci2000, o.report, o.scores});
+  // Learning without labels takes the flashes whose target is not known too (a free choice).
+  if (o.unsupervised) o.dataset.keep_unknown = true;
   try {
     o.pipeline = bci::withMethodRate(o.pipeline, o.training.method);
   } catch (const std::invalid_argument& error) {

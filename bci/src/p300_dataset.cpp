@@ -253,7 +253,7 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
         ++data.interrupted_flashes;
         continue;
       }
-      if (!e.known) {  // an online flash of a free choice: nothing to learn from
+      if (!e.known && !options.keep_unknown) {  // a free choice online: no label to learn from
         ++data.unknown_flashes;
         continue;
       }
@@ -284,7 +284,7 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
       }
       rows.push_back(extractor.features(epoch));
       const std::int64_t erp_first = e.sample - erp_baseline;
-      if (erp_first >= 0 && erp_first + erp_length <= r.samples)
+      if (e.known && erp_first >= 0 && erp_first + erp_length <= r.samples)
         erps.add(span(erp_source, erp_first, erp_length), e.target);
       data.target.push_back(e.target);
       data.code.push_back(e.code);

@@ -3,12 +3,14 @@
 // flashes; the synthetic speller file spells SPELL.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "arbci/bci/p300_model.h"
+#include "arbci/bci/unsupervised.h"
 #include "support/shared_data.h"
 #include "support/test_files.h"
 #include "support/xdf_writer.h"
@@ -144,6 +146,38 @@ TEST(P300RealEeg, Eeg3_1ThroughXdfWithItsLayoutTrainsAsTheOriginal) {
   const auto bare = test::freshTempPath("p300_xdf", "eeg3_1_bare.xdf");
   test::writeXdf(bare, eeg, markers);
   EXPECT_EQ(layoutOf(readRecording(bare)).kind, ParadigmLayout::Kind::SingleStimulus);
+}
+
+}  // namespace
+}  // namespace arbci::bci
+
+namespace arbci::bci {
+namespace {
+
+// Without labels: both copy-spelling runs with every flash's label erased ("U", as a free choice
+// online is recorded) are still learnt from, and the attended cells found spell what the subject
+// copied.
+TEST(P300RealEegUnsupervised, RecordingsWithoutLabelsSpellWhatWasCopied) {
+  std::vector<Recording> recordings = {sample("eeg3_1.dat"), sample("eeg3_2.dat")};
+  for (Recording& r : recordings) {
+    for (StimulusEvent& e : r.stimuli) {
+      e.known = false;
+      e.target = false;
+    }
+  }
+  DatasetOptions options;
+  options.keep_unknown = true;
+  const PipelineSettings pipeline = withMethodRate(PipelineSettings{}, "slda");
+  const P300Dataset data = buildDataset(recordings, pipeline, {}, options);
+  ASSERT_EQ(data.selections.size(), 8u);
+  EXPECT_EQ(std::count(data.target.begin(), data.target.end(), true), 0);
+  const UnsupervisedReport report = evaluateWithoutLabels(data);
+  EXPECT_FALSE(report.labelled);
+  std::string spelled;
+  for (int choice : report.fit.choice)
+    spelled += data.layout.symbols.at(static_cast<size_t>(choice));
+  EXPECT_EQ(spelled, "T3OF6MK?");
+  EXPECT_GE(report.fit.agreeing, 2);
 }
 
 }  // namespace

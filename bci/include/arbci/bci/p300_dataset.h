@@ -70,6 +70,10 @@ struct DatasetOptions {
   // turning a parietal positivity into a late trough) or exactly as the features (AsFeatures:
   // what the online classifier sees).
   enum class ErpFilter { ZeroPhase, AsFeatures } erp_filter = ErpFilter::ZeroPhase;
+  // Flashes recorded as "U" (whether attended not known: a free choice online) are kept as epochs
+  // with no target, for learning without labels (bci/unsupervised.h); left out otherwise. They
+  // never enter the ERP averages.
+  bool keep_unknown = false;
 };
 
 // Filters each recording as the online cycle does, cuts the response windows and computes the
