@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "arbci/bci/evaluation.h"
+#include "classifiers/linear.h"
 
 namespace arbci::bci {
 namespace {
@@ -19,26 +20,6 @@ struct Problem {
   int choices = 0;
   std::vector<std::vector<int>> codes_of;  // per choice: its codes
 };
-
-// The covariance of all epochs (no label needed), shrunk towards a multiple of the identity by
-// the Ledoit-Wolf intensity.
-Eigen::LDLT<Eigen::MatrixXd> shrunkCovariance(const Eigen::MatrixXd& centred) {
-  const double n = static_cast<double>(centred.rows()), p = static_cast<double>(centred.cols());
-  const Eigen::MatrixXd sample = centred.transpose() * centred / n;
-  const double mu = sample.trace() / p;
-  const double s_norm2 = sample.squaredNorm();
-  const double d2 = s_norm2 - p * mu * mu;
-  double sum_x4 = 0.0;
-  for (Eigen::Index i = 0; i < centred.rows(); ++i) {
-    const double r2 = centred.row(i).squaredNorm();
-    sum_x4 += r2 * r2;
-  }
-  const double b2 = (sum_x4 - n * s_norm2) / (n * n);
-  const double shrinkage = d2 > 0.0 ? std::clamp(b2 / d2, 0.0, 1.0) : 1.0;
-  Eigen::MatrixXd covariance = (1.0 - shrinkage) * sample;
-  covariance.diagonal().array() += shrinkage * mu;
-  return covariance.ldlt();
-}
 
 struct Start {
   std::vector<int> choice;
@@ -175,7 +156,9 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   }
   const Eigen::RowVectorXd mean = pr.x.colwise().mean();
   pr.x.rowwise() -= mean;
-  const Eigen::LDLT<Eigen::MatrixXd> covariance = shrunkCovariance(pr.x);
+  // The covariance of all epochs: no label needed.
+  double shrinkage = 0.0;
+  const Eigen::LDLT<Eigen::MatrixXd> covariance = ledoitWolfCovariance(pr.x, shrinkage).ldlt();
   std::mt19937_64 random(options.seed);
   std::vector<Start> starts;
   for (int r = 0; r < options.restarts; ++r)

@@ -22,6 +22,10 @@ class LinearClassifierBase : public Classifier {
       nlohmann::json::object();  // what each method adds (selected features, filters)
 };
 
+// The covariance of `centred`'s rows (already centred) shrunk towards a multiple of the identity by
+// the Ledoit-Wolf (2004) analytic intensity, which goes to `shrinkage`.
+Eigen::MatrixXd ledoitWolfCovariance(const Eigen::MatrixXd& centred, double& shrinkage);
+
 // Shrinkage LDA on rows of X: weights and bias with the decision threshold midway between the
 // class means. Returns the shrinkage intensity used.
 double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target,

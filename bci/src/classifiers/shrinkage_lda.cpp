@@ -18,6 +18,26 @@ class ShrinkageLdaClassifier final : public LinearClassifierBase {
 
 }  // namespace
 
+Eigen::MatrixXd ledoitWolfCovariance(const Eigen::MatrixXd& centred, double& shrinkage) {
+  const Eigen::Index n = centred.rows(), p = centred.cols();
+  const Eigen::MatrixXd sample = centred.transpose() * centred / static_cast<double>(n);
+  const double mu = sample.trace() / static_cast<double>(p);
+  // Ledoit-Wolf: d2 = |S - mu I|^2, b2 = min(d2, sum_k |x_k x_k' - S|^2 / n^2).
+  const double s_norm2 = sample.squaredNorm();
+  const double d2 = s_norm2 - static_cast<double>(p) * mu * mu;
+  double sum_x4 = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double r2 = centred.row(i).squaredNorm();
+    sum_x4 += r2 * r2;
+  }
+  const double b2_bar = (sum_x4 - static_cast<double>(n) * s_norm2) /
+                        (static_cast<double>(n) * static_cast<double>(n));
+  shrinkage = d2 > 0.0 ? std::clamp(b2_bar / d2, 0.0, 1.0) : 1.0;
+  Eigen::MatrixXd covariance = (1.0 - shrinkage) * sample;
+  covariance.diagonal().array() += shrinkage * mu;
+  return covariance;
+}
+
 double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& target,
                          Eigen::VectorXd& weights, double& bias) {
   const Eigen::Index n = x.rows(), p = x.cols();
@@ -40,21 +60,8 @@ double trainShrinkageLda(const Eigen::MatrixXd& x, const std::vector<bool>& targ
     centred.row(i) =
         x.row(i) - (target[static_cast<size_t>(i)] ? mean_target : mean_other).transpose();
   }
-  const Eigen::MatrixXd sample = centred.transpose() * centred / static_cast<double>(n);
-  const double mu = sample.trace() / static_cast<double>(p);
-  // Ledoit-Wolf: d2 = |S - mu I|^2, b2 = min(d2, sum_k |x_k x_k' - S|^2 / n^2).
-  const double s_norm2 = sample.squaredNorm();
-  const double d2 = s_norm2 - static_cast<double>(p) * mu * mu;
-  double sum_x4 = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double r2 = centred.row(i).squaredNorm();
-    sum_x4 += r2 * r2;
-  }
-  const double b2_bar = (sum_x4 - static_cast<double>(n) * s_norm2) /
-                        (static_cast<double>(n) * static_cast<double>(n));
-  const double shrinkage = d2 > 0.0 ? std::clamp(b2_bar / d2, 0.0, 1.0) : 1.0;
-  Eigen::MatrixXd covariance = (1.0 - shrinkage) * sample;
-  covariance.diagonal().array() += shrinkage * mu;
+  double shrinkage = 0.0;
+  const Eigen::MatrixXd covariance = ledoitWolfCovariance(centred, shrinkage);
   weights = covariance.ldlt().solve(mean_target - mean_other);
   bias = -weights.dot(0.5 * (mean_target + mean_other));
   return shrinkage;
