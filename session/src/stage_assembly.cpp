@@ -61,7 +61,9 @@ PreflightSettings preflightSettingsOf(const SessionConfig& c, const SessionOptio
   p.eeg_key = c.eeg.source == "file" ? "eeg.file" : "eeg.rate_hz";
   p.reference_id = c.world.reference_id;
   for (const WorldObjectSettings& o : c.world.objects) p.object_ids.push_back(o.id);
-  p.quality_gate = c.gates.signal_quality;
+  // Nobody to ask: a question would only be a refusal that offers what cannot be done.
+  p.quality_gate =
+      c.gates.signal_quality == "ask" && !options.experimenter ? "refuse" : c.gates.signal_quality;
   p.bad_channels_allowed = c.gates.bad_channels_allowed;
   if (c.robot.backend == "simulated") {
     p.robot_key = "robot.backend";
