@@ -102,7 +102,9 @@ void eachCommandRunsOnceThroughLoss(std::unique_ptr<RobotDriver> arm, int comman
   EXPECT_EQ(stats.executed, static_cast<std::uint64_t>(commands));  // each exactly once
   // Copies arrive when an answer was lost and the command sent again: about one command in five
   // here, so over 100 commands some always do; over fewer it can happen that none did.
-  if (commands >= 100) EXPECT_GT(stats.duplicates, 0u);
+  if (commands >= 100) {
+    EXPECT_GT(stats.duplicates, 0u);
+  }
   EXPECT_GT(relay.dropped(), static_cast<std::uint64_t>(commands / 2));
 }
 
