@@ -144,16 +144,20 @@ void learnWithoutLabels(const TrainOptions& o, bci::P300Dataset& data) {
   const bci::UnsupervisedReport u = bci::evaluateWithoutLabels(data);
   const int n = static_cast<int>(data.selections.size());
   std::cout << "unsupervised (EM over each selection's one attended choice; the labels not read): "
-            << u.fit.agreeing << " of " << u.fit.restarts << " starts agree on the decoding kept\n";
+            << u.fit.agreeing << " of " << u.fit.restarts
+            << " starts agree on the decoding kept; held-out consistency " << u.fit.consistency
+            << " (a model learnt from the other selections decodes that share as the fit does)\n";
   if (u.labelled) {
     std::cout << "post hoc, against the recordings' labels: " << u.right << " of " << n
               << " selections right\n";
   }
   std::cout << "learning curve (selection k decoded by the fit on selections 1..k; starts "
-               "agreeing):";
+               "agreeing, held-out consistency):";
   for (const auto& p : u.curve) {
+    char consistency[16];
+    std::snprintf(consistency, sizeof consistency, "%.2f", p.consistency);
     std::cout << " " << p.selection << (u.labelled ? (p.right ? " right" : " wrong") : "") << " ("
-              << p.agreeing << ")";
+              << p.agreeing << ", " << consistency << ")";
     if (&p != &u.curve.back()) std::cout << ",";
   }
   std::cout << "\n";

@@ -13,10 +13,14 @@
 namespace arbci::bci {
 namespace {
 
+// Decodings whose held-out consistency is measured: the most likely distinct ones.
+constexpr size_t kCandidates = 3;
+
 struct Problem {
   Eigen::MatrixXd x;                   // the fitted epochs' features, centred
   std::vector<std::vector<int>> rows;  // per selection: its rows of x
   std::vector<int> code;               // per row
+  std::vector<int> known;              // per selection: its choice when given (else -1)
   int choices = 0;
   std::vector<std::vector<int>> codes_of;  // per choice: its codes
 };
@@ -58,16 +62,23 @@ double expectation(const Problem& pr, const Eigen::VectorXd& odds, Eigen::Vector
     for (int r : pr.rows[s]) sum[pr.code[static_cast<size_t>(r)]] += odds[r];
     double top = -1e300;
     for (int c = 0; c < pr.choices; ++c) {
+      // A choice not flashed whole in this selection (an object out of view) cannot be it.
       double v = 0.0;
+      bool whole = true;
       for (int code : pr.codes_of[static_cast<size_t>(c)]) {
         const auto found = sum.find(code);
-        if (found != sum.end()) v += found->second;
+        if (found == sum.end()) {
+          whole = false;
+        } else {
+          v += found->second;
+        }
       }
-      post[static_cast<size_t>(c)] = v;
-      top = std::max(top, v);
+      if (pr.known[s] >= 0) v = c == pr.known[s] ? 0.0 : -1e300;
+      post[static_cast<size_t>(c)] = whole ? v : -1e300;
+      top = std::max(top, post[static_cast<size_t>(c)]);
     }
     double z = 0.0;
-    for (double& v : post) z += (v = std::exp(v - top));
+    for (double& v : post) z += (v = v <= -1e299 ? 0.0 : std::exp(v - top));
     std::map<int, double> target_of_code;
     for (int c = 0; c < pr.choices; ++c) {
       const double q = post[static_cast<size_t>(c)] / z;
@@ -86,15 +97,31 @@ double expectation(const Problem& pr, const Eigen::VectorXd& odds, Eigen::Vector
   return change;
 }
 
+// One EM run from a random projection, or (`initial`: a choice per selection, -1 where none)
+// from a decoding.
 Start runStart(const Problem& pr, const Eigen::LDLT<Eigen::MatrixXd>& covariance,
-               std::mt19937_64& random, int max_iterations) {
+               std::mt19937_64& random, int max_iterations,
+               const std::vector<int>* initial = nullptr) {
   std::normal_distribution<double> normal;
   Eigen::VectorXd w(pr.x.cols());
   for (Eigen::Index i = 0; i < w.size(); ++i) w[i] = normal(random);
   Eigen::VectorXd y = pr.x * w;
-  // The first log-odds: the random projection, standardised.
+  // The first log-odds: the random projection, standardised; or the decoding given, firmly.
   const double sd = std::sqrt(y.squaredNorm() / static_cast<double>(y.size()));
   Eigen::VectorXd odds = y / std::max(sd, 1e-12);
+  if (initial) {
+    odds.setZero();
+    for (size_t s = 0; s < pr.rows.size(); ++s) {
+      const int c = (*initial)[s];
+      if (c < 0) continue;
+      const auto& codes = pr.codes_of[static_cast<size_t>(c)];
+      for (int r : pr.rows[s])
+        odds[r] =
+            std::find(codes.begin(), codes.end(), pr.code[static_cast<size_t>(r)]) != codes.end()
+                ? 3.0
+                : -3.0;
+    }
+  }
   Eigen::VectorXd p = Eigen::VectorXd::Zero(y.size());
   Start out;
   for (out.iterations = 1; out.iterations <= max_iterations; ++out.iterations) {
@@ -112,6 +139,52 @@ Start runStart(const Problem& pr, const Eigen::LDLT<Eigen::MatrixXd>& covariance
     if (change < 1e-4 && out.iterations > 1) break;
   }
   out.w = w;
+  return out;
+}
+
+// The decoding of selection `s` by projection `w`: the whole choice with the most summed score.
+int decode(const Problem& pr, size_t s, const Eigen::VectorXd& w) {
+  std::map<int, double> by_code;
+  for (int r : pr.rows[s]) by_code[pr.code[static_cast<size_t>(r)]] += pr.x.row(r).dot(w);
+  int best = -1;
+  double top = -1e300;
+  for (int c = 0; c < pr.choices; ++c) {
+    double v = 0.0;
+    bool whole = true;
+    for (int code : pr.codes_of[static_cast<size_t>(c)]) {
+      const auto found = by_code.find(code);
+      whole = whole && found != by_code.end();
+      if (found != by_code.end()) v += found->second;
+    }
+    if (whole && v > top) {
+      top = v;
+      best = c;
+    }
+  }
+  return best;
+}
+
+// The problem without selection `s`.
+Problem without(const Problem& pr, size_t s) {
+  Problem out;
+  out.choices = pr.choices;
+  out.codes_of = pr.codes_of;
+  std::vector<int> keep;
+  for (size_t k = 0; k < pr.rows.size(); ++k) {
+    if (k == s) continue;
+    std::vector<int> rows;
+    for (int r : pr.rows[k]) {
+      rows.push_back(static_cast<int>(keep.size()));
+      keep.push_back(r);
+    }
+    out.rows.push_back(std::move(rows));
+    out.known.push_back(pr.known[k]);
+  }
+  out.x.resize(static_cast<Eigen::Index>(keep.size()), pr.x.cols());
+  for (size_t i = 0; i < keep.size(); ++i) {
+    out.x.row(static_cast<Eigen::Index>(i)) = pr.x.row(keep[i]);
+    out.code.push_back(pr.code[static_cast<size_t>(keep[i])]);
+  }
   return out;
 }
 
@@ -153,6 +226,8 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
                                   " whole choice(s) of the layout: no single attended stimulus "
                                   "among several to learn from");
     pr.rows.push_back(std::move(rows));
+    const auto given = options.known.find(s);
+    pr.known.push_back(given == options.known.end() ? -1 : given->second);
   }
   const Eigen::RowVectorXd mean = pr.x.colwise().mean();
   pr.x.rowwise() -= mean;
@@ -166,17 +241,87 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   // The most likely start: the labels that explain most of the data's variance. A start may settle
   // on the mirror solution (each selection's least P300-like stimulus as its target), a fixed
   // point too, but one that explains less.
-  const Start& kept =
-      *std::max_element(starts.begin(), starts.end(),
-                        [](const Start& a, const Start& b) { return a.explained < b.explained; });
+  const auto best = [](const std::vector<Start>& all) -> const Start& {
+    return *std::max_element(all.begin(), all.end(), [](const Start& a, const Start& b) {
+      return a.explained < b.explained;
+    });
+  };
+  // A start from the decoding given (an earlier fit's): a solution found before is not lost to
+  // the random starts of this fit.
+  std::vector<int> initial(selections.size(), -1);
+  bool warm = false;
+  for (size_t k = 0; k < selections.size(); ++k) {
+    const auto given = options.initial.find(selections[k]);
+    if (given == options.initial.end()) continue;
+    initial[k] = given->second;
+    warm = true;
+  }
+  if (warm) starts.push_back(runStart(pr, covariance, random, options.max_iterations, &initial));
+  // The held-out self-consistency of a decoding: each selection left out, the rest fitted again
+  // from new starts, and the left-out one decoded by that fit. The P300 generalises from selection
+  // to selection, so a fit that found it finds it again without any one selection, and decodes
+  // that one as the whole fit does; a labelling of noise (with few selections and many features,
+  // any labelling explains some variance) is not found again, and agrees by chance.
+  const auto heldOut = [&](const Start& start) {
+    int same = 0;
+    for (size_t s = 0; s < pr.rows.size(); ++s) {
+      const Problem rest = without(pr, s);
+      std::vector<Start> again;
+      for (int r = 0; r < options.restarts; ++r)
+        again.push_back(runStart(rest, covariance, random, options.max_iterations));
+      same += decode(pr, s, best(again).w) == start.choice[s];
+    }
+    return static_cast<double>(same) / static_cast<double>(pr.rows.size());
+  };
+  // The candidates: the most likely starts (the labels that explain most of the data's variance)
+  // and the warm one. With held-out measures, the one that generalises best is kept (the most
+  // likely of those alike): the mirror solution (each selection's least P300-like stimulus as its
+  // target) or a labelling of noise can explain much variance, but neither generalises.
+  std::vector<size_t> order(starts.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return starts[a].explained > starts[b].explained; });
+  std::vector<size_t> candidates;
+  const size_t wanted = options.held_out && pr.rows.size() >= 2 ? kCandidates : 1;
+  for (size_t i : order) {
+    if (candidates.size() >= wanted) break;
+    const bool seen = std::any_of(candidates.begin(), candidates.end(),
+                                  [&](size_t c) { return starts[c].choice == starts[i].choice; });
+    if (!seen) candidates.push_back(i);
+  }
+  if (warm && options.held_out && pr.rows.size() >= 2 &&
+      std::none_of(candidates.begin(), candidates.end(),
+                   [&](size_t c) { return starts[c].choice == starts.back().choice; }))
+    candidates.push_back(starts.size() - 1);
+  size_t keep = candidates.front();
+  double kept_consistency = 0.0;
+  if (options.held_out && pr.rows.size() >= 2) {
+    kept_consistency = -1.0;
+    for (size_t c : candidates) {
+      const double measured = heldOut(starts[c]);
+      if (measured > kept_consistency) {
+        kept_consistency = measured;
+        keep = c;
+      }
+    }
+  }
+  const Start& kept = starts[keep];
   UnsupervisedFit fit;
   fit.selections = selections;
-  fit.restarts = options.restarts;
-  for (const Start& s : starts) fit.agreeing += s.choice == kept.choice;
+  fit.restarts = static_cast<int>(starts.size());
+  // Two decodings of many selections may differ on a doubtful one or two and still be one
+  // solution: those that differ on at most a tenth of the selections count as agreeing.
+  const auto tolerance = static_cast<long>(kept.choice.size() / 10);
+  for (const Start& s : starts) {
+    long differ = 0;
+    for (size_t k = 0; k < s.choice.size(); ++k) differ += s.choice[k] != kept.choice[k];
+    fit.agreeing += differ <= tolerance;
+  }
   fit.choice = kept.choice;
   fit.posterior = kept.posterior;
   fit.weights = kept.w;
   fit.iterations = kept.iterations;
+  fit.consistency = kept_consistency;
   return fit;
 }
 
@@ -211,7 +356,7 @@ UnsupervisedReport evaluateWithoutLabels(const P300Dataset& data,
     const UnsupervisedFit online = fitWithoutLabels(data, first, options);
     report.curve.push_back(
         {k + 1, report.labelled && data.layout.codesOf(online.choice.back()) == truth(k),
-         online.agreeing});
+         online.agreeing, online.consistency});
   }
   if (!report.labelled || selections < 2) return report;
   std::vector<double> scores;
@@ -220,7 +365,9 @@ UnsupervisedReport evaluateWithoutLabels(const P300Dataset& data,
     std::vector<int> others;
     for (int i = 0; i < selections; ++i)
       if (i != k) others.push_back(i);
-    const UnsupervisedFit fit = fitWithoutLabels(data, others, options);
+    UnsupervisedOptions plain = options;
+    plain.held_out = false;  // its weights only
+    const UnsupervisedFit fit = fitWithoutLabels(data, others, plain);
     for (int e : data.selections[static_cast<size_t>(k)].epochs) {
       scores.push_back(data.features.row(e).dot(fit.weights));
       target.push_back(data.target[static_cast<size_t>(e)]);

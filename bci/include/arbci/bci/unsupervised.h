@@ -5,11 +5,14 @@
 // each choice give the posterior of each choice; given the posteriors, each epoch's probability of
 // being a target weights the class means, and w = S^-1 (mean_target - mean_other) with S the
 // covariance of all epochs, which needs no label (shrunk by the Ledoit-Wolf intensity). Several
-// starts from random projections; the decoding most of them reach is kept, and how many agree is
-// the measure of trust. Labels in the data are never read.
+// starts from random projections (and one from an earlier decoding, when given). Whether a
+// decoding is the P300 or a labelling of noise: fitted again without each selection in turn, does
+// the fit decode that selection as before (UnsupervisedFit::consistency)? Of the most likely
+// decodings (most variance explained) the most consistent is kept. Labels are never read.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -22,15 +25,29 @@ struct UnsupervisedOptions {
   int restarts = 12;
   int max_iterations = 100;
   std::uint64_t seed = 1;
+  // Selections whose choice is known (a calibration run's cued targets), by their index in the
+  // dataset's selections: held at it, the rest found (semi-supervised; a session's adaptation).
+  std::map<int, int> known;
+  // A decoding to start from as well (an earlier fit's: selection index -> choice).
+  std::map<int, int> initial;
+  // Measure the fit's held-out self-consistency (UnsupervisedFit::consistency): a fit again
+  // without each selection in turn, so as many fits as selections more.
+  bool held_out = true;
 };
 
 struct UnsupervisedFit {
-  std::vector<int> selections;     // the dataset's selections fitted (indices into selections)
-  std::vector<int> choice;         // per fitted selection: the choice decoded (0-based)
-  std::vector<double> posterior;   // its posterior
-  Eigen::VectorXd weights;         // the kept start's projection (target scores higher)
-  int restarts = 0, agreeing = 0;  // starts, and those that reached the kept decoding
-  int iterations = 0;              // the kept start's
+  std::vector<int> selections;    // the dataset's selections fitted (indices into selections)
+  std::vector<int> choice;        // per fitted selection: the choice decoded (0-based)
+  std::vector<double> posterior;  // its posterior
+  Eigen::VectorXd weights;        // the kept start's projection (target scores higher)
+  // Starts, and those that reached the kept decoding (differing on at most a tenth of the
+  // selections, rounded down: on fewer than ten, on none).
+  int restarts = 0, agreeing = 0;
+  int iterations = 0;  // the kept start's
+  // Its held-out self-consistency: the share of the selections that the same fit without them
+  // (from new starts) decodes as this fit does; chance is about one over the choices. The measure
+  // of trust (0 unless UnsupervisedOptions::held_out). The starts agreeing count the warm one.
+  double consistency = 0.0;
 };
 
 // Fits `selections` of `data` (every one if empty). Throws std::invalid_argument when a selection
@@ -52,7 +69,8 @@ struct UnsupervisedReport {
   struct Point {
     int selection = 0;  // 1-based
     bool right = false;
-    int agreeing = 0;  // starts that reached that fit's decoding
+    int agreeing = 0;          // starts that reached that fit's decoding
+    double consistency = 0.0;  // that fit's held-out self-consistency
   };
   std::vector<Point> curve;
   // Each selection's epochs scored by the fit on the others: the AUC against the true labels.
