@@ -246,6 +246,9 @@ void Paradigm::advanceTimedPhase(double due_s) {
         const Decision& d = last_decision_;
         showSelection(d.runner_up_codes, d.runner_up_choice, runnerUpCertainty(d),
                       phase_ == Phase::ObjectSelected, "runner-up");
+      } else if (!verdict_pending_ && phase_ == Phase::ObjectSelected && held_now_) {
+        held_now_ = false;
+        nextTrial(now_ + settings_.pause_s, held_why_);
       } else if (!verdict_pending_) {
         askRobot(phase_ == Phase::ObjectSelected ? Phase::Grasping : Phase::Dropping);
       }
@@ -355,6 +358,11 @@ void Paradigm::decide(const Decision& decision) {
     return;
   }
   if (phase_ != Phase::ObjectFlashing && phase_ != Phase::CellFlashing) return;
+  if (decision.choice < 0) {
+    // No model to decide with yet (learning from use, before its first fit).
+    nextTrial(now_ + settings_.pause_s, hold_why_.empty() ? "no model to decide with" : hold_why_);
+    return;
+  }
   last_decision_ = decision;
   runner_up_taken_ = false;
   runner_up_waiting_ = false;
@@ -375,6 +383,8 @@ void Paradigm::showSelection(const std::set<int>& codes, int choice, double cert
   verdict_pending_ = settings_.errp;
   phase_until_ = now_ + settings_.result_s;
   if (objects) {
+    held_now_ = hold_arm_;
+    held_why_ = hold_why_;
     selected_object_ = choice + 1;
     made.object = *selected_object_;
     event(made);
@@ -452,6 +462,11 @@ void Paradigm::modelTrained(bool ok, const std::string& text) {
   }
   trial_ = 1;
   startFlashing(nextFrame(), true);
+}
+
+void Paradigm::holdArm(bool held, const std::string& why) {
+  hold_arm_ = held;
+  hold_why_ = why;
 }
 
 void Paradigm::recalibrate() {

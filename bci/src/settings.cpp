@@ -34,6 +34,23 @@ const core::Schema<ParadigmSettings>& paradigmSchema() {
                  "sequences of each calibration selection (always all)")
         .integer("trials", &P::trials, 3, 1, 1000,
                  "online trials (select an object, grasp, select a cell, put down)")
+        .text("calibration", &P::calibration, "cued",
+              "cued: a calibration run trains the classifier first (unless a model is given); "
+              "none: the trials start at once and the classifier learns from them without "
+              "labels, the arm held until the model is trusted",
+              [] {
+                return std::vector<std::string>{"cued", "none"};
+              })
+        .integer("learning_min_selections", &P::learning_min_selections, 5, 2, 100,
+                 "calibration none: the arm moves only once the model has learnt from this many "
+                 "object selections")
+        .number("learning_min_consistency", &P::learning_min_consistency, 0.8, 0.0, 1.0,
+                "calibration none: ... and once a model learnt from the other selections "
+                "decodes at least this share of them as the fit does (held out; chance is one "
+                "over the objects)")
+        .boolean("adapt", &P::adapt, false,
+                 "a calibrated session goes on learning from its object selections (the "
+                 "calibration run's labels kept, the rest's found by EM)")
         .number("cue_s", &P::cue_s, 1.5, 0.0, 60.0,
                 "calibration: the target is shown this long before its flashes", "s")
         .number("result_s", &P::result_s, 1.0, 0.0, 60.0, "a selection is shown this long", "s")

@@ -72,3 +72,21 @@ nlohmann::json QualityPart::toJson() const {
 }
 
 }  // namespace arbci::session
+
+namespace arbci::session {
+
+std::string LearningState::line() const {
+  if (adapting)
+    return "adapting: " + std::to_string(fits) + " fit(s) over " + std::to_string(selections) +
+           " selections";
+  std::string out =
+      "learning: " + std::to_string(selections) + " selection" + (selections == 1 ? "" : "s");
+  if (trusted) return out + ", the model trusted: the arm moves";
+  out += ", not yet moving the arm";
+  if (fits == 0) out += "; waiting for the first fit";
+  if (!waiting_for.empty()) out += "; waiting for " + waiting_for;
+  if (!error.empty()) out += " (last fit: " + error + ")";
+  return out;
+}
+
+}  // namespace arbci::session

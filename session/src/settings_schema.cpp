@@ -387,7 +387,8 @@ const Schema<SessionConfig>& paradigmSectionSchema() {
     Schema<SessionConfig> t("paradigm", bci::paradigmSchema().doc());
     for (const char* key :
          {"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "calibration_selections",
-          "calibration_sequences", "trials", "cue_s", "result_s", "pause_s", "no_view_pause_s"})
+          "calibration_sequences", "trials", "cue_s", "result_s", "pause_s", "no_view_pause_s",
+          "calibration", "learning_min_selections", "learning_min_consistency", "adapt"})
       t.adopt(bci::paradigmSchema(), key, &SessionConfig::paradigm);
     t.rulesOf(bci::paradigmSchema());
     t.list("intended", &SessionConfig::intended, intentSchema(),
@@ -566,6 +567,11 @@ Broken crossRules(const Json& c) {
                            " (every fold keeps " + std::to_string(bci::kMinimumTargets) +
                            " errors to train on), or more folds (smaller held-out blocks)"};
   }
+  if (c["errp"]["enabled"].get<bool>() && c["paradigm"]["calibration"] == "none")
+    return std::pair{"errp.enabled",
+                     "= true needs the calibration run's feedback block to train the ErrP "
+                     "classifier, and paradigm.calibration is \"none\": set one of them "
+                     "otherwise"};
   if (c["errp"]["enabled"].get<bool>() && !c["errp"]["channels"].empty()) {
     const auto montage = c["eeg"]["montage"].get<std::vector<std::string>>();
     bool any = false;

@@ -176,9 +176,16 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   auto quality = std::make_unique<SignalQualityStage>(
       SignalQualitySettings{eeg_info, c.gates.thresholds(c.classifier.pipeline.filter.notch_hz)});
   auto p300 = std::make_unique<P300Stage>(
-      P300Settings{eeg_info, c.classifier.pipeline, c.classifier.training,
-                   c.paradigm.flashSeconds(), static_cast<int>(c.world.objects.size()),
-                   c.classifier.model_file, c.source},
+      P300Settings{eeg_info,
+                   c.classifier.pipeline,
+                   c.classifier.training,
+                   c.paradigm.flashSeconds(),
+                   static_cast<int>(c.world.objects.size()),
+                   c.classifier.model_file,
+                   c.source,
+                   c.learnsFromUse(),
+                   c.paradigm.adapt && c.classifier.model_file.empty(),
+                   {c.paradigm.learning_min_selections, c.paradigm.learning_min_consistency}},
       services);
   auto errp = std::make_unique<ErrpStage>(errpSettingsOf(c, eeg_info), services);
   std::unique_ptr<LslMarkersStage> markers = markersStageOf(c, lsl, eeg_info.rate_hz, services);
@@ -199,7 +206,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
                             c.eeg.seed + 11, c.errp.threshold, folder / "model.json",
                             options.experimenter, c.tracker.max_pose_age_s, c.gates.review,
-                            c.gates.min_auc, c.gates.max_retakes},
+                            c.gates.min_auc, c.gates.max_retakes, c.learnsFromUse()},
       services);
   CycleRecord warm_up;
   tracking->publish(warm_up.tracking);

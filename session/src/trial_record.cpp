@@ -108,7 +108,10 @@ nlohmann::json trialJson(const TrialRecord& t) {
       {"interruptions", interruptionsJson(t.interruptions)},
       {"outcome", t.outcome},
       {"duration_s", t.ended_s >= 0.0 ? orNull(t.ended_s - t.started_s) : nlohmann::json(nullptr)},
-      {"placement_error_m", orNull(t.placement_error_m)}};
+      {"placement_error_m", orNull(t.placement_error_m)},
+      {"arm_held", t.arm_held},
+      {"post_hoc_object", idJson(t.post_hoc_object)},
+      {"frozen_object", idJson(t.frozen_object)}};
 }
 
 // Accuracy, seconds per selection and bits per minute of one kind of selection (null: none made).
@@ -130,7 +133,11 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
   int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0, completed = 0;
   double object_seconds = 0, cell_seconds = 0, trial_seconds = 0;
   int wrong_robot_actions = 0;
+  nlohmann::json first_right = nullptr;
   for (const TrialRecord& t : records) {
+    if (first_right.is_null() && t.ended_s >= 0.0 && t.robot_object == t.intended_object &&
+        t.robot_cell == t.intended_cell && !t.robot_returned)
+      first_right = t.ended_s;
     wrong_robot_actions += t.wrongRobotActions();
     trials.push_back(trialJson(t));
     if (t.selected_object >= 0) {
@@ -163,7 +170,8 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
           {"wrong_robot_actions", wrong_robot_actions},
           {"objects", rate(object_choices, objects_right, objects_made, object_seconds)},
           {"cells", rate(cell_choices, cells_right, cells_made, cell_seconds)},
-          {"all_inclusive", all}};
+          {"all_inclusive", all},
+          {"first_right_placement_s", first_right}};
 }
 
 }  // namespace arbci::session

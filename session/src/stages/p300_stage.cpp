@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/session/session_config.h"
 
@@ -23,10 +24,16 @@ P300Stage::P300Stage(const P300Settings& settings, const StageServices& services
   calibration_.parameters["Paradigm"] =
       "single stimulus, " + std::to_string(settings_.object_stimuli) + " stimuli";
   if (!settings_.model_file.empty()) setModel(bci::P300Model::load(settings_.model_file), 0.0);
+  if (learns()) {
+    state_.adapting = !settings_.learn;
+    state_.trusted = state_.adapting;
+    published_ = std::make_shared<const LearningState>(state_);
+  }
 }
 
 P300Stage::~P300Stage() {
   if (training_.valid()) training_.wait();
+  if (refit_.valid()) refit_.wait();
 }
 
 void P300Stage::setModel(const bci::P300Model& model, double time_s, bool calibrated) {
@@ -44,7 +51,7 @@ void P300Stage::setModel(const bci::P300Model& model, double time_s, bool calibr
   // The online filter and window follow the model's pipeline.
   filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, settings_.info);
   model_ = std::make_shared<const bci::P300Model>(model);
-  if (calibrated) return;
+  if (calibrated || learns()) return;
   keep_signal_ = false;
   calibration_.data.clear();
   calibration_.data.shrink_to_fit();
@@ -62,7 +69,12 @@ void P300Stage::recalibrate() {
 }
 
 void P300Stage::startSelection(const SelectionStart& selection) {
-  if (!selection.target && keep_signal_ && model_) {
+  if (current_learnable_) complete_ = selection_;  // the selection just over
+  current_learnable_ = learns() && !selection.target && selection.objects;
+  if (learns() && selection.target) known_[selection.selection] = *selection.target - 1;
+  layout_ = selection.layout;
+  current_epochs_.clear();
+  if (!selection.target && keep_signal_ && model_ && !learns()) {
     // Online: the calibration signal is no longer needed.
     keep_signal_ = false;
     calibration_.data.clear();
@@ -126,12 +138,124 @@ void P300Stage::takeTraining(Cycle& cycle) {
     Outcome outcome = training_.get();  // rethrows the worker's error
     setModel(outcome.model, cycle.time_s, true);
     trained_erp_ = std::make_shared<const bci::ErpCurves>(std::move(outcome.erp));
+    frozen_ = model_;
     out.trained = outcome.report;
     out.trained_on = std::move(outcome.trained_on);
     out.left_out = std::move(outcome.left_out);
   } catch (const std::exception& error) {
     out.training_error = error.what();
   }
+}
+
+void P300Stage::startRefit() {
+  // As startTraining: a channel-major copy, fitted below the cycle's priority. The selections
+  // complete so far only (not one under way).
+  fitted_ = complete_;
+  bci::Recording recording = calibration_;
+  recording.stimuli.clear();
+  std::vector<int> numbers;
+  for (size_t i = 0; i < calibration_.stimuli.size(); ++i) {
+    if (calibration_selection_[i] > fitted_) continue;
+    recording.stimuli.push_back(calibration_.stimuli[i]);
+    numbers.push_back(calibration_selection_[i]);
+  }
+  const int channels = settings_.info.channelCount();
+  recording.data.assign(calibration_.data.size(), 0.0f);
+  for (std::int64_t s = 0; s < calibration_.samples; ++s) {
+    for (int c = 0; c < channels; ++c) {
+      recording.data[static_cast<size_t>(c * calibration_.samples + s)] =
+          calibration_.data[static_cast<size_t>(s * channels + c)];
+    }
+  }
+  bci::TrainingSettings training = settings_.training;
+  training.method = model_ ? model_->method : settings_.training.method;
+  const std::shared_ptr<const bci::P300Model> frozen = state_.adapting ? frozen_ : nullptr;
+  state_.fitting = true;
+  std::map<int, int> previous;
+  for (const auto& [number, code] : state_.post_hoc) previous[number] = code - 1;
+  refit_ = std::async(
+      std::launch::async,
+      [recording = std::move(recording), numbers = std::move(numbers), known = known_, previous,
+       pipeline = bci::withMethodRate(settings_.pipeline, training.method), training, frozen]() {
+        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+        LearningOutcome out;
+        out.fit = bci::learnFromUse(recording, numbers, known, previous, pipeline, training);
+        out.fit.model.provenance["training_files"] = {"this session's selections"};
+        out.fit.model.provenance["labels"] =
+            known.empty() ? "found without labels (learning from use)"
+                          : "the calibration run's, and those found for the rest (adapting)";
+        if (frozen) out.frozen = bci::decodeSelections(*frozen, recording, numbers, pipeline);
+        return out;
+      });
+}
+
+void P300Stage::takeRefit(Cycle& cycle) {
+  if (!refit_.valid() || !cycle.clock.ready(refit_)) return;
+  state_.fitting = false;
+  try {
+    LearningOutcome outcome = refit_.get();
+    bci::LearnedSelections& fit = outcome.fit;
+    std::map<int, int> before;
+    for (const auto& [number, code] : state_.post_hoc) before[number] = code - 1;
+    const bci::Trust trust = bci::judgeTrust(fit, before, settings_.trust);
+    ++state_.fits;
+    state_.error.clear();
+    state_.selections = static_cast<int>(fit.numbers.size());
+    state_.agreeing = fit.agreeing;
+    state_.restarts = fit.restarts;
+    state_.consistency = fit.consistency;
+    state_.changed = trust.changed;
+    state_.post_hoc.clear();
+    for (size_t k = 0; k < fit.numbers.size(); ++k) {
+      if (known_.count(fit.numbers[k])) continue;  // cued: not decoded
+      state_.post_hoc[fit.numbers[k]] = fit.choice[k] + 1;
+    }
+    state_.frozen = std::move(outcome.frozen);
+    if (!state_.adapting) {
+      state_.trusted = trust.trusted;
+      state_.waiting_for = trust.waiting_for;
+    }
+    s_.log.write("learning_fit", cycle.time_s,
+                 {{"fit", state_.fits},
+                  {"selections", state_.selections},
+                  {"agreeing", fit.agreeing},
+                  {"restarts", fit.restarts},
+                  {"consistency", fit.consistency},
+                  {"post_hoc", state_.post_hoc},
+                  {"changed", trust.changed},
+                  {"trusted", state_.trusted},
+                  {"waiting_for", state_.waiting_for}});
+    // The new model decides from here, the current selection's epochs scored again by it; the
+    // online filters go on as they are (the pipeline is the session's).
+    extractor_.emplace(fit.model.extractor(settings_.info));
+    model_ = std::make_shared<const bci::P300Model>(std::move(fit.model));
+    scoreCurrentAgain();
+  } catch (const std::exception& error) {
+    // The model before it is kept: a failed fit changes nothing the arm acts on.
+    state_.error = error.what();
+    s_.log.write("learning_fit_failed", cycle.time_s, {{"reason", error.what()}});
+  }
+  published_ = std::make_shared<const LearningState>(state_);
+}
+
+void P300Stage::scoreCurrentAgain() {
+  accumulator_.emplace(layout_, model_->score_model);
+  for (const auto& [code, epoch] : current_epochs_)
+    accumulator_->add(code, model_->classifier->score(extractor_->features(epoch)));
+}
+
+void P300Stage::stop(Cycle& cycle, const std::string& /*reason*/) {
+  if (!learns()) return;
+  // The last fit, over every selection decided, gives the session's post-hoc decodings.
+  if (current_learnable_ && presented_ > 0 && scored_ >= presented_) complete_ = selection_;
+  for (int round = 0; round < 2; ++round) {
+    if (refit_.valid()) {
+      refit_.wait();
+      takeRefit(cycle);
+    }
+    if (complete_ > fitted_) startRefit();
+  }
+  cycle.record.p300.learning = published_;
 }
 
 bool P300Stage::touchesLoss(std::int64_t onset) const {
@@ -172,6 +296,7 @@ void P300Stage::process(const bci::Block& eeg, double time_s) {
                     {"reason", "it overlaps lost EEG samples"}});
       continue;
     }
+    if (learns()) current_epochs_.emplace_back(record.code, epoch);
     if (accumulator_ && extractor_)
       accumulator_->add(record.code, model_->classifier->score(extractor_->features(epoch)));
   }
@@ -208,6 +333,10 @@ void P300Stage::step(Cycle& cycle) {
     if (calibrating_ && keep_signal_ && !cut) {
       calibration_.stimuli.push_back(event);
       calibration_selection_.push_back(f.selection);
+    } else if (current_learnable_ && f.code <= settings_.object_stimuli) {
+      // What the subject attended is what is to be learnt: never the label.
+      calibration_.stimuli.push_back({onset.sample, f.code, false, duration, false});
+      calibration_selection_.push_back(selection_);
     }
     flashes_[onset.sample] = {selection_, f.code};
     epocher_->addEvent(event);
@@ -218,6 +347,15 @@ void P300Stage::step(Cycle& cycle) {
     lost_spans_.emplace_back(loss.first_sample, loss.first_sample + loss.samples);
   for (const bci::Block& block : eeg.eeg_blocks) process(block, cycle.time_s);
   takeTraining(cycle);
+  if (learns()) {
+    // An object selection decided (its epochs all scored): fit it in with the rest.
+    if (current_learnable_ && cycle.previous.paradigm.phase == bci::Phase::ObjectSelected &&
+        presented_ > 0 && scored_ >= presented_)
+      complete_ = selection_;
+    takeRefit(cycle);
+    if (complete_ > fitted_ && !refit_.valid()) startRefit();
+    cycle.record.p300.learning = published_;
+  }
 
   P300Part& out = cycle.record.p300;
   out.selection = selection_;

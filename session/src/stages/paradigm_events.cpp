@@ -94,6 +94,13 @@ void ParadigmStage::onSelectionStarted(const bci::ParadigmEvent& e, Cycle& cycle
     attended = attendedCodes(e.objects_layout, cycle);
   }
   ++selection_;
+  if (!target && e.objects_layout) {
+    // An online object selection: its trial and what its codes stand for, for the post-hoc
+    // decodings of learning from use.
+    LearntSelection& learnt = learnt_[selection_];
+    learnt.trial = paradigm_.trial();
+    for (size_t slot : slots_) learnt.ids.push_back(settings_.world.objects[slot].id);
+  }
   selection_objects_ = e.objects_layout;
   truth_ = target ? std::set<int>{*target} : attended;
   cycle.record.paradigm.selection_started =
@@ -132,6 +139,8 @@ void ParadigmStage::onSelectionMade(const bci::ParadigmEvent& e, Cycle& cycle) {
   decided.selection_s = cycle.record.presentation.selection_s;
   decided.selection_interrupted_s = cycle.record.presentation.selection_interrupted_s;
   const bool correct = trials_.recordSelection(number, decided);
+  if (settings_.learns && e.objects_layout && !armHeld(cycle) && !first_trusted_trial_)
+    first_trusted_trial_ = number;
   const TrialRecord& trial = trials_.at(number);
   nlohmann::json fields = {{"trial", trial.trial},
                            {"kind", e.objects_layout ? "object" : "cell"},
@@ -239,6 +248,7 @@ void ParadigmStage::onRobotDrop(const bci::ParadigmEvent& e, Cycle& cycle) {
 
 void ParadigmStage::onTrialDone(const bci::ParadigmEvent& e, Cycle& cycle) {
   trials_.done(e.trial, cycle.time_s, e.text);
+  if (e.text == kArmHeld) trials_.at(e.trial).arm_held = true;
   s_.log.write("trial_done", cycle.time_s, {{"trial", e.trial}, {"text", e.text}});
   if (const TrialRecord* done = trials_.find(e.trial))
     s_.tell.say(cycle.time_s, Severity::Info, selectionLine(*done));

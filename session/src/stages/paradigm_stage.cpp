@@ -57,6 +57,7 @@ void ParadigmStage::step(Cycle& cycle) {
   takeRobotNotes(cycle);
   watchGrasp(cycle);
   collectTraining(cycle);
+  followLearning(cycle);
   const Presentation& shown = cycle.record.presentation;
   if (shown.shown) paradigm_.presented(shown.frame, shown.at_s);
   stimulus_ = paradigm_.frame(cycle.frame, cycle.due_s);
@@ -97,7 +98,8 @@ void ParadigmStage::act(const Request& request, Cycle& cycle) {
   if (std::holds_alternative<BeginRequest>(request)) {
     if (paradigm_.phase() != bci::Phase::Setup) return;
     chooseSelectableObjects(cycle);
-    paradigm_.start(!cycle.record.p300.model);
+    paradigm_.start(!cycle.record.p300.model && !settings_.learns);
+    if (settings_.learns) trials_.nextStartsAt(cycle.time_s);
   } else if (const auto* pause = std::get_if<PauseRequest>(&request)) {
     reasons_.stopped_because = pause->reason.empty() ? "paused by the experimenter" : pause->reason;
     if (!pause->reason.empty()) {
@@ -375,11 +377,45 @@ void ParadigmStage::decideIfReady(const Cycle& cycle) {
   const bool scored = current && p300.presented > 0 && p300.scored >= p300.presented;
   // Dynamic stopping: certain enough after the minimum number of scored sequences.
   const bci::ParadigmSettings& p = settings_.paradigm;
-  if (online && p300.model && p.certainty > 0.0 && sequences >= p.min_sequences &&
-      p300.decision.certainty >= p.certainty) {
+  // While the arm is held the selection is data to learn from: all its sequences.
+  if (online && p300.model && !armHeld(cycle) && p.certainty > 0.0 &&
+      sequences >= p.min_sequences && p300.decision.certainty >= p.certainty) {
     paradigm_.requestStopFlashing();
   }
   if (paradigm_.awaitingDecision() && scored) paradigm_.decide(p300.decision);
+}
+
+bool ParadigmStage::armHeld(const Cycle& cycle) const {
+  const auto& learning = cycle.record.p300.learning;
+  return settings_.learns && !(learning && learning->trusted);
+}
+
+void ParadigmStage::followLearning(const Cycle& cycle) {
+  const auto& learning = cycle.record.p300.learning;
+  if (settings_.learns) {
+    const bool held = armHeld(cycle);
+    paradigm_.holdArm(held, held ? std::string(kArmHeld) : "");
+  }
+  if (!learning || learning == learning_seen_) return;
+  learning_seen_ = learning;
+  const auto object = [this](const std::map<int, int>& codes, int number) -> std::optional<int> {
+    const auto code = codes.find(number);
+    const auto selection = learnt_.find(number);
+    if (code == codes.end() || selection == learnt_.end()) return std::nullopt;
+    const auto& ids = selection->second.ids;
+    if (code->second < 1 || code->second > static_cast<int>(ids.size())) return std::nullopt;
+    return ids[static_cast<size_t>(code->second - 1)];
+  };
+  for (const auto& [number, selection] : learnt_) {
+    TrialRecord* trial = trials_.find(selection.trial);
+    if (!trial) continue;
+    trial->post_hoc_object = object(learning->post_hoc, number);
+    if (learning->adapting) trial->frozen_object = object(learning->frozen, number);
+  }
+}
+
+void ParadigmStage::stop(Cycle& cycle, const std::string& /*reason*/) {
+  followLearning(cycle);  // the P300 stage's last fit
 }
 
 void ParadigmStage::report(nlohmann::json& summary) const {
@@ -389,6 +425,45 @@ void ParadigmStage::report(nlohmann::json& summary) const {
   calibration_.summarise(summary);
   view_watch_.report(summary);
   if (settings_.paradigm.errp) errp_.report(summary["errp"]);
+  if (learnt_.empty() || !learning_seen_) return;
+  // Learning from use: the online decisions beside the post-hoc ones, and where the arm went.
+  nlohmann::json& out = summary["learning"];
+  int made = 0, online_right = 0, post_hoc_made = 0, post_hoc_right = 0, held = 0, wrong_arm = 0;
+  int half_made = 0, half_post_hoc = 0, half_frozen = 0;
+  const auto& all = trials_.trials();
+  for (size_t i = 0; i < all.size(); ++i) {
+    const TrialRecord& t = all[i];
+    held += t.arm_held;
+    wrong_arm += t.robot_object && *t.robot_object != t.intended_object;
+    if (t.selections.empty() || !t.selections.front().object) continue;
+    ++made;
+    online_right += t.selections.front().object_id == t.intended_object;
+    if (t.post_hoc_object) {
+      ++post_hoc_made;
+      post_hoc_right += *t.post_hoc_object == t.intended_object;
+    }
+    if (learning_seen_->adapting && 2 * i >= all.size() && t.post_hoc_object && t.frozen_object) {
+      ++half_made;
+      half_post_hoc += *t.post_hoc_object == t.intended_object;
+      half_frozen += *t.frozen_object == t.intended_object;
+    }
+  }
+  out["mode"] = learning_seen_->adapting ? "adapt" : "none";
+  out["object_selections"] = made;
+  out["online_right"] = online_right;
+  out["post_hoc"] = {{"decoded", post_hoc_made}, {"right", post_hoc_right}};
+  out["trials_arm_held"] = held;
+  out["wrong_robot_objects"] = wrong_arm;
+  out["first_trusted_trial"] =
+      first_trusted_trial_ ? nlohmann::json(*first_trusted_trial_) : nlohmann::json(nullptr);
+  if (learning_seen_->adapting) {
+    // Did adapting help? The last half's object selections decoded post hoc by the adapted
+    // model and by the calibrated one, frozen, on the same epochs.
+    out["last_half"] = {{"selections", half_made},
+                        {"adapted_right", half_post_hoc},
+                        {"frozen_right", half_frozen},
+                        {"adapting_helped", half_post_hoc > half_frozen}};
+  }
 }
 
 }  // namespace arbci::session

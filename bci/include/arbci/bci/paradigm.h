@@ -45,6 +45,19 @@ struct ParadigmSettings {
   double no_view_pause_s;
   int calibration_selections;
   int trials;
+  // "cued": a calibration run trains the classifier before the trials (unless a model is given);
+  // "none": the trials start at once and the classifier learns from them without labels
+  // (docs/classification.md, "Learning from use"). While it learns, the arm is not sent: each
+  // trial is an object selection only, until the model is trusted: `learning_min_selections`
+  // selections learnt from, a held-out self-consistency of at least `learning_min_consistency`
+  // (bci/unsupervised.h), and its decoding of the earlier selections unchanged since the last fit
+  // (but for a tenth of them).
+  std::string calibration;
+  int learning_min_selections;
+  double learning_min_consistency;
+  // A calibrated session goes on learning from its object selections, the calibration run's
+  // labels kept: the model is retrained after each with the labels EM finds for the rest.
+  bool adapt;
   // The timing check's mode, not a setting: cued calibration selections without end (never
   // training, never trials).
   bool flashes_only = false;
@@ -183,6 +196,10 @@ class Paradigm {
   void errpVerdict(bool error);
   bool awaitingErrpVerdict() const;
   void modelTrained(bool ok, const std::string& text);
+  // Learning from use (calibration "none"): while held, an object selection is shown and its trial
+  // ends there, the arm not sent (`why` is the trial's outcome); a selection decided without a
+  // model (no choice) ends its trial at once. Read when a selection is made.
+  void holdArm(bool held, const std::string& why);
   // From Training (the experimenter's Recalibrate at the review): the calibration run again, from
   // its first selection (and its ErrP block, where there is one).
   void recalibrate();
@@ -282,6 +299,8 @@ class Paradigm {
   bool runner_up_waiting_ = false;  // the rejected selection is cleared; the runner-up comes next
   bool giving_back_ = false;        // the put-down returns the object (no cell was accepted)
   int corrections_ = 0;
+  bool hold_arm_ = false, held_now_ = false;  // asked; latched for the selection shown
+  std::string hold_why_, held_why_;
   int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
   bool errp_block_ = false;      // the calibration run's ErrP feedback block
   std::vector<bool> errp_plan_;  // the block's feedbacks: true = deliberately wrong

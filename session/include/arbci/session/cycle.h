@@ -125,6 +125,25 @@ struct RecordingPart {
   std::int64_t samples = 0;  // written so far
 };
 
+// Learning from use (paradigm.calibration none, or paradigm.adapt): the last fit over the
+// object selections so far (bci/learning_from_use.h).
+struct LearningState {
+  bool adapting = false;    // a calibrated model adapted (else one learnt from nothing)
+  bool trusted = false;     // the arm may act on the model (always, when adapting)
+  std::string waiting_for;  // what trust waits for, in words
+  int fits = 0;
+  int selections = 0;  // object selections the last fit learnt from
+  int agreeing = 0, restarts = 0;
+  double consistency = 0.0;     // held out (bci/unsupervised.h)
+  std::map<int, int> post_hoc;  // selection number -> the code the last fit decoded (1-based)
+  std::map<int, int> frozen;    // adapting: the code the calibrated model decodes
+  std::vector<int> changed;     // selections whose decoding the last fit changed
+  bool fitting = false;         // a fit is running on its worker thread
+  std::string error;            // why the last fit failed (the model before it is kept)
+  // "learning: 3 selections, not yet moving the arm; waiting for: 2 more selections".
+  std::string line() const;
+};
+
 struct P300Part {
   int selection = 0;  // the selection the counts and the decision belong to
   int presented = 0, scored = 0;
@@ -138,7 +157,8 @@ struct P300Part {
   // With `trained`: the calibration selections (the paradigm's numbers) it was trained on, and
   // those left out because they were interrupted and retaken.
   std::vector<int> trained_on, left_out;
-  bool training = false;  // on its worker thread
+  bool training = false;                          // on its worker thread
+  std::shared_ptr<const LearningState> learning;  // none unless the session learns from use
 };
 
 struct ErrpPart {

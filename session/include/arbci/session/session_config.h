@@ -234,6 +234,11 @@ struct SessionConfig {
   GateSettings gates;
 
   double displayHz() const { return paradigm.display_hz; }
+  // No calibration run and no model: the classifier learns from the trials (paradigm.calibration
+  // "none"; a model file given is used instead, as with "cued").
+  bool learnsFromUse() const {
+    return paradigm.calibration == "none" && classifier.model_file.empty();
+  }
   // The defaults, or `path` over the defaults. Throws SessionConfigError naming the key.
   static SessionConfig load(const std::optional<std::filesystem::path>& path);
   // `json` (a session file's content) over the defaults; `name` for messages.

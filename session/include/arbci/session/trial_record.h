@@ -51,6 +51,11 @@ struct TrialRecord {
   // the oldest its tracked pose grew, seconds; -1 when it had none at some point, nullopt when
   // no grasp came down.
   std::optional<double> grasp_pose_age_max_s;
+  // Learning from use (paradigm.calibration none, or adapt): the arm was held (the model not yet
+  // trusted, or none yet); the object the last fit decodes for this trial's object selection, post
+  // hoc, and (adapting) the one the calibrated model decodes on the same epochs.
+  bool arm_held = false;
+  std::optional<int> post_hoc_object, frozen_object;
   // The last object (cell) selection the ErrP classifier did not reject: what was executed.
   std::optional<int> acceptedObject() const;
   std::optional<std::pair<int, int>> acceptedCell() const;
@@ -64,7 +69,9 @@ std::string selectionLine(const TrialRecord& trial);
 // The summary's "trials" (each with the selections made and vetoed, the accepted ones or null,
 // and where the robot went or null), "wrong_robot_actions", "objects" and "cells" (accuracy,
 // seconds per selection and bits per minute, timed from the flash onsets as presented) and
-// "all_inclusive" (over all of each completed trial's time: cues, pauses, feedback, the robot).
+// "all_inclusive" (over all of each completed trial's time: cues, pauses, feedback, the robot)
+// and "first_right_placement_s" (when the first trial whose object and cell were both the
+// intended ones ended, session seconds from Start; null: none).
 nlohmann::json trialsSummary(const std::vector<TrialRecord>& trials, int object_choices,
                              int cell_choices);
 

@@ -18,6 +18,7 @@
 #include "arbci/bci/epocher.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/filters.h"
+#include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
 #include "arbci/session/stage.h"
@@ -32,6 +33,11 @@ struct P300Settings {
   int object_stimuli = 0;          // stimuli of the calibration run (the objects)
   std::string model_file;          // a trained model (empty: the calibration run trains one)
   std::string session_file;        // for messages naming a key
+  // Learning from use (bci/learning_from_use.h): `learn` (paradigm.calibration none) starts with
+  // no model and fits one after each object selection; `adapt` refits a calibrated one, the
+  // calibration run's labels kept.
+  bool learn = false, adapt = false;
+  bci::TrustRule trust;
 };
 
 class P300Stage final : public Stage {
@@ -42,6 +48,8 @@ class P300Stage final : public Stage {
   ~P300Stage() override;
   const char* name() const override { return "p300"; }
   void step(Cycle& cycle) override;
+  // The last fit is waited for: its decodings are the session's post-hoc ones.
+  void stop(Cycle& cycle, const std::string& reason) override;
   void report(nlohmann::json& summary) const override;
 
  private:
@@ -65,6 +73,12 @@ class P300Stage final : public Stage {
   void startTraining(const std::string& method);
   void takeTraining(Cycle& cycle);
   void process(const bci::Block& eeg, double time_s);
+  // Learning from use: a fit over the object selections so far, on a worker thread; its model
+  // taken in (the current selection's epochs scored again by it) and its trust judged.
+  void startRefit();
+  void takeRefit(Cycle& cycle);
+  void scoreCurrentAgain();
+  bool learns() const { return settings_.learn || settings_.adapt; }
   bool touchesLoss(std::int64_t onset) const;
 
   P300Settings settings_;
@@ -89,6 +103,24 @@ class P300Stage final : public Stage {
   // Stretches of lost samples [first, end): epochs touching them are discarded, not scored.
   std::vector<std::pair<std::int64_t, std::int64_t>> lost_spans_;
   std::int64_t discarded_ = 0;
+  // Learning from use: each kept flash's selection is in calibration_selection_ (the object
+  // selections' flashes with their labels removed); the cued selections' choices (adapt);
+  // the current selection's layout and scored epochs (scored again when a new model comes).
+  struct LearningOutcome {
+    bci::LearnedSelections fit;
+    std::map<int, int> frozen;
+  };
+  std::future<LearningOutcome> refit_;
+  int complete_ = 0, fitted_ = 0;  // the last learnable selection complete; the last fitted
+  std::shared_ptr<const bci::P300Model> frozen_;  // adapting: the calibrated model
+  bool current_learnable_ = false;                // the current selection is kept for learning
+  bool selection_objects_ = true;
+  std::map<int, int> known_;
+  bci::ParadigmLayout layout_;
+  std::vector<std::pair<int, bci::Epoch>> current_epochs_;
+  LearningState state_;
+  std::shared_ptr<const LearningState> published_;
+  int learnable_ = 0;  // object selections kept for learning
 };
 
 }  // namespace arbci::session

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -46,7 +47,13 @@ struct ParadigmStageSettings {
   bool review = false;          // gates.review: the experimenter accepts the calibration
   double min_auc = 0.0;         // gates.min_auc (0: none)
   int max_retakes = std::numeric_limits<int>::max();  // gates.max_retakes (none unless given)
+  bool learns = false;  // no calibration run: the P300 stage learns from the trials
 };
+
+// A learning trial's outcome (paradigm.calibration none): its object selection shown (or none
+// made, before the first model), the arm not sent.
+inline constexpr const char* kArmHeld =
+    "learning: the model is not yet trusted, so the arm was not sent";
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
 // ...;104=column 1;..." (object codes k for world.objects[slots[k - 1]], grid codes 100 + code).
@@ -60,6 +67,7 @@ class ParadigmStage final : public Stage {
   const char* name() const override { return "paradigm"; }
   void step(Cycle& cycle) override;
   // summary.json's "trials", "objects", "cells", "all_inclusive", "calibration" and "errp".
+  void stop(Cycle& cycle, const std::string& reason) override;
   void report(nlohmann::json& summary) const override;
 
  private:
@@ -99,6 +107,10 @@ class ParadigmStage final : public Stage {
   // The tracked object (other than the one in the gripper) standing on a grid cell, if any.
   std::optional<int> objectOnCell(std::pair<int, int> cell, const Cycle& cycle) const;
   void publish(Cycle& cycle);
+  // Learning from use: the arm held while the model is not trusted; each object selection's
+  // post-hoc decoding (and, adapting, the calibrated model's) onto its trial.
+  void followLearning(const Cycle& cycle);
+  bool armHeld(const Cycle& cycle) const;
 
   ParadigmStageSettings settings_;
   StageServices s_;
@@ -121,6 +133,14 @@ class ParadigmStage final : public Stage {
   bool retrying_ = false;  // the experimenter's Retry step is being carried out
   std::optional<ParadigmPart::Review> review_;  // the calibration awaiting the experimenter
   int calibration_round_ = 1;
+  // Learning: each online object selection's trial and the object ids its codes stood for.
+  struct LearntSelection {
+    int trial = 0;
+    std::vector<int> ids;
+  };
+  std::map<int, LearntSelection> learnt_;
+  std::shared_ptr<const LearningState> learning_seen_;
+  std::optional<int> first_trusted_trial_;
 };
 
 }  // namespace arbci::session
