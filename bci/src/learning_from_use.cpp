@@ -117,6 +117,10 @@ LearnedSelections learnFromUse(const Recording& recording,
   out.agreeing = fit.agreeing;
   out.restarts = fit.restarts;
   out.consistency = fit.consistency;
+  out.explained = fit.explained;
+  out.shuffled_explained = fit.shuffled_explained;
+  out.beats_shuffled = fit.beats_shuffled;
+  out.shuffles = em.shuffles;
   // Only the selections fitted go into training.
   const P300Dataset found = onlySelections(withLabelsFound(data, fit), usable);
   TrainingResult result = trainModel(found, pipeline, training);
@@ -167,11 +171,19 @@ Trust judgeTrust(const LearnedSelections& fit, const std::map<int, int>& previou
   if (n < rule.min_selections)
     missing.push_back(std::to_string(rule.min_selections - n) + " more selection" +
                       (rule.min_selections - n == 1 ? "" : "s"));
+  if (fit.beats_shuffled < fit.shuffles) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "a response that repeats with the attended stimulus (the fit explains %.4f of "
+                  "the variance; with the codes shuffled, up to %.4f)",
+                  fit.explained, fit.shuffled_explained);
+    missing.push_back(text);
+  }
   if (fit.consistency < rule.min_consistency) {
     char text[160];
     std::snprintf(text, sizeof text,
-                  "a held-out consistency of %.2f (now %.2f: a model learnt from the others "
-                  "decodes %d of %d selections as the fit does)",
+                  "a held-out consistency of %.2f (now %.2f: fitted again without each, %d of "
+                  "%d selections decoded as before)",
                   rule.min_consistency, fit.consistency,
                   static_cast<int>(std::lround(fit.consistency * n)), n);
     missing.push_back(text);

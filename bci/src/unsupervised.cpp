@@ -322,6 +322,27 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   fit.weights = kept.w;
   fit.iterations = kept.iterations;
   fit.consistency = kept_consistency;
+  fit.explained = kept.explained;
+  if (options.shuffles > 0) {
+    // The same fit with each selection's codes shuffled among its epochs: a response that repeats
+    // with its stimulus's flashes is gone, what the fit explains of noise alone is left.
+    for (int k = 0; k < options.shuffles; ++k) {
+      Problem shuffled = pr;
+      for (const auto& rows : pr.rows) {
+        std::vector<int> codes;
+        for (int r : rows) codes.push_back(pr.code[static_cast<size_t>(r)]);
+        std::shuffle(codes.begin(), codes.end(), random);
+        for (size_t i = 0; i < rows.size(); ++i)
+          shuffled.code[static_cast<size_t>(rows[i])] = codes[i];
+      }
+      std::vector<Start> null;
+      for (int r = 0; r < options.restarts; ++r)
+        null.push_back(runStart(shuffled, covariance, random, options.max_iterations));
+      const double explained = best(null).explained;
+      fit.shuffled_explained = std::max(fit.shuffled_explained, explained);
+      fit.beats_shuffled += kept.explained > explained;
+    }
+  }
   return fit;
 }
 
@@ -367,6 +388,7 @@ UnsupervisedReport evaluateWithoutLabels(const P300Dataset& data,
       if (i != k) others.push_back(i);
     UnsupervisedOptions plain = options;
     plain.held_out = false;  // its weights only
+    plain.shuffles = 0;
     const UnsupervisedFit fit = fitWithoutLabels(data, others, plain);
     for (int e : data.selections[static_cast<size_t>(k)].epochs) {
       scores.push_back(data.features.row(e).dot(fit.weights));

@@ -195,6 +195,41 @@ TEST(Paradigm, ATrialSelectsAnObjectGraspsItSelectsACellAndPutsItDown) {
   EXPECT_EQ(p.phase(), Phase::Finished);
 }
 
+TEST(Paradigm, WhileTheArmIsHeldASelectionEndsItsTrialWithoutTheRobot) {
+  // Learning from use: the first selection has no model (no choice), the second is made but the
+  // model is not trusted; neither sends the arm. Trusted, the third trial grasps.
+  ParadigmSettings settings = fast();
+  settings.trials = 3;
+  Paradigm p(settings, 4, 3, 3, 3);
+  std::int64_t frame = 0;
+  p.holdArm(true, "learning");
+  p.start(false);
+  EXPECT_EQ(p.phase(), Phase::ObjectFlashing);  // no calibration run
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(Decision{});
+  auto events = p.takeEvents();
+  const auto done = [](const std::vector<ParadigmEvent>& list) {
+    return std::find_if(list.begin(), list.end(),
+                        [](const ParadigmEvent& e) { return e.kind == Kind::TrialDone; });
+  };
+  ASSERT_NE(done(events), events.end());
+  EXPECT_EQ(done(events)->text, "learning");
+  EXPECT_EQ(p.trial(), 2);
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(1, {2}));
+  EXPECT_EQ(p.phase(), Phase::ObjectSelected);
+  p.holdArm(false, "");  // trusted now: the selection already shown keeps the arm held
+  events = runUntil(p, frame, [&] { return p.trial() == 3; });
+  EXPECT_TRUE(std::none_of(events.begin(), events.end(),
+                           [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; }));
+  ASSERT_NE(done(events), events.end());
+  EXPECT_EQ(done(events)->text, "learning");
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(3, {4}));
+  events = runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
+  EXPECT_EQ(p.phase(), Phase::Grasping);
+}
+
 TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {
   ParadigmSettings s = fast();
   s.sequences = 10;

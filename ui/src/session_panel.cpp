@@ -59,6 +59,12 @@ void SessionPanel::draw(const PanelInput& in) {
                 in.settings.paradigm.trials, r.paradigm.sequence, r.time_s);
   }
   buttons(in);
+  // Learning from use: how far the model is, and while the arm is held, what it waits for.
+  if (const auto& learning = r.p300.learning; learning && started) {
+    const ImVec4 colour =
+        learning->trusted ? ImVec4(0.5f, 0.9f, 0.5f, 1.0f) : ImVec4(1.0f, 0.8f, 0.35f, 1.0f);
+    colouredWrapped(colour, learning->line());
+  }
   // Why the session is not going as planned (a pause, a failed training, a refused grasp), or
   // how it ended: the same words as the operator log and the summary.
   if (const std::string why = session::reasonText(r); !why.empty())

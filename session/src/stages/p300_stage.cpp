@@ -204,6 +204,8 @@ void P300Stage::takeRefit(Cycle& cycle) {
     state_.agreeing = fit.agreeing;
     state_.restarts = fit.restarts;
     state_.consistency = fit.consistency;
+    state_.beats_shuffled = fit.beats_shuffled;
+    state_.shuffles = fit.shuffles;
     state_.changed = trust.changed;
     state_.post_hoc.clear();
     for (size_t k = 0; k < fit.numbers.size(); ++k) {
@@ -221,6 +223,9 @@ void P300Stage::takeRefit(Cycle& cycle) {
                   {"agreeing", fit.agreeing},
                   {"restarts", fit.restarts},
                   {"consistency", fit.consistency},
+                  {"explained", fit.explained},
+                  {"shuffled_explained", fit.shuffled_explained},
+                  {"beats_shuffled", fit.beats_shuffled},
                   {"post_hoc", state_.post_hoc},
                   {"changed", trust.changed},
                   {"trusted", state_.trusted},

@@ -23,6 +23,10 @@ struct LearnedSelections {
   std::vector<double> posterior;
   int agreeing = 0, restarts = 0;  // EM starts reaching the decoding kept (UnsupervisedFit)
   double consistency = 0.0;        // UnsupervisedFit::consistency
+  // UnsupervisedFit's: the variance explained, the most explained with shuffled codes, how many
+  // of `shuffles` such fits it beats.
+  double explained = 0.0, shuffled_explained = 0.0;
+  int beats_shuffled = 0, shuffles = 0;
 };
 
 // `recording`: the session's signal and flashes; `number_of_stimulus`: each stimulus's selection
@@ -48,9 +52,11 @@ struct TrustRule {
   double min_consistency = 0.8;
 };
 
-// Whether the arm may act on the model: enough selections learnt from, a held-out
-// self-consistency of at least the minimum, and its decoding of the selections the last fit knew
-// unchanged (but for a tenth of them, rounded down). A fit that changed its mind about earlier
+// Whether the arm may act on the model: enough selections learnt from; a response that repeats
+// with the attended stimulus (the fit explains more variance than every fit with the codes
+// shuffled); a held-out self-consistency of at least the minimum (the response generalises from
+// selection to selection); and its decoding of the selections the last fit knew unchanged (but
+// for a tenth of them, rounded down). A fit that changed its mind about earlier
 // selections has not settled: the arm waits, and `changed` names them.
 struct Trust {
   bool trusted = false;

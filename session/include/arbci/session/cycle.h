@@ -134,7 +134,8 @@ struct LearningState {
   int fits = 0;
   int selections = 0;  // object selections the last fit learnt from
   int agreeing = 0, restarts = 0;
-  double consistency = 0.0;     // held out (bci/unsupervised.h)
+  double consistency = 0.0;              // held out (bci/unsupervised.h)
+  int beats_shuffled = 0, shuffles = 0;  // fits with shuffled codes the fit explains more than
   std::map<int, int> post_hoc;  // selection number -> the code the last fit decoded (1-based)
   std::map<int, int> frozen;    // adapting: the code the calibrated model decodes
   std::vector<int> changed;     // selections whose decoding the last fit changed

@@ -1,0 +1,72 @@
+// Whether the arm may act on a model learnt from use: enough selections, a held-out consistency
+// at least the minimum, and a decoding of the earlier selections that the new fit kept; what is
+// missing is said in words.
+#include <gtest/gtest.h>
+
+#include "arbci/bci/learning_from_use.h"
+
+namespace arbci::bci {
+namespace {
+
+LearnedSelections fitOf(int selections, double consistency) {
+  LearnedSelections fit;
+  for (int k = 1; k <= selections; ++k) {
+    fit.numbers.push_back(2 * k);  // the session's numbers, not 1..n
+    fit.choice.push_back(k % 4);
+  }
+  fit.consistency = consistency;
+  fit.restarts = 12;
+  fit.explained = 0.02;
+  fit.shuffled_explained = 0.01;
+  fit.beats_shuffled = fit.shuffles = 9;
+  return fit;
+}
+
+std::map<int, int> decodings(const LearnedSelections& fit, int count) {
+  std::map<int, int> out;
+  for (int k = 0; k < count; ++k) out[fit.numbers[k]] = fit.choice[k];
+  return out;
+}
+
+TEST(LearningFromUse, TrustNeedsEnoughSelectionsAndAConsistentStableFit) {
+  const TrustRule rule{5, 0.8};
+  const LearnedSelections few = fitOf(3, 1.0);
+  Trust trust = judgeTrust(few, decodings(few, 2), rule);
+  EXPECT_FALSE(trust.trusted);
+  EXPECT_EQ(trust.waiting_for, "2 more selections");
+
+  const LearnedSelections weak = fitOf(10, 0.7);
+  trust = judgeTrust(weak, decodings(weak, 9), rule);
+  EXPECT_FALSE(trust.trusted);
+  EXPECT_NE(trust.waiting_for.find("held-out consistency of 0.80 (now 0.70"), std::string::npos)
+      << trust.waiting_for;
+
+  const LearnedSelections good = fitOf(12, 0.9);
+  trust = judgeTrust(good, decodings(good, 11), rule);
+  EXPECT_TRUE(trust.trusted) << trust.waiting_for;
+  EXPECT_TRUE(trust.waiting_for.empty());
+
+  LearnedSelections noise = fitOf(12, 0.9);
+  noise.beats_shuffled = 8;
+  noise.explained = 0.012;
+  trust = judgeTrust(noise, decodings(noise, 11), rule);
+  EXPECT_FALSE(trust.trusted);
+  EXPECT_NE(trust.waiting_for.find("explains 0.0120 of the variance; with the codes shuffled, up "
+                                   "to 0.0100"),
+            std::string::npos)
+      << trust.waiting_for;
+
+  // One of eleven earlier selections decoded otherwise is within a tenth; two are not: the fit
+  // changed its mind, and the arm waits.
+  std::map<int, int> before = decodings(good, 11);
+  before[2] = (before[2] + 1) % 4;
+  EXPECT_TRUE(judgeTrust(good, before, rule).trusted);
+  before[4] = (before[4] + 1) % 4;
+  trust = judgeTrust(good, before, rule);
+  EXPECT_FALSE(trust.trusted);
+  EXPECT_EQ(trust.changed, (std::vector<int>{2, 4}));
+  EXPECT_NE(trust.waiting_for.find("changed: 2, 4"), std::string::npos) << trust.waiting_for;
+}
+
+}  // namespace
+}  // namespace arbci::bci
