@@ -3,7 +3,8 @@
 // calibration run, training, the robot grasping and putting down, every object within a
 // centimetre), run twice with one seed (the same recording, byte for byte); the arm in the physics
 // engine (6 axes, three trials; 7 axes, twice for reproducibility); and a TERM signal that
-// ends a run with its summary saved, as does a disk that fills mid-run. Every other behaviour of a
+// ends a run with its summary saved, as does a disk that fills mid-run; and a session without a
+// calibration run that learns from its trials. Every other behaviour of a
 // session is tested at its own level: each stage on hand-built records (tests/session/stages), the
 // panels on hand-built records (tests/ui), the application's parts in process (tests/app/unit).
 #include <fcntl.h>
@@ -308,6 +309,63 @@ TEST(Session, ADiskThatFillsMidRunEndsItWithTheReasonAndKeepsTheRecording) {
   EXPECT_GT(summary["screenshots"]["failed"].get<int>(), 0);
   const bci::Recording recording = bci::readRecording(folder / "recording.bdf");
   EXPECT_GT(recording.samples, 256 * 5);
+}
+
+// No calibration run (paradigm.calibration none): the session starts at the trials, learns the
+// P300 from them without labels, and sends the arm only once the model is trusted; the log and
+// the summary keep each selection's online decision and the post-hoc one of the last fit.
+TEST(Session, WithoutACalibrationRunItLearnsFromItsTrialsAndHoldsTheArmUntilTrusted) {
+  const auto folder = fresh("learning");
+  const auto settings = fresh("learning.json");
+  std::ifstream in(kSessions + "/steady_head.json");
+  nlohmann::json file = nlohmann::json::parse(in);
+  file["paradigm"]["calibration"] = "none";
+  file["paradigm"]["trials"] = 8;
+  std::ofstream(settings) << file.dump();
+  const ProcessResult r = runProcess(
+      kArbci, {"run", "--headless", "--session", settings.string(), "--out", folder.string()},
+      600.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const nlohmann::json summary = readJson(folder / "summary.json");
+  EXPECT_EQ(summary["ended"], "finished");
+  EXPECT_FALSE(summary.contains("calibration") && summary["calibration"].contains("auc"))
+      << summary["calibration"].dump();  // no calibration run was trained
+  const nlohmann::json& learning = summary["learning"];
+  ASSERT_TRUE(learning.is_object()) << summary.dump();
+  EXPECT_EQ(learning["mode"], "none");
+  // The first selection has no model to decide with; every one decided is decoded post hoc too.
+  const int made = learning["object_selections"].get<int>();
+  EXPECT_GE(made, 5);
+  EXPECT_LT(made, 8);
+  EXPECT_EQ(learning["post_hoc"]["decoded"], made);
+  ASSERT_EQ(summary["trials"].size(), 8u);
+  int held = 0;
+  for (const auto& t : summary["trials"]) {
+    // The arm went nowhere in a held trial, and only after the model was first trusted.
+    if (t["arm_held"].get<bool>()) {
+      ++held;
+      EXPECT_TRUE(t["robot"]["object"].is_null()) << t.dump();
+      EXPECT_EQ(t["outcome"], "learning: the model is not yet trusted, so the arm was not sent");
+    } else {
+      ASSERT_TRUE(learning["first_trusted_trial"].is_number()) << learning.dump();
+      EXPECT_GE(t["trial"].get<int>(), learning["first_trusted_trial"].get<int>()) << t.dump();
+    }
+    if (!t["selected_object"].is_null()) {
+      EXPECT_TRUE(t["post_hoc_object"].is_number()) << t.dump();
+    }
+  }
+  EXPECT_EQ(learning["trials_arm_held"], held);
+  EXPECT_GE(held, 5);  // learning_min_selections: no arm before five selections learnt from
+  // A fit after each selection, off the cycle's thread, logged with its measures of trust.
+  int fits = 0;
+  for (const auto& line : readLog(folder / "log.jsonl")) {
+    if (line["event"] != "learning_fit") continue;
+    ++fits;
+    EXPECT_TRUE(line.contains("consistency") && line.contains("beats_shuffled") &&
+                line.contains("post_hoc") && line.contains("trusted"))
+        << line.dump();
+  }
+  EXPECT_GE(fits, 4);
 }
 
 }  // namespace
