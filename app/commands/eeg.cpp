@@ -191,6 +191,11 @@ void addEegCommand(CLI::App& root, int& exit_code) {
   sim->add_option("--alpha-hz", s.alpha_hz, "alpha peak frequency")
       ->capture_default_str()
       ->check(CLI::Range(6.0, 14.0));
+  sim->add_option("--erp-scale", s.erp_scale,
+                  "the subject's N2 and P3 amplitudes scaled (0.5: a responder at half the drawn "
+                  "amplitude, as the session's eeg.erp_scale)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   sim->add_flag("--paced", s.paced,
                 "run in real time (as a live session would) instead of as fast as possible");
   sim->callback([options, &exit_code] {

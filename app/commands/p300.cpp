@@ -175,6 +175,28 @@ void learnWithoutLabels(const TrainOptions& o, bci::P300Dataset& data) {
             << " trained on the labels found (its cross-validation is against them)\n\n";
 }
 
+// The recordings' averages with each flash labelled as the fit found it (every flash known), for
+// the ERP figures of what was learnt.
+bci::P300Dataset averagesByLabelsFound(std::vector<bci::Recording> recordings,
+                                       const bci::P300Dataset& found, const TrainOptions& o) {
+  std::map<std::pair<int, std::int64_t>, bool> target;
+  for (int e = 0; e < found.epochs(); ++e)
+    target[{found.file[static_cast<size_t>(e)], found.sample[static_cast<size_t>(e)]}] =
+        found.target[static_cast<size_t>(e)];
+  for (size_t f = 0; f < recordings.size(); ++f) {
+    std::vector<bci::StimulusEvent> kept;
+    for (bci::StimulusEvent e : recordings[f].stimuli) {
+      const auto label = target.find({static_cast<int>(f), e.sample});
+      if (label == target.end()) continue;  // not learnt from
+      e.target = label->second;
+      e.known = true;
+      kept.push_back(e);
+    }
+    recordings[f].stimuli = std::move(kept);
+  }
+  return bci::buildDataset(recordings, o.pipeline, {}, o.dataset);
+}
+
 // Every output is checked before any work: a typo in a path costs no training.
 void checkOutputs(const std::string& plots, const std::vector<std::string>& files) {
   if (!plots.empty()) ensureWritableFolder(plots);
@@ -307,7 +329,7 @@ void train(TrainOptions& o, const CLI::App& command) {
   }
   const bci::Progress progress = progressLine(std::cerr);
   bci::TrainingResult result;
-  bci::P300Dataset data;
+  bci::P300Dataset data, found_erp;
   nlohmann::json quality;
   try {
     std::vector<bci::Recording> recordings = readAll(o.files);
@@ -322,7 +344,10 @@ void train(TrainOptions& o, const CLI::App& command) {
     quality = checkChannels(recordings, o.exclude_bad_channels);
     data = bci::buildDataset(recordings, o.pipeline, progress, o.dataset);
     noteExcluded(data.erp, quality);
-    if (o.unsupervised) learnWithoutLabels(o, data);
+    if (o.unsupervised) {
+      learnWithoutLabels(o, data);
+      if (!o.plots.empty()) found_erp = averagesByLabelsFound(recordings, data, o);
+    }
     result = bci::trainModel(data, o.pipeline, o.training, progress);
     if (o.unsupervised)
       result.model.provenance["labels"] = "found without labels (arbci train --unsupervised)";
@@ -408,6 +433,14 @@ void train(TrainOptions& o, const CLI::App& command) {
         o.plots, data, result.cross_validation.report, "cross-validated " + o.training.method,
         o.errp ? ClassNames{"error", "correct"} : ClassNames{}, o.scalp.time());
     printPlots(written);
+    if (o.unsupervised) {
+      // Beside the averages by the recordings' labels (where they carry them): by the labels
+      // found, the ERP the model learnt.
+      printPlots(writeP300Plots(std::filesystem::path(o.plots) / "labels-found", found_erp,
+                                result.cross_validation.report,
+                                "labels found without labels, " + o.training.method, {},
+                                o.scalp.time()));
+    }
   }
   std::cout << "model: " << o.out << "\n";
   if (!o.bci2000.empty()) std::cout << "BCI2000 parameters: " << o.bci2000 << "\n";

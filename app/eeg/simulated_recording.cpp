@@ -92,6 +92,10 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
   config.seed = static_cast<std::uint64_t>(o.seed);
   config.line_hz = o.line_hz;
   config.alpha_hz = o.alpha_hz;
+  bci::SubjectProfile profile = bci::SubjectProfile::drawn(config.seed);
+  profile.p3_amplitude_uv *= o.erp_scale;
+  profile.n2_amplitude_uv *= o.erp_scale;
+  config.profile = profile;
   std::shared_ptr<bci::SampleClock> clock;
   auto manual = std::make_shared<bci::ManualClock>();
   if (o.paced) {

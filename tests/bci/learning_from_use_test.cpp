@@ -56,6 +56,12 @@ TEST(LearningFromUse, TrustNeedsEnoughSelectionsAndAConsistentStableFit) {
             std::string::npos)
       << trust.waiting_for;
 
+  LearnedSelections mirror = fitOf(12, 0.9);
+  mirror.p3_uv = -0.8;
+  trust = judgeTrust(mirror, decodings(mirror, 11), rule);
+  EXPECT_FALSE(trust.trusted);
+  EXPECT_NE(trust.waiting_for.find("a positive P300"), std::string::npos) << trust.waiting_for;
+
   // One of eleven earlier selections decoded otherwise is within a tenth; two are not: the fit
   // changed its mind, and the arm waits.
   std::map<int, int> before = decodings(good, 11);

@@ -226,6 +226,7 @@ void P300Stage::takeRefit(Cycle& cycle) {
                   {"explained", fit.explained},
                   {"shuffled_explained", fit.shuffled_explained},
                   {"beats_shuffled", fit.beats_shuffled},
+                  {"p3_uv", fit.p3_uv ? nlohmann::json(*fit.p3_uv) : nlohmann::json(nullptr)},
                   {"post_hoc", state_.post_hoc},
                   {"changed", trust.changed},
                   {"trusted", state_.trusted},

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,10 @@ struct LearnedSelections {
   // of `shuffles` such fits it beats.
   double explained = 0.0, shuffled_explained = 0.0;
   int beats_shuffled = 0, shuffles = 0;
+  // By the labels found, target minus non-target at the parietal and central midline sites
+  // (Pz, P3, P4, CPz, Cz, POz, P1, P2: those the features have) from 250 to 500 ms, uV; none
+  // without such sites.
+  std::optional<double> p3_uv;
 };
 
 // `recording`: the session's signal and flashes; `number_of_stimulus`: each stimulus's selection
@@ -54,9 +59,11 @@ struct TrustRule {
 
 // Whether the arm may act on the model: enough selections learnt from; a response that repeats
 // with the attended stimulus (the fit explains more variance than every fit with the codes
-// shuffled); a held-out self-consistency of at least the minimum (the response generalises from
-// selection to selection); and its decoding of the selections the last fit knew unchanged (but
-// for a tenth of them, rounded down). A fit that changed its mind about earlier
+// shuffled); that response positive at the parietal sites (the P300, not its mirror: each
+// selection's least P300-like stimulus taken as its target, a solution EM can settle on that
+// beats the shuffles too); a held-out self-consistency of at least the minimum (the response
+// generalises from selection to selection); and its decoding of the selections the last fit knew
+// unchanged (but for a tenth of them, rounded down). A fit that changed its mind about earlier
 // selections has not settled: the arm waits, and `changed` names them.
 struct Trust {
   bool trusted = false;

@@ -1,0 +1,254 @@
+// Learning from use against a calibration run, replayed on copy-task recordings (`arbci eeg
+// simulate`, or any single-stimulus recording with its targets marked): the first
+// --calibration selections are the calibration run, the next --trials the trials. Calibrated: a
+// model trained on the calibration run decides every trial, and the arm goes every time. Learning
+// from use (paradigm.calibration none): the calibration run is not used; before trial k the model
+// is the one the session would hold (bci::learnFromUse over trials 1..k-1, their labels removed),
+// it decides trial k, and the arm goes only when bci::judgeTrust trusted that fit. Per file and in
+// all: object selections right online (trials 11 on, as the issue counts them), arm sent to a
+// wrong object, post-hoc accuracy of the last fit, and the time from Start to the first right
+// placement, estimated from the session's default timing (TimeModel below; the robot's time is the
+// same in both). The session's own classifier settings (SessionConfig's defaults) are used.
+// Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11]
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "arbci/bci/learning_from_use.h"
+#include "arbci/bci/p300_dataset.h"
+#include "arbci/bci/recording.h"
+#include "arbci/session/session_config.h"
+
+using namespace arbci;
+
+namespace {
+
+struct Interval {
+  double low, high;
+};
+
+Interval wilson(int right, int n) {
+  if (n == 0) return {0.0, 1.0};
+  const double z = 1.959964, p = static_cast<double>(right) / n;
+  const double centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+  const double half = z * std::sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / (1.0 + z * z / n);
+  return {centre - half, centre + half};
+}
+
+// Seconds of the default session (paradigm defaults, 4 objects), as a headless default session
+// measured them: a cued calibration selection (cue, 8 sequences of 4 flashes, pause; the first
+// trial began 73.3 s after the first cue, training included), a learning trial (its selection, the
+// result shown, the pause) and a whole trial with the arm (both selections with dynamic stopping,
+// results, grasp and put-down at the simulated arm's default speed).
+struct TimeModel {
+  double calibration_selection_s = 8.9;
+  double training_s = 0.0;  // within the above
+  double learning_trial_s = 8.5;
+  double trial_s = 29.5;
+};
+
+struct Outcome {
+  int online_made = 0, online_right = 0;  // trials --from on
+  int arm_sent = 0, arm_wrong = 0;
+  int post_hoc_right = 0, post_hoc_made = 0;
+  double first_right_s = -1.0;  // -1: never
+  int first_trusted = 0;        // 0: never
+};
+
+struct Replay {
+  bci::Recording recording;
+  std::vector<int> number;    // each stimulus's selection (1-based)
+  std::map<int, int> target;  // selection -> attended code
+};
+
+// Selections: runs of flashes apart by more than four stimulus onsets (as buildDataset groups).
+Replay load(const std::string& file) {
+  Replay r;
+  r.recording = bci::readRecording(file);
+  const double soa = bci::layoutOf(r.recording).soa_s;
+  const double gap = std::max(1.0, 4.0 * soa) * r.recording.info.rate_hz;
+  int selection = 0;
+  std::int64_t previous = -1;
+  for (const bci::StimulusEvent& e : r.recording.stimuli) {
+    if (previous < 0 || static_cast<double>(e.sample - previous) > gap) ++selection;
+    previous = e.sample;
+    r.number.push_back(selection);
+    if (e.target) r.target[selection] = e.code;
+  }
+  return r;
+}
+
+// The recording with only the stimuli of selections [first, last], labels removed unless `keep`.
+std::pair<bci::Recording, std::vector<int>> part(const Replay& r, int first, int last, bool keep) {
+  bci::Recording out = r.recording;
+  out.stimuli.clear();
+  std::vector<int> numbers;
+  for (size_t i = 0; i < r.recording.stimuli.size(); ++i) {
+    if (r.number[i] < first || r.number[i] > last) continue;
+    bci::StimulusEvent e = r.recording.stimuli[i];
+    if (!keep) e.target = e.known = false;
+    out.stimuli.push_back(e);
+    numbers.push_back(r.number[i]);
+  }
+  return {out, numbers};
+}
+
+std::map<int, int> decode(const bci::P300Model& model, const Replay& r, int first, int last,
+                          const bci::PipelineSettings& pipeline) {
+  const auto [recording, numbers] = part(r, first, last, false);
+  return bci::decodeSelections(model, recording, numbers, pipeline);
+}
+
+Outcome calibrated(const Replay& r, int calibration, int trials, int from,
+                   const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
+                   const TimeModel& time) {
+  Outcome o;
+  const auto [recording, numbers] = part(r, 1, calibration, true);
+  const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+  const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
+  const auto decided = decode(model, r, calibration + 1, calibration + trials, pipeline);
+  double t = calibration * time.calibration_selection_s + time.training_s;
+  for (int k = 1; k <= trials; ++k) {
+    const int number = calibration + k;
+    const auto d = decided.find(number);
+    const bool right = d != decided.end() && d->second == r.target.at(number);
+    if (k >= from) {
+      ++o.online_made;
+      o.online_right += right;
+    }
+    ++o.arm_sent;
+    o.arm_wrong += !right;
+    t += time.trial_s;
+    if (right && o.first_right_s < 0.0) o.first_right_s = t;
+  }
+  return o;
+}
+
+Outcome learnt(const Replay& r, int calibration, int trials, int from,
+               const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
+               const bci::TrustRule& rule, const TimeModel& time) {
+  Outcome o;
+  std::optional<bci::LearnedSelections> fit;
+  bci::Trust trust;
+  std::map<int, int> before;  // the last fit's decodings (number -> choice)
+  double t = 0.0;
+  for (int k = 1; k <= trials; ++k) {
+    const int number = calibration + k;
+    std::optional<int> decision;
+    if (fit) {
+      const auto d = decode(fit->model, r, number, number, pipeline);
+      if (d.count(number)) decision = d.at(number);
+    }
+    const bool right = decision && *decision == r.target.at(number);
+    if (k >= from) {
+      ++o.online_made;
+      o.online_right += right;
+    }
+    const bool sent = decision && fit && trust.trusted;
+    if (sent) {
+      ++o.arm_sent;
+      o.arm_wrong += !right;
+      if (!o.first_trusted) o.first_trusted = k;
+      t += time.trial_s;
+      if (right && o.first_right_s < 0.0) o.first_right_s = t;
+    } else {
+      t += time.learning_trial_s;
+    }
+    // The session fits again with this selection in.
+    const auto [recording, numbers] = part(r, calibration + 1, number, false);
+    try {
+      bci::LearnedSelections next =
+          bci::learnFromUse(recording, numbers, {}, before, pipeline, training);
+      trust = bci::judgeTrust(next, before, rule);
+      before.clear();
+      for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
+      fit = std::move(next);
+    } catch (const std::exception&) {
+      // Too little to train on yet: the model before is kept (none at first).
+    }
+  }
+  if (fit) {
+    for (size_t i = 0; i < fit->numbers.size(); ++i) {
+      ++o.post_hoc_made;
+      o.post_hoc_right += fit->choice[i] + 1 == r.target.at(fit->numbers[i]);
+    }
+  }
+  return o;
+}
+
+void line(const char* what, const Outcome& o) {
+  std::printf(
+      "  %-10s online %2d/%-2d  arm %2d sent, %d wrong  post hoc %2d/%-2d  first trusted %2d"
+      "  first right placement %s\n",
+      what, o.online_right, o.online_made, o.arm_sent, o.arm_wrong, o.post_hoc_right,
+      o.post_hoc_made, o.first_trusted,
+      o.first_right_s < 0 ? "never"
+                          : (std::to_string(static_cast<int>(o.first_right_s)) + " s").c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"Learning from use against a calibration run, replayed on copy-task recordings"};
+  std::vector<std::string> files;
+  int calibration = 8, trials = 30, from = 11;
+  cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
+  cli.add_option("--calibration", calibration, "cued selections of the calibration run")
+      ->capture_default_str();
+  cli.add_option("--trials", trials, "trials after it")->capture_default_str();
+  cli.add_option("--from", from, "online accuracy counted from this trial on")
+      ->capture_default_str();
+  CLI11_PARSE(cli, argc, argv);
+  const session::SessionConfig config;
+  const bci::PipelineSettings pipeline =
+      bci::withMethodRate(config.classifier.pipeline, config.classifier.training.method);
+  const bci::TrustRule rule{config.paradigm.learning_min_selections,
+                            config.paradigm.learning_min_consistency};
+  const TimeModel time;
+  Outcome all_cal, all_none;
+  int faster = 0, compared = 0, wrong_more = 0;
+  for (const std::string& file : files) {
+    const Replay r = load(file);
+    if (static_cast<int>(r.target.size()) < calibration + trials) {
+      std::fprintf(stderr, "%s: %zu selections, fewer than %d\n", file.c_str(), r.target.size(),
+                   calibration + trials);
+      return 1;
+    }
+    const Outcome c =
+        calibrated(r, calibration, trials, from, pipeline, config.classifier.training, time);
+    const Outcome n =
+        learnt(r, calibration, trials, from, pipeline, config.classifier.training, rule, time);
+    std::printf("%s\n", file.c_str());
+    line("calibrated", c);
+    line("none", n);
+    std::fflush(stdout);
+    for (auto [total, one] : {std::pair{&all_cal, &c}, std::pair{&all_none, &n}}) {
+      total->online_made += one->online_made;
+      total->online_right += one->online_right;
+      total->arm_sent += one->arm_sent;
+      total->arm_wrong += one->arm_wrong;
+      total->post_hoc_made += one->post_hoc_made;
+      total->post_hoc_right += one->post_hoc_right;
+    }
+    wrong_more += n.arm_wrong > c.arm_wrong;
+    if (c.first_right_s >= 0.0) {
+      ++compared;
+      faster += n.first_right_s >= 0.0 && n.first_right_s <= c.first_right_s;
+    }
+  }
+  const auto rate = [](const char* what, int right, int made) {
+    const Interval ci = wilson(right, made);
+    std::printf("%-46s %4d/%-4d %.3f [%.3f, %.3f]\n", what, right, made,
+                made ? static_cast<double>(right) / made : 0.0, ci.low, ci.high);
+  };
+  std::printf("\nall %zu recordings\n", files.size());
+  rate("calibrated: online right (trials --from on)", all_cal.online_right, all_cal.online_made);
+  rate("none: online right (trials --from on)", all_none.online_right, all_none.online_made);
+  rate("calibrated: arm sent to a wrong object", all_cal.arm_wrong, all_cal.arm_sent);
+  rate("none: arm sent to a wrong object", all_none.arm_wrong, all_none.arm_sent);
+  rate("none: post hoc right (last fit)", all_none.post_hoc_right, all_none.post_hoc_made);
+  std::printf("recordings where none sent the arm wrong more often: %d\n", wrong_more);
+  std::printf("first right placement no later without calibration: %d of %d\n", faster, compared);
+  return 0;
+}
