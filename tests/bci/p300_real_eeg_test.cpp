@@ -178,6 +178,10 @@ TEST(P300RealEegUnsupervised, RecordingsWithoutLabelsSpellWhatWasCopied) {
     spelled += data.layout.symbols.at(static_cast<size_t>(choice));
   EXPECT_EQ(spelled, "T3OF6MK?");
   EXPECT_GE(report.fit.agreeing, 2);
+  // What an online session would trust it by: a response beyond every fit of the shuffled codes,
+  // found again without each selection.
+  EXPECT_EQ(report.fit.beats_shuffled, 9);
+  EXPECT_GE(report.fit.consistency, 0.8);
 }
 
 }  // namespace
