@@ -9,6 +9,7 @@
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
 #include "arbci/bci/settings.h"
+#include "arbci/session/settings_schema.h"
 #include "commands/commands.h"
 #include "eeg/simulated_recording.h"
 #include "support/cli_error.h"
@@ -191,11 +192,9 @@ void addEegCommand(CLI::App& root, int& exit_code) {
   sim->add_option("--alpha-hz", s.alpha_hz, "alpha peak frequency")
       ->capture_default_str()
       ->check(CLI::Range(6.0, 14.0));
-  sim->add_option("--erp-scale", s.erp_scale,
-                  "the subject's N2 and P3 amplitudes scaled (0.5: a responder at half the drawn "
-                  "amplitude, as the session's eeg.erp_scale)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+  schemaOption(*sim, "--erp-scale", s.erp_scale,
+               *session::sessionSchema().find("eeg")->table->find("erp_scale"),
+               "its N2 too; 0.5: half the drawn amplitude");
   sim->add_flag("--paced", s.paced,
                 "run in real time (as a live session would) instead of as fast as possible");
   sim->callback([options, &exit_code] {

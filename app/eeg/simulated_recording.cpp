@@ -12,6 +12,7 @@
 #include "arbci/bci/recording_writer.h"
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
+#include "arbci/session/session_config.h"
 #include "support/cli_error.h"
 #include "support/name_list.h"
 
@@ -82,6 +83,7 @@ SimulationOptions::SimulationOptions() {
   isi_ms = paradigm.isi_ms;
   line_hz = subject.line_hz;
   alpha_hz = subject.alpha_hz;
+  erp_scale = session::EegSettings().erp_scale;
 }
 
 SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& progress) {

@@ -25,7 +25,7 @@ struct SimulationOptions {
   double line_hz;
   double alpha_hz;
   bool paced = false;
-  double erp_scale = 1.0;  // the subject's N2/P3 amplitudes scaled (a weaker responder below 1)
+  double erp_scale;  // the subject's N2/P3 amplitudes scaled (a weaker responder below 1)
 };
 
 struct SimulationSummary {
