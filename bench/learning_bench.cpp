@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <map>
 
+#include "arbci/bci/intervals.h"
 #include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/recording.h"
@@ -23,18 +24,6 @@
 using namespace arbci;
 
 namespace {
-
-struct Interval {
-  double low, high;
-};
-
-Interval wilson(int right, int n) {
-  if (n == 0) return {0.0, 1.0};
-  const double z = 1.959964, p = static_cast<double>(right) / n;
-  const double centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
-  const double half = z * std::sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / (1.0 + z * z / n);
-  return {centre - half, centre + half};
-}
 
 // Seconds of the default session (paradigm defaults, 4 objects), as a headless default session
 // measured them: a cued calibration selection (cue, 8 sequences of 4 flashes, pause; the first
@@ -238,7 +227,7 @@ int main(int argc, char** argv) {
     }
   }
   const auto rate = [](const char* what, int right, int made) {
-    const Interval ci = wilson(right, made);
+    const bci::Interval ci = bci::wilsonInterval(right, made);
     std::printf("%-46s %4d/%-4d %.3f [%.3f, %.3f]\n", what, right, made,
                 made ? static_cast<double>(right) / made : 0.0, ci.low, ci.high);
   };

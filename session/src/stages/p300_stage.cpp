@@ -101,7 +101,7 @@ void P300Stage::startSelection(const SelectionStart& selection) {
   if (model_) accumulator_.emplace(selection.layout, model_->score_model);
 }
 
-void P300Stage::startTraining(const std::string& method) {
+bci::Recording P300Stage::keptSignal() const {
   // A copy, channel-major as a recording holds its samples: the cycle keeps recording meanwhile.
   bci::Recording recording = calibration_;
   const int channels = settings_.info.channelCount();
@@ -112,6 +112,11 @@ void P300Stage::startTraining(const std::string& method) {
           calibration_.data[static_cast<size_t>(s * channels + c)];
     }
   }
+  return recording;
+}
+
+void P300Stage::startTraining(const std::string& method) {
+  bci::Recording recording = keptSignal();
   bci::TrainingSettings training = settings_.training;
   training.method = method;
   std::vector<int> trained_on = calibration_selection_;
@@ -148,24 +153,16 @@ void P300Stage::takeTraining(Cycle& cycle) {
 }
 
 void P300Stage::startRefit() {
-  // As startTraining: a channel-major copy, fitted below the cycle's priority. The selections
-  // complete so far only (not one under way).
+  // As startTraining, fitted below the cycle's priority: the selections complete so far only
+  // (not one under way).
   fitted_ = complete_;
-  bci::Recording recording = calibration_;
+  bci::Recording recording = keptSignal();
   recording.stimuli.clear();
   std::vector<int> numbers;
   for (size_t i = 0; i < calibration_.stimuli.size(); ++i) {
     if (calibration_selection_[i] > fitted_) continue;
     recording.stimuli.push_back(calibration_.stimuli[i]);
     numbers.push_back(calibration_selection_[i]);
-  }
-  const int channels = settings_.info.channelCount();
-  recording.data.assign(calibration_.data.size(), 0.0f);
-  for (std::int64_t s = 0; s < calibration_.samples; ++s) {
-    for (int c = 0; c < channels; ++c) {
-      recording.data[static_cast<size_t>(c * calibration_.samples + s)] =
-          calibration_.data[static_cast<size_t>(s * channels + c)];
-    }
   }
   bci::TrainingSettings training = settings_.training;
   training.method = model_ ? model_->method : settings_.training.method;

@@ -70,6 +70,7 @@ class P300Stage final : public Stage {
   void setModel(const bci::P300Model& model, double time_s, bool calibrated = false);
   void recalibrate();
   void startSelection(const SelectionStart& selection);
+  bci::Recording keptSignal() const;  // the kept signal and flashes, channel-major
   void startTraining(const std::string& method);
   void takeTraining(Cycle& cycle);
   void process(const bci::Block& eeg, double time_s);
