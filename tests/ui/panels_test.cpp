@@ -277,6 +277,35 @@ TEST_F(Panels, TheSessionPanelOffersWhatThePhaseAllowsAndSaysWhyNotTheRest) {
   EXPECT_EQ(d.widgets.at("Start").why_disabled, "the session has started");
 }
 
+// Pixels of about this colour (RGBA image) in the drawn panel.
+int pixelsNear(const cv::Mat& image, int r, int g, int b) {
+  int n = 0;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const cv::Vec4b p = image.at<cv::Vec4b>(y, x);
+      n += std::abs(p[0] - r) < 25 && std::abs(p[1] - g) < 25 && std::abs(p[2] - b) < 25;
+    }
+  return n;
+}
+
+TEST_F(Panels, TheSessionPanelSaysWhatLearningFromUseWaitsForAndWhenTheArmMoves) {
+  auto panel = make("session");
+  const int amber_before = pixelsNear(draw(*panel).image, 255, 204, 89);
+  session::LearningState learning;
+  learning.selections = 4;
+  learning.fits = 2;
+  learning.waiting_for = "1 more selection";
+  EXPECT_EQ(learning.line(),
+            "learning: 4 selections, not yet moving the arm; waiting for 1 more selection");
+  bench_.record.p300.learning = std::make_shared<const session::LearningState>(learning);
+  EXPECT_GT(pixelsNear(draw(*panel).image, 255, 204, 89), amber_before + 50);  // amber: held
+  learning.trusted = true;
+  learning.waiting_for.clear();
+  EXPECT_EQ(learning.line(), "learning: 4 selections, the model trusted: the arm moves");
+  bench_.record.p300.learning = std::make_shared<const session::LearningState>(learning);
+  EXPECT_GT(pixelsNear(draw(*panel).image, 128, 230, 128), 50);  // green: trusted
+}
+
 TEST_F(Panels, TheSessionPanelsButtonsPostTheirRequests) {
   auto panel = make("session");
   Drawer drawer(*context_, *panel);
