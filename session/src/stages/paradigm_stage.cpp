@@ -435,13 +435,13 @@ void ParadigmStage::report(nlohmann::json& summary) const {
     const TrialRecord& t = all[i];
     held += t.arm_held;
     wrong_arm += t.robot_object && *t.robot_object != t.intended_object;
-    if (t.selections.empty() || !t.selections.front().object) continue;
-    ++made;
-    online_right += t.selections.front().object_id == t.intended_object;
-    if (t.post_hoc_object) {
+    if (t.post_hoc_object) {  // every selection the last fit decoded, one without a model too
       ++post_hoc_made;
       post_hoc_right += *t.post_hoc_object == t.intended_object;
     }
+    if (t.selections.empty() || !t.selections.front().object) continue;
+    ++made;
+    online_right += t.selections.front().object_id == t.intended_object;
     if (learning_seen_->adapting && 2 * i >= all.size() && t.post_hoc_object && t.frozen_object) {
       ++half_made;
       half_post_hoc += *t.post_hoc_object == t.intended_object;
