@@ -37,8 +37,11 @@ class FlashDriver {
   // One selection of `sequences` sequences (each code once per sequence, in random order) with
   // `target` attended; `cued`: a calibration selection (its target announced); `retake_of`: it
   // replaces an interrupted one. Runs `tail_s` more after the last flash (for its epoch).
+  // `labelled`: the code the flashes are labelled as attended, when not `target` (a wrong label,
+  // for a stage that must not read them).
   void selection(session::Stage& stage, int number, int target, bool cued, int sequences,
-                 std::optional<int> retake_of = std::nullopt, double tail_s = 1.0) {
+                 std::optional<int> retake_of = std::nullopt, double tail_s = 1.0,
+                 std::optional<int> labelled = std::nullopt) {
     session::SelectionStart start{number,
                                   true,
                                   bci::ParadigmLayout::single(stimuli_, 11.0 / 60.0),
@@ -58,7 +61,7 @@ class FlashDriver {
     for (size_t f = 0; f < order.size() * 11 + static_cast<size_t>(tail); ++f) {
       if (f % 11 == 0 && f / 11 < order.size()) {
         const int code = order[f / 11];
-        flash(number, code, code == target);
+        flash(number, code, code == labelled.value_or(target));
       }
       step(stage);
     }

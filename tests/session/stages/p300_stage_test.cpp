@@ -1,7 +1,8 @@
 // The P300 stage on hand-built records with a simulated subject's EEG: the calibration run's
 // cued flashes kept and trained on when asked (a retaken selection left out), the next selection
 // scored and decided by the model trained, epochs that touch lost samples discarded, and a model
-// that does not fit the channels refused with the reason.
+// that does not fit the channels refused with the reason; without a calibration run, the online
+// selections learnt from without their labels.
 #include <gtest/gtest.h>
 
 #include "arbci/bci/settings.h"
@@ -59,6 +60,37 @@ TEST_F(P300StageTest, TheCalibrationIsTrainedOnWhenAskedAndTheModelDecidesTheNex
   EXPECT_EQ(online.sequences, 8);
   EXPECT_EQ(online.decision.codes, std::set<int>{3});
   EXPECT_GT(online.decision.certainty, 0.5);
+}
+
+TEST(P300StageLearning, WithoutACalibrationRunItLearnsFromTheSelectionsNotTheirLabels) {
+  // Online selections only, each flash labelled with the wrong object: the stage fits after each
+  // selection and its post-hoc decodings are what the subject attended, not what the labels say.
+  test::StageBench bench("p300_learning");
+  test::FlashDriver eeg(bench, 4);
+  P300Settings settings = settingsFor(eeg.info());
+  settings.learn = true;
+  P300Stage stage(settings, bench.services());
+  const int attended[] = {2, 4, 1, 3, 3, 1, 4, 2, 1, 2};
+  for (int n = 1; n <= 10; ++n)
+    eeg.selection(stage, n, attended[n - 1], false, 8, std::nullopt, 1.0, attended[n - 1] % 4 + 1);
+  ASSERT_NE(bench.previous.p300.learning, nullptr);
+  EXPECT_FALSE(bench.previous.p300.learning->adapting);
+  EXPECT_NE(bench.previous.p300.model, nullptr);  // the fits' model decides meanwhile
+  session::Cycle closing = bench.cycle();
+  stage.stop(closing, "finished");  // the last fit, with the last selection in
+  const auto& learning = bench.record.p300.learning;
+  ASSERT_NE(learning, nullptr);
+  EXPECT_TRUE(learning->error.empty()) << learning->error;
+  EXPECT_GE(learning->fits, 8);
+  ASSERT_EQ(learning->post_hoc.size(), 10u);
+  int right = 0, as_labelled = 0;
+  for (const auto& [number, code] : learning->post_hoc) {
+    right += code == attended[number - 1];
+    as_labelled += code == attended[number - 1] % 4 + 1;
+  }
+  EXPECT_GE(right, 9);
+  EXPECT_LE(as_labelled, 1);
+  EXPECT_EQ(bench.logged("learning_fit").size(), static_cast<size_t>(learning->fits));
 }
 
 TEST_F(P300StageTest, RecalibrateAtTheReviewTrainsOnTheNewRunAlone) {
