@@ -38,6 +38,8 @@ struct TimeModel {
 };
 
 struct Outcome {
+  // Per trial k (0-based): decided right online; the arm trusted to go.
+  std::vector<bool> right_at, trusted_at;
   int online_made = 0, online_right = 0;  // trials --from on
   int arm_sent = 0, arm_wrong = 0;
   int post_hoc_right = 0, post_hoc_made = 0;
@@ -102,6 +104,8 @@ Outcome calibrated(const Replay& r, int calibration, int trials, int from,
     const int number = calibration + k;
     const auto d = decided.find(number);
     const bool right = d != decided.end() && d->second == r.target.at(number);
+    o.right_at.push_back(right);
+    o.trusted_at.push_back(true);
     if (k >= from) {
       ++o.online_made;
       o.online_right += right;
@@ -135,6 +139,8 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       o.online_right += right;
     }
     const bool sent = decision && fit && trust.trusted;
+    o.right_at.push_back(right);
+    o.trusted_at.push_back(fit && trust.trusted);
     if (sent) {
       ++o.arm_sent;
       o.arm_wrong += !right;
@@ -196,6 +202,8 @@ int main(int argc, char** argv) {
                             config.paradigm.learning_min_consistency};
   const TimeModel time;
   Outcome all_cal, all_none;
+  std::vector<int> cal_right(static_cast<size_t>(trials)), none_right(cal_right),
+      none_trusted(cal_right);
   int faster = 0, compared = 0, wrong_more = 0;
   for (const std::string& file : files) {
     const Replay r = load(file);
@@ -220,6 +228,11 @@ int main(int argc, char** argv) {
       total->post_hoc_made += one->post_hoc_made;
       total->post_hoc_right += one->post_hoc_right;
     }
+    for (size_t k = 0; k < static_cast<size_t>(trials); ++k) {
+      cal_right[k] += c.right_at[k];
+      none_right[k] += n.right_at[k];
+      none_trusted[k] += n.trusted_at[k];
+    }
     wrong_more += n.arm_wrong > c.arm_wrong;
     if (c.first_right_s >= 0.0) {
       ++compared;
@@ -238,6 +251,14 @@ int main(int argc, char** argv) {
   rate("none: arm sent to a wrong object", all_none.arm_wrong, all_none.arm_sent);
   rate("none: post hoc right (last fit)", all_none.post_hoc_right, all_none.post_hoc_made);
   std::printf("recordings where none sent the arm wrong more often: %d\n", wrong_more);
+  // The learning curve: trial k decided right online, in how many recordings, and in how many the
+  // arm was trusted to go.
+  std::printf(
+      "\nlearning curve (of %zu recordings)\ntrial  calibrated right  none right  none trusted\n",
+      files.size());
+  for (int k = 0; k < trials; ++k)
+    std::printf("%5d  %16d  %10d  %12d\n", k + 1, cal_right[static_cast<size_t>(k)],
+                none_right[static_cast<size_t>(k)], none_trusted[static_cast<size_t>(k)]);
   std::printf("first right placement no later without calibration: %d of %d\n", faster, compared);
   return 0;
 }
