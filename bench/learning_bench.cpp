@@ -25,11 +25,11 @@ using namespace arbci;
 
 namespace {
 
-// Seconds of the default session (paradigm defaults, 4 objects), as a headless default session
-// measured them: a cued calibration selection (cue, 8 sequences of 4 flashes, pause; the first
-// trial began 73.3 s after the first cue, training included), a learning trial (its selection, the
-// result shown, the pause) and a whole trial with the arm (both selections with dynamic stopping,
-// results, grasp and put-down at the simulated arm's default speed).
+// Seconds of the default session (paradigm defaults, 4 objects) as a headless default session
+// takes them: a cued calibration selection (cue, 8 sequences of 4 flashes, pause; training
+// included), a learning trial (its selection, the result shown, the pause) and a whole trial with
+// the arm (both selections with dynamic stopping, results, grasp and put-down at the simulated
+// arm's default speed). Measure them again from a session's log when the defaults change.
 struct TimeModel {
   double calibration_selection_s = 8.9;
   double training_s = 0.0;  // within the above

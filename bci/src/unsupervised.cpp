@@ -13,7 +13,7 @@
 namespace arbci::bci {
 namespace {
 
-// Decodings whose held-out consistency is measured: the most likely distinct ones.
+// Decodings whose leave-one-out consistency is measured: the most likely distinct ones.
 constexpr size_t kCandidates = 3;
 
 struct Problem {
@@ -257,7 +257,7 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
     warm = true;
   }
   if (warm) starts.push_back(runStart(pr, covariance, random, options.max_iterations, &initial));
-  // The held-out self-consistency of a decoding: each selection left out, the rest fitted again
+  // The leave-one-out consistency of a decoding: each selection left out, the rest fitted again
   // from new starts, and the left-out one decoded by that fit. The P300 generalises from selection
   // to selection, so a fit that found it finds it again without any one selection, and decodes
   // that one as the whole fit does; a labelling of noise (with few selections and many features,
@@ -274,9 +274,9 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
     return static_cast<double>(same) / static_cast<double>(pr.rows.size());
   };
   // The candidates: the most likely starts (the labels that explain most of the data's variance)
-  // and the warm one. With held-out measures, the one that generalises best is kept (the most
-  // likely of those alike): the mirror solution (each selection's least P300-like stimulus as its
-  // target) or a labelling of noise can explain much variance, but neither generalises.
+  // and the warm one. With the leave-one-out measures, the one that generalises best is kept (the
+  // most likely of those alike): the mirror solution (each selection's least P300-like stimulus as
+  // its target) or a labelling of noise can explain much variance, but neither generalises.
   std::vector<size_t> order(starts.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(),

@@ -1,4 +1,4 @@
-// Whether the arm may act on a model learnt from use: enough selections, a held-out consistency
+// Whether the arm may act on a model learnt from use: enough selections, a leave-one-out consistency
 // at least the minimum, and a decoding of the earlier selections that the new fit kept; what is
 // missing is said in words.
 #include <gtest/gtest.h>

@@ -61,7 +61,7 @@ struct TrustRule {
 // with the attended stimulus (the fit explains more variance than every fit with the codes
 // shuffled); that response positive at the parietal sites (the P300, not its mirror: each
 // selection's least P300-like stimulus taken as its target, a solution EM can settle on that
-// beats the shuffles too); a held-out self-consistency of at least the minimum (the response
+// beats the shuffles too); a leave-one-out consistency of at least the minimum (the response
 // generalises from selection to selection); and its decoding of the selections the last fit knew
 // unchanged (but for a tenth of them, rounded down). A fit that changed its mind about earlier
 // selections has not settled: the arm waits, and `changed` names them.

@@ -49,7 +49,7 @@ struct ParadigmSettings {
   // "none": the trials start at once and the classifier learns from them without labels
   // (docs/classification.md, "Learning from use"). While it learns, the arm is not sent: each
   // trial is an object selection only, until the model is trusted: `learning_min_selections`
-  // selections learnt from, a held-out self-consistency of at least `learning_min_consistency`
+  // selections learnt from, a leave-one-out consistency of at least `learning_min_consistency`
   // (bci/unsupervised.h), and its decoding of the earlier selections unchanged since the last fit
   // (but for a tenth of them).
   std::string calibration;

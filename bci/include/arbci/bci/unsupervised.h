@@ -33,7 +33,7 @@ struct UnsupervisedOptions {
   int shuffles = 9;
   // A decoding to start from as well (an earlier fit's: selection index -> choice).
   std::map<int, int> initial;
-  // Measure the fit's held-out self-consistency (UnsupervisedFit::consistency): a fit again
+  // Measure the fit's leave-one-out consistency (UnsupervisedFit::consistency): a fit again
   // without each selection in turn, so as many fits as selections more.
   bool held_out = true;
 };
@@ -47,7 +47,7 @@ struct UnsupervisedFit {
   // selections, rounded down: on fewer than ten, on none).
   int restarts = 0, agreeing = 0;
   int iterations = 0;  // the kept start's
-  // Its held-out self-consistency: the share of the selections that the same fit without them
+  // Its leave-one-out consistency: the share of the selections that the same fit without them
   // (from new starts) decodes as this fit does; chance is about one over the choices. The measure
   // of trust (0 unless UnsupervisedOptions::held_out). The starts agreeing count the warm one.
   double consistency = 0.0;
