@@ -436,10 +436,20 @@ void train(TrainOptions& o, const CLI::App& command) {
     if (o.unsupervised) {
       // Beside the averages by the recordings' labels (where they carry them): by the labels
       // found, the ERP the model learnt.
-      printPlots(writeP300Plots(std::filesystem::path(o.plots) / "labels-found", found_erp,
-                                result.cross_validation.report,
-                                "labels found without labels, " + o.training.method, {},
-                                o.scalp.time()));
+      // Its accuracy figure would score the model against the labels it was trained to find
+      // (agreement, not accuracy): only the averages and the scalp map are kept.
+      std::vector<std::filesystem::path> written_found;
+      for (const auto& path : writeP300Plots(std::filesystem::path(o.plots) / "labels-found",
+                                             found_erp, result.cross_validation.report,
+                                             "labels found without labels, " + o.training.method,
+                                             {}, o.scalp.time())) {
+        if (path.filename() == "accuracy.png") {
+          std::filesystem::remove(path);
+        } else {
+          written_found.push_back(path);
+        }
+      }
+      printPlots(written_found);
     }
   }
   std::cout << "model: " << o.out << "\n";
