@@ -35,6 +35,9 @@ struct TimeModel {
   double training_s = 0.0;  // within the above
   double learning_trial_s = 8.5;
   double trial_s = 29.5;
+  // A held selection that the fit with it in trusted and decoded as shown goes on to the arm: a
+  // whole trial whose object selection ran all its sequences and waited for that fit.
+  double held_then_sent_s = 32.5;
 };
 
 struct Outcome {
@@ -48,6 +51,7 @@ struct Outcome {
 };
 
 struct Replay {
+  int seed = 0;  // the file's index, for the trace
   bci::Recording recording;
   std::vector<int> number;    // each stimulus's selection (1-based)
   std::map<int, int> target;  // selection -> attended code
@@ -120,7 +124,7 @@ Outcome calibrated(const Replay& r, int calibration, int trials, int from,
 
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
-               const bci::TrustRule& rule, const TimeModel& time) {
+               const bci::TrustRule& rule, const TimeModel& time, std::FILE* trace) {
   Outcome o;
   std::optional<bci::LearnedSelections> fit;
   bci::Trust trust;
@@ -156,6 +160,21 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       bci::LearnedSelections next =
           bci::learnFromUse(recording, numbers, {}, before, pipeline, training);
       trust = bci::judgeTrust(next, before, rule);
+      if (!sent && decision && trust.trusted && !next.numbers.empty() &&
+          next.numbers.back() == number && next.choice.back() + 1 == *decision) {
+        // The held selection acts after all (bci::Paradigm::judgeHeldSelection).
+        ++o.arm_sent;
+        o.arm_wrong += !right;
+        if (!o.first_trusted) o.first_trusted = k;
+        o.trusted_at.back() = true;
+        t += time.held_then_sent_s - time.learning_trial_s;
+        if (right && o.first_right_s < 0.0) o.first_right_s = t;
+      }
+      if (trace)
+        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d\n", r.seed, k,
+                     decision ? *decision : 0, r.target.at(number), next.numbers.size(),
+                     next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
+                     trust.changed.size(), trust.trusted);
       before.clear();
       for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
       fit = std::move(next);
@@ -188,13 +207,19 @@ int main(int argc, char** argv) {
   CLI::App cli{"Learning from use against a calibration run, replayed on copy-task recordings"};
   std::vector<std::string> files;
   int calibration = 8, trials = 30, from = 11;
+  std::string trace_file;
   cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
   cli.add_option("--calibration", calibration, "cued selections of the calibration run")
       ->capture_default_str();
   cli.add_option("--trials", trials, "trials after it")->capture_default_str();
   cli.add_option("--from", from, "online accuracy counted from this trial on")
       ->capture_default_str();
+  cli.add_option("--trace", trace_file,
+                 "write per trial of the learning condition: file index, trial, decision, "
+                 "target, selections fitted, consistency, shuffles beaten, p3 uV, changed, "
+                 "trusted (after the fit with that trial in)");
   CLI11_PARSE(cli, argc, argv);
+  std::FILE* trace = trace_file.empty() ? nullptr : std::fopen(trace_file.c_str(), "w");
   const session::SessionConfig config;
   const bci::PipelineSettings pipeline =
       bci::withMethodRate(config.classifier.pipeline, config.classifier.training.method);
@@ -206,7 +231,8 @@ int main(int argc, char** argv) {
       none_trusted(cal_right);
   int faster = 0, compared = 0, wrong_more = 0;
   for (const std::string& file : files) {
-    const Replay r = load(file);
+    Replay r = load(file);
+    r.seed = static_cast<int>(&file - files.data());
     if (static_cast<int>(r.target.size()) < calibration + trials) {
       std::fprintf(stderr, "%s: %zu selections, fewer than %d\n", file.c_str(), r.target.size(),
                    calibration + trials);
@@ -214,8 +240,14 @@ int main(int argc, char** argv) {
     }
     const Outcome c =
         calibrated(r, calibration, trials, from, pipeline, config.classifier.training, time);
-    const Outcome n =
-        learnt(r, calibration, trials, from, pipeline, config.classifier.training, rule, time);
+    const Outcome n = learnt(r, calibration, trials, from, pipeline, config.classifier.training,
+                             rule, time, trace);
+    if (trace) {
+      std::fprintf(trace, "calibrated,%d,", r.seed);
+      for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
+      std::fputc('\n', trace);
+      std::fflush(trace);
+    }
     std::printf("%s\n", file.c_str());
     line("calibrated", c);
     line("none", n);
@@ -260,5 +292,6 @@ int main(int argc, char** argv) {
     std::printf("%5d  %16d  %10d  %12d\n", k + 1, cal_right[static_cast<size_t>(k)],
                 none_right[static_cast<size_t>(k)], none_trusted[static_cast<size_t>(k)]);
   std::printf("first right placement no later without calibration: %d of %d\n", faster, compared);
+  if (trace) std::fclose(trace);
   return 0;
 }

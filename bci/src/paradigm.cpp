@@ -247,8 +247,14 @@ void Paradigm::advanceTimedPhase(double due_s) {
         showSelection(d.runner_up_codes, d.runner_up_choice, runnerUpCertainty(d),
                       phase_ == Phase::ObjectSelected, "runner-up");
       } else if (!verdict_pending_ && phase_ == Phase::ObjectSelected && held_now_) {
+        if (held_fit_pending_) break;  // shown until the fit with it in comes back
         held_now_ = false;
-        nextTrial(now_ + settings_.pause_s, held_why_);
+        if (held_act_) {
+          held_act_ = false;
+          askRobot(Phase::Grasping);
+        } else {
+          nextTrial(now_ + settings_.pause_s, held_why_);
+        }
       } else if (!verdict_pending_) {
         askRobot(phase_ == Phase::ObjectSelected ? Phase::Grasping : Phase::Dropping);
       }
@@ -385,6 +391,7 @@ void Paradigm::showSelection(const std::set<int>& codes, int choice, double cert
   if (objects) {
     held_now_ = hold_arm_;
     held_why_ = hold_why_;
+    held_fit_pending_ = held_act_ = false;
     selected_object_ = choice + 1;
     made.object = *selected_object_;
     event(made);
@@ -467,6 +474,11 @@ void Paradigm::modelTrained(bool ok, const std::string& text) {
 void Paradigm::holdArm(bool held, const std::string& why) {
   hold_arm_ = held;
   hold_why_ = why;
+}
+
+void Paradigm::judgeHeldSelection(bool pending, bool act) {
+  held_fit_pending_ = pending;
+  held_act_ = act;
 }
 
 void Paradigm::recalibrate() {

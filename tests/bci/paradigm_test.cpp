@@ -230,6 +230,42 @@ TEST(Paradigm, WhileTheArmIsHeldASelectionEndsItsTrialWithoutTheRobot) {
   EXPECT_EQ(p.phase(), Phase::Grasping);
 }
 
+TEST(Paradigm, AHeldSelectionWaitsForItsFitAndGoesToTheArmWhenThatFitTrustsIt) {
+  ParadigmSettings settings = fast();
+  settings.trials = 3;
+  Paradigm p(settings, 4, 3, 3, 3);
+  std::int64_t frame = 0;
+  p.holdArm(true, "learning");
+  p.start(false);
+  const auto grasps = [](const std::vector<ParadigmEvent>& list) {
+    return std::count_if(list.begin(), list.end(),
+                         [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; });
+  };
+  // Trial 1: its fit is running; the selection stays shown well past result_s, then the fit
+  // comes back not trusted and the trial ends held.
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(1, {2}));
+  p.judgeHeldSelection(true, false);
+  const std::int64_t shown_from = frame;
+  auto events = runUntil(p, frame, [&] { return frame >= shown_from + 200; });
+  EXPECT_EQ(p.phase(), Phase::ObjectSelected);
+  EXPECT_EQ(p.trial(), 1);
+  p.judgeHeldSelection(false, false);
+  events = runUntil(p, frame, [&] { return p.trial() == 2; });
+  EXPECT_EQ(grasps(events), 0);
+  // Trial 2: the fit with it in is trusted and decodes it as shown: it goes on to the arm.
+  runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  p.decide(choose(2, {3}));
+  p.judgeHeldSelection(true, false);
+  const std::int64_t second_from = frame;
+  runUntil(p, frame, [&] { return frame >= second_from + 200; });
+  EXPECT_EQ(p.phase(), Phase::ObjectSelected);
+  p.judgeHeldSelection(false, true);
+  events = runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
+  EXPECT_EQ(grasps(events), 1);
+  EXPECT_EQ(p.trial(), 2);
+}
+
 TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {
   ParadigmSettings s = fast();
   s.sequences = 10;

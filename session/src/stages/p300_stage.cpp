@@ -189,6 +189,7 @@ void P300Stage::startRefit() {
 void P300Stage::takeRefit(Cycle& cycle) {
   if (!refit_.valid() || !cycle.clock.ready(refit_)) return;
   state_.fitting = false;
+  state_.fitted_through = fitted_;
   try {
     LearningOutcome outcome = refit_.get();
     bci::LearnedSelections& fit = outcome.fit;
@@ -353,10 +354,16 @@ void P300Stage::step(Cycle& cycle) {
   if (learns()) {
     // An object selection decided (its epochs all scored): fit it in with the rest.
     if (current_learnable_ && cycle.previous.paradigm.phase == bci::Phase::ObjectSelected &&
-        presented_ > 0 && scored_ >= presented_)
+        presented_ > 0 && scored_ >= presented_ && complete_ != selection_) {
       complete_ = selection_;
+      state_.awaited_through = complete_;
+      published_ = std::make_shared<const LearningState>(state_);
+    }
     takeRefit(cycle);
-    if (complete_ > fitted_ && !refit_.valid()) startRefit();
+    if (complete_ > fitted_ && !refit_.valid()) {
+      startRefit();
+      published_ = std::make_shared<const LearningState>(state_);
+    }
     cycle.record.p300.learning = published_;
   }
 

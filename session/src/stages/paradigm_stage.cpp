@@ -395,6 +395,7 @@ void ParadigmStage::followLearning(const Cycle& cycle) {
   if (settings_.learns) {
     const bool held = armHeld(cycle);
     paradigm_.holdArm(held, held ? std::string(kArmHeld) : "");
+    judgeHeldSelection(cycle);
   }
   if (!learning || learning == learning_seen_) return;
   learning_seen_ = learning;
@@ -412,6 +413,19 @@ void ParadigmStage::followLearning(const Cycle& cycle) {
     trial->post_hoc_object = object(learning->post_hoc, number);
     if (learning->adapting) trial->frozen_object = object(learning->frozen, number);
   }
+}
+
+void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
+  const auto& learning = cycle.record.p300.learning;
+  if (paradigm_.phase() != bci::Phase::ObjectSelected || !learning || !selection_objects_) return;
+  // The held selection shown now (selection_) is being fitted in with the rest, or will be.
+  const bool pending =
+      learning->awaited_through >= selection_ && learning->fitted_through < selection_;
+  const auto post_hoc = learning->post_hoc.find(selection_);
+  const bool act = !pending && learning->fitted_through >= selection_ && learning->trusted &&
+                   post_hoc != learning->post_hoc.end() &&
+                   stimulus_.selected_object == post_hoc->second;
+  paradigm_.judgeHeldSelection(pending, act);
 }
 
 void ParadigmStage::stop(Cycle& cycle, const std::string& /*reason*/) {

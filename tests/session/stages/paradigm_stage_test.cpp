@@ -64,7 +64,7 @@ class ParadigmStageTest : public ::testing::Test {
             ParadigmStageSettings{config_.paradigm, config_.world, "slda", intendedTrials(config_),
                                   11, 0.5, bench_.folder() / "model.json", experimenter, 0.5,
                                   config_.gates.review && experimenter, config_.gates.min_auc,
-                                  config_.gates.max_retakes},
+                                  config_.gates.max_retakes, config_.learnsFromUse()},
             bench_.services()) {}
 
   // The objects the cameras see now (all but `hidden`), at their places; the reference seen.
@@ -534,6 +534,67 @@ TEST_F(ParadigmStageTest, TheEmergencyStopPostsARobotStopAndEndSessionEndsWithTh
   cycle();
   EXPECT_EQ(bench_.previous.end_reason, "ended by the experimenter in: EMERGENCY STOP");
   EXPECT_EQ(bench_.previous.end_kind, "estop");
+}
+
+class LearningParadigmStageTest : public ParadigmStageTest {
+ protected:
+  static SessionConfig learning() {
+    SessionConfig c = shortSession();
+    c.paradigm.calibration = "none";
+    c.paradigm.trials = 2;
+    return c;
+  }
+  LearningParadigmStageTest() : ParadigmStageTest(learning()) {}
+  // The P300 stage's learning as the record carries it: a fit over selections up to `fitted`,
+  // one up to `awaited` running, the last fit's decodings and trust.
+  void learn(int fitted, int awaited, bool trusted, std::map<int, int> post_hoc) {
+    auto state = std::make_shared<LearningState>();
+    state->fitted_through = fitted;
+    state->awaited_through = awaited;
+    state->fitting = awaited > fitted;
+    state->trusted = trusted;
+    state->post_hoc = std::move(post_hoc);
+    learning_ = state;
+  }
+  void step() {
+    cycle([&](CycleRecord& r) { r.p300.learning = learning_; });
+  }
+  std::shared_ptr<const LearningState> learning_;
+};
+
+TEST_F(LearningParadigmStageTest, AHeldSelectionWaitsForItsFitAndActsOnlyIfThatFitTrustsItAsShown) {
+  model_ = trainedModel();  // the model of an earlier fit, not trusted
+  learn(0, 0, false, {});
+  begin();
+  ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectFlashing);
+  decide_ = 2;
+  for (int i = 0; i < 60 * 30 && bench_.previous.paradigm.phase != bci::Phase::ObjectSelected; ++i)
+    step();
+  ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectSelected);
+  const int first = selection_;
+  // Its fit is running: shown far past result_s.
+  learn(0, first, false, {});
+  for (int i = 0; i < 60 * 3; ++i) step();
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectSelected);
+  // Trusted, but decoding it as another object than was shown: the trial ends held.
+  learn(first, first, true, {{first, 3}});
+  for (int i = 0; i < 60 * 3 && bench_.previous.paradigm.trial == 1; ++i) step();
+  EXPECT_EQ(bench_.previous.paradigm.trial, 2);
+  EXPECT_TRUE(postedOf<GraspRequest>().empty());
+  // Trial 2: the fit with it in trusts it and decodes it as shown: the arm goes.
+  learn(first, first, false, {{first, 3}});
+  for (int i = 0; i < 60 * 30 && bench_.previous.paradigm.phase != bci::Phase::ObjectSelected; ++i)
+    step();
+  ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectSelected);
+  const int second = selection_;
+  learn(first, second, false, {{first, 3}});
+  step();
+  learn(second, second, true, {{first, 3}, {second, 2}});
+  for (int i = 0; i < 60 * 3 && bench_.previous.paradigm.phase != bci::Phase::Grasping; ++i) step();
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Grasping);
+  ASSERT_EQ(postedOf<GraspRequest>().size(), 1u);
+  EXPECT_EQ(postedOf<GraspRequest>()[0].object, config_.world.objects[1].id);
+  EXPECT_EQ(bench_.previous.paradigm.trial, 2);
 }
 
 class ErrpParadigmStageTest : public ParadigmStageTest {

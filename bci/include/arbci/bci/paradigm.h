@@ -200,6 +200,11 @@ class Paradigm {
   // ends there, the arm not sent (`why` is the trial's outcome); a selection decided without a
   // model (no choice) ends its trial at once. Read when a selection is made.
   void holdArm(bool held, const std::string& why);
+  // A held object selection is fitted in with the rest once shown: while that fit is `pending`
+  // the selection stays shown; when the fit came back trusted and decodes the selection as it was
+  // shown (`act`), its trial goes on to the arm after all, instead of ending held. The selection
+  // that earns the trust is not wasted. Read when the selection's showing ends.
+  void judgeHeldSelection(bool pending, bool act);
   // From Training (the experimenter's Recalibrate at the review): the calibration run again, from
   // its first selection (and its ErrP block, where there is one).
   void recalibrate();
@@ -301,6 +306,7 @@ class Paradigm {
   int corrections_ = 0;
   bool hold_arm_ = false, held_now_ = false;  // asked; latched for the selection shown
   std::string hold_why_, held_why_;
+  bool held_fit_pending_ = false, held_act_ = false;  // judgeHeldSelection's
   int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
   bool errp_block_ = false;      // the calibration run's ErrP feedback block
   std::vector<bool> errp_plan_;  // the block's feedbacks: true = deliberately wrong

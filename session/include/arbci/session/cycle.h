@@ -140,7 +140,10 @@ struct LearningState {
   std::map<int, int> frozen;    // adapting: the code the calibrated model decodes
   std::vector<int> changed;     // selections whose decoding the last fit changed
   bool fitting = false;         // a fit is running on its worker thread
-  std::string error;            // why the last fit failed (the model before it is kept)
+  // Selection numbers: the last fit taken (or failed) learnt from those up to `fitted_through`;
+  // one learning from those up to `awaited_through` is running or about to start.
+  int fitted_through = 0, awaited_through = 0;
+  std::string error;  // why the last fit failed (the model before it is kept)
   // "learning: 3 selections, not yet moving the arm; waiting for: 2 more selections".
   std::string line() const;
 };

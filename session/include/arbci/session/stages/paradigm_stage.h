@@ -111,6 +111,9 @@ class ParadigmStage final : public Stage {
   // post-hoc decoding (and, adapting, the calibrated model's) onto its trial.
   void followLearning(const Cycle& cycle);
   bool armHeld(const Cycle& cycle) const;
+  // A held object selection waits for the fit with it in; a trusted fit that decodes it as shown
+  // sends its trial on to the arm (bci::Paradigm::judgeHeldSelection).
+  void judgeHeldSelection(const Cycle& cycle);
 
   ParadigmStageSettings settings_;
   StageServices s_;
