@@ -122,6 +122,31 @@ Outcome calibrated(const Replay& r, int calibration, int trials, int from,
   return o;
 }
 
+// The ceiling of any learning without labels: before trial k, a model trained on trials 1..k-1
+// with their true labels (none before two). Per trial: decided right.
+std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials,
+                              const bci::PipelineSettings& pipeline,
+                              const bci::TrainingSettings& training) {
+  std::vector<bool> right_at;
+  for (int k = 1; k <= trials; ++k) {
+    const int number = calibration + k;
+    bool right = false;
+    if (k > 2) {
+      try {
+        const auto [recording, numbers] = part(r, calibration + 1, number - 1, true);
+        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+        const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
+        const auto d = decode(model, r, number, number, pipeline);
+        right = d.count(number) && d.at(number) == r.target.at(number);
+      } catch (const std::exception&) {
+        // Too little to train on.
+      }
+    }
+    right_at.push_back(right);
+  }
+  return right_at;
+}
+
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                const bci::TrustRule& rule, const TimeModel& time, std::FILE* trace) {
@@ -208,6 +233,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   int calibration = 8, trials = 30, from = 11;
   std::string trace_file;
+  bool ceiling_only = false;
   cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
   cli.add_option("--calibration", calibration, "cued selections of the calibration run")
       ->capture_default_str();
@@ -217,7 +243,11 @@ int main(int argc, char** argv) {
   cli.add_option("--trace", trace_file,
                  "write per trial of the learning condition: file index, trial, decision, "
                  "target, selections fitted, consistency, shuffles beaten, p3 uV, changed, "
-                 "trusted (after the fit with that trial in)");
+                 "trusted (after the fit with that trial in); and per file, each trial decided "
+                 "right by the calibrated model and by one trained on the trials before with "
+                 "their true labels (the ceiling of learning without them)");
+  cli.add_flag("--ceiling-only", ceiling_only,
+               "trace the calibrated model and the labels-known ceiling only (no learning: fast)");
   CLI11_PARSE(cli, argc, argv);
   std::FILE* trace = trace_file.empty() ? nullptr : std::fopen(trace_file.c_str(), "w");
   const session::SessionConfig config;
@@ -240,11 +270,16 @@ int main(int argc, char** argv) {
     }
     const Outcome c =
         calibrated(r, calibration, trials, from, pipeline, config.classifier.training, time);
-    const Outcome n = learnt(r, calibration, trials, from, pipeline, config.classifier.training,
-                             rule, time, trace);
+    // --ceiling-only: the learning condition skipped (reported as the calibrated one).
+    const Outcome n = ceiling_only ? c
+                                   : learnt(r, calibration, trials, from, pipeline,
+                                            config.classifier.training, rule, time, trace);
     if (trace) {
       std::fprintf(trace, "calibrated,%d,", r.seed);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
+      std::fprintf(trace, "\nknown,%d,", r.seed);
+      for (bool right : labelsKnown(r, calibration, trials, pipeline, config.classifier.training))
+        std::fputc(right ? '1' : '0', trace);
       std::fputc('\n', trace);
       std::fflush(trace);
     }

@@ -426,6 +426,7 @@ void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
                    post_hoc != learning->post_hoc.end() &&
                    stimulus_.selected_object == post_hoc->second;
   paradigm_.judgeHeldSelection(pending, act);
+  if (act && !first_trusted_trial_) first_trusted_trial_ = paradigm_.trial();
 }
 
 void ParadigmStage::stop(Cycle& cycle, const std::string& /*reason*/) {

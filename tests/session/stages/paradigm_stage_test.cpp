@@ -595,6 +595,10 @@ TEST_F(LearningParadigmStageTest, AHeldSelectionWaitsForItsFitAndActsOnlyIfThatF
   ASSERT_EQ(postedOf<GraspRequest>().size(), 1u);
   EXPECT_EQ(postedOf<GraspRequest>()[0].object, config_.world.objects[1].id);
   EXPECT_EQ(bench_.previous.paradigm.trial, 2);
+  nlohmann::json summary;
+  stage_.report(summary);
+  EXPECT_EQ(summary["learning"]["first_trusted_trial"], 2);
+  EXPECT_EQ(summary["learning"]["trials_arm_held"], 1);
 }
 
 class ErrpParadigmStageTest : public ParadigmStageTest {
