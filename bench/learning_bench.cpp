@@ -4,12 +4,14 @@
 // model trained on the calibration run decides every trial, and the arm goes every time. Learning
 // from use (paradigm.calibration none): the calibration run is not used; before trial k the model
 // is the one the session would hold (bci::learnFromUse over trials 1..k-1, their labels removed),
-// it decides trial k, and the arm goes only when bci::judgeTrust trusted that fit. Per file and in
+// it decides trial k, and the arm goes only when the fit with trial k in (1..k) is trusted
+// (bci::judgeTrust) and decodes trial k as it was decided, as the session does. Per file and in
 // all: object selections right online (trials 11 on, as the issue counts them), arm sent to a
 // wrong object, post-hoc accuracy of the last fit, and the time from Start to the first right
 // placement, estimated from the session's default timing (TimeModel below; the robot's time is the
 // same in both). The session's own classifier settings (SessionConfig's defaults) are used.
-// Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11]
+// Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
+//        [--ceiling-only]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -41,7 +43,7 @@ struct TimeModel {
 };
 
 struct Outcome {
-  // Per trial k (0-based): decided right online; the arm trusted to go.
+  // Per trial k (0-based): decided right online; the arm sent.
   std::vector<bool> right_at, trusted_at;
   int online_made = 0, online_right = 0;  // trials --from on
   int arm_sent = 0, arm_wrong = 0;
@@ -167,44 +169,40 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       ++o.online_made;
       o.online_right += right;
     }
-    const bool sent = decision && fit && trust.trusted;
     o.right_at.push_back(right);
-    o.trusted_at.push_back(fit && trust.trusted);
-    if (sent) {
-      ++o.arm_sent;
-      o.arm_wrong += !right;
-      if (!o.first_trusted) o.first_trusted = k;
-      t += time.trial_s;
-      if (right && o.first_right_s < 0.0) o.first_right_s = t;
-    } else {
-      t += time.learning_trial_s;
-    }
-    // The session fits again with this selection in.
+    // Trusted before it: its selection stopped early (dynamic stopping) like a calibrated trial's.
+    const bool trusted_before = fit && trust.trusted;
+    // The session fits again with this selection in; the arm acts on the selection only when that
+    // fit is trusted and decodes it as it was shown (bci::Paradigm::judgeHeldSelection).
+    bool sent = false;
     const auto [recording, numbers] = part(r, calibration + 1, number, false);
     try {
       bci::LearnedSelections next =
           bci::learnFromUse(recording, numbers, {}, before, pipeline, training);
       trust = bci::judgeTrust(next, before, rule);
-      if (!sent && decision && trust.trusted && !next.numbers.empty() &&
-          next.numbers.back() == number && next.choice.back() + 1 == *decision) {
-        // The held selection acts after all (bci::Paradigm::judgeHeldSelection).
-        ++o.arm_sent;
-        o.arm_wrong += !right;
-        if (!o.first_trusted) o.first_trusted = k;
-        o.trusted_at.back() = true;
-        t += time.held_then_sent_s - time.learning_trial_s;
-        if (right && o.first_right_s < 0.0) o.first_right_s = t;
-      }
+      const int fitted =
+          !next.numbers.empty() && next.numbers.back() == number ? next.choice.back() + 1 : 0;
+      sent = decision && trust.trusted && fitted == *decision;
       if (trace)
-        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d\n", r.seed, k,
+        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d\n", r.seed, k,
                      decision ? *decision : 0, r.target.at(number), next.numbers.size(),
                      next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
-                     trust.changed.size(), trust.trusted);
+                     trust.changed.size(), trust.trusted, fitted);
       before.clear();
       for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
       fit = std::move(next);
     } catch (const std::exception&) {
       // Too little to train on yet: the model before is kept (none at first).
+    }
+    o.trusted_at.push_back(sent);
+    if (sent) {
+      ++o.arm_sent;
+      o.arm_wrong += !right;
+      if (!o.first_trusted) o.first_trusted = k;
+      t += trusted_before ? time.trial_s : time.held_then_sent_s;
+      if (right && o.first_right_s < 0.0) o.first_right_s = t;
+    } else {
+      t += time.learning_trial_s;
     }
   }
   if (fit) {
@@ -243,7 +241,8 @@ int main(int argc, char** argv) {
   cli.add_option("--trace", trace_file,
                  "write per trial of the learning condition: file index, trial, decision, "
                  "target, selections fitted, consistency, shuffles beaten, p3 uV, changed, "
-                 "trusted (after the fit with that trial in); and per file, each trial decided "
+                 "trusted (after the fit with that trial in), that fit's decoding of it; and per "
+                 "file, each trial decided "
                  "right by the calibrated model and by one trained on the trials before with "
                  "their true labels (the ceiling of learning without them)");
   cli.add_flag("--ceiling-only", ceiling_only,
@@ -319,9 +318,9 @@ int main(int argc, char** argv) {
   rate("none: post hoc right (last fit)", all_none.post_hoc_right, all_none.post_hoc_made);
   std::printf("recordings where none sent the arm wrong more often: %d\n", wrong_more);
   // The learning curve: trial k decided right online, in how many recordings, and in how many the
-  // arm was trusted to go.
+  // arm was sent.
   std::printf(
-      "\nlearning curve (of %zu recordings)\ntrial  calibrated right  none right  none trusted\n",
+      "\nlearning curve (of %zu recordings)\ntrial  calibrated right  none right  none arm sent\n",
       files.size());
   for (int k = 0; k < trials; ++k)
     std::printf("%5d  %16d  %10d  %12d\n", k + 1, cal_right[static_cast<size_t>(k)],

@@ -476,9 +476,10 @@ void Paradigm::holdArm(bool held, const std::string& why) {
   hold_why_ = why;
 }
 
-void Paradigm::judgeHeldSelection(bool pending, bool act) {
+void Paradigm::judgeHeldSelection(bool pending, bool act, const std::string& why) {
   held_fit_pending_ = pending;
   held_act_ = act;
+  held_why_ = why;
 }
 
 void Paradigm::recalibrate() {

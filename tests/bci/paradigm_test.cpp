@@ -245,22 +245,26 @@ TEST(Paradigm, AHeldSelectionWaitsForItsFitAndGoesToTheArmWhenThatFitTrustsIt) {
   // comes back not trusted and the trial ends held.
   runUntil(p, frame, [&] { return p.awaitingDecision(); });
   p.decide(choose(1, {2}));
-  p.judgeHeldSelection(true, false);
+  p.judgeHeldSelection(true, false, "learning");
   const std::int64_t shown_from = frame;
   auto events = runUntil(p, frame, [&] { return frame >= shown_from + 200; });
   EXPECT_EQ(p.phase(), Phase::ObjectSelected);
   EXPECT_EQ(p.trial(), 1);
-  p.judgeHeldSelection(false, false);
+  p.judgeHeldSelection(false, false, "not as shown");
   events = runUntil(p, frame, [&] { return p.trial() == 2; });
   EXPECT_EQ(grasps(events), 0);
+  const auto done = std::find_if(events.begin(), events.end(),
+                                 [](const ParadigmEvent& e) { return e.kind == Kind::TrialDone; });
+  ASSERT_NE(done, events.end());
+  EXPECT_EQ(done->text, "not as shown");
   // Trial 2: the fit with it in is trusted and decodes it as shown: it goes on to the arm.
   runUntil(p, frame, [&] { return p.awaitingDecision(); });
   p.decide(choose(2, {3}));
-  p.judgeHeldSelection(true, false);
+  p.judgeHeldSelection(true, false, "learning");
   const std::int64_t second_from = frame;
   runUntil(p, frame, [&] { return frame >= second_from + 200; });
   EXPECT_EQ(p.phase(), Phase::ObjectSelected);
-  p.judgeHeldSelection(false, true);
+  p.judgeHeldSelection(false, true, "");
   events = runUntil(p, frame, [&] { return p.phase() == Phase::Grasping; });
   EXPECT_EQ(grasps(events), 1);
   EXPECT_EQ(p.trial(), 2);

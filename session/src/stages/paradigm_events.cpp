@@ -139,8 +139,6 @@ void ParadigmStage::onSelectionMade(const bci::ParadigmEvent& e, Cycle& cycle) {
   decided.selection_s = cycle.record.presentation.selection_s;
   decided.selection_interrupted_s = cycle.record.presentation.selection_interrupted_s;
   const bool correct = trials_.recordSelection(number, decided);
-  if (settings_.learns && e.objects_layout && !armHeld(cycle) && !first_trusted_trial_)
-    first_trusted_trial_ = number;
   const TrialRecord& trial = trials_.at(number);
   nlohmann::json fields = {{"trial", trial.trial},
                            {"kind", e.objects_layout ? "object" : "cell"},
@@ -248,7 +246,7 @@ void ParadigmStage::onRobotDrop(const bci::ParadigmEvent& e, Cycle& cycle) {
 
 void ParadigmStage::onTrialDone(const bci::ParadigmEvent& e, Cycle& cycle) {
   trials_.done(e.trial, cycle.time_s, e.text);
-  if (e.text == kArmHeld) trials_.at(e.trial).arm_held = true;
+  if (e.text == kArmHeld || e.text == kArmHeldUnconfirmed) trials_.at(e.trial).arm_held = true;
   s_.log.write("trial_done", cycle.time_s, {{"trial", e.trial}, {"text", e.text}});
   if (const TrialRecord* done = trials_.find(e.trial))
     s_.tell.say(cycle.time_s, Severity::Info, selectionLine(*done));

@@ -393,8 +393,8 @@ bool ParadigmStage::armHeld(const Cycle& cycle) const {
 void ParadigmStage::followLearning(const Cycle& cycle) {
   const auto& learning = cycle.record.p300.learning;
   if (settings_.learns) {
-    const bool held = armHeld(cycle);
-    paradigm_.holdArm(held, held ? std::string(kArmHeld) : "");
+    // Every object selection is held for the fit with it in (judgeHeldSelection), trusted or not.
+    paradigm_.holdArm(true, kArmHeld);
     judgeHeldSelection(cycle);
   }
   if (!learning || learning == learning_seen_) return;
@@ -418,14 +418,18 @@ void ParadigmStage::followLearning(const Cycle& cycle) {
 void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
   const auto& learning = cycle.record.p300.learning;
   if (paradigm_.phase() != bci::Phase::ObjectSelected || !learning || !selection_objects_) return;
-  // The held selection shown now (selection_) is being fitted in with the rest, or will be.
+  // The selection shown now (selection_) is being fitted in with the rest, or will be. The arm acts
+  // on it only when that fit is trusted and decodes it as it was shown: the model that decided it
+  // online and the one that learnt from it agree.
   const bool pending =
       learning->awaited_through >= selection_ && learning->fitted_through < selection_;
+  const bool fitted = !pending && learning->fitted_through >= selection_;
   const auto post_hoc = learning->post_hoc.find(selection_);
-  const bool act = !pending && learning->fitted_through >= selection_ && learning->trusted &&
-                   post_hoc != learning->post_hoc.end() &&
-                   stimulus_.selected_object == post_hoc->second;
-  paradigm_.judgeHeldSelection(pending, act);
+  const bool as_shown =
+      post_hoc != learning->post_hoc.end() && stimulus_.selected_object == post_hoc->second;
+  const bool act = fitted && learning->trusted && as_shown;
+  paradigm_.judgeHeldSelection(pending, act,
+                               fitted && learning->trusted ? kArmHeldUnconfirmed : kArmHeld);
   if (act && !first_trusted_trial_) first_trusted_trial_ = paradigm_.trial();
 }
 

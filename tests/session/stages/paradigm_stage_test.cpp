@@ -562,7 +562,8 @@ class LearningParadigmStageTest : public ParadigmStageTest {
   std::shared_ptr<const LearningState> learning_;
 };
 
-TEST_F(LearningParadigmStageTest, AHeldSelectionWaitsForItsFitAndActsOnlyIfThatFitTrustsItAsShown) {
+TEST_F(LearningParadigmStageTest,
+       ASelectionWaitsForItsFitAndTheArmActsOnlyIfThatFitTrustsItAsShown) {
   model_ = trainedModel();  // the model of an earlier fit, not trusted
   learn(0, 0, false, {});
   begin();
@@ -581,6 +582,9 @@ TEST_F(LearningParadigmStageTest, AHeldSelectionWaitsForItsFitAndActsOnlyIfThatF
   for (int i = 0; i < 60 * 3 && bench_.previous.paradigm.trial == 1; ++i) step();
   EXPECT_EQ(bench_.previous.paradigm.trial, 2);
   EXPECT_TRUE(postedOf<GraspRequest>().empty());
+  ASSERT_TRUE(bench_.previous.paradigm.trials);
+  EXPECT_EQ(bench_.previous.paradigm.trials->at(0).outcome, kArmHeldUnconfirmed);
+  EXPECT_TRUE(bench_.previous.paradigm.trials->at(0).arm_held);
   // Trial 2: the fit with it in trusts it and decodes it as shown: the arm goes.
   learn(first, first, false, {{first, 3}});
   for (int i = 0; i < 60 * 30 && bench_.previous.paradigm.phase != bci::Phase::ObjectSelected; ++i)

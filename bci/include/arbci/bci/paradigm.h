@@ -202,9 +202,10 @@ class Paradigm {
   void holdArm(bool held, const std::string& why);
   // A held object selection is fitted in with the rest once shown: while that fit is `pending`
   // the selection stays shown; when the fit came back trusted and decodes the selection as it was
-  // shown (`act`), its trial goes on to the arm after all, instead of ending held. The selection
-  // that earns the trust is not wasted. Read when the selection's showing ends.
-  void judgeHeldSelection(bool pending, bool act);
+  // shown (`act`), its trial goes on to the arm after all, instead of ending held (the selection
+  // that earns the trust is not wasted); otherwise the trial ends with `why`. Read when the
+  // selection's showing ends.
+  void judgeHeldSelection(bool pending, bool act, const std::string& why);
   // From Training (the experimenter's Recalibrate at the review): the calibration run again, from
   // its first selection (and its ErrP block, where there is one).
   void recalibrate();

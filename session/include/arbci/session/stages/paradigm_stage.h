@@ -51,9 +51,13 @@ struct ParadigmStageSettings {
 };
 
 // A learning trial's outcome (paradigm.calibration none): its object selection shown (or none
-// made, before the first model), the arm not sent.
+// made, before the first model), the arm not sent because the model is not yet trusted, or because
+// the fit with the selection in (trusted) decodes it as another object than was shown.
 inline constexpr const char* kArmHeld =
     "learning: the model is not yet trusted, so the arm was not sent";
+inline constexpr const char* kArmHeldUnconfirmed =
+    "learning: the fit with this selection in decodes it as another object, so the arm was not "
+    "sent";
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
 // ...;104=column 1;..." (object codes k for world.objects[slots[k - 1]], grid codes 100 + code).
@@ -111,7 +115,7 @@ class ParadigmStage final : public Stage {
   // post-hoc decoding (and, adapting, the calibrated model's) onto its trial.
   void followLearning(const Cycle& cycle);
   bool armHeld(const Cycle& cycle) const;
-  // A held object selection waits for the fit with it in; a trusted fit that decodes it as shown
+  // Every object selection waits for the fit with it in; a trusted fit that decodes it as shown
   // sends its trial on to the arm (bci::Paradigm::judgeHeldSelection).
   void judgeHeldSelection(const Cycle& cycle);
 
