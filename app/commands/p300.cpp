@@ -14,6 +14,7 @@
 #include "arbci/bci/channel_quality.h"
 #include "arbci/bci/classifier.h"
 #include "arbci/bci/errp_feedback.h"
+#include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/settings.h"
@@ -141,7 +142,9 @@ struct TrainOptions {
 // What learning without labels found, and, where the recordings carry labels (never read by it),
 // how it compares: post-hoc accuracy, the learning curve, and its AUC beside the supervised one.
 void learnWithoutLabels(const TrainOptions& o, bci::P300Dataset& data) {
-  const bci::UnsupervisedReport u = bci::evaluateWithoutLabels(data);
+  bci::UnsupervisedOptions options;
+  options.p300_direction = bci::p300Template(o.pipeline, data.info);
+  const bci::UnsupervisedReport u = bci::evaluateWithoutLabels(data, options);
   const int n = static_cast<int>(data.selections.size());
   std::cout << "unsupervised (EM over each selection's one attended choice; the labels not read): "
             << u.fit.agreeing << " of " << u.fit.restarts

@@ -74,39 +74,24 @@ P300Dataset onlySelections(const P300Dataset& data, const std::vector<int>& keep
   return out;
 }
 
-// The P300's sign by the labels found: target minus non-target averaged over the parietal and
-// central midline sites the features have, from 250 to 500 ms. None when the features have none
-// of those sites or no bin in that time.
-std::optional<double> parietalDifference(const P300Dataset& found, double window_start_s) {
-  static const std::set<std::string> sites = {"PZ", "P3", "P4", "CPZ", "CZ", "POZ", "P1", "P2"};
-  const FeatureShape& shape = found.shape;
-  if (shape.bin_s <= 0.0) return std::nullopt;
-  std::vector<Eigen::Index> columns;
-  for (int c = 0; c < shape.channels && c < static_cast<int>(found.feature_channels.size()); ++c) {
-    std::string name = found.feature_channels[static_cast<size_t>(c)];
-    for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-    if (!sites.count(name)) continue;
-    for (int b = 0; b < shape.bins; ++b) {
-      const double centre = window_start_s + (b + 0.5) * shape.bin_s;
-      if (centre >= 0.25 && centre <= 0.5) columns.push_back(c * shape.bins + b);
-    }
-  }
-  if (columns.empty()) return std::nullopt;
-  double target = 0.0, other = 0.0;
+// The P300's sign by the labels found: target minus non-target projected on the textbook P300 as
+// the pipeline's features show it (p300Template), in uV of that response. None without it.
+std::optional<double> p300Projection(const P300Dataset& found, const Eigen::VectorXd& shape) {
+  if (shape.size() != found.features.cols() || shape.norm() <= 0.0) return std::nullopt;
+  Eigen::RowVectorXd target = Eigen::RowVectorXd::Zero(found.features.cols());
+  Eigen::RowVectorXd other = target;
   int nt = 0, no = 0;
   for (int e = 0; e < found.epochs(); ++e) {
-    double v = 0.0;
-    for (Eigen::Index c : columns) v += found.features(e, c);
     if (found.target[static_cast<size_t>(e)]) {
-      target += v;
+      target += found.features.row(e);
       ++nt;
     } else {
-      other += v;
+      other += found.features.row(e);
       ++no;
     }
   }
   if (nt == 0 || no == 0) return std::nullopt;
-  return (target / nt - other / no) / static_cast<double>(columns.size());
+  return (target / nt - other / no).dot(shape.transpose()) / shape.squaredNorm();
 }
 
 }  // namespace
@@ -147,6 +132,7 @@ LearnedSelections learnFromUse(const Recording& recording,
   }
   if (usable.empty())
     throw std::invalid_argument("no selection yet flashes two whole choices to learn from");
+  if (em.p300_direction.size() == 0) em.p300_direction = p300Template(pipeline, data.info);
   const UnsupervisedFit fit = fitWithoutLabels(data, usable, em);
   out.numbers = numbers;
   out.choice = fit.choice;
@@ -160,7 +146,7 @@ LearnedSelections learnFromUse(const Recording& recording,
   out.shuffles = em.shuffles;
   // Only the selections fitted go into training.
   const P300Dataset found = onlySelections(withLabelsFound(data, fit), usable);
-  out.p3_uv = parietalDifference(found, pipeline.window.start_s);
+  out.p3_uv = p300Projection(found, em.p300_direction);
   TrainingResult result = trainModel(found, pipeline, training);
   out.model = std::move(result.model);
   return out;
@@ -220,8 +206,8 @@ Trust judgeTrust(const LearnedSelections& fit, const std::map<int, int>& previou
   if (fit.p3_uv && *fit.p3_uv <= 0.0) {
     char text[200];
     std::snprintf(text, sizeof text,
-                  "a positive P300 (by the labels found, target minus non-target at the parietal "
-                  "sites from 250 to 500 ms is %.2f uV: the mirror of the response)",
+                  "a positive P300 (by the labels found, target minus non-target along a textbook "
+                  "P300 at the parietal sites is %.2f uV: the mirror of the response)",
                   *fit.p3_uv);
     missing.push_back(text);
   }

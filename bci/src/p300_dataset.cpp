@@ -3,11 +3,13 @@
 #include "arbci/bci/channel_quality.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -339,6 +341,37 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   data.erp.zero_phase = settings.zero_phase || erp_own_pass;
   if (progress) progress(1.0, "epochs ready");
   return data;
+}
+
+Eigen::VectorXd p300Template(const PipelineSettings& settings, const SignalInfo& info) {
+  static const std::set<std::string> sites = {"PZ", "P3", "P4", "CPZ", "CZ", "POZ", "P1", "P2"};
+  const FeatureExtractor extractor(settings, info);
+  std::vector<int> parietal;
+  for (int c : extractor.channelIndices()) {
+    std::string name = info.channels[static_cast<size_t>(c)];
+    for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+    if (sites.count(name)) parietal.push_back(c);
+  }
+  if (parietal.empty()) return {};
+  // One response, three seconds after the start (the filters settled), in five seconds of signal.
+  const double rate = info.rate_hz;
+  const auto onset = static_cast<std::int64_t>(std::lround(3.0 * rate));
+  Block signal(0, info.channelCount(), static_cast<int>(std::lround(5.0 * rate)));
+  for (int c : parietal) {
+    for (int s = 0; s < signal.samples; ++s) {
+      const double t = (s - onset) / rate - 0.35;
+      signal.data[static_cast<size_t>(c) * signal.samples + s] =
+          static_cast<float>(std::exp(-0.5 * (t / 0.075) * (t / 0.075)));
+    }
+  }
+  FilterChain(settings.filter, info).process(signal);
+  if (settings.zero_phase) backwardPass(signal, settings.filter, info);
+  const Epocher window(info.channelCount(), rate, settings.window);
+  Epoch epoch;
+  epoch.channels = signal.channels;
+  epoch.samples = window.samplesPerEpoch();
+  epoch.data = span(signal, onset + window.offsetSamples(), epoch.samples);
+  return extractor.features(epoch);
 }
 
 }  // namespace arbci::bci

@@ -262,14 +262,34 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   // to selection, so a fit that found it finds it again without any one selection, and decodes
   // that one as the whole fit does; a labelling of noise (with few selections and many features,
   // any labelling explains some variance) is not found again, and agrees by chance.
+  const bool directed = options.p300_direction.size() == pr.x.cols();
+  const auto positive = [&](const Problem& problem, const Start& start) {
+    if (!directed) return true;
+    Eigen::RowVectorXd target = Eigen::RowVectorXd::Zero(problem.x.cols());
+    Eigen::RowVectorXd other = target;
+    int targets = 0, others = 0;
+    for (size_t k = 0; k < problem.rows.size(); ++k) {
+      const auto& codes = problem.codes_of[static_cast<size_t>(start.choice[k])];
+      for (int r : problem.rows[k]) {
+        const bool is_target = std::find(codes.begin(), codes.end(),
+                                         problem.code[static_cast<size_t>(r)]) != codes.end();
+        (is_target ? target : other) += problem.x.row(r);
+        (is_target ? targets : others) += 1;
+      }
+    }
+    if (targets == 0 || others == 0) return true;
+    return (target / targets - other / others).dot(options.p300_direction.transpose()) > 0.0;
+  };
   const auto heldOut = [&](const Start& start) {
     int same = 0;
     for (size_t s = 0; s < pr.rows.size(); ++s) {
       const Problem rest = without(pr, s);
-      std::vector<Start> again;
-      for (int r = 0; r < options.restarts; ++r)
+      std::vector<Start> again, admissible;
+      for (int r = 0; r < options.restarts; ++r) {
         again.push_back(runStart(rest, covariance, random, options.max_iterations));
-      same += decode(pr, s, best(again).w) == start.choice[s];
+        if (positive(rest, again.back())) admissible.push_back(again.back());
+      }
+      same += decode(pr, s, best(admissible.empty() ? again : admissible).w) == start.choice[s];
     }
     return static_cast<double>(same) / static_cast<double>(pr.rows.size());
   };

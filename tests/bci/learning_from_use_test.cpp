@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "arbci/bci/learning_from_use.h"
+#include "arbci/bci/p300_dataset.h"
 
 namespace arbci::bci {
 namespace {
@@ -26,6 +27,33 @@ std::map<int, int> decodings(const LearnedSelections& fit, int count) {
   std::map<int, int> out;
   for (int k = 0; k < count; ++k) out[fit.numbers[k]] = fit.choice[k];
   return out;
+}
+
+TEST(LearningFromUse, TheTextbookP300IsReadThroughThePipelinesOwnFilters) {
+  SignalInfo info;
+  info.rate_hz = 256.0;
+  info.block_size = 15;
+  info.channels = {"Fz", "Pz", "Oz"};
+  PipelineSettings pipeline;
+  pipeline.decimate_hz = 20.0;
+  const Eigen::VectorXd shape = p300Template(pipeline, info);
+  const FeatureExtractor extractor(pipeline, info);
+  ASSERT_EQ(shape.size(), extractor.shape().size());
+  const int bins = extractor.shape().bins;
+  // Only Pz carries it; there it peaks positive near 350 ms, and the causal high-pass leaves
+  // something of the other sign after it.
+  EXPECT_EQ(shape.head(bins).norm(), 0.0);
+  EXPECT_EQ(shape.tail(bins).norm(), 0.0);
+  const Eigen::VectorXd pz = shape.segment(bins, bins);
+  Eigen::Index peak = 0;
+  EXPECT_GT(pz.maxCoeff(&peak), 0.3);
+  const double peak_s = pipeline.window.start_s + (peak + 0.5) * extractor.shape().bin_s;
+  EXPECT_GT(peak_s, 0.3);
+  EXPECT_LT(peak_s, 0.5);
+  EXPECT_LT(pz.minCoeff(), 0.0);
+  // No parietal or central site: nothing is known.
+  info.channels = {"Fz", "Oz"};
+  EXPECT_EQ(p300Template(pipeline, info).size(), 0);
 }
 
 TEST(LearningFromUse, TrustNeedsEnoughSelectionsAndAConsistentStableFit) {

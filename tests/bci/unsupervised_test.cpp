@@ -135,6 +135,29 @@ TEST(Unsupervised, AResponseBeatsTheShuffledCodesAndGeneralisesHeldOut) {
   EXPECT_LT(noise.beats_shuffled, 9);
 }
 
+TEST(Unsupervised, HeldOutRefitsKeepTheSignTheP300IsKnownToHave) {
+  // Few selections of a weak response: fits again without a selection may settle on the mirror
+  // solution. Told the response's sign, they keep a start with that sign; told the opposite one,
+  // they keep mirrors, and the P300's decoding no longer looks consistent.
+  Eigen::VectorXd direction;
+  const P300Dataset data = generated(8, 8, 12, 1.0, 33, direction);
+  const auto run = [&](double sign) {
+    UnsupervisedOptions options;
+    options.p300_direction = sign * direction;
+    const UnsupervisedFit fit = fitWithoutLabels(data, {}, options);
+    int right = 0;
+    for (size_t k = 0; k < fit.choice.size(); ++k)
+      right += data.layout.codesOf(fit.choice[k]) == data.selections[k].target_codes;
+    return std::pair{right, fit.consistency};
+  };
+  const auto [right, consistency] = run(1.0);
+  EXPECT_GE(right, 7);
+  EXPECT_GE(consistency, 0.85);
+  const auto [right_against, consistency_against] = run(-1.0);
+  EXPECT_TRUE(right_against < right || consistency_against < 0.5)
+      << right_against << " right, consistency " << consistency_against;
+}
+
 TEST(Unsupervised, KnownSelectionsAreHeldAndAChoiceNotFlashedIsNeverDecoded) {
   Eigen::VectorXd direction;
   P300Dataset data = generated(10, 6, 8, 1.5, 4, direction);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/unsupervised.h"
@@ -28,9 +29,9 @@ struct LearnedSelections {
   // of `shuffles` such fits it beats.
   double explained = 0.0, shuffled_explained = 0.0;
   int beats_shuffled = 0, shuffles = 0;
-  // By the labels found, target minus non-target at the parietal and central midline sites
-  // (Pz, P3, P4, CPz, Cz, POz, P1, P2: those the features have) from 250 to 500 ms, uV; none
-  // without such sites.
+  // By the labels found, target minus non-target projected on the textbook P300 as the pipeline's
+  // features show it (bci::p300Template), in uV of that response: positive for the P300, negative
+  // for its mirror; none without parietal or central sites in the features.
   std::optional<double> p3_uv;
 };
 

@@ -36,6 +36,13 @@ struct UnsupervisedOptions {
   // Measure the fit's leave-one-out consistency (UnsupervisedFit::consistency): a fit again
   // without each selection in turn, so as many fits as selections more.
   bool held_out = true;
+  // What is known of the P300 before any data (empty: nothing): a direction in feature space
+  // along which target minus non-target is positive (the parietal sites from 250 to 500 ms,
+  // p300Direction). A fit again without a selection keeps the most likely of its starts whose
+  // labels find the response positive along it: a start settled on the mirror solution (each
+  // selection's least P300-like stimulus as its target) would decode the left-out selection as
+  // its mirror, and a right fit would look inconsistent.
+  Eigen::VectorXd p300_direction;
 };
 
 struct UnsupervisedFit {
