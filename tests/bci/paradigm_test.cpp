@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <set>
 
 #include "arbci/bci/decision.h"
@@ -195,15 +196,22 @@ TEST(Paradigm, ATrialSelectsAnObjectGraspsItSelectsACellAndPutsItDown) {
   EXPECT_EQ(p.phase(), Phase::Finished);
 }
 
+// Three trials learning from use: no calibration run, started with the arm held ("learning").
+std::unique_ptr<Paradigm> learningFromUse() {
+  ParadigmSettings settings = fast();
+  settings.trials = 3;
+  auto p = std::make_unique<Paradigm>(settings, 4, 3, 3, 3);
+  p->holdArm(true, "learning");
+  p->start(false);
+  return p;
+}
+
 TEST(Paradigm, WhileTheArmIsHeldASelectionEndsItsTrialWithoutTheRobot) {
   // Learning from use: the first selection has no model (no choice), the second is made but the
   // model is not trusted; neither sends the arm. Trusted, the third trial grasps.
-  ParadigmSettings settings = fast();
-  settings.trials = 3;
-  Paradigm p(settings, 4, 3, 3, 3);
+  const std::unique_ptr<Paradigm> learning = learningFromUse();
+  Paradigm& p = *learning;
   std::int64_t frame = 0;
-  p.holdArm(true, "learning");
-  p.start(false);
   EXPECT_EQ(p.phase(), Phase::ObjectFlashing);  // no calibration run
   runUntil(p, frame, [&] { return p.awaitingDecision(); });
   p.decide(Decision{});
@@ -231,12 +239,9 @@ TEST(Paradigm, WhileTheArmIsHeldASelectionEndsItsTrialWithoutTheRobot) {
 }
 
 TEST(Paradigm, AHeldSelectionWaitsForItsFitAndGoesToTheArmWhenThatFitTrustsIt) {
-  ParadigmSettings settings = fast();
-  settings.trials = 3;
-  Paradigm p(settings, 4, 3, 3, 3);
+  const std::unique_ptr<Paradigm> learning = learningFromUse();
+  Paradigm& p = *learning;
   std::int64_t frame = 0;
-  p.holdArm(true, "learning");
-  p.start(false);
   const auto grasps = [](const std::vector<ParadigmEvent>& list) {
     return std::count_if(list.begin(), list.end(),
                          [](const ParadigmEvent& e) { return e.kind == Kind::RobotGrasp; });
