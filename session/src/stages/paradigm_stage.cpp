@@ -428,8 +428,12 @@ void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
   const bool as_shown =
       post_hoc != learning->post_hoc.end() && stimulus_.selected_object == post_hoc->second;
   const bool act = fitted && learning->trusted && as_shown;
-  paradigm_.judgeHeldSelection(pending, act,
-                               fitted && learning->trusted ? kArmHeldUnconfirmed : kArmHeld);
+  const char* why = kArmHeld;
+  if (fitted && post_hoc == learning->post_hoc.end() && !learning->error.empty())
+    why = kArmHeldFitFailed;
+  else if (fitted && learning->trusted)
+    why = kArmHeldUnconfirmed;
+  paradigm_.judgeHeldSelection(pending, act, why);
   if (act && !first_trusted_trial_) first_trusted_trial_ = paradigm_.trial();
 }
 

@@ -547,8 +547,10 @@ class LearningParadigmStageTest : public ParadigmStageTest {
   LearningParadigmStageTest() : ParadigmStageTest(learning()) {}
   // The P300 stage's learning as the record carries it: a fit over selections up to `fitted`,
   // one up to `awaited` running, the last fit's decodings and trust.
-  void learn(int fitted, int awaited, bool trusted, std::map<int, int> post_hoc) {
+  void learn(int fitted, int awaited, bool trusted, std::map<int, int> post_hoc,
+             const std::string& error = "") {
     auto state = std::make_shared<LearningState>();
+    state->error = error;
     state->fitted_through = fitted;
     state->awaited_through = awaited;
     state->fitting = awaited > fitted;
@@ -603,6 +605,22 @@ TEST_F(LearningParadigmStageTest,
   stage_.report(summary);
   EXPECT_EQ(summary["learning"]["first_trusted_trial"], 2);
   EXPECT_EQ(summary["learning"]["trials_arm_held"], 1);
+}
+
+TEST_F(LearningParadigmStageTest, ASelectionWhoseFitFailedIsHeldAndSaysSo) {
+  model_ = trainedModel();
+  learn(0, 0, true, {});  // an earlier fit, trusted
+  begin();
+  for (int i = 0; i < 60 * 30 && bench_.previous.paradigm.phase != bci::Phase::ObjectSelected; ++i)
+    step();
+  ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectSelected);
+  const int first = selection_;
+  learn(first, first, true, {}, "training failed");
+  for (int i = 0; i < 60 * 3 && bench_.previous.paradigm.trial == 1; ++i) step();
+  EXPECT_TRUE(postedOf<GraspRequest>().empty());
+  ASSERT_TRUE(bench_.previous.paradigm.trials);
+  EXPECT_EQ(bench_.previous.paradigm.trials->at(0).outcome, kArmHeldFitFailed);
+  EXPECT_TRUE(bench_.previous.paradigm.trials->at(0).arm_held);
 }
 
 class ErrpParadigmStageTest : public ParadigmStageTest {
