@@ -38,7 +38,8 @@ struct TimeModel {
   double learning_trial_s = 8.5;
   double trial_s = 29.5;
   // A held selection that the fit with it in trusted and decoded as shown goes on to the arm: a
-  // whole trial whose object selection ran all its sequences and waited for that fit.
+  // whole trial whose object selection ran all its sequences and waited for that fit (an upper
+  // estimate: measure it again from a session's trial durations).
   double held_then_sent_s = 32.5;
 };
 
@@ -53,7 +54,7 @@ struct Outcome {
 };
 
 struct Replay {
-  int seed = 0;  // the file's index, for the trace
+  int index = 0;  // the file's, for the trace
   bci::Recording recording;
   std::vector<int> number;    // each stimulus's selection (1-based)
   std::map<int, int> target;  // selection -> attended code
@@ -184,7 +185,7 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
           !next.numbers.empty() && next.numbers.back() == number ? next.choice.back() + 1 : 0;
       sent = decision && trust.trusted && fitted == *decision;
       if (trace)
-        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d\n", r.seed, k,
+        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d\n", r.index, k,
                      decision ? *decision : 0, r.target.at(number), next.numbers.size(),
                      next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
                      trust.changed.size(), trust.trusted, fitted);
@@ -261,7 +262,7 @@ int main(int argc, char** argv) {
   int faster = 0, compared = 0, wrong_more = 0;
   for (const std::string& file : files) {
     Replay r = load(file);
-    r.seed = static_cast<int>(&file - files.data());
+    r.index = static_cast<int>(&file - files.data());
     if (static_cast<int>(r.target.size()) < calibration + trials) {
       std::fprintf(stderr, "%s: %zu selections, fewer than %d\n", file.c_str(), r.target.size(),
                    calibration + trials);
@@ -274,9 +275,9 @@ int main(int argc, char** argv) {
                                    : learnt(r, calibration, trials, from, pipeline,
                                             config.classifier.training, rule, time, trace);
     if (trace) {
-      std::fprintf(trace, "calibrated,%d,", r.seed);
+      std::fprintf(trace, "calibrated,%d,", r.index);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
-      std::fprintf(trace, "\nknown,%d,", r.seed);
+      std::fprintf(trace, "\nknown,%d,", r.index);
       for (bool right : labelsKnown(r, calibration, trials, pipeline, config.classifier.training))
         std::fputc(right ? '1' : '0', trace);
       std::fputc('\n', trace);
