@@ -39,6 +39,8 @@ ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const StageS
       view_watch_(settings_.world, settings_.paradigm.no_view_pause_s, settings_.experimenter,
                   settings_.max_retakes) {
   nameObjects();
+  // Learning from use: every object selection waits for the fit with it in (judgeHeldSelection).
+  if (settings_.learns) paradigm_.holdArm(true, kArmHeld);
 }
 
 void ParadigmStage::nameObjects() {
@@ -377,26 +379,23 @@ void ParadigmStage::decideIfReady(const Cycle& cycle) {
   const bool scored = current && p300.presented > 0 && p300.scored >= p300.presented;
   // Dynamic stopping: certain enough after the minimum number of scored sequences.
   const bci::ParadigmSettings& p = settings_.paradigm;
-  // While the arm is held the selection is data to learn from: all its sequences.
-  if (online && p300.model && !armHeld(cycle) && p.certainty > 0.0 &&
+  // While the model learnt from use is not trusted the selection is data to learn from: all its
+  // sequences.
+  if (online && p300.model && !untrusted(cycle) && p.certainty > 0.0 &&
       sequences >= p.min_sequences && p300.decision.certainty >= p.certainty) {
     paradigm_.requestStopFlashing();
   }
   if (paradigm_.awaitingDecision() && scored) paradigm_.decide(p300.decision);
 }
 
-bool ParadigmStage::armHeld(const Cycle& cycle) const {
+bool ParadigmStage::untrusted(const Cycle& cycle) const {
   const auto& learning = cycle.record.p300.learning;
   return settings_.learns && !(learning && learning->trusted);
 }
 
 void ParadigmStage::followLearning(const Cycle& cycle) {
   const auto& learning = cycle.record.p300.learning;
-  if (settings_.learns) {
-    // Every object selection is held for the fit with it in (judgeHeldSelection), trusted or not.
-    paradigm_.holdArm(true, kArmHeld);
-    judgeHeldSelection(cycle);
-  }
+  if (settings_.learns) judgeHeldSelection(cycle);
   if (!learning || learning == learning_seen_) return;
   learning_seen_ = learning;
   const auto object = [this](const std::map<int, int>& codes, int number) -> std::optional<int> {

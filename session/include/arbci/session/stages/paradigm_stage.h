@@ -114,10 +114,12 @@ class ParadigmStage final : public Stage {
   // The tracked object (other than the one in the gripper) standing on a grid cell, if any.
   std::optional<int> objectOnCell(std::pair<int, int> cell, const Cycle& cycle) const;
   void publish(Cycle& cycle);
-  // Learning from use: the arm held while the model is not trusted; each object selection's
-  // post-hoc decoding (and, adapting, the calibrated model's) onto its trial.
+  // Learning from use: each object selection judged by the fit with it in; each one's post-hoc
+  // decoding (and, adapting, the calibrated model's) onto its trial.
   void followLearning(const Cycle& cycle);
-  bool armHeld(const Cycle& cycle) const;
+  // Learning from use and the model not (yet) trusted: a selection is data to learn from, with all
+  // its sequences (no dynamic stopping).
+  bool untrusted(const Cycle& cycle) const;
   // Every object selection waits for the fit with it in; a trusted fit that decodes it as shown
   // sends its trial on to the arm (bci::Paradigm::judgeHeldSelection).
   void judgeHeldSelection(const Cycle& cycle);
