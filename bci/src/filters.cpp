@@ -1,5 +1,6 @@
 #include "arbci/bci/filters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -203,6 +204,21 @@ Block Decimator::process(const Block& block) {
   }
   next_input_ = block.endSample();
   return out;
+}
+
+void filterWhole(Block& signal, const FilterSettings& settings, const SignalInfo& info,
+                 bool zero_phase) {
+  FilterChain(settings, info).process(signal);
+  if (!zero_phase) return;
+  const auto reverseInTime = [&signal] {
+    for (int c = 0; c < signal.channels; ++c) {
+      auto first = signal.data.begin() + static_cast<std::ptrdiff_t>(c) * signal.samples;
+      std::reverse(first, first + signal.samples);
+    }
+  };
+  reverseInTime();
+  FilterChain(settings, info).process(signal);
+  reverseInTime();
 }
 
 }  // namespace arbci::bci

@@ -10,6 +10,7 @@
 
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/p300_dataset.h"
+#include "arbci/bci/p300_template.h"
 
 namespace arbci::bci {
 namespace {
@@ -74,26 +75,6 @@ P300Dataset onlySelections(const P300Dataset& data, const std::vector<int>& keep
   return out;
 }
 
-// The P300's sign by the labels found: target minus non-target projected on the textbook P300 as
-// the pipeline's features show it (p300Template), in uV of that response. None without it.
-std::optional<double> p300Projection(const P300Dataset& found, const Eigen::VectorXd& shape) {
-  if (shape.size() != found.features.cols() || shape.norm() <= 0.0) return std::nullopt;
-  Eigen::RowVectorXd target = Eigen::RowVectorXd::Zero(found.features.cols());
-  Eigen::RowVectorXd other = target;
-  int nt = 0, no = 0;
-  for (int e = 0; e < found.epochs(); ++e) {
-    if (found.target[static_cast<size_t>(e)]) {
-      target += found.features.row(e);
-      ++nt;
-    } else {
-      other += found.features.row(e);
-      ++no;
-    }
-  }
-  if (nt == 0 || no == 0) return std::nullopt;
-  return (target / nt - other / no).dot(shape.transpose()) / shape.squaredNorm();
-}
-
 }  // namespace
 
 LearnedSelections learnFromUse(const Recording& recording,
@@ -144,9 +125,9 @@ LearnedSelections learnFromUse(const Recording& recording,
   out.shuffled_explained = fit.shuffled_explained;
   out.beats_shuffled = fit.beats_shuffled;
   out.shuffles = em.shuffles;
+  out.p3_uv = fit.p300_uv;
   // Only the selections fitted go into training.
   const P300Dataset found = onlySelections(withLabelsFound(data, fit), usable);
-  out.p3_uv = p300Projection(found, em.p300_direction);
   TrainingResult result = trainModel(found, pipeline, training);
   out.model = std::move(result.model);
   return out;

@@ -3,13 +3,11 @@
 #include "arbci/bci/channel_quality.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,20 +22,6 @@ std::vector<float> span(const Block& signal, std::int64_t first, int length) {
                 length, out.begin() + static_cast<std::ptrdiff_t>(c) * length);
   }
   return out;
-}
-
-void reverseInTime(Block& block) {
-  for (int c = 0; c < block.channels; ++c) {
-    auto first = block.data.begin() + static_cast<std::ptrdiff_t>(c) * block.samples;
-    std::reverse(first, first + block.samples);
-  }
-}
-
-// Backward through a fresh chain after the forward pass: the phase lags of the two cancel.
-void backwardPass(Block& signal, const FilterSettings& filter, const SignalInfo& info) {
-  reverseInTime(signal);
-  FilterChain(filter, info).process(signal);
-  reverseInTime(signal);
 }
 
 // The largest peak-to-peak amplitude of `channels` in the epoch.
@@ -233,14 +217,12 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
     // The whole signal through the online filter chain (block-wise and whole are identical).
     Block signal(0, r.info.channelCount(), static_cast<int>(r.samples));
     signal.data = r.data;
-    FilterChain(settings.filter, r.info).process(signal);
-    if (settings.zero_phase) backwardPass(signal, settings.filter, r.info);
+    filterWhole(signal, settings.filter, r.info, settings.zero_phase);
     Block erp_signal;
     if (erp_own_pass) {
       erp_signal = Block(0, r.info.channelCount(), static_cast<int>(r.samples));
       erp_signal.data = r.data;
-      FilterChain(settings.filter, r.info).process(erp_signal);
-      backwardPass(erp_signal, settings.filter, r.info);
+      filterWhole(erp_signal, settings.filter, r.info, true);
     }
     const Block& erp_source = erp_own_pass ? erp_signal : signal;
 
@@ -341,37 +323,6 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
   data.erp.zero_phase = settings.zero_phase || erp_own_pass;
   if (progress) progress(1.0, "epochs ready");
   return data;
-}
-
-Eigen::VectorXd p300Template(const PipelineSettings& settings, const SignalInfo& info) {
-  static const std::set<std::string> sites = {"PZ", "P3", "P4", "CPZ", "CZ", "POZ", "P1", "P2"};
-  const FeatureExtractor extractor(settings, info);
-  std::vector<int> parietal;
-  for (int c : extractor.channelIndices()) {
-    std::string name = info.channels[static_cast<size_t>(c)];
-    for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-    if (sites.count(name)) parietal.push_back(c);
-  }
-  if (parietal.empty()) return {};
-  // One response, three seconds after the start (the filters settled), in five seconds of signal.
-  const double rate = info.rate_hz;
-  const auto onset = static_cast<std::int64_t>(std::lround(3.0 * rate));
-  Block signal(0, info.channelCount(), static_cast<int>(std::lround(5.0 * rate)));
-  for (int c : parietal) {
-    for (int s = 0; s < signal.samples; ++s) {
-      const double t = (s - onset) / rate - 0.35;
-      signal.data[static_cast<size_t>(c) * signal.samples + s] =
-          static_cast<float>(std::exp(-0.5 * (t / 0.075) * (t / 0.075)));
-    }
-  }
-  FilterChain(settings.filter, info).process(signal);
-  if (settings.zero_phase) backwardPass(signal, settings.filter, info);
-  const Epocher window(info.channelCount(), rate, settings.window);
-  Epoch epoch;
-  epoch.channels = signal.channels;
-  epoch.samples = window.samplesPerEpoch();
-  epoch.data = span(signal, onset + window.offsetSamples(), epoch.samples);
-  return extractor.features(epoch);
 }
 
 }  // namespace arbci::bci

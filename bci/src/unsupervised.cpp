@@ -188,6 +188,27 @@ Problem without(const Problem& pr, size_t s) {
   return out;
 }
 
+// Target minus non-target by the decoding `choice`, projected on `direction` in units of it (what
+// UnsupervisedFit::p300_uv says); none without a direction of the features' size.
+std::optional<double> alongP300(const Problem& pr, const std::vector<int>& choice,
+                                const Eigen::VectorXd& direction) {
+  if (direction.size() != pr.x.cols() || direction.squaredNorm() <= 0.0) return std::nullopt;
+  Eigen::RowVectorXd target = Eigen::RowVectorXd::Zero(pr.x.cols());
+  Eigen::RowVectorXd other = target;
+  int targets = 0, others = 0;
+  for (size_t k = 0; k < pr.rows.size(); ++k) {
+    const auto& codes = pr.codes_of[static_cast<size_t>(choice[k])];
+    for (int r : pr.rows[k]) {
+      const bool is_target =
+          std::find(codes.begin(), codes.end(), pr.code[static_cast<size_t>(r)]) != codes.end();
+      (is_target ? target : other) += pr.x.row(r);
+      (is_target ? targets : others) += 1;
+    }
+  }
+  if (targets == 0 || others == 0) return std::nullopt;
+  return (target / targets - other / others).dot(direction.transpose()) / direction.squaredNorm();
+}
+
 }  // namespace
 
 UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selections,
@@ -262,23 +283,9 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   // to selection, so a fit that found it finds it again without any one selection, and decodes
   // that one as the whole fit does; a labelling of noise (with few selections and many features,
   // any labelling explains some variance) is not found again, and agrees by chance.
-  const bool directed = options.p300_direction.size() == pr.x.cols();
   const auto positive = [&](const Problem& problem, const Start& start) {
-    if (!directed) return true;
-    Eigen::RowVectorXd target = Eigen::RowVectorXd::Zero(problem.x.cols());
-    Eigen::RowVectorXd other = target;
-    int targets = 0, others = 0;
-    for (size_t k = 0; k < problem.rows.size(); ++k) {
-      const auto& codes = problem.codes_of[static_cast<size_t>(start.choice[k])];
-      for (int r : problem.rows[k]) {
-        const bool is_target = std::find(codes.begin(), codes.end(),
-                                         problem.code[static_cast<size_t>(r)]) != codes.end();
-        (is_target ? target : other) += problem.x.row(r);
-        (is_target ? targets : others) += 1;
-      }
-    }
-    if (targets == 0 || others == 0) return true;
-    return (target / targets - other / others).dot(options.p300_direction.transpose()) > 0.0;
+    const auto along = alongP300(problem, start.choice, options.p300_direction);
+    return !along || *along > 0.0;
   };
   const auto heldOut = [&](const Start& start) {
     int same = 0;
@@ -342,6 +349,7 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   fit.weights = kept.w;
   fit.iterations = kept.iterations;
   fit.consistency = kept_consistency;
+  fit.p300_uv = alongP300(pr, kept.choice, options.p300_direction);
   fit.explained = kept.explained;
   if (options.shuffles > 0) {
     // The same fit with each selection's codes shuffled among its epochs: a response that repeats

@@ -1,10 +1,11 @@
-// Whether the arm may act on a model learnt from use: enough selections, a leave-one-out consistency
-// at least the minimum, and a decoding of the earlier selections that the new fit kept; what is
-// missing is said in words.
+// Whether the arm may act on a model learnt from use: enough selections, a leave-one-out
+// consistency at least the minimum, and a decoding of the earlier selections that the new fit kept;
+// what is missing is said in words.
 #include <gtest/gtest.h>
 
+#include "arbci/bci/features.h"
 #include "arbci/bci/learning_from_use.h"
-#include "arbci/bci/p300_dataset.h"
+#include "arbci/bci/p300_template.h"
 
 namespace arbci::bci {
 namespace {

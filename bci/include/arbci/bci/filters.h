@@ -64,6 +64,12 @@ class FilterChain {
   IirFilter filter_;
 };
 
+// A whole recorded signal through a fresh chain (block by block or whole, the same); with
+// `zero_phase`, backward again through another fresh chain, so that the phase lags cancel
+// (offline only: the online cycle must stay causal).
+void filterWhole(Block& signal, const FilterSettings& settings, const SignalInfo& info,
+                 bool zero_phase);
+
 // Keeps every `factor`-th sample of the moving average over the last `factor` samples; output
 // sample k covers input samples [k*factor, (k+1)*factor). State carries across blocks.
 class Decimator {

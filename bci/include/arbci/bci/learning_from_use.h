@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/unsupervised.h"

@@ -82,12 +82,4 @@ struct DatasetOptions {
 P300Dataset buildDataset(const std::vector<Recording>& recordings, const PipelineSettings& settings,
                          const Progress& progress = {}, const DatasetOptions& options = {});
 
-// What is known of the P300 before any data, in this pipeline's features: a textbook response (a
-// positive deflection peaking 350 ms after the flash, 75 ms wide, 1 uV, at the parietal and
-// central midline sites Pz, P3, P4, CPz, Cz, POz, P1, P2; nothing elsewhere) put through the same
-// filters, window and feature extraction as a recording's epochs. The filters reshape it (a causal
-// high-pass leaves a negative rebound after it), so its sign in feature space is read here, not
-// assumed. Empty when the features have none of those sites.
-Eigen::VectorXd p300Template(const PipelineSettings& settings, const SignalInfo& info);
-
 }  // namespace arbci::bci

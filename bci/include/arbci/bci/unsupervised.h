@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,11 +38,12 @@ struct UnsupervisedOptions {
   // without each selection in turn, so as many fits as selections more.
   bool held_out = true;
   // What is known of the P300 before any data (empty: nothing): a direction in feature space
-  // along which target minus non-target is positive (the parietal sites from 250 to 500 ms,
-  // p300Direction). A fit again without a selection keeps the most likely of its starts whose
-  // labels find the response positive along it: a start settled on the mirror solution (each
-  // selection's least P300-like stimulus as its target) would decode the left-out selection as
-  // its mirror, and a right fit would look inconsistent.
+  // along which target minus non-target is positive (bci::p300Template: the textbook P300 as
+  // the pipeline's features show it). A fit again without a selection keeps the most likely of
+  // its starts whose labels find the response positive along it: a start settled on the mirror
+  // solution (each selection's least P300-like stimulus as its target) would decode the left-out
+  // selection as its mirror, and a right fit would look inconsistent. UnsupervisedFit::p300_uv
+  // measures the decoding kept along it.
   Eigen::VectorXd p300_direction;
 };
 
@@ -58,6 +60,10 @@ struct UnsupervisedFit {
   // (from new starts) decodes as this fit does; chance is about one over the choices. The measure
   // of trust (0 unless UnsupervisedOptions::held_out). The starts agreeing count the warm one.
   double consistency = 0.0;
+  // By the decoding kept, target minus non-target projected on UnsupervisedOptions::p300_direction,
+  // in units of it (uV of the textbook P300): positive for the P300, negative for its mirror; none
+  // without a direction.
+  std::optional<double> p300_uv;
   // The share of the data's variance the decoding explains, and the most that a fit explains with
   // each selection's codes shuffled among its epochs (no response repeats with a stimulus there:
   // noise alone), over UnsupervisedOptions::shuffles such fits; how many of them it beats. A
