@@ -27,7 +27,8 @@ const core::Schema<ParadigmSettings>& paradigmSchema() {
                  "dynamic stopping never decides before this many sequences")
         .number("certainty", &P::certainty, 0.999, 0.0, 1.0,
                 "dynamic stopping: decide once the choice is this probable (0: always all "
-                "sequences)")
+                "sequences); calibration none: the arm acts only on an object selection at "
+                "least this probable")
         .integer("calibration_selections", &P::calibration_selections, 8, 2, 200,
                  "cued selections of the calibration run")
         .integer("calibration_sequences", &P::calibration_sequences, 8, 1, 100,

@@ -418,20 +418,27 @@ void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
   const auto& learning = cycle.record.p300.learning;
   if (paradigm_.phase() != bci::Phase::ObjectSelected || !learning || !selection_objects_) return;
   // The selection shown now (selection_) is being fitted in with the rest, or will be. The arm acts
-  // on it only when that fit is trusted and decodes it as it was shown: the model that decided it
-  // online and the one that learnt from it agree.
+  // on it only when that fit is trusted and decodes it as it was shown (the model that decided it
+  // online and the one that learnt from it agree), and when the online decision was itself as
+  // certain as dynamic stopping asks. The fit's own posterior cannot say that: a selection fitted
+  // with the rest is explained by the model it helped to make, and almost always looks certain.
   const bool pending =
       learning->awaited_through >= selection_ && learning->fitted_through < selection_;
   const bool fitted = !pending && learning->fitted_through >= selection_;
   const auto post_hoc = learning->post_hoc.find(selection_);
   const bool as_shown =
       post_hoc != learning->post_hoc.end() && stimulus_.selected_object == post_hoc->second;
-  const bool act = fitted && learning->trusted && as_shown;
+  const TrialRecord* trial = trials_.find(paradigm_.trial());
+  const bool certain =
+      trial && trial->object_certainty >= settings_.paradigm.certainty;  // 0: no such gate
+  const bool act = fitted && learning->trusted && as_shown && certain;
   const char* why = kArmHeld;
   if (fitted && post_hoc == learning->post_hoc.end() && !learning->error.empty())
     why = kArmHeldFitFailed;
-  else if (fitted && learning->trusted)
+  else if (fitted && learning->trusted && !as_shown)
     why = kArmHeldUnconfirmed;
+  else if (fitted && learning->trusted)
+    why = kArmHeldUncertain;
   paradigm_.judgeHeldSelection(pending, act, why);
   if (act && !first_trusted_trial_) first_trusted_trial_ = paradigm_.trial();
 }

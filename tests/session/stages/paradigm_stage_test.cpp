@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <utility>
 
 #include "arbci/session/record_text.h"
 #include "arbci/session/stages/p300_stage.h"
@@ -96,7 +97,7 @@ class ParadigmStageTest : public ::testing::Test {
     r.p300.model = model_;
     r.p300.decision.codes = {decide_};
     r.p300.decision.choice = decide_ - 1;
-    r.p300.decision.certainty = 0.9;
+    r.p300.decision.certainty = certainty_;
     r.robot.status = robot_;
     r.errp.model = errp_model_;
     if (more) more(r);
@@ -144,6 +145,7 @@ class ParadigmStageTest : public ::testing::Test {
   std::shared_ptr<const bci::P300Model> model_, errp_model_;
   std::optional<robot::StatusPayload> robot_;
   int selection_ = 0, flashes_ = 0, decide_ = 1;
+  double certainty_ = 0.9;  // of every decision
   std::vector<Request> posted_;
   std::vector<bci::Annotation> annotations_;
 };
@@ -544,7 +546,8 @@ class LearningParadigmStageTest : public ParadigmStageTest {
     c.paradigm.trials = 2;
     return c;
   }
-  LearningParadigmStageTest() : ParadigmStageTest(learning()) {}
+  explicit LearningParadigmStageTest(SessionConfig config = learning())
+      : ParadigmStageTest(std::move(config)) {}
   // The P300 stage's learning as the record carries it: a fit over selections up to `fitted`,
   // one up to `awaited` running, the last fit's decodings and trust.
   void learn(int fitted, int awaited, bool trusted, std::map<int, int> post_hoc,
@@ -621,6 +624,49 @@ TEST_F(LearningParadigmStageTest, ASelectionWhoseFitFailedIsHeldAndSaysSo) {
   ASSERT_TRUE(bench_.previous.paradigm.trials);
   EXPECT_EQ(bench_.previous.paradigm.trials->at(0).outcome, kArmHeldFitFailed);
   EXPECT_TRUE(bench_.previous.paradigm.trials->at(0).arm_held);
+}
+
+class CertainLearningParadigmStageTest : public LearningParadigmStageTest {
+ protected:
+  static SessionConfig certain() {
+    SessionConfig c = learning();
+    c.paradigm.certainty = 0.95;
+    return c;
+  }
+  CertainLearningParadigmStageTest() : LearningParadigmStageTest(certain()) {}
+  // Trial `trial`'s object selection (deciding object code 2 with certainty_) and the fit with it
+  // in, trusted and decoding it as shown.
+  void selectAndConfirm(int trial) {
+    for (int i = 0; i < 60 * 30 && bench_.previous.paradigm.phase != bci::Phase::ObjectSelected;
+         ++i)
+      step();
+    ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectSelected);
+    ASSERT_EQ(bench_.previous.paradigm.trial, trial);
+    confirmed_[selection_] = 2;
+    learn(selection_, selection_, true, confirmed_);
+    for (int i = 0; i < 60 * 3 && bench_.previous.paradigm.phase == bci::Phase::ObjectSelected; ++i)
+      step();
+  }
+  std::map<int, int> confirmed_;
+};
+
+TEST_F(CertainLearningParadigmStageTest, AnUncertainSelectionIsHeldThoughItsTrustedFitAgrees) {
+  model_ = trainedModel();
+  learn(0, 0, true, {});  // an earlier fit, trusted
+  begin();
+  decide_ = 2;
+  certainty_ = 0.9;  // all sequences shown, and still below paradigm.certainty
+  selectAndConfirm(1);
+  EXPECT_EQ(bench_.previous.paradigm.trial, 2);
+  EXPECT_TRUE(postedOf<GraspRequest>().empty());
+  ASSERT_TRUE(bench_.previous.paradigm.trials);
+  EXPECT_EQ(bench_.previous.paradigm.trials->at(0).outcome, kArmHeldUncertain);
+  EXPECT_TRUE(bench_.previous.paradigm.trials->at(0).arm_held);
+  certainty_ = 0.99;  // as certain as dynamic stopping asks: the arm goes
+  selectAndConfirm(2);
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Grasping);
+  ASSERT_EQ(postedOf<GraspRequest>().size(), 1u);
+  EXPECT_EQ(postedOf<GraspRequest>()[0].object, config_.world.objects[1].id);
 }
 
 class ErrpParadigmStageTest : public ParadigmStageTest {

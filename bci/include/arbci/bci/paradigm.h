@@ -36,7 +36,7 @@ struct ParadigmSettings {
   int sequences;              // per online selection (the maximum with dynamic stopping)
   int calibration_sequences;  // per calibration selection (always all)
   int min_sequences;          // dynamic stopping never stops earlier
-  double certainty;           // dynamic stopping threshold; 0: always `sequences`
+  double certainty;           // dynamic stopping's (and learning's arm's) threshold; 0: none
   double cue_s;               // calibration: the target is shown before its flashes
   double result_s;            // a selection is shown this long
   double pause_s;             // between selections

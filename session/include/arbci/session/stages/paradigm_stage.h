@@ -21,6 +21,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "arbci/bci/paradigm.h"
@@ -52,15 +53,23 @@ struct ParadigmStageSettings {
 
 // A learning trial's outcome (paradigm.calibration none): its object selection shown (or none
 // made, before the first model), the arm not sent because the model is not yet trusted, or because
-// the fit with the selection in (trusted) decodes it as another object than was shown, or failed.
+// the fit with the selection in (trusted) decodes it as another object than was shown, or because
+// the online decision was less certain than dynamic stopping asks, or because the fit failed.
 inline constexpr const char* kArmHeld =
     "learning: the model is not yet trusted, so the arm was not sent";
 inline constexpr const char* kArmHeldUnconfirmed =
     "learning: the fit with this selection in decodes it as another object, so the arm was not "
     "sent";
+inline constexpr const char* kArmHeldUncertain =
+    "learning: the selection was less certain than paradigm.certainty, so the arm was not sent";
 inline constexpr const char* kArmHeldFitFailed =
     "learning: the fit with this selection in failed (see the log's learning_fit_failed), so the "
     "arm was not sent";
+// Whether a trial's outcome is one of the above.
+inline bool armHeldOutcome(std::string_view outcome) {
+  return outcome == kArmHeld || outcome == kArmHeldUnconfirmed || outcome == kArmHeldUncertain ||
+         outcome == kArmHeldFitFailed;
+}
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
 // ...;104=column 1;..." (object codes k for world.objects[slots[k - 1]], grid codes 100 + code).
