@@ -98,19 +98,45 @@ std::map<int, int> decode(const bci::P300Model& model, const Replay& r, int firs
   return bci::decodeSelections(model, recording, numbers, pipeline);
 }
 
+// Selection `number` decided online by `model` as the session decides (bci::SelectionAccumulator
+// with the model's score model): after each whole sequence from the rule's minimum on, it stops
+// once certain enough (dynamic stopping), else after all of them.
+struct Online {
+  std::optional<int> code;
+  double certainty = 0.0;
+};
+Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
+                    const bci::PipelineSettings& pipeline, const bci::StoppingRule& rule) {
+  const auto [recording, numbers] = part(r, number, number, false);
+  bci::DatasetOptions options;
+  options.keep_unknown = true;
+  const bci::P300Dataset data = bci::buildDataset({recording}, pipeline, {}, options);
+  bci::SelectionAccumulator accumulator(data.layout, model.score_model);
+  for (int e = 0; e < data.epochs(); ++e) {
+    const auto i = static_cast<size_t>(e);
+    accumulator.add(data.code[i], model.classifier->score(data.features.row(e)));
+    const bool sequence_ends = e + 1 == data.epochs() || data.sequence[i + 1] != data.sequence[i];
+    if (sequence_ends && accumulator.shouldStop(rule)) break;
+  }
+  Online out;
+  const bci::Decision d = accumulator.decide();
+  if (!d.codes.empty() && accumulator.flashes() > 0) out.code = *d.codes.begin();
+  out.certainty = d.certainty;
+  return out;
+}
+
 Outcome calibrated(const Replay& r, int calibration, int trials, int from,
                    const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
-                   const TimeModel& time) {
+                   const bci::StoppingRule& stopping, const TimeModel& time) {
   Outcome o;
   const auto [recording, numbers] = part(r, 1, calibration, true);
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
   const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
-  const auto decided = decode(model, r, calibration + 1, calibration + trials, pipeline);
   double t = calibration * time.calibration_selection_s + time.training_s;
   for (int k = 1; k <= trials; ++k) {
     const int number = calibration + k;
-    const auto d = decided.find(number);
-    const bool right = d != decided.end() && d->second == r.target.at(number);
+    const Online d = decideOnline(model, r, number, pipeline, stopping);
+    const bool right = d.code && *d.code == r.target.at(number);
     o.right_at.push_back(right);
     o.trusted_at.push_back(true);
     if (k >= from) {
@@ -152,7 +178,8 @@ std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials,
 
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
-               const bci::TrustRule& rule, const TimeModel& time, std::FILE* trace) {
+               const bci::TrustRule& rule, const bci::StoppingRule& stopping, const TimeModel& time,
+               std::FILE* trace) {
   Outcome o;
   std::optional<bci::LearnedSelections> fit;
   bci::Trust trust;
@@ -160,10 +187,17 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
   double t = 0.0;
   for (int k = 1; k <= trials; ++k) {
     const int number = calibration + k;
+    // Trusted before it: its selection stops early (dynamic stopping) like a calibrated trial's;
+    // untrusted, it shows all its sequences.
+    const bool trusted_before = fit && trust.trusted;
+    bci::StoppingRule rule_now = stopping;
+    if (!trusted_before) rule_now.certainty = 0.0;
     std::optional<int> decision;
+    double certainty = 0.0;
     if (fit) {
-      const auto d = decode(fit->model, r, number, number, pipeline);
-      if (d.count(number)) decision = d.at(number);
+      const Online d = decideOnline(fit->model, r, number, pipeline, rule_now);
+      decision = d.code;
+      certainty = d.certainty;
     }
     const bool right = decision && *decision == r.target.at(number);
     if (k >= from) {
@@ -171,10 +205,10 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       o.online_right += right;
     }
     o.right_at.push_back(right);
-    // Trusted before it: its selection stopped early (dynamic stopping) like a calibrated trial's.
-    const bool trusted_before = fit && trust.trusted;
-    // The session fits again with this selection in; the arm acts on the selection only when that
-    // fit is trusted and decodes it as it was shown (bci::Paradigm::judgeHeldSelection).
+    // The session fits again with this selection in (here with all its flashes, where the session
+    // has those shown before it stopped); the arm acts on the selection only when that fit is
+    // trusted and decodes it as it was shown, and the decision was as certain as dynamic stopping
+    // asks (ParadigmStage::judgeHeldSelection).
     bool sent = false;
     const auto [recording, numbers] = part(r, calibration + 1, number, false);
     try {
@@ -183,12 +217,13 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       trust = bci::judgeTrust(next, before, rule);
       const int fitted =
           !next.numbers.empty() && next.numbers.back() == number ? next.choice.back() + 1 : 0;
-      sent = decision && trust.trusted && fitted == *decision;
+      sent = decision && trust.trusted && fitted == *decision && certainty >= stopping.certainty;
       if (trace)
-        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d\n", r.index, k,
+        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d,%.6f,%.6f\n", r.index, k,
                      decision ? *decision : 0, r.target.at(number), next.numbers.size(),
                      next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
-                     trust.changed.size(), trust.trusted, fitted);
+                     trust.changed.size(), trust.trusted, fitted, certainty,
+                     next.posterior.empty() ? 0.0 : next.posterior.back());
       before.clear();
       for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
       fit = std::move(next);
@@ -255,6 +290,9 @@ int main(int argc, char** argv) {
       bci::withMethodRate(config.classifier.pipeline, config.classifier.training.method);
   const bci::TrustRule rule{config.paradigm.learning_min_selections,
                             config.paradigm.learning_min_consistency};
+  // The session's dynamic stopping (its most sequences: all a recording's selection has).
+  const bci::StoppingRule stopping{config.paradigm.sequences, config.paradigm.min_sequences,
+                                   config.paradigm.certainty};
   const TimeModel time;
   Outcome all_cal, all_none;
   std::vector<int> cal_right(static_cast<size_t>(trials)), none_right(cal_right),
@@ -268,12 +306,13 @@ int main(int argc, char** argv) {
                    calibration + trials);
       return 1;
     }
-    const Outcome c =
-        calibrated(r, calibration, trials, from, pipeline, config.classifier.training, time);
+    const Outcome c = calibrated(r, calibration, trials, from, pipeline, config.classifier.training,
+                                 stopping, time);
     // --ceiling-only: the learning condition skipped (reported as the calibrated one).
-    const Outcome n = ceiling_only ? c
-                                   : learnt(r, calibration, trials, from, pipeline,
-                                            config.classifier.training, rule, time, trace);
+    const Outcome n = ceiling_only
+                          ? c
+                          : learnt(r, calibration, trials, from, pipeline,
+                                   config.classifier.training, rule, stopping, time, trace);
     if (trace) {
       std::fprintf(trace, "calibrated,%d,", r.index);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
