@@ -166,9 +166,12 @@ void Paradigm::endSequenceIfOver(double due_s) {
   // A selection repeated after an ErrP rejection shows all its sequences.
   const bool dynamic_stop = !calibrating_ && sequences_override_ == 0 && stop_requested_ &&
                             sequence_ >= settings_.min_sequences;
+  const int extended = settings_.learning_max_sequences > 0 ? settings_.learning_max_sequences
+                                                            : 2 * settings_.sequences;
   const int most = calibrating_              ? settings_.calibration_sequences
                    : sequences_override_ > 0 ? sequences_override_
-                                             : settings_.sequences;
+                   : extend_objects_ && phase_ == Phase::ObjectFlashing ? extended
+                                                                        : settings_.sequences;
   if (sequence_ < most && !dynamic_stop) {
     scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
   } else {
@@ -474,6 +477,10 @@ void Paradigm::modelTrained(bool ok, const std::string& text) {
 void Paradigm::holdArm(bool held, const std::string& why) {
   hold_arm_ = held;
   hold_why_ = why;
+}
+
+void Paradigm::extendObjectSelections(bool extend) {
+  extend_objects_ = extend;
 }
 
 void Paradigm::judgeHeldSelection(bool pending, bool act, const std::string& why) {

@@ -45,6 +45,10 @@ const core::Schema<ParadigmSettings>& paradigmSchema() {
         .integer("learning_min_selections", &P::learning_min_selections, 5, 2, 100,
                  "calibration none: the arm moves only once the model has learnt from this many "
                  "object selections")
+        .integer("learning_max_sequences", &P::learning_max_sequences, 0, 0, 100,
+                 "calibration none: once the model is trusted, an object selection flashes until "
+                 "as certain as paradigm.certainty asks (the arm acts on nothing less), up to "
+                 "this many sequences (0: twice sequences)")
         .number("learning_min_consistency", &P::learning_min_consistency, 0.8, 0.0, 1.0,
                 "calibration none: ... and once a model learnt from the other selections "
                 "decodes at least this share of them as the fit does (held out; chance is one "

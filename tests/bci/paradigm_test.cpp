@@ -275,6 +275,35 @@ TEST(Paradigm, AHeldSelectionWaitsForItsFitAndGoesToTheArmWhenThatFitTrustsIt) {
   EXPECT_EQ(p.trial(), 2);
 }
 
+TEST(Paradigm, ATrustedLearningObjectSelectionFlashesUpToTheLearningMostUntilStopped) {
+  ParadigmSettings s = fast();  // 3 sequences
+  s.trials = 3;
+  s.learning_max_sequences = 5;
+  Paradigm p(s, 4, 3, 3, 4);
+  p.holdArm(true, "learning");
+  p.extendObjectSelections(true);
+  std::int64_t frame = 0;
+  p.start(false);
+  const auto flashes = [](const std::vector<ParadigmEvent>& list) {
+    return std::count_if(list.begin(), list.end(),
+                         [](const ParadigmEvent& e) { return e.kind == Kind::Flash; });
+  };
+  // Never certain enough: all five sequences of four objects.
+  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 20);
+  // Certain after the minimum (3 here, the default): dynamic stopping ends it as ever.
+  p.decide(choose(1, {2}));
+  p.judgeHeldSelection(false, false, "learning");
+  runUntil(p, frame, [&] { return p.trial() == 2 && p.phase() == Phase::ObjectFlashing; });
+  p.requestStopFlashing();
+  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 12);
+  // Not trusted: `sequences`.
+  p.decide(choose(2, {3}));
+  p.judgeHeldSelection(false, false, "learning");
+  p.extendObjectSelections(false);
+  runUntil(p, frame, [&] { return p.phase() == Phase::ObjectFlashing; });
+  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 12);
+}
+
 TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {
   ParadigmSettings s = fast();
   s.sequences = 10;

@@ -395,7 +395,11 @@ bool ParadigmStage::untrusted(const Cycle& cycle) const {
 
 void ParadigmStage::followLearning(const Cycle& cycle) {
   const auto& learning = cycle.record.p300.learning;
-  if (settings_.learns) judgeHeldSelection(cycle);
+  if (settings_.learns) {
+    judgeHeldSelection(cycle);
+    // Trusted, a selection goes on until certain enough for the arm (dynamic stopping ends it).
+    paradigm_.extendObjectSelections(!untrusted(cycle) && settings_.paradigm.certainty > 0.0);
+  }
   if (!learning || learning == learning_seen_) return;
   learning_seen_ = learning;
   const auto object = [this](const std::map<int, int>& codes, int number) -> std::optional<int> {

@@ -52,9 +52,14 @@ struct ParadigmSettings {
   // selections learnt from, a leave-one-out consistency of at least `learning_min_consistency`
   // (bci/unsupervised.h), and its decoding of the earlier selections unchanged since the last fit
   // (but for a tenth of them).
+  // Once the model is trusted, an object selection goes on flashing until dynamic stopping ends it
+  // (the arm acts only on a selection at least `certainty` probable), up to
+  // `learning_max_sequences` (0: twice `sequences`): a selection the arm would be held for costs
+  // the trial, more sequences cost seconds.
   std::string calibration;
   int learning_min_selections;
   double learning_min_consistency;
+  int learning_max_sequences;
   // A calibrated session goes on learning from its object selections, the calibration run's
   // labels kept: the model is retrained after each with the labels EM finds for the rest.
   bool adapt;
@@ -200,6 +205,9 @@ class Paradigm {
   // ends there, the arm not sent (`why` is the trial's outcome); a selection decided without a
   // model (no choice) ends its trial at once. Read when a selection is made.
   void holdArm(bool held, const std::string& why);
+  // Learning from use, the model trusted: online object selections may flash up to
+  // `learning_max_sequences` (dynamic stopping ends them once certain); false: `sequences`.
+  void extendObjectSelections(bool extend);
   // A held object selection is fitted in with the rest once shown: while that fit is `pending`
   // the selection stays shown; when the fit came back trusted and decodes the selection as it was
   // shown (`act`), its trial goes on to the arm after all, instead of ending held (the selection
@@ -306,6 +314,7 @@ class Paradigm {
   bool giving_back_ = false;        // the put-down returns the object (no cell was accepted)
   int corrections_ = 0;
   bool hold_arm_ = false, held_now_ = false;  // asked; latched for the selection shown
+  bool extend_objects_ = false;               // extendObjectSelections's
   std::string hold_why_, held_why_;
   bool held_fit_pending_ = false, held_act_ = false;  // judgeHeldSelection's
   int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
