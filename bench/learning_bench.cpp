@@ -5,12 +5,17 @@
 // from use (paradigm.calibration none): the calibration run is not used; before trial k the model
 // is the one the session would hold (bci::learnFromUse over trials 1..k-1, their labels removed),
 // it decides trial k, and the arm goes only when the fit with trial k in (1..k) is trusted
-// (bci::judgeTrust) and decodes trial k as it was decided, as the session does. Per file and in
-// all: object selections right online (trials 11 on, as the issue counts them), arm sent to a
-// wrong object, post-hoc accuracy of the last fit, and the time from Start to the first right
-// placement, estimated from the session's default timing (TimeModel below; the robot's time is the
-// same in both). The session's own classifier settings (SessionConfig's defaults) are used.
-// Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
+// (bci::judgeTrust) and decodes trial k as it was decided, and that decision was as certain as
+// paradigm.certainty, as the session does. Decisions are made as the session makes them: scores
+// accumulated under the model's score model, dynamic stopping for the calibrated model and, once
+// trusted, for the learning one, whose selections may then flash up to
+// paradigm.learning_max_sequences (record that many per selection: `--sequences 16`); fits and
+// decisions see only the sequences a session would have shown. Per file and in all: object
+// selections right online (trials 11 on, as the issue counts them), arm sent to a wrong object,
+// post-hoc accuracy of the last fit, and the time from Start to the first right placement,
+// estimated from the session's default timing (TimeModel below; the robot's time is the same in
+// both). The session's own classifier settings (SessionConfig's defaults) are used. Usage:
+// learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
 //        [--ceiling-only]
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -38,9 +43,10 @@ struct TimeModel {
   double learning_trial_s = 8.5;
   double trial_s = 29.5;
   // A held selection that the fit with it in trusted and decoded as shown goes on to the arm: a
-  // whole trial whose object selection ran all its sequences and waited for that fit (an upper
-  // estimate: measure it again from a session's trial durations).
-  double held_then_sent_s = 32.5;
+  // whole trial whose object selection ran all its sequences and waited for that fit (the median
+  // duration of such trials in headless sessions). A selection that flashes more sequences than
+  // `sequences` (learning, trusted) adds their time to any of these.
+  double held_then_sent_s = 30.0;
 };
 
 struct Outcome {
@@ -58,6 +64,19 @@ struct Replay {
   bci::Recording recording;
   std::vector<int> number;    // each stimulus's selection (1-based)
   std::map<int, int> target;  // selection -> attended code
+  std::vector<int> sequence;  // each stimulus's sequence within its selection (0-based)
+};
+
+// How many sequences of each selection the session would have shown (a recording may hold
+// more): the rest are left out of every fit and decision.
+struct Shown {
+  explicit Shown(int all) : otherwise(all) {}
+  int otherwise;
+  std::map<int, int> of;  // selection -> sequences, where it differs
+  int at(int number) const {
+    const auto found = of.find(number);
+    return found != of.end() ? found->second : otherwise;
+  }
 };
 
 // Selections: runs of flashes apart by more than four stimulus onsets (as buildDataset groups).
@@ -68,22 +87,30 @@ Replay load(const std::string& file) {
   const double gap = std::max(1.0, 4.0 * soa) * r.recording.info.rate_hz;
   int selection = 0;
   std::int64_t previous = -1;
+  std::map<int, int> flashed;  // of the selection: code -> times
   for (const bci::StimulusEvent& e : r.recording.stimuli) {
-    if (previous < 0 || static_cast<double>(e.sample - previous) > gap) ++selection;
+    if (previous < 0 || static_cast<double>(e.sample - previous) > gap) {
+      ++selection;
+      flashed.clear();
+    }
     previous = e.sample;
     r.number.push_back(selection);
+    r.sequence.push_back(flashed[e.code]++);
     if (e.target) r.target[selection] = e.code;
   }
   return r;
 }
 
-// The recording with only the stimuli of selections [first, last], labels removed unless `keep`.
-std::pair<bci::Recording, std::vector<int>> part(const Replay& r, int first, int last, bool keep) {
+// The recording with only the stimuli of selections [first, last] the session would have shown,
+// labels removed unless `keep`.
+std::pair<bci::Recording, std::vector<int>> part(const Replay& r, int first, int last, bool keep,
+                                                 const Shown& shown) {
   bci::Recording out = r.recording;
   out.stimuli.clear();
   std::vector<int> numbers;
   for (size_t i = 0; i < r.recording.stimuli.size(); ++i) {
     if (r.number[i] < first || r.number[i] > last) continue;
+    if (r.sequence[i] >= shown.at(r.number[i])) continue;
     bci::StimulusEvent e = r.recording.stimuli[i];
     if (!keep) e.target = e.known = false;
     out.stimuli.push_back(e);
@@ -93,8 +120,8 @@ std::pair<bci::Recording, std::vector<int>> part(const Replay& r, int first, int
 }
 
 std::map<int, int> decode(const bci::P300Model& model, const Replay& r, int first, int last,
-                          const bci::PipelineSettings& pipeline) {
-  const auto [recording, numbers] = part(r, first, last, false);
+                          const bci::PipelineSettings& pipeline, const Shown& shown) {
+  const auto [recording, numbers] = part(r, first, last, false, shown);
   return bci::decodeSelections(model, recording, numbers, pipeline);
 }
 
@@ -104,10 +131,11 @@ std::map<int, int> decode(const bci::P300Model& model, const Replay& r, int firs
 struct Online {
   std::optional<int> code;
   double certainty = 0.0;
+  int sequences = 0;
 };
 Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
                     const bci::PipelineSettings& pipeline, const bci::StoppingRule& rule) {
-  const auto [recording, numbers] = part(r, number, number, false);
+  const auto [recording, numbers] = part(r, number, number, false, Shown{rule.max_sequences});
   bci::DatasetOptions options;
   options.keep_unknown = true;
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline, {}, options);
@@ -122,6 +150,7 @@ Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
   const bci::Decision d = accumulator.decide();
   if (!d.codes.empty() && accumulator.flashes() > 0) out.code = *d.codes.begin();
   out.certainty = d.certainty;
+  out.sequences = accumulator.completeSequences();
   return out;
 }
 
@@ -129,7 +158,7 @@ Outcome calibrated(const Replay& r, int calibration, int trials, int from,
                    const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                    const bci::StoppingRule& stopping, const TimeModel& time) {
   Outcome o;
-  const auto [recording, numbers] = part(r, 1, calibration, true);
+  const auto [recording, numbers] = part(r, 1, calibration, true, Shown{stopping.max_sequences});
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
   const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
   double t = calibration * time.calibration_selection_s + time.training_s;
@@ -153,7 +182,7 @@ Outcome calibrated(const Replay& r, int calibration, int trials, int from,
 
 // The ceiling of any learning without labels: before trial k, a model trained on trials 1..k-1
 // with their true labels (none before two). Per trial: decided right.
-std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials,
+std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials, const Shown& shown,
                               const bci::PipelineSettings& pipeline,
                               const bci::TrainingSettings& training) {
   std::vector<bool> right_at;
@@ -162,10 +191,10 @@ std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials,
     bool right = false;
     if (k > 2) {
       try {
-        const auto [recording, numbers] = part(r, calibration + 1, number - 1, true);
+        const auto [recording, numbers] = part(r, calibration + 1, number - 1, true, shown);
         const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
         const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
-        const auto d = decode(model, r, number, number, pipeline);
+        const auto d = decode(model, r, number, number, pipeline, shown);
         right = d.count(number) && d.at(number) == r.target.at(number);
       } catch (const std::exception&) {
         // Too little to train on.
@@ -178,26 +207,34 @@ std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials,
 
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
-               const bci::TrustRule& rule, const bci::StoppingRule& stopping, const TimeModel& time,
-               std::FILE* trace) {
+               const bci::TrustRule& rule, const bci::StoppingRule& stopping,
+               int extended_sequences, const TimeModel& time, std::FILE* trace) {
   Outcome o;
+  const bci::ParadigmLayout layout = bci::layoutOf(r.recording);
+  Shown shown{stopping.max_sequences};
   std::optional<bci::LearnedSelections> fit;
   bci::Trust trust;
   std::map<int, int> before;  // the last fit's decodings (number -> choice)
   double t = 0.0;
   for (int k = 1; k <= trials; ++k) {
     const int number = calibration + k;
-    // Trusted before it: its selection stops early (dynamic stopping) like a calibrated trial's;
-    // untrusted, it shows all its sequences.
+    // Trusted before it: its selection flashes until dynamic stopping ends it, up to the
+    // learning's most sequences (paradigm.learning_max_sequences); untrusted, it shows all of
+    // `sequences` (data to learn from).
     const bool trusted_before = fit && trust.trusted;
     bci::StoppingRule rule_now = stopping;
-    if (!trusted_before) rule_now.certainty = 0.0;
+    if (trusted_before)
+      rule_now.max_sequences = extended_sequences;
+    else
+      rule_now.certainty = 0.0;
     std::optional<int> decision;
-    double certainty = 0.0;
+    double certainty = 0.0, extra_s = 0.0;
     if (fit) {
       const Online d = decideOnline(fit->model, r, number, pipeline, rule_now);
       decision = d.code;
       certainty = d.certainty;
+      shown.of[number] = d.sequences;
+      extra_s = std::max(0, d.sequences - stopping.max_sequences) * layout.stimuli * layout.soa_s;
     }
     const bool right = decision && *decision == r.target.at(number);
     if (k >= from) {
@@ -205,12 +242,11 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       o.online_right += right;
     }
     o.right_at.push_back(right);
-    // The session fits again with this selection in (here with all its flashes, where the session
-    // has those shown before it stopped); the arm acts on the selection only when that fit is
-    // trusted and decodes it as it was shown, and the decision was as certain as dynamic stopping
-    // asks (ParadigmStage::judgeHeldSelection).
+    // The session fits again with this selection in (as shown); the arm acts on the selection only
+    // when that fit is trusted and decodes it as it was shown, and the decision was as certain as
+    // dynamic stopping asks (ParadigmStage::judgeHeldSelection).
     bool sent = false;
-    const auto [recording, numbers] = part(r, calibration + 1, number, false);
+    const auto [recording, numbers] = part(r, calibration + 1, number, false, shown);
     try {
       bci::LearnedSelections next =
           bci::learnFromUse(recording, numbers, {}, before, pipeline, training);
@@ -219,11 +255,11 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
           !next.numbers.empty() && next.numbers.back() == number ? next.choice.back() + 1 : 0;
       sent = decision && trust.trusted && fitted == *decision && certainty >= stopping.certainty;
       if (trace)
-        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d,%.6f,%.6f\n", r.index, k,
-                     decision ? *decision : 0, r.target.at(number), next.numbers.size(),
+        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d,%.6f,%.6f,%d\n", r.index,
+                     k, decision ? *decision : 0, r.target.at(number), next.numbers.size(),
                      next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
                      trust.changed.size(), trust.trusted, fitted, certainty,
-                     next.posterior.empty() ? 0.0 : next.posterior.back());
+                     next.posterior.empty() ? 0.0 : next.posterior.back(), shown.at(number));
       before.clear();
       for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
       fit = std::move(next);
@@ -235,10 +271,10 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       ++o.arm_sent;
       o.arm_wrong += !right;
       if (!o.first_trusted) o.first_trusted = k;
-      t += trusted_before ? time.trial_s : time.held_then_sent_s;
+      t += (trusted_before ? time.trial_s : time.held_then_sent_s) + extra_s;
       if (right && o.first_right_s < 0.0) o.first_right_s = t;
     } else {
-      t += time.learning_trial_s;
+      t += time.learning_trial_s + extra_s;
     }
   }
   if (fit) {
@@ -277,9 +313,10 @@ int main(int argc, char** argv) {
   cli.add_option("--trace", trace_file,
                  "write per trial of the learning condition: file index, trial, decision, "
                  "target, selections fitted, consistency, shuffles beaten, p3 uV, changed, "
-                 "trusted (after the fit with that trial in), that fit's decoding of it; and per "
-                 "file, each trial decided "
-                 "right by the calibrated model and by one trained on the trials before with "
+                 "trusted (after the fit with that trial in), that fit's decoding of it, the "
+                 "online decision's certainty, that fit's posterior of its decoding, the "
+                 "sequences shown; and per file, each trial decided right by the calibrated model "
+                 "and by one trained on the trials before with "
                  "their true labels (the ceiling of learning without them)");
   cli.add_flag("--ceiling-only", ceiling_only,
                "trace the calibrated model and the labels-known ceiling only (no learning: fast)");
@@ -293,6 +330,9 @@ int main(int argc, char** argv) {
   // The session's dynamic stopping (its most sequences: all a recording's selection has).
   const bci::StoppingRule stopping{config.paradigm.sequences, config.paradigm.min_sequences,
                                    config.paradigm.certainty};
+  const int extended = config.paradigm.learning_max_sequences > 0
+                           ? config.paradigm.learning_max_sequences
+                           : 2 * config.paradigm.sequences;
   const TimeModel time;
   Outcome all_cal, all_none;
   std::vector<int> cal_right(static_cast<size_t>(trials)), none_right(cal_right),
@@ -309,15 +349,16 @@ int main(int argc, char** argv) {
     const Outcome c = calibrated(r, calibration, trials, from, pipeline, config.classifier.training,
                                  stopping, time);
     // --ceiling-only: the learning condition skipped (reported as the calibrated one).
-    const Outcome n = ceiling_only
-                          ? c
-                          : learnt(r, calibration, trials, from, pipeline,
-                                   config.classifier.training, rule, stopping, time, trace);
+    const Outcome n =
+        ceiling_only ? c
+                     : learnt(r, calibration, trials, from, pipeline, config.classifier.training,
+                              rule, stopping, extended, time, trace);
     if (trace) {
       std::fprintf(trace, "calibrated,%d,", r.index);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
       std::fprintf(trace, "\nknown,%d,", r.index);
-      for (bool right : labelsKnown(r, calibration, trials, pipeline, config.classifier.training))
+      for (bool right : labelsKnown(r, calibration, trials, Shown{stopping.max_sequences}, pipeline,
+                                    config.classifier.training))
         std::fputc(right ? '1' : '0', trace);
       std::fputc('\n', trace);
       std::fflush(trace);
