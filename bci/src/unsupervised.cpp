@@ -97,14 +97,16 @@ double expectation(const Problem& pr, const Eigen::VectorXd& odds, Eigen::Vector
   return change;
 }
 
-// One EM run from a random projection, or (`initial`: a choice per selection, -1 where none)
-// from a decoding.
+// One EM run from a random projection, or from `projection` (the textbook P300 as a matched
+// filter), or (`initial`: a choice per selection, -1 where none) from a decoding.
 Start runStart(const Problem& pr, const Eigen::LDLT<Eigen::MatrixXd>& covariance,
                std::mt19937_64& random, int max_iterations,
-               const std::vector<int>* initial = nullptr) {
+               const std::vector<int>* initial = nullptr,
+               const Eigen::VectorXd* projection = nullptr) {
   std::normal_distribution<double> normal;
   Eigen::VectorXd w(pr.x.cols());
   for (Eigen::Index i = 0; i < w.size(); ++i) w[i] = normal(random);
+  if (projection) w = *projection;
   Eigen::VectorXd y = pr.x * w;
   // The first log-odds: the random projection, standardised; or the decoding given, firmly.
   const double sd = std::sqrt(y.squaredNorm() / static_cast<double>(y.size()));
@@ -256,9 +258,20 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   double shrinkage = 0.0;
   const Eigen::LDLT<Eigen::MatrixXd> covariance = ledoitWolfCovariance(pr.x, shrinkage).ldlt();
   std::mt19937_64 random(options.seed);
-  std::vector<Start> starts;
-  for (int r = 0; r < options.restarts; ++r)
-    starts.push_back(runStart(pr, covariance, random, options.max_iterations));
+  // A start from the textbook P300 (known before any data): with few selections most random
+  // starts settle on a labelling of noise or the mirror, and this one starts near the response.
+  const bool has_template =
+      options.p300_direction.size() == pr.x.cols() && options.p300_direction.squaredNorm() > 0.0;
+  const auto starting = [&](const Problem& problem) {
+    std::vector<Start> out;
+    for (int r = 0; r < options.restarts; ++r)
+      out.push_back(runStart(problem, covariance, random, options.max_iterations));
+    if (has_template)
+      out.push_back(runStart(problem, covariance, random, options.max_iterations, nullptr,
+                             &options.p300_direction));
+    return out;
+  };
+  std::vector<Start> starts = starting(pr);
   // The most likely start: the labels that explain most of the data's variance. A start may settle
   // on the mirror solution (each selection's least P300-like stimulus as its target), a fixed
   // point too, but one that explains less.
@@ -291,11 +304,10 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
     int same = 0;
     for (size_t s = 0; s < pr.rows.size(); ++s) {
       const Problem rest = without(pr, s);
-      std::vector<Start> again, admissible;
-      for (int r = 0; r < options.restarts; ++r) {
-        again.push_back(runStart(rest, covariance, random, options.max_iterations));
-        if (positive(rest, again.back())) admissible.push_back(again.back());
-      }
+      const std::vector<Start> again = starting(rest);
+      std::vector<Start> admissible;
+      for (const Start& start : again)
+        if (positive(rest, start)) admissible.push_back(start);
       same += decode(pr, s, best(admissible.empty() ? again : admissible).w) == start.choice[s];
     }
     return static_cast<double>(same) / static_cast<double>(pr.rows.size());
@@ -316,10 +328,15 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
                                   [&](size_t c) { return starts[c].choice == starts[i].choice; });
     if (!seen) candidates.push_back(i);
   }
-  if (warm && options.held_out && pr.rows.size() >= 2 &&
-      std::none_of(candidates.begin(), candidates.end(),
-                   [&](size_t c) { return starts[c].choice == starts.back().choice; }))
-    candidates.push_back(starts.size() - 1);
+  // The warm start and the template's are candidates too, however much they explain.
+  const auto offer = [&](size_t i) {
+    if (options.held_out && pr.rows.size() >= 2 &&
+        std::none_of(candidates.begin(), candidates.end(),
+                     [&](size_t c) { return starts[c].choice == starts[i].choice; }))
+      candidates.push_back(i);
+  };
+  if (has_template) offer(static_cast<size_t>(options.restarts));
+  if (warm) offer(starts.size() - 1);
   size_t keep = candidates.front();
   double kept_consistency = 0.0;
   if (options.held_out && pr.rows.size() >= 2) {
@@ -363,10 +380,7 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
         for (size_t i = 0; i < rows.size(); ++i)
           shuffled.code[static_cast<size_t>(rows[i])] = codes[i];
       }
-      std::vector<Start> null;
-      for (int r = 0; r < options.restarts; ++r)
-        null.push_back(runStart(shuffled, covariance, random, options.max_iterations));
-      const double explained = best(null).explained;
+      const double explained = best(starting(shuffled)).explained;
       fit.shuffled_explained = std::max(fit.shuffled_explained, explained);
       fit.beats_shuffled += kept.explained > explained;
     }
