@@ -384,6 +384,8 @@ void ParadigmStage::decideIfReady(const Cycle& cycle) {
   if (online && p300.model && !untrusted(cycle) && p.certainty > 0.0 &&
       sequences >= p.min_sequences && p300.decision.certainty >= p.certainty) {
     paradigm_.requestStopFlashing();
+    if (!p300.decision.codes.empty())
+      stopped_certain_ = std::pair{selection_, *p300.decision.codes.begin()};
   }
   if (paradigm_.awaitingDecision() && scored) paradigm_.decide(p300.decision);
 }
@@ -424,7 +426,8 @@ void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
   // The selection shown now (selection_) is being fitted in with the rest, or will be. The arm acts
   // on it only when that fit is trusted and decodes it as it was shown (the model that decided it
   // online and the one that learnt from it agree), and when the online decision was itself as
-  // certain as dynamic stopping asks. The fit's own posterior cannot say that: a selection fitted
+  // certain as dynamic stopping asks (when it stopped the selection, or at its end). The fit's
+  // own posterior cannot say that: a selection fitted
   // with the rest is explained by the model it helped to make, and almost always looks certain.
   const bool pending =
       learning->awaited_through >= selection_ && learning->fitted_through < selection_;
@@ -433,8 +436,10 @@ void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
   const bool as_shown =
       post_hoc != learning->post_hoc.end() && stimulus_.selected_object == post_hoc->second;
   const TrialRecord* trial = trials_.find(paradigm_.trial());
-  const bool certain =
-      trial && trial->object_certainty >= settings_.paradigm.certainty;  // 0: no such gate
+  const bool stopped_certain = stopped_certain_ && stopped_certain_->first == selection_ &&
+                               stimulus_.selected_object == stopped_certain_->second;
+  const bool certain = stopped_certain || (trial && trial->object_certainty >=
+                                                        settings_.paradigm.certainty);  // 0: none
   const bool act = fitted && learning->trusted && as_shown && certain;
   const char* why = kArmHeld;
   if (fitted && post_hoc == learning->post_hoc.end() && !learning->error.empty())

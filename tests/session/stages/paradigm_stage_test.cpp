@@ -669,6 +669,28 @@ TEST_F(CertainLearningParadigmStageTest, AnUncertainSelectionIsHeldThoughItsTrus
   EXPECT_EQ(postedOf<GraspRequest>()[0].object, config_.world.objects[1].id);
 }
 
+TEST_F(CertainLearningParadigmStageTest, ASelectionDynamicStoppingEndedAsCertainGoesToTheArm) {
+  model_ = trainedModel();
+  learn(0, 0, true, {});
+  begin();
+  decide_ = 2;
+  certainty_ = 0.9;
+  // Three sequences (of four objects) shown and scored, the decision then certain enough:
+  // dynamic stopping ends the selection. The flashes still being scored lower its certainty
+  // below paradigm.certainty; it goes to the arm all the same, as decided when it stopped.
+  for (int i = 0; i < 60 * 30 && flashes_ < 12; ++i) step();
+  cycle([&](CycleRecord& r) {
+    r.p300.learning = learning_;
+    r.p300.sequences = 3;
+    r.p300.decision.certainty = 0.99;
+  });
+  selectAndConfirm(1);
+  EXPECT_EQ(bench_.previous.paradigm.phase, bci::Phase::Grasping);
+  ASSERT_EQ(postedOf<GraspRequest>().size(), 1u);
+  ASSERT_TRUE(bench_.previous.paradigm.trials);
+  EXPECT_LT(bench_.previous.paradigm.trials->at(0).object_certainty, 0.95);
+}
+
 class ErrpParadigmStageTest : public ParadigmStageTest {
  protected:
   static SessionConfig withErrp() {

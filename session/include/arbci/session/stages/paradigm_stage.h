@@ -151,6 +151,9 @@ class ParadigmStage final : public Stage {
   bool selection_objects_ = true;
   std::set<int> truth_;
   int selection_flashes_ = 0;
+  // Dynamic stopping ended this selection on this code: certain enough then, as the certainty
+  // condition of learning's arm asks, though the flashes still being scored may lower it a little.
+  std::optional<std::pair<int, int>> stopped_certain_;  // (selection, code)
   bool retrying_ = false;  // the experimenter's Retry step is being carried out
   std::optional<ParadigmPart::Review> review_;  // the calibration awaiting the experimenter
   int calibration_round_ = 1;
