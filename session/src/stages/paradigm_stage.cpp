@@ -397,13 +397,13 @@ bool ParadigmStage::untrusted(const Cycle& cycle) const {
 
 void ParadigmStage::followLearning(const Cycle& cycle) {
   const auto& learning = cycle.record.p300.learning;
-  if (settings_.learns) {
-    judgeHeldSelection(cycle);
-    // Trusted, a selection goes on until certain enough for the arm (dynamic stopping ends it).
-    paradigm_.extendObjectSelections(!untrusted(cycle) && settings_.paradigm.certainty > 0.0);
-  }
+  if (settings_.learns) judgeHeldSelection(cycle);
   if (!learning || learning == learning_seen_) return;
   learning_seen_ = learning;
+  // Trusted (judged once per fit), a selection goes on until certain enough for the arm: dynamic
+  // stopping ends it.
+  if (settings_.learns)
+    paradigm_.extendObjectSelections(learning->trusted && settings_.paradigm.certainty > 0.0);
   const auto object = [this](const std::map<int, int>& codes, int number) -> std::optional<int> {
     const auto code = codes.find(number);
     const auto selection = learnt_.find(number);
@@ -427,8 +427,8 @@ void ParadigmStage::judgeHeldSelection(const Cycle& cycle) {
   // on it only when that fit is trusted and decodes it as it was shown (the model that decided it
   // online and the one that learnt from it agree), and when the online decision was itself as
   // certain as dynamic stopping asks (when it stopped the selection, or at its end). The fit's
-  // own posterior cannot say that: a selection fitted
-  // with the rest is explained by the model it helped to make, and almost always looks certain.
+  // own posterior cannot say that: a selection fitted with the rest is explained by the model it
+  // helped to make, and almost always looks certain.
   const bool pending =
       learning->awaited_through >= selection_ && learning->fitted_through < selection_;
   const bool fitted = !pending && learning->fitted_through >= selection_;
