@@ -361,7 +361,9 @@ TEST(Session, WithoutACalibrationRunItLearnsFromItsTrialsAndHoldsTheArmUntilTrus
     EXPECT_TRUE(t["post_hoc_object"].is_number()) << t.dump();
   }
   EXPECT_EQ(learning["trials_arm_held"], held);
-  EXPECT_GE(held, 5);  // learning_min_selections: no arm before five selections learnt from
+  // learning_min_selections: no arm before five selections are learnt from (the fifth's own fit
+  // may send it).
+  EXPECT_GE(held, 4);
   // A fit after each selection, off the cycle's thread, logged with its measures of trust.
   int fits = 0;
   for (const auto& line : readLog(folder / "log.jsonl")) {
