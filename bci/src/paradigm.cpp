@@ -256,7 +256,7 @@ void Paradigm::advanceTimedPhase(double due_s) {
           held_act_ = false;
           askRobot(Phase::Grasping);
         } else {
-          nextTrial(now_ + settings_.pause_s, held_why_);
+          nextTrial(now_ + settings_.pause_s, held_why_, true);
         }
       } else if (!verdict_pending_) {
         askRobot(phase_ == Phase::ObjectSelected ? Phase::Grasping : Phase::Dropping);
@@ -369,7 +369,8 @@ void Paradigm::decide(const Decision& decision) {
   if (phase_ != Phase::ObjectFlashing && phase_ != Phase::CellFlashing) return;
   if (decision.choice < 0) {
     // No model to decide with yet (learning from use, before its first fit).
-    nextTrial(now_ + settings_.pause_s, hold_why_.empty() ? "no model to decide with" : hold_why_);
+    nextTrial(now_ + settings_.pause_s, hold_why_.empty() ? "no model to decide with" : hold_why_,
+              hold_arm_);
     return;
   }
   last_decision_ = decision;
@@ -513,9 +514,10 @@ void Paradigm::robotFinished(bool success, const std::string& text) {
   nextTrial(now_ + settings_.pause_s, "");
 }
 
-void Paradigm::nextTrial(double at_s, const std::string& why) {
+void Paradigm::nextTrial(double at_s, const std::string& why, bool arm_held) {
   ParadigmEvent done{ParadigmEvent::Kind::TrialDone};
   done.text = why;
+  done.arm_held = arm_held;
   event(done);
   selected_object_.reset();
   selected_cell_.reset();

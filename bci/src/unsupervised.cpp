@@ -105,6 +105,7 @@ Start runStart(const Problem& pr, const Eigen::LDLT<Eigen::MatrixXd>& covariance
                const Eigen::VectorXd* projection = nullptr) {
   std::normal_distribution<double> normal;
   Eigen::VectorXd w(pr.x.cols());
+  // Every start takes the same numbers from the stream, whichever kind it is.
   for (Eigen::Index i = 0; i < w.size(); ++i) w[i] = normal(random);
   if (projection) w = *projection;
   Eigen::VectorXd y = pr.x * w;
@@ -190,11 +191,16 @@ Problem without(const Problem& pr, size_t s) {
   return out;
 }
 
+// A direction in the problem's feature space (UnsupervisedOptions::p300_direction) is given.
+bool hasDirection(const Problem& pr, const Eigen::VectorXd& direction) {
+  return direction.size() == pr.x.cols() && direction.squaredNorm() > 0.0;
+}
+
 // Target minus non-target by the decoding `choice`, projected on `direction` in units of it (what
-// UnsupervisedFit::p300_uv says); none without a direction of the features' size.
+// UnsupervisedFit::p300_uv says); none without a direction.
 std::optional<double> alongP300(const Problem& pr, const std::vector<int>& choice,
                                 const Eigen::VectorXd& direction) {
-  if (direction.size() != pr.x.cols() || direction.squaredNorm() <= 0.0) return std::nullopt;
+  if (!hasDirection(pr, direction)) return std::nullopt;
   Eigen::RowVectorXd target = Eigen::RowVectorXd::Zero(pr.x.cols());
   Eigen::RowVectorXd other = target;
   int targets = 0, others = 0;
@@ -260,8 +266,7 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   std::mt19937_64 random(options.seed);
   // A start from the textbook P300 (known before any data): with few selections most random
   // starts settle on a labelling of noise or the mirror, and this one starts near the response.
-  const bool has_template =
-      options.p300_direction.size() == pr.x.cols() && options.p300_direction.squaredNorm() > 0.0;
+  const bool has_template = hasDirection(pr, options.p300_direction);
   const auto starting = [&](const Problem& problem) {
     std::vector<Start> out;
     for (int r = 0; r < options.restarts; ++r)
@@ -306,8 +311,8 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
       const Problem rest = without(pr, s);
       const std::vector<Start> again = starting(rest);
       std::vector<Start> admissible;
-      for (const Start& start : again)
-        if (positive(rest, start)) admissible.push_back(start);
+      for (const Start& refit : again)
+        if (positive(rest, refit)) admissible.push_back(refit);
       same += decode(pr, s, best(admissible.empty() ? again : admissible).w) == start.choice[s];
     }
     return static_cast<double>(same) / static_cast<double>(pr.rows.size());

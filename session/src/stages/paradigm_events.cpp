@@ -246,7 +246,7 @@ void ParadigmStage::onRobotDrop(const bci::ParadigmEvent& e, Cycle& cycle) {
 
 void ParadigmStage::onTrialDone(const bci::ParadigmEvent& e, Cycle& cycle) {
   trials_.done(e.trial, cycle.time_s, e.text);
-  if (armHeldOutcome(e.text)) trials_.at(e.trial).arm_held = true;
+  if (e.arm_held) trials_.at(e.trial).arm_held = true;
   s_.log.write("trial_done", cycle.time_s, {{"trial", e.trial}, {"text", e.text}});
   if (const TrialRecord* done = trials_.find(e.trial))
     s_.tell.say(cycle.time_s, Severity::Info, selectionLine(*done));

@@ -149,6 +149,7 @@ struct ParadigmEvent {
   std::set<int> codes;
   bool objects_layout = true;  // the selection's stimuli are objects (else grid rows/columns)
   bool give_back = false;
+  bool arm_held = false;  // TrialDone: ended with the arm held (learning from use; text says why)
   double certainty = 0.0;
   int trial = 0;
   std::string text;
@@ -254,7 +255,7 @@ class Paradigm {
   // selection retaken.
   void returnToFlashing(Phase phase);
   void retakeCalibrationSelection();
-  void nextTrial(double at_s, const std::string& why);
+  void nextTrial(double at_s, const std::string& why, bool arm_held = false);
   void askRobot(Phase phase);  // Grasping or Dropping, with its command
   // frame()'s parts: a sequence over starts the next or ends the flashing; the flash due shown
   // (true) and those still lit; a timed phase (cue, feedback, selection shown) over moves on; what

@@ -4,13 +4,14 @@
 // being a target (a one-dimensional Gaussian model of w.x per class) summed over the epochs of
 // each choice give the posterior of each choice; given the posteriors, each epoch's probability of
 // being a target weights the class means, and w = S^-1 (mean_target - mean_other) with S the
-// covariance of all epochs, which needs no label (shrunk by the Ledoit-Wolf intensity). Several
-// starts from random projections, one from the textbook P300 as a matched filter (when
-// UnsupervisedOptions::p300_direction is given) and one from an earlier decoding (when given);
-// the shuffled and held-out fits start alike. Whether a
-// decoding is the P300 or a labelling of noise: fitted again without each selection in turn, does
-// the fit decode that selection as before (UnsupervisedFit::consistency)? Of the most likely
-// decodings (most variance explained) the most consistent is kept. Labels are never read.
+// covariance of all epochs, which needs no label (shrunk by the Ledoit-Wolf intensity).
+// Starts: several random projections; the textbook P300 as a matched filter, when
+// UnsupervisedOptions::p300_direction is given (with few selections most random starts settle on
+// noise); an earlier decoding, when given. The held-out and shuffled fits get the same kinds of
+// start, so that neither side of those comparisons has one the other lacks. Whether a decoding
+// is the P300 or a labelling of noise: fitted again without each selection in turn, does the fit
+// decode that selection as before (UnsupervisedFit::consistency)? Of the most likely decodings
+// (most variance explained) the most consistent is kept. Labels are never read.
 #pragma once
 
 #include <cstdint>

@@ -21,7 +21,6 @@
 #include <optional>
 #include <set>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "arbci/bci/paradigm.h"
@@ -65,11 +64,6 @@ inline constexpr const char* kArmHeldUncertain =
 inline constexpr const char* kArmHeldFitFailed =
     "learning: the fit with this selection in failed (see the log's learning_fit_failed), so the "
     "arm was not sent";
-// Whether a trial's outcome is one of the above.
-inline bool armHeldOutcome(std::string_view outcome) {
-  return outcome == kArmHeld || outcome == kArmHeldUnconfirmed || outcome == kArmHeldUncertain ||
-         outcome == kArmHeldFitFailed;
-}
 
 // What each stimulus code of the recording stands for: "1=object 20;2=object 40;...;101=row 1;
 // ...;104=column 1;..." (object codes k for world.objects[slots[k - 1]], grid codes 100 + code).
