@@ -32,11 +32,15 @@ const std::map<std::string, Polar>& table() {
 
 }  // namespace
 
-std::optional<std::pair<double, double>> electrodePosition(const std::string& name) {
+std::string electrodeKey(const std::string& name) {
   std::string key = name;
   std::transform(key.begin(), key.end(), key.begin(),
                  [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  const auto found = table().find(key);
+  return key;
+}
+
+std::optional<std::pair<double, double>> electrodePosition(const std::string& name) {
+  const auto found = table().find(electrodeKey(name));
   if (found == table().end()) return std::nullopt;
   const double theta = found->second.theta_deg * M_PI / 180.0;
   return std::make_pair(found->second.radius * std::sin(theta),

@@ -1,11 +1,11 @@
 #include "arbci/bci/p300_template.h"
 
-#include <cctype>
 #include <cmath>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "arbci/bci/electrode_positions.h"
 #include "arbci/bci/epocher.h"
 #include "arbci/bci/filters.h"
 
@@ -16,9 +16,7 @@ Eigen::VectorXd p300Template(const PipelineSettings& settings, const SignalInfo&
   const FeatureExtractor extractor(settings, info);
   std::vector<int> parietal;
   for (int c : extractor.channelIndices()) {
-    std::string name = info.channels[static_cast<size_t>(c)];
-    for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-    if (sites.count(name)) parietal.push_back(c);
+    if (sites.count(electrodeKey(info.channels[static_cast<size_t>(c)]))) parietal.push_back(c);
   }
   if (parietal.empty()) return {};
   // One response three seconds in (the filters settled), in five seconds of signal, cut by the

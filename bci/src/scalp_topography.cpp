@@ -1,14 +1,13 @@
 #include "scalp_topography.h"
 
 #include <algorithm>
-#include <cctype>
+
+#include "arbci/bci/electrode_positions.h"
 
 namespace arbci::bci {
 
 ScalpWeights scalpWeights(const std::string& electrode) {
-  std::string name;
-  for (char c : electrode)
-    name.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+  const std::string name = electrodeKey(electrode);
   const bool midline = !name.empty() && name.back() == 'Z';
   auto starts = [&](const char* prefix) { return name.rfind(prefix, 0) == 0; };
   ScalpWeights w;

@@ -9,6 +9,10 @@
 
 namespace arbci::bci {
 
+// An electrode's name as the tables here and elsewhere key it (upper case): montages spell the
+// same site "Pz", "PZ" or "pz".
+std::string electrodeKey(const std::string& name);
+
 // (x, y): x to the right ear, y to the nose; none for a name not in the table (case-insensitive;
 // the old names T3, T4, T5, T6 are known too).
 std::optional<std::pair<double, double>> electrodePosition(const std::string& name);
