@@ -14,13 +14,16 @@
 // selections right online (trials 11 on, as the issue counts them), arm sent to a wrong object,
 // post-hoc accuracy of the last fit, and the time from Start to the first right placement,
 // estimated from the session's default timing (TimeModel below; the robot's time is the same in
-// both). The session's own classifier settings (SessionConfig's defaults) are used. Usage:
-// learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
+// both); beside them, the soonest any learner that waits for certainty could place, its models
+// trained with the true labels (certainCeiling). The session's own classifier settings
+// (SessionConfig's defaults) are used. Usage: learning_bench FILES... [--calibration 8] [--trials
+// 30] [--from 11] [--trace F]
 //        [--ceiling-only]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <string>
 
 #include "arbci/bci/intervals.h"
 #include "arbci/bci/learning_from_use.h"
@@ -205,6 +208,38 @@ std::vector<bool> labelsKnown(const Replay& r, int calibration, int trials, cons
   return right_at;
 }
 
+// The soonest any learner that waits for certainty can place an object right: before trial k, a
+// model trained on trials 1..k-1 with their true labels (as shown: `sequences` each) decides trial
+// k with dynamic stopping up to `extended` sequences; the first decision both right and as certain
+// as the rule asks is placed, on that trial, the trials before counted as learning trials (none of
+// them extended). The learner without labels can only be later: its models are at best these.
+// Seconds from Start, -1: never.
+double certainCeiling(const Replay& r, int calibration, int trials,
+                      const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
+                      const bci::StoppingRule& stopping, int extended, const TimeModel& time) {
+  const bci::ParadigmLayout layout = bci::layoutOf(r.recording);
+  bci::StoppingRule rule = stopping;
+  rule.max_sequences = extended;
+  for (int k = 3; k <= trials; ++k) {
+    const int number = calibration + k;
+    try {
+      const auto [recording, numbers] =
+          part(r, calibration + 1, number - 1, true, Shown{stopping.max_sequences});
+      const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+      const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
+      const Online d = decideOnline(model, r, number, pipeline, rule);
+      if (d.code && *d.code == r.target.at(number) && d.certainty >= stopping.certainty) {
+        const double extra_s =
+            std::max(0, d.sequences - stopping.max_sequences) * layout.stimuli * layout.soa_s;
+        return (k - 1) * time.learning_trial_s + time.trial_s + extra_s;
+      }
+    } catch (const std::exception&) {
+      // Too little to train on.
+    }
+  }
+  return -1.0;
+}
+
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                const bci::TrustRule& rule, const bci::StoppingRule& stopping,
@@ -286,14 +321,16 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
   return o;
 }
 
+std::string seconds(double s) {
+  return s < 0 ? "never" : std::to_string(static_cast<int>(s)) + " s";
+}
+
 void line(const char* what, const Outcome& o) {
   std::printf(
       "  %-10s online %2d/%-2d  arm %2d sent, %d wrong  post hoc %2d/%-2d  first trusted %2d"
       "  first right placement %s\n",
       what, o.online_right, o.online_made, o.arm_sent, o.arm_wrong, o.post_hoc_right,
-      o.post_hoc_made, o.first_trusted,
-      o.first_right_s < 0 ? "never"
-                          : (std::to_string(static_cast<int>(o.first_right_s)) + " s").c_str());
+      o.post_hoc_made, o.first_trusted, seconds(o.first_right_s).c_str());
 }
 
 }  // namespace
@@ -337,7 +374,7 @@ int main(int argc, char** argv) {
   Outcome all_cal, all_none;
   std::vector<int> cal_right(static_cast<size_t>(trials)), none_right(cal_right),
       none_trusted(cal_right);
-  int faster = 0, compared = 0, wrong_more = 0;
+  int faster = 0, compared = 0, wrong_more = 0, ceiling_later = 0, later_both = 0;
   for (const std::string& file : files) {
     Replay r = load(file);
     r.index = static_cast<int>(&file - files.data());
@@ -363,9 +400,13 @@ int main(int argc, char** argv) {
       std::fputc('\n', trace);
       std::fflush(trace);
     }
+    const double ceiling = certainCeiling(r, calibration, trials, pipeline,
+                                          config.classifier.training, stopping, extended, time);
     std::printf("%s\n", file.c_str());
     line("calibrated", c);
     line("none", n);
+    std::printf("  labels known, waiting for certainty: first right placement %s\n",
+                seconds(ceiling).c_str());
     std::fflush(stdout);
     for (auto [total, one] : {std::pair{&all_cal, &c}, std::pair{&all_none, &n}}) {
       total->online_made += one->online_made;
@@ -383,7 +424,11 @@ int main(int argc, char** argv) {
     wrong_more += n.arm_wrong > c.arm_wrong;
     if (c.first_right_s >= 0.0) {
       ++compared;
-      faster += n.first_right_s >= 0.0 && n.first_right_s <= c.first_right_s;
+      const bool later = n.first_right_s < 0.0 || n.first_right_s > c.first_right_s;
+      faster += !later;
+      const bool ceiling_late = ceiling < 0.0 || ceiling > c.first_right_s;
+      ceiling_later += ceiling_late;
+      later_both += later && ceiling_late;
     }
   }
   const auto rate = [](const char* what, int right, int made) {
@@ -407,6 +452,10 @@ int main(int argc, char** argv) {
     std::printf("%5d  %16d  %10d  %12d\n", k + 1, cal_right[static_cast<size_t>(k)],
                 none_right[static_cast<size_t>(k)], none_trusted[static_cast<size_t>(k)]);
   std::printf("first right placement no later without calibration: %d of %d\n", faster, compared);
+  std::printf(
+      "first right placement later than calibrated even with labels known (waiting for "
+      "certainty): %d of %d; of the later ones without calibration: %d of %d\n",
+      ceiling_later, compared, later_both, compared - faster);
   if (trace) std::fclose(trace);
   return 0;
 }
