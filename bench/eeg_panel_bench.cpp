@@ -21,7 +21,8 @@ arbci::bci::SignalScope makeScope(int channels) {
     info.channels.push_back(name);
   }
   info.channels.back() = "Photodiode";
-  arbci::bci::SignalScope scope(info, 10.0, arbci::bci::FilterSettings{});
+  arbci::bci::SignalScope scope(info, 10.0, arbci::bci::FilterSettings{},
+                                arbci::bci::QualityThresholds{});
   std::mt19937 random(1);
   std::normal_distribution<float> noise(0.0f, 10.0f);
   for (std::int64_t first = 0; first < 2560 + 15; first += 15) {
@@ -67,9 +68,13 @@ void EegPanelFrame(benchmark::State& state) {
   ImGuiFrame imgui;
   arbci::ui::EegView view;
   view.setTimeBase(time_base_s);
+  // The grades as the session's record carries them.
+  arbci::session::QualityPart quality;
+  quality.channels = scope.info().channels;
+  quality.quality = scope.quality();
   for (auto _ : state) {
     imgui.frame([&] {
-      if (draw_view) view.draw(scope, "Photodiode", "");
+      if (draw_view) view.draw(scope, quality, arbci::bci::QualityThresholds{}, "Photodiode", "");
     });
     benchmark::DoNotOptimize(ImGui::GetDrawData());
   }

@@ -6,7 +6,8 @@
 namespace arbci::bci {
 
 SignalScope::SignalScope(const SignalInfo& info, double seconds,
-                         const FilterSettings& display_filter, const QualityThresholds& thresholds)
+                         const FilterSettings& display_filter,
+                         std::optional<QualityThresholds> thresholds)
     : info_(info),
       capacity_(std::max(1, static_cast<int>(std::lround(seconds * info.rate_hz)))),
       thresholds_(thresholds),
@@ -47,7 +48,8 @@ void SignalScope::append(const Block& block) {
   end_ += block.samples;
   while (!stimuli_.empty() && stimuli_.front() < end_ - capacity_) stimuli_.pop_front();
   // Twice a second, over the last two seconds.
-  if (end_ - assessed_at_ >= static_cast<std::int64_t>(info_.rate_hz / 2.0)) assess();
+  if (thresholds_ && end_ - assessed_at_ >= static_cast<std::int64_t>(info_.rate_hz / 2.0))
+    assess();
 }
 
 void SignalScope::markStimulus(std::int64_t sample) {
@@ -83,7 +85,7 @@ void SignalScope::assess() {
   std::vector<float> window(static_cast<size_t>(n));
   for (int c = 0; c < info_.channelCount(); ++c) {
     for (int k = 0; k < n; ++k) window[static_cast<size_t>(k)] = at(c, n - 1 - k, false);
-    quality_[static_cast<size_t>(c)] = assessSignal(window.data(), n, info_.rate_hz, thresholds_);
+    quality_[static_cast<size_t>(c)] = assessSignal(window.data(), n, info_.rate_hz, *thresholds_);
   }
 }
 

@@ -93,7 +93,7 @@ TEST(SignalScope, KeepsTheLastSecondsInOrderAndGradesEachChannel) {
   info.channels = {"Cz", "Pz"};
   FilterSettings none;
   none.highpass_hz = none.lowpass_hz = none.notch_hz = 0.0;
-  SignalScope scope(info, 4.0, none);
+  SignalScope scope(info, 4.0, none, QualityThresholds{});
   EXPECT_TRUE(scope.quality().empty());
   const std::vector<float> clean = signal(10.0, 0.0, 50.0, 0.0, 1);
   const std::vector<float> noisy = signal(5.0, 30.0, 50.0, 0.0, 2);

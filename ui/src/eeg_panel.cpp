@@ -1,6 +1,7 @@
 // The EEG panel: every channel scrolling (scale, time base, the session's filter on or off), the
 // stimulus onsets and the photodiode channel marked, each channel's quality graded with its
-// finding — over the window's EEG scope, fed from the cycle records.
+// finding — over the window's EEG scope, fed from the cycle records; the grades are the records'
+// own (SignalQualityStage's).
 #include <imgui.h>
 
 #include "arbci/ui/eeg_view.h"
@@ -18,7 +19,9 @@ class EegPanel final : public Panel {
       ImGui::TextDisabled("no EEG yet: the source has delivered nothing");
       return;
     }
-    view_.draw(*scope, in.settings.eeg.photodiode_channel, in.record.eeg.impedance);
+    view_.draw(*scope, in.record.quality,
+               in.settings.gates.thresholds(in.settings.classifier.pipeline.filter.notch_hz),
+               in.settings.eeg.photodiode_channel, in.record.eeg.impedance);
   }
 
  private:

@@ -34,11 +34,13 @@ ImU32 gradeColour(bci::Grade grade) {
 
 }  // namespace
 
-void EegView::draw(const bci::SignalScope& scope, const std::string& photodiode,
+void EegView::draw(const bci::SignalScope& scope, const session::QualityPart& quality,
+                   const bci::QualityThresholds& thresholds, const std::string& photodiode,
                    const std::string& impedance) {
   photodiode_ = photodiode;
+  matchQuality(scope, quality);
   drawControls();
-  drawQualityLegend(scope, impedance);
+  drawQualityLegend(thresholds, impedance);
   drawTraces(scope);
   drawQualityTable(scope);
 }
@@ -79,8 +81,17 @@ void EegView::drawControls() {
     ImGui::SetTooltip("the session's online filter (what the classifier sees); off: raw signal");
 }
 
-void EegView::drawQualityLegend(const bci::SignalScope& scope, const std::string& impedance) {
-  const bci::QualityThresholds& t = scope.thresholds();
+void EegView::matchQuality(const bci::SignalScope& scope, const session::QualityPart& quality) {
+  const std::vector<std::string>& channels = scope.info().channels;
+  quality_.assign(channels.size(), nullptr);
+  for (size_t q = 0; q < quality.quality.size() && q < quality.channels.size(); ++q) {
+    const auto at = std::find(channels.begin(), channels.end(), quality.channels[q]);
+    if (at != channels.end())
+      quality_[static_cast<size_t>(at - channels.begin())] = &quality.quality[q];
+  }
+}
+
+void EegView::drawQualityLegend(const bci::QualityThresholds& t, const std::string& impedance) {
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
   ImGui::TextWrapped(
       "quality over the last 2 s: green good, amber poor, red bad (flat SD < %g uV, saturated "
@@ -99,7 +110,6 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
   const bci::SignalInfo& info = scope.info();
   const int channels = info.channelCount();
   const std::string& photodiode = photodiode_;
-  const auto& quality = scope.quality();
   const int shown = std::min(scope.capacity(),
                              static_cast<int>(std::lround(kTimeBasesS[time_base_] * info.rate_hz)));
   const ImVec2 origin = ImGui::GetCursorScreenPos();
@@ -138,10 +148,10 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
     const float mid = origin.y + row * (static_cast<float>(c) + 0.5f);
     const bool is_photodiode = info.channels[static_cast<size_t>(c)] == photodiode;
     // The label, in its grade's colour (the photodiode is no EEG: no grade).
+    const bci::SignalQuality* q = quality_[static_cast<size_t>(c)];
     const ImU32 label_colour = is_photodiode ? IM_COL32(230, 210, 90, 255)
-                               : static_cast<size_t>(c) < quality.size()
-                                   ? gradeColour(quality[static_cast<size_t>(c)].grade)
-                                   : IM_COL32(150, 150, 150, 255);
+                               : q           ? gradeColour(q->grade)
+                                             : IM_COL32(150, 150, 150, 255);
     draw->AddRectFilled(ImVec2(origin.x, mid - row / 2 + 1),
                         ImVec2(origin.x + 8, mid + row / 2 - 1), label_colour);
     // Rows lower than the text: every k-th channel named (the marks and the table name all).
@@ -202,15 +212,14 @@ void EegView::drawTraces(const bci::SignalScope& scope) {
   // The row under the pointer says its channel's quality.
   if (ImGui::IsItemHovered()) {
     const int c = static_cast<int>((ImGui::GetMousePos().y - origin.y) / row);
-    if (c >= 0 && c < channels && static_cast<size_t>(c) < quality.size())
+    if (c >= 0 && c < channels && quality_[static_cast<size_t>(c)])
       ImGui::SetTooltip("%s: %s", info.channels[static_cast<size_t>(c)].c_str(),
-                        quality[static_cast<size_t>(c)].finding.c_str());
+                        quality_[static_cast<size_t>(c)]->finding.c_str());
   }
 }
 
 void EegView::drawQualityTable(const bci::SignalScope& scope) {
-  const auto& quality = scope.quality();
-  if (quality.empty()) {
+  if (std::none_of(quality_.begin(), quality_.end(), [](const auto* q) { return q; })) {
     ImGui::TextDisabled("quality: after two seconds of signal");
     return;
   }
@@ -224,9 +233,9 @@ void EegView::drawQualityTable(const bci::SignalScope& scope) {
   ImGui::TableHeadersRow();
   const std::string& photodiode = photodiode_;
   const bci::SignalInfo& info = scope.info();
-  for (size_t c = 0; c < quality.size(); ++c) {
-    if (info.channels[c] == photodiode) continue;
-    const bci::SignalQuality& q = quality[c];
+  for (size_t c = 0; c < quality_.size(); ++c) {
+    if (info.channels[c] == photodiode || !quality_[c]) continue;
+    const bci::SignalQuality& q = *quality_[c];
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
     ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(gradeColour(q.grade)), "%s",

@@ -20,8 +20,7 @@ StageTiming timingOf(const std::string& stage, const std::vector<double>& values
 void WindowState::ingest(const session::CycleRecord& record,
                          const session::SessionConfig& settings) {
   if (!scope_ && record.eeg.info)
-    scope_.emplace(*record.eeg.info, kScopeSeconds, settings.classifier.pipeline.filter,
-                   settings.gates.thresholds(settings.classifier.pipeline.filter.notch_hz));
+    scope_.emplace(*record.eeg.info, kScopeSeconds, settings.classifier.pipeline.filter);
   if (scope_) {
     for (const bci::Block& block : record.eeg.blocks) scope_->append(block);
     for (const session::Presentation::Onset& onset : record.presentation.onsets)

@@ -1,12 +1,14 @@
 // The last seconds of every channel as acquired, for the experimenter's EEG view: raw and through
-// a display filter, the stimulus onsets among them, and each channel's quality (signal_quality.h)
-// re-assessed twice a second over its last two seconds. Fed block by block on the session's
+// a display filter, the stimulus onsets among them, and, where given thresholds, each channel's
+// quality (signal_quality.h) re-assessed twice a second over its last two seconds (the session's
+// SignalQualityStage grades; the view shows its grades). Fed block by block on the session's
 // thread; read between blocks.
 #pragma once
 
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,9 +21,10 @@ namespace arbci::bci {
 class SignalScope {
  public:
   // `info`: every channel as acquired; `display_filter`: what the filtered view runs (the
-  // session's online filter: the experimenter sees what the classifier sees).
+  // session's online filter: the experimenter sees what the classifier sees); `thresholds`: what
+  // quality() grades against, none: no grading.
   SignalScope(const SignalInfo& info, double seconds, const FilterSettings& display_filter,
-              const QualityThresholds& thresholds = {});
+              std::optional<QualityThresholds> thresholds = std::nullopt);
   void append(const Block& block);
   void markStimulus(std::int64_t sample);
 
@@ -36,15 +39,14 @@ class SignalScope {
   void copyLast(int channel, int n, bool filtered, std::vector<float>& out) const;
   // Onsets (sample indices) still in view, oldest first.
   const std::deque<std::int64_t>& stimuli() const { return stimuli_; }
-  // One per channel; empty until two seconds have been seen.
+  // One per channel; empty until two seconds have been seen, or without thresholds.
   const std::vector<SignalQuality>& quality() const { return quality_; }
-  const QualityThresholds& thresholds() const { return thresholds_; }
 
  private:
   void assess();
   SignalInfo info_;
   int capacity_;
-  QualityThresholds thresholds_;
+  std::optional<QualityThresholds> thresholds_;
   std::unique_ptr<FilterChain> filter_;
   std::vector<float> raw_, filtered_;  // [channel][capacity], a ring ending at end_
   std::int64_t first_ = 0, end_ = 0, assessed_at_ = 0;
