@@ -134,6 +134,12 @@ void Session::recordCycleTime() {
       {"frame", record.frame}, {"compute_ms", total}, {"stages", timing_.lastCycle()}};
   if (total > timing_.budgetMs()) log_->write("overrun", record.time_s, fields);
   if (record.frame % 6 == 0) log_->write("cycle", record.time_s, fields);
+  tellLogNews(record.time_s);
+}
+
+void Session::tellLogNews(double time_s) {
+  if (const std::string news = log_->news(); !news.empty())
+    operator_log_.add(time_s, log_->failing() ? Severity::Error : Severity::Warning, news);
 }
 
 void Session::endIfDone() {
@@ -183,6 +189,7 @@ void Session::endRun(const std::string& reason, const std::string& kind) {
               closing.eeg_sample, clock_,         closing,       last_record};
   for (const auto& stage : stages_) stage->stop(cycle, reason);
   log_->write("session_ended", last_record.time_s, {{"reason", reason}});
+  tellLogNews(last_record.time_s);
   // The terminal prints the end itself (after its status line); the window lists it here.
   operator_log_.add(
       last_record.time_s, end_kind_ == "finished" ? Severity::Info : Severity::Error,
@@ -227,6 +234,7 @@ nlohmann::json Session::summary() const {
       {"cycle", timing_.toJson()},
       {"overruns", timing_.overruns()},
   };
+  if (log_->lost() > 0) out["log_lines_lost"] = log_->lost();
   for (const auto& stage : stages_) stage->report(out);
   return out;
 }

@@ -108,6 +108,8 @@ class Session {
  private:
   void beginCycle();
   void recordCycleTime();
+  // What happened to the log's writing (failed, resumed), told the experimenter once.
+  void tellLogNews(double time_s);
   void endIfDone();
   void endRun(const std::string& reason, const std::string& kind = "");
 
