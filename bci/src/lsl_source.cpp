@@ -84,6 +84,9 @@ LslSource::LslSource(const LslSourceSettings& settings) : settings_(settings) {
   for (int c = 0; c < full.channel_count; ++c)
     scale_.push_back(
         c < static_cast<int>(full.channels.size()) ? microvoltsPer(full.channels[c].unit) : 1.0);
+  std::vector<std::string> units;
+  for (const auto& channel : full.channels) units.push_back(channel.unit);
+  unit_note_ = nonVoltageNote(info_.channels, units);
   name_ = full.name;
   host_ = full.hostname;
   for (size_t c = 0; c < full.channels.size() && c < info_.channels.size(); ++c) {
@@ -175,7 +178,13 @@ std::string LslSource::describe() const {
                 status.clock_known ? status.clock_rtt_s * 1e3 : 0.0,
                 static_cast<long long>(gap_samples_),
                 status.clock_known ? "" : " (clock not yet estimated)");
-  return text;
+  return unit_note_.empty() ? std::string(text) : std::string(text) + "; " + unit_note_;
+}
+
+std::vector<Annotation> LslSource::takeAnnotations() {
+  if (unit_note_.empty() || unit_note_taken_ || next_index_ == 0) return {};
+  unit_note_taken_ = true;
+  return {Annotation{0, unit_note_, 0}};
 }
 
 }  // namespace arbci::bci

@@ -29,4 +29,16 @@ bool isVoltageUnit(std::string_view unit) {
          u == "microvolt" || u == "microvolts";
 }
 
+std::string nonVoltageNote(const std::vector<std::string>& channels,
+                           const std::vector<std::string>& units) {
+  std::string listed;
+  for (size_t k = 0; k < channels.size() && k < units.size(); ++k) {
+    if (isVoltageUnit(units[k])) continue;
+    listed += (listed.empty() ? "" : ", ") + channels[k] + " (\"" + units[k] + "\")";
+  }
+  if (listed.empty()) return "";
+  return "channel(s) " + listed +
+         " are not in a voltage unit: their values are kept as they are, not microvolts";
+}
+
 }  // namespace arbci::bci

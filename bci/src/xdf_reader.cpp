@@ -126,17 +126,8 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
       r.data[static_cast<size_t>(c) * r.samples + s] = static_cast<float>(
           eeg->values[static_cast<size_t>(s) * channels + c] * scale[static_cast<size_t>(c)]);
   if (!footer_note.empty()) r.notes.push_back(footer_note);
-  std::string not_voltage;
-  for (int c = 0; c < channels; ++c) {
-    const auto k = static_cast<size_t>(c);
-    if (k < eeg->units.size() && !isVoltageUnit(eeg->units[k]))
-      not_voltage +=
-          (not_voltage.empty() ? "" : ", ") + r.info.channels[k] + " (\"" + eeg->units[k] + "\")";
-  }
-  if (!not_voltage.empty())
-    r.notes.push_back("channel(s) " + not_voltage +
-                      " are not in a voltage unit: their values are kept as they are, not "
-                      "microvolts");
+  if (std::string note = nonVoltageNote(r.info.channels, eeg->units); !note.empty())
+    r.notes.push_back(std::move(note));
   r.parameters["XdfStream"] = eeg->name;
   r.parameters["XdfStreamType"] = eeg->type;
   if (!cut.empty()) {

@@ -348,6 +348,39 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
       << source.impedance();
 }
 
+// A channel whose stated unit is no voltage ("counts") is kept as it is, and said so: in the
+// Session panel's source line and, once, in the recording's annotations.
+TEST(LslSource, AChannelNotInVoltsIsKeptAsItIsAndSaidSo) {
+  const std::string name = uniqueName("counts");
+  StreamInfo info = eegStream(name, 2, 256, ChannelFormat::Double64);
+  info.channels[0].unit = "microvolts";
+  info.channels[1].unit = "counts";
+  Outlet outlet(info, machineScope());
+  LslSourceSettings settings;
+  settings.name = name;
+  settings.block_size = 4;
+  settings.config = machineScope();
+  settings.require_samples = false;
+  LslSource source(settings);
+  EXPECT_TRUE(source.takeAnnotations().empty());  // nothing delivered yet
+  waitForClient(outlet);
+  const double values[8] = {1.0, 100.0, 2.0, 200.0, 3.0, 300.0, 4.0, 400.0};
+  outlet.pushRaw(values, 4, 50.0);
+  std::vector<Block> blocks;
+  for (int i = 0; i < 200 && blocks.empty(); ++i) {
+    blocks = source.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_EQ(blocks.size(), 1u);
+  EXPECT_FLOAT_EQ(blocks[0].at(1, 2), 300.0f);
+  const std::string said = "channel(s) E2 (\"counts\") are not in a voltage unit";
+  EXPECT_NE(source.describe().find(said), std::string::npos) << source.describe();
+  const std::vector<Annotation> notes = source.takeAnnotations();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].text.rfind(said, 0), 0u) << notes[0].text;
+  EXPECT_TRUE(source.takeAnnotations().empty());  // once
+}
+
 // The check: a second process streams 64 channels at 2048 Hz for 10 minutes of
 // simulated time (at 100 times real time).
 TEST(LslTwoProcesses, TenMinutesOf64ChannelsAt2048HzArriveCompleteAndBitIdentical) {

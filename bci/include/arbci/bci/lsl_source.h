@@ -52,6 +52,9 @@ class LslSource final : public EegSource {
   std::string describe() const override;
   // From the stream's metadata (<desc><channels><channel><impedance>), as connected.
   std::string impedance() const override { return impedance_; }
+  // Once, at the first sample: the channels whose stated unit is not a voltage (their values
+  // kept as they are), for the recording.
+  std::vector<Annotation> takeAnnotations() override;
   // Samples the stream missed while its outlet was away (as counted from the timestamps).
   std::int64_t gapSamples() const { return gap_samples_; }
 
@@ -63,6 +66,8 @@ class LslSource final : public EegSource {
   SignalInfo info_;
   std::vector<double> scale_;  // per channel, to microvolts
   std::string name_, host_, impedance_;
+  std::string unit_note_;  // bci::nonVoltageNote of the stream's channels
+  bool unit_note_taken_ = false;
   Block pending_;
   std::int64_t next_index_ = 0;
   int connection_ = 0;
