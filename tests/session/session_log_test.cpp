@@ -3,9 +3,7 @@
 // there is room, its first line saying how many were lost. Real files: /dev/full, and a file
 // held to a size limit (RLIMIT_FSIZE) that is then lifted.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "arbci/session/session_log.h"
+#include "support/file_size_limit.h"
 
 namespace arbci::session {
 namespace {
@@ -25,27 +24,6 @@ std::vector<nlohmann::json> linesOf(const std::filesystem::path& path) {
   for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
   return out;
 }
-
-// The file size limit for this process while it lives; writing past it fails with EFBIG (the
-// signal that would otherwise end the process ignored).
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    getrlimit(RLIMIT_FSIZE, &before_);
-    previous_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limited = before_;
-    limited.rlim_cur = bytes;
-    setrlimit(RLIMIT_FSIZE, &limited);
-  }
-  ~FileSizeLimit() {
-    setrlimit(RLIMIT_FSIZE, &before_);
-    std::signal(SIGXFSZ, previous_);
-  }
-
- private:
-  rlimit before_{};
-  void (*previous_)(int) = nullptr;
-};
 
 TEST(SessionLog, WritesOneJsonObjectPerLine) {
   const auto path = std::filesystem::path(::testing::TempDir()) / "log_plain.jsonl";
@@ -82,7 +60,7 @@ TEST(SessionLog, KeepsWholeLinesWhenFullAndResumesWithTheCountLost) {
   SessionLog log(path);
   const nlohmann::json fields = {{"text", std::string(40, 'x')}};
   {
-    const FileSizeLimit limit(300);
+    const test::FileSizeLimit limit(300);
     for (int i = 0; i < 10; ++i) log.write("note", 0.1 * i, fields);
   }
   EXPECT_TRUE(log.failing());
