@@ -2,6 +2,7 @@
 find_package(PkgConfig REQUIRED)
 find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
 find_package(glfw3 3.3 REQUIRED)
+find_package(X11 REQUIRED)  # the window's display lost: render::onDisplayLost
 find_package(glm REQUIRED)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(OpenCV 4.6 REQUIRED COMPONENTS core imgproc imgcodecs calib3d videoio aruco)

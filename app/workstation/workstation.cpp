@@ -103,6 +103,16 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   OpenedSession opened = openSession(config, options, main_window);
   if (workstation.opened) workstation.opened();
   session::Session& session = *opened.session;
+  // The X server gone (killed, logged out): Xlib would end the process where it stands. The run
+  // ends as a fault and its summary is saved first (the recording and the log are written as
+  // they go); exit 3, as for any run that did not finish.
+  render::onDisplayLost(
+      [&session](const std::string& reason) {
+        session.endNow(reason);
+        std::cerr << "\nended: fault (" << reason << "); " << session.folder().string()
+                  << "/summary.json written\n";
+      },
+      3);
   // Unattended, the session starts itself.
   if (!workstation.wait_for_start && !workstation.unattended)
     session.request(session::StartRequest{});

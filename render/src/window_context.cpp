@@ -3,7 +3,9 @@
 #include <algorithm>
 
 #include <GLFW/glfw3.h>
+#include <X11/Xlib.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <string>
 
@@ -110,6 +112,36 @@ int WindowContext::monitorCount() {
   int count = 0;
   glfwGetMonitors(&count);
   return count;
+}
+
+namespace {
+
+std::function<void(const std::string&)> g_save_on_loss;
+int g_loss_exit_code = 1;
+
+// Xlib calls this when the connection to the X server breaks, and ends the process when it
+// returns: it never does. A second loss met while saving (a stop that touched the display) ends
+// the process as it stands.
+int displayLost(Display* display) {
+  static std::atomic<bool> entered{false};
+  if (!entered.exchange(true) && g_save_on_loss) {
+    try {
+      const char* name = display ? DisplayString(display) : nullptr;
+      g_save_on_loss(std::string("the display (X server ") + (name ? name : "?") +
+                     ") went away: the window could not go on");
+    } catch (...) {
+      // Nothing more can be saved.
+    }
+  }
+  std::_Exit(g_loss_exit_code);
+}
+
+}  // namespace
+
+void onDisplayLost(std::function<void(const std::string& reason)> save, int exit_code) {
+  g_save_on_loss = std::move(save);
+  g_loss_exit_code = exit_code;
+  XSetIOErrorHandler(displayLost);
 }
 
 }  // namespace arbci::render

@@ -9,12 +9,17 @@
 // behaviour on its own is tested in process on hand-built records (tests/ui/panels_test.cpp).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <sstream>
+#include <thread>
 
+#include "support/background_process.h"
 #include "support/run_process.h"
 #include "support/test_files.h"
 #include "support/xvfb_server.h"
@@ -247,6 +252,44 @@ TEST(RecoveryWindow, ASessionFileThatCannotStartIsShownInTheWindowWithItsReason)
   std::vector<cv::Mat> bgr;
   cv::split(top, bgr);
   EXPECT_GT(cv::countNonZero((bgr[2] > 180) & (bgr[1] < 140)), 100);
+}
+
+// The X server gone under the window (killed, the desktop logged out): Xlib would end the process
+// on the spot. The run ends as a fault with the reason, its summary written and its recording
+// whole; exit 3.
+TEST(RecoveryWindow, TheDisplayGoneEndsTheRunAsAFaultWithItsSummary) {
+  const auto folder = kArtefacts / "recovery_display_gone";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  writeSession(folder / "session.json");
+  const auto out = folder / "out";
+  std::optional<XvfbServer> x(std::in_place, "1280x720x24");
+  BackgroundProcess arbci(
+      "/usr/bin/env",
+      {"-u", "XAUTHORITY", "DISPLAY=" + x->display(),
+       "XDG_CONFIG_HOME=" + (folder / "config").string(), kArbci, "run", "--session",
+       (folder / "session.json").string(), "--out", out.string(), "--start-now"});
+  // Running: the log has its cycles (however slowly this machine draws them).
+  const auto running = [&] {
+    std::ifstream log(out / "log.jsonl");
+    std::stringstream text;
+    text << log.rdbuf();
+    return text.str().find("\"event\":\"cycle\"") != std::string::npos;
+  };
+  for (int i = 0; i < 1200 && !running(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(running());
+  x.reset();  // the X server ends
+  const std::optional<int> status = arbci.wait(120.0);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 3);
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["ended"], "fault");
+  EXPECT_NE(summary["end_reason"].get<std::string>().find("the display (X server"),
+            std::string::npos)
+      << summary["end_reason"];
+  const ProcessResult info = runProcess(kArbci, {"eeg", "info", (out / "recording.bdf").string()});
+  EXPECT_EQ(info.exit_code, 0) << info.err;
 }
 
 }  // namespace

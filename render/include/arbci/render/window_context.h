@@ -1,6 +1,7 @@
 // The windowed back end of GlContext: a GLFW window with an OpenGL 3.3 core context.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "arbci/render/gl_context.h"
@@ -46,5 +47,12 @@ class WindowContext final : public GlContext {
 
 // True when a window system is reachable (an X display), so a window could open.
 bool displayAvailable();
+
+// What to do when the window system goes away under the windows (the X server killed, the
+// session logged out): Xlib would end the process on the spot, and whatever was not yet saved
+// would be lost. `save` is called once, with the reason, on the thread that met the loss; it must
+// not draw. Then the process ends with `exit_code` at once (no destructor runs: the display's
+// objects are gone). Call once a window exists.
+void onDisplayLost(std::function<void(const std::string& reason)> save, int exit_code);
 
 }  // namespace arbci::render

@@ -81,6 +81,9 @@ class Session {
   void presented(double host_s);
   // Steps until the end (headless); `interrupted` (when given) aborts it. Returns the summary.
   nlohmann::json run(const std::function<bool()>& interrupted = {});
+  // Ends the run now, between cycles, as a fault with `reason` (the window's display lost): the
+  // stages stop and the summary is written, as at any end. Nothing once ended.
+  void endNow(const std::string& reason) { endRun(reason, "fault"); }
 
   // The experimenter: queued for the next cycle, or refused (and logged) with the reason
   // whyNot() gives. An emergency stop goes to the arm at once.
