@@ -316,6 +316,29 @@ TEST(LslSource, AStreamAtAnotherRateThanTheSessionsIsRefused) {
   }
 }
 
+// Settings for a source of the stream `name` on this machine, blocks of 4, connected before the
+// stream pushes anything.
+LslSourceSettings fourSampleBlocksOf(const std::string& name) {
+  LslSourceSettings settings;
+  settings.name = name;
+  settings.block_size = 4;
+  settings.config = machineScope();
+  settings.require_samples = false;  // it pushes once connected
+  return settings;
+}
+
+// Four samples of two channels pushed once the source is connected, and the block they make.
+std::vector<Block> pushFourAndPoll(Outlet& outlet, LslSource& source, const double (&values)[8]) {
+  waitForClient(outlet);
+  outlet.pushRaw(values, 4, 50.0);
+  std::vector<Block> blocks;
+  for (int i = 0; i < 200 && blocks.empty(); ++i) {
+    blocks = source.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return blocks;
+}
+
 // Also: impedances in the stream's metadata (as amplifier apps that measure them write them) are
 // reported for the EEG panel, per channel, with the caveat that LSL states no unit.
 TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
@@ -324,21 +347,10 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
   info.channels[0].unit = "V";
   info.channels[1].impedance = "12.5";
   Outlet outlet(info, machineScope());
-  LslSourceSettings settings;
-  settings.name = name;
-  settings.block_size = 4;
-  settings.config = machineScope();
-  settings.require_samples = false;  // it pushes once connected
-  LslSource source(settings);
+  LslSource source(fourSampleBlocksOf(name));
   EXPECT_EQ(source.info().channels, (std::vector<std::string>{"E1", "E2"}));
-  waitForClient(outlet);
-  const double values[8] = {1e-5, 3.0, 2e-5, 4.0, 3e-5, 5.0, 4e-5, 6.0};
-  outlet.pushRaw(values, 4, 50.0);
-  std::vector<Block> blocks;
-  for (int i = 0; i < 200 && blocks.empty(); ++i) {
-    blocks = source.poll();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  const std::vector<Block> blocks =
+      pushFourAndPoll(outlet, source, {1e-5, 3.0, 2e-5, 4.0, 3e-5, 5.0, 4e-5, 6.0});
   ASSERT_EQ(blocks.size(), 1u);
   EXPECT_NEAR(blocks[0].at(0, 2), 30.0, 1e-4);  // 3e-5 V
   EXPECT_FLOAT_EQ(blocks[0].at(1, 3), 6.0);
@@ -356,21 +368,10 @@ TEST(LslSource, AChannelNotInVoltsIsKeptAsItIsAndSaidSo) {
   info.channels[0].unit = "microvolts";
   info.channels[1].unit = "counts";
   Outlet outlet(info, machineScope());
-  LslSourceSettings settings;
-  settings.name = name;
-  settings.block_size = 4;
-  settings.config = machineScope();
-  settings.require_samples = false;
-  LslSource source(settings);
+  LslSource source(fourSampleBlocksOf(name));
   EXPECT_TRUE(source.takeAnnotations().empty());  // nothing delivered yet
-  waitForClient(outlet);
-  const double values[8] = {1.0, 100.0, 2.0, 200.0, 3.0, 300.0, 4.0, 400.0};
-  outlet.pushRaw(values, 4, 50.0);
-  std::vector<Block> blocks;
-  for (int i = 0; i < 200 && blocks.empty(); ++i) {
-    blocks = source.poll();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  const std::vector<Block> blocks =
+      pushFourAndPoll(outlet, source, {1.0, 100.0, 2.0, 200.0, 3.0, 300.0, 4.0, 400.0});
   ASSERT_EQ(blocks.size(), 1u);
   EXPECT_FLOAT_EQ(blocks[0].at(1, 2), 300.0f);
   const std::string said = "channel(s) E2 (\"counts\") are not in a voltage unit";
