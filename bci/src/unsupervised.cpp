@@ -345,10 +345,18 @@ UnsupervisedFit fitWithoutLabels(const P300Dataset& data, std::vector<int> selec
   size_t keep = candidates.front();
   double kept_consistency = 0.0;
   if (options.held_out && pr.rows.size() >= 2) {
+    // A candidate whose response is a positive P300 (along the template, known before any data)
+    // before one that is its mirror, however consistent: the mirror is never trusted, and kept it
+    // would be the next fit's warm start, holding the fits on it selection after selection.
+    // Among the positive ones (or among mirrors, when no candidate is positive), the most
+    // consistent.
+    bool kept_positive = false;
     kept_consistency = -1.0;
     for (size_t c : candidates) {
       const double measured = heldOut(starts[c]);
-      if (measured > kept_consistency) {
+      const bool is_positive = positive(pr, starts[c]);
+      if (std::pair(is_positive, measured) > std::pair(kept_positive, kept_consistency)) {
+        kept_positive = is_positive;
         kept_consistency = measured;
         keep = c;
       }

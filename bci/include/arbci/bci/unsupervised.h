@@ -11,7 +11,8 @@
 // start, so that neither side of those comparisons has one the other lacks. Whether a decoding
 // is the P300 or a labelling of noise: fitted again without each selection in turn, does the fit
 // decode that selection as before (UnsupervisedFit::consistency)? Of the most likely decodings
-// (most variance explained) the most consistent is kept. Labels are never read.
+// (most variance explained) the most consistent is kept, one with a positive P300 along
+// UnsupervisedOptions::p300_direction before any mirror. Labels are never read.
 #pragma once
 
 #include <cstdint>
