@@ -316,6 +316,15 @@ TEST(LslSource, AStreamAtAnotherRateThanTheSessionsIsRefused) {
   }
 }
 
+// Two channels of doubles at 256 Hz, E1 and E2 in these units.
+StreamInfo twoChannels(const std::string& name, const std::string& unit1,
+                       const std::string& unit2) {
+  StreamInfo info = eegStream(name, 2, 256, ChannelFormat::Double64);
+  info.channels[0].unit = unit1;
+  info.channels[1].unit = unit2;
+  return info;
+}
+
 // Settings for a source of the stream `name` on this machine, blocks of 4, connected before the
 // stream pushes anything.
 LslSourceSettings fourSampleBlocksOf(const std::string& name) {
@@ -343,8 +352,7 @@ std::vector<Block> pushFourAndPoll(Outlet& outlet, LslSource& source, const doub
 // reported for the EEG panel, per channel, with the caveat that LSL states no unit.
 TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
   const std::string name = uniqueName("volts");
-  StreamInfo info = eegStream(name, 2, 256, ChannelFormat::Double64);
-  info.channels[0].unit = "V";
+  StreamInfo info = twoChannels(name, "V", "");
   info.channels[1].impedance = "12.5";
   Outlet outlet(info, machineScope());
   LslSource source(fourSampleBlocksOf(name));
@@ -364,10 +372,7 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
 // Session panel's source line and, once, in the recording's annotations.
 TEST(LslSource, AChannelNotInVoltsIsKeptAsItIsAndSaidSo) {
   const std::string name = uniqueName("counts");
-  StreamInfo info = eegStream(name, 2, 256, ChannelFormat::Double64);
-  info.channels[0].unit = "microvolts";
-  info.channels[1].unit = "counts";
-  Outlet outlet(info, machineScope());
+  Outlet outlet(twoChannels(name, "microvolts", "counts"), machineScope());
   LslSource source(fourSampleBlocksOf(name));
   EXPECT_TRUE(source.takeAnnotations().empty());  // nothing delivered yet
   const std::vector<Block> blocks =
