@@ -243,7 +243,8 @@ double certainCeiling(const Replay& r, int calibration, int trials,
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                const bci::TrustRule& rule, const bci::StoppingRule& stopping,
-               int extended_sequences, const TimeModel& time, std::FILE* trace) {
+               int extended_sequences, int untrusted_sequences, const TimeModel& time,
+               std::FILE* trace) {
   Outcome o;
   const bci::ParadigmLayout layout = bci::layoutOf(r.recording);
   Shown shown{stopping.max_sequences};
@@ -255,13 +256,15 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
     const int number = calibration + k;
     // Trusted before it: its selection flashes until dynamic stopping ends it, up to the
     // learning's most sequences (paradigm.learning_max_sequences); untrusted, it shows all of
-    // `sequences` (data to learn from).
+    // `untrusted_sequences` (data to learn from: paradigm.learning_sequences).
     const bool trusted_before = fit && trust.trusted;
     bci::StoppingRule rule_now = stopping;
-    if (trusted_before)
+    if (trusted_before) {
       rule_now.max_sequences = extended_sequences;
-    else
+    } else {
+      rule_now.max_sequences = untrusted_sequences;
       rule_now.certainty = 0.0;
+    }
     std::optional<int> decision;
     double certainty = 0.0, extra_s = 0.0;
     if (fit) {
@@ -269,8 +272,11 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       decision = d.code;
       certainty = d.certainty;
       shown.of[number] = d.sequences;
-      extra_s = std::max(0, d.sequences - stopping.max_sequences) * layout.stimuli * layout.soa_s;
+    } else {
+      shown.of[number] = untrusted_sequences;
     }
+    extra_s =
+        std::max(0, shown.at(number) - stopping.max_sequences) * layout.stimuli * layout.soa_s;
     const bool right = decision && *decision == r.target.at(number);
     if (k >= from) {
       ++o.online_made;
@@ -341,6 +347,7 @@ int main(int argc, char** argv) {
   int calibration = 8, trials = 30, from = 11;
   std::string trace_file;
   bool ceiling_only = false;
+  int untrusted_sequences = 0;
   cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
   cli.add_option("--calibration", calibration, "cued selections of the calibration run")
       ->capture_default_str();
@@ -357,6 +364,9 @@ int main(int argc, char** argv) {
                  "their true labels (the ceiling of learning without them)");
   cli.add_flag("--ceiling-only", ceiling_only,
                "trace the calibrated model and the labels-known ceiling only (no learning: fast)");
+  cli.add_option("--untrusted-sequences", untrusted_sequences,
+                 "sequences an untrusted learning selection shows (0: as the session's "
+                 "paradigm.learning_sequences gives them)");
   CLI11_PARSE(cli, argc, argv);
   std::FILE* trace = trace_file.empty() ? nullptr : std::fopen(trace_file.c_str(), "w");
   const session::SessionConfig config;
@@ -370,6 +380,9 @@ int main(int argc, char** argv) {
   const int extended = config.paradigm.learning_max_sequences > 0
                            ? config.paradigm.learning_max_sequences
                            : 2 * config.paradigm.sequences;
+  // An untrusted learning selection's sequences, as the session's paradigm gives them.
+  const int learning =
+      config.paradigm.learning_sequences > 0 ? config.paradigm.learning_sequences : extended;
   const TimeModel time;
   Outcome all_cal, all_none;
   std::vector<int> cal_right(static_cast<size_t>(trials)), none_right(cal_right),
@@ -387,9 +400,11 @@ int main(int argc, char** argv) {
                                  stopping, time);
     // --ceiling-only: the learning condition skipped (reported as the calibrated one).
     const Outcome n =
-        ceiling_only ? c
-                     : learnt(r, calibration, trials, from, pipeline, config.classifier.training,
-                              rule, stopping, extended, time, trace);
+        ceiling_only
+            ? c
+            : learnt(r, calibration, trials, from, pipeline, config.classifier.training, rule,
+                     stopping, extended, untrusted_sequences > 0 ? untrusted_sequences : learning,
+                     time, trace);
     if (trace) {
       std::fprintf(trace, "calibrated,%d,", r.index);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);

@@ -166,12 +166,10 @@ void Paradigm::endSequenceIfOver(double due_s) {
   // A selection repeated after an ErrP rejection shows all its sequences.
   const bool dynamic_stop = !calibrating_ && sequences_override_ == 0 && stop_requested_ &&
                             sequence_ >= settings_.min_sequences;
-  const int extended = settings_.learning_max_sequences > 0 ? settings_.learning_max_sequences
-                                                            : 2 * settings_.sequences;
-  const int most = calibrating_              ? settings_.calibration_sequences
-                   : sequences_override_ > 0 ? sequences_override_
-                   : extend_objects_ && phase_ == Phase::ObjectFlashing ? extended
-                                                                        : settings_.sequences;
+  const int most = calibrating_                      ? settings_.calibration_sequences
+                   : sequences_override_ > 0         ? sequences_override_
+                   : phase_ == Phase::ObjectFlashing ? objectSequences()
+                                                     : settings_.sequences;
   if (sequence_ < most && !dynamic_stop) {
     scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
   } else {
@@ -480,8 +478,22 @@ void Paradigm::holdArm(bool held, const std::string& why) {
   hold_why_ = why;
 }
 
-void Paradigm::extendObjectSelections(bool extend) {
-  extend_objects_ = extend;
+void Paradigm::setObjectSequences(ObjectSequences mode) {
+  object_sequences_ = mode;
+}
+
+int Paradigm::objectSequences() const {
+  const int extended = settings_.learning_max_sequences > 0 ? settings_.learning_max_sequences
+                                                            : 2 * settings_.sequences;
+  switch (object_sequences_) {
+    case ObjectSequences::Learning:
+      return settings_.learning_sequences > 0 ? settings_.learning_sequences : extended;
+    case ObjectSequences::Trusted:
+      return extended;
+    case ObjectSequences::Usual:
+      break;
+  }
+  return settings_.sequences;
 }
 
 void Paradigm::judgeHeldSelection(bool pending, bool act, const std::string& why) {

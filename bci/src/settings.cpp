@@ -45,6 +45,10 @@ const core::Schema<ParadigmSettings>& paradigmSchema() {
         .integer("learning_min_selections", &P::learning_min_selections, 5, 2, 100,
                  "calibration none: the arm moves only once the model has learnt from this many "
                  "object selections")
+        .integer("learning_sequences", &P::learning_sequences, 0, 0, 100,
+                 "calibration none: until the model is trusted, an object selection flashes this "
+                 "many sequences, all of them: nothing is acted on, so its time goes to evidence "
+                 "for the fit (0: as many as learning_max_sequences allows)")
         .integer("learning_max_sequences", &P::learning_max_sequences, 0, 0, 100,
                  "calibration none: once the model is trusted, an object selection flashes until "
                  "as certain as paradigm.certainty asks (the arm acts on nothing less), up to "

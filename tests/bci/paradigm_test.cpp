@@ -281,7 +281,7 @@ TEST(Paradigm, ATrustedLearningObjectSelectionFlashesUpToTheLearningMostUntilSto
   s.learning_max_sequences = 5;
   Paradigm p(s, 4, 3, 3, 4);
   p.holdArm(true, "learning");
-  p.extendObjectSelections(true);
+  p.setObjectSequences(Paradigm::ObjectSequences::Trusted);
   std::int64_t frame = 0;
   p.start(false);
   const auto flashes = [](const std::vector<ParadigmEvent>& list) {
@@ -296,12 +296,40 @@ TEST(Paradigm, ATrustedLearningObjectSelectionFlashesUpToTheLearningMostUntilSto
   runUntil(p, frame, [&] { return p.trial() == 2 && p.phase() == Phase::ObjectFlashing; });
   p.requestStopFlashing();
   EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 12);
-  // Not trusted: `sequences`.
+  // Trusted without dynamic stopping's certainty: `sequences`.
   p.decide(choose(2, {3}));
   p.judgeHeldSelection(false, false, "learning");
-  p.extendObjectSelections(false);
+  p.setObjectSequences(Paradigm::ObjectSequences::Usual);
   runUntil(p, frame, [&] { return p.phase() == Phase::ObjectFlashing; });
   EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 12);
+}
+
+TEST(Paradigm, AnUntrustedLearningObjectSelectionFlashesAllTheLearningSequences) {
+  ParadigmSettings s = fast();  // 3 sequences
+  s.trials = 3;
+  s.learning_max_sequences = 5;
+  Paradigm p(s, 4, 3, 3, 4);
+  p.holdArm(true, "learning");
+  p.setObjectSequences(Paradigm::ObjectSequences::Learning);
+  std::int64_t frame = 0;
+  p.start(false);
+  const auto flashes = [](const std::vector<ParadigmEvent>& list) {
+    return std::count_if(list.begin(), list.end(),
+                         [](const ParadigmEvent& e) { return e.kind == Kind::Flash; });
+  };
+  // learning_sequences 0: as many as a trusted selection may flash (five of four objects).
+  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 20);
+  p.decide(choose(1, {2}));
+  p.judgeHeldSelection(false, false, "learning");
+  // Set: that many.
+  ParadigmSettings four = s;
+  four.learning_sequences = 4;
+  Paradigm q(four, 4, 3, 3, 4);
+  q.holdArm(true, "learning");
+  q.setObjectSequences(Paradigm::ObjectSequences::Learning);
+  frame = 0;
+  q.start(false);
+  EXPECT_EQ(flashes(runUntil(q, frame, [&] { return q.awaitingDecision(); })), 16);
 }
 
 TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {

@@ -40,7 +40,10 @@ ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const StageS
                   settings_.max_retakes) {
   nameObjects();
   // Learning from use: every object selection waits for the fit with it in (judgeHeldSelection).
-  if (settings_.learns) paradigm_.holdArm(true, kArmHeld);
+  if (settings_.learns) {
+    paradigm_.holdArm(true, kArmHeld);
+    paradigm_.setObjectSequences(bci::Paradigm::ObjectSequences::Learning);
+  }
 }
 
 void ParadigmStage::nameObjects() {
@@ -401,9 +404,12 @@ void ParadigmStage::followLearning(const Cycle& cycle) {
   if (!learning || learning == learning_seen_) return;
   learning_seen_ = learning;
   // Trusted (judged once per fit), a selection goes on until certain enough for the arm: dynamic
-  // stopping ends it.
+  // stopping ends it. Untrusted, it flashes the learning's sequences: evidence for the next fit.
+  using Sequences = bci::Paradigm::ObjectSequences;
   if (settings_.learns)
-    paradigm_.extendObjectSelections(learning->trusted && settings_.paradigm.certainty > 0.0);
+    paradigm_.setObjectSequences(!learning->trusted                   ? Sequences::Learning
+                                 : settings_.paradigm.certainty > 0.0 ? Sequences::Trusted
+                                                                      : Sequences::Usual);
   const auto object = [this](const std::map<int, int>& codes, int number) -> std::optional<int> {
     const auto code = codes.find(number);
     const auto selection = learnt_.find(number);

@@ -567,6 +567,20 @@ class LearningParadigmStageTest : public ParadigmStageTest {
   std::shared_ptr<const LearningState> learning_;
 };
 
+// Untrusted, nothing is acted on: the selection flashes the learning's sequences, all of them
+// (paradigm.learning_sequences 0: twice `sequences`, as a trusted one may), evidence for the fit.
+TEST_F(LearningParadigmStageTest, AnUntrustedSelectionFlashesAllTheLearningSequences) {
+  model_ = trainedModel();
+  learn(0, 0, false, {});
+  begin();
+  ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectFlashing);
+  for (int i = 0; i < 60 * 30 && bench_.previous.paradigm.phase != bci::Phase::ObjectSelected; ++i)
+    step();
+  ASSERT_EQ(bench_.previous.paradigm.phase, bci::Phase::ObjectSelected);
+  const int objects = static_cast<int>(config_.world.objects.size());
+  EXPECT_EQ(flashes_, objects * 2 * config_.paradigm.sequences);
+}
+
 TEST_F(LearningParadigmStageTest,
        ASelectionWaitsForItsFitAndTheArmActsOnlyIfThatFitTrustsItAsShown) {
   model_ = trainedModel();  // the model of an earlier fit, not trusted

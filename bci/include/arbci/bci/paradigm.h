@@ -52,13 +52,17 @@ struct ParadigmSettings {
   // selections learnt from, a leave-one-out consistency of at least `learning_min_consistency`
   // (bci/unsupervised.h), and its decoding of the earlier selections unchanged since the last fit
   // (but for a tenth of them).
-  // Once the model is trusted, an object selection goes on flashing until dynamic stopping ends it
-  // (the arm acts only on a selection at least `certainty` probable), up to
+  // Until then an object selection flashes `learning_sequences` (0: as many as
+  // `learning_max_sequences` allows), all of them: nothing is acted on, so the trial's time is
+  // spent on evidence for the fit (a weak P300 is found in longer selections where it is not in
+  // shorter ones). Once the model is trusted, an object selection goes on flashing until dynamic
+  // stopping ends it (the arm acts only on a selection at least `certainty` probable), up to
   // `learning_max_sequences` (0: twice `sequences`): a selection the arm would be held for costs
   // the trial, more sequences cost seconds.
   std::string calibration;
   int learning_min_selections;
   double learning_min_consistency;
+  int learning_sequences;
   int learning_max_sequences;
   // A calibrated session goes on learning from its object selections, the calibration run's
   // labels kept: the model is retrained after each with the labels EM finds for the rest.
@@ -206,9 +210,11 @@ class Paradigm {
   // ends there, the arm not sent (`why` is the trial's outcome); a selection decided without a
   // model (no choice) ends its trial at once. Read when a selection is made.
   void holdArm(bool held, const std::string& why);
-  // Learning from use, the model trusted: online object selections may flash up to
-  // `learning_max_sequences` (dynamic stopping ends them once certain); false: `sequences`.
-  void extendObjectSelections(bool extend);
+  // How many sequences an online object selection flashes. Usual: `sequences`. Learning from use,
+  // the model not trusted: `learning_sequences`, all of them. Trusted: up to
+  // `learning_max_sequences` (dynamic stopping ends them once certain).
+  enum class ObjectSequences { Usual, Learning, Trusted };
+  void setObjectSequences(ObjectSequences mode);
   // A held object selection is fitted in with the rest once shown: while that fit is `pending`
   // the selection stays shown; when the fit came back trusted and decodes the selection as it was
   // shown (`act`), its trial goes on to the arm after all, instead of ending held (the selection
@@ -244,6 +250,7 @@ class Paradigm {
   const ParadigmSettings& settings() const { return settings_; }
 
  private:
+  int objectSequences() const;  // the most sequences of an online object selection
   void enter(Phase phase, const std::string& text = "");
   void startFlashing(double at_s, bool objects);
   void cueCalibrationTarget(double at_s);  // the next calibration selection's (or feedback's) cue
@@ -315,7 +322,7 @@ class Paradigm {
   bool giving_back_ = false;        // the put-down returns the object (no cell was accepted)
   int corrections_ = 0;
   bool hold_arm_ = false, held_now_ = false;  // asked; latched for the selection shown
-  bool extend_objects_ = false;               // extendObjectSelections's
+  ObjectSequences object_sequences_ = ObjectSequences::Usual;
   std::string hold_why_, held_why_;
   bool held_fit_pending_ = false, held_act_ = false;  // judgeHeldSelection's
   int sequences_override_ = 0;   // a repeated selection's fixed number of sequences
