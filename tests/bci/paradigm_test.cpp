@@ -275,61 +275,61 @@ TEST(Paradigm, AHeldSelectionWaitsForItsFitAndGoesToTheArmWhenThatFitTrustsIt) {
   EXPECT_EQ(p.trial(), 2);
 }
 
-TEST(Paradigm, ATrustedLearningObjectSelectionFlashesUpToTheLearningMostUntilStopped) {
-  ParadigmSettings s = fast();  // 3 sequences
+// Learning from use's paradigm: 3 sequences (fast()), a trusted selection up to 5.
+ParadigmSettings learningSettings() {
+  ParadigmSettings s = fast();
   s.trials = 3;
   s.learning_max_sequences = 5;
-  Paradigm p(s, 4, 3, 3, 4);
+  return s;
+}
+
+// Starts `p` as learning from use does, the arm held, its object selections flashing as `mode`.
+void startLearning(Paradigm& p, Paradigm::ObjectSequences mode) {
   p.holdArm(true, "learning");
-  p.setObjectSequences(Paradigm::ObjectSequences::Trusted);
-  std::int64_t frame = 0;
+  p.setObjectSequences(mode);
   p.start(false);
-  const auto flashes = [](const std::vector<ParadigmEvent>& list) {
-    return std::count_if(list.begin(), list.end(),
-                         [](const ParadigmEvent& e) { return e.kind == Kind::Flash; });
-  };
+}
+
+// The flashes until the paradigm awaits its decision.
+long flashesToDecision(Paradigm& p, std::int64_t& frame) {
+  const std::vector<ParadigmEvent> list = runUntil(p, frame, [&] { return p.awaitingDecision(); });
+  return std::count_if(list.begin(), list.end(),
+                       [](const ParadigmEvent& e) { return e.kind == Kind::Flash; });
+}
+
+TEST(Paradigm, ATrustedLearningObjectSelectionFlashesUpToTheLearningMostUntilStopped) {
+  Paradigm p(learningSettings(), 4, 3, 3, 4);
+  startLearning(p, Paradigm::ObjectSequences::Trusted);
+  std::int64_t frame = 0;
   // Never certain enough: all five sequences of four objects.
-  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 20);
+  EXPECT_EQ(flashesToDecision(p, frame), 20);
   // Certain after the minimum (3 here, the default): dynamic stopping ends it as ever.
   p.decide(choose(1, {2}));
   p.judgeHeldSelection(false, false, "learning");
   runUntil(p, frame, [&] { return p.trial() == 2 && p.phase() == Phase::ObjectFlashing; });
   p.requestStopFlashing();
-  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 12);
+  EXPECT_EQ(flashesToDecision(p, frame), 12);
   // Trusted without dynamic stopping's certainty: `sequences`.
   p.decide(choose(2, {3}));
   p.judgeHeldSelection(false, false, "learning");
   p.setObjectSequences(Paradigm::ObjectSequences::Usual);
   runUntil(p, frame, [&] { return p.phase() == Phase::ObjectFlashing; });
-  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 12);
+  EXPECT_EQ(flashesToDecision(p, frame), 12);
 }
 
 TEST(Paradigm, AnUntrustedLearningObjectSelectionFlashesAllTheLearningSequences) {
-  ParadigmSettings s = fast();  // 3 sequences
-  s.trials = 3;
-  s.learning_max_sequences = 5;
-  Paradigm p(s, 4, 3, 3, 4);
-  p.holdArm(true, "learning");
-  p.setObjectSequences(Paradigm::ObjectSequences::Learning);
-  std::int64_t frame = 0;
-  p.start(false);
-  const auto flashes = [](const std::vector<ParadigmEvent>& list) {
-    return std::count_if(list.begin(), list.end(),
-                         [](const ParadigmEvent& e) { return e.kind == Kind::Flash; });
-  };
   // learning_sequences 0: as many as a trusted selection may flash (five of four objects).
-  EXPECT_EQ(flashes(runUntil(p, frame, [&] { return p.awaitingDecision(); })), 20);
-  p.decide(choose(1, {2}));
-  p.judgeHeldSelection(false, false, "learning");
+  Paradigm p(learningSettings(), 4, 3, 3, 4);
+  startLearning(p, Paradigm::ObjectSequences::Learning);
+  std::int64_t frame = 0;
+  EXPECT_EQ(flashesToDecision(p, frame), 20);
   // Set: that many.
-  ParadigmSettings four = s;
+  ParadigmSettings four = learningSettings();
   four.learning_sequences = 4;
   Paradigm q(four, 4, 3, 3, 4);
-  q.holdArm(true, "learning");
-  q.setObjectSequences(Paradigm::ObjectSequences::Learning);
+  startLearning(q, Paradigm::ObjectSequences::Learning);
   frame = 0;
-  q.start(false);
-  EXPECT_EQ(flashes(runUntil(q, frame, [&] { return q.awaitingDecision(); })), 16);
+  EXPECT_EQ(flashesToDecision(q, frame), 16);
 }
 
 TEST(Paradigm, DynamicStoppingEndsFlashingAfterTheMinimumSequences) {
