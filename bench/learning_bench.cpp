@@ -16,9 +16,9 @@
 // estimated from the session's default timing (TimeModel below; the robot's time is the same in
 // both); beside them, the soonest any learner that waits for certainty could place, its models
 // trained with the true labels (certainCeiling). The session's own classifier settings
-// (SessionConfig's defaults) are used. Usage: learning_bench FILES... [--calibration 8] [--trials
-// 30] [--from 11] [--trace F]
-//        [--ceiling-only]
+// (SessionConfig's defaults) are used.
+// Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
+//        [--ceiling-only] [--untrusted-sequences N]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
