@@ -377,12 +377,8 @@ int main(int argc, char** argv) {
   // The session's dynamic stopping (its most sequences: all a recording's selection has).
   const bci::StoppingRule stopping{config.paradigm.sequences, config.paradigm.min_sequences,
                                    config.paradigm.certainty};
-  const int extended = config.paradigm.learning_max_sequences > 0
-                           ? config.paradigm.learning_max_sequences
-                           : 2 * config.paradigm.sequences;
-  // An untrusted learning selection's sequences, as the session's paradigm gives them.
-  const int learning =
-      config.paradigm.learning_sequences > 0 ? config.paradigm.learning_sequences : extended;
+  const int extended = config.paradigm.trustedMaxSequences();
+  const int learning = config.paradigm.untrustedSequences();
   const TimeModel time;
   Outcome all_cal, all_none;
   std::vector<int> cal_right(static_cast<size_t>(trials)), none_right(cal_right),

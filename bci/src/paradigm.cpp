@@ -483,13 +483,11 @@ void Paradigm::setObjectSequences(ObjectSequences mode) {
 }
 
 int Paradigm::objectSequences() const {
-  const int extended = settings_.learning_max_sequences > 0 ? settings_.learning_max_sequences
-                                                            : 2 * settings_.sequences;
   switch (object_sequences_) {
     case ObjectSequences::Learning:
-      return settings_.learning_sequences > 0 ? settings_.learning_sequences : extended;
+      return settings_.untrustedSequences();
     case ObjectSequences::Trusted:
-      return extended;
+      return settings_.trustedMaxSequences();
     case ObjectSequences::Usual:
       break;
   }

@@ -90,6 +90,14 @@ struct ParadigmSettings {
   int onsetFrames() const;  // frames from one flash onset to the next (180 ms: 11)
   double flashSeconds() const { return flashFrames() / display_hz; }
   double soaSeconds() const { return onsetFrames() / display_hz; }
+  // Learning from use's object selections, their zeros resolved: a trusted one's most sequences,
+  // an untrusted one's.
+  int trustedMaxSequences() const {
+    return learning_max_sequences > 0 ? learning_max_sequences : 2 * sequences;
+  }
+  int untrustedSequences() const {
+    return learning_sequences > 0 ? learning_sequences : trustedMaxSequences();
+  }
 };
 
 enum class Phase {

@@ -7,12 +7,12 @@
 // covariance of all epochs, which needs no label (shrunk by the Ledoit-Wolf intensity).
 // Starts: several random projections; the textbook P300 as a matched filter, when
 // UnsupervisedOptions::p300_direction is given (with few selections most random starts settle on
-// noise); an earlier decoding, when given. The held-out and shuffled fits start the same ways, so
-// that comparing the fit with them measures the data, not a start one side lacked. Whether a
-// decoding is the P300 or a labelling of noise: fitted again without each selection in turn, does
-// the fit decode that selection as before (UnsupervisedFit::consistency)? Of the most likely
-// decodings (most variance explained) the most consistent is kept, one with a positive P300 along
-// UnsupervisedOptions::p300_direction before any mirror. Labels are never read.
+// noise); an earlier decoding, when given. Every fit the decoding is compared with (a selection
+// left out, the flashes shuffled) starts the same ways: the comparison then measures the data.
+// Whether a decoding is the P300 or a labelling of noise: fitted again without each selection in
+// turn, does the fit decode that selection as before (UnsupervisedFit::consistency)? Of the most
+// likely decodings (most variance explained) the most consistent is kept, one with a positive P300
+// along UnsupervisedOptions::p300_direction before any mirror. Labels are never read.
 #pragma once
 
 #include <cstdint>
