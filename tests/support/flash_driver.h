@@ -33,6 +33,8 @@ class FlashDriver {
   }
   const bci::SignalInfo& info() const { return subject_->info(); }
   bci::SimulatedSubject& subject() { return *subject_; }
+  // From now on the subject attends none of the stimuli (the selections still name a target).
+  void lookAway() { attentive_ = false; }
 
   // One selection of `sequences` sequences (each code once per sequence, in random order) with
   // `target` attended; `cued`: a calibration selection (its target announced); `retake_of`: it
@@ -48,7 +50,7 @@ class FlashDriver {
                                   {target},
                                   cued ? std::optional<int>(target) : std::nullopt,
                                   retake_of};
-    subject_->attend({target});
+    subject_->attend(attentive_ ? std::set<int>{target} : std::set<int>{});
     bench_.previous.paradigm.selection_started = start;
     std::vector<int> order;
     for (int s = 0; s < sequences; ++s) {
@@ -104,6 +106,7 @@ class FlashDriver {
   StageBench& bench_;
   int stimuli_;
   std::mt19937_64 random_;
+  bool attentive_ = true;
   std::shared_ptr<bci::ManualClock> clock_;
   std::unique_ptr<bci::SimulatedSubject> subject_;
 };

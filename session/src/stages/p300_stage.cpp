@@ -68,8 +68,15 @@ void P300Stage::recalibrate() {
   calibration_selection_.clear();
 }
 
+void P300Stage::completeSelection() {
+  complete_ = selection_;
+  if (!current_scored_.code.empty()) held_out_.push_back(std::move(current_scored_));
+  current_scored_ = {};
+}
+
 void P300Stage::startSelection(const SelectionStart& selection) {
-  if (current_learnable_) complete_ = selection_;  // the selection just over
+  if (current_learnable_) completeSelection();  // the selection just over
+  current_scored_ = {};
   current_learnable_ = learns() && !selection.target && selection.objects;
   if (learns() && selection.target) known_[selection.selection] = *selection.target - 1;
   layout_ = selection.layout;
@@ -173,10 +180,18 @@ void P300Stage::startRefit() {
   refit_ = std::async(
       std::launch::async,
       [recording = std::move(recording), numbers = std::move(numbers), known = known_, previous,
-       pipeline = bci::withMethodRate(settings_.pipeline, training.method), training, frozen]() {
+       pipeline = bci::withMethodRate(settings_.pipeline, training.method), training, frozen,
+       held_out = held_out_, objects = bci::ParadigmLayout::single(settings_.object_stimuli)]() {
         ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
         LearningOutcome out;
         out.fit = bci::learnFromUse(recording, numbers, known, previous, pipeline, training);
+        // Its certainty may claim no more than the selections decided so far, scored by models
+        // that had not seen them, show.
+        bci::ScoreModel& scores = out.fit.model.score_model;
+        out.fitted_separation = (scores.target_mean - scores.other_mean) / scores.sd;
+        out.held_out_separation = bci::heldOutSeparation(held_out, objects);
+        if (out.held_out_separation)
+          scores = bci::boundSeparation(scores, *out.held_out_separation);
         out.fit.model.provenance["training_files"] = {"this session's selections"};
         out.fit.model.provenance["labels"] =
             known.empty() ? "found without labels (learning from use)"
@@ -225,6 +240,10 @@ void P300Stage::takeRefit(Cycle& cycle) {
                   {"shuffled_explained", fit.shuffled_explained},
                   {"beats_shuffled", fit.beats_shuffled},
                   {"p3_uv", fit.p3_uv ? nlohmann::json(*fit.p3_uv) : nlohmann::json(nullptr)},
+                  {"separation_fitted", outcome.fitted_separation},
+                  {"separation_held_out", outcome.held_out_separation
+                                              ? nlohmann::json(*outcome.held_out_separation)
+                                              : nlohmann::json(nullptr)},
                   {"post_hoc", state_.post_hoc},
                   {"changed", trust.changed},
                   {"trusted", state_.trusted},
@@ -244,14 +263,21 @@ void P300Stage::takeRefit(Cycle& cycle) {
 
 void P300Stage::scoreCurrentAgain() {
   accumulator_.emplace(layout_, model_->score_model);
-  for (const auto& [code, epoch] : current_epochs_)
-    accumulator_->add(code, model_->classifier->score(extractor_->features(epoch)));
+  current_scored_ = {};
+  for (const auto& [code, epoch] : current_epochs_) {
+    const double score = model_->classifier->score(extractor_->features(epoch));
+    accumulator_->add(code, score);
+    if (current_learnable_) {
+      current_scored_.code.push_back(code);
+      current_scored_.z.push_back(bci::standardised(model_->score_model, score));
+    }
+  }
 }
 
 void P300Stage::stop(Cycle& cycle, const std::string& /*reason*/) {
   if (!learns()) return;
   // The last fit, over every selection decided, gives the session's post-hoc decodings.
-  if (current_learnable_ && presented_ > 0 && scored_ >= presented_) complete_ = selection_;
+  if (current_learnable_ && presented_ > 0 && scored_ >= presented_) completeSelection();
   for (int round = 0; round < 2; ++round) {
     if (refit_.valid()) {
       refit_.wait();
@@ -301,8 +327,14 @@ void P300Stage::process(const bci::Block& eeg, double time_s) {
       continue;
     }
     if (learns()) current_epochs_.emplace_back(record.code, epoch);
-    if (accumulator_ && extractor_)
-      accumulator_->add(record.code, model_->classifier->score(extractor_->features(epoch)));
+    if (accumulator_ && extractor_) {
+      const double score = model_->classifier->score(extractor_->features(epoch));
+      accumulator_->add(record.code, score);
+      if (current_learnable_) {
+        current_scored_.code.push_back(record.code);
+        current_scored_.z.push_back(bci::standardised(model_->score_model, score));
+      }
+    }
   }
 }
 
@@ -355,7 +387,7 @@ void P300Stage::step(Cycle& cycle) {
     // An object selection decided (its epochs all scored): fit it in with the rest.
     if (current_learnable_ && cycle.previous.paradigm.phase == bci::Phase::ObjectSelected &&
         presented_ > 0 && scored_ >= presented_ && complete_ != selection_) {
-      complete_ = selection_;
+      completeSelection();
       state_.awaited_through = complete_;
       published_ = std::make_shared<const LearningState>(state_);
     }

@@ -2,7 +2,8 @@
 // cued flashes kept and trained on when asked (a retaken selection left out), the next selection
 // scored and decided by the model trained, epochs that touch lost samples discarded, and a model
 // that does not fit the channels refused with the reason; without a calibration run, the online
-// selections learnt from without their labels.
+// selections learnt from without their labels, and a model learnt from a subject who attends
+// nothing held to the separation the selections it had not seen show.
 #include <gtest/gtest.h>
 
 #include "arbci/bci/settings.h"
@@ -90,7 +91,37 @@ TEST(P300StageLearning, WithoutACalibrationRunItLearnsFromTheSelectionsNotTheirL
   }
   EXPECT_GE(right, 9);
   EXPECT_LE(as_labelled, 1);
-  EXPECT_EQ(bench.logged("learning_fit").size(), static_cast<size_t>(learning->fits));
+  const auto fits = bench.logged("learning_fit");
+  EXPECT_EQ(fits.size(), static_cast<size_t>(learning->fits));
+  // The selections decided by models that had not seen them show the response too.
+  ASSERT_FALSE(fits.back()["separation_held_out"].is_null());
+  EXPECT_GT(fits.back()["separation_held_out"].get<double>(), 0.5);
+}
+
+TEST(P300StageLearning, AModelLearntFromNoResponseClaimsNoMoreThanTheSelectionsDecidedShow) {
+  // The subject attends none of the objects: any labels a fit finds are noise that fits itself,
+  // and each fit's certainty is held to what the selections it had not seen show.
+  test::StageBench bench("p300_learning_noise");
+  test::FlashDriver eeg(bench, 4);
+  eeg.lookAway();
+  P300Settings settings = settingsFor(eeg.info());
+  settings.learn = true;
+  P300Stage stage(settings, bench.services());
+  for (int n = 1; n <= 8; ++n) eeg.selection(stage, n, n % 4 + 1, false, 8);
+  const P300Part& now = bench.previous.p300;
+  ASSERT_NE(now.model, nullptr);
+  ASSERT_NE(now.learning, nullptr);
+  EXPECT_FALSE(now.learning->trusted);
+  const auto fits = bench.logged("learning_fit");
+  ASSERT_GE(fits.size(), 4u);
+  // The model deciding now is the last fit taken.
+  const nlohmann::json& last = fits.at(static_cast<size_t>(now.learning->fits) - 1);
+  ASSERT_FALSE(last["separation_held_out"].is_null());
+  const double fitted = last["separation_fitted"].get<double>();
+  const double held_out = last["separation_held_out"].get<double>();
+  const bci::ScoreModel& scores = now.model->score_model;
+  EXPECT_NEAR((scores.target_mean - scores.other_mean) / scores.sd,
+              std::min(fitted, std::max(held_out, 0.0)), 1e-9);
 }
 
 TEST_F(P300StageTest, RecalibrateAtTheReviewTrainsOnTheNewRunAlone) {

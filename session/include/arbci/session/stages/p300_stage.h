@@ -18,6 +18,7 @@
 #include "arbci/bci/epocher.h"
 #include "arbci/bci/features.h"
 #include "arbci/bci/filters.h"
+#include "arbci/bci/held_out_separation.h"
 #include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_model.h"
 #include "arbci/bci/recording.h"
@@ -79,6 +80,8 @@ class P300Stage final : public Stage {
   void startRefit();
   void takeRefit(Cycle& cycle);
   void scoreCurrentAgain();
+  // The current selection is over: complete_ moves to it and its scores join held_out_.
+  void completeSelection();
   bool learns() const { return settings_.learn || settings_.adapt; }
   bool touchesLoss(std::int64_t onset) const;
 
@@ -110,6 +113,10 @@ class P300Stage final : public Stage {
   struct LearningOutcome {
     bci::LearnedSelections fit;
     std::map<int, int> frozen;
+    // The fit's separation as its cross-validation gave it, and as the selections decided before
+    // show it (none before any), which bounds it.
+    double fitted_separation = 0.0;
+    std::optional<double> held_out_separation;
   };
   std::future<LearningOutcome> refit_;
   int complete_ = 0, fitted_ = 0;  // the last learnable selection complete; the last fitted
@@ -119,6 +126,11 @@ class P300Stage final : public Stage {
   std::map<int, int> known_;
   bci::ParadigmLayout layout_;
   std::vector<std::pair<int, bci::Epoch>> current_epochs_;
+  // The learnable selections decided by a model fitted without them, each flash's score
+  // standardised by that model (bci/held_out_separation.h: they bound what a fit may claim), and
+  // the current one's so far.
+  std::vector<bci::HeldOutSelection> held_out_;
+  bci::HeldOutSelection current_scored_;
   LearningState state_;
   std::shared_ptr<const LearningState> published_;
   int learnable_ = 0;  // object selections kept for learning
