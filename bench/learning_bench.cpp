@@ -7,8 +7,9 @@
 // it decides trial k, and the arm goes only when the fit with trial k in (1..k) is trusted
 // (bci::judgeTrust) and decodes trial k as it was decided, and that decision was as certain as
 // paradigm.certainty, as the session does. Decisions are made as the session makes them: scores
-// accumulated under the model's score model, dynamic stopping for the calibrated model and, once
-// trusted, for the learning one, whose selections may then flash up to
+// accumulated under the model's score model (a learnt one's separation bounded by the selections
+// decided before, as scored then: bci/held_out_separation.h), dynamic stopping for the calibrated
+// model and, once trusted, for the learning one, whose selections may then flash up to
 // paradigm.learning_max_sequences (record that many per selection: `--sequences 16`); fits and
 // decisions see only the sequences a session would have shown. Per file and in all: object
 // selections right online (trials 11 on, as the issue counts them), arm sent to a wrong object,
@@ -18,13 +19,14 @@
 // trained with the true labels (certainCeiling). The session's own classifier settings
 // (SessionConfig's defaults) are used.
 // Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
-//        [--ceiling-only] [--untrusted-sequences N]
+//        [--ceiling-only] [--untrusted-sequences N] [--unbounded]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
 
+#include "arbci/bci/held_out_separation.h"
 #include "arbci/bci/intervals.h"
 #include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_dataset.h"
@@ -135,6 +137,7 @@ struct Online {
   std::optional<int> code;
   double certainty = 0.0;
   int sequences = 0;
+  bci::HeldOutSelection scored;  // its flashes as decided, standardised by the model's scores
 };
 Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
                     const bci::PipelineSettings& pipeline, const bci::StoppingRule& rule) {
@@ -143,13 +146,16 @@ Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
   options.keep_unknown = true;
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline, {}, options);
   bci::SelectionAccumulator accumulator(data.layout, model.score_model);
+  Online out;
   for (int e = 0; e < data.epochs(); ++e) {
     const auto i = static_cast<size_t>(e);
-    accumulator.add(data.code[i], model.classifier->score(data.features.row(e)));
+    const double score = model.classifier->score(data.features.row(e));
+    accumulator.add(data.code[i], score);
+    out.scored.code.push_back(data.code[i]);
+    out.scored.z.push_back(bci::standardised(model.score_model, score));
     const bool sequence_ends = e + 1 == data.epochs() || data.sequence[i + 1] != data.sequence[i];
     if (sequence_ends && accumulator.shouldStop(rule)) break;
   }
-  Online out;
   const bci::Decision d = accumulator.decide();
   if (!d.codes.empty() && accumulator.flashes() > 0) out.code = *d.codes.begin();
   out.certainty = d.certainty;
@@ -243,10 +249,11 @@ double certainCeiling(const Replay& r, int calibration, int trials,
 Outcome learnt(const Replay& r, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                const bci::TrustRule& rule, const bci::StoppingRule& stopping,
-               int extended_sequences, int untrusted_sequences, const TimeModel& time,
+               int extended_sequences, int untrusted_sequences, bool bounded, const TimeModel& time,
                std::FILE* trace) {
   Outcome o;
   const bci::ParadigmLayout layout = bci::layoutOf(r.recording);
+  std::vector<bci::HeldOutSelection> held_out;  // the selections decided, as scored then
   Shown shown{stopping.max_sequences};
   std::optional<bci::LearnedSelections> fit;
   bci::Trust trust;
@@ -272,6 +279,7 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       decision = d.code;
       certainty = d.certainty;
       shown.of[number] = d.sequences;
+      held_out.push_back(d.scored);
     } else {
       shown.of[number] = untrusted_sequences;
     }
@@ -291,16 +299,23 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
     try {
       bci::LearnedSelections next =
           bci::learnFromUse(recording, numbers, {}, before, pipeline, training);
+      const double fitted_separation =
+          (next.model.score_model.target_mean - next.model.score_model.other_mean) /
+          next.model.score_model.sd;
+      const std::optional<double> separation = bci::heldOutSeparation(held_out, layout);
+      if (bounded && separation)
+        next.model.score_model = bci::boundSeparation(next.model.score_model, *separation);
       trust = bci::judgeTrust(next, before, rule);
       const int fitted =
           !next.numbers.empty() && next.numbers.back() == number ? next.choice.back() + 1 : 0;
       sent = decision && trust.trusted && fitted == *decision && certainty >= stopping.certainty;
       if (trace)
-        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d,%.6f,%.6f,%d\n", r.index,
-                     k, decision ? *decision : 0, r.target.at(number), next.numbers.size(),
+        std::fprintf(trace, "none,%d,%d,%d,%d,%zu,%.3f,%d,%.3f,%zu,%d,%d,%.6f,%.6f,%d,%.3f,%.3f\n",
+                     r.index, k, decision ? *decision : 0, r.target.at(number), next.numbers.size(),
                      next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
                      trust.changed.size(), trust.trusted, fitted, certainty,
-                     next.posterior.empty() ? 0.0 : next.posterior.back(), shown.at(number));
+                     next.posterior.empty() ? 0.0 : next.posterior.back(), shown.at(number),
+                     fitted_separation, separation.value_or(-1.0));
       before.clear();
       for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
       fit = std::move(next);
@@ -348,6 +363,7 @@ int main(int argc, char** argv) {
   std::string trace_file;
   bool ceiling_only = false;
   int untrusted_sequences = 0;
+  bool unbounded = false;
   cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
   cli.add_option("--calibration", calibration, "cued selections of the calibration run")
       ->capture_default_str();
@@ -359,7 +375,9 @@ int main(int argc, char** argv) {
                  "target, selections fitted, consistency, shuffles beaten, p3 uV, changed, "
                  "trusted (after the fit with that trial in), that fit's decoding of it, the "
                  "online decision's certainty, that fit's posterior of its decoding, the "
-                 "sequences shown; and per file, each trial decided right by the calibrated model "
+                 "sequences shown, the fit's separation as cross-validated and as the selections "
+                 "decided show it (-1: none yet); and per file, each trial decided right by the "
+                 "calibrated model "
                  "and by one trained on the trials before with "
                  "their true labels (the ceiling of learning without them)");
   cli.add_flag("--ceiling-only", ceiling_only,
@@ -367,6 +385,10 @@ int main(int argc, char** argv) {
   cli.add_option("--untrusted-sequences", untrusted_sequences,
                  "sequences an untrusted learning selection shows (0: as the session's "
                  "paradigm.learning_sequences gives them)");
+  cli.add_flag("--unbounded", unbounded,
+               "leave each fit's score model as its cross-validation on the labels found gives "
+               "it (the session bounds its separation by the selections decided: "
+               "bci/held_out_separation.h)");
   CLI11_PARSE(cli, argc, argv);
   std::FILE* trace = trace_file.empty() ? nullptr : std::fopen(trace_file.c_str(), "w");
   const session::SessionConfig config;
@@ -400,7 +422,7 @@ int main(int argc, char** argv) {
             ? c
             : learnt(r, calibration, trials, from, pipeline, config.classifier.training, rule,
                      stopping, extended, untrusted_sequences > 0 ? untrusted_sequences : learning,
-                     time, trace);
+                     !unbounded, time, trace);
     if (trace) {
       std::fprintf(trace, "calibrated,%d,", r.index);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
