@@ -279,7 +279,9 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       decision = d.code;
       certainty = d.certainty;
       shown.of[number] = d.sequences;
-      held_out.push_back(d.scored);
+      // As the session keeps them: decided by a model fitted on as many selections as trust asks.
+      if (static_cast<int>(fit->numbers.size()) >= rule.min_selections)
+        held_out.push_back(d.scored);
     } else {
       shown.of[number] = untrusted_sequences;
     }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_dataset.h"
@@ -51,6 +52,7 @@ void P300Stage::setModel(const bci::P300Model& model, double time_s, bool calibr
   // The online filter and window follow the model's pipeline.
   filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, settings_.info);
   model_ = std::make_shared<const bci::P300Model>(model);
+  model_selections_ = std::numeric_limits<int>::max();  // trained on labels, or given
   if (calibrated || learns()) return;
   keep_signal_ = false;
   calibration_.data.clear();
@@ -70,7 +72,11 @@ void P300Stage::recalibrate() {
 
 void P300Stage::completeSelection() {
   complete_ = selection_;
-  if (!current_scored_.code.empty()) held_out_.push_back(std::move(current_scored_));
+  // Only models that could have been trusted (fitted on as many selections as trust asks, or not
+  // learnt at all) say what a trusted one can show: the first, fitted on two or three selections,
+  // would hold every later model to their chance-level scores.
+  if (!current_scored_.code.empty() && model_selections_ >= settings_.trust.min_selections)
+    held_out_.push_back(std::move(current_scored_));
   current_scored_ = {};
 }
 
@@ -252,6 +258,7 @@ void P300Stage::takeRefit(Cycle& cycle) {
     // online filters go on as they are (the pipeline is the session's).
     extractor_.emplace(fit.model.extractor(settings_.info));
     model_ = std::make_shared<const bci::P300Model>(std::move(fit.model));
+    model_selections_ = static_cast<int>(fit.numbers.size());
     scoreCurrentAgain();
   } catch (const std::exception& error) {
     // The model before it is kept: a failed fit changes nothing the arm acts on.

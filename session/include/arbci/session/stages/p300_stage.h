@@ -126,11 +126,12 @@ class P300Stage final : public Stage {
   std::map<int, int> known_;
   bci::ParadigmLayout layout_;
   std::vector<std::pair<int, bci::Epoch>> current_epochs_;
-  // The learnable selections decided by a model fitted without them, each flash's score
-  // standardised by that model (bci/held_out_separation.h: they bound what a fit may claim), and
-  // the current one's so far.
+  // The learnable selections decided by a model fitted without them (on at least as many
+  // selections as trust asks), each flash's score standardised by that model
+  // (bci/held_out_separation.h: they bound what a fit may claim), and the current one's so far.
   std::vector<bci::HeldOutSelection> held_out_;
   bci::HeldOutSelection current_scored_;
+  int model_selections_ = 0;  // the selections model_ was learnt from (trained on labels: all)
   LearningState state_;
   std::shared_ptr<const LearningState> published_;
   int learnable_ = 0;  // object selections kept for learning
