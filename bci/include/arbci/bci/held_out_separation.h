@@ -11,7 +11,8 @@
 // each selection's one attended choice, the class means weighted by its posterior, never by a
 // hard choice), and a new fit's score model is allowed no larger separation than that. The models
 // that scored them were fitted on fewer selections than the new one, so the bound errs towards
-// less certainty.
+// less certainty; the session leaves out selections decided by models fitted on fewer selections
+// than trust asks, which would hold every later model to their chance-level scores.
 #pragma once
 
 #include <optional>
@@ -35,10 +36,10 @@ double standardised(const ScoreModel& model, double score);
 
 // The separation of the class means (target minus non-target, in pooled standard deviations) that
 // the held-out selections show, each with exactly one attended choice (an object; a row and a
-// column) that is not known. All of them count: the first were decided by weaker models, which
-// holds the bound low while the model is new (measuring only the later ones, the estimate from
-// fewer selections strays higher more often, and the arm with it). None when no selection holds
-// two codes of a group that flashed.
+// column) that is not known. Every selection given counts (the session gives those decided by
+// models that could have been trusted); measuring only the latest few, the estimate from fewer
+// selections strays higher more often, and the arm with it. None when no selection holds two
+// codes of a group that flashed.
 std::optional<double> heldOutSeparation(const std::vector<HeldOutSelection>& selections,
                                         const ParadigmLayout& layout);
 
