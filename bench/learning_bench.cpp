@@ -301,12 +301,9 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
     try {
       bci::LearnedSelections next =
           bci::learnFromUse(recording, numbers, {}, before, pipeline, training);
-      const double fitted_separation =
-          (next.model.score_model.target_mean - next.model.score_model.other_mean) /
-          next.model.score_model.sd;
-      const std::optional<double> separation = bci::heldOutSeparation(held_out, layout);
-      if (bounded && separation)
-        next.model.score_model = bci::boundSeparation(next.model.score_model, *separation);
+      bci::ScoreModel bound = next.model.score_model;
+      const bci::SeparationBound separation = bci::boundByHeldOut(bound, held_out, layout);
+      if (bounded) next.model.score_model = bound;
       trust = bci::judgeTrust(next, before, rule);
       const int fitted =
           !next.numbers.empty() && next.numbers.back() == number ? next.choice.back() + 1 : 0;
@@ -317,7 +314,7 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
                      next.consistency, next.beats_shuffled, next.p3_uv.value_or(0.0),
                      trust.changed.size(), trust.trusted, fitted, certainty,
                      next.posterior.empty() ? 0.0 : next.posterior.back(), shown.at(number),
-                     fitted_separation, separation.value_or(-1.0));
+                     separation.fitted, separation.held_out.value_or(-1.0));
       before.clear();
       for (size_t i = 0; i < next.numbers.size(); ++i) before[next.numbers[i]] = next.choice[i];
       fit = std::move(next);

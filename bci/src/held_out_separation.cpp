@@ -134,14 +134,20 @@ std::optional<double> heldOutSeparation(const std::vector<HeldOutSelection>& sel
 }
 
 ScoreModel boundSeparation(const ScoreModel& fitted, double separation) {
-  const double now = (fitted.target_mean - fitted.other_mean) / fitted.sd;
-  if (separation >= now) return fitted;
+  if (separation >= fitted.separation()) return fitted;
   ScoreModel bounded = fitted;
   const double mid = 0.5 * (fitted.target_mean + fitted.other_mean);
   const double half = 0.5 * std::max(separation, 0.0) * fitted.sd;
   bounded.target_mean = mid + half;
   bounded.other_mean = mid - half;
   return bounded;
+}
+
+SeparationBound boundByHeldOut(ScoreModel& model, const std::vector<HeldOutSelection>& selections,
+                               const ParadigmLayout& layout) {
+  SeparationBound out{model.separation(), heldOutSeparation(selections, layout)};
+  if (out.held_out) model = boundSeparation(model, *out.held_out);
+  return out;
 }
 
 }  // namespace arbci::bci

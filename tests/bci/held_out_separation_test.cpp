@@ -111,7 +111,7 @@ TEST(HeldOutSeparation, ABoundedScoreModelKeepsItsMidpointAndSpreadAndClaimsLess
   const ScoreModel bounded = boundSeparation(fitted, 0.5);
   EXPECT_DOUBLE_EQ(bounded.target_mean + bounded.other_mean, 2.0);
   EXPECT_DOUBLE_EQ(bounded.sd, 2.0);
-  EXPECT_DOUBLE_EQ((bounded.target_mean - bounded.other_mean) / bounded.sd, 0.5);
+  EXPECT_DOUBLE_EQ(bounded.separation(), 0.5);
   EXPECT_DOUBLE_EQ(bounded.median, -0.5);
   EXPECT_DOUBLE_EQ(standardised(bounded, 1.0), standardised(fitted, 1.0));
   // A larger separation than the fit's changes nothing.

@@ -193,11 +193,7 @@ void P300Stage::startRefit() {
         out.fit = bci::learnFromUse(recording, numbers, known, previous, pipeline, training);
         // Its certainty may claim no more than the selections decided so far, scored by models
         // that had not seen them, show.
-        bci::ScoreModel& scores = out.fit.model.score_model;
-        out.fitted_separation = (scores.target_mean - scores.other_mean) / scores.sd;
-        out.held_out_separation = bci::heldOutSeparation(held_out, objects);
-        if (out.held_out_separation)
-          scores = bci::boundSeparation(scores, *out.held_out_separation);
+        out.separation = bci::boundByHeldOut(out.fit.model.score_model, held_out, objects);
         out.fit.model.provenance["training_files"] = {"this session's selections"};
         out.fit.model.provenance["labels"] =
             known.empty() ? "found without labels (learning from use)"
@@ -246,9 +242,9 @@ void P300Stage::takeRefit(Cycle& cycle) {
                   {"shuffled_explained", fit.shuffled_explained},
                   {"beats_shuffled", fit.beats_shuffled},
                   {"p3_uv", fit.p3_uv ? nlohmann::json(*fit.p3_uv) : nlohmann::json(nullptr)},
-                  {"separation_fitted", outcome.fitted_separation},
-                  {"separation_held_out", outcome.held_out_separation
-                                              ? nlohmann::json(*outcome.held_out_separation)
+                  {"separation_fitted", outcome.separation.fitted},
+                  {"separation_held_out", outcome.separation.held_out
+                                              ? nlohmann::json(*outcome.separation.held_out)
                                               : nlohmann::json(nullptr)},
                   {"post_hoc", state_.post_hoc},
                   {"changed", trust.changed},
@@ -271,13 +267,15 @@ void P300Stage::takeRefit(Cycle& cycle) {
 void P300Stage::scoreCurrentAgain() {
   accumulator_.emplace(layout_, model_->score_model);
   current_scored_ = {};
-  for (const auto& [code, epoch] : current_epochs_) {
-    const double score = model_->classifier->score(extractor_->features(epoch));
-    accumulator_->add(code, score);
-    if (current_learnable_) {
-      current_scored_.code.push_back(code);
-      current_scored_.z.push_back(bci::standardised(model_->score_model, score));
-    }
+  for (const auto& [code, epoch] : current_epochs_) scoreEpoch(code, epoch);
+}
+
+void P300Stage::scoreEpoch(int code, const bci::Epoch& epoch) {
+  const double score = model_->classifier->score(extractor_->features(epoch));
+  accumulator_->add(code, score);
+  if (current_learnable_) {
+    current_scored_.code.push_back(code);
+    current_scored_.z.push_back(bci::standardised(model_->score_model, score));
   }
 }
 
@@ -334,14 +332,7 @@ void P300Stage::process(const bci::Block& eeg, double time_s) {
       continue;
     }
     if (learns()) current_epochs_.emplace_back(record.code, epoch);
-    if (accumulator_ && extractor_) {
-      const double score = model_->classifier->score(extractor_->features(epoch));
-      accumulator_->add(record.code, score);
-      if (current_learnable_) {
-        current_scored_.code.push_back(record.code);
-        current_scored_.z.push_back(bci::standardised(model_->score_model, score));
-      }
-    }
+    if (accumulator_ && extractor_) scoreEpoch(record.code, epoch);
   }
 }
 

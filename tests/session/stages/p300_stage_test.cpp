@@ -120,8 +120,7 @@ TEST(P300StageLearning, AModelLearntFromNoResponseClaimsNoMoreThanTheSelectionsD
   const double fitted = last["separation_fitted"].get<double>();
   const double held_out = last["separation_held_out"].get<double>();
   const bci::ScoreModel& scores = now.model->score_model;
-  EXPECT_NEAR((scores.target_mean - scores.other_mean) / scores.sd,
-              std::min(fitted, std::max(held_out, 0.0)), 1e-9);
+  EXPECT_NEAR(scores.separation(), std::min(fitted, std::max(held_out, 0.0)), 1e-9);
 }
 
 TEST_F(P300StageTest, RecalibrateAtTheReviewTrainsOnTheNewRunAlone) {

@@ -24,6 +24,9 @@ struct ScoreModel {
   double median = std::numeric_limits<double>::quiet_NaN();
   // Fitted to scores and labels; throws std::invalid_argument without both classes.
   static ScoreModel fit(const std::vector<double>& scores, const std::vector<bool>& target);
+  // Target minus non-target mean in standard deviations: how far apart the classes are, which is
+  // what a decision's certainty grows with.
+  double separation() const { return (target_mean - other_mean) / sd; }
 };
 
 struct Decision {

@@ -36,10 +36,9 @@ double standardised(const ScoreModel& model, double score);
 
 // The separation of the class means (target minus non-target, in pooled standard deviations) that
 // the held-out selections show, each with exactly one attended choice (an object; a row and a
-// column) that is not known. Every selection given counts (the session gives those decided by
-// models that could have been trusted); measuring only the latest few, the estimate from fewer
-// selections strays higher more often, and the arm with it. None when no selection holds two
-// codes of a group that flashed.
+// column) that is not known. Every selection given counts: an estimate from fewer selections
+// strays further, and it is its upward strays that would let the arm act on too little. None when
+// no selection holds two codes of a group that flashed.
 std::optional<double> heldOutSeparation(const std::vector<HeldOutSelection>& selections,
                                         const ParadigmLayout& layout);
 
@@ -47,5 +46,15 @@ std::optional<double> heldOutSeparation(const std::vector<HeldOutSelection>& sel
 // most `separation` (in its standard deviations; the midpoint and the standard deviation kept,
 // so scores standardise the same); at zero or below, both means at the midpoint: no evidence.
 ScoreModel boundSeparation(const ScoreModel& fitted, double separation);
+
+// A learnt fit's score model held to what the selections decided before it show: `model` bounded
+// by heldOutSeparation(selections, layout) where there is one. Returns both separations, the
+// fitted one (before the bound) and the held-out one (none before any selection), for the log.
+struct SeparationBound {
+  double fitted = 0.0;
+  std::optional<double> held_out;
+};
+SeparationBound boundByHeldOut(ScoreModel& model, const std::vector<HeldOutSelection>& selections,
+                               const ParadigmLayout& layout);
 
 }  // namespace arbci::bci

@@ -80,6 +80,8 @@ class P300Stage final : public Stage {
   void startRefit();
   void takeRefit(Cycle& cycle);
   void scoreCurrentAgain();
+  // One epoch into the selection's scores (and, for a learnable selection, current_scored_).
+  void scoreEpoch(int code, const bci::Epoch& epoch);
   // The current selection is over: complete_ moves to it and its scores join held_out_.
   void completeSelection();
   bool learns() const { return settings_.learn || settings_.adapt; }
@@ -115,8 +117,7 @@ class P300Stage final : public Stage {
     std::map<int, int> frozen;
     // The fit's separation as its cross-validation gave it, and as the selections decided before
     // show it (none before any), which bounds it.
-    double fitted_separation = 0.0;
-    std::optional<double> held_out_separation;
+    bci::SeparationBound separation;
   };
   std::future<LearningOutcome> refit_;
   int complete_ = 0, fitted_ = 0;  // the last learnable selection complete; the last fitted
