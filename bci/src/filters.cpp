@@ -93,6 +93,23 @@ IirFilter::IirFilter(std::vector<Biquad> sections, int channels)
 
 void IirFilter::reset() {
   std::fill(state_.begin(), state_.end(), 0.0);
+  started_ = false;
+}
+
+// A constant input x gives each section the output g x (g its gain at DC) for ever; the two
+// state words that hold it follow from the section's equations with x and y fixed.
+void IirFilter::settleOn(int channel, double value) {
+  const size_t n_sections = sections_.size();
+  double* z = state_.data() + static_cast<size_t>(channel) * n_sections * 2;
+  double x = value;
+  for (size_t k = 0; k < n_sections; ++k) {
+    const Biquad& q = sections_[k];
+    const double denominator = 1.0 + q.a1 + q.a2;
+    const double y = std::abs(denominator) > 1e-300 ? (q.b0 + q.b1 + q.b2) * x / denominator : 0.0;
+    z[2 * k + 1] = q.b2 * x - q.a2 * y;
+    z[2 * k] = y - q.b0 * x;
+    x = y;
+  }
 }
 
 void IirFilter::process(Block& block) {
@@ -101,6 +118,11 @@ void IirFilter::process(Block& block) {
                                 " channels, the filter " + std::to_string(channels_));
   }
   const size_t n_sections = sections_.size();
+  if (!started_ && block.samples > 0) {
+    for (int c = 0; c < channels_; ++c)
+      settleOn(c, block.data[static_cast<size_t>(c) * block.samples]);
+    started_ = true;
+  }
   for (int c = 0; c < channels_; ++c) {
     float* x = block.data.data() + static_cast<size_t>(c) * block.samples;
     double* z = state_.data() + static_cast<size_t>(c) * n_sections * 2;

@@ -101,6 +101,32 @@ TEST(Filters, PassBandKeptStopBandAndLineRemoved) {
   EXPECT_LT(amplitude(50.0), 0.01);
 }
 
+// A DC-coupled amplifier's offset (1 mV, 50 mV) with a slow drift on top: the chain starts in
+// the offset's steady state, so the output is the noise band-passed, never a start-up ringing.
+TEST(Filters, AnOffsetAtTheStartRingsNowhere) {
+  FilterSettings settings = wideBand();
+  settings.common_average = false;
+  const Block clean = noise(8, 2560, 3);
+  Block reference = clean;
+  FilterChain(settings, eightChannels()).process(reference);
+  for (const double offset_uv : {1000.0, 50000.0}) {
+    Block shifted = clean;
+    for (int c = 0; c < 8; ++c) {
+      for (int s = 0; s < shifted.samples; ++s)
+        shifted.at(c, s) += static_cast<float>(offset_uv * (c % 2 ? -1 : 1) + 20.0 * s / 256.0);
+    }
+    FilterChain(settings, eightChannels()).process(shifted);
+    double largest = 0.0;
+    for (int c = 0; c < 8; ++c) {
+      for (int s = 0; s < shifted.samples; ++s)
+        largest = std::max(largest, std::abs(double(shifted.at(c, s) - reference.at(c, s))));
+    }
+    // What is left is the drift's ramp through the high-pass (its step response to a slope of
+    // 20 uV/s settles below a few microvolts) and float rounding of the offset.
+    EXPECT_LT(largest, 10.0) << offset_uv << " uV";
+  }
+}
+
 TEST(Filters, CommonAverageReferenceLeavesZeroMean) {
   Block b = noise(8, 100, 2);
   commonAverageReference(b);

@@ -35,6 +35,15 @@ class FlashDriver {
   bci::SimulatedSubject& subject() { return *subject_; }
   // From now on the subject attends none of the stimuli (the selections still name a target).
   void lookAway() { attentive_ = false; }
+  // A DC-coupled amplifier: every channel offset by `offset_uv` (alternating in sign) plus a
+  // drift of `drift_uv_per_s` from sample 0.
+  void amplifierOffset(double offset_uv, double drift_uv_per_s) {
+    offset_uv_ = offset_uv;
+    drift_uv_per_s_ = drift_uv_per_s;
+  }
+  // Every block delivered so far and every flash shown, as an offline analysis would read them.
+  const std::vector<bci::Block>& delivered() const { return delivered_; }
+  const std::vector<bci::StimulusEvent>& shown() const { return shown_; }
 
   // One selection of `sequences` sequences (each code once per sequence, in random order) with
   // `target` attended; `cued`: a calibration selection (its target announced); `retake_of`: it
@@ -76,6 +85,7 @@ class FlashDriver {
     bench_.record.presentation.onsets.push_back(
         {session::Flash{code, true, target, true, selection}, sample});
     subject_->present({sample, code, target, 15, true});
+    shown_.push_back({sample, code, target, 15, true});
   }
   // A feedback first shown on this cycle's frame.
   void feedback(const std::set<int>& codes, std::optional<bool> error) {
@@ -89,6 +99,14 @@ class FlashDriver {
     const double t = bench_.record.frame / 60.0;
     clock_->advanceTo(t);
     for (bci::Block& block : subject_->poll(1000)) {
+      for (int c = 0; c < block.channels; ++c) {
+        for (int i = 0; i < block.samples; ++i) {
+          const double t_s = static_cast<double>(block.first_sample + i) / info().rate_hz;
+          block.at(c, i) +=
+              static_cast<float>((c % 2 ? -offset_uv_ : offset_uv_) + drift_uv_per_s_ * t_s);
+        }
+      }
+      delivered_.push_back(block);
       bench_.record.eeg.eeg_blocks.push_back(block);
       bench_.record.eeg.blocks.push_back(std::move(block));
     }
@@ -107,6 +125,9 @@ class FlashDriver {
   int stimuli_;
   std::mt19937_64 random_;
   bool attentive_ = true;
+  double offset_uv_ = 0.0, drift_uv_per_s_ = 0.0;
+  std::vector<bci::Block> delivered_;
+  std::vector<bci::StimulusEvent> shown_;
   std::shared_ptr<bci::ManualClock> clock_;
   std::unique_ptr<bci::SimulatedSubject> subject_;
 };

@@ -1,6 +1,8 @@
 // Causal filtering of blocks: common average reference, IIR band-pass and notch (biquad
 // cascades whose state carries across blocks, so filtering block by block gives exactly the
-// output of filtering the whole signal) and decimation by moving average.
+// output of filtering the whole signal) and decimation by moving average. A cascade starts in
+// the steady state of its first sample held since ever (each channel its own): a DC-coupled
+// amplifier's offset of millivolts is not a step that rings through the high-pass for seconds.
 #pragma once
 
 #include <vector>
@@ -22,18 +24,24 @@ Biquad notchFilter(double frequency_hz, double q, double rate_hz);
 // Magnitude response of a cascade at `frequency_hz`.
 double magnitudeResponse(const std::vector<Biquad>& sections, double frequency_hz, double rate_hz);
 
-// A biquad cascade with one state per channel (transposed direct form II, in double).
+// A biquad cascade with one state per channel (transposed direct form II, in double). Its state
+// starts as if each channel's first sample had always been its value (the steady state of a
+// constant input), so an offset passes without a start-up transient.
 class IirFilter {
  public:
   IirFilter(std::vector<Biquad> sections, int channels);
   void process(Block& block);  // in place
+  // Forgets the signal: the next sample starts it again (in its steady state).
   void reset();
   const std::vector<Biquad>& sections() const { return sections_; }
 
  private:
+  void settleOn(int channel, double value);  // the steady state of `value` held
+
   std::vector<Biquad> sections_;
   int channels_;
   std::vector<double> state_;  // [channel][section][2]
+  bool started_ = false;
 };
 
 // Subtracts the mean over channels from every sample.
@@ -42,6 +50,7 @@ void commonAverageReference(Block& block);
 // Each field's default, range and meaning: bci::filterSchema() (bci/settings.h).
 struct FilterSettings {
   FilterSettings();  // the schema's defaults
+  bool operator==(const FilterSettings&) const = default;
   bool common_average;
   double highpass_hz;  // 0: none
   double lowpass_hz;   // 0: none
