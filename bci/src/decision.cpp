@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <vector>
 
@@ -31,6 +32,59 @@ ScoreModel ScoreModel::fit(const std::vector<double>& scores, const std::vector<
   return model;
 }
 
+double fitWithinSelectionCorrelation(const ScoreModel& model, const std::vector<double>& scores,
+                                     const std::vector<bool>& target,
+                                     const std::vector<int>& selection,
+                                     const std::vector<int>& code) {
+  // Each flash's residual from its class mean, by selection and code.
+  std::map<int, std::map<int, std::vector<double>>> residuals;
+  for (size_t i = 0; i < scores.size(); ++i)
+    residuals[selection[i]][code[i]].push_back(scores[i] -
+                                               (target[i] ? model.target_mean : model.other_mean));
+  // Within a selection (what it shares removed), residuals of variance t^2 correlate by rho
+  // within a code. Over a selection of N flashes in K codes of n_c each:
+  //   E[sum_i (r_i - mean r)^2]       = t^2 (N - 1 + rho (1 - sum n_c^2 / N))
+  //   E[sum_c (m_c - mean of m_c)^2]  = t^2 (1 - 1/K) (sum 1/n_c + rho (K - sum 1/n_c))
+  // (m_c a code's mean residual). The ratio of the two sums is free of t^2: solved for rho.
+  double flashes_scatter = 0.0, codes_scatter = 0.0;
+  double a0 = 0.0, a1 = 0.0, b0 = 0.0, b1 = 0.0;
+  for (const auto& [number, codes] : residuals) {
+    if (codes.size() < 2) continue;
+    const double k = static_cast<double>(codes.size());
+    double n_all = 0.0, sum_all = 0.0, squares_counts = 0.0, inverse_counts = 0.0,
+           mean_of_means = 0.0;
+    for (const auto& [c, r] : codes) {
+      const double n = static_cast<double>(r.size());
+      double sum = 0.0;
+      for (double v : r) sum += v;
+      n_all += n;
+      sum_all += sum;
+      squares_counts += n * n;
+      inverse_counts += 1.0 / n;
+      mean_of_means += sum / n / k;
+    }
+    const double mean_all = sum_all / n_all;
+    for (const auto& [c, r] : codes) {
+      double sum = 0.0;
+      for (double v : r) {
+        flashes_scatter += (v - mean_all) * (v - mean_all);
+        sum += v;
+      }
+      const double d = sum / static_cast<double>(r.size()) - mean_of_means;
+      codes_scatter += d * d;
+    }
+    a0 += n_all - 1.0;
+    a1 += 1.0 - squares_counts / n_all;
+    b0 += (1.0 - 1.0 / k) * inverse_counts;
+    b1 += (1.0 - 1.0 / k) * (k - inverse_counts);
+  }
+  if (flashes_scatter <= 0.0 || b1 <= 0.0) return 0.0;
+  const double ratio = codes_scatter / flashes_scatter;
+  const double denominator = ratio * a1 - b1;
+  if (std::abs(denominator) < 1e-12) return 0.0;
+  return std::clamp((b0 - ratio * a0) / denominator, 0.0, 0.5);
+}
+
 SelectionAccumulator::SelectionAccumulator(const ParadigmLayout& layout, const ScoreModel& model)
     : layout_(layout), model_(model) {
   for (int code = 1; code <= layout.codes(); ++code) {
@@ -48,6 +102,10 @@ void SelectionAccumulator::add(int code, double score) {
   ++flashes_;
 }
 
+double SelectionAccumulator::discounted(int code) const {
+  return evidence_.at(code) / model_.overdispersion(counts_.at(code));
+}
+
 int SelectionAccumulator::completeSequences() const {
   int least = std::numeric_limits<int>::max();
   for (const auto& [code, count] : counts_) least = std::min(least, count);
@@ -56,11 +114,11 @@ int SelectionAccumulator::completeSequences() const {
 
 std::map<int, double> SelectionAccumulator::posterior(int first_code, int count) const {
   double top = -std::numeric_limits<double>::infinity();
-  for (int c = first_code; c < first_code + count; ++c) top = std::max(top, evidence_.at(c));
+  for (int c = first_code; c < first_code + count; ++c) top = std::max(top, discounted(c));
   std::map<int, double> p;
   double total = 0.0;
   for (int c = first_code; c < first_code + count; ++c)
-    total += p[c] = std::exp(evidence_.at(c) - top);
+    total += p[c] = std::exp(discounted(c) - top);
   for (auto& [code, value] : p) value /= total;
   return p;
 }
@@ -76,6 +134,8 @@ double errorPosterior(const ScoreModel& errp, double score, double prior_error) 
 
 Decision SelectionAccumulator::decide() const {
   Decision decision;
+  decision.evidence = evidence_;
+  decision.flashes = counts_;
   using Entry = std::pair<int, double>;
   auto ranked = [](const std::map<int, double>& p) {
     std::vector<Entry> order(p.begin(), p.end());

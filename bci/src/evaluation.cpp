@@ -300,13 +300,18 @@ CrossValidation crossValidate(const P300Dataset& data, const TrainingSettings& s
   for (int s : labelled) tested.selections.push_back(data.selections[static_cast<size_t>(s)]);
   std::vector<double> scored;
   std::vector<bool> labels;
-  for (const SelectionEpochs& s : tested.selections) {
-    for (int row : s.epochs) {
+  std::vector<int> selection, code;
+  for (size_t s = 0; s < tested.selections.size(); ++s) {
+    for (int row : tested.selections[s].epochs) {
       scored.push_back(cv.scores[static_cast<size_t>(row)]);
       labels.push_back(data.target[static_cast<size_t>(row)]);
+      selection.push_back(static_cast<int>(s));
+      code.push_back(data.code[static_cast<size_t>(row)]);
     }
   }
   cv.score_model = ScoreModel::fit(scored, labels);
+  cv.score_model.rho =
+      fitWithinSelectionCorrelation(cv.score_model, scored, labels, selection, code);
   cv.report = evaluateScores(tested, cv.scores, cv.score_model, settings.dynamic);
   return cv;
 }

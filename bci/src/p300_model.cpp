@@ -1,5 +1,6 @@
 #include "arbci/bci/p300_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -44,6 +45,7 @@ nlohmann::json P300Model::toJson() const {
                          {"other_mean", score_model.other_mean},
                          {"sd", score_model.sd}};
   if (!std::isnan(score_model.median)) json["score_model"]["median"] = score_model.median;
+  json["score_model"]["rho"] = score_model.rho;
   json["paradigm"] = {
       {"kind", layout.kind == ParadigmLayout::Kind::RowColumn ? "row/column" : "single stimulus"},
       {"stimuli", layout.stimuli},
@@ -97,6 +99,8 @@ P300Model P300Model::fromJson(const nlohmann::json& json, const std::string& sou
                          s.at("sd").get<double>(),
                          s.contains("median") ? s.at("median").get<double>()
                                               : std::numeric_limits<double>::quiet_NaN()};
+    // A model from before the correlation was kept: its flashes counted as independent.
+    model.score_model.rho = std::clamp(s.value("rho", 0.0), 0.0, 0.5);
     const auto& l = json.at("paradigm");
     if (l.at("kind").get<std::string>() == "row/column") {
       model.layout = ParadigmLayout::matrix(l.at("rows").get<int>(), l.at("columns").get<int>(),

@@ -17,8 +17,9 @@ P300Stage::P300Stage(const P300Settings& settings, const StageServices& services
     : settings_(settings), s_(services) {
   const bci::SignalInfo& info = settings_.info;
   filters_ = std::make_unique<bci::FilterChain>(settings_.pipeline.filter, info);
+  filter_settings_ = settings_.pipeline.filter;
   epocher_ = std::make_unique<bci::Epocher>(info.channelCount(), info.rate_hz,
-                                            settings_.pipeline.window, 10.0);
+                                            settings_.pipeline.window, kHistoryS);
   calibration_.source = "calibration run";
   calibration_.format = "memory";
   calibration_.info = info;
@@ -49,14 +50,43 @@ void P300Stage::setModel(const bci::P300Model& model, double time_s, bool calibr
     s_.tell.say(time_s, Severity::Warning, text);
   }
   extractor_.emplace(model.extractor(settings_.info));
-  // The online filter and window follow the model's pipeline.
-  filters_ = std::make_unique<bci::FilterChain>(model.pipeline.filter, settings_.info);
+  // The online filter follows the model's pipeline. The same filter goes on as it is: a fresh one
+  // would start in the middle of the signal, and its start-up would reach the next epochs.
+  if (!(model.pipeline.filter == filter_settings_)) refilter(model.pipeline.filter);
   model_ = std::make_shared<const bci::P300Model>(model);
   model_selections_ = std::numeric_limits<int>::max();  // trained on labels, or given
   if (calibrated || learns()) return;
   keep_signal_ = false;
   calibration_.data.clear();
   calibration_.data.shrink_to_fit();
+}
+
+void P300Stage::refilter(const bci::FilterSettings& filter) {
+  // Another filter: it starts on the raw signal kept (its history's first sample its steady
+  // state), and the epochs not yet cut are cut from its output over that history, so no flash
+  // still to be scored sees two filters or the new one's start.
+  filters_ = std::make_unique<bci::FilterChain>(filter, settings_.info);
+  filter_settings_ = filter;
+  const bci::SignalInfo& info = settings_.info;
+  missed_before_ += epocher_->missed();
+  epocher_ = std::make_unique<bci::Epocher>(info.channelCount(), info.rate_hz,
+                                            settings_.pipeline.window, kHistoryS);
+  for (const auto& [sample, flash] : flashes_) epocher_->addEvent(flash.event);
+  for (bci::Block block : raw_history_) {
+    filters_->process(block);
+    refiltered_.push_back(std::move(block));
+  }
+}
+
+void P300Stage::keepRaw(const bci::Block& block) {
+  raw_history_.push_back(block);
+  std::int64_t kept = 0;
+  for (const bci::Block& b : raw_history_) kept += b.samples;
+  const auto limit = static_cast<std::int64_t>(kHistoryS * settings_.info.rate_hz);
+  while (!raw_history_.empty() && kept - raw_history_.front().samples >= limit) {
+    kept -= raw_history_.front().samples;
+    raw_history_.pop_front();
+  }
 }
 
 void P300Stage::recalibrate() {
@@ -108,10 +138,29 @@ void P300Stage::startSelection(const SelectionStart& selection) {
     left_out_.push_back(cut);
   }
   selection_ = selection.selection;
+  if (selection.trial > 0) trial_of_[selection.selection] = selection.trial;
   calibrating_ = selection.target.has_value();
   presented_ = scored_ = 0;
+  // The online selection just over joins those of its kind; the new one is decided under the
+  // model's score model held to what they showed.
+  if (online_kind_ >= 0 && !online_scored_.code.empty())
+    decided_[online_kind_].push_back(std::move(online_scored_));
+  online_scored_ = {};
+  online_kind_ = selection.target ? -1 : (selection.objects ? 0 : 1);
   accumulator_.reset();
-  if (model_) accumulator_.emplace(selection.layout, model_->score_model);
+  if (model_) accumulator_.emplace(selection.layout, scoreModelNow());
+}
+
+bci::ScoreModel P300Stage::scoreModelNow() {
+  bci::ScoreModel model = model_->score_model;
+  held_out_now_.reset();
+  // Learnt object selections are bounded at each fit (startRefit), by the selections its rule
+  // keeps; every other online kind here, by the selections of that kind decided so far.
+  if (online_kind_ < 0 || (learns() && online_kind_ == 0)) return model;
+  const auto& decided = decided_[online_kind_];
+  if (static_cast<int>(decided.size()) < bci::kMinHeldOutSelections) return model;
+  held_out_now_ = bci::boundByHeldOut(model, decided, layout_).held_out;
+  return model;
 }
 
 bci::Recording P300Stage::keptSignal() const {
@@ -246,8 +295,8 @@ void P300Stage::takeRefit(Cycle& cycle) {
                   {"separation_held_out", outcome.separation.held_out
                                               ? nlohmann::json(*outcome.separation.held_out)
                                               : nlohmann::json(nullptr)},
-                  {"post_hoc", state_.post_hoc},
-                  {"changed", trust.changed},
+                  {"post_hoc", byTrial(state_.post_hoc)},
+                  {"changed", trialsOf(trust.changed)},
                   {"trusted", state_.trusted},
                   {"waiting_for", state_.waiting_for}});
     // The new model decides from here, the current selection's epochs scored again by it; the
@@ -264,8 +313,28 @@ void P300Stage::takeRefit(Cycle& cycle) {
   published_ = std::make_shared<const LearningState>(state_);
 }
 
+// The log names a learnt selection by its trial, as the experimenter counts them.
+nlohmann::json P300Stage::byTrial(const std::map<int, int>& by_selection) const {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [number, code] : by_selection) {
+    const auto trial = trial_of_.find(number);
+    out[std::to_string(trial != trial_of_.end() ? trial->second : 0)] = code;
+  }
+  return out;
+}
+
+std::vector<int> P300Stage::trialsOf(const std::vector<int>& selections) const {
+  std::vector<int> out;
+  for (int number : selections) {
+    const auto trial = trial_of_.find(number);
+    out.push_back(trial != trial_of_.end() ? trial->second : 0);
+  }
+  return out;
+}
+
 void P300Stage::scoreCurrentAgain() {
-  accumulator_.emplace(layout_, model_->score_model);
+  accumulator_.emplace(layout_, scoreModelNow());
+  online_scored_ = {};
   current_scored_ = {};
   for (const auto& [code, epoch] : current_epochs_) scoreEpoch(code, epoch);
 }
@@ -273,6 +342,10 @@ void P300Stage::scoreCurrentAgain() {
 void P300Stage::scoreEpoch(int code, const bci::Epoch& epoch) {
   const double score = model_->classifier->score(extractor_->features(epoch));
   accumulator_->add(code, score);
+  if (online_kind_ >= 0) {
+    online_scored_.code.push_back(code);
+    online_scored_.z.push_back(bci::standardised(model_->score_model, score));
+  }
   if (current_learnable_) {
     current_scored_.code.push_back(code);
     current_scored_.z.push_back(bci::standardised(model_->score_model, score));
@@ -314,7 +387,16 @@ void P300Stage::process(const bci::Block& eeg, double time_s) {
     }
     calibration_.samples += block.samples;
   }
+  keepRaw(block);
   filters_->process(block);
+  // After a change of filter: its output over the history first (refilter()).
+  std::vector<bci::Block> filtered = std::move(refiltered_);
+  refiltered_.clear();
+  filtered.push_back(std::move(block));
+  for (const bci::Block& b : filtered) cutEpochs(b, time_s);
+}
+
+void P300Stage::cutEpochs(const bci::Block& block, double time_s) {
   for (const bci::Epoch& epoch : epocher_->push(block)) {
     const auto found = flashes_.find(epoch.event.sample);
     if (found == flashes_.end()) continue;
@@ -372,7 +454,7 @@ void P300Stage::step(Cycle& cycle) {
       calibration_.stimuli.push_back({onset.sample, f.code, false, duration, false});
       calibration_selection_.push_back(selection_);
     }
-    flashes_[onset.sample] = {selection_, f.code};
+    flashes_[onset.sample] = {selection_, f.code, event};
     epocher_->addEvent(event);
     ++presented_;
   }
@@ -403,13 +485,15 @@ void P300Stage::step(Cycle& cycle) {
   out.scored = scored_;
   out.sequences = accumulator_ ? accumulator_->completeSequences() : 0;
   out.decision = accumulator_ ? accumulator_->decide() : bci::Decision{};
+  if (accumulator_) out.scored_by = accumulator_->scoreModel();
+  out.held_out_separation = held_out_now_;
   out.model = model_;
   out.erp = trained_erp_;
   out.training = training_.valid();
 }
 
 void P300Stage::report(nlohmann::json& summary) const {
-  summary["eeg"]["missed_epochs"] = epocher_->missed();
+  summary["eeg"]["missed_epochs"] = missed_before_ + epocher_->missed();
   summary["eeg"]["discarded_epochs"] = discarded_;
 }
 

@@ -3,6 +3,8 @@
 // requests for the other stages (training, the robot's grasp, put-down and stop).
 #include <cstdio>
 
+#include "arbci/bci/selection_marks.h"
+
 #include "arbci/session/stages/paradigm_stage.h"
 
 namespace arbci::session {
@@ -101,6 +103,15 @@ void ParadigmStage::onSelectionStarted(const bci::ParadigmEvent& e, Cycle& cycle
     learnt.trial = paradigm_.trial();
     for (size_t slot : slots_) learnt.ids.push_back(settings_.world.objects[slot].id);
   }
+  // The recording says where each selection starts and what it is, so an analysis splits the
+  // flashes as the session did (bci/selection_marks.h).
+  bci::MarkedSelection mark;
+  mark.number = selection_;
+  mark.kind = target ? bci::SelectionKind::Calibration
+                     : (e.objects_layout ? bci::SelectionKind::Objects : bci::SelectionKind::Cells);
+  mark.trial = target ? 0 : paradigm_.trial();
+  mark.retake_of = retake_of;
+  cycle.annotate(cycle.eeg_sample, bci::selectionMark(mark));
   selection_objects_ = e.objects_layout;
   truth_ = target ? std::set<int>{*target} : attended;
   cycle.record.paradigm.selection_started =
@@ -109,7 +120,8 @@ void ParadigmStage::onSelectionStarted(const bci::ParadigmEvent& e, Cycle& cycle
                      e.objects_layout ? paradigm_.objectLayout() : paradigm_.gridLayout(),
                      attended,
                      target,
-                     retake_of};
+                     retake_of,
+                     mark.trial};
 }
 
 void ParadigmStage::onFlash(const bci::ParadigmEvent& e, Cycle& cycle) {
@@ -152,6 +164,21 @@ void ParadigmStage::onSelectionMade(const bci::ParadigmEvent& e, Cycle& cycle) {
     fields["selected"] = {e.cell.first, e.cell.second};
     fields["intended"] = {trial.intended_cell.first, trial.intended_cell.second};
   }
+  // The evidence behind the certainty: each code's summed log-likelihood ratio and flashes, and
+  // the score model it was weighed under.
+  const P300Part& p300 = cycle.record.p300;
+  nlohmann::json evidence = nlohmann::json::object();
+  for (const auto& [code, value] : p300.decision.evidence) {
+    const auto n = p300.decision.flashes.find(code);
+    evidence[std::to_string(code)] = {
+        {"llr", value}, {"flashes", n != p300.decision.flashes.end() ? n->second : 0}};
+  }
+  fields["evidence"] = evidence;
+  fields["score_model"] = {
+      {"separation", p300.scored_by.separation()},
+      {"rho", p300.scored_by.rho},
+      {"held_out_separation",
+       p300.held_out_separation ? nlohmann::json(*p300.held_out_separation) : nlohmann::json()}};
   s_.log.write("selection", cycle.time_s, fields);
   cycle.annotate(cycle.eeg_sample,
                  std::string("Selected ") +
@@ -233,7 +260,7 @@ void ParadigmStage::onRobotDrop(const bci::ParadigmEvent& e, Cycle& cycle) {
                 "trial " + std::to_string(trial.trial) + ": " + trial.outcome);
   }
   if (e.give_back) {
-    trial.outcome = "returned: the ErrP rejected every cell selected";
+    trial.outcome = "returned: " + e.text;
     s_.tell.say(time, Severity::Warning,
                 "trial " + std::to_string(trial.trial) + ": " + trial.outcome);
   }

@@ -123,6 +123,86 @@ TEST(P300StageLearning, AModelLearntFromNoResponseClaimsNoMoreThanTheSelectionsD
   EXPECT_NEAR(scores.separation(), std::min(fitted, std::max(held_out, 0.0)), 1e-9);
 }
 
+// The decision an offline analysis makes of the last `flashes` flashes shown: the whole signal
+// through the model's filters at once (bci::buildDataset), scored and accumulated.
+bci::Decision offlineDecision(const test::FlashDriver& eeg, const bci::P300Model& model,
+                              int flashes) {
+  bci::Recording r;
+  r.info = eeg.info();
+  for (const bci::Block& b : eeg.delivered()) r.samples += b.samples;
+  r.data.assign(static_cast<size_t>(r.samples * r.info.channelCount()), 0.0f);
+  std::int64_t at = 0;
+  for (const bci::Block& b : eeg.delivered()) {
+    for (int c = 0; c < b.channels; ++c) {
+      for (int s = 0; s < b.samples; ++s)
+        r.data[static_cast<size_t>(c * r.samples + at + s)] = b.at(c, s);
+    }
+    at += b.samples;
+  }
+  r.stimuli.assign(eeg.shown().end() - flashes, eeg.shown().end());
+  r.parameters["Paradigm"] = "single stimulus, 4 stimuli";
+  const bci::P300Dataset data = bci::buildDataset({r}, model.pipeline);
+  bci::SelectionAccumulator accumulator(data.layout, model.score_model);
+  for (int e = 0; e < data.epochs(); ++e)
+    accumulator.add(data.code[static_cast<size_t>(e)],
+                    model.classifier->score(data.features.row(e)));
+  return accumulator.decide();
+}
+
+void expectSameEvidence(const bci::Decision& online, const bci::Decision& offline, double within) {
+  ASSERT_EQ(online.flashes, offline.flashes);
+  for (const auto& [code, evidence] : offline.evidence)
+    EXPECT_NEAR(online.evidence.at(code), evidence, within) << "code " << code;
+}
+
+// A DC-coupled amplifier's offset (1 mV, 50 mV) and a slow drift: the model arrives between the
+// calibration run and the first online selection, and that selection is scored exactly as an
+// offline analysis of the whole signal scores it (the filter goes on; it never starts again in
+// the middle of the signal).
+TEST(P300StageFilter, TheFirstOnlineSelectionIsScoredAsOfflineDespiteAnOffsetAndDrift) {
+  for (const double offset_uv : {1000.0, 50000.0}) {
+    test::StageBench bench("p300_offset");
+    test::FlashDriver eeg(bench, 4);
+    eeg.amplifierOffset(offset_uv, 5.0);
+    P300Stage stage(settingsFor(eeg.info()), bench.services());
+    const int targets[] = {1, 3, 2, 4, 4, 2};
+    for (int n = 1; n <= 6; ++n) eeg.selection(stage, n, targets[n - 1], true, 8);
+    bench.record.requests.push_back(TrainRequest{"slda"});
+    eeg.step(stage);
+    ASSERT_NE(bench.previous.p300.model, nullptr) << bench.previous.p300.training_error;
+    eeg.selection(stage, 7, 2, false, 8, std::nullopt, 0.0);  // at once, as trial 1 starts
+    eeg.idle(stage, 1.0);
+    const P300Part& online = bench.previous.p300;
+    ASSERT_EQ(online.scored, 32);
+    SCOPED_TRACE(offset_uv);
+    expectSameEvidence(online.decision, offlineDecision(eeg, *online.model, 32), 1e-4);
+    EXPECT_EQ(online.decision.codes, std::set<int>{2});
+  }
+}
+
+// A model given with another filter mid-run: the new filter starts on the signal kept, so the
+// next selection is scored as an offline analysis through that filter scores it, to within the
+// new filter's memory of what came before the history.
+TEST(P300StageFilter, AModelWithAnotherFilterStartsItOnTheSignalAlreadyReceived) {
+  test::StageBench bench("p300_refilter");
+  test::FlashDriver eeg(bench, 4);
+  eeg.amplifierOffset(1000.0, 5.0);
+  P300Stage stage(settingsFor(eeg.info()), bench.services());
+  for (int n = 1; n <= 4; ++n) eeg.selection(stage, n, n, true, 6);
+  bench.record.requests.push_back(TrainRequest{"slda"});
+  eeg.step(stage);
+  ASSERT_NE(bench.previous.p300.model, nullptr) << bench.previous.p300.training_error;
+  bci::P300Model other = *bench.previous.p300.model;
+  other.pipeline.filter.highpass_hz = 1.0;
+  bench.record.requests.push_back(UseModelRequest{std::make_shared<const bci::P300Model>(other)});
+  eeg.step(stage);
+  eeg.selection(stage, 5, 3, false, 8, std::nullopt, 0.0);
+  eeg.idle(stage, 1.0);
+  const P300Part& online = bench.previous.p300;
+  ASSERT_EQ(online.scored, 32);
+  expectSameEvidence(online.decision, offlineDecision(eeg, other, 32), 0.05);
+}
+
 TEST_F(P300StageTest, RecalibrateAtTheReviewTrainsOnTheNewRunAlone) {
   for (int n = 1; n <= 3; ++n) eeg_.selection(stage_, n, n, true, 6);
   bench_.record.requests.push_back(TrainRequest{"slda"});

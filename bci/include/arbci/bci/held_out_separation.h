@@ -23,6 +23,10 @@
 
 namespace arbci::bci {
 
+// Fewer decided selections than this bound nothing: the separation they show strays too far
+// (downwards as much as upwards) to hold a model to it.
+inline constexpr int kMinHeldOutSelections = 5;
+
 // One selection's flashes as the session decided them: each flash's code and its score
 // standardised by the model that scored it (bci::standardised).
 struct HeldOutSelection {

@@ -66,6 +66,7 @@ struct SelectionStart {
   // A calibration selection interrupted and cued again: the number of the one it replaces,
   // whose flashes are no whole selection and are left out of training.
   std::optional<int> retake_of;
+  int trial = 0;  // online: the trial it belongs to (0: a calibration selection)
 };
 
 // The last frame as the screen showed it, stamped on the EEG sample clock once presented.
@@ -153,6 +154,10 @@ struct P300Part {
   int presented = 0, scored = 0;
   int sequences = 0;  // complete sequences scored
   bci::Decision decision;
+  // The score model the decision's evidence is weighed under (the model's, its separation held
+  // to what the online selections of its kind showed), and that separation when it was known.
+  bci::ScoreModel scored_by;
+  std::optional<double> held_out_separation;
   std::shared_ptr<const bci::P300Model> model;  // none before training (or a model file)
   std::shared_ptr<const bci::ErpCurves> erp;    // the averages this session trained on
   // Training ended this cycle: the model's cross-validation, or why it failed.

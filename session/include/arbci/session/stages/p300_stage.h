@@ -1,10 +1,13 @@
 // The P300 classifier's stage: the EEG filtered causally, cut into epochs around the flashes as
 // presented, scored by the model and accumulated for the current selection (its decision and
-// certainty drive dynamic stopping). Until there is a model it keeps the calibration run's signal
-// and flashes, and trains on them, when asked, on a worker thread exactly as `arbci train` would;
-// the cycle goes on meanwhile. Epochs that touch lost samples are discarded, not scored.
+// certainty drive dynamic stopping), under the model's score model held to the separation the
+// online selections of its kind (objects, cells) decided so far show. Until there is a model it
+// keeps the calibration run's signal and flashes, and trains on them, when asked, on a worker
+// thread exactly as `arbci train` would; the cycle goes on meanwhile. Epochs that touch lost
+// samples are discarded, not scored.
 #pragma once
 
+#include <deque>
 #include <filesystem>
 #include <future>
 #include <map>
@@ -57,7 +60,10 @@ class P300Stage final : public Stage {
   struct FlashRecord {
     int selection = 0;
     int code = 0;
+    bci::StimulusEvent event;
   };
+  // Raw signal kept for a new filter to start on, and the epocher's history (seconds).
+  static constexpr double kHistoryS = 10.0;
   struct Outcome {
     bci::P300Model model;
     bci::EvaluationReport report;
@@ -75,6 +81,11 @@ class P300Stage final : public Stage {
   void startTraining(const std::string& method);
   void takeTraining(Cycle& cycle);
   void process(const bci::Block& eeg, double time_s);
+  // A filtered block into the epocher; its epochs scored.
+  void cutEpochs(const bci::Block& block, double time_s);
+  // A model with another filter: that filter, started on the raw history (see the source).
+  void refilter(const bci::FilterSettings& filter);
+  void keepRaw(const bci::Block& block);
   // Learning from use: a fit over the object selections so far, on a worker thread; its model
   // taken in (the current selection's epochs scored again by it) and its trust judged.
   void startRefit();
@@ -82,14 +93,23 @@ class P300Stage final : public Stage {
   void scoreCurrentAgain();
   // One epoch into the selection's scores (and, for a learnable selection, current_scored_).
   void scoreEpoch(int code, const bci::Epoch& epoch);
+  // The score model the current selection is decided under (see the source).
+  bci::ScoreModel scoreModelNow();
   // The current selection is over: complete_ moves to it and its scores join held_out_.
   void completeSelection();
   bool learns() const { return settings_.learn || settings_.adapt; }
+  // Learnt selections' numbers as the trials they belong to, for the log.
+  nlohmann::json byTrial(const std::map<int, int>& by_selection) const;
+  std::vector<int> trialsOf(const std::vector<int>& selections) const;
   bool touchesLoss(std::int64_t onset) const;
 
   P300Settings settings_;
   StageServices s_;
   std::unique_ptr<bci::FilterChain> filters_;
+  bci::FilterSettings filter_settings_;  // filters_'s
+  std::deque<bci::Block> raw_history_;   // the last kHistoryS of the signal, unfiltered
+  std::vector<bci::Block> refiltered_;   // the history through a new filter, to be epoched
+  std::int64_t missed_before_ = 0;       // by the epochers before a change of filter
   std::unique_ptr<bci::Epocher> epocher_;
   std::shared_ptr<const bci::P300Model> model_;
   std::optional<bci::FeatureExtractor> extractor_;
@@ -125,6 +145,7 @@ class P300Stage final : public Stage {
   bool current_learnable_ = false;                // the current selection is kept for learning
   bool selection_objects_ = true;
   std::map<int, int> known_;
+  std::map<int, int> trial_of_;  // online selection -> its trial
   bci::ParadigmLayout layout_;
   std::vector<std::pair<int, bci::Epoch>> current_epochs_;
   // The learnable selections decided by a model fitted without them (on at least as many
@@ -132,6 +153,14 @@ class P300Stage final : public Stage {
   // (bci/held_out_separation.h: they bound what a fit may claim), and the current one's so far.
   std::vector<bci::HeldOutSelection> held_out_;
   bci::HeldOutSelection current_scored_;
+  // Every online selection decided, by kind (0 objects, 1 cells), each flash standardised by the
+  // model that scored it: they bound the separation the next of their kind is decided under
+  // (bci/held_out_separation.h). The current one's so far, its kind (-1: a cued selection), and
+  // the bound now (none below bci::kMinHeldOutSelections).
+  std::vector<bci::HeldOutSelection> decided_[2];
+  bci::HeldOutSelection online_scored_;
+  int online_kind_ = -1;
+  std::optional<double> held_out_now_;
   int model_selections_ = 0;  // the selections model_ was learnt from (trained on labels: all)
   LearningState state_;
   std::shared_ptr<const LearningState> published_;
