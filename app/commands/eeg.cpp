@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "arbci/bci/recording.h"
@@ -133,6 +134,7 @@ void addEegCommand(CLI::App& root, int& exit_code) {
     std::string file, in, out;
     bool salvage = false;
     SimulationOptions simulation;
+    std::optional<int> session_trials;  // --trials
   };
   auto options = std::make_shared<Options>();
 
@@ -166,14 +168,23 @@ void addEegCommand(CLI::App& root, int& exit_code) {
       eeg->add_subcommand("simulate",
                           "Record the simulated subject in a copy task to BDF+: selections of\n"
                           "--sequences sequences of --stimuli flashing stimuli, one attended\n"
-                          "target per selection (marked in the file).");
+                          "target per selection (marked in the file). With --trials, a\n"
+                          "session-shaped run instead: a calibration run, then trials of an\n"
+                          "object selection and a grid selection, annotated as a session is.");
   SimulationOptions& s = options->simulation;
-  sim->add_option("--seconds", s.seconds, "length of the recording")
-      ->required()
-      ->check(CLI::Range(1.0, 86400.0));
-  sim->add_option("--out", s.out, "BDF+ file to write")->required();
   const auto& subject = bci::subjectSchema();
   const auto& paradigm = bci::paradigmSchema();
+  CLI::Option* seconds = sim->add_option("--seconds", s.seconds, "length of the recording")
+                             ->check(CLI::Range(1.0, 86400.0));
+  CLI::Option* trials =
+      schemaOverride(*sim, "--trials", options->session_trials, paradigm.at("trials"))
+          ->excludes(seconds);
+  trials->description(trials->get_description() +
+                      "; given, a session-shaped run of that many trials (its length follows)");
+  schemaOption(*sim, "--calibration", s.calibration, paradigm.at("calibration_selections"),
+               "with --trials")
+      ->needs(trials);
+  sim->add_option("--out", s.out, "BDF+ file to write")->required();
   schemaOption(*sim, "--seed", s.seed, subject.at("seed"), "the same seed, the same recording");
   schemaOption(*sim, "--rate", s.rate_hz, subject.at("rate_hz"));
   schemaOption(*sim, "--montage", s.montage, subject.at("montage"), "comma-separated");
@@ -202,8 +213,15 @@ void addEegCommand(CLI::App& root, int& exit_code) {
     if (std::filesystem::path(options->simulation.out).extension() != ".bdf") {
       throw CliError(options->simulation.out + ": ARBCI records BDF+ files; name the output *.bdf");
     }
+    options->simulation.trials = options->session_trials.value_or(0);
     if ((options->simulation.rows > 0) != (options->simulation.columns > 0))
       throw CliError("give both --rows and --columns");
+    if (options->simulation.trials == 0 && options->simulation.seconds <= 0.0)
+      throw CliError("give --seconds (a copy task) or --trials (a session-shaped run)");
+    if (options->simulation.trials > 0 && options->simulation.rows > 0)
+      throw CliError(
+          "--trials flashes the session's objects (--stimuli) and its grid (world.grid); "
+          "--rows and --columns are for a copy task");
     const SimulationSummary summary = recordSimulation(options->simulation, std::cerr);
     std::cout << "wrote " << options->simulation.out << ": " << summary.samples << " samples, "
               << summary.stimuli << " stimuli (" << summary.targets << " targets), "

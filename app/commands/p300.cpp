@@ -1,8 +1,10 @@
 // `arbci train` and `arbci evaluate`: P300 models from recordings, cross-validated by selection,
 // and their accuracy, selections and bit rate on other recordings.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iomanip>
@@ -24,6 +26,7 @@
 #include "commands/commands.h"
 #include "eeg/p300_plots.h"
 #include "eeg/p300_report.h"
+#include "eeg/session_evaluation.h"
 #include "support/cli_error.h"
 #include "support/name_list.h"
 #include "support/output_path.h"
@@ -467,7 +470,65 @@ struct EvaluateOptions {
   bci::StoppingRule dynamic = bci::kOfflineStopping;
   std::string align = "per-file";
   ScalpOptions scalp;
+  bool replay_stopping = false;  // session recordings: dynamic stopping replayed
 };
+
+// Whether the model was trained on `recording`'s calibration run: its provenance names the file,
+// or says it is the session's own model and lies beside it.
+bool trainedOn(const bci::P300Model& model, const std::string& model_file,
+               const bci::Recording& recording) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::path file = fs::weakly_canonical(recording.source, error);
+  for (const auto& f : model.provenance.value("training_files", nlohmann::json::array())) {
+    const std::string name = f.get<std::string>();
+    if (name == "this session's calibration run" &&
+        fs::weakly_canonical(model_file, error).parent_path() == file.parent_path())
+      return true;
+    if (fs::weakly_canonical(name, error) == file) return true;
+  }
+  return false;
+}
+
+// Session recordings: the calibration run apart (in-sample when the model was trained on it) and
+// every online selection decided as the session decides it (eeg/session_evaluation.h).
+void evaluateSessions(const EvaluateOptions& o, const bci::P300Model& model,
+                      const std::vector<bci::Recording>& recordings) {
+  // The session's dynamic stopping, replayed only when asked (--replay-stopping): a session's
+  // recording holds the flashes it showed, which it decided on.
+  const session::SessionConfig config;
+  const bci::StoppingRule rule{0, config.paradigm.min_sequences,
+                               o.replay_stopping ? config.paradigm.certainty : 0.0};
+  nlohmann::json report = {
+      {"command", "evaluate"}, {"model", o.model}, {"sessions", nlohmann::json::array()}};
+  for (const bci::Recording& r : recordings) {
+    SessionEvaluation e = evaluateSession(model, r, rule, o.sequences);
+    e.in_sample = trainedOn(model, o.model, r);
+    printSessionEvaluation(std::cout, e, rule);
+    nlohmann::json online = nlohmann::json::array();
+    for (const OnlineDecision& d : e.online) {
+      online.push_back({{"kind", bci::toString(d.kind)},
+                        {"trial", d.trial},
+                        {"selection", d.number},
+                        {"codes", d.decision.codes},
+                        {"certainty", d.decision.certainty},
+                        {"sequences", d.sequences},
+                        {"attended", d.truth},
+                        {"right", d.truth.empty() ? nlohmann::json() : nlohmann::json(d.right())}});
+    }
+    report["sessions"].push_back({{"source", e.source},
+                                  {"calibration",
+                                   {{"selections", e.calibration_selections},
+                                    {"right", e.calibration_right},
+                                    {"in_sample", e.in_sample}}},
+                                  {"online", online}});
+  }
+  if (!o.report.empty()) {
+    std::ofstream out(o.report);
+    out << report.dump(2) << "\n";
+    if (!out) throw CliError(o.report + ": cannot write the report");
+  }
+}
 
 void evaluate(EvaluateOptions& o) {
   checkOutputs(o.plots, {o.report, o.scores});
@@ -478,6 +539,11 @@ void evaluate(EvaluateOptions& o) {
     throw CliError(error.what());
   }
   std::vector<bci::Recording> recordings = readAll(o.files);
+  const auto sessions = std::count_if(recordings.begin(), recordings.end(), isSessionRecording);
+  if (sessions > 0 && sessions < static_cast<long>(recordings.size()))
+    throw CliError(
+        "evaluate session recordings (their calibration run and online trials scored apart) "
+        "apart from copy-task recordings");
   const nlohmann::json quality = checkChannels(recordings, false);
   for (const bci::Recording& r : recordings) {
     try {
@@ -498,6 +564,16 @@ void evaluate(EvaluateOptions& o) {
                      " recording, but the model was trained on " + model.layout.describeShape() +
                      " recordings; evaluate it on recordings of its layout (an XDF carries its "
                      "layout only from ARBCI's marker stream)");
+  }
+  if (sessions > 0) {
+    if (!o.plots.empty() || !o.scores.empty())
+      throw CliError("--plots and --scores are for copy-task recordings, not a session's");
+    try {
+      evaluateSessions(o, model, recordings);
+    } catch (const std::invalid_argument& error) {
+      throw CliError(error.what());
+    }
+    return;
   }
   try {
     bci::P300Dataset data = bci::buildDataset(recordings, model.pipeline, {}, o.dataset);
@@ -680,7 +756,11 @@ void addP300Commands(CLI::App& root, int& exit_code) {
   CLI::App* eval_cmd =
       root.add_subcommand("evaluate",
                           "Apply a P300 model to recordings: selections, accuracy by number of\n"
-                          "sequences, bit rate, and dynamic stopping.");
+                          "sequences, bit rate, and dynamic stopping. A session's recording is\n"
+                          "split where the session marked its selections: the calibration run\n"
+                          "apart (in-sample when the model was trained on it), each online\n"
+                          "selection decided as the session decides (paradigm.certainty,\n"
+                          "paradigm.min_sequences), with the certainty each claimed.");
   eval_cmd->add_option("--model", e->model, "model file (from arbci train)")->required();
   eval_cmd->add_option("FILES", e->files, "recordings to evaluate")->required();
   eval_cmd
@@ -697,6 +777,12 @@ void addP300Commands(CLI::App& root, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::IsMember({"per-file", "none"}));
   addDatasetOptions(*eval_cmd, e->dataset);
+  eval_cmd->add_flag(
+      "--replay-stopping", e->replay_stopping,
+      "session recordings: decide each online selection with the session's "
+      "dynamic stopping (paradigm.certainty from paradigm.min_sequences) replayed on "
+      "its flashes, for a recording that holds every sequence (arbci eeg simulate "
+      "--trials); without it, on every flash recorded, as the session decided");
   eval_cmd->add_option("--report", e->report, "also write the report as JSON (everything printed)");
   eval_cmd->add_option("--scores", e->scores,
                        "also write every flash's score as CSV (file,sample,code,label,score,fold)");

@@ -10,6 +10,7 @@
 #include "arbci/bci/paradigm_layout.h"
 #include "arbci/bci/recording.h"
 #include "arbci/bci/recording_writer.h"
+#include "arbci/bci/selection_marks.h"
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
 #include "arbci/session/session_config.h"
@@ -23,12 +24,36 @@ struct Selection {
   std::int64_t start = 0;  // sample at which the target is cued
   std::set<int> attended;
   std::string label;
+  // A session-shaped run's: the phase annotation at the first flash.
+  std::string phase;
+  std::int64_t first_flash = 0;
 };
 
 struct Schedule {
   std::vector<Selection> selections;
   std::vector<bci::StimulusEvent> stimuli;
 };
+
+// One selection's flashes from `onset_s` on: `sequences` sequences of the layout's codes (each
+// code plus `code_base`), labelled by `attended`. Returns the time after the last onset.
+double flashSelection(const SimulationOptions& o, const bci::ParadigmLayout& layout,
+                      bci::StimulusSequencer& sequencer, const std::set<int>& attended,
+                      int code_base, double onset_s, Schedule& schedule) {
+  const double soa = (o.flash_ms + o.isi_ms) / 1000.0;
+  for (int sequence = 0; sequence < o.sequences; ++sequence) {
+    for (int code : sequencer.next()) {
+      bci::StimulusEvent e;
+      e.sample = static_cast<std::int64_t>(std::llround(onset_s * o.rate_hz));
+      e.code = code + code_base;
+      e.target = attended.count(code) > 0;
+      e.duration_samples = static_cast<int>(std::lround(o.flash_ms / 1000.0 * o.rate_hz));
+      schedule.stimuli.push_back(e);
+      onset_s += soa;
+    }
+  }
+  (void)layout;
+  return onset_s;
+}
 
 Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
   Schedule schedule;
@@ -52,20 +77,50 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
     } else {
       selection.label += std::to_string(*selection.attended.begin());
     }
-    double onset = t + 1.0;
-    for (int sequence = 0; sequence < o.sequences; ++sequence) {
-      for (int code : sequencer.next()) {
-        bci::StimulusEvent e;
-        e.sample = static_cast<std::int64_t>(std::llround(onset * o.rate_hz));
-        e.code = code;
-        e.target = selection.attended.count(code) > 0;
-        e.duration_samples = static_cast<int>(std::lround(o.flash_ms / 1000.0 * o.rate_hz));
-        schedule.stimuli.push_back(e);
-        onset += soa;
-      }
-    }
+    flashSelection(o, layout, sequencer, selection.attended, 0, t + 1.0, schedule);
     schedule.selections.push_back(selection);
     t += selection_seconds;
+  }
+  return schedule;
+}
+
+// As a session runs (bci::Paradigm's phases and the session's annotations): the calibration run's
+// cued object selections, then trials of an object selection and a grid selection, each chosen
+// freely (drawn) and labelled by that choice; every selection `sequences` long (dynamic stopping
+// is for the analysis to replay).
+Schedule sessionTask(const SimulationOptions& o) {
+  Schedule schedule;
+  const bci::ParadigmLayout objects = bci::ParadigmLayout::single(o.stimuli);
+  const bci::ParadigmLayout grid = bci::ParadigmLayout::matrix(o.grid_rows, o.grid_columns);
+  bci::StimulusSequencer object_order(objects.codes(), o.seed + 1);
+  bci::StimulusSequencer grid_order(grid.codes(), o.seed + 3);
+  std::mt19937_64 random(o.seed + 2);
+  const bci::ParadigmSettings paradigm;
+  double t = 0.5;
+  auto add = [&](bci::MarkedSelection mark, const bci::ParadigmLayout& layout,
+                 bci::StimulusSequencer& order, bci::Phase phase, double lead_s) {
+    Selection s;
+    mark.number = static_cast<int>(schedule.selections.size()) + 1;
+    s.start = static_cast<std::int64_t>(std::llround(t * o.rate_hz));
+    s.attended = layout.drawTarget(random);
+    s.label = bci::selectionMark(mark);
+    s.phase = std::string(bci::kPhaseAnnotation) + bci::toString(phase);
+    s.first_flash = static_cast<std::int64_t>(std::llround((t + lead_s) * o.rate_hz));
+    const int base = layout.kind == bci::ParadigmLayout::Kind::RowColumn ? bci::kGridCodeBase : 0;
+    t = flashSelection(o, layout, order, s.attended, base, t + lead_s, schedule);
+    for (int code : std::set<int>(s.attended)) s.attended.insert(code + base);
+    if (base > 0) std::erase_if(s.attended, [&](int code) { return code <= base; });
+    schedule.selections.push_back(std::move(s));
+    t += paradigm.pause_s;
+  };
+  for (int k = 0; k < o.calibration; ++k)
+    add({0, bci::SelectionKind::Calibration, 0, 0, {}}, objects, object_order,
+        bci::Phase::CalibrationFlashing, paradigm.cue_s);
+  for (int trial = 1; trial <= o.trials; ++trial) {
+    add({0, bci::SelectionKind::Objects, trial, 0, {}}, objects, object_order,
+        bci::Phase::ObjectFlashing, paradigm.pause_s);
+    add({0, bci::SelectionKind::Cells, trial, 0, {}}, grid, grid_order, bci::Phase::CellFlashing,
+        paradigm.result_s);
   }
   return schedule;
 }
@@ -84,6 +139,10 @@ SimulationOptions::SimulationOptions() {
   line_hz = subject.line_hz;
   alpha_hz = subject.alpha_hz;
   erp_scale = session::EegSettings().erp_scale;
+  calibration = paradigm.calibration_selections;
+  const session::GridSettings grid;
+  grid_rows = grid.rows;
+  grid_columns = grid.columns;
 }
 
 SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& progress) {
@@ -106,8 +165,14 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
     clock = manual;
   }
   bci::SimulatedSubject subject(config, clock);
-  const auto total = static_cast<std::int64_t>(std::llround(o.seconds * o.rate_hz));
-  const Schedule schedule = copyTask(o, total);
+  const bool session_shaped = o.trials > 0;
+  const Schedule schedule =
+      session_shaped ? sessionTask(o)
+                     : copyTask(o, static_cast<std::int64_t>(std::llround(o.seconds * o.rate_hz)));
+  // A session-shaped run lasts until its last epoch is whole (and a second more).
+  const auto total = session_shaped && !schedule.stimuli.empty()
+                         ? schedule.stimuli.back().sample + 2 * static_cast<std::int64_t>(o.rate_hz)
+                         : static_cast<std::int64_t>(std::llround(o.seconds * o.rate_hz));
 
   std::map<std::string, std::string> parameters = {
       {"Source", "ARBCI simulated subject"},
@@ -121,6 +186,20 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
       {"P3Amplitude", std::to_string(subject.profile().p3_amplitude_uv) + "uV"},
       {"P3Latency", std::to_string(subject.profile().p3_latency_s * 1000.0) + "ms"},
   };
+  if (session_shaped) {
+    // The session's own parameters for its two paradigms (session/src/stage_assembly.cpp).
+    std::string map;
+    for (int k = 1; k <= o.stimuli; ++k)
+      map += std::to_string(k) + "=object " + std::to_string(k) + ";";
+    for (int r = 1; r <= o.grid_rows; ++r)
+      map += std::to_string(bci::kGridCodeBase + r) + "=row " + std::to_string(r) + ";";
+    for (int c = 1; c <= o.grid_columns; ++c)
+      map += std::to_string(bci::kGridCodeBase + o.grid_rows + c) + "=column " + std::to_string(c) +
+             ";";
+    map.pop_back();
+    parameters["StimulusCodeMap"] = map;
+    parameters["Paradigm"] = "single stimulus, " + std::to_string(o.stimuli) + " stimuli";
+  }
   SimulationSummary summary;
   try {
     bci::RecordingWriter writer(o.out, subject.info(), parameters);
@@ -134,6 +213,7 @@ SimulationSummary recordSimulation(const SimulationOptions& o, std::ostream& pro
         const Selection& s = schedule.selections[next_selection++];
         subject.attend(s.attended);
         writer.addAnnotation({s.start, s.label, 0});
+        if (!s.phase.empty()) writer.addAnnotation({s.first_flash, s.phase, 0});
         ++summary.selections;
       }
       while (next_stimulus < schedule.stimuli.size() &&

@@ -12,7 +12,7 @@ namespace arbci::app {
 // The subject's and the paradigm's options default to a session's (bci/settings.h).
 struct SimulationOptions {
   SimulationOptions();
-  double seconds = 60.0;
+  double seconds = 0.0;  // a copy task's length
   std::string out;
   int seed;
   double rate_hz;
@@ -24,6 +24,13 @@ struct SimulationOptions {
   double isi_ms;
   double line_hz;
   double alpha_hz;
+  // > 0: a session-shaped run instead of a copy task (its length follows; `seconds` unused):
+  // `calibration` cued object selections, then `trials` trials of an object selection and a
+  // selection on the grid_rows x grid_columns grid (codes 100 + row, 100 + rows + column), each
+  // annotated as a session annotates it (bci/selection_marks.h) and labelled by a drawn choice.
+  int trials = 0;
+  int calibration;
+  int grid_rows, grid_columns;
   bool paced = false;
   double erp_scale;  // the subject's N2/P3 amplitudes scaled (a weaker responder below 1)
 };

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 
 namespace arbci::bci {
 
@@ -43,6 +45,52 @@ double chanceLevel95(int choices, int trials) {
     if (tail >= 0.05) return std::min(1.0, (k + 1.0) / trials);
   }
   return 0.0;
+}
+
+namespace {
+
+// The smallest and largest wrong counts inside the central 95 % of the Poisson-binomial
+// distribution of independent wrong-probabilities `p_wrong`.
+std::pair<int, int> wrongInterval(const std::vector<double>& p_wrong) {
+  std::vector<double> p(p_wrong.size() + 1, 0.0);
+  p[0] = 1.0;
+  for (size_t i = 0; i < p_wrong.size(); ++i) {
+    const double w = p_wrong[i];
+    for (size_t k = i + 1; k > 0; --k) p[k] = p[k] * (1.0 - w) + p[k - 1] * w;
+    p[0] *= 1.0 - w;
+  }
+  double below = 0.0;
+  int low = -1, high = 0;
+  for (size_t k = 0; k < p.size(); ++k) {
+    below += p[k];
+    if (low < 0 && below > 0.025) low = static_cast<int>(k);
+    if (below < 0.975) high = static_cast<int>(k) + 1;
+  }
+  return {std::max(low, 0), std::min(high, static_cast<int>(p_wrong.size()))};
+}
+
+}  // namespace
+
+std::vector<ReliabilityBand> reliabilityBands(const std::vector<ClaimedDecision>& decisions) {
+  static constexpr double kEdges[] = {0.0, 0.9, 0.99, 0.999, 1.0};
+  std::vector<ReliabilityBand> bands;
+  for (int b = 0; b < 4; ++b) {
+    ReliabilityBand band{kEdges[b], kEdges[b + 1]};
+    std::vector<double> p_wrong;
+    for (const ClaimedDecision& d : decisions) {
+      const bool last = b == 3;
+      if (d.certainty < band.low || (last ? d.certainty > band.high : d.certainty >= band.high))
+        continue;
+      ++band.decisions;
+      band.wrong += !d.right;
+      p_wrong.push_back(std::clamp(1.0 - d.certainty, 0.0, 1.0));
+      band.expected_wrong += p_wrong.back();
+    }
+    if (band.decisions == 0) continue;
+    std::tie(band.wrong_low, band.wrong_high) = wrongInterval(p_wrong);
+    bands.push_back(band);
+  }
+  return bands;
 }
 
 }  // namespace arbci::bci

@@ -245,7 +245,14 @@ P300Dataset buildDataset(const std::vector<Recording>& given, const PipelineSett
         ++data.other_code_flashes;
         continue;
       }
-      if (previous < 0 || e.sample - previous > gap_limit) {
+      const bool marked_start =
+          !options.selection_starts.empty() &&
+          std::upper_bound(options.selection_starts.begin(), options.selection_starts.end(),
+                           previous) != std::upper_bound(options.selection_starts.begin(),
+                                                         options.selection_starts.end(), e.sample);
+      const bool new_selection =
+          options.selection_starts.empty() ? e.sample - previous > gap_limit : marked_start;
+      if (previous < 0 || new_selection) {
         data.selections.push_back(SelectionEpochs{{}, {}, static_cast<int>(f)});
         in_selection = 0;
       }

@@ -74,6 +74,10 @@ struct DatasetOptions {
   // with no target, for learning without labels (bci/unsupervised.h); left out otherwise. They
   // never enter the ERP averages.
   bool keep_unknown = false;
+  // Where selections start (samples, ascending; bci/selection_marks.h): a flash after a start
+  // that the flash before it had not reached begins a new selection. Empty: selections are the
+  // runs of flashes apart by more than four stimulus onsets (a recording without marks).
+  std::vector<std::int64_t> selection_starts;
 };
 
 // Filters each recording as the online cycle does, cuts the response windows and computes the
