@@ -24,6 +24,8 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
+#include <set>
 #include <string>
 
 #include "arbci/bci/held_out_separation.h"
@@ -31,6 +33,7 @@
 #include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/recording.h"
+#include "arbci/bci/selection_marks.h"
 #include "arbci/session/session_config.h"
 
 using namespace arbci;
@@ -54,7 +57,17 @@ struct TimeModel {
   double held_then_sent_s = 30.0;
 };
 
+// An online decision, for the reliability tables: what it claimed and whether it was right.
+struct Judged {
+  const char* kind;  // "objects" or "cells"
+  int file = 0, trial = 0;
+  double certainty = 0.0;
+  bool right = false;
+  int sequences = 0;
+};
+
 struct Outcome {
+  std::vector<Judged> decisions;
   // Per trial k (0-based): decided right online; the arm sent.
   std::vector<bool> right_at, trusted_at;
   int online_made = 0, online_right = 0;  // trials --from on
@@ -67,9 +80,10 @@ struct Outcome {
 struct Replay {
   int index = 0;  // the file's, for the trace
   bci::Recording recording;
-  std::vector<int> number;    // each stimulus's selection (1-based)
-  std::map<int, int> target;  // selection -> attended code
-  std::vector<int> sequence;  // each stimulus's sequence within its selection (0-based)
+  std::vector<int> number;             // each stimulus's selection (1-based)
+  std::map<int, int> target;           // selection -> attended code (a cell's: its row's)
+  std::map<int, std::set<int>> truth;  // selection -> attended codes
+  std::vector<int> sequence;           // each stimulus's sequence within its selection (0-based)
 };
 
 // How many sequences of each selection the session would have shown (a recording may hold
@@ -84,26 +98,66 @@ struct Shown {
   }
 };
 
-// Selections: runs of flashes apart by more than four stimulus onsets (as buildDataset groups).
-Replay load(const std::string& file) {
+// Each stimulus's selection: where the recording marks them (a session, or `arbci eeg simulate
+// --trials`), the mark it follows; else runs of flashes apart by more than four stimulus onsets
+// (as buildDataset groups a copy task).
+Replay replayOf(bci::Recording recording, const std::vector<std::int64_t>& starts) {
   Replay r;
-  r.recording = bci::readRecording(file);
+  r.recording = std::move(recording);
   const double soa = bci::layoutOf(r.recording).soa_s;
   const double gap = std::max(1.0, 4.0 * soa) * r.recording.info.rate_hz;
   int selection = 0;
   std::int64_t previous = -1;
+  size_t next_start = 0;
   std::map<int, int> flashed;  // of the selection: code -> times
   for (const bci::StimulusEvent& e : r.recording.stimuli) {
-    if (previous < 0 || static_cast<double>(e.sample - previous) > gap) {
+    bool begins = previous < 0;
+    if (starts.empty()) {
+      begins = begins || static_cast<double>(e.sample - previous) > gap;
+    } else {
+      while (next_start < starts.size() && starts[next_start] <= e.sample) {
+        begins = begins || starts[next_start] > previous;
+        ++next_start;
+      }
+    }
+    if (begins) {
       ++selection;
       flashed.clear();
     }
     previous = e.sample;
     r.number.push_back(selection);
     r.sequence.push_back(flashed[e.code]++);
-    if (e.target) r.target[selection] = e.code;
+    if (e.target) {
+      r.truth[selection].insert(e.code);
+      if (!r.target.count(selection)) r.target[selection] = e.code;
+    }
   }
   return r;
+}
+
+// The object selections (the calibration run's, then each trial's) and, where the recording has
+// them, the trials' cell selections (numbered by trial).
+struct Loaded {
+  Replay objects;
+  std::optional<Replay> cells;
+};
+
+Loaded load(const std::string& file) {
+  bci::Recording recording = bci::readRecording(file);
+  const std::vector<bci::MarkedSelection> marks = bci::markedSelections(recording);
+  if (marks.empty()) return {replayOf(std::move(recording), {}), std::nullopt};
+  auto starts = [](const bci::SelectionsOfKind& part) {
+    std::vector<std::int64_t> out;
+    for (const auto& m : part.selections) out.push_back(m.sample);
+    return out;
+  };
+  const bci::SelectionsOfKind objects = bci::selectionsOfKind(
+      recording, marks, {bci::SelectionKind::Calibration, bci::SelectionKind::Objects});
+  Loaded loaded{replayOf(objects.recording, starts(objects)), std::nullopt};
+  const bci::SelectionsOfKind cells =
+      bci::selectionsOfKind(recording, marks, {bci::SelectionKind::Cells});
+  if (!cells.selections.empty()) loaded.cells = replayOf(cells.recording, starts(cells));
+  return loaded;
 }
 
 // The recording with only the stimuli of selections [first, last] the session would have shown,
@@ -135,17 +189,34 @@ std::map<int, int> decode(const bci::P300Model& model, const Replay& r, int firs
 // once certain enough (dynamic stopping), else after all of them.
 struct Online {
   std::optional<int> code;
+  std::set<int> codes;  // a cell's: its row and column
   double certainty = 0.0;
   int sequences = 0;
   bci::HeldOutSelection scored;  // its flashes as decided, standardised by the model's scores
 };
+// The selections of one kind decided so far (objects, or cells), each flash standardised by the
+// model that scored it: the session decides the next of that kind under the model's score model
+// held to the separation they show (P300Stage::scoreModelNow), once there are enough.
+struct Decided {
+  std::vector<bci::HeldOutSelection> selections;
+  bool bounds = true;  // false: a learnt model's objects, bounded at each fit instead
+  bci::ScoreModel bound(const bci::ScoreModel& model, const bci::ParadigmLayout& layout) const {
+    bci::ScoreModel out = model;
+    if (bounds && static_cast<int>(selections.size()) >= bci::kMinHeldOutSelections)
+      bci::boundByHeldOut(out, selections, layout);
+    return out;
+  }
+};
+
 Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
-                    const bci::PipelineSettings& pipeline, const bci::StoppingRule& rule) {
+                    const bci::PipelineSettings& pipeline, const bci::StoppingRule& rule,
+                    Decided* decided = nullptr) {
   const auto [recording, numbers] = part(r, number, number, false, Shown{rule.max_sequences});
   bci::DatasetOptions options;
   options.keep_unknown = true;
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline, {}, options);
-  bci::SelectionAccumulator accumulator(data.layout, model.score_model);
+  bci::SelectionAccumulator accumulator(
+      data.layout, decided ? decided->bound(model.score_model, data.layout) : model.score_model);
   Online out;
   for (int e = 0; e < data.epochs(); ++e) {
     const auto i = static_cast<size_t>(e);
@@ -157,24 +228,78 @@ Online decideOnline(const bci::P300Model& model, const Replay& r, int number,
     if (sequence_ends && accumulator.shouldStop(rule)) break;
   }
   const bci::Decision d = accumulator.decide();
-  if (!d.codes.empty() && accumulator.flashes() > 0) out.code = *d.codes.begin();
+  if (!d.codes.empty() && accumulator.flashes() > 0) {
+    out.code = *d.codes.begin();
+    out.codes = d.codes;
+  }
   out.certainty = d.certainty;
   out.sequences = accumulator.completeSequences();
+  if (decided) decided->selections.push_back(out.scored);
   return out;
 }
 
-Outcome calibrated(const Replay& r, int calibration, int trials, int from,
+// Trial k's cell selection decided by `model` as the session decides it, into the decisions.
+void decideCell(const bci::P300Model& model, const Replay& cells, int trial,
+                const bci::PipelineSettings& pipeline, const bci::StoppingRule& rule,
+                Decided& decided, Outcome& o) {
+  if (!cells.truth.count(trial)) return;
+  const Online d = decideOnline(model, cells, trial, pipeline, rule, &decided);
+  o.decisions.push_back(
+      {"cells", cells.index, trial, d.certainty, d.codes == cells.truth.at(trial), d.sequences});
+}
+
+// Every flash of the selections [first, last] scored by `model`, all the sequences recorded, as
+// CSV rows: file, kind, selection, its flash index, sample, code, target, score.
+void writeScores(std::FILE* out, const char* kind, const bci::P300Model& model, const Replay& r,
+                 int first, int last, const bci::PipelineSettings& pipeline) {
+  for (int number = first; number <= last; ++number) {
+    const auto [recording, numbers] = part(r, number, number, true, Shown{1000});
+    if (recording.stimuli.empty()) continue;
+    const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+    for (int e = 0; e < data.epochs(); ++e) {
+      const auto i = static_cast<size_t>(e);
+      std::fprintf(out, "%d,%s,%d,%d,%lld,%d,%d,%.6f\n", r.index, kind, number, e,
+                   static_cast<long long>(data.sample[i]), data.code[i],
+                   static_cast<int>(data.target[i]), model.classifier->score(data.features.row(e)));
+    }
+  }
+}
+
+Outcome calibrated(const Replay& r, const Replay* cells, int calibration, int trials, int from,
                    const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
-                   const bci::StoppingRule& stopping, const TimeModel& time) {
+                   const bci::StoppingRule& stopping, const TimeModel& time,
+                   std::FILE* scores = nullptr) {
   Outcome o;
   const auto [recording, numbers] = part(r, 1, calibration, true, Shown{stopping.max_sequences});
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
-  const bci::P300Model model = bci::trainModel(data, pipeline, training).model;
+  const bci::TrainingResult trained = bci::trainModel(data, pipeline, training);
+  const bci::P300Model& model = trained.model;
+  if (scores) {
+    // The calibration run's flashes as cross-validation scored them (what the score model is
+    // fitted on), then every trial's flashes by the model.
+    const auto& cv = trained.cross_validation;
+    for (size_t s = 0; s < data.selections.size(); ++s) {
+      int index = 0;
+      for (int row : data.selections[s].epochs) {
+        const auto i = static_cast<size_t>(row);
+        std::fprintf(scores, "%d,cv,%zu,%d,%lld,%d,%d,%.6f\n", r.index, s + 1, index++,
+                     static_cast<long long>(data.sample[i]), data.code[i],
+                     static_cast<int>(data.target[i]), cv.scores[i]);
+      }
+    }
+    std::fprintf(scores, "%d,model,%.9g,%.9g,%.9g,0,0,0\n", r.index, model.score_model.target_mean,
+                 model.score_model.other_mean, model.score_model.sd);
+    writeScores(scores, "objects", model, r, calibration + 1, calibration + trials, pipeline);
+    if (cells) writeScores(scores, "cells", model, *cells, 1, trials, pipeline);
+  }
   double t = calibration * time.calibration_selection_s + time.training_s;
+  Decided decided_objects, decided_cells;
   for (int k = 1; k <= trials; ++k) {
     const int number = calibration + k;
-    const Online d = decideOnline(model, r, number, pipeline, stopping);
+    const Online d = decideOnline(model, r, number, pipeline, stopping, &decided_objects);
     const bool right = d.code && *d.code == r.target.at(number);
+    o.decisions.push_back({"objects", r.index, k, d.certainty, right, d.sequences});
+    if (cells) decideCell(model, *cells, k, pipeline, stopping, decided_cells, o);
     o.right_at.push_back(right);
     o.trusted_at.push_back(true);
     if (k >= from) {
@@ -246,7 +371,7 @@ double certainCeiling(const Replay& r, int calibration, int trials,
   return -1.0;
 }
 
-Outcome learnt(const Replay& r, int calibration, int trials, int from,
+Outcome learnt(const Replay& r, const Replay* cells, int calibration, int trials, int from,
                const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                const bci::TrustRule& rule, const bci::StoppingRule& stopping,
                int extended_sequences, int untrusted_sequences, bool bounded, const TimeModel& time,
@@ -258,6 +383,7 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
   std::optional<bci::LearnedSelections> fit;
   bci::Trust trust;
   std::map<int, int> before;  // the last fit's decodings (number -> choice)
+  Decided decided_cells;
   double t = 0.0;
   for (int k = 1; k <= trials; ++k) {
     const int number = calibration + k;
@@ -288,6 +414,8 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
     extra_s =
         std::max(0, shown.at(number) - stopping.max_sequences) * layout.stimuli * layout.soa_s;
     const bool right = decision && *decision == r.target.at(number);
+    if (decision)
+      o.decisions.push_back({"objects", r.index, k, certainty, right, shown.at(number)});
     if (k >= from) {
       ++o.online_made;
       o.online_right += right;
@@ -322,6 +450,13 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
       // Too little to train on yet: the model before is kept (none at first).
     }
     o.trusted_at.push_back(sent);
+    // The object held, its cell is chosen by the model that trusted it (with dynamic stopping up
+    // to the learning's most sequences).
+    if (sent && cells) {
+      bci::StoppingRule cell_rule = stopping;
+      cell_rule.max_sequences = extended_sequences;
+      decideCell(fit->model, *cells, k, pipeline, cell_rule, decided_cells, o);
+    }
     if (sent) {
       ++o.arm_sent;
       o.arm_wrong += !right;
@@ -339,6 +474,22 @@ Outcome learnt(const Replay& r, int calibration, int trials, int from,
     }
   }
   return o;
+}
+
+// Decisions by the certainty they claimed, against how many were wrong (bci::reliabilityBands).
+void reliability(const char* condition, const std::vector<Judged>& decisions) {
+  for (const char* kind : {"objects", "cells"}) {
+    std::vector<bci::ClaimedDecision> claimed;
+    for (const Judged& j : decisions)
+      if (std::string(j.kind) == kind) claimed.push_back({j.certainty, j.right});
+    if (claimed.empty()) continue;
+    std::printf("%s, %s: band        decisions  wrong  expected  95 %% of claims   verdict\n",
+                condition, kind);
+    for (const bci::ReliabilityBand& b : bci::reliabilityBands(claimed))
+      std::printf("  [%.3f, %.3f%c  %9d  %5d  %8.2f  [%d, %d]  %s\n", b.low, b.high,
+                  b.high >= 1.0 ? ']' : ')', b.decisions, b.wrong, b.expected_wrong, b.wrong_low,
+                  b.wrong_high, b.verdict());
+  }
 }
 
 std::string seconds(double s) {
@@ -363,6 +514,7 @@ int main(int argc, char** argv) {
   bool ceiling_only = false;
   int untrusted_sequences = 0;
   bool unbounded = false;
+  std::string decisions_file, scores_file;
   cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
   cli.add_option("--calibration", calibration, "cued selections of the calibration run")
       ->capture_default_str();
@@ -388,7 +540,16 @@ int main(int argc, char** argv) {
                "leave each fit's score model as its cross-validation on the labels found gives "
                "it (the session bounds its separation by the selections decided: "
                "bci/held_out_separation.h)");
+  cli.add_option("--decisions", decisions_file,
+                 "write every online decision: condition, kind (objects, cells), file index, "
+                 "trial, certainty, right, sequences");
+  cli.add_option("--scores", scores_file,
+                 "write every flash's score in the calibrated condition (the calibration run's "
+                 "cross-validated, the trials' by the model, all sequences recorded): file, kind "
+                 "(cv, objects, cells; a 'model' row: its score model's means and SD), "
+                 "selection, flash index, sample, code, target, score");
   CLI11_PARSE(cli, argc, argv);
+  std::FILE* scores = scores_file.empty() ? nullptr : std::fopen(scores_file.c_str(), "w");
   std::FILE* trace = trace_file.empty() ? nullptr : std::fopen(trace_file.c_str(), "w");
   const session::SessionConfig config;
   const bci::PipelineSettings pipeline =
@@ -406,22 +567,25 @@ int main(int argc, char** argv) {
       none_trusted(cal_right);
   int faster = 0, compared = 0, wrong_more = 0, ceiling_later = 0, later_both = 0;
   for (const std::string& file : files) {
-    Replay r = load(file);
+    Loaded loaded = load(file);
+    Replay& r = loaded.objects;
     r.index = static_cast<int>(&file - files.data());
+    if (loaded.cells) loaded.cells->index = r.index;
+    const Replay* cells = loaded.cells ? &*loaded.cells : nullptr;
     if (static_cast<int>(r.target.size()) < calibration + trials) {
       std::fprintf(stderr, "%s: %zu selections, fewer than %d\n", file.c_str(), r.target.size(),
                    calibration + trials);
       return 1;
     }
-    const Outcome c = calibrated(r, calibration, trials, from, pipeline, config.classifier.training,
-                                 stopping, time);
+    const Outcome c = calibrated(r, cells, calibration, trials, from, pipeline,
+                                 config.classifier.training, stopping, time, scores);
     // --ceiling-only: the learning condition skipped (reported as the calibrated one).
-    const Outcome n =
-        ceiling_only
-            ? c
-            : learnt(r, calibration, trials, from, pipeline, config.classifier.training, rule,
-                     stopping, extended, untrusted_sequences > 0 ? untrusted_sequences : learning,
-                     !unbounded, time, trace);
+    const Outcome n = ceiling_only
+                          ? c
+                          : learnt(r, cells, calibration, trials, from, pipeline,
+                                   config.classifier.training, rule, stopping, extended,
+                                   untrusted_sequences > 0 ? untrusted_sequences : learning,
+                                   !unbounded, time, trace);
     if (trace) {
       std::fprintf(trace, "calibrated,%d,", r.index);
       for (bool right : c.right_at) std::fputc(right ? '1' : '0', trace);
@@ -441,6 +605,7 @@ int main(int argc, char** argv) {
                 seconds(ceiling).c_str());
     std::fflush(stdout);
     for (auto [total, one] : {std::pair{&all_cal, &c}, std::pair{&all_none, &n}}) {
+      total->decisions.insert(total->decisions.end(), one->decisions.begin(), one->decisions.end());
       total->online_made += one->online_made;
       total->online_right += one->online_right;
       total->arm_sent += one->arm_sent;
@@ -488,6 +653,20 @@ int main(int argc, char** argv) {
       "first right placement later than calibrated even with labels known (waiting for "
       "certainty): %d of %d; of the later ones without calibration: %d of %d\n",
       ceiling_later, compared, later_both, compared - faster);
+  std::printf("\nreliability of the online decisions (trials 1 on)\n");
+  reliability("calibrated", all_cal.decisions);
+  if (!ceiling_only) reliability("none", all_none.decisions);
+  if (!decisions_file.empty()) {
+    std::FILE* out = std::fopen(decisions_file.c_str(), "w");
+    std::fprintf(out, "condition,kind,file,trial,certainty,right,sequences\n");
+    for (auto [name, outcome] : {std::pair{"calibrated", &all_cal}, std::pair{"none", &all_none}}) {
+      for (const Judged& j : outcome->decisions)
+        std::fprintf(out, "%s,%s,%d,%d,%.9f,%d,%d\n", name, j.kind, j.file, j.trial, j.certainty,
+                     j.right, j.sequences);
+    }
+    std::fclose(out);
+  }
   if (trace) std::fclose(trace);
+  if (scores) std::fclose(scores);
   return 0;
 }

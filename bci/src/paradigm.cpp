@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace arbci::bci {
@@ -166,10 +167,14 @@ void Paradigm::endSequenceIfOver(double due_s) {
   // A selection repeated after an ErrP rejection shows all its sequences.
   const bool dynamic_stop = !calibrating_ && sequences_override_ == 0 && stop_requested_ &&
                             sequence_ >= settings_.min_sequences;
-  const int most = calibrating_                      ? settings_.calibration_sequences
-                   : sequences_override_ > 0         ? sequences_override_
-                   : phase_ == Phase::ObjectFlashing ? objectSequences()
-                                                     : settings_.sequences;
+  // A cell held to the objects' certainty (learning from use, trusted) gets the objects' room to
+  // reach it.
+  const bool cell_as_object =
+      hold_uncertain_cells_ && object_sequences_ == ObjectSequences::Trusted;
+  const int most = calibrating_              ? settings_.calibration_sequences
+                   : sequences_override_ > 0 ? sequences_override_
+                   : phase_ == Phase::ObjectFlashing || cell_as_object ? objectSequences()
+                                                                       : settings_.sequences;
   if (sequence_ < most && !dynamic_stop) {
     scheduleSequence(schedule_.back().onset_s + settings_.soaSeconds());
   } else {
@@ -256,6 +261,15 @@ void Paradigm::advanceTimedPhase(double due_s) {
         } else {
           nextTrial(now_ + settings_.pause_s, held_why_, true);
         }
+      } else if (!verdict_pending_ && phase_ == Phase::CellSelected && hold_uncertain_cells_ &&
+                 settings_.certainty > 0.0 && shown_certainty_ < settings_.certainty) {
+        char why[160];
+        std::snprintf(why, sizeof why,
+                      "the cell was chosen at a certainty of %.4f, below paradigm.certainty %g",
+                      shown_certainty_, settings_.certainty);
+        giving_back_ = true;
+        give_back_why_ = why;
+        askRobot(Phase::Dropping);
       } else if (!verdict_pending_) {
         askRobot(phase_ == Phase::ObjectSelected ? Phase::Grasping : Phase::Dropping);
       }
@@ -334,6 +348,7 @@ void Paradigm::askRobot(Phase phase) {
   ParadigmEvent e{ParadigmEvent::Kind::RobotDrop};
   e.cell = *selected_cell_;
   e.give_back = giving_back_;
+  if (giving_back_) e.text = give_back_why_;
   event(e);
 }
 
@@ -386,6 +401,7 @@ void Paradigm::showSelection(const std::set<int>& codes, int choice, double cert
   made.objects_layout = objects;
   made.text = text;
   shown_codes_ = codes;
+  shown_certainty_ = certainty;
   shown_error_.reset();
   feedback_pending_ = true;
   verdict_pending_ = settings_.errp;
@@ -433,6 +449,7 @@ void Paradigm::errpVerdict(bool error) {
       correction.text = "return";
       event(correction);
       giving_back_ = true;
+      give_back_why_ = "the ErrP rejected every cell selected";
       askRobot(Phase::Dropping);
     }
     return;
@@ -470,7 +487,9 @@ void Paradigm::modelTrained(bool ok, const std::string& text) {
     return;
   }
   trial_ = 1;
-  startFlashing(nextFrame(), true);
+  // The pause between selections, as between trials: the subject sees the calibration is over
+  // before the first free choice flashes (and the recording shows a gap between them).
+  startFlashing(now_ + settings_.pause_s, true);
 }
 
 void Paradigm::holdArm(bool held, const std::string& why) {

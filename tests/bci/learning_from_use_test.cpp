@@ -101,6 +101,14 @@ TEST(LearningFromUse, TrustNeedsEnoughSelectionsAndAConsistentStableFit) {
   EXPECT_FALSE(trust.trusted);
   EXPECT_EQ(trust.changed, (std::vector<int>{2, 4}));
   EXPECT_NE(trust.waiting_for.find("changed: 2, 4"), std::string::npos) << trust.waiting_for;
+
+  // Below ten selections compared, one may still change (a tenth of them is less than one).
+  const LearnedSelections five = fitOf(5, 1.0);
+  std::map<int, int> four = decodings(five, 4);
+  four[6] = (four[6] + 1) % 4;
+  EXPECT_TRUE(judgeTrust(five, four, rule).trusted) << judgeTrust(five, four, rule).waiting_for;
+  four[2] = (four[2] + 1) % 4;
+  EXPECT_FALSE(judgeTrust(five, four, rule).trusted);
 }
 
 }  // namespace

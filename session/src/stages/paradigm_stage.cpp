@@ -42,6 +42,7 @@ ParadigmStage::ParadigmStage(const ParadigmStageSettings& settings, const StageS
   // Learning from use: every object selection waits for the fit with it in (judgeHeldSelection).
   if (settings_.learns) {
     paradigm_.holdArm(true, kArmHeld);
+    paradigm_.holdUncertainCells(true);
     paradigm_.setObjectSequences(bci::Paradigm::ObjectSequences::Learning);
   }
 }

@@ -63,8 +63,9 @@ struct TrustRule {
 // selection's least P300-like stimulus taken as its target, a solution EM can settle on that
 // beats the shuffles too); a leave-one-out consistency of at least the minimum (the response
 // generalises from selection to selection); and its decoding of the selections the last fit knew
-// unchanged (but for a tenth of them, rounded down). A fit that changed its mind about earlier
-// selections has not settled: the arm waits, and `changed` names them.
+// unchanged but for a tenth of them, or one (a weakly attended selection may flip between fits of
+// a settled model). A fit that changed its mind about more has not settled: the arm waits, and
+// `changed` names them.
 struct Trust {
   bool trusted = false;
   std::string waiting_for;  // empty once trusted: what is missing, in words

@@ -147,7 +147,7 @@ struct ParadigmEvent {
     ErrpCorrection,
     TrainModel,  // the calibration run is complete: train now and call modelTrained()
     RobotGrasp,  // object slot in `object`
-    RobotDrop,   // cell in `cell`; `give_back`: put the object back where it was taken
+    RobotDrop,   // cell in `cell`; `give_back`: put the object back where it was taken (text: why)
     RobotStop,
     TrialDone,
   };
@@ -218,6 +218,10 @@ class Paradigm {
   // ends there, the arm not sent (`why` is the trial's outcome); a selection decided without a
   // model (no choice) ends its trial at once. Read when a selection is made.
   void holdArm(bool held, const std::string& why);
+  // Learning from use: a cell shown at a certainty below `certainty` is not put down on; the
+  // object goes back where it was taken (the arm acts on a cell by the same condition as on an
+  // object: only what the model is as sure of as dynamic stopping asks).
+  void holdUncertainCells(bool hold) { hold_uncertain_cells_ = hold; }
   // How many sequences an online object selection flashes. Usual: `sequences`. Learning from use,
   // the model not trusted: `learning_sequences`, all of them. Trusted: up to
   // `learning_max_sequences` (dynamic stopping ends them once certain).
@@ -328,6 +332,9 @@ class Paradigm {
   bool runner_up_taken_ = false;
   bool runner_up_waiting_ = false;  // the rejected selection is cleared; the runner-up comes next
   bool giving_back_ = false;        // the put-down returns the object (no cell was accepted)
+  std::string give_back_why_;       // and why
+  bool hold_uncertain_cells_ = false;
+  double shown_certainty_ = 0.0;  // of the selection shown
   int corrections_ = 0;
   bool hold_arm_ = false, held_now_ = false;  // asked; latched for the selection shown
   ObjectSequences object_sequences_ = ObjectSequences::Usual;
