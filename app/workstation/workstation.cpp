@@ -140,11 +140,12 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   // Ctrl+C or a TERM closes the window like the menu does: the session ends and saves its summary.
   watchInterrupts();
   auto last = std::chrono::steady_clock::now();
-  bool summary_shown = false;
+  bool summary_shown = false, interrupted = false;
   while (!main_window.shouldClose()) {
     // A script runs to its end first (its last screenshot may show the ended session).
     const bool script_over = !script || script->done();
-    if (interruptRequested() || (close_when_ended && session.ended() && script_over))
+    if (interruptRequested()) interrupted = true;
+    if (interrupted || (close_when_ended && session.ended() && script_over))
       main_window.requestClose();
     render::WindowContext::pollEvents();
     main_window.makeCurrent();  // the simulated cameras render in it
@@ -206,8 +207,11 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
           bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
     }
   }
+  // Quit (or the window closed) before the end: the run ends as an abort, saying who.
+  if (!session.ended())
+    session.abortNow(interrupted ? "interrupted (Ctrl+C or TERM)" : "by the experimenter (Quit)");
   if (script && !script->error().empty()) return 4;
-  // Closed before the end: the session ends now (its summary says "closed"), not finished.
+  // Closed before the end: not finished.
   return session.ended() && session.endKind() == "finished" ? 0 : 3;
 }
 

@@ -1,6 +1,7 @@
 #include "arbci/bci/file_source.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 namespace arbci::bci {
@@ -45,6 +46,13 @@ std::vector<StimulusEvent> FileSource::takeRecordedStimuli() {
     out.push_back(recording_.stimuli[next_stimulus_++]);
   }
   return out;
+}
+
+std::string FileSource::describe() const {
+  char text[96];
+  std::snprintf(text, sizeof text, " (%d channels at %g Hz, %.1f s)",
+                recording_.info.channelCount(), recording_.info.rate_hz, recording_.seconds());
+  return "the file " + recording_.source + text;
 }
 
 }  // namespace arbci::bci

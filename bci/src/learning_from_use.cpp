@@ -177,11 +177,12 @@ Trust judgeTrust(const LearnedSelections& fit, const std::map<int, int>& previou
     missing.push_back(std::to_string(rule.min_selections - n) + " more selection" +
                       (rule.min_selections - n == 1 ? "" : "s"));
   if (fit.beats_shuffled < fit.shuffles) {
-    char text[200];
+    char text[240];
     std::snprintf(text, sizeof text,
-                  "a response that repeats with the attended stimulus (the fit explains %.4f of "
-                  "the variance; with the codes shuffled, up to %.4f)",
-                  fit.explained, fit.shuffled_explained);
+                  "a response that follows the flashes: so far the EEG fits the objects as "
+                  "flashed no better than with the flashes' order shuffled (beaten in %d of %d "
+                  "shuffles; fit %.3f against up to %.3f)",
+                  fit.beats_shuffled, fit.shuffles, fit.explained, fit.shuffled_explained);
     missing.push_back(text);
   }
   if (fit.p3_uv && *fit.p3_uv <= 0.0) {
@@ -195,10 +196,10 @@ Trust judgeTrust(const LearnedSelections& fit, const std::map<int, int>& previou
   if (fit.consistency < rule.min_consistency) {
     char text[160];
     std::snprintf(text, sizeof text,
-                  "a held-out consistency of %.2f (now %.2f: fitted again without each, %d of "
-                  "%d selections decoded as before)",
-                  rule.min_consistency, fit.consistency,
-                  static_cast<int>(std::lround(fit.consistency * n)), n);
+                  "selections that decode the same when left out of the fit: %d of %d do (%.2f), "
+                  "%.2f needed",
+                  static_cast<int>(std::lround(fit.consistency * n)), n, fit.consistency,
+                  rule.min_consistency);
     missing.push_back(text);
   }
   int compared = 0;

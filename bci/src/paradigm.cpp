@@ -583,12 +583,13 @@ void Paradigm::pause() {
 
 void Paradigm::restartSequence() {
   if (awaiting_decision_) return;
+  if (next_flash_ > 0) ++reflashed_sequences_;
   --sequence_;
   scheduleSequence(nextFrame());
 }
 
-void Paradigm::returnToFlashing(Phase phase) {
-  if (phase == Phase::CalibrationFlashing && !awaiting_decision_) {
+void Paradigm::returnToFlashing(Phase phase, bool retake) {
+  if (phase == Phase::CalibrationFlashing && !awaiting_decision_ && retake) {
     retakeCalibrationSelection();
   } else if (phase == Phase::CalibrationFlashing || phase == Phase::ObjectFlashing ||
              phase == Phase::CellFlashing) {
@@ -618,12 +619,12 @@ std::optional<Phase> Paradigm::interrupted() const {
   return paused_from_;
 }
 
-void Paradigm::resume() {
+void Paradigm::resume(bool retake) {
   if (phase_ == Phase::Paused) {
     const Phase back = paused_from_;
     phase_until_ += now_;
-    if (back != Phase::CalibrationFlashing || awaiting_decision_) enter(back, "resumed");
-    returnToFlashing(back);
+    if (back != Phase::CalibrationFlashing || awaiting_decision_ || !retake) enter(back, "resumed");
+    returnToFlashing(back, retake);
     return;
   }
   const auto was = interrupted();
@@ -653,11 +654,9 @@ void Paradigm::retryStep() {
     askRobot(*was);
     return;
   }
-  if (*was != Phase::CalibrationFlashing || awaiting_decision_) {
-    enter(*was, std::string("resumed after the ") +
-                    (phase_ == Phase::EmergencyStop ? "emergency stop" : "robot fault"));
-  }
-  returnToFlashing(*was);
+  enter(*was, std::string("resumed after the ") +
+                  (phase_ == Phase::EmergencyStop ? "emergency stop" : "robot fault"));
+  returnToFlashing(*was, false);
   // A timed phase (cue, selection shown) starts its time again.
   if (*was == Phase::CalibrationCue) phase_until_ = now_ + settings_.cue_s;
   if (*was == Phase::ObjectSelected || *was == Phase::CellSelected)

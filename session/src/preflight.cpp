@@ -1,7 +1,10 @@
 #include "arbci/session/preflight.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+
+#include "arbci/session/stimulus_timing.h"
 
 namespace arbci::session {
 namespace {
@@ -14,9 +17,11 @@ std::string format(const char* pattern, double a, double b = 0.0) {
 
 }  // namespace
 
-void Preflight::begin(const PreflightObservation& now, bool quality_accepted) {
+void Preflight::begin(const PreflightObservation& now, Accepted accepted) {
   state_ = State::Running;
-  quality_accepted_ = quality_accepted;
+  accepted_ = accepted;
+  frame_intervals_s_.clear();
+  last_frame_s_.reset();
   first_ = last_ = now;
   camera_frames_ = 0;
   reference_seen_ = false;
@@ -37,6 +42,10 @@ Preflight::State Preflight::update(const PreflightObservation& now) {
     return state_;
   }
   camera_frames_ += now.camera_frame;
+  if (now.frame_host_s) {
+    if (last_frame_s_) frame_intervals_s_.push_back(*now.frame_host_s - *last_frame_s_);
+    last_frame_s_ = now.frame_host_s;
+  }
   reference_seen_ |= now.reference_age_s && *now.reference_age_s <= now.max_pose_age_s;
   objects_seen_.insert(now.objects_seen.begin(), now.objects_seen.end());
   const double elapsed = now.time_s - first_.time_s;
@@ -53,7 +62,9 @@ Preflight::State Preflight::update(const PreflightObservation& now) {
   const double counted = eeg_from_ ? eeg_last_.time_s - eeg_from_->time_s : 0.0;
   if (counted > 0.0)
     eeg_rate_hz_ = static_cast<double>(eeg_last_.eeg_samples - eeg_from_->eeg_samples) / counted;
-  if (elapsed < settings_.min_s || (first_eeg_s_ && counted < settings_.min_s)) {
+  const bool display_judged =
+      settings_.display_hz <= 0.0 || static_cast<int>(frame_intervals_s_.size()) >= kDisplayFrames;
+  if (elapsed < settings_.min_s || (first_eeg_s_ && counted < settings_.min_s) || !display_judged) {
     // Still counting, unless time is up: then judge what there is.
     if (elapsed < settings_.timeout_s) return state_;
   }
@@ -107,6 +118,7 @@ std::vector<std::string> Preflight::check(bool final) const {
                   "screenshots (hmd.screenshots)");
   }
   if (std::string quality = qualityFailure(); !quality.empty()) out.push_back(std::move(quality));
+  if (std::string display = displayFailure(); !display.empty()) out.push_back(std::move(display));
   if (!last_.robot_answered && last_.robot_key_refused) {
     out.push_back(settings_.robot_key + ": " + settings_.robot_what +
                   " answered that our key is not its key: give both sides the same robot.key_file "
@@ -118,8 +130,42 @@ std::vector<std::string> Preflight::check(bool final) const {
   return out;
 }
 
+std::optional<double> Preflight::frameIntervalS() const {
+  if (static_cast<int>(frame_intervals_s_.size()) < kDisplayFrames) return std::nullopt;
+  std::vector<double> sorted = frame_intervals_s_;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                   sorted.end());
+  return sorted[sorted.size() / 2];
+}
+
+std::string Preflight::displayQuestion() const {
+  const auto interval = frameIntervalS();
+  if (settings_.display_hz <= 0.0 || !interval ||
+      !StimulusTiming::tooSlow(*interval, settings_.display_hz))
+    return "";
+  const double frame_ms = 1000.0 / settings_.display_hz;
+  const double flash_frames = std::max(1.0, std::round(settings_.flash_ms / frame_ms));
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "display: a frame every %.0f ms (%.1f Hz; display_hz %.0f asks for %.1f ms): "
+                "flashes will last about %.0f ms instead of %.0f and every onset comes late",
+                *interval * 1000.0, 1.0 / *interval, settings_.display_hz, frame_ms,
+                flash_frames * *interval * 1000.0, flash_frames * frame_ms);
+  return text;
+}
+
+std::string Preflight::displayFailure() const {
+  if (accepted_.display) return "";
+  std::string question = displayQuestion();
+  if (question.empty()) return "";
+  return question + (settings_.display_question
+                         ? ": run annotated (every flash off limits noted; no timing pauses), or "
+                           "cancel and free the PC or the display"
+                         : " (gates.timing)");
+}
+
 std::string Preflight::qualityFailure() const {
-  if (settings_.quality_gate == "off" || quality_accepted_) return "";
+  if (settings_.quality_gate == "off" || accepted_.quality) return "";
   if (!last_.bad_channels)
     return settings_.eeg_key + ": the channels' quality is not known yet (it needs 2 s of signal)";
   const auto& bad = *last_.bad_channels;
@@ -133,14 +179,27 @@ std::string Preflight::qualityFailure() const {
 }
 
 bool Preflight::questioned() const {
-  if (state_ != State::Failed || settings_.quality_gate != "ask" || quality_accepted_) return false;
-  // The quality is the only failure: everything else passed.
-  return failures_.size() == 1 && failures_.front().rfind("gates.signal_quality", 0) == 0;
+  if (state_ != State::Failed || failures_.empty()) return false;
+  // Every failure is one the experimenter may accept: everything else passed.
+  for (const std::string& f : failures_) {
+    const bool quality = f.rfind("gates.signal_quality", 0) == 0 &&
+                         settings_.quality_gate == "ask" && !accepted_.quality;
+    const bool display = f.rfind("display:", 0) == 0 && settings_.display_question;
+    if (!quality && !display) return false;
+  }
+  return true;
+}
+
+bool Preflight::qualityQuestioned() const {
+  if (!questioned()) return false;
+  for (const std::string& f : failures_)
+    if (f.rfind("gates.signal_quality", 0) == 0) return true;
+  return false;
 }
 
 std::string Preflight::qualityVerdict() const {
   if (settings_.quality_gate == "off") return "not checked";
-  if (quality_accepted_) return "accepted by the experimenter";
+  if (accepted_.quality) return "accepted by the experimenter";
   if (state_ == State::Passed) return "passed";
   for (const std::string& f : failures_)
     if (f.rfind("gates.signal_quality", 0) == 0)
@@ -162,8 +221,8 @@ std::vector<std::string> Preflight::lines() const {
       return out;
     case State::Failed:
       out.emplace_back(questioned()
-                           ? "pre-flight: all passed but the EEG's quality (Start checks again; "
-                             "Start anyway accepts it):"
+                           ? "pre-flight: all passed but what you may accept (Start checks "
+                             "again; the buttons below accept it):"
                            : "pre-flight FAILED (Start checks again):");
       for (const std::string& f : failures_) out.push_back("  " + f);
       return out;

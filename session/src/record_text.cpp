@@ -17,6 +17,31 @@ std::string reasonText(const CycleRecord& record) {
   return record.ended ? phaseText(record) : record.paradigm.status;
 }
 
+std::string recoveryText(const CycleRecord& record) {
+  const ParadigmPart& p = record.paradigm;
+  if (record.ended || (p.phase != bci::Phase::EmergencyStop && p.phase != bci::Phase::RobotFault) ||
+      !p.interrupted)
+    return "";
+  const bci::Phase was = *p.interrupted;
+  const bool robot_step = was == bci::Phase::Grasping || was == bci::Phase::Dropping;
+  const auto holding = record.robot.holding();
+  std::string where = record.robot.at_home ? "The arm is at home" : "The arm is where it stopped";
+  where += holding ? ", holding object " + std::to_string(*holding) + ". " : ", holding nothing. ";
+  if (!record.robot.at_home) where += "Home (Robot panel) first where it must be cleared. ";
+  const std::string step = std::string(bci::toString(was));
+  if (robot_step) {
+    return "Stopped in trial " + std::to_string(p.trial) + " (" + step + "). " + where +
+           "Next: Retry step does the " + (was == bci::Phase::Grasping ? "grasp" : "put-down") +
+           " again; Skip trial or Resume ends this trial here and starts the next" +
+           (holding ? " (the object stays in the gripper until a put-down: Open gripper in "
+                      "the Robot panel)"
+                    : "") +
+           ".";
+  }
+  return "Stopped in trial " + std::to_string(p.trial) + " (" + step + "). " + where +
+         "Next: Resume (or Retry step) goes on with " + step + "; Skip trial starts the next.";
+}
+
 std::string timingWarning(const CycleRecord& record, const SessionConfig& settings) {
   const Presentation& p = record.presentation;
   if (!p.display_too_slow || !p.median_frame_ms) return "";

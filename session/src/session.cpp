@@ -163,8 +163,12 @@ void Session::endIfDone() {
   if (phase == bci::Phase::Aborted) {
     // The whole reason (who or what aborted it), not the word alone.
     std::string reason = "aborted";
-    for (const PhaseChange& change : record.paradigm.phase_changes)
-      if (change.phase == bci::Phase::Aborted && !change.text.empty()) reason = change.text;
+    const std::string said = std::string(bci::toString(bci::Phase::Aborted)) + ": ";
+    for (const PhaseChange& change : record.paradigm.phase_changes) {
+      if (change.phase != bci::Phase::Aborted || change.text.empty()) continue;
+      // "aborted: by the experimenter" is the kind and the reason: the reason alone.
+      reason = change.text.rfind(said, 0) == 0 ? change.text.substr(said.size()) : change.text;
+    }
     endRun(reason, "aborted");
   }
   if (options_.flashes_only_s > 0.0 && time >= options_.flashes_only_s) endRun("timing check done");

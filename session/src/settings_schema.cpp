@@ -573,6 +573,21 @@ Broken crossRules(const Json& c) {
                      "= true needs the calibration run's feedback block to train the ErrP "
                      "classifier, and paradigm.calibration is \"none\": set one of them "
                      "otherwise"};
+  if (c["paradigm"]["calibration"] == "none") {
+    // Learning from use trusts no model before learning_min_selections object selections are
+    // fitted: a run of fewer trials ends without the arm ever moving.
+    const int trials = c["paradigm"]["trials"].get<int>();
+    const int needed = c["paradigm"]["learning_min_selections"].get<int>();
+    if (trials < needed)
+      return std::pair{"paradigm.trials",
+                       "= " + std::to_string(trials) +
+                           " with paradigm.calibration \"none\": the learner trusts no model "
+                           "before " +
+                           std::to_string(needed) +
+                           " object selections (paradigm.learning_min_selections), so the arm "
+                           "would never move; run at least " +
+                           std::to_string(needed) + " trials (the docs' runs use 30)"};
+  }
   if (c["errp"]["enabled"].get<bool>() && !c["errp"]["channels"].empty()) {
     const auto montage = c["eeg"]["montage"].get<std::vector<std::string>>();
     bool any = false;

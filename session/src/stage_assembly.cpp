@@ -65,6 +65,13 @@ PreflightSettings preflightSettingsOf(const SessionConfig& c, const SessionOptio
   p.quality_gate =
       c.gates.signal_quality == "ask" && !options.experimenter ? "refuse" : c.gates.signal_quality;
   p.bad_channels_allowed = c.gates.bad_channels_allowed;
+  // A display that cannot hold its rate is asked about before Start where the timing gate would
+  // pause the run for it (headless, the simulated display holds its rate by construction).
+  if (options.experimenter && c.gates.timing == "pause") {
+    p.display_hz = c.paradigm.display_hz;
+    p.flash_ms = c.paradigm.flash_ms;
+    p.display_question = true;
+  }
   if (c.robot.backend == "simulated") {
     p.robot_key = "robot.backend";
     p.robot_what = "the simulated arm (arbci-robotd)";
@@ -151,7 +158,8 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
   // Every stage's settings, checked before anything starts.
   checkNamedResources(c);
   const SceneSettings scene_settings = SceneSettings::of(c);
-  const EegAcquisitionSettings eeg_settings{c.eeg, c.paradigm.flashSeconds(), c.source};
+  const EegAcquisitionSettings eeg_settings{c.eeg, c.paradigm.flashSeconds(), c.source,
+                                            options.experimenter};
   bci::lsl::LslConfig lsl;
   if (c.eeg.live() || c.lsl.markers) lsl = c.lsl.config(c.source);
   const int camera_every =

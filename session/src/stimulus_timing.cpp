@@ -102,7 +102,7 @@ std::optional<double> StimulusTiming::medianFrameIntervalMs() const {
 
 bool StimulusTiming::displayTooSlow() const {
   const auto median = medianFrameIntervalMs();
-  return median && *median > 1.5 * 1000.0 / paradigm_.display_hz;
+  return median && tooSlow(*median / 1000.0, paradigm_.display_hz);
 }
 
 nlohmann::json StimulusTiming::summary() const {

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "arbci/bci/evaluation.h"
+#include "arbci/bci/intervals.h"
 
 namespace arbci::session {
 
@@ -118,8 +119,12 @@ nlohmann::json trialJson(const TrialRecord& t) {
 nlohmann::json rate(int choices, int right, int made, double total_seconds) {
   if (made == 0) return nlohmann::json(nullptr);
   const double seconds = total_seconds / made;
+  const bci::Interval interval = bci::wilsonInterval(right, made);
   return nlohmann::json{
       {"accuracy", static_cast<double>(right) / made},
+      {"right", right},
+      {"of", made},
+      {"accuracy_interval", {interval.low, interval.high}},
       {"seconds_per_selection", seconds},
       {"bits_per_minute",
        bci::wolpawBits(choices, static_cast<double>(right) / made) * 60.0 / seconds}};
@@ -132,13 +137,17 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
   nlohmann::json trials = nlohmann::json::array();
   int objects_right = 0, cells_right = 0, objects_made = 0, cells_made = 0, completed = 0;
   double object_seconds = 0, cell_seconds = 0, trial_seconds = 0;
-  int wrong_robot_actions = 0;
+  int wrong_robot_actions = 0, post_hoc_right = 0, post_hoc_made = 0;
   nlohmann::json first_right = nullptr;
   for (const TrialRecord& t : records) {
     if (first_right.is_null() && t.ended_s >= 0.0 && t.robot_object == t.intended_object &&
         t.robot_cell == t.intended_cell && !t.robot_returned)
       first_right = t.ended_s;
     wrong_robot_actions += t.wrongRobotActions();
+    if (t.post_hoc_object) {
+      ++post_hoc_made;
+      post_hoc_right += *t.post_hoc_object == t.intended_object;
+    }
     trials.push_back(trialJson(t));
     if (t.selected_object >= 0) {
       ++objects_made;
@@ -166,7 +175,20 @@ nlohmann::json trialsSummary(const std::vector<TrialRecord>& records, int object
            {"seconds_per_selection", trial_seconds / (2 * completed)},
            {"bits_per_minute", bits / trial_seconds * 60.0}};
   }
+  // The online trials' objects as decided after the run: by the last fit where the session
+  // learnt from use; else by the model that decided them online, so the same as online. Either
+  // way these, not the calibration run's in-sample figures, say how the model did on new data.
+  nlohmann::json post_hoc = {{"scored_by", "the model that decided them online"},
+                             {"objects", {{"right", objects_right}, {"of", objects_made}}}};
+  if (post_hoc_made > 0)
+    post_hoc = {{"scored_by", "the last fit learnt from use"},
+                {"objects", {{"right", post_hoc_right}, {"of", post_hoc_made}}}};
+  const auto& counts = post_hoc["objects"];
+  const bci::Interval interval =
+      bci::wilsonInterval(counts["right"].get<int>(), counts["of"].get<int>());
+  post_hoc["objects"]["accuracy_interval"] = {interval.low, interval.high};
   return {{"trials", trials},
+          {"post_hoc", post_hoc},
           {"wrong_robot_actions", wrong_robot_actions},
           {"objects", rate(object_choices, objects_right, objects_made, object_seconds)},
           {"cells", rate(cell_choices, cells_right, cells_made, cell_seconds)},

@@ -256,6 +256,19 @@ TEST(SessionConfig, AnErrpCalibrationTooSmallForItsFoldsIsRefusedWithTheMinimum)
   EXPECT_LE(bci::minimumCalibrationFeedbacks(0.25, 10), least);
 }
 
+// A run without a calibration run learns from its trials and trusts no model before
+// learning_min_selections of them: with fewer trials the arm could never move, which is said
+// before Start, naming the key.
+TEST(SessionConfig, ANoCalibrationRunTooShortForTheLearnerToTrustIsRefused) {
+  const std::string short_run = errorOf(R"({"paradigm": {"calibration": "none"}})");
+  EXPECT_NE(short_run.find("paradigm.trials = 3 with paradigm.calibration \"none\""),
+            std::string::npos)
+      << short_run;
+  EXPECT_NE(short_run.find("at least 5 trials"), std::string::npos) << short_run;
+  EXPECT_NO_THROW(SessionConfig::load(
+      sessionFile("learning_enough", R"({"paradigm": {"calibration": "none", "trials": 5}})")));
+}
+
 // Before the run each stage checks what its settings name can be used, and says which key.
 std::string validationErrorOf(const std::string& json) {
   const SessionConfig config = SessionConfig::load(sessionFile("resources", json));

@@ -67,7 +67,9 @@ TEST(LearningFromUse, TrustNeedsEnoughSelectionsAndAConsistentStableFit) {
   const LearnedSelections weak = fitOf(10, 0.7);
   trust = judgeTrust(weak, decodings(weak, 9), rule);
   EXPECT_FALSE(trust.trusted);
-  EXPECT_NE(trust.waiting_for.find("held-out consistency of 0.80 (now 0.70"), std::string::npos)
+  EXPECT_NE(trust.waiting_for.find("decode the same when left out of the fit: 7 of 10 do (0.70), "
+                                   "0.80 needed"),
+            std::string::npos)
       << trust.waiting_for;
 
   const LearnedSelections good = fitOf(12, 0.9);
@@ -80,8 +82,8 @@ TEST(LearningFromUse, TrustNeedsEnoughSelectionsAndAConsistentStableFit) {
   noise.explained = 0.012;
   trust = judgeTrust(noise, decodings(noise, 11), rule);
   EXPECT_FALSE(trust.trusted);
-  EXPECT_NE(trust.waiting_for.find("explains 0.0120 of the variance; with the codes shuffled, up "
-                                   "to 0.0100"),
+  EXPECT_NE(trust.waiting_for.find("no better than with the flashes' order shuffled (beaten in 8 "
+                                   "of 9 shuffles"),
             std::string::npos)
       << trust.waiting_for;
 

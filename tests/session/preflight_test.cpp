@@ -55,6 +55,53 @@ TEST(Preflight, AFailureTheDisplayFoundFailsOnTheFirstFrameNamingItsKey) {
   EXPECT_NE(p.lines()[1].find("hmd.mirror_monitor = 3"), std::string::npos);
 }
 
+// A display that shows a frame every 110 ms where 60 Hz is asked: a question before Start with
+// the figures (what the flashes will last), which the experimenter may accept (run annotated);
+// one that holds its rate passes. Frames from before the check do not count.
+TEST(Preflight, ADisplayTooSlowForItsRateIsAQuestionWithTheFigures) {
+  PreflightSettings s = settings();
+  s.display_hz = 60.0;
+  s.flash_ms = 60.0;
+  s.display_question = true;
+  auto slow = [](int i) {
+    PreflightObservation o = healthy(i);
+    if (i % 7 == 0) o.frame_host_s = 100.0 + i / 60.0;  // every 7th cycle: 117 ms apart
+    return o;
+  };
+  Preflight p(s);
+  p.begin(slow(0));
+  Preflight::State state = Preflight::State::Running;
+  for (int frame = 1; frame < 2000 && state == Preflight::State::Running; ++frame)
+    state = p.update(slow(frame));
+  ASSERT_EQ(state, Preflight::State::Failed);
+  EXPECT_TRUE(p.questioned());
+  EXPECT_FALSE(p.qualityQuestioned());
+  ASSERT_EQ(p.failures().size(), 1u);
+  EXPECT_EQ(p.failures()[0].rfind("display: a frame every 117 ms (8.6 Hz; display_hz 60 asks for "
+                                  "16.7 ms): flashes will last about 467 ms instead of 67",
+                                  0),
+            0u)
+      << p.failures()[0];
+  EXPECT_NE(p.failures()[0].find("run annotated"), std::string::npos);
+  // Accepted: the check passes, and says the display was accepted.
+  p.begin(slow(2000), {false, true});
+  state = Preflight::State::Running;
+  for (int frame = 2001; frame < 4000 && state == Preflight::State::Running; ++frame)
+    state = p.update(slow(frame));
+  EXPECT_EQ(state, Preflight::State::Passed);
+  EXPECT_TRUE(p.displayAccepted());
+  // A display at its rate passes unasked.
+  Preflight steady(s);
+  steady.begin(healthy(0));
+  state = Preflight::State::Running;
+  for (int frame = 1; frame < 600 && state == Preflight::State::Running; ++frame) {
+    PreflightObservation o = healthy(frame);
+    o.frame_host_s = frame / 60.0;
+    state = steady.update(o);
+  }
+  EXPECT_EQ(state, Preflight::State::Passed);
+}
+
 TEST(Preflight, FewerThanTwoObjectsInViewFailNamingThoseNotSeen) {
   PreflightSettings s = settings();
   s.object_ids = {10, 20, 30, 40};

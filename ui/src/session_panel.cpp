@@ -48,12 +48,13 @@ void SessionPanel::draw(const PanelInput& in) {
   ImGui::Text("%s", session::phaseText(r).c_str());
   // The calibration run counts its own selections (the trials come after it).
   if (const auto& c = r.paradigm.calibration_selection) {
+    std::string counts;
+    if (r.paradigm.calibration_retakes > 0)
+      counts += ", " + std::to_string(r.paradigm.calibration_retakes) + " retaken";
+    if (r.paradigm.reflashed_sequences > 0)
+      counts += ", " + std::to_string(r.paradigm.reflashed_sequences) + " sequences shown again";
     ImGui::Text("calibration selection %d of %d%s, sequence %d, session time %.1f s", c->first,
-                c->second,
-                r.paradigm.calibration_retakes > 0
-                    ? (" (" + std::to_string(r.paradigm.calibration_retakes) + " retaken)").c_str()
-                    : "",
-                r.paradigm.sequence, r.time_s);
+                c->second, counts.c_str(), r.paradigm.sequence, r.time_s);
   } else {
     ImGui::Text("trial %d of %d, sequence %d, session time %.1f s", r.paradigm.trial,
                 in.settings.paradigm.trials, r.paradigm.sequence, r.time_s);
@@ -70,6 +71,9 @@ void SessionPanel::draw(const PanelInput& in) {
   if (const std::string why = session::reasonText(r); !why.empty())
     colouredWrapped(ImVec4(1.0f, 0.55f, 0.3f, 1.0f), why);
   if (!started && !r.ended) runLabels(in);
+  // After an E-STOP or a robot fault: what each way on does, as long as the run waits for it.
+  if (const std::string next = session::recoveryText(r); !next.empty())
+    colouredWrapped(ImVec4(1.0f, 0.8f, 0.35f, 1.0f), next);
   if (r.robot.status && !r.robot.status->stop_reason.empty() && !r.ended) {
     colouredWrapped(
         ImVec4(1, 0.3f, 0.3f, 1),
@@ -87,9 +91,17 @@ void SessionPanel::draw(const PanelInput& in) {
   }
   // The quality gate asked: the experimenter may start with the channels as they are (the log,
   // the recording and the summary say so).
-  if (!r.preflight.questioned.empty() && !started &&
-      button("Start anyway, with these channels", ""))
-    in.requests.post(session::StartRequest{true});
+  // So may the display's: run with every flash off limits annotated and no timing pauses.
+  const bool quality = !r.preflight.questioned.empty(),
+             display = !r.preflight.display_question.empty();
+  if (quality && !started &&
+      button(display ? "Start anyway, with these channels and this display"
+                     : "Start anyway, with these channels",
+             ""))
+    in.requests.post(session::StartRequest{true, display});
+  if (display && !quality && !started &&
+      button("Run annotated on this display (no timing pauses this run)", ""))
+    in.requests.post(session::StartRequest{false, true});
   notes(in);
   trackingHealth(in);
   timing(in);

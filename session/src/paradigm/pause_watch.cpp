@@ -82,31 +82,29 @@ void ViewWatch::flashWithheld(int object_id, int selection, Cycle& cycle, bci::P
     return;
   }
   if (paradigm.calibrationRetakes() >= max_retakes_) {
-    // Retakes that keep coming: the experimenter looks before the run loops on.
-    std::string reason = "calibration selections retaken " +
-                         std::to_string(paradigm.calibrationRetakes()) +
-                         " times (gates.max_retakes): object " + std::to_string(object_id) +
-                         " keeps leaving the cameras' view";
-    if (!stalls_.empty())
-      reason += ", and the PC stalled " + std::to_string(stalls_.size()) + " times";
-    s.log.write("paused", time, {{"reason", reason}});
-    if (!experimenter_) {
-      cycle.end(reason, "aborted");
-      return;
+    // A hard cap: the run never loops on retakes. From here a selection goes on with the flashes
+    // of an object out of view withheld (training takes the flashes there are), said once.
+    if (!retakes_capped_) {
+      retakes_capped_ = true;
+      std::string reason =
+          "calibration selections retaken " + std::to_string(paradigm.calibrationRetakes()) +
+          " times (gates.max_retakes): no more retakes; an object out of view "
+          "(now " +
+          std::to_string(object_id) + ") has its flashes withheld and the selection goes on";
+      s.log.write("retakes_capped", time, {{"reason", reason}});
+      s.tell.say(time, Severity::Warning, reason);
+      cycle.annotate(cycle.eeg_sample, "Retakes capped: " + reason);
     }
-    pause("too many retakes", reason + "; check the markers and cameras, then Resume", time,
-          paradigm, reasons);
-    asked_retakes_ = true;
-    s.tell.say(time, Severity::Error, "paused: " + reason);
     return;
   }
-  // A calibration flash withheld: the selection stops there, paused until every object is in
-  // view again, and is then retaken (training needs whole selections).
+  // A calibration flash withheld: the selection stops there, paused until every object has been
+  // in view for a second, and is then retaken (it lacks that object's flash).
   const std::string reason = "calibration selection " + std::to_string(selection) + ": object " +
                              std::to_string(object_id) +
                              "'s flash withheld (tracking lost); the selection is retaken once "
                              "every object has been in view for 1 s";
   pause("tracking lost: object " + std::to_string(object_id), reason, time, paradigm, reasons);
+  retake_on_resume_ = true;
   s.log.write("paused", time, {{"reason", reason}});
   s.tell.say(time, Severity::Warning, "paused: " + reason);
 }
@@ -127,16 +125,16 @@ void ViewWatch::watch(Cycle& cycle, bci::Paradigm& paradigm, size_t offered, Sto
   }
   if (paused_) {
     if (phase != Phase::Paused) {
-      paused_ = false;  // the experimenter resumed or ended it
+      paused_ = retake_on_resume_ = asking_ = false;  // the experimenter resumed or ended it
       withheld_since_ = -1.0;
       return;
     }
-    // Asked about the retakes: only the experimenter goes on from here.
-    if (asked_retakes_) return;
+    // A question (the PC too slow) waits for the experimenter's answer.
+    if (asking_) return;
     in_view_since_ = stale_.empty() ? (in_view_since_ < 0.0 ? time : in_view_since_) : -1.0;
     if (in_view_since_ >= 0.0 && time - in_view_since_ >= 1.0) {
-      paradigm.resume();
-      paused_ = false;
+      paradigm.resume(retake_on_resume_);
+      paused_ = retake_on_resume_ = false;
       withheld_since_ = -1.0;
       reasons.status.clear();
       s.log.write("resumed", time, {{"reason", "the objects are in view again"}});
@@ -189,25 +187,36 @@ void ViewWatch::endHold(Cycle& cycle, bci::Paradigm& paradigm, StopReasons& reas
   paradigm.resumeHeld();
   s.log.write("stall_ended", time, {{"seconds", seconds}});
   cycle.annotate(cycle.eeg_sample, "Stall ended: flashes go on");
-  // Stalls that keep coming: the PC cannot hold the session's pace.
+  // Stalls that keep coming: the PC cannot hold the session's pace. Asked once (the run paused);
+  // the answer lasts for the run: resumed, every later stall is held and annotated unasked.
   int recent = 0;
   for (double at : stalls_) recent += at >= time - kSlowWindowS;
-  if (recent < kSlowStalls || (too_slow_told_ > 0 && recent % kSlowStalls != 0)) return;
+  if (recent < kSlowStalls || too_slow_told_ > 0) return;
   ++too_slow_told_;
-  char text[240];
+  char text[400];
   std::snprintf(text, sizeof text,
                 "the PC is too slow for this session: %d stalls in the last %.0f s (the longest "
                 "%.0f ms) froze the cameras and the screen; close other programs, or run the "
-                "EEG panel and the mirror window less (each stall is held and annotated)",
+                "EEG panel and the mirror window less",
                 recent, kSlowWindowS, 1000.0 * longest_stall_s_);
   s.log.write("pc_too_slow", time,
               {{"stalls", recent}, {"window_s", kSlowWindowS}, {"longest_s", longest_stall_s_}});
-  s.tell.say(time, Severity::Error, text);
+  if (!experimenter_) {
+    s.tell.say(time, Severity::Error, std::string(text) + " (each stall is held and annotated)");
+    return;
+  }
+  const std::string question =
+      std::string(text) +
+      ". Resume: carry on, each later stall held and annotated without asking again; Abort: end "
+      "the run here (what was recorded is kept)";
+  pause("the PC is too slow", question, time, paradigm, reasons);
+  asking_ = true;
+  s.tell.say(time, Severity::Error, "paused: " + question);
 }
 
 std::string ViewWatch::waitingFor() const {
   if (held_) return "the markers to come back after the stall";
-  if (!paused_ || asked_retakes_) return "";
+  if (!paused_ || !retake_on_resume_) return "";
   std::string lost;
   for (int id : stale_) lost += (lost.empty() ? "" : ", ") + std::to_string(id);
   return "every object in view for 1 s" + (lost.empty() ? "" : " (not seen: " + lost + ")");
@@ -217,6 +226,7 @@ void ViewWatch::report(nlohmann::json& summary) const {
   summary["stalls"] = {{"count", stalls_.size()},
                        {"longest_s", longest_stall_s_},
                        {"pc_too_slow_warnings", too_slow_told_}};
+  summary["retakes_capped"] = retakes_capped_;
 }
 
 void ViewWatch::pause(const std::string& why, const std::string& status, double time,

@@ -76,6 +76,47 @@ bci::Block EegAcquisitionStage::eegOnly(const bci::Block& block) const {
   return out;
 }
 
+void EegAcquisitionStage::watchDelivery(Cycle& cycle, bool delivered) {
+  EegPart& out = cycle.record.eeg;
+  bool finished = false;
+  acquisition_->withSource([&](bci::EegSource& source) { finished = source.finished(); });
+  if (delivered || !last_delivery_s_) {
+    if (delivered) {
+      last_delivery_s_ = cycle.time_s;
+      last_delivery_host_s_ = cycle.host_s;
+    }
+    silence_.clear();
+  }
+  // (Blocks the acquisition thread still holds come within a cycle or two.)
+  if (finished && !delivered && last_delivery_s_ && cycle.time_s - *last_delivery_s_ >= 0.25) {
+    // Every sample of the file delivered: the recording and the paradigm have nothing more to go
+    // on. The run ends as a fault, with its summary and the recording whole.
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the EEG source ended: %s delivered its last sample (%.1f s of signal); the run "
+                  "cannot go on without EEG",
+                  settings_.eeg.file.empty() ? "the source" : settings_.eeg.file.c_str(),
+                  static_cast<double>(next_sample_) / acquisition_->info().rate_hz);
+    out.fault = text;
+    cycle.end(text, "fault");
+    return;
+  }
+  // Live: silence on the host's clock (a session whose cycles stall still sees the time pass).
+  if (acquisition_->mode() != bci::Acquisition::Mode::Live || !last_delivery_s_) return;
+  const double silent = cycle.host_s - last_delivery_host_s_;
+  if (silent < kSilentS) return;
+  char text[240];
+  std::snprintf(text, sizeof text,
+                "no EEG sample from %s for %.1f s (the last arrived at session time %.1f s)",
+                sourceLine().empty() ? "the source" : sourceLine().c_str(), silent,
+                *last_delivery_s_);
+  // The text changes each second it lasts; the fault is logged as it starts.
+  if (silence_.empty()) silence_ = text;
+  out.fault = silence_;
+  if (!settings_.experimenter && silent >= kSilentEndS)
+    cycle.end(std::string(text) + "; nobody at the window to bring it back", "fault");
+}
+
 void EegAcquisitionStage::take(Cycle& cycle) {
   EegPart& out = cycle.record.eeg;
   out.info = all_info_;
@@ -170,13 +211,16 @@ void EegAcquisitionStage::step(Cycle& cycle) {
     }
   });
   if (const std::string fault = acquisition_->fault(); !fault.empty()) out.fault = fault;
+  if (out.fault.empty()) watchDelivery(cycle, !out.blocks.empty());
   if (out.fault != fault_logged_) {
     s_.log.write("eeg_source", cycle.time_s,
                  {{"fault", out.fault}, {"state", out.fault.empty() ? "delivering" : "fault"}});
-    if (out.fault.empty())
+    if (out.fault.empty()) {
       s_.tell.say(cycle.time_s, Severity::Info, "EEG source delivering again");
-    else
+    } else {
       s_.tell.say(cycle.time_s, Severity::Error, "EEG source: " + out.fault);
+      faults_.push_back({{"t", cycle.time_s}, {"fault", out.fault}});
+    }
     fault_logged_ = out.fault;
   }
   cycle.eeg_sample = cycle.record.eeg_sample = acquisition_->firstSampleAtOrAfter(cycle.host_s);
@@ -219,6 +263,8 @@ void EegAcquisitionStage::report(nlohmann::json& summary) const {
   summary["eeg"]["lost_samples"] = acquisition_->lostSamples();
   summary["eeg"]["source_markers"] = source_markers_;
   summary["eeg"]["source"] = sourceLine();
+  // Every fault the source had (an end, a silence, a lost stream), when it began.
+  summary["eeg"]["faults"] = faults_;
   acquisition_->withSource([&](bci::EegSource& source) {
     if (const std::string impedance = source.impedance(); !impedance.empty())
       summary["eeg"]["impedance"] = impedance;

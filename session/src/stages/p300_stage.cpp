@@ -183,14 +183,20 @@ void P300Stage::startTraining(const std::string& method) {
   training.method = method;
   std::vector<int> trained_on = calibration_selection_;
   trained_on.erase(std::unique(trained_on.begin(), trained_on.end()), trained_on.end());
+  // Selections as the paradigm numbered them, never as gaps split them: one interrupted and
+  // resumed is one selection with a pause inside.
+  bci::DatasetOptions options;
+  for (size_t i = 0; i < calibration_.stimuli.size(); ++i)
+    if (i == 0 || calibration_selection_[i] != calibration_selection_[i - 1])
+      options.selection_starts.push_back(calibration_.stimuli[i].sample);
   training_ = std::async(
       std::launch::async,
       [recording = std::move(recording), pipeline = bci::withMethodRate(settings_.pipeline, method),
-       training, trained_on = std::move(trained_on), left_out = left_out_]() {
+       training, trained_on = std::move(trained_on), left_out = left_out_, options]() {
         // Below the cycle's priority (Linux nice is per thread): on a machine with few cores the
         // frames come first and the training takes what is left.
         ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
-        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
+        const bci::P300Dataset data = bci::buildDataset({recording}, pipeline, {}, options);
         bci::TrainingResult result = bci::trainModel(data, pipeline, training);
         result.model.provenance["training_files"] = {"this session's calibration run"};
         return Outcome{std::move(result.model), result.cross_validation.report, data.erp,

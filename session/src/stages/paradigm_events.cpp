@@ -272,6 +272,10 @@ void ParadigmStage::onRobotDrop(const bci::ParadigmEvent& e, Cycle& cycle) {
 }
 
 void ParadigmStage::onTrialDone(const bci::ParadigmEvent& e, Cycle& cycle) {
+  // An interruption the experimenter resumed by going on to the next trial ends here.
+  if (TrialRecord* trial = trials_.find(e.trial);
+      trial && !trial->interruptions.empty() && trial->interruptions.back().resumed_s < 0.0)
+    trial->interruptions.back().resumed_s = cycle.time_s;
   trials_.done(e.trial, cycle.time_s, e.text);
   if (e.arm_held) trials_.at(e.trial).arm_held = true;
   s_.log.write("trial_done", cycle.time_s, {{"trial", e.trial}, {"text", e.text}});

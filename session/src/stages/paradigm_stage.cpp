@@ -87,6 +87,7 @@ void ParadigmStage::publish(Cycle& cycle) {
         std::min(paradigm_.calibrationDone() + 1, settings_.paradigm.calibration_selections),
         settings_.paradigm.calibration_selections};
   part.calibration_retakes = paradigm_.calibrationRetakes();
+  part.reflashed_sequences = paradigm_.reflashedSequences();
   part.errp_awaited = paradigm_.awaitingErrpVerdict();
   part.stimulus = stimulus_;
   part.slots = slots_;
@@ -116,7 +117,8 @@ void ParadigmStage::act(const Request& request, Cycle& cycle) {
   } else if (std::holds_alternative<ResumeRequest>(request)) {
     if (paradigm_.interrupted()) cycle.post(RobotResetIfLatchedRequest{time});
     reasons_.status.clear();
-    paradigm_.resume();
+    // Only a selection that lacks a withheld flash is retaken; any other goes on.
+    paradigm_.resume(view_watch_.retakeOnResume());
   } else if (std::holds_alternative<AbortRequest>(request)) {
     paradigm_.abort();
   } else if (std::holds_alternative<EmergencyStopRequest>(request)) {
@@ -468,6 +470,12 @@ void ParadigmStage::report(nlohmann::json& summary) const {
   summary.update(
       trialsSummary(trials_.trials(), static_cast<int>(settings_.world.objects.size()), cells));
   calibration_.summarise(summary);
+  // Counts as they happened: a selection retaken is one selection more, a sequence begun again
+  // after an interruption is only more flashes of its selection.
+  if (summary.contains("calibration")) {
+    summary["calibration"]["retakes"] = paradigm_.calibrationRetakes();
+    summary["calibration"]["reflashed_sequences"] = paradigm_.reflashedSequences();
+  }
   view_watch_.report(summary);
   if (settings_.paradigm.errp) errp_.report(summary["errp"]);
   if (learnt_.empty() || !learning_seen_) return;

@@ -28,6 +28,7 @@ PreflightObservation PreflightStage::observe(const Cycle& cycle) const {
   const QualityPart& quality = cycle.record.quality;
   o.channels = static_cast<int>(quality.channels.size());
   if (!quality.quality.empty()) o.bad_channels = quality.bad();
+  if (cycle.record.presentation.shown) o.frame_host_s = cycle.record.presentation.host_s;
   return o;
 }
 
@@ -36,8 +37,11 @@ void PreflightStage::step(Cycle& cycle) {
   const bool begin = !starts.empty() && cycle.previous.paradigm.phase == bci::Phase::Setup &&
                      preflight_.state() != Preflight::State::Running;
   if (begin) {
-    // Accepting the quality is the experimenter's answer to the question just asked, no other.
-    const bool accepted = starts.back()->despite_quality && preflight_.questioned();
+    // Accepting is the experimenter's answer to the question just asked, no other.
+    Preflight::Accepted accepted;
+    accepted.quality = starts.back()->despite_quality && preflight_.qualityQuestioned();
+    accepted.display = starts.back()->despite_display && !preflight_.displayQuestion().empty() &&
+                       preflight_.questioned();
     s_.log.write("preflight_started", cycle.time_s, {});
     // Once a check: the disk does not fill in the seconds it lasts.
     disk_free_.reset();
@@ -56,7 +60,10 @@ void PreflightStage::step(Cycle& cycle) {
   }
   cycle.record.preflight.running = preflight_.state() == Preflight::State::Running;
   cycle.record.preflight.lines = preflight_.lines();
-  if (preflight_.questioned()) cycle.record.preflight.questioned = cycle.record.quality.bad();
+  if (preflight_.qualityQuestioned())
+    cycle.record.preflight.questioned = cycle.record.quality.bad();
+  if (preflight_.questioned())
+    cycle.record.preflight.display_question = preflight_.displayQuestion();
 }
 
 void PreflightStage::logQuality(Cycle& cycle) {
@@ -88,6 +95,16 @@ void PreflightStage::finish(Cycle& cycle, Preflight::State state) {
                   {"camera_frames", preflight_.cameraFrames()},
                   {"eeg_rate_hz", preflight_.eegRateHz()}});
     s_.tell.say(cycle.time_s, Severity::Info, "pre-flight passed");
+    if (preflight_.displayAccepted()) {
+      // The experimenter's answer lasts for the run: the flashes off limits are annotated and
+      // the timing gate does not pause for them.
+      const std::string why =
+          "the experimenter runs annotated on a display that cannot hold "
+          "display_hz (" +
+          preflight_.displayQuestion() + ")";
+      s_.log.write("timing_policy", cycle.time_s, {{"policy", "annotate"}, {"why", why}});
+      cycle.post(TimingPolicyRequest{"annotate", why});
+    }
     cycle.post(BeginRequest{});
   } else if (state == Preflight::State::Failed) {
     s_.log.write("preflight", cycle.time_s,
@@ -95,9 +112,9 @@ void PreflightStage::finish(Cycle& cycle, Preflight::State state) {
                   {"failures", preflight_.failures()},
                   {"questioned", preflight_.questioned()}});
     if (preflight_.questioned() && settings_.experimenter) {
-      s_.tell.say(cycle.time_s, Severity::Warning,
-                  "pre-flight: " + preflight_.failures().front() +
-                      " (Start anyway, or fix them and Start)");
+      for (const std::string& f : preflight_.failures())
+        s_.tell.say(cycle.time_s, Severity::Warning,
+                    "pre-flight asks: " + f + " (answer with the button, or fix it and Start)");
       return;
     }
     for (const std::string& f : preflight_.failures())

@@ -24,18 +24,47 @@ TimingLimits timingLimitsOf(double max_flash_ms, double min_gap_ms, double min_s
 }
 
 TimingGateStage::TimingGateStage(const TimingGateSettings& settings, const StageServices& services)
-    : settings_(settings), s_(services) {}
+    : settings_(settings), s_(services), policy_(settings.policy) {}
+
+namespace {
+
+bool flashingPhase(bci::Phase phase) {
+  return phase == bci::Phase::CalibrationFlashing || phase == bci::Phase::ObjectFlashing ||
+         phase == bci::Phase::CellFlashing;
+}
+
+}  // namespace
+
+void TimingGateStage::followPause(Cycle& cycle) {
+  const bci::Phase phase = cycle.previous.paradigm.phase;
+  // The pause asked for: seen begun, then seen over. Only then do the limits count afresh (the
+  // cycle after the request the paradigm has not paused yet: that is no resumption).
+  if (pause_ == Pause::Asked && phase == bci::Phase::Paused) pause_ = Pause::Holding;
+  if (pause_ != Pause::Holding || phase == bci::Phase::Paused) return;
+  pause_ = Pause::None;
+  off_ = flashes_ = 0;
+  late_.clear();
+  if (phase == bci::Phase::Aborted || phase == bci::Phase::Finished) return;
+  // Asked once: the experimenter's Resume carries the run on annotated.
+  setPolicy(cycle, "annotate",
+            "the experimenter resumed a timing pause: the run goes on with every flash off "
+            "limits annotated, without timing pauses");
+}
+
+void TimingGateStage::setPolicy(Cycle& cycle, const std::string& policy, const std::string& why) {
+  if (policy == policy_) return;
+  policy_ = policy;
+  ++policy_changes_;
+  s_.log.write("timing_policy", cycle.time_s, {{"policy", policy}, {"why", why}});
+  s_.tell.say(cycle.time_s, Severity::Info, "timing: " + why);
+}
 
 void TimingGateStage::step(Cycle& cycle) {
-  if (settings_.policy == "off") return;
+  for (const TimingPolicyRequest* request : requestsOf<TimingPolicyRequest>(cycle.record.requests))
+    setPolicy(cycle, request->policy, request->why);
+  if (policy_ == "off") return;
   const Presentation& shown = cycle.record.presentation;
-  // Resumed (or never paused): the limits count afresh.
-  if (paused_ && cycle.previous.paradigm.phase != bci::Phase::Paused &&
-      cycle.previous.paradigm.phase != bci::Phase::Setup) {
-    paused_ = false;
-    off_ = flashes_ = 0;
-    late_.clear();
-  }
+  followPause(cycle);
   const TimingLimits& l = settings_.limits;
   for (const Presentation::Ended& e : shown.ended) {
     const double d = ms(e.duration_samples);
@@ -72,7 +101,9 @@ void TimingGateStage::step(Cycle& cycle) {
     }
     last_onset_ = o.sample;
   }
-  if (shown.shown) {
+  // Late frames count while flashes are due (never before Start, in a pause or a cue): a slow
+  // frame elsewhere times no stimulus.
+  if (shown.shown && flashingPhase(cycle.previous.paradigm.phase)) {
     late_.push_back(shown.late);
     if (static_cast<int>(late_.size()) > kLateWindow) late_.pop_front();
   }
@@ -116,17 +147,14 @@ void TimingGateStage::pauseIfPastLimits(Cycle& cycle) {
                   "gates.max_late_share): is the PC busy?",
                   late, kLateWindow, 100.0 * l.max_late_share);
   }
-  if (why[0] == '\0' || paused_) return;
-  const bci::Phase phase = cycle.previous.paradigm.phase;
-  const bool flashing = phase == bci::Phase::CalibrationFlashing ||
-                        phase == bci::Phase::ObjectFlashing || phase == bci::Phase::CellFlashing;
-  if (!flashing) return;
-  s_.log.write("timing_limit", cycle.time_s,
-               {{"text", why}, {"paused", settings_.policy == "pause" && settings_.experimenter}});
+  if (why[0] == '\0' || pause_ != Pause::None) return;
+  if (!flashingPhase(cycle.previous.paradigm.phase)) return;
+  const bool pausing = policy_ == "pause" && settings_.experimenter;
+  s_.log.write("timing_limit", cycle.time_s, {{"text", why}, {"paused", pausing}});
   // Counted once per selection (or late stretch): the limits count afresh from here.
   off_ = flashes_ = 0;
   late_.clear();
-  if (settings_.policy != "pause" || !settings_.experimenter) {
+  if (!pausing) {
     // Not paused, the same warning would come every few seconds: once a minute is enough.
     if (!told_at_ || cycle.time_s - *told_at_ >= kTellEveryS) {
       s_.tell.say(cycle.time_s, Severity::Warning,
@@ -136,14 +164,20 @@ void TimingGateStage::pauseIfPastLimits(Cycle& cycle) {
     return;
   }
   ++pauses_;
-  paused_ = true;
-  s_.tell.say(cycle.time_s, Severity::Error, std::string("paused: ") + why);
-  cycle.post(PauseRequest{why});
+  pause_ = Pause::Asked;
+  const std::string question =
+      std::string(why) +
+      ". Resume: the run goes on with every flash off limits annotated (no more timing pauses "
+      "this run); Abort: the run ends here (what was recorded is kept)";
+  s_.tell.say(cycle.time_s, Severity::Error, "paused: " + question);
+  cycle.post(PauseRequest{question});
 }
 
 void TimingGateStage::report(nlohmann::json& summary) const {
   nlohmann::json& g = summary["timing_gate"];
   g = {{"policy", settings_.policy},
+       {"policy_at_end", policy_},
+       {"policy_changes", policy_changes_},
        {"limits",
         {{"max_flash_ms", settings_.limits.max_flash_ms},
          {"min_gap_ms", settings_.limits.min_gap_ms},

@@ -33,7 +33,8 @@ class ScriptedSource final : public bci::EegSource {
     std::vector<bci::Block> out;
     if (hold) return out;
     const std::int64_t available = clock_->available(info_.rate_hz);
-    while (next_ + 16 <= available && static_cast<int>(out.size()) < max_blocks) {
+    while (next_ + 16 <= available && static_cast<int>(out.size()) < max_blocks &&
+           (ends_at == 0 || next_ < ends_at)) {
       if (gap > 0) {
         next_ += gap.exchange(0);
         continue;
@@ -69,12 +70,14 @@ class ScriptedSource final : public bci::EegSource {
     return fault_text;
   }
   std::string impedance() const override { return "Fz 4.2, Cz 12"; }
+  bool finished() const override { return ends_at > 0 && next_ >= ends_at; }
   std::vector<bci::Annotation> takeAnnotations() override {
     std::lock_guard lock(mutex);
     return std::exchange(markers, {});
   }
 
   std::atomic<std::int64_t> gap{0};
+  std::int64_t ends_at = 0;  // a finite source (a file): no sample from here on (0: endless)
   std::atomic<bool> hold{false};
   mutable std::mutex mutex;
   std::string fault_text;
@@ -92,6 +95,7 @@ class ScriptedSource final : public bci::EegSource {
 
 EegAcquisitionSettings settings(const std::string& photodiode = "Photodiode") {
   EegAcquisitionSettings s;
+  s.experimenter = true;
   s.eeg.photodiode_channel = photodiode;
   s.flash_s = 4.0 / 60.0;
   s.session_file = "test.json";
@@ -215,6 +219,64 @@ TEST(EegAcquisitionStage, ASourcesFaultIsNamedWhenItStartsAndWhenItEnds) {
   EXPECT_EQ(bench.previous.eeg.fault, "");
   EXPECT_EQ(bench.logged("eeg_source").size(), 2u);
   EXPECT_TRUE(bench.toldOf("EEG source: the LSL stream EEG is gone"));
+  EXPECT_TRUE(bench.toldOf("EEG source delivering again"));
+}
+
+// A file at its end: a fault on the record within a second, and the run ends with the reason
+// (the recording and the summary whole), never a paradigm waiting for EEG that cannot come.
+TEST(EegAcquisitionStage, AFiniteSourceAtItsEndEndsTheRunWithTheReason) {
+  test::StageBench bench("eeg_end");
+  Acquiring eeg(bench);
+  eeg.source->ends_at = 256 * 2;
+  int frame = 0;
+  for (; frame < 600 && bench.record.end_reason.empty(); ++frame) {
+    bench.record.time_s = frame / 60.0;
+    bench.step(*eeg.stage);
+    if (!bench.record.end_reason.empty()) break;
+    bench.next();
+  }
+  ASSERT_FALSE(bench.record.end_reason.empty());
+  EXPECT_EQ(bench.record.end_kind, "fault");
+  EXPECT_NE(bench.record.end_reason.find("the EEG source ended"), std::string::npos)
+      << bench.record.end_reason;
+  EXPECT_NE(bench.record.end_reason.find("(2.0 s of signal)"), std::string::npos)
+      << bench.record.end_reason;
+  EXPECT_LE(frame / 60.0, 2.0 + 1.0);  // within a second of the last sample
+  EXPECT_EQ(bench.record.eeg.fault, bench.record.end_reason);
+  nlohmann::json summary;
+  eeg.stage->report(summary);
+  ASSERT_EQ(summary["eeg"]["faults"].size(), 1u);
+}
+
+// A live source that goes silent: within about a second its silence is the record's fault (the
+// paradigm pauses on it), named with the time since its last sample; it clears when samples come
+// again.
+TEST(EegAcquisitionStage, ALiveSourceThatGoesSilentIsAFaultNamingTheSilence) {
+  test::StageBench bench("eeg_silent", Clock::Mode::RealTime);
+  Acquiring eeg(bench);
+  auto cycle = [&] {
+    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+    bench.record.host_s = bci::hostSeconds();
+    bench.step(*eeg.stage);
+    const std::string fault = bench.record.eeg.fault;
+    bench.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    return fault;
+  };
+  for (int i = 0; i < 30; ++i) ASSERT_EQ(cycle(), "");
+  eeg.source->hold = true;
+  const double from = bci::hostSeconds();
+  std::string fault;
+  while (fault.empty() && bci::hostSeconds() - from < 5.0) fault = cycle();
+  const double after = bci::hostSeconds() - from;
+  EXPECT_NE(fault.find("no EEG sample from"), std::string::npos) << fault;
+  EXPECT_NE(fault.find("the last arrived at session time"), std::string::npos) << fault;
+  EXPECT_GE(after, 0.9);
+  EXPECT_LT(after, 3.0);
+  EXPECT_TRUE(bench.record.end_reason.empty());  // with an experimenter: a pause, not an end
+  eeg.source->hold = false;
+  for (int i = 0; i < 50 && !fault.empty(); ++i) fault = cycle();
+  EXPECT_EQ(fault, "");
   EXPECT_TRUE(bench.toldOf("EEG source delivering again"));
 }
 

@@ -125,6 +125,58 @@ TEST_F(TimingGateTest, ManyLateFramesPauseTheRun) {
   EXPECT_NE(pauses_[0].find("frames presented late"), std::string::npos) << pauses_[0];
 }
 
+// Late frames before Start, in a cue or a pause time no flash: they never count. On a display
+// that is late throughout, the gate pauses once, a few seconds into the flashing; the cycle after
+// it asked, the paradigm has not paused yet, which is no resumption.
+TEST_F(TimingGateTest, LateFramesCountOnlyWhileFlashesAreDue) {
+  for (const bci::Phase not_flashing :
+       {bci::Phase::Setup, bci::Phase::CalibrationCue, bci::Phase::Paused, bci::Phase::Training}) {
+    phase_ = not_flashing;
+    for (int k = 0; k < 2 * TimingGateStage::kLateWindow; ++k) present([](Presentation&) {}, true);
+  }
+  EXPECT_TRUE(pauses_.empty());
+  phase_ = bci::Phase::CalibrationFlashing;
+  int frames = 0;
+  while (pauses_.empty() && frames < 10 * TimingGateStage::kLateWindow) {
+    present([](Presentation&) {}, true);
+    ++frames;
+  }
+  EXPECT_EQ(frames, TimingGateStage::kLateWindow);  // a whole window of flashing frames, no more
+}
+
+// Asked once: the experimenter's Resume of a timing pause carries the run on annotated, its window
+// started afresh; a display late throughout never pauses the run again, and the summary says so.
+TEST_F(TimingGateTest, AfterOneTimingPauseIsResumedTheRunGoesOnAnnotated) {
+  while (pauses_.empty()) present([](Presentation&) {}, true);
+  ASSERT_EQ(pauses_.size(), 1u);
+  EXPECT_NE(pauses_[0].find("Resume: the run goes on with every flash off limits annotated"),
+            std::string::npos)
+      << pauses_[0];
+  present([](Presentation&) {}, true);  // the paradigm has not taken the pause yet
+  phase_ = bci::Phase::Paused;
+  for (int k = 0; k < 30; ++k) present([](Presentation&) {}, true);
+  phase_ = bci::Phase::ObjectFlashing;  // resumed
+  for (int k = 0; k < 5 * TimingGateStage::kLateWindow; ++k) present([](Presentation&) {}, true);
+  EXPECT_EQ(pauses_.size(), 1u);
+  EXPECT_EQ(bench_.logged("timing_policy").size(), 1u);
+  EXPECT_GE(bench_.logged("timing_limit").size(), 4u);  // still noted, once per late stretch
+  nlohmann::json summary;
+  stage_.report(summary);
+  EXPECT_EQ(summary["timing_gate"]["pauses"], 1);
+  EXPECT_EQ(summary["timing_gate"]["policy_at_end"], "annotate");
+}
+
+// The pre-flight's answer for a slow display (run annotated) reaches the gate as a request: no
+// timing pause in the run.
+TEST_F(TimingGateTest, ARunAnnotatedFromStartNeverPausesForTiming) {
+  bench_.record.requests.push_back(TimingPolicyRequest{"annotate", "the display is slow"});
+  for (int k = 0; k < 3 * TimingGateStage::kLateWindow; ++k) present([](Presentation&) {}, true);
+  std::int64_t at = 1000;
+  for (int k = 0; k < 24; ++k, at += 100) flash(3, at, 80);
+  EXPECT_TRUE(pauses_.empty());
+  EXPECT_EQ(notes_.size(), 24u);
+}
+
 class UnattendedTimingGateTest : public TimingGateTest {
  protected:
   UnattendedTimingGateTest() : TimingGateTest("pause", false) {}

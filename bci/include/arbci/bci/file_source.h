@@ -19,6 +19,8 @@ class FileSource final : public EegSource {
   std::vector<Block> poll(int max_blocks = 64) override;
   bool finished() const override { return delivered_ >= recording_.samples; }
   std::vector<StimulusEvent> takeRecordedStimuli() override;
+  // "the file F (8 channels at 256 Hz, 45.0 s)".
+  std::string describe() const override;
   const Recording& recording() const { return recording_; }
 
  private:

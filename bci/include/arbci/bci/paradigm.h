@@ -181,8 +181,9 @@ class Paradigm {
   // Also acknowledges a robot fault or an emergency stop: an interrupted selection starts its
   // sequence again; a trial whose robot step was interrupted is over (the next one starts). The
   // session checks first that the arm is home and holds nothing. An interrupted calibration
-  // selection is retaken instead: its target cued again, all its sequences flashed anew.
-  void resume();
+  // selection goes on the same way, unless `retake`: then it is retaken, its target cued again
+  // and all its sequences flashed anew (for a selection some of whose flashes were withheld).
+  void resume(bool retake = false);
   // After a hold (a stall of the machine, not of the subject): the paused flashing goes on with
   // its current sequence again, a calibration selection included (not retaken).
   void resumeHeld();
@@ -251,6 +252,9 @@ class Paradigm {
   int corrections() const { return corrections_; }
   int sequence() const { return sequence_; }  // the current sequence of a flashing phase (1-based)
   int calibrationRetakes() const { return calibration_retakes_; }
+  // Sequences begun again after an interruption: their flashes shown before it are kept, so the
+  // selection has that many flashes more (counted apart, never as a selection).
+  int reflashedSequences() const { return reflashed_sequences_; }
   // Calibration selections done so far (the one under way is this plus one).
   int calibrationDone() const { return calibration_done_; }
   bool calibrating() const { return calibrating_; }
@@ -270,9 +274,9 @@ class Paradigm {
                      const std::string& text);
   void scheduleSequence(double first_onset_s);
   void restartSequence();  // an interrupted selection shows its sequence again from the start
-  // Going back to an interrupted flashing phase: the sequence again, or (calibration) the
-  // selection retaken.
-  void returnToFlashing(Phase phase);
+  // Back to `phase` after an interruption: the sequence begun again, or (`retake`) the
+  // calibration selection retaken.
+  void returnToFlashing(Phase phase, bool retake);
   void retakeCalibrationSelection();
   void nextTrial(double at_s, const std::string& why, bool arm_held = false);
   void askRobot(Phase phase);  // Grasping or Dropping, with its command
@@ -317,6 +321,7 @@ class Paradigm {
   bool calibrating_ = false;
   int calibration_done_ = 0;
   int calibration_retakes_ = 0;
+  int reflashed_sequences_ = 0;
   std::optional<int> calibration_target_;
   int trial_ = 0;
   std::optional<int> selected_object_;

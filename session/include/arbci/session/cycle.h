@@ -250,6 +250,7 @@ struct ParadigmPart {
   // In the calibration run: the selection under way (1-based) of how many, and retakes so far.
   std::optional<std::pair<int, int>> calibration_selection;
   int calibration_retakes = 0;
+  int reflashed_sequences = 0;  // begun again after an interruption (more flashes, no selection)
   bool errp_awaited = false;
   bci::FrameStimulus stimulus;            // what this frame shows
   std::vector<Flash> first_shown;         // flashes this frame shows for the first time
@@ -287,6 +288,9 @@ struct PreflightPart {
   // The check passed but for the EEG's quality (gates.signal_quality "ask"): the bad channels,
   // which the experimenter may accept with StartRequest{despite_quality}.
   std::vector<std::string> questioned;
+  // The check asks about the display (too slow for display_hz): the question, which the
+  // experimenter answers with StartRequest{despite_display} (run annotated), else "".
+  std::string display_question;
 };
 
 struct CycleRecord {

@@ -35,6 +35,13 @@ struct PreflightSettings {
   // more bad channels than `bad_channels_allowed` fail it.
   std::string quality_gate = "off";
   int bad_channels_allowed = 0;
+  // The display: frames every 1 / display_hz are what the flashes are timed in. A display whose
+  // frames come slower (StimulusTiming::tooSlow) is a question where the timing gate would pause
+  // the run for it (`display_question`: gates.timing "pause" with an experimenter): run with the
+  // flashes off limits annotated, or cancel. 0: not checked.
+  double display_hz = 0.0;
+  double flash_ms = 0.0;  // the paradigm's, for the question's figures
+  bool display_question = false;
   // Failures known before the check begins (the display's: a missing HMD monitor); any fails
   // the pre-flight on its first frame.
   std::vector<std::string> known_failures;
@@ -55,6 +62,14 @@ struct PreflightObservation {
   // The EEG channels graded bad ("C3: flat: ..."), of how many; none: not assessed yet.
   std::optional<std::vector<std::string>> bad_channels;
   int channels = 0;
+  // A frame reached the screen since the last observation, and when (host clock).
+  std::optional<double> frame_host_s;
+};
+
+// What the experimenter accepted when the last check asked: the channels as they are (the gate
+// "ask"), the display as it is (the run's flashes annotated, no timing pauses).
+struct PreflightAccepted {
+  bool quality = false, display = false;
 };
 
 class Preflight {
@@ -62,8 +77,8 @@ class Preflight {
   enum class State { Idle, Running, Passed, Failed };
   explicit Preflight(PreflightSettings settings) : settings_(std::move(settings)) {}
 
-  // `quality_accepted`: the experimenter chose to start despite bad channels (the gate "ask").
-  void begin(const PreflightObservation& now, bool quality_accepted = false);
+  using Accepted = PreflightAccepted;
+  void begin(const PreflightObservation& now, Accepted accepted = {});
   // Running: updates the state from this frame's observation.
   State update(const PreflightObservation& now);
   State state() const { return state_; }
@@ -71,8 +86,16 @@ class Preflight {
   const std::vector<std::string>& failures() const { return failures_; }
   // For the panel: one line per check with what was measured so far.
   std::vector<std::string> lines() const;
-  // Failed on the signal's quality alone, which the experimenter may accept (the gate "ask").
+  // Failed only on what the experimenter may accept: the signal's quality (the gate "ask"), the
+  // display's rate (display_question).
   bool questioned() const;
+  bool qualityQuestioned() const;
+  // The display's question ("" when none): the frame interval measured and what it does to the
+  // flashes.
+  std::string displayQuestion() const;
+  // The median interval between the frames the check saw (seconds; none before 10 frames).
+  std::optional<double> frameIntervalS() const;
+  bool displayAccepted() const { return accepted_.display; }
   // The quality verdict once the check ended: "passed", "refused", "questioned", "accepted by the
   // experimenter" or "not checked".
   std::string qualityVerdict() const;
@@ -83,6 +106,8 @@ class Preflight {
   std::vector<std::string> check(bool final) const;
   // "" when the channels pass the gate, else its failure.
   std::string qualityFailure() const;
+  // "" when the display holds its rate (or is not judged), else its failure.
+  std::string displayFailure() const;
   PreflightSettings settings_;
   State state_ = State::Idle;
   PreflightObservation first_, last_;
@@ -98,7 +123,11 @@ class Preflight {
   std::optional<PreflightObservation> eeg_from_;  // where the rate is counted from
   PreflightObservation eeg_last_;                 // the last frame on which samples arrived
   std::vector<std::string> failures_;
-  bool quality_accepted_ = false;
+  Accepted accepted_;
+  std::vector<double> frame_intervals_s_;  // between the frames the check saw
+  std::optional<double> last_frame_s_;
+  // Frames the display is judged on, at the least.
+  static constexpr int kDisplayFrames = 10;
 };
 
 }  // namespace arbci::session

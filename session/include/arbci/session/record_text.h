@@ -17,6 +17,9 @@ std::string phaseText(const CycleRecord& record);
 // Why the session is not going as planned now (a pause, a failed training, a refused grasp; ""
 // when it is), or once ended, phaseText().
 std::string reasonText(const CycleRecord& record);
+// After an emergency stop or a robot fault: where the arm is and what each way on does (Retry
+// step, Skip trial, Resume), in a line; "" otherwise.
+std::string recoveryText(const CycleRecord& record);
 // "display too slow: a frame every 25.0 ms (configured 16.7 ms)" while the display cannot hold
 // paradigm.display_hz, else "".
 std::string timingWarning(const CycleRecord& record, const SessionConfig& settings);

@@ -22,6 +22,14 @@ namespace arbci::session {
 // `despite_quality`: the experimenter starts although the pre-flight questioned the EEG's quality.
 struct StartRequest {
   bool despite_quality = false;
+  // `despite_display`: the experimenter runs on a display the pre-flight found too slow, with the
+  // flashes off limits annotated (no timing pauses this run).
+  bool despite_display = false;
+};
+// To the timing gate: the policy (gates.timing) for the rest of this run, and why.
+struct TimingPolicyRequest {
+  std::string policy;
+  std::string why;
 };
 struct BeginRequest {};
 // The experimenter, to the paradigm.
@@ -117,10 +125,10 @@ struct LabelsRequest {
 };
 
 using Request =
-    std::variant<StartRequest, BeginRequest, PauseRequest, ResumeRequest, AbortRequest,
-                 EmergencyStopRequest, RetryStepRequest, SkipTrialRequest, EndSessionRequest,
-                 GoOnlineRequest, RecalibrateRequest, GraspRequest, DropRequest, RobotStopRequest,
-                 RobotResetRequest, RobotResetIfLatchedRequest, RobotHomeRequest,
+    std::variant<StartRequest, TimingPolicyRequest, BeginRequest, PauseRequest, ResumeRequest,
+                 AbortRequest, EmergencyStopRequest, RetryStepRequest, SkipTrialRequest,
+                 EndSessionRequest, GoOnlineRequest, RecalibrateRequest, GraspRequest, DropRequest,
+                 RobotStopRequest, RobotResetRequest, RobotResetIfLatchedRequest, RobotHomeRequest,
                  RobotReleaseRequest, FinishPutDownRequest, RobotProbeRequest, TrainRequest,
                  UseModelRequest, ThresholdRequest, ReferenceRequest, HoldBoardRequest,
                  LabelsRequest, NoteRequest>;

@@ -84,6 +84,8 @@ class Session {
   // Ends the run now, between cycles, as a fault with `reason` (the window's display lost): the
   // stages stop and the summary is written, as at any end. Nothing once ended.
   void endNow(const std::string& reason) { endRun(reason, "fault"); }
+  // Ends the run now as an Abort does, with `reason` (the window quit while the run went on).
+  void abortNow(const std::string& reason) { endRun(reason, "aborted"); }
 
   // The experimenter: queued for the next cycle, or refused (and logged) with the reason
   // whyNot() gives. An emergency stop goes to the arm at once.

@@ -55,6 +55,11 @@ class StimulusTiming {
   // periods (the display cannot hold its rate).
   std::optional<double> medianFrameIntervalMs() const;
   bool displayTooSlow() const;
+  // Frames this far apart (median) are no display at `display_hz`: more than one and a half of
+  // its frame periods (frames skipped as a rule, not by chance).
+  static bool tooSlow(double median_interval_s, double display_hz) {
+    return median_interval_s > 1.5 / display_hz;
+  }
   // The summary's "timing": soa_ms (configured, in frames, median, p95, p5, min, slipped: over
   // the SOA by half a frame), flash_rules (overlapped and gapless flashes, the least dark gap),
   // flash_ms, display, late_frames.

@@ -42,8 +42,9 @@ class EegFaultWatch {
 // Every marker lost at once, the reference with the objects, is a stall of the machine (the
 // process or the cameras held up), not of tracking: the flashes are held and go on with the
 // sequence once the markers are back, the selection not retaken; stalls that keep coming are
-// named (the PC is too slow, with the figures). After gates.max_retakes retakes of calibration
-// selections the experimenter is asked (the run paused; without one, it ends) instead of looping.
+// named (the PC is too slow, with the figures) and asked about once (the run paused; resumed, it
+// goes on without asking again). gates.max_retakes is a hard cap: past it no selection is
+// retaken, an object out of view has its calibration flashes withheld and the selection goes on.
 class ViewWatch {
  public:
   ViewWatch(const WorldSettings& world, double no_view_pause_s, bool experimenter, int max_retakes)
@@ -62,6 +63,9 @@ class ViewWatch {
   void flashShown() { withheld_since_ = -1.0; }
   // What a pause it made waits for before it resumes by itself ("" when none does).
   std::string waitingFor() const;
+  // The pause now is its own for a withheld calibration flash: resumed, the selection is
+  // retaken (it lacks that flash).
+  bool retakeOnResume() const { return paused_ && retake_on_resume_; }
   // summary.json's "stalls" (count, longest, the PC-too-slow warnings).
   void report(nlohmann::json& summary) const;
 
@@ -92,7 +96,9 @@ class ViewWatch {
   double held_at_ = 0.0, longest_stall_s_ = 0.0;
   std::vector<double> stalls_;
   int too_slow_told_ = 0;
-  bool asked_retakes_ = false;
+  bool retakes_capped_ = false;
+  bool retake_on_resume_ = false;
+  bool asking_ = false;  // its pause asks the experimenter: no resuming by itself
   // Since when every flash of the selection has been withheld (-1: a flash was shown since).
   double withheld_since_ = -1.0;
   bool paused_ = false;

@@ -4,12 +4,15 @@
 // overflows), and the source's fault, and stamps the cycle with its EEG sample. What the screen
 // showed and what the subject attends go to the source, as they would reach a subject: a
 // simulated one answers with its ERPs and its virtual photodiode. The clock model it fits lends
-// the session's clock its sample map.
+// the session's clock its sample map. A source that ends or goes silent is a fault on the record
+// within a second: a file at its end ends the run; a live source pauses it, named with the time
+// since its last sample.
 #pragma once
 
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "arbci/bci/acquisition.h"
@@ -21,8 +24,9 @@ namespace arbci::session {
 
 struct EegAcquisitionSettings {
   EegSettings eeg;
-  double flash_s = 0.06;     // a flash's nominal duration (the paradigm's, in whole frames)
-  std::string session_file;  // for messages naming a key
+  double flash_s = 0.06;      // a flash's nominal duration (the paradigm's, in whole frames)
+  std::string session_file;   // for messages naming a key
+  bool experimenter = false;  // someone at the window who can bring a silent source back
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.
   void validate() const;
 };
@@ -64,7 +68,8 @@ class EegAcquisitionStage final : public Stage {
   std::int64_t lost_logged_ = 0;     // lost samples already in the log
   std::int64_t source_markers_ = 0;  // the amplifier's own markers, recorded as annotations
   std::string fault_logged_;         // the source's fault last logged (empty: none)
-  std::int64_t next_sample_ = 0;     // after the last block taken
+  nlohmann::json faults_ = nlohmann::json::array();  // each fault as it began, for the summary
+  std::int64_t next_sample_ = 0;                     // after the last block taken
   // The flashes presented lately (host time, onset sample): those a stall covered are named.
   std::deque<std::pair<double, std::int64_t>> recent_onsets_;
   struct StallTotals {
@@ -74,6 +79,15 @@ class EegAcquisitionStage final : public Stage {
     int uncertain_flashes = 0;
   } stalls_;
   bool drift_warned_ = false;
+  // A source that stops: a finite one (a file) at its end ends the run; a live one silent for
+  // kSilentS is a fault (the paradigm pauses) named with the time since its last sample, and
+  // without an experimenter ends the run after kSilentEndS.
+  void watchDelivery(Cycle& cycle, bool delivered);
+  std::optional<double> last_delivery_s_;  // session time the last samples arrived
+  double last_delivery_host_s_ = 0.0;      // and host time
+  std::string silence_;                    // the silence's fault while it lasts
+  static constexpr double kSilentS = 1.0;
+  static constexpr double kSilentEndS = 10.0;
 };
 
 }  // namespace arbci::session

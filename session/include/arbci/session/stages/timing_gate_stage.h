@@ -3,7 +3,9 @@
 // noted in the recording at its onset (so in a BIDS export's events) and in the log; when too many
 // of a selection's flashes are off limits, or too many of the last frames came late, the run
 // pauses with the reason (gates.timing "pause", with an experimenter to resume it; a run without
-// one carries on, its flashes annotated). The summary's "timing_gate" counts them all.
+// one carries on, its flashes annotated). It asks once: resumed, the run goes on annotated (so
+// does a run whose pre-flight asked about the display and was told so). Late frames count only
+// while flashes are due. The summary's "timing_gate" counts them all.
 #pragma once
 
 #include <cstdint>
@@ -52,6 +54,9 @@ class TimingGateStage final : public Stage {
   void offLimits(Cycle& cycle, const char* what, double value_ms, double limit_ms,
                  std::int64_t onset_sample, int selection);
   void pauseIfPastLimits(Cycle& cycle);
+  // A pause it asked for, followed until the experimenter resumes it (see the source).
+  void followPause(Cycle& cycle);
+  void setPolicy(Cycle& cycle, const std::string& policy, const std::string& why);
   double ms(std::int64_t samples) const { return 1000.0 * samples / settings_.eeg_rate_hz; }
 
   TimingGateSettings settings_;
@@ -59,8 +64,13 @@ class TimingGateStage final : public Stage {
   // The current selection: its number, flashes, those off limits, the last onset.
   int selection_ = -1, flashes_ = 0, off_ = 0;
   std::optional<std::int64_t> last_onset_, last_end_;
-  std::deque<bool> late_;  // the last frames presented: late or not
-  bool paused_ = false;    // asked for a pause that has not been resumed yet
+  std::deque<bool> late_;  // the last frames presented while flashing: late or not
+  // A pause it asked for: asked (not yet taken), holding (the run is paused), none.
+  enum class Pause { None, Asked, Holding } pause_ = Pause::None;
+  // gates.timing for the rest of the run: the session file's, until the experimenter answers
+  // (the pre-flight's display question, a timing pause resumed): each cause is asked once.
+  std::string policy_;
+  int policy_changes_ = 0;
   std::optional<double> told_at_;
   // For the summary.
   int long_flashes_ = 0, short_gaps_ = 0, short_soas_ = 0, pauses_ = 0;
