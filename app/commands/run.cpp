@@ -14,6 +14,7 @@
 #include "arbci/session/settings_schema.h"
 #include "commands/bids_options.h"
 #include "commands/commands.h"
+#include "eeg/session_report.h"
 #include "hmd/open_session.h"
 #include "support/cli_error.h"
 #include "support/headless_run.h"
@@ -155,6 +156,17 @@ int runSession(const RunOptions& o) {
   }
 }
 
+// The folder's report.html, once the run has ended; a report that cannot be written is said and
+// changes nothing else (the run's files are whole).
+void writeReport(const std::filesystem::path& folder) {
+  if (!std::filesystem::exists(folder / "summary.json")) return;
+  try {
+    std::cout << "report: " << writeSessionReport(folder).string() << "\n";
+  } catch (const std::exception& error) {
+    std::cerr << "arbci run: no report.html: " << error.what() << "\n";
+  }
+}
+
 int runSessionIn(const RunOptions& o, bool headless) {
   const session::SessionConfig config = loadSessionOption(o.session);
   session::SessionOptions options;
@@ -169,13 +181,16 @@ int runSessionIn(const RunOptions& o, bool headless) {
   try {
     if (!headless) {
       // Once open, the window shows the session's own failures and offers a retry in place.
-      return runWorkstation(config, options,
-                            {o.script, !o.start_now, o.exit_when_done,
-                             // Started at once and closed at the end, with no script: a batch
-                             // run in a window, which nobody watches. What would wait for an
-                             // experimenter (a failed pre-flight, objects out of view) ends it.
-                             o.start_now && o.exit_when_done && o.script.empty(), o.bids_root,
-                             [&] { claim.keep(); }});
+      const int status =
+          runWorkstation(config, options,
+                         {o.script, !o.start_now, o.exit_when_done,
+                          // Started at once and closed at the end, with no script: a batch
+                          // run in a window, which nobody watches. What would wait for an
+                          // experimenter (a failed pre-flight, objects out of view) ends it.
+                          o.start_now && o.exit_when_done && o.script.empty(), o.bids_root,
+                          [&] { claim.keep(); }});
+      writeReport(options.folder);
+      return status;
     }
     // A live amplifier cannot be stepped by a simulated clock: it runs on the wall clock.
     options.clock = !o.realtime && !config.eeg.live() ? session::Clock::Mode::Stepped
@@ -189,6 +204,7 @@ int runSessionIn(const RunOptions& o, bool headless) {
     claim.keep();
     runHeadless(*opened.session);
     printSummary(*opened.session);
+    writeReport(opened.session->folder());
     return opened.session->endKind() == "finished" ? 0 : 3;
   } catch (const session::SessionConfigError& error) {
     throw CliError(error.what());

@@ -663,9 +663,10 @@ void Paradigm::retryStep() {
     phase_until_ = now_ + settings_.result_s;
 }
 
-void Paradigm::skipTrial() {
+void Paradigm::skipTrial(const std::string& why) {
   if (!interrupted() || trial_ < 1) return;
-  nextTrial(nextFrame(), "trial " + std::to_string(trial_) + " skipped by the experimenter");
+  nextTrial(nextFrame(),
+            why.empty() ? "trial " + std::to_string(trial_) + " skipped by the experimenter" : why);
 }
 
 void Paradigm::abort() {

@@ -28,6 +28,11 @@ constexpr size_t kMaxChallenges = 256;
 constexpr std::int64_t kWakeMarginUs = 1000;
 // Source addresses whose unbound budget is remembered at once (see SourceBudgets::forgetQuiet).
 constexpr size_t kBudgetedSources = 1024;
+// A client's heartbeats arrive at their rate (its heartbeat thread runs) once this many have come,
+// the last two within half a watchdog period of each other. One heartbeat alone (the client sends
+// one as it binds, from its command thread) shows nothing of the thread that must keep feeding
+// the watchdog while the arm moves.
+constexpr int kStreamingHeartbeats = 3;
 
 std::uint64_t randomId() {
   std::uint64_t id = 0;
@@ -125,10 +130,15 @@ struct RobotBackend::Impl {
     // address is answered again (its BOUND may have been lost).
     std::uint64_t bound_challenge = 0, bind_sequence = 0;
     SteadyClock::time_point active;
-    // A motion that came before any heartbeat (when, on this backend's clock): it starts when the
-    // first heartbeat arrives fresh, and is refused when that arrives stale or not at all.
+    // A motion that came before the session's heartbeats arrive at their rate (since when, on
+    // this backend's clock): it starts once they do, fresh, and is refused when they arrive stale
+    // or do not come.
     std::optional<Message> held;
     std::int64_t held_us = 0;
+    // Heartbeats received, and when the one before the last arrived.
+    int heartbeats = 0;
+    std::int64_t previous_received_us = 0;
+    bool held_since = false;  // held_us is the first hold's (a motion held again keeps it)
   };
   std::map<std::uint64_t, Session> sessions;
 
@@ -534,6 +544,8 @@ struct RobotBackend::Impl {
     const std::int64_t now = steadyMicros();
     const std::int64_t sent = std::min(m.time_us, now);  // a clock error cannot extend the deadline
     s.last_heartbeat_age_us = now - sent;
+    ++s.heartbeats;
+    s.previous_received_us = s.heartbeat_received_us;
     s.heartbeat_received_us = now;
     if (watchdogActive() && now - sent > watchdogMicros()) count(&BackendStats::stale_heartbeats);
     if (!s.heartbeat_us || sent > *s.heartbeat_us) s.heartbeat_us = sent;
@@ -541,8 +553,14 @@ struct RobotBackend::Impl {
     if (running && running->session == m.session && running->sequence < s.abandon_below)
       latchStop("halted: the client gave up on the command",
                 "halted: the client gave up on the command");
-    // The link has now shown how old its heartbeats arrive: a held motion starts or is refused.
+    // The link has shown how old its heartbeats arrive, and whether they come at their rate: a
+    // held motion starts, is refused, or waits for the next.
     if (s.held) motion(*std::exchange(s.held, std::nullopt), s);
+  }
+
+  bool streaming(const Session& s) const {
+    return s.heartbeats >= kStreamingHeartbeats &&
+           s.heartbeat_received_us - s.previous_received_us <= watchdogMicros() / 2;
   }
 
   void process(const Message& m, Session& s) {
@@ -607,7 +625,8 @@ struct RobotBackend::Impl {
     if (s.held) {
       reject(m, s.peer, RejectReason::Busy,
              std::string("busy: ") + toString(s.held->type) + " " +
-                 std::to_string(s.held->sequence) + " waits for the client's first heartbeat");
+                 std::to_string(s.held->sequence) +
+                 " waits for the client's heartbeats to come at their rate");
       return;
     }
     if (running) {
@@ -617,12 +636,16 @@ struct RobotBackend::Impl {
       return;
     }
     const std::int64_t now_us = steadyMicros();
-    if (watchdogActive() && !s.heartbeat_us) {
-      // No heartbeat yet: nothing shows that the watchdog could halt this motion in time.
+    if (watchdogActive() && !streaming(s) && s.last_heartbeat_age_us <= watchdogMicros()) {
+      // Its heartbeats not yet coming at their rate: nothing shows that they will go on coming
+      // while the arm moves, so the watchdog could halt a healthy client's motion. Held (since its
+      // first arrival) until they do.
+      if (!s.held_since) s.held_us = now_us;
       s.held = m;
-      s.held_us = now_us;
+      s.held_since = true;
       return;
     }
+    s.held_since = false;
     if (watchdogActive() && s.last_heartbeat_age_us > watchdogMicros()) {
       // The link delays the heartbeats past the watchdog: it could not halt the arm in time.
       reject(m, s.peer, RejectReason::Unreachable,
@@ -711,10 +734,13 @@ struct RobotBackend::Impl {
       const std::int64_t wait_us = std::llround(options.first_heartbeat_wait_s * 1e6);
       if (!s.held || steadyMicros() - s.held_us < wait_us) continue;
       const Message held = *std::exchange(s.held, std::nullopt);
+      s.held_since = false;
       reject(held, s.peer, RejectReason::Unreachable,
-             "no heartbeat came from the client within " + std::to_string(wait_us / 1000) +
-                 " ms of its " + toString(held.type) +
-                 ": the link has not shown that the watchdog could halt the arm in time");
+             "the client's heartbeats did not come at their rate within " +
+                 std::to_string(wait_us / 1000) + " ms of its " + toString(held.type) + " (" +
+                 std::to_string(s.heartbeats) +
+                 " received): the link has not shown that the watchdog could halt the arm in "
+                 "time");
     }
     std::erase_if(sessions, [&](const auto& entry) {
       return now - entry.second.active > kSessionLifetime &&

@@ -97,8 +97,16 @@ void RobotClient::heartbeatLoop() {
   std::unique_lock lock(heartbeat_mutex_);
   while (!heartbeat_wake_.wait_for(lock, std::chrono::microseconds(heartbeat_period_us_.load()),
                                    [this] { return stopping_; })) {
-    if (connected_ && offset_known_) sendHeartbeat();
+    if (connected_ && offset_known_) {
+      sendHeartbeat();
+      ++thread_heartbeats_;
+    }
   }
+}
+
+bool RobotClient::heartbeatsFlowing() const {
+  return options_.heartbeats_per_watchdog <= 0 || watchdog_ms_ == 0 ||
+         thread_heartbeats_.load() >= kHeartbeatsBeforeMotion;
 }
 
 // Stamped with its send time on the backend's clock. From the heartbeat thread, and once from
@@ -160,6 +168,12 @@ std::uint64_t RobotClient::send(MessageType type, const Vec3& target) {
 }
 
 void RobotClient::transmit(Pending& p) {
+  if (isMotion(p.type) && !heartbeatsFlowing()) {
+    // Not before this client's heartbeat thread has shown it runs: the backend would hold the
+    // motion anyway, and a first motion sent on a thread not yet scheduled could be halted.
+    p.next_send = Clock::now() + std::chrono::milliseconds(2);
+    return;
+  }
   if (isMotion(p.type) && !p.epoch) {
     // Made after a RESET of this client that the backend has not confirmed: it waits for the
     // RESET's epoch (stamped with the old one it could never run).
@@ -300,6 +314,7 @@ void RobotClient::bound(const Message& m) {
   epoch_ = m.stop_epoch;
   if (connected_) return;  // a rebinding (after silence): nothing else changes
   connected_ = true;
+  thread_heartbeats_ = 0;
   events_.push_back(event(
       RobotEvent::Kind::Connected,
       "bound to backend run " + std::to_string(m.boot) +

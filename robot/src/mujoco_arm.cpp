@@ -25,6 +25,11 @@ constexpr double kRestingFor = 0.1;    // s
 constexpr double kLiftedClear = 0.02;  // m: a held object's base this far above the table
 constexpr double kForceBaselineSeconds = 0.2;
 constexpr int kCheckIterations = 60;  // a reachable point converges in far fewer from either seed
+// A path is checked every this far along it, each point's joints from the last's: a joint that
+// would move further than kMaxJointJump between two such points flips the arm's posture, which
+// the path cannot follow either.
+constexpr double kCheckStep = 0.02;     // m
+constexpr double kMaxJointJump = 0.35;  // rad
 
 double distance(const Vec3& a, const Vec3& b) {
   return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
@@ -205,8 +210,10 @@ struct MujocoArm::Impl {
     const double travel_z = std::max(t.z, config.table_z + config.lift_height);
     switch (c.type) {
       case MessageType::Grasp: {
+        // To the travel height where the tool is (down from home), across, then down: crossing at
+        // home's height would stretch an arm of this reach at the far cells.
         const Vec3 above{c.target.x, c.target.y, c.target.z + config.approach_height};
-        const double high = std::max(travel_z, above.z);
+        const double high = std::max(config.table_z + config.lift_height, above.z);
         plan.push_back({Segment::Kind::Open, {}});
         plan.push_back({Segment::Kind::Move, {t.x, t.y, high}});
         plan.push_back({Segment::Kind::Move, {above.x, above.y, high}});
@@ -339,6 +346,62 @@ struct MujocoArm::Impl {
 
   double path_done_at = -1.0;
   int grasped = -1;  // what the fingers closed on
+
+  // The corners of the tool's path for a command from `from` (the plan's moves, as planFor
+  // makes them), and the way home after it.
+  std::vector<Vec3> pathOf(MessageType type, const Vec3& from, const Vec3& target,
+                           double tool_above_base) const {
+    const double travel_z = std::max(from.z, config.table_z + config.lift_height);
+    std::vector<Vec3> path{from, {from.x, from.y, travel_z}};
+    Vec3 end = path.back();
+    if (type == MessageType::Grasp) {
+      const Vec3 above{target.x, target.y, target.z + config.approach_height};
+      const double high = std::max(config.table_z + config.lift_height, above.z);
+      path = {from,
+              {from.x, from.y, high},
+              {above.x, above.y, high},
+              above,
+              {target.x, target.y, std::max(target.z - kGraspDepth, config.table_z)},
+              {target.x, target.y, config.table_z + config.lift_height}};
+      end = path.back();
+    } else if (type == MessageType::Drop) {
+      path.push_back({target.x, target.y, travel_z});
+      path.push_back({target.x, target.y, target.z + tool_above_base});
+      path.push_back({target.x, target.y, travel_z});
+      end = path.back();
+    }
+    // Home: across at the height it is at (at least the travel height), then down to home.
+    const double home_z = std::max(end.z, config.table_z + config.lift_height);
+    path.push_back({end.x, end.y, home_z});
+    path.push_back({config.home.x, config.home.y, home_z});
+    path.push_back(config.home);
+    return path;
+  }
+
+  // The path followed as advancePath follows it: every kCheckStep along each straight stretch,
+  // each point's joints found from the last point's. The first point no joint motion reaches
+  // (a joint limit, a singularity, or a flip of the posture), or nothing.
+  std::optional<Vec3> unreachableOn(const std::vector<Vec3>& corners) const {
+    std::optional<std::vector<double>> q =
+        kinematics->solve(corners.front(), q_des, kCheckIterations);
+    if (!q) q = kinematics->solve(corners.front(), q_home, kCheckIterations);
+    if (!q) return corners.front();
+    for (size_t k = 1; k < corners.size(); ++k) {
+      const Vec3& a = corners[k - 1];
+      const Vec3& b = corners[k];
+      const int steps = std::max(1, static_cast<int>(std::ceil(distance(a, b) / kCheckStep)));
+      for (int i = 1; i <= steps; ++i) {
+        const double f = static_cast<double>(i) / steps;
+        const Vec3 p{a.x + (b.x - a.x) * f, a.y + (b.y - a.y) * f, a.z + (b.z - a.z) * f};
+        const auto next = kinematics->solve(p, *q, kCheckIterations);
+        if (!next) return p;
+        for (size_t j = 0; j < next->size(); ++j)
+          if (std::abs((*next)[j] - (*q)[j]) > kMaxJointJump) return p;
+        q = next;
+      }
+    }
+    return std::nullopt;
+  }
 };
 
 MujocoArm::MujocoArm(const RobotConfig& config) : impl_(std::make_unique<Impl>()) {
@@ -399,22 +462,36 @@ int MujocoArm::armJoints() const {
 std::optional<Rejection> MujocoArm::check(const DriverCommand& c) const {
   const Impl& m = *impl_;
   const RobotConfig& cfg = m.config;
+  const int holding = m.held();
   if (c.type == MessageType::Grasp || c.type == MessageType::Drop) {
-    const Vec3& p = c.target;
-    if (auto outside = outsideWorkspace(cfg, p)) return outside;
-    for (const Vec3& point : {p, approachPoint(cfg, p)}) {
-      // From where the arm is, then from its home posture: a few milliseconds at most, as the
-      // backend's loop (the watchdog's) waits for check (the many-start search is for start-up).
-      if (!m.kinematics->solve(point, m.q_des, kCheckIterations) &&
-          !m.kinematics->solve(point, m.q_home, kCheckIterations))
-        return Rejection{RejectReason::Unreachable, pointText(p) + " is out of the arm's reach"};
-    }
-    const int holding = m.held();
+    if (auto outside = outsideWorkspace(cfg, c.target)) return outside;
     if (c.type == MessageType::Grasp && holding >= 0)
       return Rejection{RejectReason::InvalidState,
                        "already holding object " + std::to_string(holding)};
     if (c.type == MessageType::Drop && holding < 0)
       return Rejection{RejectReason::InvalidState, "holding nothing to drop"};
+  }
+  // The whole path, not its ends: the travel height, the approach, the descent, the lift and the
+  // way home, as the plan will follow them from where the arm is.
+  const auto* held = holding >= 0 ? m.object(holding) : nullptr;
+  const double tool_above_base = held ? m.tool().z - m.bottom(*held) : 0.0;
+  if (const auto point = m.unreachableOn(m.pathOf(c.type, m.path, c.target, tool_above_base)))
+    return Rejection{RejectReason::Unreachable,
+                     std::string(toString(c.type)) + " " + pointText(c.target) +
+                         ": its path passes " + pointText(*point) +
+                         ", which no joint motion of the arm reaches (joint limit or singularity)"};
+  if (c.type == MessageType::Drop && held) {
+    // Put down, the object must be graspable there again (the next trial may choose it): from
+    // home, its top where the drop leaves it.
+    // The tool holds it kGraspDepth below its top face: its top lies that far above the tool.
+    const double height = tool_above_base + kGraspDepth;
+    const Vec3 top{c.target.x, c.target.y, c.target.z + std::max(height, 0.0)};
+    if (const auto point = m.unreachableOn(m.pathOf(MessageType::Grasp, cfg.home, top, 0.0)))
+      return Rejection{RejectReason::Unreachable,
+                       "DROP " + pointText(c.target) +
+                           ": the arm could put the object there but not grasp it again (the path "
+                           "passes " +
+                           pointText(*point) + ", which no joint motion reaches)"};
   }
   return std::nullopt;
 }

@@ -143,14 +143,20 @@ std::string Preflight::displayQuestion() const {
   if (settings_.display_hz <= 0.0 || !interval ||
       !StimulusTiming::tooSlow(*interval, settings_.display_hz))
     return "";
-  const double frame_ms = 1000.0 / settings_.display_hz;
-  const double flash_frames = std::max(1.0, std::round(settings_.flash_ms / frame_ms));
+  // The flashes are timed in seconds and shown on the frames there are: a flash stays lit
+  // until the first frame after its time, an onset waits for the first frame at or after it.
+  const double frame_ms = 1000.0 / settings_.display_hz, got_ms = *interval * 1000.0;
+  const double flash_ms = std::max(1.0, std::round(settings_.flash_ms / frame_ms)) * frame_ms;
+  const double shown_ms = std::max(1.0, std::ceil(flash_ms / got_ms - 1e-9)) * got_ms;
+  const double soa_ms = std::max(1.0, std::round(settings_.soa_ms / frame_ms)) * frame_ms;
+  const double soa_shown_ms = std::ceil(soa_ms / got_ms - 1e-9) * got_ms;
   char text[400];
   std::snprintf(text, sizeof text,
                 "display: a frame every %.0f ms (%.1f Hz; display_hz %.0f asks for %.1f ms): "
-                "flashes will last about %.0f ms instead of %.0f and every onset comes late",
-                *interval * 1000.0, 1.0 / *interval, settings_.display_hz, frame_ms,
-                flash_frames * *interval * 1000.0, flash_frames * frame_ms);
+                "flashes will last about %.0f ms instead of %.0f, and onsets come about %.0f ms "
+                "apart instead of %.0f",
+                got_ms, 1.0 / *interval, settings_.display_hz, frame_ms, shown_ms, flash_ms,
+                soa_shown_ms, soa_ms);
   return text;
 }
 

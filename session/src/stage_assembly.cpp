@@ -70,6 +70,7 @@ PreflightSettings preflightSettingsOf(const SessionConfig& c, const SessionOptio
   if (options.experimenter && c.gates.timing == "pause") {
     p.display_hz = c.paradigm.display_hz;
     p.flash_ms = c.paradigm.flash_ms;
+    p.soa_ms = c.paradigm.flash_ms + c.paradigm.isi_ms;
     p.display_question = true;
   }
   if (c.robot.backend == "simulated") {

@@ -1,8 +1,8 @@
 // The link proves itself before the arm moves, and a new client is heard whatever else arrives:
-// a motion waits for its session's first heartbeat (started when it comes fresh, refused when it
-// comes stale or not at all), a flood from one address does not spend the budget of a new
-// client at another, and the arm's state and refusals after a STOP and RESET say what is true.
-// Real UDP on 127.0.0.1; every wait is bounded.
+// a motion waits for its session's heartbeats to come at their rate (started when it comes fresh,
+// refused when it comes stale or not at all), a flood from one address does not spend the budget of
+// a new client at another, and the arm's state and refusals after a STOP and RESET say what is
+// true. Real UDP on 127.0.0.1; every wait is bounded.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -61,7 +61,9 @@ struct WaitingHome {
   bool bound;
 };
 
-TEST(RobotLinkProof, AMotionWaitsForTheSessionsFirstHeartbeatAndThenRuns) {
+// A motion waits until the session's heartbeats come at their rate: one heartbeat (a client sends
+// one as it binds) shows nothing of the thread that must go on feeding the watchdog.
+TEST(RobotLinkProof, AMotionWaitsForTheSessionsHeartbeatsToComeAtTheirRateAndThenRuns) {
   WaitingHome w(60.0);
   ASSERT_TRUE(w.bound);
   RunningBackend& backend = w.backend;
@@ -70,6 +72,11 @@ TEST(RobotLinkProof, AMotionWaitsForTheSessionsFirstHeartbeatAndThenRuns) {
   std::this_thread::sleep_for(100ms);
   EXPECT_EQ(backend.stats().executed, 0u);
   raw.heartbeat(103);
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(backend.stats().executed, 0u);  // one heartbeat, then silence: still held
+  raw.heartbeat(104);
+  std::this_thread::sleep_for(5ms);
+  raw.heartbeat(105);
   const auto accepted = raw.answer(102);
   ASSERT_TRUE(accepted);
   EXPECT_EQ(accepted->type, MessageType::Accepted);
@@ -81,7 +88,10 @@ TEST(RobotLinkProof, AMotionWithNoHeartbeatIsRefusedAsUnreachable) {
   ASSERT_TRUE(w.bound);
   RunningBackend& backend = w.backend;
   RawSession& raw = w.raw;
-  expectRefused(raw, 102, RejectReason::Unreachable, "no heartbeat came from the client", 5s);
+  expectRefused(raw, 102, RejectReason::Unreachable,
+                "the client's heartbeats did not come at their rate within 200 ms of its HOME (0 "
+                "received)",
+                5s);
   EXPECT_EQ(backend.stats().executed, 0u);
 }
 

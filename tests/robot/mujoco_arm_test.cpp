@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "arbci/robot/mujoco_arm.h"
 
@@ -150,6 +151,67 @@ TEST(MujocoArm, AStopHoldsTheArmWhereItIs) {
   // A new command starts from there.
   const DriverResult home = runToEnd(arm, {MessageType::Home, {}});
   EXPECT_EQ(home.outcome, Outcome::Success) << home.text;
+}
+
+// The default session's table: four objects in a row, the grid of 3 x 3 cells of 9 cm around
+// (0, 0.66) (session/settings_schema.cpp's world).
+RobotConfig defaultTable() {
+  RobotConfig c;
+  for (int k = 0; k < 4; ++k)
+    c.objects.push_back({10 * (k + 1), {-0.27 + 0.18 * k, 0.42, 0.06}, 0.06, 0.035});
+  return c;
+}
+
+// A sweep of the default grid: the object put down on every cell and grasped from it again, the
+// arm home between, every step accepted and carried out.
+TEST(MujocoArm, EveryCellOfTheDefaultGridIsPutDownOnAndGraspedFromAgain) {
+  MujocoArm arm(defaultTable());
+  for (int row = 1; row <= 3; ++row) {
+    for (int column = 1; column <= 3; ++column) {
+      SCOPED_TRACE("cell " + std::to_string(row) + "," + std::to_string(column));
+      const Vec3 cell{(column - 2) * 0.09, 0.66 + (2 - row) * 0.09, 0.0};
+      const Vec3 at = objectNamed(arm, 20).position;
+      const DriverResult grasp = runToEnd(arm, {MessageType::Grasp, at});
+      ASSERT_EQ(grasp.outcome, Outcome::Success) << grasp.text;
+      const DriverResult drop = runToEnd(arm, {MessageType::Drop, cell});
+      ASSERT_EQ(drop.outcome, Outcome::Success) << drop.text;
+      ASSERT_EQ(runToEnd(arm, {MessageType::Home, {}}).outcome, Outcome::Success);
+      EXPECT_NEAR(objectNamed(arm, 20).position.x, cell.x, 0.01);
+      EXPECT_NEAR(objectNamed(arm, 20).position.y, cell.y, 0.01);
+    }
+  }
+  // And from the last cell once more.
+  EXPECT_EQ(runToEnd(arm, {MessageType::Grasp, objectNamed(arm, 20).position}).outcome,
+            Outcome::Success);
+}
+
+// What the arm accepts, it can do: at the edge of its reach (where the arm once accepted grasps
+// whose travel it could not follow), every accepted grasp ends without a path fault, every
+// refused one says which point of its path no joint motion reaches.
+TEST(MujocoArm, AtTheEdgeOfItsReachItAcceptsOnlyPathsItCanFollow) {
+  int accepted = 0, refused = 0;
+  for (const double x : {0.0, 0.25}) {
+    for (const double y : {0.70, 0.75, 0.80, 0.85, 0.90}) {
+      MujocoArm arm(twoObjects());
+      const DriverCommand grasp{MessageType::Grasp, {x, y, 0.06}};
+      if (const auto no = arm.check(grasp)) {
+        ++refused;
+        EXPECT_EQ(no->reason, RejectReason::Unreachable) << no->text;
+        EXPECT_NE(no->text.find("its path passes"), std::string::npos) << no->text;
+        continue;
+      }
+      ++accepted;
+      arm.start(grasp);
+      std::optional<DriverResult> result;
+      for (double t = 0.0; t < 60.0 && !result; t += 0.05) result = arm.step(0.05);
+      ASSERT_TRUE(result);
+      EXPECT_EQ(result->text.find("no joint motion"), std::string::npos)
+          << x << ", " << y << ": " << result->text;
+      EXPECT_NE(arm.status().state, RobotState::Fault) << x << ", " << y;
+    }
+  }
+  EXPECT_GT(accepted, 0);
+  EXPECT_GT(refused, 0);
 }
 
 TEST(MujocoArm, TheSevenAxisArmGraspsAndPutsDown) {

@@ -62,6 +62,7 @@ TEST(Preflight, ADisplayTooSlowForItsRateIsAQuestionWithTheFigures) {
   PreflightSettings s = settings();
   s.display_hz = 60.0;
   s.flash_ms = 60.0;
+  s.soa_ms = 180.0;
   s.display_question = true;
   auto slow = [](int i) {
     PreflightObservation o = healthy(i);
@@ -78,7 +79,8 @@ TEST(Preflight, ADisplayTooSlowForItsRateIsAQuestionWithTheFigures) {
   EXPECT_FALSE(p.qualityQuestioned());
   ASSERT_EQ(p.failures().size(), 1u);
   EXPECT_EQ(p.failures()[0].rfind("display: a frame every 117 ms (8.6 Hz; display_hz 60 asks for "
-                                  "16.7 ms): flashes will last about 467 ms instead of 67",
+                                  "16.7 ms): flashes will last about 117 ms instead of 67, and "
+                                  "onsets come about 233 ms apart instead of 183",
                                   0),
             0u)
       << p.failures()[0];

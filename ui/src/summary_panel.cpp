@@ -1,6 +1,8 @@
-// The end-of-session summary: how it ended, accuracy, time per selection, bit rate, placements,
-// late frames, from the summary the ended session's last record carries (the window opens it when
-// the session ends).
+// The end-of-session summary: first whether to trust the data (session/trust_report.h: the
+// calibration's AUC against chance and the simulated subject, the review, online and post-hoc
+// accuracy, timing, channels, the EEG's faults, interruptions, notes), then how it ended,
+// accuracy, time per selection, bit rate, placements, late frames, from the summary the ended
+// session's last record carries (the window opens it when the session ends).
 #include <imgui.h>
 
 #include <cstdio>
@@ -8,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "arbci/session/trust_report.h"
 #include "arbci/ui/panel_registry.h"
 
 namespace arbci::ui {
@@ -125,7 +128,34 @@ class SummaryPanel final : public Panel {
     if (shown_ != in.record.summary) {
       shown_ = in.record.summary;
       rows_ = summaryRows(*shown_);
+      trust_ = session::trustRows(*shown_);
     }
+    // Whether to trust the data first: what a new experimenter must look at again is marked.
+    int cautions = 0;
+    for (const session::TrustRow& row : trust_) cautions += row.caution;
+    ImGui::TextColored(
+        cautions ? ImVec4(1.0f, 0.7f, 0.3f, 1.0f) : ImVec4(0.5f, 0.9f, 0.5f, 1.0f), "%s",
+        cautions ? (std::to_string(cautions) +
+                    " reason(s) to look again before using this run's data (marked !)")
+                       .c_str()
+                 : "nothing in this run's record calls for caution");
+    if (ImGui::BeginTable("trust", 2, ImGuiTableFlags_RowBg)) {
+      ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed,
+                              ImGui::CalcTextSize("post hoc objects  ").x);
+      ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch);
+      for (const session::TrustRow& row : trust_) {
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        if (row.caution)
+          ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.25f, 1.0f), "! %s", row.what.c_str());
+        else
+          ImGui::TextDisabled("%s", row.what.c_str());
+        ImGui::TableNextColumn();
+        ImGui::TextWrapped("%s", row.text.c_str());
+      }
+      ImGui::EndTable();
+    }
+    ImGui::Separator();
     if (!ImGui::BeginTable("summary", 2, ImGuiTableFlags_RowBg)) return;
     ImGui::TableSetupColumn("what", ImGuiTableColumnFlags_WidthFixed,
                             ImGui::CalcTextSize("late frames  ").x);
@@ -143,6 +173,7 @@ class SummaryPanel final : public Panel {
  private:
   std::shared_ptr<const nlohmann::json> shown_;
   Rows rows_;
+  std::vector<session::TrustRow> trust_;
 };
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "arbci/bci/evaluation.h"
 #include "arbci/bci/p300_dataset.h"
 #include "arbci/bci/p300_model.h"
+#include "arbci/session/trust_report.h"
 #include "arbci/ui/panel_registry.h"
 #include "erp_plots.h"
 #include "evaluation_plots.h"
@@ -227,18 +228,26 @@ void TrainingPanel::controls(const PanelInput& in) {
 // cross-validation), and the experimenter's decision before any online trial.
 void TrainingPanel::review(const PanelInput& in, const session::ParadigmPart::Review& r) {
   heading("calibration review: go online with this model?");
-  const ImVec4 colour = r.below ? ImVec4(1.0f, 0.45f, 0.3f, 1.0f) : ImVec4(0.5f, 0.9f, 0.5f, 1.0f);
-  char text[240];
+  // Red below the lab's minimum, amber under what the simulated default subject reaches, green
+  // above: never green by default.
+  const ImVec4 colour = r.below ? ImVec4(1.0f, 0.45f, 0.3f, 1.0f)
+                        : r.auc < session::kSimulatedSubjectAuc.low
+                            ? ImVec4(1.0f, 0.75f, 0.3f, 1.0f)
+                            : ImVec4(0.5f, 0.9f, 0.5f, 1.0f);
+  // The AUC beside what chance gives and what the simulated default subject reaches: a figure a
+  // new experimenter can judge.
+  std::string text = "calibration run " + std::to_string(r.round) + ": " +
+                     session::aucReference(r.auc, r.auc_low, r.auc_high, r.targets, r.others) +
+                     ". ";
   if (r.below) {
-    std::snprintf(text, sizeof text,
-                  "calibration run %d: cross-validated AUC %.3f, below the minimum %.3f "
-                  "(gates.min_auc). Recalibrate, or go online on your own judgement.",
-                  r.round, r.auc, r.min_auc);
+    char minimum[160];
+    std::snprintf(minimum, sizeof minimum,
+                  "Below the lab's minimum %.3f (gates.min_auc): Recalibrate, or go online on "
+                  "your own judgement.",
+                  r.min_auc);
+    text += minimum;
   } else {
-    std::snprintf(text, sizeof text,
-                  "calibration run %d: cross-validated AUC %.3f. The ERP and the accuracy by "
-                  "sequences are below.",
-                  r.round, r.auc);
+    text += "The ERP and the accuracy by sequences are below.";
   }
   colouredWrapped(colour, text);
   if (button(r.below ? "Go online anyway" : "Go online"))

@@ -146,10 +146,13 @@ void CalibrationRun::restart() {
 void CalibrationRun::summarise(nlohmann::json& summary) const {
   if (!reviews_.empty()) summary["calibration"]["reviews"] = reviews_;
   if (report_) {
-    summary["calibration"].update({{"selections", report_->selections.size()},
-                                   {"selections_used", trained_on_},
-                                   {"auc", report_->auc},
-                                   {"accuracy_by_sequences", report_->accuracy}});
+    summary["calibration"].update(
+        {{"selections", report_->selections.size()},
+         {"selections_used", trained_on_},
+         {"auc", report_->auc},
+         {"auc_95", {report_->auc_interval.low, report_->auc_interval.high}},
+         {"flashes", {{"targets", report_->target_flashes}, {"others", report_->other_flashes}}},
+         {"accuracy_by_sequences", report_->accuracy}});
   }
   if (retakes_.empty()) return;
   nlohmann::json& retaken = summary["calibration"]["retaken"];

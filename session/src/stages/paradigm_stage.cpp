@@ -167,6 +167,7 @@ void ParadigmStage::takeRobotNotes(Cycle& cycle) {
         if (!note.success && paradigm_.phase() != bci::Phase::RobotFault)
           reasons_.status = note.text;
         paradigm_.robotFinished(note.success, note.text);
+        if (!note.success && !settings_.experimenter) recoverUnattended(note.text, cycle);
         break;
       case Kind::PutDownEnded:
         // Home after a put-down, the table seen again: the next trial offers what is in view.
@@ -175,6 +176,26 @@ void ParadigmStage::takeRobotNotes(Cycle& cycle) {
         break;
     }
   }
+}
+
+// Nobody to ask after a robot step that failed (a grasp that closed on nothing, a path the arm
+// could not follow): the arm goes home and the run goes on with the next trial, the trial's
+// outcome saying what happened. An arm that still holds the object cannot go on: the run waits
+// as for a fault (and ends after robot fault_wait_s, saying so).
+void ParadigmStage::recoverUnattended(const std::string& why, Cycle& cycle) {
+  if (paradigm_.phase() != bci::Phase::RobotFault || cycle.record.robot.holding()) return;
+  const double time = cycle.time_s;
+  const int trial = paradigm_.trial();
+  const std::string outcome = "failed: " + why + "; the arm went home and the run went on";
+  s_.log.write(
+      "recovery", time,
+      {{"action", "home and the next trial (unattended)"}, {"trial", trial}, {"why", why}});
+  s_.tell.say(time, Severity::Warning, "trial " + std::to_string(trial) + ": " + outcome);
+  cycle.post(RobotResetIfLatchedRequest{time});
+  cycle.post(RobotHomeRequest{time});
+  reasons_.status.clear();
+  paradigm_.skipTrial(outcome);
+  handleEvents(cycle);
 }
 
 void ParadigmStage::watchGrasp(Cycle& cycle) {
@@ -233,6 +254,12 @@ void ParadigmStage::reviewCalibration(Cycle& cycle) {
     return;
   }
   review_ = ParadigmPart::Review{auc, minimum, below, calibration_round_};
+  if (const auto& r = calibration_.report()) {
+    review_->auc_low = r->auc_interval.low;
+    review_->auc_high = r->auc_interval.high;
+    review_->targets = r->target_flashes;
+    review_->others = r->other_flashes;
+  }
   reasons_.status = "calibration review: " + words +
                     "; Go online or Recalibrate (Classifier training panel: ERP, AUC, accuracy)";
   s_.log.write("calibration_review", cycle.time_s,

@@ -42,6 +42,7 @@ void RecordingStage::step(Cycle& cycle) {
     s_.log.write("note", cycle.time_s, {{"text", note->text}, {"sample", cycle.eeg_sample}});
     s_.tell.say(cycle.time_s, Severity::Info, "note: " + note->text);
     cycle.annotate(cycle.eeg_sample, "Note: " + note->text);
+    notes_.push_back({{"t", cycle.time_s}, {"text", note->text}});
   }
   if (!failed_.empty()) return;
   try {
@@ -74,6 +75,7 @@ void RecordingStage::report(nlohmann::json& summary) const {
   summary["eeg"]["recording"] = writer_->path().filename().string();
   summary["eeg"]["samples"] = writer_->samplesWritten();
   if (!failed_.empty()) summary["eeg"]["recording_error"] = failed_;
+  summary["notes"] = notes_;
 }
 
 }  // namespace arbci::session

@@ -453,6 +453,29 @@ class HeadlessParadigmStageTest : public ParadigmStageTest {
   HeadlessParadigmStageTest() : ParadigmStageTest(shortSession(), false) {}
 };
 
+// Nobody to ask after a grasp that failed (the arm could not follow its path): the arm goes home
+// and the run goes on with the next trial, the trial saying what happened; never a stalled run.
+TEST_F(HeadlessParadigmStageTest, AFailedGraspWithoutExperimenterSendsTheArmHomeAndGoesOn) {
+  model_ = trainedModel();
+  begin();
+  ASSERT_TRUE(until(bci::Phase::Grasping));
+  const std::string why =
+      "no joint motion reaches (0.000, 0.727, 0.451) (joint limit or singularity)";
+  cycle([&](CycleRecord& r) {
+    r.robot.notes.push_back({Kind::Outcome, false, why});
+    r.robot.notes.push_back({Kind::Finished, false, why});
+  });
+  // The next trial, or the end after the last.
+  EXPECT_EQ(bench_.previous.paradigm.phase,
+            config_.paradigm.trials > 1 ? bci::Phase::ObjectFlashing : bci::Phase::Finished);
+  EXPECT_EQ(postedOf<RobotHomeRequest>().size(), 1u);
+  const TrialRecord& first = (*bench_.previous.paradigm.trials)[0];
+  EXPECT_NE(first.outcome.find("the arm went home and the run went on"), std::string::npos)
+      << first.outcome;
+  EXPECT_EQ(bench_.logged("recovery").size(), 1u);
+  EXPECT_TRUE(bench_.record.end_reason.empty());
+}
+
 TEST_F(HeadlessParadigmStageTest, WithNoObjectInViewARunWithoutExperimenterEndsWithTheReason) {
   model_ = trainedModel();
   for (const WorldObjectSettings& o : config_.world.objects) hidden_.insert(o.id);

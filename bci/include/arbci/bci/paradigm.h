@@ -193,7 +193,8 @@ class Paradigm {
   // robot step (grasp or put-down) is asked for again, or an interrupted selection goes on.
   // Skip: the trial ends as it stands and the next one starts (or the run finishes).
   void retryStep();
-  void skipTrial();
+  // `why`: the trial's outcome ("": skipped by the experimenter).
+  void skipTrial(const std::string& why = "");
   // In an emergency stop or a robot fault: the phase it interrupted.
   std::optional<Phase> interrupted() const;
 

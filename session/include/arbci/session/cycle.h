@@ -267,6 +267,9 @@ struct ParadigmPart {
     double auc = 0.0, min_auc = 0.0;
     bool below = false;  // under gates.min_auc
     int round = 1;       // the calibration run's number (a recalibration is the second)
+    // The AUC's 95 % interval and the flashes it was measured on, for its reference.
+    double auc_low = 0.0, auc_high = 0.0;
+    int targets = 0, others = 0;
   };
   std::optional<Review> review;
   // Paused by the session itself until something comes back ("every object in view for 1 s"):

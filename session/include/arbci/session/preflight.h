@@ -40,7 +40,7 @@ struct PreflightSettings {
   // the run for it (`display_question`: gates.timing "pause" with an experimenter): run with the
   // flashes off limits annotated, or cancel. 0: not checked.
   double display_hz = 0.0;
-  double flash_ms = 0.0;  // the paradigm's, for the question's figures
+  double flash_ms = 0.0, soa_ms = 0.0;  // the paradigm's, for the question's figures
   bool display_question = false;
   // Failures known before the check begins (the display's: a missing HMD monitor); any fails
   // the pre-flight on its first frame.

@@ -84,6 +84,7 @@ class ParadigmStage final : public Stage {
   // In.
   void act(const Request& request, Cycle& cycle);
   void takeRobotNotes(Cycle& cycle);
+  void recoverUnattended(const std::string& why, Cycle& cycle);
   void watchGrasp(Cycle& cycle);
   void collectTraining(Cycle& cycle);
   // Trained: online at once, or the review first (or, below the minimum AUC with nobody to ask,

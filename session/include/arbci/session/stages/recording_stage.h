@@ -39,6 +39,7 @@ class RecordingStage final : public Stage {
   std::unique_ptr<bci::RecordingWriter> writer_;
   std::map<std::int64_t, Flash> unrecorded_;  // by onset sample, until its duration is known
   std::string failed_;  // why a write failed (the run ended there); "" while all is written
+  nlohmann::json notes_ = nlohmann::json::array();  // the experimenter's notes, for the summary
 };
 
 }  // namespace arbci::session
