@@ -1,59 +1,32 @@
-// arbci: the experimenter workstation and its batch commands.
+// arbci: the command line's front door. `arbci robot ...` runs here, in an executable that loads
+// no GL, OpenCV or MuJoCo: a STOP typed in a fresh shell on a busy machine starts in milliseconds,
+// not in the second or more that loading the workstation's libraries takes. Every other command
+// is the workstation's executable beside this one (arbci-workstation), started in this process's
+// place (the same process id, arguments and environment).
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
-#include <exception>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
+#include <string>
 
-#include "commands/commands.h"
-#include "support/cli_error.h"
-#include "support/status_line.h"
-
-namespace {
-
-// The command the user gave, as far as it was parsed: "arbci eeg convert".
-std::string commandPath(const CLI::App& root) {
-  std::string path = "arbci";
-  const CLI::App* app = &root;
-  while (app) {
-    const auto chosen = app->get_subcommands();
-    app = chosen.empty() ? nullptr : chosen.front();
-    if (app) path += " " + app->get_name();
-  }
-  return path;
-}
-
-}  // namespace
+#include "robot_cli/robot_command.h"
+#include "support/command_line.h"
 
 int main(int argc, char** argv) {
-  CLI::App root{
-      "ARBCI: augmented-reality BCI experimenter workstation.\n"
-      "Markers, EEG, P300 classification and a robot arm, in one cycle.",
-      "arbci"};
-  root.set_version_flag("--version", std::string("arbci ") + ARBCI_VERSION);
-  root.require_subcommand(0, 1);
-  // Every error points to the help of the command that failed.
-  root.failure_message([&root](const CLI::App*, const CLI::Error& error) {
-    return std::string("arbci: ") + error.what() + " (see " + commandPath(root) + " --help)\n";
-  });
-
-  int exit_code = 0;
-  arbci::app::addCommands(root, exit_code);
-
-  try {
-    root.parse(argc, argv);
-    if (root.get_subcommands().empty()) {
-      std::cout << root.help();
-      return 0;
-    }
-  } catch (const CLI::ParseError& error) {
-    return root.exit(error);
-  } catch (const arbci::app::CliError& error) {
-    if (arbci::app::statusLineOpen()) std::cerr << "\n";  // not over a progress line
-    std::cerr << "arbci: " << error.what() << " (see " << commandPath(root) << " --help)\n";
-    return error.exitCode();
-  } catch (const std::exception& error) {
-    if (arbci::app::statusLineOpen()) std::cerr << "\n";
-    std::cerr << "arbci: " << error.what() << " (see " << commandPath(root) << " --help)\n";
-    return 1;
+  if (argc >= 2 && std::string(argv[1]) == "robot") {
+    CLI::App root{"ARBCI: the robot backend from the shell.", "arbci"};
+    int exit_code = 0;
+    arbci::app::addRobotCommand(root, exit_code);
+    return arbci::app::runCommandLine(root, argc, argv, exit_code);
   }
-  return exit_code;
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path workstation = self.parent_path() / "arbci-workstation";
+  ::execv(workstation.c_str(), argv);
+  std::cerr << "arbci: cannot start " << workstation.string() << " (" << std::strerror(errno)
+            << "): it is built beside arbci (cmake --build --preset release)\n";
+  return 127;
 }

@@ -1,5 +1,7 @@
 #include "commands/commands.h"
 
+#include "robot_cli/robot_command.h"
+
 namespace arbci::app {
 
 void addCommands(CLI::App& root, int& exit_code) {

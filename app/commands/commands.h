@@ -17,7 +17,6 @@ void addCalibrateCommand(CLI::App& root, int& exit_code);
 void addEegCommand(CLI::App& root, int& exit_code);
 void addEegStreamCommands(CLI::App* eeg, int& exit_code);  // stream, streams (under eeg)
 void addP300Commands(CLI::App& root, int& exit_code);      // train, evaluate
-void addRobotCommand(CLI::App& root, int& exit_code);
 void addRunCommand(CLI::App& root, int& exit_code);
 void addTimingCheckCommand(CLI::App& root, int& exit_code);
 void addSettingsCommand(CLI::App& root, int& exit_code);

@@ -28,11 +28,6 @@ constexpr size_t kMaxChallenges = 256;
 constexpr std::int64_t kWakeMarginUs = 1000;
 // Source addresses whose unbound budget is remembered at once (see SourceBudgets::forgetQuiet).
 constexpr size_t kBudgetedSources = 1024;
-// A client's heartbeats arrive at their rate (its heartbeat thread runs) once this many have come,
-// the last two within half a watchdog period of each other. One heartbeat alone (the client sends
-// one as it binds, from its command thread) shows nothing of the thread that must keep feeding
-// the watchdog while the arm moves.
-constexpr int kStreamingHeartbeats = 3;
 
 std::uint64_t randomId() {
   std::uint64_t id = 0;
@@ -558,6 +553,8 @@ struct RobotBackend::Impl {
     if (s.held) motion(*std::exchange(s.held, std::nullopt), s);
   }
 
+  // One heartbeat alone (a client sends one as it binds, from its command thread) shows nothing
+  // of the thread that must keep feeding the watchdog while the arm moves (kStreamingHeartbeats).
   bool streaming(const Session& s) const {
     return s.heartbeats >= kStreamingHeartbeats &&
            s.heartbeat_received_us - s.previous_received_us <= watchdogMicros() / 2;

@@ -106,7 +106,7 @@ void RobotClient::heartbeatLoop() {
 
 bool RobotClient::heartbeatsFlowing() const {
   return options_.heartbeats_per_watchdog <= 0 || watchdog_ms_ == 0 ||
-         thread_heartbeats_.load() >= kHeartbeatsBeforeMotion;
+         thread_heartbeats_.load() >= kStreamingHeartbeats;
 }
 
 // Stamped with its send time on the backend's clock. From the heartbeat thread, and once from

@@ -107,25 +107,13 @@ const core::Schema<RobotConfig>& configSchema() {
 const core::Schema<LinkSettings>& linkSchema() {
   static const core::Schema<LinkSettings> table = [] {
     core::Schema<LinkSettings> t("link", "The robot backend: its UDP address and its arm");
-    t.text("host", &LinkSettings::host, kLoopback,
-           "the backend's host (arbci-robotd: the address it listens on)")
-        .integer("port", &LinkSettings::port, 47800, 1, 65535, "its UDP port")
-        // 100 ms: the client sends 20 heartbeats in it (every 5 ms), so only 19 or more lost in
-        // a row halt the arm. The deadline counts from each heartbeat's send time, so a delayed
-        // link halts as a dead one does; a busy PC only delays the heartbeat thread (the highest
-        // priority the process may take), which sleeps between beats and is woken promptly even
-        // at normal priority (docs/robot.md has the loss model and the false-halt counts).
-        .integer("watchdog_ms", &LinkSettings::watchdog_ms, 100, 0, 60000,
-                 "the backend halts a running motion (and latches the stop) this long after the "
-                 "send time of the commanding client's newest heartbeat (a heartbeat the link "
-                 "delayed counts as missing); 0: off (not for a real arm); raise it on a lossy "
-                 "link",
-                 "ms")
-        // The kinematic arm by default: it puts an object exactly where it was sent, so the
-        // default session measures the tracker and the classifier, not the grasp.
-        .text("driver", &LinkSettings::driver, "simulated",
-              "the arm arbci-robotd drives: " + robotDrivers().list(", "),
-              [] { return robotDrivers().names(); });
+    for (const char* key : {"host", "port", "watchdog_ms", "key_file"})
+      t.adopt(clientLinkSchema(), key);
+    // The kinematic arm by default: it puts an object exactly where it was sent, so the
+    // default session measures the tracker and the classifier, not the grasp.
+    t.text("driver", &LinkSettings::driver, "simulated",
+           "the arm arbci-robotd drives: " + robotDrivers().list(", "),
+           [] { return robotDrivers().names(); });
     return t;
   }();
   return table;

@@ -522,7 +522,10 @@ const Schema<RobotSettings>& robotSchema() {
             robot::linkSchema().at("watchdog_ms"),
             [](R& r, const Json& j) { r.watchdog_ms = j.get<int>(); },
             [](const R& r) { return Json(r.watchdog_ms); })
-        .text("key_file", &R::key_file, "", "remote: the shared key (arbci robot keygen)");
+        .custom(
+            robot::linkSchema().at("key_file"),
+            [](R& r, const Json& j) { r.key_file = j.get<std::string>(); },
+            [](const R& r) { return Json(r.key_file); });
     t.rule([](const Json& r) -> Broken {
       if (r["backend"] == "remote" && r["key_file"].get<std::string>().empty())
         return std::pair{"key_file", "is required for a remote robot"};

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include "arbci/robot/mujoco_arm.h"
 #include "support/halt_recording_arm.h"
@@ -392,11 +393,14 @@ TEST(RobotLink, TheReplayWindowHoldsAtTheTopOfTheSequenceRange) {
   RawSession raw(backend.port());
   constexpr std::uint64_t kTop = std::numeric_limits<std::uint64_t>::max();
   ASSERT_TRUE(raw.hello(kTop - 2 * kReplayWindow));
-  // The link proven (a motion waits for the session's first heartbeat; both clocks are this
-  // machine's), a command at the very top runs once, however many copies arrive.
-  Message heartbeat = raw.message(MessageType::Heartbeat, kTop - 1);
-  heartbeat.time_us = steadyMicros();
-  raw.send(heartbeat);
+  // The link proven (a motion waits until the session's heartbeats come at their rate; both
+  // clocks are this machine's), a command at the very top runs once, however many copies arrive.
+  for (int i = kStreamingHeartbeats; i >= 1; --i) {
+    Message heartbeat = raw.message(MessageType::Heartbeat, kTop - static_cast<std::uint64_t>(i));
+    heartbeat.time_us = steadyMicros();
+    raw.send(heartbeat);
+    std::this_thread::sleep_for(10ms);
+  }
   const Message home = raw.message(MessageType::Home, kTop);
   for (int i = 0; i < 3; ++i) raw.send(home);
   const auto accepted = raw.answer(kTop);

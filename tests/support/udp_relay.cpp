@@ -1,10 +1,22 @@
 #include "support/udp_relay.h"
 
+#include <utility>
+
+#include "arbci/robot/thread_priority.h"
+
 namespace arbci::test {
 
-UdpRelay::UdpRelay(int backend_port, const robot::Key& key, unsigned seed)
+UdpRelay::UdpRelay(int backend_port, const robot::Key& key, unsigned seed, bool real_time)
     : backend_(robot::Endpoint::resolve("127.0.0.1", backend_port)), key_(key), random_(seed) {
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this, real_time] {
+    // A network does not stall because the PC is busy: at the priority the link's own ends take.
+    if (real_time) robot::raiseThreadPriority();
+    run();
+  });
+}
+
+double UdpRelay::takeLongestStallMs() {
+  return static_cast<double>(longest_stall_us_.exchange(0)) / 1000.0;
 }
 
 UdpRelay::~UdpRelay() {
@@ -98,8 +110,14 @@ bool UdpRelay::lose(double probability) {
 
 void UdpRelay::run() {
   std::optional<robot::Endpoint>& client = client_;
+  auto last = std::chrono::steady_clock::now();
   while (!stop_) {
     front_.wait(1);
+    // How long the relay itself went without a turn (it waits at most 1 ms for datagrams).
+    const auto turn = std::chrono::steady_clock::now();
+    const auto gap = std::chrono::duration_cast<std::chrono::microseconds>(turn - last).count();
+    last = turn;
+    if (gap > longest_stall_us_.load()) longest_stall_us_ = gap;
     std::lock_guard lock(mutex_);
     while (auto d = front_.receive()) {
       client = d->from;

@@ -22,7 +22,12 @@ namespace arbci::test {
 class UdpRelay {
  public:
   using Bytes = std::vector<std::uint8_t>;
-  UdpRelay(int backend_port, const robot::Key& key, unsigned seed = 1234);
+  // `real_time`: its thread at the highest priority the process may take (as the link's ends
+  // run), so a busy machine delays the client and the backend but not the relay between them.
+  UdpRelay(int backend_port, const robot::Key& key, unsigned seed = 1234, bool real_time = false);
+  // The longest the relay's own loop went without a turn since the last call (ms): over a few
+  // milliseconds, the relay, not the link, held datagrams back.
+  double takeLongestStallMs();
   ~UdpRelay();
   UdpRelay(const UdpRelay&) = delete;
   UdpRelay& operator=(const UdpRelay&) = delete;
@@ -64,6 +69,7 @@ class UdpRelay {
   robot::Key key_;
   std::mt19937 random_;
   mutable std::mutex mutex_;
+  std::atomic<std::int64_t> longest_stall_us_{0};
   double loss_to_backend_ = 0.0, loss_to_client_ = 0.0;
   bool cut_ = false;
   std::chrono::milliseconds delay_{0};

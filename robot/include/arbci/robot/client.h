@@ -153,9 +153,8 @@ class RobotClient {
   std::atomic<bool> offset_known_{false};
   std::atomic<std::int64_t> heartbeat_period_us_{5'000};  // from the bound run's watchdog
   // Heartbeats the heartbeat thread sent since the binding: a motion goes out once it has sent
-  // this many (the backend holds one until they come at their rate).
+  // kStreamingHeartbeats (the backend holds one until they come at their rate).
   std::atomic<int> thread_heartbeats_{0};
-  static constexpr int kHeartbeatsBeforeMotion = 3;
   bool heartbeatsFlowing() const;
   std::uint64_t epoch_ = 0;
   // HELLOs awaiting their WELCOME: nonce and send time (this clock); the BIND awaiting ACCEPTED.

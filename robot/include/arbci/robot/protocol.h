@@ -1,4 +1,4 @@
-// The ARBCI robot protocol, version 3: UDP datagrams, little-endian, each authenticated with
+// The ARBCI robot protocol, version 4: UDP datagrams, little-endian, each authenticated with
 // HMAC-SHA256 over its content under a shared key. A client binds its session to one run of the
 // backend by a challenge and response (HELLO with the client's nonce, WELCOME echoing it with
 // the backend's, BIND echoing that: a replayed HELLO or BIND binds nothing, a replayed WELCOME is
@@ -25,6 +25,10 @@ constexpr int kMaxWorldObjects = 32;
 // command retransmitted until the client gives up (15 s) stays inside it while heartbeats (at
 // most 200 a second) and statuses (5) advance the highest.
 constexpr std::uint64_t kReplayWindow = 4096;
+// A session's heartbeats come at their rate (its heartbeat thread runs) once this many have
+// arrived, the last two within half a watchdog of each other: the backend holds a motion until
+// then, and a client sends one only after its heartbeat thread has sent this many.
+constexpr int kStreamingHeartbeats = 3;
 
 enum class MessageType : std::uint8_t {
   // Commands (client to backend).

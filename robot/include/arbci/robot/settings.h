@@ -25,9 +25,12 @@ struct LinkSettings {
   std::string host;
   int port;
   int watchdog_ms;
-  std::string driver;  // the arm arbci-robotd drives: robotDrivers()'s name
+  std::string driver;    // the arm arbci-robotd drives: robotDrivers()'s name
+  std::string key_file;  // the shared key a client authenticates with
 };
 const core::Schema<LinkSettings>& linkSchema();
+// Its keys a client needs (host, port, watchdog_ms, key_file), without the drivers' registry.
+const core::Schema<LinkSettings>& clientLinkSchema();
 
 struct DriverParts {
   // Throws std::runtime_error with the reason when the arm cannot be driven.

@@ -14,8 +14,7 @@
 #include "arbci/robot/client.h"
 #include "arbci/robot/key_file.h"
 #include "arbci/robot/settings.h"
-#include "arbci/session/settings_schema.h"
-#include "commands/commands.h"
+#include "robot_cli/robot_command.h"
 #include "support/cli_error.h"
 #include "support/schema_option.h"
 
@@ -221,9 +220,9 @@ void addRobotCommand(CLI::App& root, int& exit_code) {
       "printed when the backend can say). A motion that cannot be confirmed is followed by a\n"
       "STOP, which stays in force until `arbci robot reset`.");
   robot_cmd->require_subcommand(1);
-  schemaOption(*robot_cmd, "--host", o->host, session::sessionKey("robot.host"));
-  schemaOption(*robot_cmd, "--port", o->port, session::sessionKey("robot.port"));
-  schemaOption(*robot_cmd, "--key-file", o->key_file, session::sessionKey("robot.key_file"));
+  schemaOption(*robot_cmd, "--host", o->host, robot::clientLinkSchema().at("host"));
+  schemaOption(*robot_cmd, "--port", o->port, robot::clientLinkSchema().at("port"));
+  schemaOption(*robot_cmd, "--key-file", o->key_file, robot::clientLinkSchema().at("key_file"));
   robot_cmd->add_option("--timeout", o->timeout_s, "seconds to wait for the outcome")
       ->capture_default_str();
   robot_cmd
