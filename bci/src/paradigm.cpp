@@ -261,12 +261,20 @@ void Paradigm::advanceTimedPhase(double due_s) {
         } else {
           nextTrial(now_ + settings_.pause_s, held_why_, true);
         }
-      } else if (!verdict_pending_ && phase_ == Phase::CellSelected && hold_uncertain_cells_ &&
-                 settings_.certainty > 0.0 && shown_certainty_ < settings_.certainty) {
-        char why[160];
+      } else if (!verdict_pending_ && phase_ == Phase::ObjectSelected && unsure()) {
+        // A selection that ran out of sequences below what the arm acts on is an "I don't
+        // know": said and recorded, and its trial ends without the arm.
+        char why[200];
         std::snprintf(why, sizeof why,
-                      "the cell was chosen at a certainty of %.4f, below paradigm.certainty %g",
-                      shown_certainty_, settings_.certainty);
+                      "not grasped: the object was chosen at a certainty of %.4f, below "
+                      "paradigm.%s %g",
+                      shown_certainty_, actThresholdName(), actThreshold());
+        nextTrial(now_ + settings_.pause_s, why, true);
+      } else if (!verdict_pending_ && phase_ == Phase::CellSelected && unsure()) {
+        char why[200];
+        std::snprintf(why, sizeof why,
+                      "the cell was chosen at a certainty of %.4f, below paradigm.%s %g",
+                      shown_certainty_, actThresholdName(), actThreshold());
         giving_back_ = true;
         give_back_why_ = why;
         askRobot(Phase::Dropping);
@@ -277,6 +285,19 @@ void Paradigm::advanceTimedPhase(double due_s) {
     default:
       break;
   }
+}
+
+double Paradigm::actThreshold() const {
+  return hold_uncertain_cells_ ? settings_.certainty : settings_.act_certainty;
+}
+
+const char* Paradigm::actThresholdName() const {
+  return hold_uncertain_cells_ ? "certainty" : "act_certainty";
+}
+
+bool Paradigm::unsure() const {
+  // An ErrP correction is the runner-up the rejection left: its own rule (errp_runner_up) decided.
+  return actThreshold() > 0.0 && !shown_correction_ && shown_certainty_ < actThreshold();
 }
 
 void Paradigm::showCalibrationFeedback(double due_s) {
@@ -402,6 +423,7 @@ void Paradigm::showSelection(const std::set<int>& codes, int choice, double cert
   made.text = text;
   shown_codes_ = codes;
   shown_certainty_ = certainty;
+  shown_correction_ = text == "runner-up";
   shown_error_.reset();
   feedback_pending_ = true;
   verdict_pending_ = settings_.errp;

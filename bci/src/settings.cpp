@@ -29,6 +29,11 @@ const core::Schema<ParadigmSettings>& paradigmSchema() {
                 "dynamic stopping: decide once the choice is this probable (0: always all "
                 "sequences); calibration none: the arm acts only on an object selection at "
                 "least this probable")
+        .number("act_certainty", &P::act_certainty, 0.9, 0.0, 1.0,
+                "the arm acts only on a selection at least this probable: an object below it "
+                "is not grasped (its trial ends), a cell below it not put down on (the object "
+                "goes back); what ran out of sequences below it is said, not acted on (0: act "
+                "on every selection; calibration none: paradigm.certainty)")
         .integer("calibration_selections", &P::calibration_selections, 8, 2, 200,
                  "cued selections of the calibration run")
         .integer("calibration_sequences", &P::calibration_sequences, 8, 1, 100,

@@ -386,10 +386,10 @@ const Schema<SessionConfig>& paradigmSectionSchema() {
   static const Schema<SessionConfig> t = [] {
     Schema<SessionConfig> t("paradigm", bci::paradigmSchema().doc());
     for (const char* key :
-         {"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "calibration_selections",
-          "calibration_sequences", "trials", "cue_s", "result_s", "pause_s", "no_view_pause_s",
-          "calibration", "learning_min_selections", "learning_min_consistency",
-          "learning_sequences", "learning_max_sequences", "adapt"})
+         {"flash_ms", "isi_ms", "sequences", "min_sequences", "certainty", "act_certainty",
+          "calibration_selections", "calibration_sequences", "trials", "cue_s", "result_s",
+          "pause_s", "no_view_pause_s", "calibration", "learning_min_selections",
+          "learning_min_consistency", "learning_sequences", "learning_max_sequences", "adapt"})
       t.adopt(bci::paradigmSchema(), key, &SessionConfig::paradigm);
     t.rulesOf(bci::paradigmSchema());
     t.list("intended", &SessionConfig::intended, intentSchema(),

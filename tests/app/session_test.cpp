@@ -62,7 +62,7 @@ std::vector<std::pair<std::int64_t, int>> stims(const std::filesystem::path& fil
   return out;
 }
 
-TEST(Session, ThreeTrialsAllRightEachObjectWithinACentimetreAndTheSameSeedTheSameRecording) {
+TEST(Session, ThreeTrialsPlacedWithinACentimetreOrSaidUnsureAndTheSameSeedTheSameRecording) {
   auto run = [](const std::string& name) {
     const auto folder = fresh(name);
     const ProcessResult r =
@@ -83,13 +83,29 @@ TEST(Session, ThreeTrialsAllRightEachObjectWithinACentimetreAndTheSameSeedTheSam
   const nlohmann::json summary = readJson(folder / "summary.json");
   EXPECT_EQ(summary["ended"], "finished");
   ASSERT_EQ(summary["trials"].size(), 3u);
+  // A simulated subject is sometimes misread. What is asserted is what the arm does with it: a
+  // selection decided at least paradigm.act_certainty (0.9 here) probable is acted on and right,
+  // one below it is said and not acted on (the object goes back where it was taken).
+  for (const auto& e : readLog(folder / "log.jsonl")) {
+    if (e.value("event", "") != "selection" || !e.contains("correct")) continue;
+    if (e["certainty"].get<double>() >= 0.9) {
+      EXPECT_TRUE(e["correct"].get<bool>()) << e.dump();
+    }
+  }
+  int placed = 0;
   for (const auto& t : summary["trials"]) {
     EXPECT_EQ(t["selected_object"], t["intended_object"]) << t.dump();
-    EXPECT_EQ(t["selected_cell"], t["intended_cell"]) << t.dump();
+    if (t["selected_cell"] != t["intended_cell"]) {
+      EXPECT_EQ(t["outcome"].get<std::string>().rfind("returned: the cell was chosen at", 0), 0u)
+          << t.dump();
+      continue;
+    }
     ASSERT_TRUE(t["placement_error_m"].is_number()) << t.dump();
     EXPECT_LT(t["placement_error_m"].get<double>(), 0.01) << t.dump();
     EXPECT_EQ(t["outcome"], "placed");
+    ++placed;
   }
+  EXPECT_GE(placed, 2);
   // How long the run took and its overruns are the machine's, not the session's behaviour: they
   // are reported (summary, bench/), and here only checked to be logged one for one (below).
   EXPECT_DOUBLE_EQ(summary["objects"]["accuracy"].get<double>(), 1.0);

@@ -37,6 +37,7 @@ struct ParadigmSettings {
   int calibration_sequences;  // per calibration selection (always all)
   int min_sequences;          // dynamic stopping never stops earlier
   double certainty;           // dynamic stopping's (and learning's arm's) threshold; 0: none
+  double act_certainty;       // a calibrated run's arm acts on nothing less probable; 0: none
   double cue_s;               // calibration: the target is shown before its flashes
   double result_s;            // a selection is shown this long
   double pause_s;             // between selections
@@ -220,9 +221,10 @@ class Paradigm {
   // ends there, the arm not sent (`why` is the trial's outcome); a selection decided without a
   // model (no choice) ends its trial at once. Read when a selection is made.
   void holdArm(bool held, const std::string& why);
-  // Learning from use: a cell shown at a certainty below `certainty` is not put down on; the
-  // object goes back where it was taken (the arm acts on a cell by the same condition as on an
-  // object: only what the model is as sure of as dynamic stopping asks).
+  // In every run the arm acts only on a selection the model is sure enough of (`act_certainty`;
+  // learning from use: `certainty`, as dynamic stopping asks): an object shown below it is not
+  // grasped (its trial ends), a cell below it is not put down on (the object goes back where it
+  // was taken). Learning from use, trusted, a cell also gets the objects' room to reach it.
   void holdUncertainCells(bool hold) { hold_uncertain_cells_ = hold; }
   // How many sequences an online object selection flashes. Usual: `sequences`. Learning from use,
   // the model not trusted: `learning_sequences`, all of them. Trusted: up to
@@ -340,7 +342,11 @@ class Paradigm {
   bool giving_back_ = false;        // the put-down returns the object (no cell was accepted)
   std::string give_back_why_;       // and why
   bool hold_uncertain_cells_ = false;
-  double shown_certainty_ = 0.0;  // of the selection shown
+  double shown_certainty_ = 0.0;   // of the selection shown
+  bool shown_correction_ = false;  // the selection shown is an ErrP's runner-up
+  bool unsure() const;             // the selection shown is below what the arm acts on
+  double actThreshold() const;     // act_certainty; learning from use: certainty
+  const char* actThresholdName() const;
   int corrections_ = 0;
   bool hold_arm_ = false, held_now_ = false;  // asked; latched for the selection shown
   ObjectSequences object_sequences_ = ObjectSequences::Usual;
