@@ -125,7 +125,7 @@ void streamFile(const LslOptions& o) {
   // Blocks of about 1/32 s, each due when its last sample would have been taken.
   const int block = std::max(1, static_cast<int>(r.info.rate_hz / 32));
   std::vector<float> chunk;
-  std::int64_t sent_total = 0;
+  std::int64_t sent_total = 0, pushed = 0, markers_pushed = 0;  // the last two: what went out
   do {
     const double t0 = bci::lsl::localClock() - static_cast<double>(sent_total) / r.info.rate_hz;
     size_t next_stimulus = 0;
@@ -141,11 +141,13 @@ void streamFile(const LslOptions& o) {
         for (int c = 0; c < eeg.channel_count; ++c)
           chunk[static_cast<size_t>(s) * eeg.channel_count + c] = r.at(c, first + s);
       eeg_outlet->pushRaw(chunk.data(), n, stamp);
+      pushed += n;
       for (; next_stimulus < r.stimuli.size() && r.stimuli[next_stimulus].sample < first + n;
            ++next_stimulus) {
         const auto& e = r.stimuli[next_stimulus];
         marker_outlet->pushStrings(
             {markerText(e)}, t0 + static_cast<double>(sent_total + e.sample) / r.info.rate_hz);
+        ++markers_pushed;
       }
       const double at = static_cast<double>(first + n) / r.info.rate_hz;
       if (at >= next_report) {
@@ -158,7 +160,10 @@ void streamFile(const LslOptions& o) {
     sent_total += r.samples;
   } while (o.loop && !interruptRequested());
   std::cerr << "\n";
-  std::printf("streamed %lld samples\n", static_cast<long long>(sent_total));
+  // What went out, an interrupted stream's too (not the file's length).
+  std::printf("streamed %lld samples (%.1f s) and %lld markers%s\n", static_cast<long long>(pushed),
+              static_cast<double>(pushed) / r.info.rate_hz, static_cast<long long>(markers_pushed),
+              interruptRequested() ? " before it was interrupted" : "");
   std::fflush(stdout);
   // Let the consumers take the last samples before the outlet closes.
   std::this_thread::sleep_for(std::chrono::milliseconds(500));

@@ -26,15 +26,23 @@ std::string labelsProblem(const core::RunLabels& l, const std::filesystem::path&
 }  // namespace
 
 bool SessionRequests::post(session::Request request) {
+  if (auto* apply = std::get_if<session::ApplySettingsRequest>(&request)) {
+    // Only before Start: a running session keeps the settings it started with.
+    const session::CycleRecord& last = session_->last();
+    if (last.paradigm.phase != bci::Phase::Setup || last.preflight.running || session_->ended())
+      return false;
+    settings_ = nlohmann::json::parse(apply->settings_json);
+    return true;
+  }
   if (std::holds_alternative<session::StartRequest>(request)) {
     // Without a BIDS dataset, a named subject's runs are numbered among the session folders.
-    core::RunLabels labels = session_.labels();
+    core::RunLabels labels = session_->labels();
     if (bids_root_.empty() && !labels.subject.empty() && labels.run.empty()) {
-      labels.run = std::to_string(nextFolderRun(session_.folder(), labels));
-      session_.setLabels(labels);
+      labels.run = std::to_string(nextFolderRun(session_->folder(), labels));
+      session_->setLabels(labels);
     }
   }
-  return session_.request(std::move(request));
+  return session_->request(std::move(request));
 }
 
 ui::RunTarget describeRun(const core::RunLabels& l, const std::filesystem::path& folder,

@@ -1,9 +1,12 @@
 // The window's request sink: the panels' requests to the running session (Session::request, which
-// refuses with the reason and logs it). At Start, a named subject's run without a number and
+// refuses with the reason and logs it); the start screen's settings kept for the window, which
+// opens the session again with them. At Start, a named subject's run without a number and
 // without a BIDS root is numbered among the session folders beside this one first.
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <utility>
 
 #include "arbci/session/session.h"
 #include "arbci/ui/panel.h"
@@ -15,12 +18,17 @@ class SessionRequests final : public ui::RequestSink {
  public:
   // `bids_root`: where the run is exported when it ends ("" for none).
   SessionRequests(session::Session& session, std::filesystem::path bids_root)
-      : session_(session), bids_root_(std::move(bids_root)) {}
+      : session_(&session), bids_root_(std::move(bids_root)) {}
   bool post(session::Request request) override;
+  // The session the requests go to (the window opened it again with new settings).
+  void retarget(session::Session& session) { session_ = &session; }
+  // Settings the start screen asked to apply (ApplySettingsRequest), once.
+  std::optional<nlohmann::json> takeSettings() { return std::exchange(settings_, std::nullopt); }
 
  private:
-  session::Session& session_;
+  session::Session* session_;
   std::filesystem::path bids_root_;
+  std::optional<nlohmann::json> settings_;
 };
 
 // The start screen's account of a run's labels: what stops a start with them, and where the run

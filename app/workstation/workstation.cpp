@@ -8,6 +8,7 @@
 
 #include <imgui.h>
 
+#include "arbci/core/whole_file.h"
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/window_context.h"
 #include "arbci/session/record_text.h"
@@ -47,6 +48,48 @@ void showOpening(render::WindowContext& window, ui::ImGuiLayer& imgui,
   render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
   imgui.endFrame();
   window.present();
+}
+
+// The start screen's settings applied to the run about to start: the session (not started) is
+// closed and opened again in its folder with them, keeping the run's labels; the command line's
+// --trials and --seed give way to the settings' own. Settings that cannot open a session (a
+// device gone since they were checked) leave the session as it was, saying why.
+void reopen(OpenedSession& opened, const nlohmann::json& settings, session::SessionOptions options,
+            render::GlContext& context) {
+  const session::SessionConfig before = opened.session->config();
+  options.labels = opened.session->labels();
+  options.folder = opened.session->folder();
+  options.trials.reset();
+  options.seed.reset();
+  // Kept in the folder: the run's settings are in a file, as a session file's are.
+  const std::filesystem::path file = options.folder / "settings.json";
+  std::optional<session::SessionConfig> next;
+  try {
+    next = session::SessionConfig::parse(settings, file.string());
+    session::checkNamedResources(*next);
+    if (const std::string why = core::writeWholeFile(file, settings.dump(2) + "\n"); !why.empty())
+      throw std::runtime_error(why);
+  } catch (const std::exception& error) {
+    std::cerr << "\nsettings not applied: " << error.what() << "\n";
+    return;
+  }
+  // One session in the folder at a time: the first closes (it never started) before the next
+  // writes its log, recording and session.json there; its closing summary is not this run's.
+  opened = OpenedSession{};
+  std::error_code ignored;
+  std::filesystem::remove(options.folder / "summary.json", ignored);
+  // A simulated robot's key is the closed session's own, made for its backend (now ended); the
+  // next makes its own and never replaces a key it did not write.
+  if (before.robot.backend == "simulated")
+    std::filesystem::remove(options.folder / "robot.key", ignored);
+  try {
+    opened = openSession(*next, options, context);
+    std::cerr << "\nsettings applied from the Settings panel: the session opened again\n";
+  } catch (const std::exception& error) {
+    std::cerr << "\nsettings not applied (" << error.what()
+              << "); the session opened again with the settings it had\n";
+    opened = openSession(before, options, context);
+  }
 }
 
 }  // namespace
@@ -102,27 +145,33 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   showOpening(main_window, imgui, config);
   OpenedSession opened = openSession(config, options, main_window);
   if (workstation.opened) workstation.opened();
-  session::Session& session = *opened.session;
+  // The session the window runs: the start screen may open it again with other settings.
+  session::Session* session = opened.session.get();
   // The X server gone (killed, logged out): Xlib would end the process where it stands. The run
   // ends as a fault and its summary is saved first (the recording and the log are written as
   // they go); exit 3, as for any run that did not finish.
   render::onDisplayLost(
       [&session](const std::string& reason) {
-        session.endNow(reason);
-        std::cerr << "\nended: fault (" << reason << "); " << session.folder().string()
+        session->endNow(reason);
+        std::cerr << "\nended: fault (" << reason << "); " << session->folder().string()
                   << "/summary.json written\n";
       },
       3);
   // Unattended, the session starts itself.
   if (!workstation.wait_for_start && !workstation.unattended)
-    session.request(session::StartRequest{});
-  SessionRequests requests(session, workstation.bids_root);
-  ui::WindowState state([&](const core::RunLabels& labels) {
-    return describeRun(labels, session.folder(), workstation.bids_root);
-  });
-  state.hmd_texture = opened.hmd->texture();
-  state.hmd_aspect = static_cast<float>(config.hmd.width) / config.hmd.height;
-  state.ingest(session.last(), session.config());
+    session->request(session::StartRequest{});
+  SessionRequests requests(*session, workstation.bids_root);
+  const auto describe = [&](const core::RunLabels& labels) {
+    return describeRun(labels, session->folder(), workstation.bids_root);
+  };
+  ui::WindowState state(describe);
+  const auto attach = [&] {
+    state.hmd_texture = opened.hmd->texture();
+    state.hmd_aspect = static_cast<float>(session->config().hmd.width) /
+                       static_cast<float>(session->config().hmd.height);
+    state.ingest(session->last(), session->config());
+  };
+  attach();
   ui::ExperimenterShell shell;
   // Every registered panel, in the registry's order; the summary opens when the session ends.
   std::vector<std::unique_ptr<ui::Panel>> panels;
@@ -145,14 +194,21 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     // A script runs to its end first (its last screenshot may show the ended session).
     const bool script_over = !script || script->done();
     if (interruptRequested()) interrupted = true;
-    if (interrupted || (close_when_ended && session.ended() && script_over))
+    if (interrupted || (close_when_ended && session->ended() && script_over))
       main_window.requestClose();
     render::WindowContext::pollEvents();
     main_window.makeCurrent();  // the simulated cameras render in it
-    session.step();
-    state.ingest(session.last(), session.config());
+    if (std::optional<nlohmann::json> settings = requests.takeSettings()) {
+      reopen(opened, *settings, options, main_window);
+      session = opened.session.get();
+      requests.retarget(*session);
+      state = ui::WindowState(describe);
+      attach();
+    }
+    session->step();
+    state.ingest(session->last(), session->config());
     // The calibration waits for the experimenter: its review opens in front (once per review).
-    const bool review = session.last().paradigm.review.has_value();
+    const bool review = session->last().paradigm.review.has_value();
     // Opened for it, it closes once answered: it would cover the panels the trials need.
     if (review && !reviewing && training_panel) {
       opened_for_review = !shell.isOpen(*training_panel);
@@ -160,7 +216,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     }
     if (!review && reviewing && opened_for_review && training_panel) shell.hide(*training_panel);
     reviewing = review;
-    if (session.ended() && !summary_shown) {
+    if (session->ended() && !summary_shown) {
       if (summary_panel) shell.show(*summary_panel);  // once: the experimenter may close it
       summary_shown = true;
     }
@@ -169,7 +225,7 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     const float frame_ms = std::chrono::duration<float, std::milli>(now - last).count();
     last = now;
     const render::Size size = main_window.framebufferSize();
-    const session::CycleRecord& record = session.last();
+    const session::CycleRecord& record = session->last();
     const std::string phase = session::phaseText(record);
     ui::SyntheticInput input;
     if (script) {
@@ -178,15 +234,15 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
         std::cerr << "\nscript: no panel \"" << panel << "\" to open\n";
     }
     imgui.beginFrame(frame_ms / 1000.0f, script ? &input : nullptr);
-    const ui::PanelInput panel_input{record, session.config(), session.operatorLog(), state,
+    const ui::PanelInput panel_input{record, session->config(), session->operatorLog(), state,
                                      requests};
-    shell.draw(size,
-               {frame_ms, phase, session::statusLine(record, session.config(), state.cycleP50Ms())},
-               panel_input);
+    shell.draw(
+        size, {frame_ms, phase, session::statusLine(record, session->config(), state.cycleP50Ms())},
+        panel_input);
     render::clearFramebuffer(0, size, {0.08f, 0.09f, 0.11f, 1.0f});
     imgui.endFrame();
     if (script) {
-      script->afterFrame(main_window, size, session::phaseText(session.last()), session.time());
+      script->afterFrame(main_window, size, session::phaseText(session->last()), session->time());
       if (!script->error().empty()) {
         std::cerr << "\nerror: " << script->error() << "\n";
         main_window.requestClose();
@@ -198,21 +254,21 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
       mirror->makeCurrent();
       render::blitTexture(opened.hmd->texture(), opened.hmd->size(), mirror->framebufferSize());
       mirror->present();
-      session.presented(bci::hostSeconds());  // the HMD's swap is done: its flashes are on screen
+      session->presented(bci::hostSeconds());  // the HMD's swap is done: its flashes are on screen
       main_window.makeCurrent();
       main_window.present();
     } else {
       main_window.present();
-      session.presented(
+      session->presented(
           bci::hostSeconds());  // the swap is done: this frame's flashes are on screen
     }
   }
   // Quit (or the window closed) before the end: the run ends as an abort, saying who.
-  if (!session.ended())
-    session.abortNow(interrupted ? "interrupted (Ctrl+C or TERM)" : "by the experimenter (Quit)");
+  if (!session->ended())
+    session->abortNow(interrupted ? "interrupted (Ctrl+C or TERM)" : "by the experimenter (Quit)");
   if (script && !script->error().empty()) return 4;
   // Closed before the end: not finished.
-  return session.ended() && session.endKind() == "finished" ? 0 : 3;
+  return session->ended() && session->endKind() == "finished" ? 0 : 3;
 }
 
 }  // namespace arbci::app

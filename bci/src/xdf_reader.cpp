@@ -153,12 +153,12 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
     r.notes.push_back(std::to_string(eeg_clock.breaks.size()) +
                       " break(s) in the EEG's stamps, each annotated where it falls");
 
-  // Markers: each at the first EEG sample taken at or after it (as ARBCI stamps a flash); one
-  // that falls in a break goes to the first sample after it. The EEG's fitted stamps are exact
-  // to a few microseconds, not to zero: a marker stamped on a sample's time may fall a hair
-  // before or after it, so "at" allows a quarter of a period.
+  // Markers: each at the EEG sample nearest its time (docs/eeg.md, "One marker rule"). The
+  // EEG's fitted stamps are exact to a few microseconds, not to zero: a marker stamped on a
+  // sample's time (as ARBCI's own outlets stamp them) falls a hair before or after it, and the
+  // nearest sample is that one whichever side; one stamped in between lands within half a period.
   const double period = 1.0 / r.info.rate_hz;
-  const double slack = period / 4.0;
+  const double slack = period / 2.0;
   int before = 0, after = 0, marker_resets = 0;
   for (const xdf::Stream& s : file.streams) {
     if (s.numeric()) continue;
@@ -172,11 +172,13 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
         ++before;
         continue;
       }
-      const auto found = std::lower_bound(stamps.begin(), stamps.end(), at - slack);
-      if (found == stamps.end()) {
+      if (at > stamps.back() + slack) {
         ++after;
         continue;
       }
+      auto found = std::lower_bound(stamps.begin(), stamps.end(), at);
+      if (found == stamps.end() || (found != stamps.begin() && at - *(found - 1) <= *found - at))
+        --found;
       const std::int64_t sample = found - stamps.begin();
       const std::vector<std::string>& texts = s.strings[k];
       StimulusEvent stimulus;

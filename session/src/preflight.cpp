@@ -151,12 +151,16 @@ std::string Preflight::displayQuestion() const {
   const double soa_ms = std::max(1.0, std::round(settings_.soa_ms / frame_ms)) * frame_ms;
   const double soa_shown_ms = std::ceil(soa_ms / got_ms - 1e-9) * got_ms;
   char text[400];
-  std::snprintf(text, sizeof text,
-                "display: a frame every %.0f ms (%.1f Hz; display_hz %.0f asks for %.1f ms): "
-                "flashes will last about %.0f ms instead of %.0f, and onsets come about %.0f ms "
-                "apart instead of %.0f",
-                got_ms, 1.0 / *interval, settings_.display_hz, frame_ms, shown_ms, flash_ms,
-                soa_shown_ms, soa_ms);
+  int n = std::snprintf(text, sizeof text,
+                        "display: a frame every %.0f ms (%.1f Hz; display_hz %.0f asks for %.1f "
+                        "ms): ",
+                        got_ms, 1.0 / *interval, settings_.display_hz, frame_ms);
+  // A flash that still fits its frames keeps its length: only what changes is said.
+  if (std::lround(shown_ms) != std::lround(flash_ms))
+    n += std::snprintf(text + n, sizeof text - static_cast<size_t>(n),
+                       "flashes will last about %.0f ms instead of %.0f, and ", shown_ms, flash_ms);
+  std::snprintf(text + n, sizeof text - static_cast<size_t>(n),
+                "onsets come about %.0f ms apart instead of %.0f", soa_shown_ms, soa_ms);
   return text;
 }
 

@@ -54,6 +54,13 @@ bool Session::request(Request request) {
     operator_log_.add(time(), Severity::Warning, "subject and run not changed: " + why);
     return false;
   }
+  if (std::holds_alternative<ApplySettingsRequest>(request)) {
+    // The window opens a session again with them; a session cannot change its own.
+    operator_log_.add(time(), Severity::Warning,
+                      "settings not applied: only the window's start screen applies settings to "
+                      "a run (this one keeps its own)");
+    return false;
+  }
   const std::optional<Action> action = actionOf(request);
   if (action) {
     const std::string why = whyNot(*action);

@@ -36,7 +36,7 @@ TEST(Xdf, OneEegStreamAndItsMarkersReadBackWithTheRightSamplesAndEvents) {
   test::writeXdf(path, eeg,
                  {{t0 + 50 * dt, "Trial 1 start"},
                   {t0 + 100 * dt, "flash 3 target"},
-                  {t0 + 200.4 * dt, "flash 4 nontarget"},  // between samples: the next one
+                  {t0 + 200.4 * dt, "flash 4 nontarget"},  // between samples: the nearest
                   {t0 + 300 * dt, "7"},
                   {t0 + 2000 * dt, "flash 1 target"}});  // after the EEG ended: dropped
   const Recording r = readRecording(path);
@@ -50,7 +50,7 @@ TEST(Xdf, OneEegStreamAndItsMarkersReadBackWithTheRightSamplesAndEvents) {
   EXPECT_EQ(r.stimuli[0].sample, 100);
   EXPECT_EQ(r.stimuli[0].code, 3);
   EXPECT_TRUE(r.stimuli[0].target && r.stimuli[0].known);
-  EXPECT_EQ(r.stimuli[1].sample, 201);
+  EXPECT_EQ(r.stimuli[1].sample, 200);
   EXPECT_EQ(r.stimuli[1].code, 4);
   EXPECT_FALSE(r.stimuli[1].target);
   EXPECT_TRUE(r.stimuli[1].known);

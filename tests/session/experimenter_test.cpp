@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "arbci/session/experimenter.h"
+#include "arbci/session/record_text.h"
 
 namespace arbci::session {
 namespace {
@@ -27,6 +28,30 @@ TEST(Experimenter, AStopDuringCalibrationCannotSkipATrialButCanRetry) {
   const CycleRecord last = stoppedIn(bci::Phase::CalibrationFlashing, 0);
   EXPECT_NE(whyNot(Action::SkipTrial, last), "");
   EXPECT_EQ(whyNot(Action::RetryStep, last), "");
+}
+
+// After an E-STOP the next step is said as long as the run waits: where the arm is, and what Retry
+// step, Skip trial and Resume each do (Resume after a robot step ends that trial).
+TEST(Experimenter, AfterAStopTheNextStepIsSaidWithWhereTheArmIs) {
+  CycleRecord last = stoppedIn(bci::Phase::Grasping, 2);
+  last.robot.at_home = true;
+  const std::string next = recoveryText(last);
+  EXPECT_NE(next.find("Stopped in trial 2 (robot grasping). The arm is at home, holding nothing."),
+            std::string::npos)
+      << next;
+  EXPECT_NE(next.find("Retry step does the grasp again; Skip trial or Resume ends this trial here "
+                      "and starts the next"),
+            std::string::npos)
+      << next;
+  last.robot.at_home = false;
+  EXPECT_NE(recoveryText(last).find("Home (Robot panel) first"), std::string::npos);
+  const CycleRecord flashing = stoppedIn(bci::Phase::CellFlashing, 1);
+  EXPECT_NE(recoveryText(flashing).find("Resume (or Retry step) goes on with phase 2"),
+            std::string::npos)
+      << recoveryText(flashing);
+  CycleRecord running;
+  running.paradigm.phase = bci::Phase::ObjectFlashing;
+  EXPECT_EQ(recoveryText(running), "");
 }
 
 TEST(Experimenter, AStopInATrialCanSkipIt) {

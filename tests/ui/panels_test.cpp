@@ -182,6 +182,16 @@ class Drawer {
     frame(bench, input);
     return true;
   }
+  // A text field clicked and `text` typed in it (a number field selects its value on the click,
+  // so the text replaces it); false when no field is drawn under that label.
+  bool type(test::PanelBench& bench, const std::string& label, const std::string& text) {
+    if (!click(bench, label)) return false;
+    SyntheticInput input;
+    input.text = text;
+    frame(bench, input);
+    frames(bench, 2);
+    return true;
+  }
   // A key pressed with Ctrl (a shortcut), over one frame.
   void ctrlKey(test::PanelBench& bench, char key) {
     SyntheticInput input;
@@ -359,6 +369,26 @@ TEST_F(Panels, BeforeStartTheSessionPanelTakesTheSubjectAndPostsStart) {
   EXPECT_FALSE(refused.widgets.at("Start").enabled);
   EXPECT_EQ(refused.widgets.at("Start").why_disabled,
             "give the subject: the run is exported to the BIDS dataset bids");
+}
+
+// The pre-flight asks about a display too slow for display_hz: the Session panel offers to run
+// annotated, and the answer is the Start that accepts the display.
+TEST_F(Panels, ASlowDisplaysQuestionIsAnsweredFromTheSessionPanel) {
+  bench_.record = session::CycleRecord{};
+  bench_.record.preflight.display_question =
+      "display: a frame every 75 ms (13.3 Hz; display_hz 60 asks for 16.7 ms): flashes will last "
+      "about 75 ms instead of 67, and onsets come about 225 ms apart instead of 183";
+  bench_.window = WindowState([](const core::RunLabels&) { return RunTarget{"", "a run"}; });
+  bench_.window.ingest(bench_.record, bench_.settings);
+  auto panel = make("session");
+  Drawer drawer(*context_, *panel);
+  const std::string label = "Run annotated on this display (no timing pauses this run)";
+  ASSERT_TRUE(drawer.frames(bench_).widgets.count(label));
+  ASSERT_TRUE(drawer.click(bench_, label));
+  ASSERT_EQ(bench_.requests.count<session::StartRequest>(), 1);
+  const auto& start = std::get<session::StartRequest>(bench_.requests.posted.back());
+  EXPECT_TRUE(start.despite_display);
+  EXPECT_FALSE(start.despite_quality);
 }
 
 // A double click must not land on a button that took another's place: Start, Pause, Resume and
@@ -676,6 +706,32 @@ TEST_F(Panels, TheSettingsPanelRefusesABadValueWithItsReason) {
   EXPECT_FALSE(d.widgets.at("Save").enabled);
   const std::string why = d.widgets.at("Save").why_disabled;
   EXPECT_NE(why.find("paradigm.flash_ms"), std::string::npos) << why;
+}
+
+// Before Start an edit applies to the run about to start (the window opens the session again
+// with it); once the run goes on, the panel offers it to the next run only.
+TEST_F(Panels, TheSettingsPanelAppliesAnEditBeforeStartAndNotOnceRunning) {
+  bench_.record.paradigm.phase = bci::Phase::Setup;
+  bench_.settings.paradigm.trials = 3;
+  auto panel = make("settings");
+  Drawer drawer(*context_, *panel);
+  const Drawn unedited = drawer.frames(bench_);
+  ASSERT_TRUE(unedited.widgets.count("Apply to this run"));
+  EXPECT_FALSE(unedited.widgets.at("Apply to this run").enabled) << "nothing edited yet";
+  ASSERT_TRUE(drawer.type(bench_, "find a setting", "trials"));
+  ASSERT_TRUE(drawer.type(bench_, "paradigm.trials", "2"));
+  const Drawn edited = drawer.frames(bench_);
+  ASSERT_TRUE(edited.widgets.at("Apply to this run").enabled)
+      << edited.widgets.at("Apply to this run").why_disabled;
+  ASSERT_TRUE(drawer.click(bench_, "Apply to this run"));
+  ASSERT_EQ(bench_.requests.count<session::ApplySettingsRequest>(), 1);
+  const auto& apply = std::get<session::ApplySettingsRequest>(bench_.requests.posted.back());
+  EXPECT_EQ(nlohmann::json::parse(apply.settings_json).at("paradigm").at("trials"), 2);
+
+  bench_.record.paradigm.phase = bci::Phase::CalibrationFlashing;
+  const Drawn running = drawer.frames(bench_);
+  EXPECT_FALSE(running.widgets.count("Apply to this run"));
+  EXPECT_TRUE(running.widgets.count("Save"));
 }
 
 TEST(StartError, TheScreenShowsTheReasonAndQuitEndsIt) {

@@ -1,7 +1,8 @@
 // The session's settings in the window, built from the settings schema: every key with the
 // widget of its type, its unit and range, and its documentation as a tooltip; each edit checked
-// at once by the same code and with the same messages as a session file; saved to a session file
-// for the next run (a running session keeps the settings it started with).
+// at once by the same code and with the same messages as a session file. Before Start they can be
+// applied to the run about to start (the window opens the session again with them, as BCI2000's
+// Set Config); once it runs they are shown read-only, to be saved for the next run.
 #include <imgui.h>
 
 #include <algorithm>
@@ -85,6 +86,8 @@ std::string saveSettings(const nlohmann::json& settings, const std::string& file
   return "saved " + file + " (arbci run --session " + file + ")";
 }
 
+constexpr const char* kNothingToApply = "these are already the run's settings";
+
 class SettingsPanel final : public Panel {
  public:
   const char* title() const override { return "Settings"; }
@@ -96,6 +99,7 @@ class SettingsPanel final : public Panel {
   bool editTable(const core::Table& table, nlohmann::json& object, const std::string& path);
   bool editKey(const core::Key& key, nlohmann::json& value, const std::string& path);
   bool initialised_ = false;
+  bool applied_ = false;  // posted: the next frame's settings are the session's new ones
   nlohmann::json document_;
   std::string error_, message_;
   char filter_[128] = "";
@@ -231,10 +235,30 @@ bool SettingsPanel::editTable(const core::Table& table, nlohmann::json& object,
 
 void SettingsPanel::draw(const PanelInput& in) {
   initialise(in);
+  if (applied_) {
+    // The session opened again: its settings as it reads them (defaults written out).
+    applied_ = false;
+    document_ = in.settings.toJson();
+    check();
+  }
   const core::Table& schema = session::sessionSchema();
-  ImGui::TextWrapped(
-      "The settings this session runs with. Edits are checked as a session file is; save them "
-      "and start the next run with arbci run --session FILE (a running session keeps its own).");
+  const session::CycleRecord& r = in.record;
+  // Applicable until Start is pressed (the pre-flight running is a start under way).
+  const bool before_start =
+      r.paradigm.phase == bci::Phase::Setup && !r.preflight.running && !r.ended;
+  const bool pending = document_ != in.settings.toJson();
+  if (before_start) {
+    ImGui::TextWrapped(
+        "The settings of the run about to start. Edits are checked as a session file is; Apply "
+        "to this run opens the session again with them (the window keeps the subject and run).");
+  } else {
+    ImGui::TextWrapped(
+        "Read-only: this run keeps the settings it started with; changes apply to the next run "
+        "(Save writes a session file to start it with: arbci run --session FILE).");
+    if (pending)
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.2f, 1.0f),
+                         "the edits below were not applied to this run; Save keeps them");
+  }
   ImGui::SetNextItemWidth(-FLT_MIN);
   ImGui::InputTextWithHint("##find", "find a setting (name or description)", filter_,
                            sizeof filter_);
@@ -248,6 +272,15 @@ void SettingsPanel::draw(const PanelInput& in) {
   }
   pathInput("session file to save", save_path_, sizeof save_path_, ".json",
             "where Save writes these settings (a complete session file)");
+  if (before_start) {
+    // Refused while the document does not check, with the reason shown above.
+    if (button("Apply to this run", !error_.empty() ? error_ : !pending ? kNothingToApply : "")) {
+      applied_ = in.requests.post(session::ApplySettingsRequest{document_.dump()});
+      message_ = applied_ ? "applied: the session opened again with these settings"
+                          : "not applied: the run has started (these apply to the next run)";
+    }
+    ImGui::SameLine();
+  }
   if (button("Save", error_)) {
     message_ = saveSettings(document_, save_path_);
   }
@@ -261,9 +294,14 @@ void SettingsPanel::draw(const PanelInput& in) {
     ImGui::SameLine();
     ImGui::TextWrapped("%s", message_.c_str());
   }
+  if (before_start && pending)
+    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.2f, 1.0f),
+                       "edited: not this run's settings until applied");
   ImGui::Separator();
   ImGui::BeginChild("settings", ImVec2(0, 0), false);
+  ImGui::BeginDisabled(!before_start);
   if (editTable(schema, document_, "")) check();
+  ImGui::EndDisabled();
   ImGui::EndChild();
 }
 

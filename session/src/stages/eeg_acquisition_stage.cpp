@@ -113,8 +113,18 @@ void EegAcquisitionStage::watchDelivery(Cycle& cycle, bool delivered) {
   // The text changes each second it lasts; the fault is logged as it starts.
   if (silence_.empty()) silence_ = text;
   out.fault = silence_;
-  if (!settings_.experimenter && silent >= kSilentEndS)
-    cycle.end(std::string(text) + "; nobody at the window to bring it back", "fault");
+}
+
+void EegAcquisitionStage::endIfNobodyCanHelp(Cycle& cycle) {
+  const std::string& fault = cycle.record.eeg.fault;
+  if (fault.empty()) {
+    fault_since_host_s_.reset();
+    return;
+  }
+  if (!fault_since_host_s_) fault_since_host_s_ = cycle.host_s;
+  // A source in fault (its own word, or its silence) that nobody at a window can bring back.
+  if (!settings_.experimenter && cycle.host_s - *fault_since_host_s_ >= kSilentEndS)
+    cycle.end(fault + "; nobody at the window to bring it back", "fault");
 }
 
 void EegAcquisitionStage::take(Cycle& cycle) {
@@ -212,6 +222,8 @@ void EegAcquisitionStage::step(Cycle& cycle) {
   });
   if (const std::string fault = acquisition_->fault(); !fault.empty()) out.fault = fault;
   if (out.fault.empty()) watchDelivery(cycle, !out.blocks.empty());
+  if (!out.blocks.empty()) last_delivery_host_s_ = cycle.host_s;
+  endIfNobodyCanHelp(cycle);
   if (out.fault != fault_logged_) {
     s_.log.write("eeg_source", cycle.time_s,
                  {{"fault", out.fault}, {"state", out.fault.empty() ? "delivering" : "fault"}});

@@ -93,9 +93,10 @@ class ScriptedSource final : public bci::EegSource {
   std::int64_t next_ = 0;
 };
 
-EegAcquisitionSettings settings(const std::string& photodiode = "Photodiode") {
+EegAcquisitionSettings settings(const std::string& photodiode = "Photodiode",
+                                bool experimenter = true) {
   EegAcquisitionSettings s;
-  s.experimenter = true;
+  s.experimenter = experimenter;
   s.eeg.photodiode_channel = photodiode;
   s.flash_s = 4.0 / 60.0;
   s.session_file = "test.json";
@@ -103,14 +104,15 @@ EegAcquisitionSettings settings(const std::string& photodiode = "Photodiode") {
 }
 
 struct Acquiring {
-  explicit Acquiring(test::StageBench& bench, const std::string& photodiode = "Photodiode") {
+  explicit Acquiring(test::StageBench& bench, const std::string& photodiode = "Photodiode",
+                     bool experimenter = true) {
     OpenedEegSource opened;
     opened.clock = bench.clock().sourceClock(0.0);
     auto own = std::make_unique<ScriptedSource>(opened.clock);
     source = own.get();
     opened.source = std::move(own);
-    stage = std::make_unique<EegAcquisitionStage>(settings(photodiode), std::move(opened),
-                                                  bench.clock(), bench.services());
+    stage = std::make_unique<EegAcquisitionStage>(
+        settings(photodiode, experimenter), std::move(opened), bench.clock(), bench.services());
   }
   ScriptedSource* source;
   std::unique_ptr<EegAcquisitionStage> stage;
@@ -278,6 +280,33 @@ TEST(EegAcquisitionStage, ALiveSourceThatGoesSilentIsAFaultNamingTheSilence) {
   for (int i = 0; i < 50 && !fault.empty(); ++i) fault = cycle();
   EXPECT_EQ(fault, "");
   EXPECT_TRUE(bench.toldOf("EEG source delivering again"));
+}
+
+// Without an experimenter nobody can bring a silent source back: the run ends 2.5 s after its
+// last sample, with the silence as its reason.
+TEST(EegAcquisitionStage, ASilentSourceEndsARunWithoutAnExperimenterWithinThreeSeconds) {
+  test::StageBench bench("eeg_silent_headless", Clock::Mode::RealTime);
+  Acquiring eeg(bench, "Photodiode", false);
+  auto cycle = [&] {
+    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+    bench.record.host_s = bci::hostSeconds();
+    bench.step(*eeg.stage);
+    const std::string ended = bench.record.end_reason;
+    bench.next();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    return ended;
+  };
+  for (int i = 0; i < 30; ++i) ASSERT_EQ(cycle(), "");
+  eeg.source->hold = true;
+  const double from = bci::hostSeconds();
+  std::string ended;
+  while (ended.empty() && bci::hostSeconds() - from < 6.0) ended = cycle();
+  const double after = bci::hostSeconds() - from;
+  EXPECT_NE(ended.find("no EEG sample from"), std::string::npos) << ended;
+  EXPECT_NE(ended.find("nobody at the window to bring it back"), std::string::npos) << ended;
+  // 1 s to be a silence, 1.5 s more for an outlet restarted at once: 2.5 s of the host's time
+  // (a loaded machine's cycles may come later; bench/ reports the figure).
+  EXPECT_GE(after, 2.4);
 }
 
 TEST(EegAcquisitionStage, APhotodiodeChannelTheSourceLacksIsRefusedNamingTheKey) {

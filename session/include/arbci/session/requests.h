@@ -123,6 +123,11 @@ struct NoteRequest {
 struct LabelsRequest {
   core::RunLabels labels;
 };
+// The settings edited on the start screen, for the run about to start (BCI2000's Set Config): to
+// the window, which opens the session again with them (a running session keeps its own).
+struct ApplySettingsRequest {
+  std::string settings_json;  // the whole session document, as a session file holds it
+};
 
 using Request =
     std::variant<StartRequest, TimingPolicyRequest, BeginRequest, PauseRequest, ResumeRequest,
@@ -131,7 +136,7 @@ using Request =
                  RobotStopRequest, RobotResetRequest, RobotResetIfLatchedRequest, RobotHomeRequest,
                  RobotReleaseRequest, FinishPutDownRequest, RobotProbeRequest, TrainRequest,
                  UseModelRequest, ThresholdRequest, ReferenceRequest, HoldBoardRequest,
-                 LabelsRequest, NoteRequest>;
+                 LabelsRequest, NoteRequest, ApplySettingsRequest>;
 
 // The requests of one kind among `requests`, in order.
 template <class T>

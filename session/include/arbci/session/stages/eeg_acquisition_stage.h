@@ -83,11 +83,16 @@ class EegAcquisitionStage final : public Stage {
   // kSilentS is a fault (the paradigm pauses) named with the time since its last sample, and
   // without an experimenter ends the run after kSilentEndS.
   void watchDelivery(Cycle& cycle, bool delivered);
+  // Without an experimenter a fault that lasts kSilentEndS ends the run, saying why.
+  void endIfNobodyCanHelp(Cycle& cycle);
+  std::optional<double> fault_since_host_s_;
   std::optional<double> last_delivery_s_;  // session time the last samples arrived
   double last_delivery_host_s_ = 0.0;      // and host time
   std::string silence_;                    // the silence's fault while it lasts
   static constexpr double kSilentS = 1.0;
-  static constexpr double kSilentEndS = 10.0;
+  // Long enough for an outlet restarted at once to be found again, short enough that a run
+  // nobody watches ends within 3 s of its last sample.
+  static constexpr double kSilentEndS = 1.5;
 };
 
 }  // namespace arbci::session
