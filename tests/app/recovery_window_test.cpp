@@ -33,11 +33,14 @@ const std::filesystem::path kArtefacts = ARBCI_TEST_ARTEFACTS_DIR;
 // A quick session (a short calibration run, one trial) with a slow arm, so a grasp lasts long
 // enough to be stopped. Under Xvfb on a loaded machine most frames come late: the timing gate
 // would pause the run (gates.timing "pause", its own tests' subject); here flashes are annotated.
+// A quick calibration gives a model too unsure for the arm's paradigm.act_certainty; what these
+// tests check is the window and the arm's recovery, so the arm acts on every selection.
 void writeSession(const std::filesystem::path& file) {
   std::ofstream(file) << R"({
     "cameras": {"head_motion_m": 0.0, "head_motion_deg": 0.0},
     "paradigm": {"calibration_selections": 4, "calibration_sequences": 5, "sequences": 5,
-                 "min_sequences": 5, "certainty": 0.0, "trials": 1, "cue_s": 1.0, "pause_s": 0.5,
+                 "min_sequences": 5, "certainty": 0.0, "act_certainty": 0.0, "trials": 1,
+                 "cue_s": 1.0, "pause_s": 0.5,
                  "intended": [{"object": 40, "cell": [3, 1]}]},
     "robot": {"speed_factor": 2},
     "gates": {"timing": "annotate"}})";

@@ -217,6 +217,8 @@ std::filesystem::path physicsRun(const std::string& name, const std::string& arm
   nlohmann::json file = nlohmann::json::parse(in);
   file["robot"]["model"] = arm;
   file["classifier"]["model"] = kSessions + "/simulated_subject_model.json";
+  // What is checked is the arm: it acts on every selection, however sure the classifier is.
+  file["paradigm"]["act_certainty"] = 0.0;
   std::ofstream(settings) << file.dump();
   const ProcessResult r = runProcess(kArbci,
                                      {"run", "--headless", "--session", settings.string(),
