@@ -250,21 +250,24 @@ TEST(EegAcquisitionStage, AFiniteSourceAtItsEndEndsTheRunWithTheReason) {
   ASSERT_EQ(summary["eeg"]["faults"].size(), 1u);
 }
 
+// One cycle at the host's pace (a live source): the record as the stage left it.
+CycleRecord liveCycle(test::StageBench& bench, Acquiring& eeg) {
+  bench.record.time_s = bench.clock().frameTime(bench.record.frame);
+  bench.record.host_s = bci::hostSeconds();
+  bench.step(*eeg.stage);
+  CycleRecord stepped = bench.record;
+  bench.next();
+  std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  return stepped;
+}
+
 // A live source that goes silent: within about a second its silence is the record's fault (the
 // paradigm pauses on it), named with the time since its last sample; it clears when samples come
 // again.
 TEST(EegAcquisitionStage, ALiveSourceThatGoesSilentIsAFaultNamingTheSilence) {
   test::StageBench bench("eeg_silent", Clock::Mode::RealTime);
   Acquiring eeg(bench);
-  auto cycle = [&] {
-    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
-    bench.record.host_s = bci::hostSeconds();
-    bench.step(*eeg.stage);
-    const std::string fault = bench.record.eeg.fault;
-    bench.next();
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    return fault;
-  };
+  auto cycle = [&] { return liveCycle(bench, eeg).eeg.fault; };
   for (int i = 0; i < 30; ++i) ASSERT_EQ(cycle(), "");
   eeg.source->hold = true;
   const double from = bci::hostSeconds();
@@ -287,15 +290,7 @@ TEST(EegAcquisitionStage, ALiveSourceThatGoesSilentIsAFaultNamingTheSilence) {
 TEST(EegAcquisitionStage, ASilentSourceEndsARunWithoutAnExperimenterWithinThreeSeconds) {
   test::StageBench bench("eeg_silent_headless", Clock::Mode::RealTime);
   Acquiring eeg(bench, "Photodiode", false);
-  auto cycle = [&] {
-    bench.record.time_s = bench.clock().frameTime(bench.record.frame);
-    bench.record.host_s = bci::hostSeconds();
-    bench.step(*eeg.stage);
-    const std::string ended = bench.record.end_reason;
-    bench.next();
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    return ended;
-  };
+  auto cycle = [&] { return liveCycle(bench, eeg).end_reason; };
   for (int i = 0; i < 30; ++i) ASSERT_EQ(cycle(), "");
   eeg.source->hold = true;
   const double from = bci::hostSeconds();
