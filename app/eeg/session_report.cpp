@@ -111,11 +111,15 @@ std::filesystem::path writeSessionReport(const std::filesystem::path& folder) {
   const std::filesystem::path figures = folder / "report";
   const std::string missing = calibrationFigures(folder, figures);
   if (missing.empty()) {
-    html << "<p>The ERP at each channel (target and non-target, the difference) and the "
-            "accuracy by sequences, cross-validated by selection, made again from recording.bdf "
-            "with the model's pipeline (the figures summary.json gives are the session's own; "
-            "the filter's start on the recording's first sample can move them a little); the "
-            "numbers in report/erp.json.</p>\n<img src=\"report/erp.png\" alt=\"ERP\">\n"
+    html << "<p>The ERP at each channel (target and non-target, the difference), where in time "
+            "and on the scalp the classes differ (signed r&sup2;; the difference at its peak), "
+            "and the accuracy by sequences, cross-validated by selection, made again from "
+            "recording.bdf with the model's pipeline (the figures summary.json gives are the "
+            "session's own; the filter's start on the recording's first sample can move them a "
+            "little); the numbers in report/erp.json.</p>\n"
+            "<img src=\"report/erp.png\" alt=\"ERP\">\n"
+            "<img src=\"report/r2.png\" alt=\"signed r-squared by channel and time\">\n"
+            "<img src=\"report/scalp.png\" alt=\"the difference on the scalp at its peak\">\n"
             "<img src=\"report/accuracy.png\" alt=\"accuracy by sequences\">\n";
   } else {
     html << "<p>No figures: " << escaped(missing) << ".</p>\n";

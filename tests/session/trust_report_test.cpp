@@ -55,7 +55,7 @@ TEST(TrustReport, ACleanRunHasNoCautionAndItsAucIsPutBesideChanceAndTheSubject) 
   EXPECT_NE(calibration->text.find("chance with these 64 target and 192 other flashes: 0.50 +/-"),
             std::string::npos)
       << calibration->text;
-  EXPECT_NE(calibration->text.find("the simulated default subject reaches 0.76"),
+  EXPECT_NE(calibration->text.find("the simulated default subject reaches 0.78"),
             std::string::npos);
   ASSERT_NE(row(rows, "note at 30.5 s"), nullptr);
   EXPECT_EQ(row(rows, "note at 30.5 s")->text, "the subject blinked a lot");
