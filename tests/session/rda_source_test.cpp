@@ -307,6 +307,56 @@ TEST(RdaSource, AStreamThatStopsAndStartsAgainGoesOnAfterAGap) {
   EXPECT_EQ(blocks[2].first_sample, blocks[1].first_sample + 16);  // the new counter is no loss
   EXPECT_EQ(faultWhen(*o.source, [](const std::string& f) { return f.empty(); }), "");
   EXPECT_NE(o.source->describe().find("1 restart(s)"), std::string::npos) << o.source->describe();
+  // The counter started again at 0: the host clock measured the time away.
+  EXPECT_NE(o.source->describe().find("0 resumption(s) counted from the block numbers, 1 from the "
+                                      "host clock"),
+            std::string::npos)
+      << o.source->describe();
+}
+
+// Block numbers that go on after a stop count the time away exactly: blocks 1-6 (16 points each)
+// were taken while the stream was stopped for about 0.4 s, so block 7 starts on sample 112
+// whatever the host clock says.
+TEST(RdaSource, AStopWhoseBlockNumbersGoOnIsAGapOfExactlyTheBlocksMissed) {
+  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0), message(3, {}),
+                    Step::pause(400), startMessage(kNames, 256.0, 1.0), dataMessage(7, 16, 4, 112),
+                    dataMessage(8, 16, 4, 128)});
+  Opened o = openRda(server.port());
+  const std::vector<bci::Block> blocks = pollSamples(*o.source, 48, false);
+  ASSERT_EQ(blocks.size(), 3u);
+  EXPECT_EQ(blocks[1].first_sample, 112);
+  EXPECT_FLOAT_EQ(blocks[1].at(0, 0), 1120.0f);
+  EXPECT_EQ(blocks[2].first_sample, 128);
+  EXPECT_NE(o.source->describe().find("96 samples lost to gaps (1 resumption(s) counted from the "
+                                      "block numbers, 0 from the host clock)"),
+            std::string::npos)
+      << o.source->describe();
+}
+
+// Data after a stop with no start message: nothing confirms its channels, so it is left out, a
+// fault while it lasts and a note in the recording; the next start goes on, the blocks left out
+// counted in the gap by their numbers.
+TEST(RdaSource, DataAfterAStopWithoutAStartIsLeftOutAsAFaultWithANote) {
+  RdaServer server({startMessage(kNames, 256.0, 1.0), dataMessage(0, 16, 4, 0), message(3, {}),
+                    Step::pause(100), dataMessage(1, 16, 4, 16), dataMessage(2, 16, 4, 32),
+                    Step::pause(400), startMessage(kNames, 256.0, 1.0), dataMessage(3, 16, 4, 48)});
+  Opened o = openRda(server.port());
+  const std::string fault = faultWhen(*o.source, [](const std::string& f) {
+    return f.find("without a new start message") != std::string::npos;
+  });
+  EXPECT_NE(fault.find("left out until the stream starts again"), std::string::npos) << fault;
+  const std::vector<bci::Block> blocks = pollSamples(*o.source, 32, false);
+  ASSERT_EQ(blocks.size(), 2u);
+  EXPECT_EQ(blocks[1].first_sample, 48);
+  EXPECT_FLOAT_EQ(blocks[1].at(2, 0), 482.0f);
+  EXPECT_EQ(faultWhen(*o.source, [](const std::string& f) { return f.empty(); }), "");
+  const std::vector<bci::Annotation> notes = o.source->takeAnnotations();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].sample, 16);
+  EXPECT_NE(notes[0].text.find("without a start message"), std::string::npos) << notes[0].text;
+  EXPECT_NE(o.source->describe().find("2 block(s) after a stop without a start left out"),
+            std::string::npos)
+      << o.source->describe();
 }
 
 // The server goes away (Recorder closed) and comes back 0.4 s later: the client reconnects by

@@ -13,11 +13,14 @@
 // Blocks carry no time stamps: they are stamped on arrival. Nothing is filled in here: a jump in
 // the block number (blocks the server sent and this client never got) and the time a stopped or
 // lost stream was away are gaps in the sample numbers, which the acquisition fills with zeros,
-// counts and annotates like any source's. A stop, or a connection that closes, is a fault while
-// it lasts: the client waits for a new start message (reconnecting every second if the
-// connection went) and goes on when data returns, as an LSL source does. Markers become
-// annotations "<type>/<description>" ("Stimulus/S  1", as BrainVision's marker files name them)
-// on their sample.
+// counts and annotates like any source's. The time away is counted from the block numbers where
+// they go on after the stop (exact), from the host clock where they start again. A stop, or a
+// connection that closes, is a fault while it lasts: the client waits for a new start message
+// (reconnecting every second if the connection went) and goes on when data returns, as an LSL
+// source does; data that comes after a stop without a start is left out, a fault and a note in
+// the recording, since nothing confirms its channels. Markers become annotations
+// "<type>/<description>" ("Stimulus/S  1", as BrainVision's marker files name them) on their
+// sample.
 #include <arpa/inet.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -160,7 +163,10 @@ class RdaSource final : public bci::EegSource {
     return "RDA stream at " + where_ + ": " + std::to_string(info_.channelCount()) +
            " channels at " + core::formatNumber(info_.rate_hz) + " Hz; " +
            std::to_string(lost_blocks_) + " block(s) lost, " + std::to_string(restarts_) +
-           " restart(s), " + std::to_string(gap_samples_) + " samples lost to gaps";
+           " restart(s), " + std::to_string(gap_samples_) + " samples lost to gaps (" +
+           std::to_string(gaps_by_blocks_) + " resumption(s) counted from the block numbers, " +
+           std::to_string(gaps_by_clock_) + " from the host clock); " +
+           std::to_string(unconfirmed_blocks_) + " block(s) after a stop without a start left out";
   }
 
  private:
@@ -281,13 +287,38 @@ class RdaSource final : public bci::EegSource {
       throw RdaError("an RDA data message shorter than its " + std::to_string(points) + " points");
     const double now = bci::hostSeconds();
     std::lock_guard lock(mutex_);
+    if (awaiting_start_) {
+      // Data after a stop (or a new connection) with no start message: its layout is not
+      // confirmed, so it is not read. The blocks it held become a gap when the stream starts again.
+      ++unconfirmed_blocks_;
+      if (!unconfirmed_noted_) {
+        unconfirmed_noted_ = true;
+        fault_ = "the RDA server at " + where_ +
+                 " sent data after a stop without a new start message; it is left out until the "
+                 "stream starts again";
+        markers_.push_back({pending_first_ + pendingPoints(),
+                            "RDA: data after a stop without a start message left out", 0});
+      }
+      return;
+    }
     if (resumed_) {
-      // After a stop or a lost connection: the samples the amplifier took meanwhile (the time
-      // away less this block's own) are a gap; its block numbers start again.
+      // After a stop or a lost connection the samples the amplifier took meanwhile are a gap. Where
+      // the block numbers go on from the last one they count it exactly; where they start again
+      // (or claim more than the time away could hold) the host clock measures it: the time away
+      // less this block's own samples.
       resumed_ = false;
-      const auto missing =
+      const std::int64_t by_clock =
           std::llround((now - last_data_host_) * info_.rate_hz) - static_cast<std::int64_t>(points);
-      if (last_data_host_ > 0.0 && missing > 0) skip(missing);
+      const std::uint32_t jump = last_block_ ? block - *last_block_ - 1 : 0x80000000u;
+      const std::int64_t by_blocks = static_cast<std::int64_t>(jump) * points;
+      if (jump < 0x80000000u &&
+          by_blocks <= std::max<std::int64_t>(by_clock, 0) + std::llround(info_.rate_hz)) {
+        if (by_blocks > 0) skip(by_blocks);
+        ++gaps_by_blocks_;
+      } else {
+        if (last_data_host_ > 0.0 && by_clock > 0) skip(by_clock);
+        ++gaps_by_clock_;
+      }
     } else if (last_block_) {
       // Blocks the server sent and this client never got (uint32 arithmetic: the counter wraps).
       const std::uint32_t jump = block - *last_block_ - 1;
@@ -347,7 +378,11 @@ class RdaSource final : public bci::EegSource {
           if (closed_) {
             ::close(fd_);
             fd_ = -1;
-            resumed_ = true;
+            {
+              std::lock_guard lock(mutex_);
+              resumed_ = true;
+              awaiting_start_ = true;
+            }
             setFault("the RDA server at " + where_ +
                      " closed the connection; reconnecting when it is back");
           }
@@ -356,7 +391,11 @@ class RdaSource final : public bci::EegSource {
         if (type == kData32) readData(message);
         if (type == kData16) throw RdaError(sixteenBit());
         if (type == kStop) {
-          resumed_ = true;
+          {
+            std::lock_guard lock(mutex_);
+            resumed_ = true;
+            awaiting_start_ = true;
+          }
           setFault("the RDA server at " + where_ +
                    " stopped the stream (Recorder stopped, or switched to impedance mode); "
                    "going on when it starts again");
@@ -370,6 +409,8 @@ class RdaSource final : public bci::EegSource {
           std::lock_guard lock(mutex_);
           ++restarts_;
           resumed_ = true;
+          awaiting_start_ = false;
+          unconfirmed_noted_ = false;
         }
       }
     } catch (const std::exception& error) {
@@ -392,8 +433,11 @@ class RdaSource final : public bci::EegSource {
   std::vector<bci::Annotation> markers_;
   std::optional<std::uint32_t> last_block_;
   double last_data_host_ = 0.0;
-  bool resumed_ = false;  // the next data follows a stop or a reconnection
-  std::int64_t lost_blocks_ = 0, gap_samples_ = 0;
+  bool resumed_ = false;            // the next data follows a stop or a reconnection
+  bool awaiting_start_ = false;     // stopped or reconnected, and no start message since
+  bool unconfirmed_noted_ = false;  // the recording notes data without a start once per stop
+  std::int64_t lost_blocks_ = 0, gap_samples_ = 0, unconfirmed_blocks_ = 0;
+  int gaps_by_blocks_ = 0, gaps_by_clock_ = 0;  // how each resumption's gap was counted
   int restarts_ = 0;
   std::string fault_;
 };
