@@ -118,6 +118,9 @@ void convert(const std::string& in, const std::string& out, bool salvage) {
       for (const std::string& text : writer.shortenedTexts()) std::cout << " \"" << text << "...\"";
     }
     std::cout << "\n";
+    // What the reader had to decide (outlier stamps, breaks, markers left out): said here too,
+    // since the BDF alone cannot say it.
+    for (const std::string& note : r.notes) std::cout << "note: " << note << "\n";
   } catch (const bci::RecordingError& error) {
     throw CliError(error.what());
   }

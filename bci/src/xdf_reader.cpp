@@ -152,6 +152,15 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
   if (!eeg_clock.breaks.empty())
     r.notes.push_back(std::to_string(eeg_clock.breaks.size()) +
                       " break(s) in the EEG's stamps, each annotated where it falls");
+  if (eeg_clock.outliers > 0) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "%zu EEG stamp(s) that no line through their neighbours explains (the furthest "
+                  "%.3g s off) were left out of the stamps' fit: their samples keep the places "
+                  "the line gives them, and no marker moved",
+                  eeg_clock.outliers, eeg_clock.largest_outlier_s);
+    r.notes.push_back(text);
+  }
 
   // Markers: each at the EEG sample nearest its time (docs/eeg.md, "One marker rule"). The
   // EEG's fitted stamps are exact to a few microseconds, not to zero: a marker stamped on a

@@ -204,6 +204,45 @@ TEST(Xdf, ABreakInTheEegIsAnnotatedAndMarkersAfterItStayOnTheirSamples) {
       << r.annotations[0].text;
 }
 
+// Jittered stamps (0.5-1.5 ms, as LSL stamps a USB amplifier's chunks) with wild ones among them
+// (a bit flipped: +6e8 s; a clock read wrong: -512 s and +1e8 s), markers at arbitrary times:
+// every marker on its nearest sample, no break, and the wild stamps counted in a note.
+TEST(Xdf, AWildStampIsAnOutlierNotedNeverABreakNorAShift) {
+  const auto path = test::freshTempPath("xdf", "wild_stamp.xdf");
+  const test::XdfNumericStream eeg = eegStream(256 * 60);
+  const double t0 = eeg.first_timestamp, dt = 1.0 / eeg.rate;
+  test::XdfExtras extras;
+  std::uint64_t state = 12345;
+  auto uniform = [&] {  // a small LCG: the test's own, so that it never changes under it
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (size_t s = 0; s < eeg.samples.size(); ++s)
+    extras.eeg_stamps.push_back(t0 + static_cast<double>(s) * dt + 0.0005 + 0.001 * uniform());
+  extras.eeg_stamps[100] += 6e8;
+  extras.eeg_stamps[7000] -= 512.0;
+  extras.eeg_stamps.back() += 1e8;
+  std::vector<test::XdfMarker> markers;
+  std::vector<std::int64_t> expected;
+  for (int i = 0; i < 150; ++i) {
+    // Anywhere within 0.4 periods of sample k's place on the stamps' line (t0 + k dt + the
+    // jitter's 1 ms mean), either side.
+    const std::int64_t k = 51 + 100 * i;
+    markers.push_back(
+        {t0 + k * dt + 0.001 + (uniform() - 0.5) * 0.8 * dt, "flash 1 nontarget", {}});
+    expected.push_back(k);
+  }
+  test::writeXdf(path, eeg, markers, extras);
+  const Recording r = readRecording(path);
+  ASSERT_EQ(r.stimuli.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(r.stimuli[i].sample, expected[i]) << i;
+  EXPECT_TRUE(r.annotations.empty()) << r.annotations.front().text;  // no break
+  bool noted = false;
+  for (const std::string& note : r.notes)
+    noted |= note.rfind("3 EEG stamp(s) that no line through their neighbours explains", 0) == 0;
+  EXPECT_TRUE(noted) << ::testing::PrintToString(r.notes);
+}
+
 // A file cut anywhere (at a chunk's end, or inside one) is never read as whole: refused, saying
 // so, or (salvaging) read with the truncation noted.
 TEST(Xdf, AFileCutAnywhereIsReportedAsCutShort) {

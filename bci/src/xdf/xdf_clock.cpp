@@ -14,11 +14,17 @@ namespace {
 // stamps over the half second after it differs from the half second before it by this much too.
 constexpr double kBreakS = 0.05;
 constexpr double kLevelWindowS = 0.5;
+constexpr std::size_t kLevelSamples = 3;
 // A clock reset: successive offsets whose collection times step back, or forward by more than
 // kResetTimeS and kResetStds spreads beyond the usual interval, while their values jump by more
 // than kResetValueS and kResetStds spreads (pyxdf's criteria, with its thresholds).
 constexpr double kResetTimeS = 5.0, kResetValueS = 1.0;
 constexpr double kResetTimeStds = 5.0, kResetValueStds = 10.0;
+// An outlier: a stamp further than both of these from its stretch's robust line. Jitter of LSL's
+// chunk stamps is milliseconds to tens of them; the floor keeps every stamp a late chunk explains
+// in the fit (a stamp kept 0.1 s off moves a line through n stamps by 0.1/n s at most).
+constexpr double kOutlierS = 0.1;
+constexpr double kOutlierSpreads = 10.0;
 // A stamp this far outside its segment's offsets (before the first, after the last) may belong
 // to the next segment, if it lies within that one.
 constexpr double kSegmentMarginS = 10.0;
@@ -126,13 +132,63 @@ std::vector<ClockReport::Break> breaksIn(const std::vector<double>& stamps, doub
   for (std::size_t i = 1; i < n; ++i) {
     const double step = stamps[i] - stamps[i - 1];
     if (step - period <= kBreakS && step >= -kBreakS) continue;
-    const double shift =
-        level(i, std::min(n, i + window)) - level(std::max(stretch, i - std::min(i, window)), i);
+    // Levels of at least kLevelSamples stamps each side: one wild stamp at either end of the
+    // stream is never a level of its own (it is an outlier of the line).
+    const std::size_t before = std::max(stretch, i - std::min(i, window)),
+                      after = std::min(n, i + window);
+    if (i - before < kLevelSamples || after - i < kLevelSamples) continue;
+    const double shift = level(i, after) - level(before, i);
     if (std::abs(shift) < kBreakS) continue;  // a late or early stamp, not a break
     out.push_back({i, shift});
     stretch = i;
   }
   return out;
+}
+
+// stamps[first, end) as a + b * index, fitted so that no single stamp can move it: a line through
+// medians first (the slope from stamps half the stretch apart, which outliers among them cannot
+// pull; the intercept the median of what is left), then least squares over the stamps within the
+// outlier limit of it. Counts what it left out into `report`.
+Line robustFit(const std::vector<double>& stamps, std::size_t first, std::size_t end,
+               ClockReport& report) {
+  const std::size_t n = end - first;
+  const std::size_t lag = std::max<std::size_t>(1, n / 2);
+  std::vector<double> slopes;
+  for (std::size_t i = first; i + lag < end; ++i)
+    slopes.push_back((stamps[i + lag] - stamps[i]) / static_cast<double>(lag));
+  const double b = median(std::move(slopes));
+  std::vector<double> residual(n);
+  for (std::size_t i = 0; i < n; ++i)
+    residual[i] = stamps[first + i] - b * static_cast<double>(first + i);
+  const double a = median(residual);
+  std::vector<double> distance(n);
+  for (std::size_t i = 0; i < n; ++i) distance[i] = std::abs(residual[i] - a);
+  const double spread = 1.4826 * median(distance);  // a robust standard deviation
+  const double limit = std::max(kOutlierS, kOutlierSpreads * spread);
+  double sx = 0.0, sy = 0.0, count = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (distance[i] > limit) {
+      ++report.outliers;
+      report.largest_outlier_s = std::max(report.largest_outlier_s, distance[i]);
+      continue;
+    }
+    sx += static_cast<double>(first + i);
+    sy += stamps[first + i];
+    ++count;
+  }
+  // Centred least squares over the stamps kept (at least half of them, by the median).
+  const double mx = sx / count, my = sy / count;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (distance[i] > limit) continue;
+    const double x = static_cast<double>(first + i) - mx;
+    sxy += x * (stamps[first + i] - my);
+    sxx += x * x;
+  }
+  Line line;
+  line.b = sxx > 0.0 ? sxy / sxx : b;
+  line.a = my - line.b * mx;
+  return line;
 }
 
 }  // namespace
@@ -161,14 +217,13 @@ std::vector<double> recorderStamps(const Stream& s, ClockReport& report) {
   if (s.nominal_rate <= 0.0 || stamps.size() < 2) return stamps;
   report.breaks = breaksIn(stamps, 1.0 / s.nominal_rate);
   // Dejitter each stretch between breaks: stamps = a + b * index.
-  std::vector<double> index(stamps.size());
-  for (std::size_t i = 0; i < index.size(); ++i) index[i] = static_cast<double>(i);
   std::size_t first = 0;
   for (std::size_t k = 0; k <= report.breaks.size(); ++k) {
     const std::size_t end = k < report.breaks.size() ? report.breaks[k].sample : stamps.size();
     if (end - first >= 2) {
-      const Line line = fit(index, stamps, first, end - 1);
-      for (std::size_t i = first; i < end; ++i) stamps[i] = line.a + line.b * index[i];
+      const Line line = robustFit(stamps, first, end, report);
+      for (std::size_t i = first; i < end; ++i)
+        stamps[i] = line.a + line.b * static_cast<double>(i);
     }
     first = end;
   }

@@ -4,8 +4,11 @@
 // both collection time and value); then, for a regular stream, the stamps of each stretch without
 // a break replaced by a straight line through them (dejittered: LSL stamps chunks as they arrive,
 // not samples as they are taken). A break (the stamps shift by 50 ms or more and stay shifted: a
-// gap in the samples, or a clock that stepped) is kept and reported, never closed up; a stamp
-// that is merely late or early, however much, is jitter.
+// gap in the samples, or a clock that stepped) is kept and reported, never closed up. A stamp
+// that is late or early is jitter, and the line goes through it; one that no line through its
+// neighbours explains (further from the stretch's robust line than 0.1 s and ten spreads of its
+// stamps: a flipped bit, a clock read wrong) is an outlier, left out of the line and counted, and
+// its sample keeps the place the line gives it.
 #pragma once
 
 #include <cstddef>
@@ -24,6 +27,10 @@ struct ClockReport {
     double seconds = 0.0;
   };
   std::vector<Break> breaks;
+  // Regular streams: stamps left out of their stretch's line as outliers, and the largest's
+  // distance from it.
+  std::size_t outliers = 0;
+  double largest_outlier_s = 0.0;
 };
 
 // The stream's stamps on the recorder's clock (dejittered when `regular`).
