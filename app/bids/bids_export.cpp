@@ -93,9 +93,83 @@ void describeDataset(const fs::path& dir, const std::string& name, const std::st
   writeText(file, d.dump(2) + "\n");
 }
 
+// participants.tsv's columns, as participants.json describes them.
+constexpr const char* kParticipantColumns[] = {"participant_id", "age", "sex", "handedness"};
+
+std::string participantsJson() {
+  nlohmann::ordered_json j;
+  j["participant_id"] = {{"Description", "the participant's label, as in the sub- folders"}};
+  j["age"] = {{"Description", "age of the participant at the recording"}, {"Units", "year"}};
+  j["sex"] = {{"Description", "sex of the participant, as they reported it"},
+              {"Levels", {{"F", "female"}, {"M", "male"}, {"O", "other"}}}};
+  j["handedness"] = {{"Description", "handedness of the participant, as they reported it"},
+                     {"Levels", {{"R", "right"}, {"L", "left"}, {"A", "ambidextrous"}}}};
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::string> splitTabs(const std::string& line) {
+  std::vector<std::string> cells;
+  std::istringstream in(line);
+  for (std::string c; std::getline(in, c, '\t');) cells.push_back(c);
+  return cells;
+}
+
+// The subject's row in participants.tsv: added when missing; a cell that is n/a filled from
+// `participant`, a stated one never changed. A table of an older export (participant_id only)
+// gains the columns, n/a for the subjects already there; columns a curator added are kept.
+void recordParticipant(const fs::path& root, const std::string& subject,
+                       const BidsParticipant& participant) {
+  const fs::path file = root / "participants.tsv";
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  if (std::ifstream in(file); in) {
+    std::string line;
+    if (std::getline(in, line)) header = splitTabs(line);
+    while (std::getline(in, line))
+      if (!line.empty()) rows.push_back(splitTabs(line));
+  }
+  if (header.empty() || header[0] != "participant_id") {
+    if (!header.empty())
+      throw BidsError(file.string() +
+                      " does not start with a participant_id column: fix it by hand");
+    header.push_back("participant_id");
+  }
+  for (const char* column : kParticipantColumns)
+    if (std::find(header.begin(), header.end(), column) == header.end()) header.push_back(column);
+  const auto column = [&](const std::string& name) {
+    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  for (auto& row : rows) row.resize(header.size(), "n/a");
+  const std::string id = "sub-" + subject;
+  auto row = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r[0] == id; });
+  if (row == rows.end()) {
+    rows.push_back(std::vector<std::string>(header.size(), "n/a"));
+    rows.back()[0] = id;
+    row = rows.end() - 1;
+  }
+  const std::pair<const char*, std::string> given[] = {
+      {"age", participant.age}, {"sex", participant.sex}, {"handedness", participant.handedness}};
+  for (const auto& [name, value] : given) {
+    std::string& c = (*row)[column(name)];
+    if ((c.empty() || c == "n/a") && !value.empty()) c = value;
+  }
+  std::ostringstream out;
+  for (const auto& r : [&] {
+         std::vector<std::vector<std::string>> all{header};
+         all.insert(all.end(), rows.begin(), rows.end());
+         return all;
+       }()) {
+    for (size_t i = 0; i < r.size(); ++i) out << (i ? "\t" : "") << cell(r[i]);
+    out << "\n";
+  }
+  writeText(file, out.str());
+  if (!fs::exists(root / "participants.json"))
+    writeText(root / "participants.json", participantsJson());
+}
+
 void ensureDatasetFiles(const fs::path& root, const std::string& subject,
-                        const std::vector<std::string>& authors) {
-  describeDataset(root, "ARBCI sessions", "raw", authors);
+                        const BidsDescription& description) {
+  describeDataset(root, "ARBCI sessions", "raw", description.authors);
   if (!fs::exists(root / "README"))
     writeText(root / "README",
               "EEG of augmented-reality P300 brain-computer interface sessions recorded with "
@@ -105,22 +179,7 @@ void ensureDatasetFiles(const fs::path& root, const std::string& subject,
               "phases, selections, feedback, robot commands and error-potential verdicts.\n"
               "ARBCI's own files for each run (summary, log, model, screenshots) are under "
               "derivatives/arbci/.\n");
-  const fs::path participants = root / "participants.tsv";
-  std::set<std::string> known;
-  if (std::ifstream in(participants); in) {
-    std::string line;
-    std::getline(in, line);  // header
-    while (std::getline(in, line)) known.insert(line.substr(0, line.find('\t')));
-  } else {
-    writeText(participants, "participant_id\n");
-  }
-  if (!known.count("sub-" + subject)) {
-    std::ofstream out(participants, std::ios::app);
-    out << "sub-" << subject << "\n";
-    out.close();
-    if (!out)
-      throw BidsError("cannot write " + participants.string() + ": " + std::strerror(errno));
-  }
+  recordParticipant(root, subject, description.participant);
   describeDataset(root / "derivatives" / "arbci", "ARBCI session files", "derivative");
 }
 
@@ -141,7 +200,7 @@ double bdfSeconds(const fs::path& bdf) {
   }
 }
 
-std::string eegSidecar(const bci::Recording& r, const std::string& task, int misc,
+std::string eegSidecar(const bci::Recording& r, const std::string& task, int triggers,
                        const BidsDescription& description, double file_seconds) {
   nlohmann::ordered_json j;
   j["TaskName"] = task;
@@ -170,13 +229,15 @@ std::string eegSidecar(const bci::Recording& r, const std::string& task, int mis
   j["SoftwareFilters"] = "n/a";  // the recording is unfiltered; the online filter is ARBCI's own
   const std::string source = parameter(r, "EegSource");
   const std::string manufacturer = stated(description.manufacturer, "EegManufacturer");
-  j["Manufacturer"] = !manufacturer.empty() ? manufacturer
-                      : source == "simulated" || source.empty()
-                          ? "n/a (ARBCI's simulated subject)"
-                          : "n/a (ARBCI EEG source: " + source + ")";
-  j["SoftwareVersions"] = std::string("ARBCI ") + ARBCI_VERSION;
-  j["EEGChannelCount"] = r.info.channelCount() - misc;
-  j["MiscChannelCount"] = misc;
+  // A maker or "n/a", as BIDS reads it (the validator takes no key of ARBCI's own in the
+  // sidecar): where the signal came from is said in SoftwareVersions, the software that made it.
+  j["Manufacturer"] = !manufacturer.empty() ? manufacturer : "n/a";
+  j["SoftwareVersions"] = std::string("ARBCI ") + ARBCI_VERSION +
+                          (source.empty() || source == "simulated"
+                               ? " (simulated subject: the EEG was generated, no amplifier)"
+                               : " (recording software; EEG source: " + source + ")");
+  j["EEGChannelCount"] = r.info.channelCount() - triggers;
+  j["TriggerChannelCount"] = triggers;
   // The data file's length (what a reader of the BDF gets); the zeros after the signal's end are
   // a "padding" event.
   j["RecordingDuration"] = file_seconds;
@@ -191,6 +252,23 @@ void checkBidsEntities(const BidsEntities& entities) {
   if (!entities.session.empty()) checkLabel("session", entities.session, false);
   checkLabel("task", entities.task, false);
   if (!entities.run.empty()) checkLabel("run", entities.run, true);
+}
+
+void checkBidsParticipant(const BidsParticipant& p) {
+  if (!p.age.empty()) {
+    const bool digits =
+        p.age.size() <= 3 &&
+        std::all_of(p.age.begin(), p.age.end(), [](unsigned char c) { return std::isdigit(c); });
+    if (!digits || std::stoi(p.age) > 150)
+      throw BidsError("the age \"" + p.age + "\" is not a whole number of years (0-150)");
+  }
+  const auto oneOf = [](const std::string& what, const std::string& value,
+                        const std::string& levels, const std::string& meaning) {
+    if (!value.empty() && (value.size() != 1 || levels.find(value) == std::string::npos))
+      throw BidsError("the " + what + " \"" + value + "\" is not one of " + meaning);
+  };
+  oneOf("sex", p.sex, "FMO", "F, M, O (female, male, other) or empty");
+  oneOf("handedness", p.handedness, "RLA", "R, L, A (right, left, ambidextrous) or empty");
 }
 
 namespace {
@@ -254,11 +332,25 @@ BidsExport exportToBids(const fs::path& session_dir, const fs::path& root,
     throw BidsError("run " + std::to_string(run) + " of " + prefix + " is already in " +
                     root.string() + "; runs are never overwritten (leave --run out for the next, " +
                     std::to_string(*runs.rbegin() + 1) + ")");
-  ensureDatasetFiles(root, entities.subject, description.authors);
+  BidsDescription described = description;
+  BidsParticipant& participant = described.participant;
+  {
+    // Unless the export was given them, what the start screen (or --age ...) recorded.
+    std::ifstream in(session_dir / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+    if (summary.is_object() && summary.contains("labels") && summary["labels"].is_object()) {
+      const nlohmann::json& l = summary["labels"];
+      if (participant.age.empty()) participant.age = l.value("age", "");
+      if (participant.sex.empty()) participant.sex = l.value("sex", "");
+      if (participant.handedness.empty()) participant.handedness = l.value("handedness", "");
+    }
+  }
+  checkBidsParticipant(participant);
+  ensureDatasetFiles(root, entities.subject, described);
   fs::create_directories(eeg_dir);
   const std::string stem = prefix + "_run-" + std::to_string(run);
   try {
-    return exportRun(recording, session_dir, root, layout, stem, entities, description);
+    return exportRun(recording, session_dir, root, layout, stem, entities, described);
   } catch (const std::exception& error) {
     // A run half exported (a full disk) would block its own export later ("already in"): what
     // was written of it goes, so that the same command can be run again once there is room.
@@ -285,16 +377,17 @@ BidsExport exportRun(const bci::Recording& recording, const fs::path& session_di
   out.eeg_file = eeg_dir / (stem + "_eeg.bdf");
   fs::copy_file(bdf, out.eeg_file, fs::copy_options::none);
 
-  // Channels: EEG in microvolts, the photodiode a MISC channel (its level in the units the BDF
-  // gives every channel).
+  // Channels: EEG in microvolts; the photodiode a TRIG channel, as BIDS types an analog trigger
+  // (MNE reads it as a stim channel, in the volts its BDF unit gives, so its unit does not
+  // change on reading), in the unit the BDF gives every channel.
   const std::string photodiode = parameter(recording, "PhotodiodeChannel");
   std::ostringstream channels;
   channels << "name\ttype\tunits\tstatus\tstatus_description\n";
-  int misc = 0;
+  int triggers = 0;
   for (const std::string& name : recording.info.channels) {
     const bool is_photodiode = name == photodiode || name == "Photodiode";
-    misc += is_photodiode ? 1 : 0;
-    channels << cell(name) << "\t" << (is_photodiode ? "MISC" : "EEG") << "\t"
+    triggers += is_photodiode ? 1 : 0;
+    channels << cell(name) << "\t" << (is_photodiode ? "TRIG" : "EEG") << "\t"
              << "uV"
              << "\tgood\t"
              << (is_photodiode ? "photodiode on the display: the flashes' presented onsets" : "n/a")
@@ -303,7 +396,7 @@ BidsExport exportRun(const bci::Recording& recording, const fs::path& session_di
   writeText(eeg_dir / (stem + "_channels.tsv"), channels.str());
   const double file_seconds = bdfSeconds(out.eeg_file);
   writeText(eeg_dir / (stem + "_eeg.json"),
-            eegSidecar(recording, entities.task, misc, description, file_seconds));
+            eegSidecar(recording, entities.task, triggers, description, file_seconds));
 
   BidsEvents events = sessionEvents(recording, session_dir / "log.jsonl");
   if (const double padded = file_seconds - recording.seconds();

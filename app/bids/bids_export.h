@@ -21,11 +21,19 @@ struct BidsEntities {
   std::string run;             // optional: the next free run when empty; digits only
 };
 
+// The subject's row in participants.tsv (participants.json describes the columns); empty: n/a.
+struct BidsParticipant {
+  std::string age;         // whole years, 0-150
+  std::string sex;         // F, M or O
+  std::string handedness;  // R, L or A
+};
+
 // What the sidecars say that the recording may not (one made before the session stated it).
 struct BidsDescription {
   std::string reference;     // EEGReference; empty: the recording's (eeg.reference), else "n/a"
   std::string manufacturer;  // Manufacturer; empty: the recording's (eeg.manufacturer)
   std::vector<std::string> authors;  // the dataset's Authors; empty: left as they are
+  BidsParticipant participant;       // empty fields: the session's summary.json labels
 };
 
 struct BidsExport {
@@ -43,6 +51,8 @@ class BidsError : public std::runtime_error {
 // Throws BidsError naming a label BIDS does not allow (checked before a run, so that its export
 // cannot fail on a typo after the session).
 void checkBidsEntities(const BidsEntities& entities);
+// Throws BidsError naming a participant value participants.json does not describe.
+void checkBidsParticipant(const BidsParticipant& participant);
 
 // Where an export of `entities` into `root` goes: "sub-S/ses-N/eeg, run R" (R the next free run
 // when entities.run is empty). Throws BidsError for a label BIDS does not allow.

@@ -12,8 +12,8 @@
 
 namespace arbci::app {
 
-void addBidsOptions(CLI::App* command, BidsEntities& entities, std::string& root,
-                    bool root_option) {
+void addBidsOptions(CLI::App* command, BidsEntities& entities, BidsParticipant& participant,
+                    std::string& root, bool root_option) {
   if (root_option)
     command->add_option("--bids", root,
                         "also write the session into this EEG-BIDS dataset when it ends "
@@ -26,6 +26,12 @@ void addBidsOptions(CLI::App* command, BidsEntities& entities, std::string& root
   command->add_option("--run", entities.run,
                       "BIDS run number (default: the next free one; an existing run is never "
                       "overwritten)");
+  command->add_option("--age", participant.age,
+                      "the subject's age in whole years, for participants.tsv (optional)");
+  command->add_option("--sex", participant.sex,
+                      "the subject's sex for participants.tsv: F, M or O (optional)");
+  command->add_option("--handedness", participant.handedness,
+                      "the subject's handedness for participants.tsv: R, L or A (optional)");
 }
 
 void reportBidsExport(const BidsExport& done) {
@@ -48,13 +54,14 @@ void addBidsCommand(CLI::App& root, int& exit_code) {
       "Write an ARBCI session folder into an EEG-BIDS dataset: the recording as BDF with its\n"
       "_eeg.json, _channels.tsv, _events.tsv (every flash with T/N/U, phases, selections,\n"
       "feedback, robot commands and replies, ErrP verdicts) and _events.json; the dataset's\n"
-      "dataset_description.json, participants.tsv and README; ARBCI's files under\n"
+      "dataset_description.json, participants.tsv (age, sex, handedness: given here or\n"
+      "recorded on the start screen) with participants.json, and README; ARBCI's files under\n"
       "derivatives/arbci/. A run is never overwritten.");
   out->add_option("SESSION_DIR", o->session_dir, "the session folder (arbci run --out)")
       ->required();
   out->add_option("ROOT", o->root, "the BIDS dataset's folder (made when missing)")->required();
   std::string unused;
-  addBidsOptions(out, o->entities, unused, false);
+  addBidsOptions(out, o->entities, o->description.participant, unused, false);
   out->get_option("--subject")->required();
   schemaOption(*out, "--reference", o->description.reference, session::sessionKey("eeg.reference"),
                "for _eeg.json's EEGReference; not given: what the session recorded, else n/a");

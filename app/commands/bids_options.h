@@ -8,8 +8,10 @@
 
 namespace arbci::app {
 
-// --subject, --session, --task, --run; with `root_option`, also --bids ROOT.
-void addBidsOptions(CLI::App* command, BidsEntities& entities, std::string& root, bool root_option);
+// --subject, --session, --task, --run, --age, --sex, --handedness; with `root_option`, also
+// --bids ROOT.
+void addBidsOptions(CLI::App* command, BidsEntities& entities, BidsParticipant& participant,
+                    std::string& root, bool root_option);
 void reportBidsExport(const BidsExport& done);
 
 }  // namespace arbci::app

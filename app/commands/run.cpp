@@ -37,6 +37,7 @@ struct RunOptions {
   double fault_wait_s = 5.0;
   std::string bids_root;  // --bids: export the session folder there when it ends
   BidsEntities bids;
+  BidsParticipant participant;  // --age, --sex, --handedness: the summary's labels
 };
 
 // arbci-session-<date>-<time>, with -2, -3, ... when a session of the same second exists.
@@ -104,6 +105,11 @@ int runAndExport(const RunOptions& o) {
     }
   } else if (!o.bids.subject.empty() || !o.bids.session.empty() || !o.bids.run.empty()) {
     throw CliError("--subject, --bids-session and --run go with --bids ROOT");
+  }
+  try {
+    checkBidsParticipant(o.participant);  // recorded in summary.json with or without --bids
+  } catch (const BidsError& error) {
+    throw CliError(error.what());
   }
   RunOptions run = o;
   if (run.out.empty()) run.out = defaultFolder();
@@ -174,7 +180,9 @@ int runSessionIn(const RunOptions& o, bool headless) {
   options.folder = o.out.empty() ? defaultFolder() : o.out;
   FolderClaim claim(options.folder);
   if (o.trials) options.trials = *o.trials;
-  options.labels = {o.bids.subject, o.bids.session, o.bids.task, o.bids.run};
+  options.labels = {
+      o.bids.subject,    o.bids.session,          o.bids.task, o.bids.run, o.participant.age,
+      o.participant.sex, o.participant.handedness};
   if (o.seed) options.seed = static_cast<std::uint64_t>(*o.seed);
   options.fault_wait_s = o.fault_wait_s;
   options.progress = &std::cerr;
@@ -260,7 +268,7 @@ void addRunCommand(CLI::App& root, int& exit_code) {
   run->add_option("--fault-wait", o->fault_wait_s,
                   "headless: seconds to wait for an experimenter after a robot fault")
       ->capture_default_str();
-  addBidsOptions(run, o->bids, o->bids_root, true);
+  addBidsOptions(run, o->bids, o->participant, o->bids_root, true);
   run->callback([o, &exit_code] { exit_code = runAndExport(*o); });
 }
 

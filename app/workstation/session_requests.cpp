@@ -18,6 +18,7 @@ std::string labelsProblem(const core::RunLabels& l, const std::filesystem::path&
   if (entities.subject.empty()) entities.subject = "unnamed";
   try {
     checkBidsEntities(entities);
+    checkBidsParticipant({l.age, l.sex, l.handedness});
   } catch (const BidsError& error) {
     return error.what();
   }

@@ -234,7 +234,13 @@ nlohmann::json Session::summary() const {
   const core::RunLabels& l = options_.labels;
   nlohmann::json out = {
       {"labels",
-       {{"subject", l.subject}, {"session", l.session}, {"task", l.task}, {"run", l.run}}},
+       {{"subject", l.subject},
+        {"session", l.session},
+        {"task", l.task},
+        {"run", l.run},
+        {"age", l.age},
+        {"sex", l.sex},
+        {"handedness", l.handedness}}},
       {"session", config_.source},
       {"folder", folder_.string()},
       {"seed", config_.eeg.seed},

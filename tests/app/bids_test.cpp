@@ -50,12 +50,30 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
   std::ofstream(dir / "session.json") << R"({
     "paradigm": {"calibration_selections": 4, "cue_s": 1.0, "pause_s": 0.5},
     "robot": {"speed_factor": 20}})";
-  const ProcessResult run =
-      runProcess(kArbci,
-                 {"run", "--headless", "--session", (dir / "session.json").string(), "--trials",
-                  "1", "--seed", "3", "--out", (dir / "session").string(), "--bids", root.string(),
-                  "--subject", "01", "--bids-session", "1"},
-                 600.0);
+  const ProcessResult run = runProcess(kArbci,
+                                       {"run",
+                                        "--headless",
+                                        "--session",
+                                        (dir / "session.json").string(),
+                                        "--trials",
+                                        "1",
+                                        "--seed",
+                                        "3",
+                                        "--out",
+                                        (dir / "session").string(),
+                                        "--bids",
+                                        root.string(),
+                                        "--subject",
+                                        "01",
+                                        "--bids-session",
+                                        "1",
+                                        "--age",
+                                        "34",
+                                        "--sex",
+                                        "F",
+                                        "--handedness",
+                                        "R"},
+                                       600.0);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("BIDS: wrote"), std::string::npos) << run.out;
   const fs::path eeg = root / "sub-01" / "ses-1" / "eeg";
@@ -89,10 +107,15 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
 
   // The same folder again, as an older session: the next run, never over the first; a run given
   // that exists is refused.
-  const ProcessResult again =
-      runProcess(kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject",
-                          "01", "--session", "1"});
+  const ProcessResult again = runProcess(
+      kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject", "01",
+               "--session", "1", "--author", "Ada Lovelace", "--author", "Alan Turing"});
   ASSERT_EQ(again.exit_code, 0) << again.err;
+  // The subject as the run recorded them, described for a curator.
+  EXPECT_EQ(read(root / "participants.tsv"),
+            "participant_id\tage\tsex\thandedness\nsub-01\t34\tF\tR\n");
+  EXPECT_TRUE(fs::exists(root / "participants.json"));
+  EXPECT_NE(read(eeg / (stem + "_channels.tsv")).find("Photodiode\tTRIG\tuV"), std::string::npos);
   EXPECT_TRUE(fs::exists(eeg / "sub-01_ses-1_task-arbci_run-2_eeg.bdf"));
   const ProcessResult taken =
       runProcess(kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject",
@@ -104,11 +127,12 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("letters and digits"), std::string::npos) << bad.err;
 
-  // The official validator: 0 errors.
+  // The official validator: 0 errors, 0 warnings.
   const ProcessResult validated = runProcess(BIDS_VALIDATOR, {root.string()}, 300.0);
   std::cout << validated.out;
   EXPECT_EQ(validated.exit_code, 0) << validated.out << validated.err;
   EXPECT_EQ(validated.out.find("[ERR]"), std::string::npos) << validated.out;
+  EXPECT_EQ(validated.out.find("[WARN]"), std::string::npos) << validated.out;
   EXPECT_NE(validated.out.find("Summary"), std::string::npos) << validated.out;
 
   // MNE reads the recording and the events table: the attended flashes' average is positive at

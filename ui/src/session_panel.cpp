@@ -17,6 +17,22 @@ namespace {
 
 using session::Action;
 
+// participants.tsv's levels (BIDS): the code written, the label shown; the first is "not given".
+struct Level {
+  const char* code;
+  const char* label;
+};
+constexpr Level kSexes[] = {
+    {"", "sex: n/a"}, {"F", "F (female)"}, {"M", "M (male)"}, {"O", "O (other)"}};
+constexpr Level kHands[] = {
+    {"", "hand: n/a"}, {"R", "R (right)"}, {"L", "L (left)"}, {"A", "A (ambidextrous)"}};
+template <size_t N>
+int levelIndex(const Level (&levels)[N], const std::string& code) {
+  for (size_t i = 0; i < N; ++i)
+    if (code == levels[i].code) return static_cast<int>(i);
+  return 0;
+}
+
 std::string seconds(double s) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f s", s);
@@ -39,6 +55,8 @@ class SessionPanel final : public Panel {
   bool labels_read_ = false;
   char note_[256] = "";
   char subject_[64] = "", visit_[64] = "", task_[64] = "", run_[16] = "";
+  char age_[8] = "";
+  int sex_ = 0, handedness_ = 0;  // indices into kSexes, kHands (0: not given)
 };
 
 void SessionPanel::draw(const PanelInput& in) {
@@ -152,6 +170,9 @@ void SessionPanel::runLabels(const PanelInput& in) {
     std::snprintf(visit_, sizeof visit_, "%s", l.session.c_str());
     std::snprintf(task_, sizeof task_, "%s", l.task.c_str());
     std::snprintf(run_, sizeof run_, "%s", l.run.c_str());
+    std::snprintf(age_, sizeof age_, "%s", l.age.c_str());
+    sex_ = levelIndex(kSexes, l.sex);
+    handedness_ = levelIndex(kHands, l.handedness);
     labels_read_ = true;
   }
   bool changed = false;
@@ -176,7 +197,32 @@ void SessionPanel::runLabels(const PanelInput& in) {
       ImGui::SetTooltip("%s (BIDS entity: letters and digits)", fields[i].hint);
     recordField(fields[i].label, width);
   }
-  if (changed) in.requests.post(session::LabelsRequest{{subject_, visit_, task_, run_}});
+  // What participants.tsv says of the subject (BIDS; each may stay not given).
+  ImGui::SetNextItemWidth(width);
+  changed |= ImGui::InputTextWithHint("##age", "age (years)", age_, sizeof age_,
+                                      ImGuiInputTextFlags_CharsDecimal);
+  recordField("age", width);
+  const auto level = [&](const char* id, const Level* levels, size_t count, int& chosen) {
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(width);
+    const bool open = ImGui::BeginCombo(id, levels[chosen].label);
+    recordCombo(std::string(id + 2), width, open);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("the subject's %s, for participants.tsv (BIDS)", id + 2);
+    if (open) {
+      for (size_t i = 0; i < count; ++i)
+        if (ImGui::Selectable(levels[i].label, static_cast<int>(i) == chosen)) {
+          chosen = static_cast<int>(i);
+          changed = true;
+        }
+      ImGui::EndCombo();
+    }
+  };
+  level("##sex", kSexes, std::size(kSexes), sex_);
+  level("##handedness", kHands, std::size(kHands), handedness_);
+  if (changed)
+    in.requests.post(session::LabelsRequest{
+        {subject_, visit_, task_, run_, age_, kSexes[sex_].code, kHands[handedness_].code}});
   const RunTarget& target = in.window.runTarget();
   if (!target.problem.empty()) {
     colouredWrapped(ImVec4(1.0f, 0.55f, 0.3f, 1.0f), target.problem);

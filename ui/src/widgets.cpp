@@ -70,6 +70,12 @@ void recordField(const std::string& label, float width) {
                         max.y, true, "", ImGui::IsItemActive()});
 }
 
+void recordCombo(const std::string& label, float width, bool open) {
+  const ImVec2 min = ImGui::GetItemRectMin(), max = ImGui::GetItemRectMax();
+  detail::recordWidget({label, currentWindowTitle(), min.x, min.y, std::min(max.x, min.x + width),
+                        max.y, true, "", open});
+}
+
 bool stopButton(const char* label, bool small, const std::string& why_not) {
   // Red only while it can stop the arm: a disabled one in red (ImGui only fades it) reads as
   // armed after the session has ended.

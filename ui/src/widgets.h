@@ -37,6 +37,9 @@ bool containsIgnoringCase(const std::string& text, const std::string& needle);
 // (widget_registry.h); "clicked" there means the field took the keyboard.
 // `width`: the field's own (its label beside it is not part of what a click should hit).
 void recordField(const std::string& label, float width);
+// The same for a combo, called right after ImGui::BeginCombo with what it returned: "clicked"
+// there means its list is open.
+void recordCombo(const std::string& label, float width, bool open);
 
 // The same, in the emergency stop's red.
 bool stopButton(const char* label, bool small = false, const std::string& why_not = "");

@@ -104,11 +104,50 @@ TEST(BidsExport, TheDurationIsTheFilesAndThePaddingIsAnEvent) {
       nlohmann::json::parse(read(eeg / "sub-01_task-arbci_run-1_eeg.json"));
   EXPECT_DOUBLE_EQ(sidecar["RecordingDuration"].get<double>(), 10.25);  // 41 records of 0.25 s
   EXPECT_EQ(sidecar["EEGReference"], "n/a");
-  EXPECT_EQ(sidecar["Manufacturer"], "n/a (ARBCI EEG source: rda)");
+  EXPECT_EQ(sidecar["Manufacturer"], "n/a");  // no maker stated: n/a, and the source apart
+  EXPECT_EQ(sidecar["SoftwareVersions"],
+            "ARBCI " ARBCI_VERSION " (recording software; EEG source: rda)");
+  EXPECT_EQ(sidecar["EEGChannelCount"], 1);
+  EXPECT_EQ(sidecar["TriggerChannelCount"], 1);
   const std::string events = read(eeg / "sub-01_task-arbci_run-1_events.tsv");
   EXPECT_NE(events.find("\t0.15234375\tpadding\tn/a\t2585\t"), std::string::npos) << events;
   const std::string channels = read(eeg / "sub-01_task-arbci_run-1_channels.tsv");
-  EXPECT_NE(channels.find("Photodiode\tMISC\tuV\t"), std::string::npos) << channels;
+  EXPECT_NE(channels.find("Photodiode\tTRIG\tuV\t"), std::string::npos) << channels;
+}
+
+// The subject's row: from the session's summary.json labels (the start screen's age, sex and
+// handedness), or the command's; a stated cell is never changed by a later export, an n/a one is
+// filled; an older table (participant_id only) gains the columns; participants.json describes
+// them; a value participants.json does not describe is refused.
+TEST(BidsExport, TheParticipantsRowHoldsAgeSexAndHandedness) {
+  const fs::path dir = sessionFolder("participants", "");
+  const fs::path root = dir / "bids";
+  fs::create_directories(root);
+  std::ofstream(root / "participants.tsv") << "participant_id\nsub-00\n";
+  std::ofstream(dir / "summary.json")
+      << R"({"labels": {"subject": "01", "age": "34", "sex": "F", "handedness": ""}})";
+  exportToBids(dir, root, {"01", "", "arbci", ""});
+  EXPECT_EQ(read(root / "participants.tsv"),
+            "participant_id\tage\tsex\thandedness\nsub-00\tn/a\tn/a\tn/a\nsub-01\t34\tF\tn/a\n");
+  BidsDescription described;
+  described.participant = {"35", "M", "L"};
+  exportToBids(dir, root, {"01", "", "arbci", ""}, described);
+  EXPECT_EQ(read(root / "participants.tsv"),
+            "participant_id\tage\tsex\thandedness\nsub-00\tn/a\tn/a\tn/a\nsub-01\t34\tF\tL\n");
+  const nlohmann::json columns = nlohmann::json::parse(read(root / "participants.json"));
+  EXPECT_EQ(columns["age"]["Units"], "year");
+  EXPECT_EQ(columns["sex"]["Levels"]["O"], "other");
+  EXPECT_EQ(columns["handedness"]["Levels"]["A"], "ambidextrous");
+  described.participant = {"", "X", ""};
+  try {
+    exportToBids(dir, root, {"02", "", "arbci", ""}, described);
+    FAIL() << "a sex participants.json does not describe was taken";
+  } catch (const BidsError& error) {
+    EXPECT_NE(std::string(error.what()).find("F, M, O"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(checkBidsParticipant({"abc", "", ""}), BidsError);
+  EXPECT_THROW(checkBidsParticipant({"200", "", ""}), BidsError);
+  EXPECT_NO_THROW(checkBidsParticipant({"7", "O", "A"}));
 }
 
 TEST(BidsExport, ReferenceManufacturerAndAuthorsFromTheSessionOrTheCommand) {

@@ -11,6 +11,13 @@
 namespace arbci::app {
 namespace {
 
+core::RunLabels labels(const std::string& subject, const std::string& session) {
+  core::RunLabels l;
+  l.subject = subject;
+  l.session = session;
+  return l;
+}
+
 void pastRun(const std::filesystem::path& folder, const std::string& subject,
              const std::string& run) {
   std::filesystem::create_directories(folder);
@@ -25,24 +32,23 @@ TEST(RunTarget, WithoutABidsRootRunsAreNumberedAmongTheSessionFolders) {
   pastRun(study / "monday", "07", "1");
   pastRun(study / "tuesday", "07", "2");
   pastRun(study / "other", "08", "5");
-  const ui::RunTarget target = describeRun({"07", "", "arbci", ""}, study / "today", {});
+  const ui::RunTarget target = describeRun(labels("07", ""), study / "today", {});
   EXPECT_EQ(target.problem, "");
   EXPECT_EQ(target.target.rfind("run 3 (the next free among the session folders", 0), 0u)
       << target.target;
   // Unnamed, the run is only recorded where it is.
-  EXPECT_EQ(describeRun({"", "", "arbci", ""}, study / "today", {}).target.rfind("recorded in", 0),
-            0u);
+  EXPECT_EQ(describeRun(labels("", ""), study / "today", {}).target.rfind("recorded in", 0), 0u);
 }
 
 TEST(RunTarget, WithABidsRootTheSubjectIsNeededAndTheRunIsTheDatasetsNext) {
   const auto root = test::freshTempPath("run_target", "bids");
-  const ui::RunTarget unnamed = describeRun({"", "", "arbci", ""}, root / "out", root);
+  const ui::RunTarget unnamed = describeRun(labels("", ""), root / "out", root);
   EXPECT_NE(unnamed.problem.find("give the subject"), std::string::npos) << unnamed.problem;
-  const ui::RunTarget named = describeRun({"07", "01", "arbci", ""}, root / "out", root);
+  const ui::RunTarget named = describeRun(labels("07", "01"), root / "out", root);
   EXPECT_EQ(named.problem, "");
   EXPECT_NE(named.target.find("sub-07"), std::string::npos) << named.target;
   EXPECT_NE(named.target.find("run 1 (the next free)"), std::string::npos) << named.target;
-  const ui::RunTarget bad = describeRun({"0 7", "", "arbci", ""}, root / "out", root);
+  const ui::RunTarget bad = describeRun(labels("0 7", ""), root / "out", root);
   EXPECT_FALSE(bad.problem.empty());
 }
 
