@@ -4,6 +4,7 @@
 
 #include "arbci/core/whole_file.h"
 #include "arbci/session/stages/robot_stage.h"
+#include "arbci/session/trigger_output.h"
 #include "stage_assembly.h"
 
 namespace arbci::session {
@@ -25,6 +26,7 @@ Session::Session(SessionConfig config, const SessionOptions& requested,
   AssembledStages assembled = assembleStages(config_, options_, clock_, folder_, services, display);
   stages_ = std::move(assembled.stages);
   robot_ = assembled.robot;
+  trigger_ = std::move(assembled.trigger);
   std::ofstream(folder_ / "session.json") << nlohmann::json{
       {"source", config_.source},
       {"seed", config_.eeg.seed},
@@ -129,6 +131,36 @@ void Session::presented(double host_s) {
   CycleRecord& record = records_[current_];
   if (ended_ || record.presented) return;
   record.presented = CycleRecord::Presented{host_s, clock_.sampleAt(host_s)};
+  if (trigger_) writeTriggers(record, host_s);
+}
+
+void Session::writeTriggers(const CycleRecord& record, double host_s) {
+  const auto& feedback = record.paradigm.feedback;
+  const double after = clock_.stepped() ? 0.0 : std::max(0.0, bci::hostSeconds() - host_s);
+  trigger_->presented(record.frame, host_s, after, record.paradigm.first_shown,
+                      feedback ? &*feedback : nullptr);
+  for (const TriggerWrite& w : trigger_->take()) {
+    const double latency_ms = 1000.0 * (w.written_host_s - w.swap_host_s);
+    trigger_writes_ += 1;
+    trigger_latency_max_ms_ = std::max(trigger_latency_max_ms_, latency_ms);
+    log_->write("trigger", clock_.sessionOf(w.swap_host_s),
+                {{"frame", w.frame},
+                 {"byte", w.byte},
+                 {"what", w.what},
+                 {"swap_s", clock_.sessionOf(w.swap_host_s)},
+                 {"written_s", clock_.sessionOf(w.written_host_s)},
+                 {"latency_ms", latency_ms}});
+  }
+  if (trigger_->failedWrites() > trigger_failures_told_) {
+    // Told once: the flashes go on, and the recording keeps their onsets.
+    if (trigger_failures_told_ == 0)
+      operator_log_.add(record.time_s, Severity::Warning,
+                        trigger_->fault() + " (" + std::to_string(trigger_->failedWrites()) +
+                            " trigger(s) not sent; the recording keeps every onset)");
+    log_->write("trigger_failed", record.time_s,
+                {{"text", trigger_->fault()}, {"failed", trigger_->failedWrites()}});
+    trigger_failures_told_ = trigger_->failedWrites();
+  }
 }
 
 void Session::recordCycleTime() {
@@ -252,6 +284,11 @@ nlohmann::json Session::summary() const {
       {"overruns", timing_.overruns()},
   };
   if (log_->lost() > 0) out["log_lines_lost"] = log_->lost();
+  if (trigger_)
+    out["trigger"] = {{"device", trigger_->device()},
+                      {"written", trigger_writes_},
+                      {"failed", trigger_->failedWrites()},
+                      {"latency_max_ms", trigger_latency_max_ms_}};
   for (const auto& stage : stages_) stage->report(out);
   return out;
 }

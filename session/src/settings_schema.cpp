@@ -13,6 +13,7 @@
 #include "arbci/robot/settings.h"
 #include "arbci/session/eeg_sources.h"
 #include "arbci/session/scene_source.h"
+#include "arbci/session/trigger_output.h"
 #include "arbci/vision/settings.h"
 
 namespace arbci::session {
@@ -326,6 +327,24 @@ const Schema<EegSettings>& eegSchema() {
             return found == e.sources.end() ? Json::object() : found->second;
           });
     }
+    t.text("trigger_out", &E::trigger_out, "none",
+           "a trigger byte to the amplifier at each flash's presentation: none, or serial "
+           "(a trigger box on eeg.trigger.device)",
+           [] { return triggerOutputs(); });
+    {
+      Key k{"trigger", Type::Section, nullptr, triggerSchema().doc()};
+      k.table = &triggerSchema();
+      t.custom(
+          k, [](E& e, const Json& j) { e.trigger = j; }, [](const E& e) { return e.trigger; });
+    }
+    t.rule([](const Json& eeg) -> Broken {
+      const Json trigger = eeg.value("trigger", Json::object());
+      if (eeg.value("trigger_out", "none") == "serial" &&
+          (!trigger.is_object() || trigger.value("device", "").empty()))
+        return std::pair{"trigger.device",
+                         "must name the trigger box's serial port when trigger_out is serial"};
+      return std::nullopt;
+    });
     t.rule([](const Json& eeg) -> Broken {
       const auto* source = eegSources().find(eeg["source"].get<std::string>());
       if (source && source->make.required) return source->make.required(eeg);

@@ -144,8 +144,23 @@ SessionOptions optionsFor(SessionOptions options, const SessionConfig& config) {
   return options;
 }
 
+// eeg.trigger_out "serial": the port, opened (nullptr for "none"). Throws SessionConfigError
+// naming eeg.trigger.device and why it cannot be used.
+std::unique_ptr<TriggerOutput> openTriggerOutput(const SessionConfig& c) {
+  if (c.eeg.trigger_out != "serial") return nullptr;
+  TriggerSettings settings;
+  triggerSchema().read(c.eeg.trigger, settings);
+  try {
+    return std::make_unique<TriggerOutput>(settings);
+  } catch (const std::runtime_error& error) {
+    throw SessionConfigError(c.source + ": eeg.trigger.device = \"" + settings.device +
+                             "\": " + error.what());
+  }
+}
+
 void checkNamedResources(const SessionConfig& c) {
   SceneSettings::of(c).validate();
+  openTriggerOutput(c);  // opened and closed: the run opens it again
   EegAcquisitionSettings{c.eeg, 0.0, c.source}.validate();
   if (!c.classifier.model_file.empty() && !std::filesystem::exists(c.classifier.model_file))
     throw SessionConfigError(c.source + ": classifier.model = \"" + c.classifier.model_file +
@@ -167,6 +182,7 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
       std::max(1, static_cast<int>(std::lround(c.paradigm.display_hz / c.cameras.rate_hz)));
 
   AssembledStages out;
+  out.trigger = openTriggerOutput(c);
   std::unique_ptr<SceneSource> scene = sceneSources().at(c.cameras.source).make(scene_settings);
   // The robot: arbci-robotd on 127.0.0.1 with a fresh key, or a remote backend.
   RobotLink link = connectRobot(c.robot, scene->simulatedRobot(), folder, clock);

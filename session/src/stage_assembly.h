@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "arbci/session/session.h"
+#include "arbci/session/trigger_output.h"
 
 namespace arbci::session {
 
@@ -21,6 +22,7 @@ SessionOptions optionsFor(SessionOptions options, const SessionConfig& config);
 struct AssembledStages {
   std::vector<std::unique_ptr<Stage>> stages;  // in the order they run
   RobotStage* robot = nullptr;
+  std::unique_ptr<TriggerOutput> trigger;  // eeg.trigger_out "serial": its port, open
 };
 
 // Throws SessionConfigError naming the key, or std::runtime_error with the reason.

@@ -30,6 +30,7 @@
 namespace arbci::session {
 
 class RobotStage;
+class TriggerOutput;
 
 struct SessionOptions {
   Clock::Mode clock = Clock::Mode::Stepped;  // a live amplifier always runs in real time
@@ -113,6 +114,8 @@ class Session {
  private:
   void beginCycle();
   void recordCycleTime();
+  // eeg.trigger_out: the bytes of the frame just presented, written and logged.
+  void writeTriggers(const CycleRecord& record, double host_s);
   // What happened to the log's writing (failed, resumed), told the experimenter once.
   void tellLogNews(double time_s);
   void endIfDone();
@@ -127,6 +130,11 @@ class Session {
   CycleTiming timing_;
   std::vector<std::unique_ptr<Stage>> stages_;  // in the order they run
   RobotStage* robot_ = nullptr;                 // for the emergency stop, which cannot wait
+  // eeg.trigger_out: written at the swap itself, which no stage sees (they run before it).
+  std::unique_ptr<TriggerOutput> trigger_;
+  int trigger_failures_told_ = 0;
+  std::int64_t trigger_writes_ = 0;
+  double trigger_latency_max_ms_ = 0.0;
   CycleRecord records_[2];
   int current_ = 0;
   std::vector<Request> queued_;  // the experimenter's, since the last cycle

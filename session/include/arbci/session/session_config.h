@@ -130,6 +130,11 @@ struct EegSettings {
   std::string reference, manufacturer;
   // Each source's own section (eeg.lsl, eeg.eegdev, eeg.rda, ...), resolved by its schema.
   std::map<std::string, nlohmann::json> sources;
+  // A trigger written to the amplifier at each flash's presentation: "none" or "serial"; the
+  // port's section (eeg.trigger: device, baud, bytes), resolved by triggerSchema()
+  // (session/trigger_output.h).
+  std::string trigger_out;
+  nlohmann::json trigger;
   // A source that runs on its own clock in real time (an amplifier): the session cannot step it.
   bool live() const;
 };

@@ -1,0 +1,108 @@
+// The trigger output alone, on a pseudo-terminal (openpty) in place of a trigger box: each flash
+// writes its base plus its code, in order; with pulse, the lines go back to 0 on the next frame;
+// the feedback byte when set; every write stamped after its swap; a port that cannot be opened, or
+// is no serial port, is refused naming it.
+#include "arbci/session/trigger_output.h"
+
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <pty.h>
+#include <unistd.h>
+
+#include <stdexcept>
+
+#include "arbci/session/cycle.h"
+
+namespace arbci::session {
+namespace {
+
+struct Pty {
+  Pty() {
+    char name[256] = {};
+    ::openpty(&master, &slave, name, nullptr, nullptr);
+    path = name;
+  }
+  ~Pty() {
+    ::close(slave);
+    ::close(master);
+  }
+  std::vector<std::uint8_t> read() const {
+    std::vector<std::uint8_t> out;
+    pollfd p{master, POLLIN, 0};
+    while (::poll(&p, 1, 100) > 0) {
+      std::uint8_t buffer[64];
+      const ssize_t n = ::read(master, buffer, sizeof buffer);
+      if (n <= 0) break;
+      out.insert(out.end(), buffer, buffer + n);
+    }
+    return out;
+  }
+  int master = -1, slave = -1;
+  std::string path;
+};
+
+Flash flash(int code, bool objects) {
+  Flash f;
+  f.code = code;
+  f.objects = objects;
+  return f;
+}
+
+TEST(TriggerOutput, EachFlashWritesItsCodeAndThePulseEndsOnTheNextFrame) {
+  Pty pty;
+  TriggerSettings settings;
+  settings.device = pty.path;
+  settings.feedback_byte = 200;
+  TriggerOutput out(settings);
+  FeedbackShown feedback;
+  out.presented(1, 10.0, 0.0, {flash(3, true)}, nullptr);
+  out.presented(2, 10.016, 0.002, {}, nullptr);
+  out.presented(3, 10.032, 0.0, {flash(2, false)}, nullptr);
+  out.presented(4, 10.048, 0.0, {}, &feedback);
+  EXPECT_EQ(pty.read(), (std::vector<std::uint8_t>{3, 0, 102, 0, 200}));
+  const std::vector<TriggerWrite> writes = out.take();
+  ASSERT_EQ(writes.size(), 5u);
+  EXPECT_EQ(writes[0].what, "object 3");
+  EXPECT_EQ(writes[2].what, "grid 2");
+  EXPECT_EQ(writes[1].what, "reset");
+  EXPECT_EQ(writes[4].what, "feedback");
+  for (const TriggerWrite& w : writes) EXPECT_GE(w.written_host_s, w.swap_host_s);
+  EXPECT_GE(writes[1].written_host_s, 10.018);  // the call came 2 ms after its swap
+  EXPECT_TRUE(out.take().empty());
+  EXPECT_EQ(out.failedWrites(), 0);
+}
+
+TEST(TriggerOutput, BasesShiftTheCodesAndWithoutPulseNoResetIsWritten) {
+  Pty pty;
+  TriggerSettings settings;
+  settings.device = pty.path;
+  settings.object_base = 10;
+  settings.grid_base = 50;
+  settings.pulse = false;
+  TriggerOutput out(settings);
+  out.presented(1, 1.0, 0.0, {flash(1, true)}, nullptr);
+  out.presented(2, 1.1, 0.0, {}, nullptr);
+  out.presented(3, 1.2, 0.0, {flash(4, false)}, nullptr);
+  EXPECT_EQ(pty.read(), (std::vector<std::uint8_t>{11, 54}));
+}
+
+TEST(TriggerOutput, APortThatCannotBeUsedIsRefusedNamingIt) {
+  TriggerSettings settings;
+  settings.device = "/dev/ttyUSB-arbci-missing";
+  try {
+    TriggerOutput out(settings);
+    FAIL() << "a missing port was opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/ttyUSB-arbci-missing"), std::string::npos);
+  }
+  settings.device = "/dev/null";
+  try {
+    TriggerOutput out(settings);
+    FAIL() << "/dev/null was taken for a serial port";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a serial port"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace arbci::session
