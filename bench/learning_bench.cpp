@@ -19,7 +19,7 @@
 // trained with the true labels (certainCeiling). The session's own classifier settings
 // (SessionConfig's defaults) are used.
 // Usage: learning_bench FILES... [--calibration 8] [--trials 30] [--from 11] [--trace F]
-//        [--ceiling-only] [--untrusted-sequences N] [--unbounded]
+//        [--ceiling-only] [--untrusted-sequences N] [--unbounded] [--independent-flashes]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -268,12 +268,15 @@ void writeScores(std::FILE* out, const char* kind, const bci::P300Model& model, 
 Outcome calibrated(const Replay& r, const Replay* cells, int calibration, int trials, int from,
                    const bci::PipelineSettings& pipeline, const bci::TrainingSettings& training,
                    const bci::StoppingRule& stopping, const TimeModel& time,
-                   std::FILE* scores = nullptr) {
+                   bool independent_flashes, std::FILE* scores = nullptr) {
   Outcome o;
   const auto [recording, numbers] = part(r, 1, calibration, true, Shown{stopping.max_sequences});
   const bci::P300Dataset data = bci::buildDataset({recording}, pipeline);
   const bci::TrainingResult trained = bci::trainModel(data, pipeline, training);
-  const bci::P300Model& model = trained.model;
+  bci::P300Model model = trained.model;
+  // --independent-flashes: the certainty as it was before its two terms (every flash independent
+  // evidence, no selection's separation held to what those decided show), for comparison.
+  if (independent_flashes) model.score_model.rho = 0.0;
   if (scores) {
     // The calibration run's flashes as cross-validation scored them (what the score model is
     // fitted on), then every trial's flashes by the model.
@@ -294,6 +297,7 @@ Outcome calibrated(const Replay& r, const Replay* cells, int calibration, int tr
   }
   double t = calibration * time.calibration_selection_s + time.training_s;
   Decided decided_objects, decided_cells;
+  decided_objects.bounds = decided_cells.bounds = !independent_flashes;
   for (int k = 1; k <= trials; ++k) {
     const int number = calibration + k;
     const Online d = decideOnline(model, r, number, pipeline, stopping, &decided_objects);
@@ -513,7 +517,7 @@ int main(int argc, char** argv) {
   std::string trace_file;
   bool ceiling_only = false;
   int untrusted_sequences = 0;
-  bool unbounded = false;
+  bool unbounded = false, independent_flashes = false;
   std::string decisions_file, scores_file;
   cli.add_option("files", files, "recordings (copy task, single stimulus)")->required();
   cli.add_option("--calibration", calibration, "cued selections of the calibration run")
@@ -540,6 +544,10 @@ int main(int argc, char** argv) {
                "leave each fit's score model as its cross-validation on the labels found gives "
                "it (the session bounds its separation by the selections decided: "
                "bci/held_out_separation.h)");
+  cli.add_flag("--independent-flashes", independent_flashes,
+               "the calibrated model's certainty as before its two terms: every flash independent "
+               "evidence (rho 0) and no selection held to the separation those decided show; to "
+               "measure what the terms cost and what they buy");
   cli.add_option("--decisions", decisions_file,
                  "write every online decision: condition, kind (objects, cells), file index, "
                  "trial, certainty, right, sequences");
@@ -577,8 +585,9 @@ int main(int argc, char** argv) {
                    calibration + trials);
       return 1;
     }
-    const Outcome c = calibrated(r, cells, calibration, trials, from, pipeline,
-                                 config.classifier.training, stopping, time, scores);
+    const Outcome c =
+        calibrated(r, cells, calibration, trials, from, pipeline, config.classifier.training,
+                   stopping, time, independent_flashes, scores);
     // --ceiling-only: the learning condition skipped (reported as the calibrated one).
     const Outcome n = ceiling_only
                           ? c
