@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "arbci/core/text.h"
+
 namespace arbci::app {
 namespace {
 
@@ -28,11 +30,6 @@ std::map<int, std::string> codeMap(const bci::Recording& recording) {
   return out;
 }
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
 bool endsWith(const std::string& text, const std::string& end) {
   return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
 }
@@ -40,7 +37,7 @@ bool endsWith(const std::string& text, const std::string& end) {
 // An annotation's condition from its words, as "kind/level" where a reader epochs by the level
 // (MNE selects "feedback" for every "feedback/..."): "Feedback 3 error" is feedback/error.
 std::string annotationType(const std::string& text) {
-  const std::string first = lower(text.substr(0, text.find(' ')));
+  const std::string first = core::lowerCase(text.substr(0, text.find(' ')));
   if (first == "selected") return "selection";
   if (first == "feedback") {
     for (const char* level : {"correct", "error"})

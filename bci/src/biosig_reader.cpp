@@ -17,6 +17,7 @@
 
 #include "arbci/bci/recording.h"
 #include "arbci/bci/units.h"
+#include "arbci/core/text.h"
 #include "bdf_layout.h"
 
 namespace arbci::bci {
@@ -33,13 +34,6 @@ struct HeaderCloser {
   }
 };
 using Header = std::unique_ptr<HDRTYPE, HeaderCloser>;
-
-std::string trimmed(std::string text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.pop_back();
-  size_t start = 0;
-  while (start < text.size() && std::isspace(static_cast<unsigned char>(text[start]))) ++start;
-  return text.substr(start);
-}
 
 // "Stim 12 T" -> a stimulus; false for any other text.
 bool parseStimulus(const std::string& text, StimulusEvent& event) {
@@ -188,7 +182,7 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   if (!hdr) fail(path, "BioSig could not open it");
   if (serror2(hdr.get())) {
     char* message = biosig_get_errormsg(hdr.get());
-    std::string text = message ? trimmed(message) : "unknown error";
+    std::string text = message ? core::trimmed(message) : "unknown error";
     std::free(message);
     fail(path, "BioSig: " + text);
   }
@@ -220,7 +214,7 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   for (long c = 0; c < channels; ++c) {
     CHANNEL_TYPE* channel = biosig_get_channel(hdr.get(), static_cast<int>(c));
     const char* label = channel ? biosig_channel_get_label(channel) : nullptr;
-    recording.info.channels.push_back(label && *label ? trimmed(label)
+    recording.info.channels.push_back(label && *label ? core::trimmed(label)
                                                       : "Ch" + std::to_string(c + 1));
     if (channel && biosig_get_channel_samplerate(hdr.get(), static_cast<int>(c)) != rate) {
       fail(path, "channel " + recording.info.channels.back() +
@@ -235,7 +229,7 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
   for (long c = 0; c < channels; ++c) {
     CHANNEL_TYPE* channel = biosig_get_channel(hdr.get(), static_cast<int>(c));
     const std::string unit = channel && biosig_channel_get_physdim(channel)
-                                 ? trimmed(biosig_channel_get_physdim(channel))
+                                 ? core::trimmed(biosig_channel_get_physdim(channel))
                                  : "";
     const double scale = microvoltsPer(unit);
     for (std::int64_t s = 0; s < samples; ++s) {
@@ -259,7 +253,7 @@ Recording readWithBiosig(const std::filesystem::path& path, const ReadOptions& o
     const auto sample = static_cast<std::int64_t>(std::llround(position * to_samples));
     const auto length = static_cast<int>(std::lround(duration * to_samples));
     const std::string text =
-        description ? trimmed(description) : "event type " + std::to_string(type);
+        description ? core::trimmed(description) : "event type " + std::to_string(type);
     StimulusEvent stimulus;
     if (parseStimulus(text, stimulus)) {
       stimulus.sample = sample;

@@ -10,6 +10,7 @@
 
 #include "arbci/bci/recording.h"
 #include "arbci/bci/units.h"
+#include "arbci/core/text.h"
 #include "xdf/xdf_clock.h"
 #include "xdf/xdf_file.h"
 
@@ -18,11 +19,6 @@ namespace {
 
 [[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
   throw RecordingError(path.string() + ": " + what);
-}
-
-std::string lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 // ARBCI's markers ("flash <code> target|nontarget|unknown"), "<code> [target|nontarget]" or a bare
@@ -94,7 +90,7 @@ Recording readXdf(const std::filesystem::path& path, const ReadOptions& options)
   const xdf::Stream* eeg = nullptr;
   for (const xdf::Stream& s : file.streams) {
     if (s.nominal_rate <= 0 || !s.numeric() || s.samples() == 0) continue;
-    if (lower(s.type) == "eeg") {
+    if (core::lowerCase(s.type) == "eeg") {
       eeg = &s;
       break;
     }

@@ -5,16 +5,13 @@
 #include <opencv2/core.hpp>
 #include <sstream>
 
+#include "arbci/core/text.h"
+
 namespace arbci::vision {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const std::string& what) {
   throw CalibrationFileError(source + ": " + what);
-}
-
-std::string lower(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return text;
 }
 
 cv::Mat readMatrix(const cv::FileNode& node, const std::string& source, const std::string& field) {
@@ -162,7 +159,7 @@ void CameraModel::checkImageSize(cv::Size size) const {
 }
 
 CameraModel CameraModel::load(const std::filesystem::path& path) {
-  if (lower(path.extension().string()) == ".cal") {
+  if (core::lowerCase(path.extension().string()) == ".cal") {
     if (!std::filesystem::is_regular_file(path)) fail(path.string(), "no such file");
     return readArToolKitPlus(path);
   }

@@ -9,26 +9,21 @@
 #include <map>
 #include <sstream>
 
+#include "arbci/core/text.h"
+
 namespace arbci::bci::lsl {
 namespace {
 
-std::string trimmed(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t\r\n");
-  if (begin == std::string::npos) return "";
-  const auto end = s.find_last_not_of(" \t\r\n");
-  return s.substr(begin, end - begin + 1);
-}
-
 // liblsl's set syntax: {a, b, c}.
 std::vector<std::string> parseSet(const std::string& value, const std::string& where) {
-  const std::string v = trimmed(value);
+  const std::string v = core::trimmed(value);
   if (v.size() < 2 || v.front() != '{' || v.back() != '}')
     throw LslError(where + ": \"" + v + "\" is not a set (write it as {a, b, ...})");
   std::vector<std::string> out;
   std::stringstream items(v.substr(1, v.size() - 2));
   std::string item;
   while (std::getline(items, item, ','))
-    if (!trimmed(item).empty()) out.push_back(trimmed(item));
+    if (!core::trimmed(item).empty()) out.push_back(core::trimmed(item));
   return out;
 }
 
@@ -89,17 +84,17 @@ LslConfig LslConfig::parse(const std::string& text, const std::string& origin) {
   std::string line, section;
   for (int number = 1; std::getline(lines, line); ++number) {
     const std::string where = origin + ":" + std::to_string(number);
-    const std::string t = trimmed(line);
+    const std::string t = core::trimmed(line);
     if (t.empty() || t[0] == ';' || t[0] == '#') continue;
     if (t[0] == '[') {
       const auto close = t.find(']');
       if (close == std::string::npos) throw LslError(where + ": no closing ] for the section");
-      section = trimmed(t.substr(1, close - 1)) + ".";
+      section = core::trimmed(t.substr(1, close - 1)) + ".";
       continue;
     }
     const auto eq = t.find('=');
     if (eq == std::string::npos) throw LslError(where + ": expected key = value");
-    const std::string key = trimmed(t.substr(0, eq)), value = trimmed(t.substr(eq + 1));
+    const std::string key = core::trimmed(t.substr(0, eq)), value = core::trimmed(t.substr(eq + 1));
     if (key.empty() || value.empty()) throw LslError(where + ": empty key or value");
     values[section + key] = value;
   }

@@ -7,16 +7,10 @@
 #include <algorithm>
 #include <sstream>
 
+#include "arbci/core/text.h"
+
 namespace arbci::bci::lsl {
-namespace {
-
-std::string trimmed(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t\r\n");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r\n") - begin + 1);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::optional<std::pair<int, std::string>> shortinfoReply(const std::string& request_lines,
                                                           const StreamInfo& info,
@@ -30,7 +24,7 @@ std::optional<std::pair<int, std::string>> shortinfoReply(const std::string& req
   std::string id;
   if (!(fields >> port >> id) || port <= 0 || port > 65535) return std::nullopt;
   try {
-    if (!info.matches(trimmed(query))) return std::nullopt;
+    if (!info.matches(core::trimmed(query))) return std::nullopt;
   } catch (const LslError&) {
     return std::nullopt;  // an invalid query matches nothing
   }
@@ -111,7 +105,7 @@ void DiscoveryResponder::serve() {
       if (!datagram) continue;
       const auto newline = datagram->bytes.find('\n');
       if (newline == std::string::npos ||
-          trimmed(datagram->bytes.substr(0, newline)) != "LSL:shortinfo")
+          core::trimmed(datagram->bytes.substr(0, newline)) != "LSL:shortinfo")
         continue;
       const std::string rest = datagram->bytes.substr(newline + 1);
       if (ntohl(datagram->from.sin_addr.s_addr) == INADDR_LOOPBACK) passOn(i, datagram->bytes);

@@ -10,6 +10,7 @@
 
 #include "arbci/bci/lsl/outlet.h"
 #include "arbci/bci/lsl/resolver.h"
+#include "arbci/core/text.h"
 #include "lsl/socket.h"
 
 namespace arbci::bci::lsl {
@@ -17,17 +18,6 @@ namespace {
 
 constexpr double kConnectTimeoutS = 5.0;
 constexpr double kRetryPauseS = 0.25;
-
-std::string lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::string trimmed(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t\r\n");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r\n") - begin + 1);
-}
 
 void sleepUnless(const std::atomic<bool>& stop, double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
@@ -180,8 +170,8 @@ void Inlet::streamOnce() {
   for (std::string line; !(line = stream.readLine(kConnectTimeoutS)).empty();) {
     const auto colon = line.find(':');
     if (colon == std::string::npos) continue;
-    const std::string key = lower(trimmed(line.substr(0, colon)));
-    const std::string value = trimmed(line.substr(colon + 1));
+    const std::string key = core::lowerCase(core::trimmed(line.substr(0, colon)));
+    const std::string value = core::trimmed(line.substr(colon + 1));
     if (key == "byte-order") reverse = value != "1234" && value != "0";
     if (key == "uid" && value != target.uid) throw LslError("the outlet serves another stream now");
     if (key == "data-protocol-version" && value != std::to_string(kProtocolVersion))

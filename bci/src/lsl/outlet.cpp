@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "arbci/core/text.h"
 #include "lsl/discovery_responder.h"
 #include "lsl/socket.h"
 
@@ -36,17 +37,6 @@ std::string hostName() {
   char name[256] = "";
   if (::gethostname(name, sizeof name - 1) != 0) return "localhost";
   return name;
-}
-
-std::string lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::string trimmed(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t\r\n");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r\n") - begin + 1);
 }
 
 }  // namespace
@@ -200,7 +190,7 @@ void Outlet::serveDiscovery() {
       std::istringstream request(datagram->bytes);
       std::string method;
       std::getline(request, method);
-      method = trimmed(method);
+      method = core::trimmed(method);
       if (method == "LSL:shortinfo") {
         std::string rest((std::istreambuf_iterator<char>(request)),
                          std::istreambuf_iterator<char>());
@@ -231,9 +221,9 @@ void Outlet::serveClient(std::shared_ptr<Client> client, int raw_fd) {
     client->done = true;
   };
   try {
-    const std::string method = trimmed(stream.readLine(kRequestTimeoutS));
+    const std::string method = core::trimmed(stream.readLine(kRequestTimeoutS));
     if (method == "LSL:shortinfo") {
-      const std::string query = trimmed(stream.readLine(kRequestTimeoutS));
+      const std::string query = core::trimmed(stream.readLine(kRequestTimeoutS));
       bool match = false;
       try {
         match = info_.matches(query);
@@ -251,8 +241,8 @@ void Outlet::serveClient(std::shared_ptr<Client> client, int raw_fd) {
       for (std::string line; !(line = stream.readLine(kRequestTimeoutS)).empty();) {
         const auto colon = line.find(':');
         if (colon == std::string::npos) continue;
-        const std::string key = lower(trimmed(line.substr(0, colon)));
-        if (key == "value-size") value_size_text = trimmed(line.substr(colon + 1));
+        const std::string key = core::lowerCase(core::trimmed(line.substr(0, colon)));
+        if (key == "value-size") value_size_text = core::trimmed(line.substr(colon + 1));
       }
       const std::string status = "LSL/" + std::to_string(kProtocolVersion);
       if (version / 100 > kProtocolVersion / 100) {
