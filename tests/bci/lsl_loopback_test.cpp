@@ -16,16 +16,11 @@
 #include "arbci/bci/lsl/resolver.h"
 #include "arbci/bci/lsl_source.h"
 #include "support/background_process.h"
+#include "support/lsl_scope.h"
 #include "support/lsl_test_signal.h"
 
 namespace arbci::bci::lsl {
 namespace {
-
-LslConfig machineScope() {
-  LslConfig c;
-  c.resolve_scope = "machine";
-  return c;
-}
 
 std::string uniqueName(const std::string& what) {
   return what + "-" + std::to_string(::getpid()) + "-" +
@@ -64,14 +59,15 @@ void waitForClient(const Outlet& outlet) {
 
 TEST(LslLoopback, AnOutletIsFoundByNameAndTypeOnLoopbackOnly) {
   const std::string name = uniqueName("found");
-  Outlet outlet(eegStream(name, 4, 256, ChannelFormat::Float32), machineScope());
+  Outlet outlet(eegStream(name, 4, 256, ChannelFormat::Float32), test::machineScope());
   EXPECT_TRUE(outlet.warnings().empty()) << outlet.warnings().front();
-  const auto found = resolveStreams(machineScope(), buildQuery("default", name, "EEG"), 3.0);
+  const auto found = resolveStreams(test::machineScope(), buildQuery("default", name, "EEG"), 3.0);
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found[0].uid, outlet.info().uid);
   EXPECT_EQ(found[0].v4address, "127.0.0.1");
   EXPECT_EQ(found[0].v4data_port, outlet.info().v4data_port);
-  EXPECT_TRUE(resolveStreams(machineScope(), buildQuery("default", name, "Markers"), 0.6).empty());
+  EXPECT_TRUE(
+      resolveStreams(test::machineScope(), buildQuery("default", name, "Markers"), 0.6).empty());
   // The full description carries the channel labels.
   const StreamInfo full = fetchFullInfo(found[0], 2.0);
   EXPECT_EQ(full.channelLabels(), (std::vector<std::string>{"E1", "E2", "E3", "E4"}));
@@ -82,10 +78,10 @@ TEST(LslLoopback, EveryFormatArrivesBitIdenticalWithItsTimestamps) {
                                ChannelFormat::Int32, ChannelFormat::Int16}) {
     SCOPED_TRACE(formatName(format));
     const std::string name = uniqueName(formatName(format));
-    Outlet outlet(eegStream(name, 7, 500, format), machineScope());
-    const auto found = resolveStreams(machineScope(), buildQuery("default", name, ""), 3.0);
+    Outlet outlet(eegStream(name, 7, 500, format), test::machineScope());
+    const auto found = resolveStreams(test::machineScope(), buildQuery("default", name, ""), 3.0);
     ASSERT_EQ(found.size(), 1u);
-    Inlet inlet(found[0], machineScope());
+    Inlet inlet(found[0], test::machineScope());
     waitForClient(outlet);
     const SampleCodec codec(format, 7);
     std::vector<char> chunk;
@@ -110,10 +106,10 @@ TEST(LslLoopback, EveryFormatArrivesBitIdenticalWithItsTimestamps) {
 
 TEST(LslLoopback, TheClockOffsetOnOneMachineIsEstimatedNearZero) {
   const std::string name = uniqueName("clock");
-  Outlet outlet(eegStream(name, 1, 100, ChannelFormat::Float32), machineScope());
-  const auto found = resolveStreams(machineScope(), buildQuery("default", name, ""), 3.0);
+  Outlet outlet(eegStream(name, 1, 100, ChannelFormat::Float32), test::machineScope());
+  const auto found = resolveStreams(test::machineScope(), buildQuery("default", name, ""), 3.0);
   ASSERT_EQ(found.size(), 1u);
-  Inlet inlet(found[0], machineScope());
+  Inlet inlet(found[0], test::machineScope());
   InletStatus status;
   for (int i = 0; i < 300 && !(status = inlet.status()).clock_known; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -130,10 +126,11 @@ TEST(LslLoopback, StringMarkersArriveWithTheirOwnTimestamps) {
   markers.type = "Markers";
   markers.channel_count = 1;
   markers.channel_format = ChannelFormat::String;
-  Outlet outlet(markers, machineScope());
-  const auto found = resolveStreams(machineScope(), buildQuery("default", name, "Markers"), 3.0);
+  Outlet outlet(markers, test::machineScope());
+  const auto found =
+      resolveStreams(test::machineScope(), buildQuery("default", name, "Markers"), 3.0);
   ASSERT_EQ(found.size(), 1u);
-  Inlet inlet(found[0], machineScope());
+  Inlet inlet(found[0], test::machineScope());
   waitForClient(outlet);
   outlet.pushStrings({"flash 3 target"}, 10.25);
   outlet.pushStrings({std::string(400, 'm')}, 11.5);
@@ -149,7 +146,7 @@ TEST(LslSource, NoStreamIsRefusedWithAMessageNamingItAndTheScope) {
   LslSourceSettings settings;
   settings.name = uniqueName("absent");
   settings.resolve_timeout_s = 0.6;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   try {
     LslSource source(settings);
     FAIL() << "a source without a stream was made";
@@ -167,11 +164,11 @@ TEST(LslSource, StreamsOfTheSameNameAreToldApartBySourceId) {
   StreamInfo second = eegStream(name, 3, 256, ChannelFormat::Float32);
   first.source_id = name + "-left";
   second.source_id = name + "-right";
-  Outlet a(first, machineScope()), b(second, machineScope());
+  Outlet a(first, test::machineScope()), b(second, test::machineScope());
   LslSourceSettings settings;
   settings.name = name;
   settings.resolve_timeout_s = 1.0;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   settings.require_samples = false;
   try {
     LslSource source(settings);
@@ -193,7 +190,7 @@ TEST(LslSource, StreamsOfTheSameNameAreToldApartBySourceId) {
 // for a liblsl outlet's unicast server and gets the query as sent. (Called from the test below:
 // a plain responder bound by a test running beside it would take the query and pass nothing on.)
 void checkPassedOn(const std::string& name) {
-  const LslConfig config = machineScope();
+  const LslConfig config = test::machineScope();
   arbci::test::BackgroundProcess outlet(
       LSL_OUTLET_HELPER, {name, name + "-src", "2", "256", "1", "0", "1000", "-1", "30"});
   ASSERT_TRUE(outlet.waitForLine("ready", 10.0)) << "the outlet process did not start";
@@ -247,7 +244,7 @@ TEST(LslLoopback, TheDiscoveryPortIsSharedAsLiblslBindsIt) {
   arbci::test::BackgroundProcess outlet(
       LSL_OUTLET_HELPER, {name, name + "-src", "2", "256", "1", "0", "1000", "-1", "30"});
   ASSERT_TRUE(outlet.waitForLine("ready", 10.0)) << "the outlet process did not start";
-  const int port = machineScope().multicast_port;
+  const int port = test::machineScope().multicast_port;
   auto udp = [](const char* address, int at, bool reuse) {
     const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
     const int one = 1;
@@ -286,11 +283,11 @@ TEST(LslLoopback, TheDiscoveryPortIsSharedAsLiblslBindsIt) {
 
 TEST(LslSource, AStreamThatSendsNothingIsRefusedBeforeTheSession) {
   const std::string name = uniqueName("silent");
-  Outlet outlet(eegStream(name, 2, 256, ChannelFormat::Float32), machineScope());
+  Outlet outlet(eegStream(name, 2, 256, ChannelFormat::Float32), test::machineScope());
   LslSourceSettings settings;
   settings.name = name;
   settings.resolve_timeout_s = 1.0;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   try {
     LslSource source(settings);
     FAIL();
@@ -301,11 +298,11 @@ TEST(LslSource, AStreamThatSendsNothingIsRefusedBeforeTheSession) {
 
 TEST(LslSource, AStreamAtAnotherRateThanTheSessionsIsRefused) {
   const std::string name = uniqueName("rate");
-  Outlet outlet(eegStream(name, 2, 500, ChannelFormat::Float32), machineScope());
+  Outlet outlet(eegStream(name, 2, 500, ChannelFormat::Float32), test::machineScope());
   LslSourceSettings settings;
   settings.name = name;
   settings.expected_rate_hz = 256;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   settings.require_samples = false;
   try {
     LslSource source(settings);
@@ -331,7 +328,7 @@ LslSourceSettings fourSampleBlocksOf(const std::string& name) {
   LslSourceSettings settings;
   settings.name = name;
   settings.block_size = 4;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   settings.require_samples = false;  // it pushes once connected
   return settings;
 }
@@ -354,7 +351,7 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
   const std::string name = uniqueName("volts");
   StreamInfo info = twoChannels(name, "V", "");
   info.channels[1].impedance = "12.5";
-  Outlet outlet(info, machineScope());
+  Outlet outlet(info, test::machineScope());
   LslSource source(fourSampleBlocksOf(name));
   EXPECT_EQ(source.info().channels, (std::vector<std::string>{"E1", "E2"}));
   const std::vector<Block> blocks =
@@ -372,7 +369,7 @@ TEST(LslSource, VoltsAreTurnedIntoMicrovoltsAndBlocksCarryTheLabels) {
 // Session panel's source line and, once, in the recording's annotations.
 TEST(LslSource, AChannelNotInVoltsIsKeptAsItIsAndSaidSo) {
   const std::string name = uniqueName("counts");
-  Outlet outlet(twoChannels(name, "microvolts", "counts"), machineScope());
+  Outlet outlet(twoChannels(name, "microvolts", "counts"), test::machineScope());
   LslSource source(fourSampleBlocksOf(name));
   EXPECT_TRUE(source.takeAnnotations().empty());  // nothing delivered yet
   const std::vector<Block> blocks =
@@ -404,7 +401,7 @@ TEST(LslTwoProcesses, TenMinutesOf64ChannelsAt2048HzArriveCompleteAndBitIdentica
   settings.name = name;
   settings.expected_rate_hz = kRate;
   settings.block_size = 64;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   LslSource source(settings);
   std::int64_t next = 0, wrong_values = 0, wrong_stamps = 0;
   double worst_stamp_error = 0;
@@ -449,7 +446,7 @@ TEST(LslTwoProcesses, AnOutletKilledAndRestartedIsReconnectedAndTheGapCountedExa
   LslSourceSettings settings;
   settings.name = name;
   settings.block_size = 10;
-  settings.config = machineScope();
+  settings.config = test::machineScope();
   LslSource source(settings);
   std::vector<Block> blocks;
   const auto collect = [&](std::int64_t until, double timeout_s) {

@@ -27,11 +27,6 @@ test::XdfNumericStream eegStream(int samples) {
   return s;
 }
 
-std::string fileBytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // The files the cases start from: what LabRecorder writes, and what real files hold.
 std::vector<std::string> seeds() {
   std::vector<std::string> out;
@@ -39,12 +34,12 @@ std::vector<std::string> seeds() {
   const test::XdfNumericStream eeg = eegStream(300);
   const double t0 = eeg.first_timestamp;
   test::writeXdf(path, eeg, {{t0 + 0.1, "flash 1 target"}, {t0 + 0.5, "note"}});
-  out.push_back(fileBytes(path));
+  out.push_back(test::fileBytes(path));
   test::XdfExtras extras;
   extras.empty_stream = true;
   extras.marker_channels = 2;
   test::writeXdf(path, eeg, {{t0 + 0.2, "flash 2 nontarget", {"detail"}}}, extras);
-  out.push_back(fileBytes(path));
+  out.push_back(test::fileBytes(path));
   test::XdfExtras reset;
   for (int s = 0; s < 300; ++s)
     reset.eeg_stamps.push_back(s < 150 ? 500000.0 + s / 256.0
@@ -52,7 +47,7 @@ std::vector<std::string> seeds() {
   reset.eeg_offsets = {{500000.0, -499000.0}, {500000.5, -499000.0}, {10.7, 990.0}, {13.0, 990.0}};
   reset.marker_offsets = reset.eeg_offsets;
   test::writeXdf(path, eeg, {{500000.1, "flash 1 target"}, {11.0, "flash 2 target"}}, reset);
-  out.push_back(fileBytes(path));
+  out.push_back(test::fileBytes(path));
   return out;
 }
 

@@ -84,11 +84,6 @@ TEST(Xdf, ACorruptFileIsRefusedWithItsNameNotACrash) {
   }
 }
 
-std::string fileBytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // As the public example empty_streams.xdf: a stream with a header and not one sample.
 TEST(Xdf, AStreamWithoutSamplesIsAcceptedAndAFileWithNoEegNamesItsStreams) {
   const auto path = test::freshTempPath("xdf", "empty_stream.xdf");
@@ -248,7 +243,7 @@ TEST(Xdf, AWildStampIsAnOutlierNotedNeverABreakNorAShift) {
 TEST(Xdf, AFileCutAnywhereIsReportedAsCutShort) {
   const auto whole = test::freshTempPath("xdf", "whole_for_cuts.xdf");
   test::writeXdf(whole, eegStream(450), {{100.5, "flash 2 target"}, {101.0, "flash 1 nontarget"}});
-  const std::string bytes = fileBytes(whole);
+  const std::string bytes = test::fileBytes(whole);
   EXPECT_EQ(readRecording(whole).samples, 450);
   const auto cut = test::freshTempPath("xdf", "cut_anywhere.xdf");
   ReadOptions salvage;
@@ -282,7 +277,7 @@ TEST(Xdf, AFileCutShortIsRefusedOrSalvagedUpToItsLastWholeChunk) {
   const auto whole = test::freshTempPath("xdf", "whole.xdf");
   const test::XdfNumericStream eeg = eegStream(1000);
   test::writeXdf(whole, eeg, {});
-  const std::string bytes = fileBytes(whole);
+  const std::string bytes = test::fileBytes(whole);
   const auto cut = test::freshTempPath("xdf", "cut.xdf");
   std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   try {
@@ -307,7 +302,7 @@ TEST(Xdf, AFileCutShortIsRefusedOrSalvagedUpToItsLastWholeChunk) {
 TEST(Xdf, DamagedFilesAreRefusedOrReadNeverACrash) {
   const auto whole = test::freshTempPath("xdf", "undamaged.xdf");
   test::writeXdf(whole, eegStream(300), {{100.5, "flash 2 target"}});
-  const std::string bytes = fileBytes(whole);
+  const std::string bytes = test::fileBytes(whole);
   const auto damaged = test::freshTempPath("xdf", "damaged.xdf");
   std::uint32_t state = 12345;
   int refused = 0, read = 0;

@@ -11,6 +11,8 @@ namespace arbci::test {
 // <temp>/arbci_<suite>_<process id>_<name>, removed if it exists (a folder or file the test then
 // makes); the process id keeps tests run in parallel apart.
 std::filesystem::path freshTempPath(const std::string& suite, const std::string& name);
+// A file's bytes ("" when it cannot be read).
+std::string fileBytes(const std::filesystem::path& path);
 // Throws (through nlohmann::json) when the file is missing or not JSON.
 nlohmann::json readJson(const std::filesystem::path& path);
 

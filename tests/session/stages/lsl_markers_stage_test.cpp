@@ -10,16 +10,11 @@
 #include "arbci/bci/lsl/inlet.h"
 #include "arbci/bci/lsl/resolver.h"
 #include "arbci/session/stages/lsl_markers_stage.h"
+#include "support/lsl_scope.h"
 #include "support/stage_bench.h"
 
 namespace arbci::session {
 namespace {
-
-bci::lsl::LslConfig machineScope() {
-  bci::lsl::LslConfig c;
-  c.resolve_scope = "machine";
-  return c;
-}
 
 std::vector<bci::lsl::Sample> pull(bci::lsl::Inlet& inlet, size_t count) {
   std::vector<bci::lsl::Sample> got;
@@ -35,12 +30,12 @@ TEST(LslMarkersStage, NotesFlashesFeedbackAndTheEndGoOutAsTheyHappen) {
   test::StageBench bench("lsl_markers", Clock::Mode::RealTime);
   const std::string name = "markers-" + std::to_string(::getpid());
   LslMarkersStage stage(
-      LslMarkersSettings{name, machineScope(), 256.0, "test.json", {{"Paradigm", "single"}}},
+      LslMarkersSettings{name, test::machineScope(), 256.0, "test.json", {{"Paradigm", "single"}}},
       bench.services());
   const auto found = bci::lsl::resolveStreams(
-      machineScope(), bci::lsl::buildQuery("default", name, "Markers"), 3.0);
+      test::machineScope(), bci::lsl::buildQuery("default", name, "Markers"), 3.0);
   ASSERT_EQ(found.size(), 1u);
-  bci::lsl::Inlet inlet(found[0], machineScope());
+  bci::lsl::Inlet inlet(found[0], test::machineScope());
   // The inlet connects before anything is sent (a marker pushed before is not kept).
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   bench.previous.annotations.push_back({0, "Phase calibration: flashing", 0});
