@@ -19,12 +19,11 @@ namespace {
 struct Pty {
   Pty() {
     char name[256] = {};
-    ::openpty(&master, &slave, name, nullptr, nullptr);
-    path = name;
+    if (::openpty(&master, &slave, name, nullptr, nullptr) == 0) path = name;
   }
   ~Pty() {
-    ::close(slave);
-    ::close(master);
+    if (slave >= 0) ::close(slave);
+    if (master >= 0) ::close(master);
   }
   std::vector<std::uint8_t> read() const {
     std::vector<std::uint8_t> out;
@@ -50,6 +49,7 @@ Flash flash(int code, bool objects) {
 
 TEST(TriggerOutput, EachFlashWritesItsCodeAndThePulseEndsOnTheNextFrame) {
   Pty pty;
+  if (pty.path.empty()) GTEST_SKIP() << "this machine gives no pseudo-terminal (openpty failed)";
   TriggerSettings settings;
   settings.device = pty.path;
   settings.feedback_byte = 200;
@@ -74,6 +74,7 @@ TEST(TriggerOutput, EachFlashWritesItsCodeAndThePulseEndsOnTheNextFrame) {
 
 TEST(TriggerOutput, BasesShiftTheCodesAndWithoutPulseNoResetIsWritten) {
   Pty pty;
+  if (pty.path.empty()) GTEST_SKIP() << "this machine gives no pseudo-terminal (openpty failed)";
   TriggerSettings settings;
   settings.device = pty.path;
   settings.object_base = 10;
