@@ -146,7 +146,7 @@ SessionOptions optionsFor(SessionOptions options, const SessionConfig& config) {
 
 // eeg.trigger_out "serial": the port, opened (nullptr for "none"). Throws SessionConfigError
 // naming eeg.trigger.device and why it cannot be used.
-std::unique_ptr<TriggerOutput> openTriggerOutput(const SessionConfig& c) {
+static std::unique_ptr<TriggerOutput> openTriggerOutput(const SessionConfig& c) {
   if (c.eeg.trigger_out != "serial") return nullptr;
   TriggerSettings settings;
   triggerSchema().read(c.eeg.trigger, settings);
@@ -158,9 +158,9 @@ std::unique_ptr<TriggerOutput> openTriggerOutput(const SessionConfig& c) {
   }
 }
 
-void checkNamedResources(const SessionConfig& c) {
+// The files the session file names; the devices are checked by opening them.
+static void checkNamedFiles(const SessionConfig& c) {
   SceneSettings::of(c).validate();
-  openTriggerOutput(c);  // opened and closed: the run opens it again
   EegAcquisitionSettings{c.eeg, 0.0, c.source}.validate();
   if (!c.classifier.model_file.empty() && !std::filesystem::exists(c.classifier.model_file))
     throw SessionConfigError(c.source + ": classifier.model = \"" + c.classifier.model_file +
@@ -168,11 +168,18 @@ void checkNamedResources(const SessionConfig& c) {
   checkRobotKey(c.robot, c.source);
 }
 
+void checkNamedResources(const SessionConfig& c) {
+  checkNamedFiles(c);
+  // Opened and closed again: before a run that is not made yet (the window's Apply).
+  openTriggerOutput(c);
+}
+
 AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& options, Clock& clock,
                                const std::filesystem::path& folder, const StageServices& services,
                                const DisplayFactory& display) {
-  // Every stage's settings, checked before anything starts.
-  checkNamedResources(c);
+  // Every stage's settings, checked before anything starts; the trigger port opened once, for
+  // the run (opening a serial port can reset the box on it).
+  checkNamedFiles(c);
   const SceneSettings scene_settings = SceneSettings::of(c);
   const EegAcquisitionSettings eeg_settings{c.eeg, c.paradigm.flashSeconds(), c.source,
                                             options.experimenter};
