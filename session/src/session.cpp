@@ -154,7 +154,7 @@ void Session::writeTriggers(const CycleRecord& record, double host_s) {
   if (trigger_->failedWrites() > trigger_failures_told_) {
     // Told once: the flashes go on, and the recording keeps their onsets.
     if (trigger_failures_told_ == 0)
-      operator_log_.add(record.time_s, Severity::Warning,
+      operator_log_.say(record.time_s, Severity::Warning,
                         trigger_->fault() + " (" + std::to_string(trigger_->failedWrites()) +
                             " trigger(s) not sent; the recording keeps every onset)");
     log_->write("trigger_failed", record.time_s,

@@ -116,6 +116,20 @@ void timing(const Json& s, std::vector<TrustRow>& rows) {
   rows.push_back({"timing", text, off > 0});
 }
 
+// eeg.trigger_out: whether the amplifier's own file holds every flash's trigger.
+void triggers(const Json& s, std::vector<TrustRow>& rows) {
+  const Json& t = at(s, "trigger");
+  if (t.is_null()) return;
+  const int failed = integer(at(t, "failed"));
+  std::string text = std::to_string(integer(at(t, "written"))) + " bytes to " +
+                     t.value("device", "") +
+                     format(", at most %.2f ms after their swap", number(at(t, "latency_max_ms")));
+  if (failed > 0)
+    text += "; " + std::to_string(failed) +
+            " not sent: the amplifier's file lacks them (ARBCI's recording keeps every onset)";
+  rows.push_back({"triggers", text, failed > 0});
+}
+
 void eeg(const Json& s, std::vector<TrustRow>& rows) {
   const Json& q = at(s, "signal_quality");
   if (!q.is_null()) {
@@ -196,6 +210,7 @@ std::vector<TrustRow> trustRows(const Json& summary) {
   calibration(summary, rows);
   online(summary, rows);
   timing(summary, rows);
+  triggers(summary, rows);
   eeg(summary, rows);
   interruptions(summary, rows);
   for (const Json& note : at(summary, "notes"))

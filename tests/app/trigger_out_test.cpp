@@ -89,7 +89,7 @@ TEST(TriggerOut, EveryFlashsCodeArrivesInOrderWithinAFrameOfItsSwap) {
                                 .dump();
   const ProcessResult r = runProcess(kArbci,
                                      {"timing-check", "--headless", "--session", session,
-                                      "--seconds", "10", "--out", folder.string()},
+                                      "--seconds", "8", "--out", folder.string()},
                                      120.0);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the last bytes, read
@@ -99,7 +99,7 @@ TEST(TriggerOut, EveryFlashsCodeArrivesInOrderWithinAFrameOfItsSwap) {
   std::vector<std::uint8_t> recorded;
   for (const bci::StimulusEvent& s : recording.stimuli)
     recorded.push_back(static_cast<std::uint8_t>(s.code));
-  ASSERT_GE(recorded.size(), 20u);
+  ASSERT_GE(recorded.size(), 10u);
 
   // Each flash a pulse: its code, then 0 (on the next frame), nothing else between.
   const std::vector<std::uint8_t> bytes = port.bytes();

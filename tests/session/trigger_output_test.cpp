@@ -47,11 +47,19 @@ Flash flash(int code, bool objects) {
   return f;
 }
 
-TEST(TriggerOutput, EachFlashWritesItsCodeAndThePulseEndsOnTheNextFrame) {
+// A pseudo-terminal in place of the box, and settings naming it (skipped where the machine gives
+// no pseudo-terminal).
+class TriggerOutputOnPty : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (pty.path.empty()) GTEST_SKIP() << "this machine gives no pseudo-terminal (openpty failed)";
+    settings.device = pty.path;
+  }
   Pty pty;
-  if (pty.path.empty()) GTEST_SKIP() << "this machine gives no pseudo-terminal (openpty failed)";
   TriggerSettings settings;
-  settings.device = pty.path;
+};
+
+TEST_F(TriggerOutputOnPty, EachFlashWritesItsCodeAndThePulseEndsOnTheNextFrame) {
   settings.feedback_byte = 200;
   TriggerOutput out(settings);
   FeedbackShown feedback;
@@ -72,11 +80,7 @@ TEST(TriggerOutput, EachFlashWritesItsCodeAndThePulseEndsOnTheNextFrame) {
   EXPECT_EQ(out.failedWrites(), 0);
 }
 
-TEST(TriggerOutput, BasesShiftTheCodesAndWithoutPulseNoResetIsWritten) {
-  Pty pty;
-  if (pty.path.empty()) GTEST_SKIP() << "this machine gives no pseudo-terminal (openpty failed)";
-  TriggerSettings settings;
-  settings.device = pty.path;
+TEST_F(TriggerOutputOnPty, BasesShiftTheCodesAndWithoutPulseNoResetIsWritten) {
   settings.object_base = 10;
   settings.grid_base = 50;
   settings.pulse = false;
@@ -85,6 +89,22 @@ TEST(TriggerOutput, BasesShiftTheCodesAndWithoutPulseNoResetIsWritten) {
   out.presented(2, 1.1, 0.0, {}, nullptr);
   out.presented(3, 1.2, 0.0, {flash(4, false)}, nullptr);
   EXPECT_EQ(pty.read(), (std::vector<std::uint8_t>{11, 54}));
+}
+
+// The box unplugged mid-run (the pseudo-terminal's other end closed): each write that fails is
+// counted, the fault names the port, and nothing is stamped as written.
+TEST_F(TriggerOutputOnPty, APortThatGoesAwayCountsItsFailedWrites) {
+  TriggerOutput out(settings);
+  out.presented(1, 1.0, 0.0, {flash(1, true)}, nullptr);
+  ASSERT_EQ(out.take().size(), 1u);
+  ::close(pty.master);
+  ::close(pty.slave);
+  pty.master = pty.slave = -1;
+  out.presented(2, 1.1, 0.0, {flash(2, true)}, nullptr);
+  out.presented(3, 1.2, 0.0, {flash(3, true)}, nullptr);
+  EXPECT_GE(out.failedWrites(), 2);
+  EXPECT_NE(out.fault().find(settings.device), std::string::npos) << out.fault();
+  EXPECT_TRUE(out.take().empty());
 }
 
 TEST(TriggerOutput, APortThatCannotBeUsedIsRefusedNamingIt) {

@@ -79,12 +79,14 @@ TEST(TrustReport, EachReasonForCautionIsMarked) {
       {"bad_channels", 1},
       {"channels", {{{"channel", "Oz"}, {"grade", "bad"}, {"finding", "flat: SD 0.1 uV"}}}}};
   s["eeg"]["faults"] = {{{"t", 45.0}, {"fault", "the EEG source ended"}}};
+  s["trigger"] = {
+      {"device", "/dev/ttyUSB0"}, {"written", 122}, {"failed", 35}, {"latency_max_ms", 0.23}};
   s["trials"] = {
       {{"trial", 2},
        {"interruptions", {{{"kind", "emergency stop"}, {"at_s", 80.2}, {"resumed_s", 89.0}}}}}};
   const auto rows = trustRows(s);
   for (const char* what :
-       {"calibration", "review", "timing", "EEG channels", "EEG stream", "trial 2"}) {
+       {"calibration", "review", "timing", "triggers", "EEG channels", "EEG stream", "trial 2"}) {
     ASSERT_NE(row(rows, what), nullptr) << what;
     EXPECT_TRUE(row(rows, what)->caution) << what;
   }
@@ -93,6 +95,8 @@ TEST(TrustReport, EachReasonForCautionIsMarked) {
   EXPECT_NE(row(rows, "timing")->text.find("went on annotated"), std::string::npos);
   EXPECT_NE(row(rows, "EEG channels")->text.find("Oz (flat: SD 0.1 uV)"), std::string::npos);
   EXPECT_NE(row(rows, "trial 2")->text.find("went on at 89.0 s"), std::string::npos);
+  EXPECT_NE(row(rows, "triggers")->text.find("35 not sent"), std::string::npos)
+      << row(rows, "triggers")->text;
 }
 
 }  // namespace
