@@ -154,14 +154,12 @@ void recordParticipant(const fs::path& root, const std::string& subject,
     if ((c.empty() || c == "n/a") && !value.empty()) c = value;
   }
   std::ostringstream out;
-  for (const auto& r : [&] {
-         std::vector<std::vector<std::string>> all{header};
-         all.insert(all.end(), rows.begin(), rows.end());
-         return all;
-       }()) {
-    for (size_t i = 0; i < r.size(); ++i) out << (i ? "\t" : "") << cell(r[i]);
+  const auto line = [&out](const std::vector<std::string>& cells) {
+    for (size_t i = 0; i < cells.size(); ++i) out << (i ? "\t" : "") << cell(cells[i]);
     out << "\n";
-  }
+  };
+  line(header);
+  for (const auto& r : rows) line(r);
   writeText(file, out.str());
   if (!fs::exists(root / "participants.json"))
     writeText(root / "participants.json", participantsJson());
