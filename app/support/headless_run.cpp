@@ -15,12 +15,13 @@ std::string statusLine(const session::Session& session) {
 }
 }  // namespace
 
-void runHeadless(session::Session& session) {
+void runHeadless(session::Session& session, const std::function<void()>& presented) {
   auto show = [&session] {
     std::cerr << "\r" << statusLine(session) << "      " << std::flush;
     setStatusLineOpen(true);
   };
   while (session.step()) {
+    if (presented) presented();
     if (!session.last().paradigm.phase_changes.empty() || session.frame() % 600 == 0) show();
     if (interruptRequested()) session.request(session::AbortRequest{});
   }

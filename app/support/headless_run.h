@@ -3,10 +3,14 @@
 // summary is still saved.
 #pragma once
 
+#include <functional>
+
 #include "arbci/session/session.h"
 
 namespace arbci::app {
 
-void runHeadless(session::Session& session);
+// `presented`, when given, runs after each step: the display that presents the frame (an HMD
+// runtime) tells the session when.
+void runHeadless(session::Session& session, const std::function<void()>& presented = {});
 
 }  // namespace arbci::app

@@ -17,6 +17,7 @@
 #include "arbci/ui/panel_registry.h"
 #include "hmd/hmd_stage.h"
 #include "hmd/open_session.h"
+#include "hmd/openxr_output.h"
 #include "support/interrupt.h"
 #include "workstation/experimenter_script.h"
 #include "workstation/session_requests.h"
@@ -123,6 +124,8 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
   options.presents_itself = false;  // the window's swap is the presentation
   render::WindowOptions window;
   window.title = "ARBCI workstation";
+  // A headset's runtime paces the frames; the monitor's refresh must not pace them too.
+  window.vsync = config.hmd.output != "openxr";
   render::WindowContext main_window(window);
   std::unique_ptr<render::WindowContext> mirror;
   const int monitors = render::WindowContext::monitorCount();
@@ -139,6 +142,14 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
     m.fullscreen_monitor = config.hmd.mirror_monitor;
     m.share_with = main_window.window();
     mirror = std::make_unique<render::WindowContext>(m);
+    main_window.makeCurrent();
+  }
+  // A headset through its OpenXR runtime: opened on the main window's context (the HMD stage
+  // draws there); what fails is the pre-flight's to say, in the window.
+  std::optional<OpenXrOutput> xr;
+  if (config.hmd.output == "openxr") {
+    xr.emplace(config, main_window);
+    if (!xr->open()) options.display_failures.push_back(xr->failure());
     main_window.makeCurrent();
   }
   ui::ImGuiLayer imgui(main_window, layoutFile());
@@ -248,9 +259,15 @@ int runWorkstation(const session::SessionConfig& config, session::SessionOptions
         main_window.requestClose();
       }
     }
-    // The subject's view is stamped at its own swap: the HMD window's when there is one (its
-    // picture carries the photodiode patch), else the experimenter window's, which shows it.
-    if (mirror) {
+    // The subject's view is stamped at its own swap: the headset's predicted display time, the
+    // HMD window's swap when there is one (its picture carries the photodiode patch), else the
+    // experimenter window's, which shows it.
+    const bool on_headset =
+        xr && xr->present(*session, opened.hmd->texture(), opened.hmd->size(), true);
+    if (on_headset) {
+      main_window.makeCurrent();
+      main_window.present();
+    } else if (mirror) {
       mirror->makeCurrent();
       render::blitTexture(opened.hmd->texture(), opened.hmd->size(), mirror->framebufferSize());
       mirror->present();

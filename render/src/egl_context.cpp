@@ -117,9 +117,8 @@ class EglContext final : public GlContext {
                                         EGL_DEPTH_SIZE,
                                         24,
                                         EGL_NONE};
-    EGLConfig config = nullptr;
     EGLint count = 0;
-    if (!eglChooseConfig(display_->get(), config_attributes, &config, 1, &count) || count == 0) {
+    if (!eglChooseConfig(display_->get(), config_attributes, &config_, 1, &count) || count == 0) {
       fail("eglChooseConfig (no pbuffer-capable OpenGL config)");
     }
     const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
@@ -129,7 +128,7 @@ class EglContext final : public GlContext {
                                          EGL_CONTEXT_OPENGL_PROFILE_MASK,
                                          EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                          EGL_NONE};
-    context_ = eglCreateContext(display_->get(), config, EGL_NO_CONTEXT, context_attributes);
+    context_ = eglCreateContext(display_->get(), config_, EGL_NO_CONTEXT, context_attributes);
     if (context_ == EGL_NO_CONTEXT) fail("eglCreateContext (OpenGL 3.3 core)");
     makeCurrent();
     framebuffer_ = std::make_unique<Framebuffer>(size);
@@ -153,9 +152,17 @@ class EglContext final : public GlContext {
   Size framebufferSize() const override { return framebuffer_->size(); }
   void present() override { glFinish(); }
   bool isHeadless() const override { return true; }
+  NativeGl native() const override {
+    NativeGl n;
+    n.egl_display = display_->get();
+    n.egl_config = config_;
+    n.egl_context = context_;
+    return n;
+  }
 
  private:
   std::shared_ptr<EglDisplay> display_;
+  EGLConfig config_ = nullptr;
   EGLContext context_ = EGL_NO_CONTEXT;
   std::unique_ptr<Framebuffer> framebuffer_;
 };

@@ -88,6 +88,17 @@ RgbaImage readPixels(unsigned int framebuffer, Size size) {
   return image;
 }
 
+RgbaImage readTexture(unsigned int texture, Size size) {
+  GLuint fbo = 0;
+  glGenFramebuffers(1, &fbo);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+  RgbaImage image = readPixels(fbo, size);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  return image;
+}
+
 void blitTexture(unsigned int texture, Size source, Size target) {
   GLuint read = 0;
   glGenFramebuffers(1, &read);

@@ -4,6 +4,10 @@
 
 #include <GLFW/glfw3.h>
 #include <X11/Xlib.h>
+#define GLFW_EXPOSE_NATIVE_X11
+#define GLFW_EXPOSE_NATIVE_GLX
+#include <GL/glx.h>
+#include <GLFW/glfw3native.h>
 
 #include <atomic>
 #include <cstdlib>
@@ -89,6 +93,26 @@ Size WindowContext::framebufferSize() const {
   Size size;
   glfwGetFramebufferSize(window_, &size.width, &size.height);
   return size;
+}
+
+NativeGl WindowContext::native() const {
+  NativeGl n;
+  Display* display = glfwGetX11Display();
+  GLXContext context = glfwGetGLXContext(window_);
+  if (!display || !context) return n;  // not a GLX context (GLFW on EGL or Wayland)
+  // The context's own frame buffer configuration, which an OpenXR runtime needs to share it.
+  int id = 0;
+  if (glXQueryContext(display, context, GLX_FBCONFIG_ID, &id) != Success) return n;
+  const int wanted[] = {GLX_FBCONFIG_ID, id, None};
+  int count = 0;
+  GLXFBConfig* configs = glXChooseFBConfig(display, DefaultScreen(display), wanted, &count);
+  if (!configs || count == 0) return n;
+  n.x_display = display;
+  n.glx_fbconfig = configs[0];
+  XFree(configs);
+  n.glx_drawable = glfwGetGLXWindow(window_);
+  n.glx_context = context;
+  return n;
 }
 
 void WindowContext::present() {

@@ -127,10 +127,20 @@ bool Session::step() {
   return !ended_;
 }
 
-void Session::presented(double host_s) {
+void Session::presented(double host_s, const std::optional<RuntimeFrame>& runtime) {
   CycleRecord& record = records_[current_];
   if (ended_ || record.presented) return;
   record.presented = CycleRecord::Presented{host_s, clock_.sampleAt(host_s)};
+  if (runtime) {
+    // The stamp the flashes take (the predicted display time) beside the handover, which is what
+    // a window's swap stamp would have been.
+    nlohmann::json fields = {{"frame", record.frame},
+                             {"display_s", clock_.sessionOf(host_s)},
+                             {"submitted_s", clock_.sessionOf(runtime->submitted_host_s)},
+                             {"lead_ms", 1000.0 * (host_s - runtime->submitted_host_s)}};
+    if (runtime->head) fields["head"] = *runtime->head;
+    log_->write("hmd_frame", clock_.sessionOf(host_s), fields);
+  }
   if (trigger_) writeTriggers(record, host_s);
 }
 

@@ -51,6 +51,13 @@ const Schema<HmdConfig>& hmdSchema() {
                  "the camera images undistorted before the overlays")
         .integer("mirror_monitor", &HmdConfig::mirror_monitor, -1, -1, 15,
                  "the monitor (0-based) the HMD's view is shown on full screen (-1: none)")
+        .text("output", &HmdConfig::output, "window",
+              "where the subject's view goes: window (a window, or the monitor "
+              "mirror_monitor names) or openxr (a headset through its OpenXR runtime: SteamVR, "
+              "Monado, Varjo Base; flashes stamped at the runtime's predicted display time)",
+              [] {
+                return std::vector<std::string>{"window", "openxr"};
+              })
         // PNG of the whole HMD frame, about 760 kB each at 1280x480 (camera images barely
         // compress): "phases" keeps 6 a trial, ~270 MB over a 60-trial day.
         .text("screenshots", &HmdConfig::screenshots, "phases",

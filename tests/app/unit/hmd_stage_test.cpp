@@ -1,12 +1,14 @@
 // The HMD's render stage on hand-built records, headless (EGL): what the paradigm shows this frame
 // drawn over the camera images (both eyes), the photodiode patch read back from the frame drawn,
-// an unchanged frame not drawn again, and the phase's screenshot written once a flash shows.
+// an unchanged frame not drawn again, the phase's screenshot written once a flash shows, and the
+// frame copied into each eye's image as an OpenXR headset is given it.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "arbci/render/framebuffer.h"
 #include "arbci/render/gl_context.h"
+#include "arbci/render/openxr_display.h"
 #include "hmd/hmd_stage.h"
 #include "support/stage_bench.h"
 #include "support/test_camera.h"
@@ -102,6 +104,56 @@ TEST_F(HmdStageTest, AnUnchangedFrameIsNotDrawnAgainAndADarkOneReadsBackDark) {
   bench_.step(*stage_);
   EXPECT_FALSE(bench_.record.display.redrawn);
   EXPECT_FALSE(bench_.record.display.patch_lit.has_value());
+}
+
+// A row of the grid flashing: the grid and the lit photodiode patch in both eyes.
+void drawFlash(test::StageBench& bench, HmdStage& stage) {
+  tracked(bench.record);
+  bci::FrameStimulus& shown = bench.record.paradigm.stimulus;
+  shown.phase = bci::Phase::CellFlashing;
+  shown.grid_visible = true;
+  shown.lit = {2};
+  bench.step(stage);
+  ASSERT_TRUE(bench.record.display.redrawn);
+}
+
+bool samePixels(const render::RgbaImage& a, const render::RgbaImage& b, int b_x0) {
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      for (int c = 0; c < 4; ++c)
+        if (a.at(x, y)[c] != b.at(b_x0 + x, y)[c]) return false;
+  return true;
+}
+
+TEST_F(HmdStageTest, EachEyesImageForTheHeadsetIsItsHalfOfTheFrameAsDrawn) {
+  drawFlash(bench_, *stage_);
+  const render::Size eye{640, 480};
+  ASSERT_EQ(stage_->size(), (render::Size{1280, 480}));
+  render::Framebuffer left(eye), right(eye);
+  render::copyEyes(stage_->texture(), stage_->size(), left.colorTexture(), right.colorTexture(),
+                   eye);
+  const render::RgbaImage frame = render::readTexture(stage_->texture(), stage_->size());
+  const render::RgbaImage l = render::readTexture(left.colorTexture(), eye);
+  const render::RgbaImage r = render::readTexture(right.colorTexture(), eye);
+  EXPECT_TRUE(samePixels(l, frame, 0));
+  EXPECT_TRUE(samePixels(r, frame, 640));
+  // The eyes differ (the cameras are apart), and each carries the lit patch in its corner.
+  EXPECT_FALSE(samePixels(l, frame, 640));
+  for (const render::RgbaImage* image : {&l, &r}) EXPECT_GT(image->at(10, 10)[0], 225);
+}
+
+TEST_F(HmdStageTest, AHeadsetsSmallerEyeImageIsTheWholeHalfScaled) {
+  drawFlash(bench_, *stage_);
+  const render::Size eye{320, 240};  // the runtime's largest image, smaller than the HMD's eye
+  render::Framebuffer left(eye), right(eye);
+  render::copyEyes(stage_->texture(), stage_->size(), left.colorTexture(), right.colorTexture(),
+                   eye);
+  for (const render::Framebuffer* target : {&left, &right}) {
+    const render::RgbaImage image = render::readTexture(target->colorTexture(), eye);
+    EXPECT_GT(image.at(5, 5)[0], 225);      // the patch, half as large
+    EXPECT_LT(image.at(300, 230)[0], 225);  // the table's grey, far from it
+    EXPECT_GT(image.at(300, 230)[0], 60);
+  }
 }
 
 }  // namespace

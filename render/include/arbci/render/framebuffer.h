@@ -38,6 +38,8 @@ void blitTexture(unsigned int texture, Size source, Size target);
 
 // Reads the colour attachment of `framebuffer` (0 = default) into a top-down RGBA image.
 RgbaImage readPixels(unsigned int framebuffer, Size size);
+// The same of a colour texture of `size` (another framebuffer's, an OpenXR swapchain image).
+RgbaImage readTexture(unsigned int texture, Size size);
 // The grey level (mean of R, G, B, 0-255) of one pixel, `x` from the left, `y` from the top.
 int readGrey(unsigned int framebuffer, Size size, int x, int y);
 

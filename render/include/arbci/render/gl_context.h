@@ -28,6 +28,18 @@ class GlError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The native handles of a context, for an OpenXR runtime to bind to (null where the back end
+// has none): EGL's (headless) or GLX's (a window on X11).
+struct NativeGl {
+  void* egl_display = nullptr;
+  void* egl_config = nullptr;
+  void* egl_context = nullptr;
+  void* x_display = nullptr;
+  void* glx_fbconfig = nullptr;
+  unsigned long glx_drawable = 0;
+  void* glx_context = nullptr;
+};
+
 class GlContext {
  public:
   virtual ~GlContext() = default;
@@ -42,6 +54,7 @@ class GlContext {
   // Ends a frame: swaps buffers in a window, waits for the GPU when headless.
   virtual void present() = 0;
   virtual bool isHeadless() const = 0;
+  virtual NativeGl native() const = 0;
 
   // Vendor, renderer and version strings of this context (it must be current).
   GlInfo info() const;

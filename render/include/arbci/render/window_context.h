@@ -33,6 +33,7 @@ class WindowContext final : public GlContext {
   Size framebufferSize() const override;
   void present() override;
   bool isHeadless() const override { return false; }
+  NativeGl native() const override;
 
   bool shouldClose() const;
   void requestClose();

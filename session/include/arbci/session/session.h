@@ -7,6 +7,7 @@
 // on by their stage in the next cycle; an emergency stop reaches the arm at once.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -67,6 +68,14 @@ using DisplayFactory =
 // key and the value.
 void checkNamedResources(const SessionConfig& config);
 
+// What an HMD runtime told of a frame it was given (hmd.output "openxr"): when it was handed
+// over, the counterpart of a window's swap, and where the headset was when it was shown.
+struct RuntimeFrame {
+  double submitted_host_s = 0.0;
+  // x, y, z (m) and the quaternion x, y, z, w, in the runtime's LOCAL space; none: not tracked.
+  std::optional<std::array<double, 7>> head;
+};
+
 class Session {
  public:
   // Validates every stage's settings, creates the session folder, starts the robot backend
@@ -78,8 +87,10 @@ class Session {
   // One displayed frame. Returns false once the session has ended.
   bool step();
   // The frame the last step() drew reached the screen at `host_s` (a window's owner calls it once
-  // the buffer swap is done): its flashes are stamped with this instant's EEG sample.
-  void presented(double host_s);
+  // the buffer swap is done): its flashes are stamped with this instant's EEG sample. An HMD
+  // runtime's predicted display time comes with the runtime's account of the frame, logged as
+  // "hmd_frame" beside it.
+  void presented(double host_s, const std::optional<RuntimeFrame>& runtime = std::nullopt);
   // Steps until the end (headless); `interrupted` (when given) aborts it. Returns the summary.
   nlohmann::json run(const std::function<bool()>& interrupted = {});
   // Ends the run now, between cycles, as a fault with `reason` (the window's display lost): the

@@ -35,6 +35,7 @@ struct HmdConfig {
   int width, height;  // both eyes side by side
   bool undistort;
   int mirror_monitor;       // -1: no mirror window
+  std::string output;       // where the subject's view goes: "window" or "openxr"
   std::string screenshots;  // which HMD frames are kept: "phases", "first_trial", "end", "none"
 };
 
