@@ -1,8 +1,9 @@
 # Every dependency is a Debian 12 package; scripts/install-deps installs them.
 find_package(PkgConfig REQUIRED)
 find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL GLX)
-# The OpenXR loader and headers (libopenxr-dev): hmd.output "openxr". No runtime is needed to
-# build or test; a headset's runtime (SteamVR, Monado, Varjo Base) is found at run time.
+# The OpenXR headers (libopenxr-dev): hmd.output "openxr". The loader (libopenxr-loader1) is
+# opened at run time, only for that output; a headset's runtime (SteamVR, Monado, Varjo Base) is
+# the loader's to find. Neither is needed to build or test.
 find_package(OpenXR REQUIRED)
 find_package(glfw3 3.3 REQUIRED)
 find_package(X11 REQUIRED)  # the window's display lost: render::onDisplayLost

@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "arbci/bci/sample_clock.h"
 #include "arbci/core/whole_file.h"
 #include "arbci/render/window_context.h"
 #include "arbci/session/session.h"
@@ -16,11 +15,8 @@
 #include "commands/bids_options.h"
 #include "commands/commands.h"
 #include "eeg/session_report.h"
-#include "hmd/hmd_stage.h"
-#include "hmd/open_session.h"
-#include "hmd/openxr_output.h"
+#include "hmd/headless_session.h"
 #include "support/cli_error.h"
-#include "support/headless_run.h"
 #include "support/interrupt.h"
 #include "support/schema_option.h"
 #include "support/session_file.h"
@@ -210,26 +206,8 @@ int runSessionIn(const RunOptions& o, bool headless) {
       std::cerr << "eeg.source is \"" << config.eeg.source
                 << "\" (a live amplifier): running in real time\n";
     auto context = render::createHeadlessContext({64, 64});
-    // A headset's runtime paces the frames and says when each is shown: real time, stamped by it.
-    std::optional<OpenXrOutput> xr;
-    if (config.hmd.output == "openxr") {
-      if (!o.realtime) std::cerr << "hmd.output is \"openxr\" (a headset): running in real time\n";
-      options.clock = session::Clock::Mode::RealTime;
-      xr.emplace(config, *context);
-      if (xr->open()) {
-        options.presents_itself = false;
-        std::cerr << "HMD: " << xr->describe() << "\n";
-      } else {
-        options.display_failures.push_back(xr->failure());
-      }
-    }
     watchInterrupts();
-    OpenedSession opened = openSession(config, options, *context);
-    claim.keep();
-    runHeadless(*opened.session, [&] {
-      if (xr && !xr->present(*opened.session, opened.hmd->texture(), opened.hmd->size(), false))
-        opened.session->presented(bci::hostSeconds());
-    });
+    OpenedSession opened = runHeadlessSession(config, options, *context, [&] { claim.keep(); });
     printSummary(*opened.session);
     writeReport(opened.session->folder());
     return opened.session->endKind() == "finished" ? 0 : 3;

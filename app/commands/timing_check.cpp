@@ -14,9 +14,8 @@
 #include "arbci/session/session.h"
 #include "commands/commands.h"
 #include "eeg/timing_plot.h"
-#include "hmd/open_session.h"
+#include "hmd/headless_session.h"
 #include "support/cli_error.h"
-#include "support/headless_run.h"
 #include "support/interrupt.h"
 #include "support/session_file.h"
 #include "workstation/workstation.h"
@@ -63,8 +62,7 @@ int runTimingCheck(const TimingCheckOptions& o) {
     if (headless) {
       auto context = render::createHeadlessContext({64, 64});
       watchInterrupts();
-      OpenedSession opened = openSession(config, options, *context);
-      runHeadless(*opened.session);
+      runHeadlessSession(config, options, *context);
     } else {
       runWorkstation(config, options, {{}, false, true, true, {}, {}});
     }

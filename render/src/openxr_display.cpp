@@ -9,9 +9,14 @@
 #define XR_USE_PLATFORM_XLIB
 #define XR_USE_GRAPHICS_API_OPENGL
 #define XR_USE_TIMESPEC
+// Every call through the loader opened at run time (dlopen): a machine without it runs the
+// window path as ever and fails only hmd.output "openxr", saying so.
+#define XR_NO_PROTOTYPES
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 #include <openxr/openxr_reflection.h>
+
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <chrono>
@@ -77,6 +82,29 @@ void copyEyes(unsigned int texture, Size size, unsigned int left, unsigned int r
 
 namespace {
 
+// The OpenXR functions ARBCI calls, each resolved through xrGetInstanceProcAddr.
+#define ARBCI_XR_GLOBAL_FUNCTIONS(X) X(xrEnumerateInstanceExtensionProperties) X(xrCreateInstance)
+#define ARBCI_XR_INSTANCE_FUNCTIONS(X)                                                            \
+  X(xrAcquireSwapchainImage)                                                                      \
+  X(xrBeginFrame)                                                                                 \
+  X(xrBeginSession) X(xrCreateReferenceSpace) X(xrCreateSession) X(xrCreateSwapchain)             \
+      X(xrDestroyInstance) X(xrDestroySession) X(xrDestroySpace) X(xrDestroySwapchain)            \
+          X(xrEndFrame) X(xrEndSession) X(xrEnumerateSwapchainFormats)                            \
+              X(xrEnumerateSwapchainImages) X(xrEnumerateViewConfigurationViews)                  \
+                  X(xrGetInstanceProperties) X(xrGetSystem) X(xrGetSystemProperties)              \
+                      X(xrLocateSpace) X(xrLocateViews) X(xrPollEvent) X(xrReleaseSwapchainImage) \
+                          X(xrRequestExitSession) X(xrWaitFrame) X(xrWaitSwapchainImage)          \
+                              X(xrConvertTimeToTimespecTimeKHR)                                   \
+                                  X(xrGetOpenGLGraphicsRequirementsKHR)
+
+struct XrApi {
+  PFN_xrGetInstanceProcAddr xrGetInstanceProcAddr = nullptr;
+#define ARBCI_XR_DECLARE(name) PFN_##name name = nullptr;
+  ARBCI_XR_GLOBAL_FUNCTIONS(ARBCI_XR_DECLARE)
+  ARBCI_XR_INSTANCE_FUNCTIONS(ARBCI_XR_DECLARE)
+#undef ARBCI_XR_DECLARE
+};
+
 double secondsOf(const timespec& t) {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
@@ -95,8 +123,8 @@ struct OpenXrDisplay::State {
   std::string runtime, system_name;
   Size eye;
   double period_s = 0.0;
-  PFN_xrConvertTimeToTimespecTimeKHR to_timespec = nullptr;
-  PFN_xrConvertTimespecTimeToTimeKHR from_timespec = nullptr;
+  void* loader = nullptr;  // dlopen's handle, closed last
+  XrApi api;
 
   // The runtime's name leads every message, once one answered.
   [[noreturn]] void fail(const std::string& what, XrResult result) const {
@@ -106,11 +134,28 @@ struct OpenXrDisplay::State {
   void check(XrResult result, const char* what) const {
     if (XR_FAILED(result)) fail(what, result);
   }
+  // The loader, and through it the functions that need no instance.
+  void openLoader(const std::string& library) {
+    // Not a call's result: said as what is missing.
+    loader = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!loader)
+      throw OpenXrError("OpenXR: no OpenXR loader: " + std::string(dlerror()) +
+                            " (install Debian's libopenxr-loader1)",
+                        XR_ERROR_RUNTIME_UNAVAILABLE);
+    api.xrGetInstanceProcAddr =
+        reinterpret_cast<PFN_xrGetInstanceProcAddr>(dlsym(loader, "xrGetInstanceProcAddr"));
+    if (!api.xrGetInstanceProcAddr)
+      throw OpenXrError("OpenXR: " + library + " has no xrGetInstanceProcAddr",
+                        XR_ERROR_RUNTIME_UNAVAILABLE);
+#define ARBCI_XR_LOAD(name) load(XR_NULL_HANDLE, #name, api.name);
+    ARBCI_XR_GLOBAL_FUNCTIONS(ARBCI_XR_LOAD)
+#undef ARBCI_XR_LOAD
+  }
   template <typename F>
-  F function(const char* name) const {
-    PFN_xrVoidFunction f = nullptr;
-    check(xrGetInstanceProcAddr(instance, name, &f), name);
-    return reinterpret_cast<F>(f);
+  void load(XrInstance from, const char* name, F& f) const {
+    PFN_xrVoidFunction any = nullptr;
+    check(api.xrGetInstanceProcAddr(from, name, &any), name);
+    f = reinterpret_cast<F>(any);
   }
 
   // Takes the runtime's events; the session's state tells when frames may go and when it ends.
@@ -118,7 +163,7 @@ struct OpenXrDisplay::State {
     XrEventDataBuffer event = xrStruct<XrEventDataBuffer>(XR_TYPE_EVENT_DATA_BUFFER);
     while (true) {
       event = xrStruct<XrEventDataBuffer>(XR_TYPE_EVENT_DATA_BUFFER);
-      const XrResult r = xrPollEvent(instance, &event);
+      const XrResult r = api.xrPollEvent(instance, &event);
       if (r == XR_EVENT_UNAVAILABLE) return;
       check(r, "xrPollEvent");
       if (event.type == XR_TYPE_EVENT_DATA_INSTANCE_LOSS_PENDING)
@@ -128,10 +173,10 @@ struct OpenXrDisplay::State {
       if (state == XR_SESSION_STATE_READY && !running) {
         XrSessionBeginInfo begin = xrStruct<XrSessionBeginInfo>(XR_TYPE_SESSION_BEGIN_INFO);
         begin.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
-        check(xrBeginSession(session, &begin), "xrBeginSession");
+        check(api.xrBeginSession(session, &begin), "xrBeginSession");
         running = true;
       } else if (state == XR_SESSION_STATE_STOPPING) {
-        xrEndSession(session);
+        api.xrEndSession(session);
         running = false;
         fail("the runtime stopped the session (state STOPPING)", XR_ERROR_SESSION_NOT_RUNNING);
       } else if (state == XR_SESSION_STATE_LOSS_PENDING || state == XR_SESSION_STATE_EXITING) {
@@ -145,7 +190,7 @@ struct OpenXrDisplay::State {
 
   void createInstance(bool egl) {
     uint32_t count = 0;
-    XrResult r = xrEnumerateInstanceExtensionProperties(nullptr, 0, &count, nullptr);
+    XrResult r = api.xrEnumerateInstanceExtensionProperties(nullptr, 0, &count, nullptr);
     if (XR_FAILED(r))
       fail(
           "no runtime answered (is one installed and active? XR_RUNTIME_JSON or "
@@ -154,7 +199,7 @@ struct OpenXrDisplay::State {
           r);
     std::vector<XrExtensionProperties> available(
         count, xrStruct<XrExtensionProperties>(XR_TYPE_EXTENSION_PROPERTIES));
-    check(xrEnumerateInstanceExtensionProperties(nullptr, count, &count, available.data()),
+    check(api.xrEnumerateInstanceExtensionProperties(nullptr, count, &count, available.data()),
           "xrEnumerateInstanceExtensionProperties");
     auto has = [&](const char* name) {
       return std::any_of(available.begin(), available.end(), [&](const XrExtensionProperties& e) {
@@ -177,32 +222,32 @@ struct OpenXrDisplay::State {
     info.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
     info.enabledExtensionCount = static_cast<uint32_t>(wanted.size());
     info.enabledExtensionNames = wanted.data();
-    check(xrCreateInstance(&info, &instance), "xrCreateInstance");
+    check(api.xrCreateInstance(&info, &instance), "xrCreateInstance");
+#define ARBCI_XR_LOAD(name) load(instance, #name, api.name);
+    ARBCI_XR_INSTANCE_FUNCTIONS(ARBCI_XR_LOAD)
+#undef ARBCI_XR_LOAD
     XrInstanceProperties properties = xrStruct<XrInstanceProperties>(XR_TYPE_INSTANCE_PROPERTIES);
-    check(xrGetInstanceProperties(instance, &properties), "xrGetInstanceProperties");
+    check(api.xrGetInstanceProperties(instance, &properties), "xrGetInstanceProperties");
     runtime = std::string(properties.runtimeName) + " " +
               std::to_string(XR_VERSION_MAJOR(properties.runtimeVersion)) + "." +
               std::to_string(XR_VERSION_MINOR(properties.runtimeVersion)) + "." +
               std::to_string(XR_VERSION_PATCH(properties.runtimeVersion));
-    to_timespec = function<PFN_xrConvertTimeToTimespecTimeKHR>("xrConvertTimeToTimespecTimeKHR");
-    from_timespec = function<PFN_xrConvertTimespecTimeToTimeKHR>("xrConvertTimespecTimeToTimeKHR");
   }
 
   void findHeadset() {
     XrSystemGetInfo info = xrStruct<XrSystemGetInfo>(XR_TYPE_SYSTEM_GET_INFO);
     info.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
-    const XrResult r = xrGetSystem(instance, &info, &system);
+    const XrResult r = api.xrGetSystem(instance, &info, &system);
     if (r == XR_ERROR_FORM_FACTOR_UNAVAILABLE)
       fail("no headset is connected (or it is off): xrGetSystem", r);
     check(r, "xrGetSystem");
     XrSystemProperties properties = xrStruct<XrSystemProperties>(XR_TYPE_SYSTEM_PROPERTIES);
-    check(xrGetSystemProperties(instance, system, &properties), "xrGetSystemProperties");
+    check(api.xrGetSystemProperties(instance, system, &properties), "xrGetSystemProperties");
     system_name = properties.systemName;
     XrGraphicsRequirementsOpenGLKHR requirements =
         xrStruct<XrGraphicsRequirementsOpenGLKHR>(XR_TYPE_GRAPHICS_REQUIREMENTS_OPENGL_KHR);
-    auto get =
-        function<PFN_xrGetOpenGLGraphicsRequirementsKHR>("xrGetOpenGLGraphicsRequirementsKHR");
-    check(get(instance, system, &requirements), "xrGetOpenGLGraphicsRequirementsKHR");
+    check(api.xrGetOpenGLGraphicsRequirementsKHR(instance, system, &requirements),
+          "xrGetOpenGLGraphicsRequirementsKHR");
   }
 
   void createSession(const NativeGl& gl) {
@@ -228,22 +273,23 @@ struct OpenXrDisplay::State {
       glx.visualid = static_cast<uint32_t>(visual);
       info.next = &glx;
     }
-    check(xrCreateSession(instance, &info, &session), "xrCreateSession");
+    check(api.xrCreateSession(instance, &info, &session), "xrCreateSession");
     XrReferenceSpaceCreateInfo space =
         xrStruct<XrReferenceSpaceCreateInfo>(XR_TYPE_REFERENCE_SPACE_CREATE_INFO);
     space.poseInReferenceSpace.orientation.w = 1.0f;
     space.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
-    check(xrCreateReferenceSpace(session, &space, &local), "xrCreateReferenceSpace (LOCAL)");
+    check(api.xrCreateReferenceSpace(session, &space, &local), "xrCreateReferenceSpace (LOCAL)");
     space.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_VIEW;
-    check(xrCreateReferenceSpace(session, &space, &view), "xrCreateReferenceSpace (VIEW)");
+    check(api.xrCreateReferenceSpace(session, &space, &view), "xrCreateReferenceSpace (VIEW)");
   }
 
   // The camera images are sRGB-encoded already: a linear 8-bit format shows them as drawn.
   int64_t swapchainFormat() const {
     uint32_t count = 0;
-    check(xrEnumerateSwapchainFormats(session, 0, &count, nullptr), "xrEnumerateSwapchainFormats");
+    check(api.xrEnumerateSwapchainFormats(session, 0, &count, nullptr),
+          "xrEnumerateSwapchainFormats");
     std::vector<int64_t> formats(count);
-    check(xrEnumerateSwapchainFormats(session, count, &count, formats.data()),
+    check(api.xrEnumerateSwapchainFormats(session, count, &count, formats.data()),
           "xrEnumerateSwapchainFormats");
     for (int64_t wanted : {int64_t{GL_RGBA8}, int64_t{GL_SRGB8_ALPHA8}}) {
       if (std::find(formats.begin(), formats.end(), wanted) != formats.end()) return wanted;
@@ -254,7 +300,7 @@ struct OpenXrDisplay::State {
 
   void createSwapchains(Size wanted) {
     uint32_t count = 0;
-    check(xrEnumerateViewConfigurationViews(
+    check(api.xrEnumerateViewConfigurationViews(
               instance, system, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, 0, &count, nullptr),
           "xrEnumerateViewConfigurationViews (stereo)");
     if (count != 2)
@@ -262,9 +308,9 @@ struct OpenXrDisplay::State {
            XR_ERROR_VIEW_CONFIGURATION_TYPE_UNSUPPORTED);
     std::vector<XrViewConfigurationView> views(
         count, xrStruct<XrViewConfigurationView>(XR_TYPE_VIEW_CONFIGURATION_VIEW));
-    check(xrEnumerateViewConfigurationViews(instance, system,
-                                            XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, count,
-                                            &count, views.data()),
+    check(api.xrEnumerateViewConfigurationViews(instance, system,
+                                                XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO, count,
+                                                &count, views.data()),
           "xrEnumerateViewConfigurationViews (stereo)");
     // The HMD stage's eye as drawn, within what the runtime allows.
     eye = {std::min<int>(wanted.width, static_cast<int>(views[0].maxImageRectWidth)),
@@ -281,12 +327,12 @@ struct OpenXrDisplay::State {
       info.faceCount = 1;
       info.arraySize = 1;
       info.mipCount = 1;
-      check(xrCreateSwapchain(session, &info, &swapchains[i]), "xrCreateSwapchain");
+      check(api.xrCreateSwapchain(session, &info, &swapchains[i]), "xrCreateSwapchain");
       uint32_t n = 0;
-      check(xrEnumerateSwapchainImages(swapchains[i], 0, &n, nullptr),
+      check(api.xrEnumerateSwapchainImages(swapchains[i], 0, &n, nullptr),
             "xrEnumerateSwapchainImages");
       images[i].assign(n, xrStruct<XrSwapchainImageOpenGLKHR>(XR_TYPE_SWAPCHAIN_IMAGE_OPENGL_KHR));
-      check(xrEnumerateSwapchainImages(
+      check(api.xrEnumerateSwapchainImages(
                 swapchains[i], n, &n,
                 reinterpret_cast<XrSwapchainImageBaseHeader*>(images[i].data())),
             "xrEnumerateSwapchainImages");
@@ -308,7 +354,7 @@ struct OpenXrDisplay::State {
 
   double hostOf(XrTime time) const {
     timespec t{};
-    check(to_timespec(instance, time, &t), "xrConvertTimeToTimespecTimeKHR");
+    check(api.xrConvertTimeToTimespecTimeKHR(instance, time, &t), "xrConvertTimeToTimespecTimeKHR");
     return secondsOf(t);
   }
 
@@ -322,13 +368,13 @@ struct OpenXrDisplay::State {
     for (int i = 0; i < kFrames; ++i) {
       XrFrameState frame = xrStruct<XrFrameState>(XR_TYPE_FRAME_STATE);
       XrFrameWaitInfo wait = xrStruct<XrFrameWaitInfo>(XR_TYPE_FRAME_WAIT_INFO);
-      check(xrWaitFrame(session, &wait, &frame), "xrWaitFrame");
+      check(api.xrWaitFrame(session, &wait, &frame), "xrWaitFrame");
       XrFrameBeginInfo begin = xrStruct<XrFrameBeginInfo>(XR_TYPE_FRAME_BEGIN_INFO);
-      check(xrBeginFrame(session, &begin), "xrBeginFrame");
+      check(api.xrBeginFrame(session, &begin), "xrBeginFrame");
       XrFrameEndInfo end = xrStruct<XrFrameEndInfo>(XR_TYPE_FRAME_END_INFO);
       end.displayTime = frame.predictedDisplayTime;
       end.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
-      check(xrEndFrame(session, &end), "xrEndFrame");
+      check(api.xrEndFrame(session, &end), "xrEndFrame");
       if (i >= kFrames / 2 && last != 0)
         intervals.push_back(1e-9 * static_cast<double>(frame.predictedDisplayTime - last));
       last = frame.predictedDisplayTime;
@@ -340,16 +386,16 @@ struct OpenXrDisplay::State {
   // A running session is asked to end and ended once the runtime says it is stopping (within
   // a second; a runtime gone is not waited for).
   void endSession() {
-    if (XR_FAILED(xrRequestExitSession(session))) return;
+    if (XR_FAILED(api.xrRequestExitSession(session))) return;
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
     while (std::chrono::steady_clock::now() < until) {
       XrEventDataBuffer event = xrStruct<XrEventDataBuffer>(XR_TYPE_EVENT_DATA_BUFFER);
-      const XrResult r = xrPollEvent(instance, &event);
+      const XrResult r = api.xrPollEvent(instance, &event);
       if (XR_FAILED(r)) return;
       if (r == XR_SUCCESS && event.type == XR_TYPE_EVENT_DATA_SESSION_STATE_CHANGED &&
           reinterpret_cast<const XrEventDataSessionStateChanged&>(event).state ==
               XR_SESSION_STATE_STOPPING) {
-        xrEndSession(session);
+        api.xrEndSession(session);
         return;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -358,25 +404,28 @@ struct OpenXrDisplay::State {
 
   ~State() {
     for (XrSwapchain s : swapchains) {
-      if (s != XR_NULL_HANDLE) xrDestroySwapchain(s);
+      if (s != XR_NULL_HANDLE) api.xrDestroySwapchain(s);
     }
-    if (view != XR_NULL_HANDLE) xrDestroySpace(view);
-    if (local != XR_NULL_HANDLE) xrDestroySpace(local);
+    if (view != XR_NULL_HANDLE) api.xrDestroySpace(view);
+    if (local != XR_NULL_HANDLE) api.xrDestroySpace(local);
     if (session != XR_NULL_HANDLE) {
       if (running) endSession();
-      xrDestroySession(session);
+      api.xrDestroySession(session);
     }
-    if (instance != XR_NULL_HANDLE) xrDestroyInstance(instance);
+    if (instance != XR_NULL_HANDLE) api.xrDestroyInstance(instance);
+    if (loader) dlclose(loader);
   }
 };
 
-OpenXrDisplay::OpenXrDisplay(GlContext& context, Size eye, double ready_s)
+OpenXrDisplay::OpenXrDisplay(GlContext& context, Size eye, double ready_s,
+                             const std::string& loader)
     : s_(std::make_unique<State>()) {
   context.makeCurrent();
   const NativeGl gl = context.native();
   if (!gl.egl_context && !gl.glx_context)
     throw OpenXrError("OpenXR: the OpenGL context is neither EGL nor GLX on X11",
                       XR_ERROR_GRAPHICS_DEVICE_INVALID);
+  s_->openLoader(loader);
   s_->createInstance(gl.egl_context != nullptr);
   s_->findHeadset();
   s_->createSession(gl);
@@ -406,9 +455,9 @@ XrFrameTiming OpenXrDisplay::submit(unsigned int texture, Size size) {
   XrFrameTiming timing;
   XrFrameState frame = xrStruct<XrFrameState>(XR_TYPE_FRAME_STATE);
   XrFrameWaitInfo wait = xrStruct<XrFrameWaitInfo>(XR_TYPE_FRAME_WAIT_INFO);
-  s.check(xrWaitFrame(s.session, &wait, &frame), "xrWaitFrame");
+  s.check(s.api.xrWaitFrame(s.session, &wait, &frame), "xrWaitFrame");
   XrFrameBeginInfo begin = xrStruct<XrFrameBeginInfo>(XR_TYPE_FRAME_BEGIN_INFO);
-  s.check(xrBeginFrame(s.session, &begin), "xrBeginFrame");
+  s.check(s.api.xrBeginFrame(s.session, &begin), "xrBeginFrame");
   timing.period_s = 1e-9 * static_cast<double>(frame.predictedDisplayPeriod);
   timing.display_host_s = s.hostOf(frame.predictedDisplayTime);
 
@@ -426,26 +475,26 @@ XrFrameTiming OpenXrDisplay::submit(unsigned int texture, Size size) {
     XrViewState view_state = xrStruct<XrViewState>(XR_TYPE_VIEW_STATE);
     std::array<XrView, 2> views{xrStruct<XrView>(XR_TYPE_VIEW), xrStruct<XrView>(XR_TYPE_VIEW)};
     uint32_t count = 0;
-    s.check(xrLocateViews(s.session, &locate, &view_state, 2, &count, views.data()),
+    s.check(s.api.xrLocateViews(s.session, &locate, &view_state, 2, &count, views.data()),
             "xrLocateViews");
     std::array<unsigned int, 2> targets{};
     for (size_t i = 0; i < 2; ++i) {
       uint32_t index = 0;
       XrSwapchainImageAcquireInfo acquire =
           xrStruct<XrSwapchainImageAcquireInfo>(XR_TYPE_SWAPCHAIN_IMAGE_ACQUIRE_INFO);
-      s.check(xrAcquireSwapchainImage(s.swapchains[i], &acquire, &index),
+      s.check(s.api.xrAcquireSwapchainImage(s.swapchains[i], &acquire, &index),
               "xrAcquireSwapchainImage");
       XrSwapchainImageWaitInfo wait_image =
           xrStruct<XrSwapchainImageWaitInfo>(XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO);
       wait_image.timeout = 1'000'000'000;  // 1 s: a runtime that never frees an image is lost
-      s.check(xrWaitSwapchainImage(s.swapchains[i], &wait_image), "xrWaitSwapchainImage");
+      s.check(s.api.xrWaitSwapchainImage(s.swapchains[i], &wait_image), "xrWaitSwapchainImage");
       targets[i] = s.images[i][index].image;
     }
     copyEyes(texture, size, targets[0], targets[1], s.eye);
     for (size_t i = 0; i < 2; ++i) {
       XrSwapchainImageReleaseInfo release =
           xrStruct<XrSwapchainImageReleaseInfo>(XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO);
-      s.check(xrReleaseSwapchainImage(s.swapchains[i], &release), "xrReleaseSwapchainImage");
+      s.check(s.api.xrReleaseSwapchainImage(s.swapchains[i], &release), "xrReleaseSwapchainImage");
     }
     projection.fill(s.local, views, s.swapchains, s.eye);
     end.layerCount = 1;
@@ -454,14 +503,14 @@ XrFrameTiming OpenXrDisplay::submit(unsigned int texture, Size size) {
     XrSpaceLocation head = xrStruct<XrSpaceLocation>(XR_TYPE_SPACE_LOCATION);
     const XrSpaceLocationFlags tracked =
         XR_SPACE_LOCATION_POSITION_VALID_BIT | XR_SPACE_LOCATION_ORIENTATION_VALID_BIT;
-    if (XR_SUCCEEDED(xrLocateSpace(s.view, s.local, frame.predictedDisplayTime, &head)) &&
+    if (XR_SUCCEEDED(s.api.xrLocateSpace(s.view, s.local, frame.predictedDisplayTime, &head)) &&
         (head.locationFlags & tracked) == tracked) {
       const XrPosef& p = head.pose;
       timing.head = HeadPose{{p.position.x, p.position.y, p.position.z},
                              {p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w}};
     }
   }
-  s.check(xrEndFrame(s.session, &end), "xrEndFrame");
+  s.check(s.api.xrEndFrame(s.session, &end), "xrEndFrame");
   timing.submitted_host_s = secondsOf([] {
     timespec t{};
     clock_gettime(CLOCK_MONOTONIC, &t);

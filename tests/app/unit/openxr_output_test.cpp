@@ -51,6 +51,20 @@ TEST(OpenXrResult, ResultCodesAreNamed) {
   EXPECT_EQ(render::xrResultText(-123456), "XrResult -123456");
 }
 
+TEST(OpenXrOutputOpen, WithoutTheLoaderTheFailureSaysWhichPackageToInstall) {
+  auto context = render::createHeadlessContext({64, 64});
+  try {
+    render::OpenXrDisplay display(*context, {640, 480}, 5.0, "libarbci_no_such_openxr_loader.so");
+    FAIL() << "opened without a loader";
+  } catch (const render::OpenXrError& error) {
+    const std::string what = error.what();
+    EXPECT_EQ(what.rfind("OpenXR: no OpenXR loader: ", 0), 0u) << what;
+    EXPECT_NE(what.find("libarbci_no_such_openxr_loader.so"), std::string::npos) << what;
+    EXPECT_NE(what.find("install Debian's libopenxr-loader1"), std::string::npos) << what;
+    EXPECT_EQ(error.result(), XR_ERROR_RUNTIME_UNAVAILABLE);
+  }
+}
+
 TEST(OpenXrOutputOpen, WithoutARuntimeTheFailureNamesTheSettingTheCallAndTheCode) {
   auto context = render::createHeadlessContext({64, 64});
   ::setenv("XR_RUNTIME_JSON", "/nonexistent/arbci/no_runtime.json", 1);

@@ -52,10 +52,12 @@ struct XrFrameTiming {
 
 class OpenXrDisplay {
  public:
-  // Opens the runtime and the headset on `context` (current) with eyes of `eye` pixels each, and
-  // waits up to `ready_s` for the runtime to make the session ready. Throws OpenXrError saying
-  // what is missing: no loader or runtime, no headset, no OpenGL binding, a session never ready.
-  OpenXrDisplay(GlContext& context, Size eye, double ready_s = 5.0);
+  // Opens the OpenXR `loader` (a shared library, opened now: nothing else needs it), the runtime
+  // and the headset on `context` (current) with eyes of `eye` pixels each, and waits up to
+  // `ready_s` for the runtime to make the session ready. Throws OpenXrError saying what is
+  // missing: no loader or runtime, no headset, no OpenGL binding, a session never ready.
+  OpenXrDisplay(GlContext& context, Size eye, double ready_s = 5.0,
+                const std::string& loader = "libopenxr_loader.so.1");
   ~OpenXrDisplay();
   OpenXrDisplay(const OpenXrDisplay&) = delete;
   OpenXrDisplay& operator=(const OpenXrDisplay&) = delete;
