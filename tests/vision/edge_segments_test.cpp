@@ -1,7 +1,9 @@
 // The edge-segment pass (tracker.passes.edge_segments) on a hand-made frame: a finger over a
 // marker's corner that reaches a dark background joins the border to the background, so no
 // outline of the marker is left; the marker's straight sides still make its quad. The pass runs
-// when the caller expects an id the outline search missed, or expects nothing in particular.
+// when the caller expects an id the outline search missed, or, expecting nothing in particular,
+// where a marker may hide (dark components no quad came of, quads that did not decode): a frame
+// whose candidates all decoded pays nothing for it.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -55,6 +57,24 @@ TEST(EdgeSegments, RunOnlyWhenAnExpectedIdIsMissing) {
   EXPECT_EQ(idsFound(config), (std::set<int>{kClear}));
   config.expected_ids = {kClear, kCovered};
   EXPECT_EQ(idsFound(config), (std::set<int>{kCovered, kClear}));
+}
+
+TEST(EdgeSegments, AFrameWhoseCandidatesAllDecodedPaysNothingForThePass) {
+  cv::Mat f(480, 640, CV_8UC1, cv::Scalar(190));
+  const cv::Mat clear = test::markerImage(test::MarkerFamily::ArbciBch, kClear, 12, 2);
+  test::drawWarped(f, clear, {{{400, 150}, {544, 150}, {544, 294}, {400, 294}}});
+  for (const int decimate : {1, 2}) {
+    DetectorConfig config;
+    config.search_decimate = decimate;
+    MarkerDetector detector(config);
+    const DetectionResult r = detector.detect(f);
+    ASSERT_EQ(r.markers.size(), 1u) << "decimate " << decimate;
+    EXPECT_EQ(r.timing.edges, 0.0) << "decimate " << decimate;
+    // The covered marker's frame: the pass runs, and finds it.
+    const DetectionResult covered = detector.detect(frame());
+    EXPECT_GT(covered.timing.edges, 0.0) << "decimate " << decimate;
+    EXPECT_EQ(covered.markers.size(), 2u) << "decimate " << decimate;
+  }
 }
 
 }  // namespace

@@ -123,6 +123,10 @@ struct MarkerDetector::Impl {
   FoundQuads found;
   std::vector<DarkComponent> traced;  // the first pass's components whose outline was fitted
   RetryRegions retry_regions;         // where the later passes look again
+  // Searched px: the first pass's dark components no quad came of (a marker merged with a hand
+  // or with the background has no outline of its own), where the edge pass looks when no id is
+  // expected.
+  std::vector<cv::Rect> hiding;
   RetrySearch retry_search;
   std::vector<SquareCorners> squares, ideal_squares;
   // decode(): quads by decreasing area, the markers decoded (by quad index), their samples'
@@ -199,6 +203,7 @@ struct MarkerDetector::Impl {
     quads.clear();
     found.on_frame.clear();
     traced.clear();
+    hiding.clear();
     const int width = searched->cols, height = searched->rows;
     const float min_side = std::max(4.0f, config.min_side_px / static_cast<float>(scale));
     const int min_area = std::max(12, static_cast<int>(0.2f * min_side * min_side));
@@ -212,9 +217,16 @@ struct MarkerDetector::Impl {
     const SearchPasses::OccludedCorners& occluded = config.passes.occluded_corners;
     int occluded_tries = 0;
     for (const DarkComponent& c : labels.components()) {
-      if (c.area < min_area || c.touchesBorder(width, height)) continue;
+      if (c.area < min_area) continue;
       const int w = c.max_x - c.min_x + 1, h = c.max_y - c.min_y + 1;
       if (std::max(w, h) < min_side || std::min(w, h) < 3) continue;
+      const cv::Rect box(c.min_x, c.min_y, w, h);
+      if (c.touchesBorder(width, height)) {
+        // Enclosing light regions, it may hold a marker joined to what runs off the frame (a
+        // sleeve, a dark background).
+        if (c.holes > 0) hiding.emplace_back(c.min_x, c.min_y, w, h);
+        continue;
+      }
       const int max_length = 4 * (w + h) + 64;
       traced.push_back(c);
       if (!traceOuterContour(labels, {c.first_x, c.first_y}, max_length, contour)) continue;
@@ -234,6 +246,7 @@ struct MarkerDetector::Impl {
         if (!solid) quads.push_back(*fit.quad);
         continue;
       }
+      hiding.push_back(box);
       if (occluded.enabled && occluded_tries < occluded.max_tries &&
           std::min(w, h) >= 2.0f * min_side && (c.holes > 0 || cutOpen(c, contour))) {
         // It is still retried below as any near miss, in case it was a marker's broken border
@@ -257,16 +270,22 @@ struct MarkerDetector::Impl {
 
   // passes.edge_segments, after the outline search's quads were decoded: as the other later
   // passes, with adaptive thresholds only (a constant or automatic threshold is the
-  // experimenter's choice of what counts as dark), and, where the caller said which ids to
-  // expect, only when one of them was not read.
+  // experimenter's choice of what counts as dark). Where the caller said which ids to expect,
+  // over the whole frame and only when one of them was not read (a tracked marker may vanish
+  // anywhere); otherwise only where a marker may hide (hidingPlaces): a frame whose candidates
+  // all decoded pays nothing for it.
   void searchEdges(StageTimes& time, std::vector<MarkerDetection>& markers) {
     const SearchPasses::EdgeSegments& pass = config.passes.edge_segments;
     if (config.threshold.mode != ThresholdMode::Adaptive || !pass.enabled || pass.max_quads <= 0)
       return;
+    std::vector<cv::Rect> regions;  // empty: the whole frame
     if (!config.expected_ids.empty()) {
       std::set<int> missing = config.expected_ids;
       for (const MarkerDetection& m : markers) missing.erase(m.id);
       if (missing.empty()) return;
+    } else {
+      regions = hidingPlaces(markers);
+      if (regions.empty()) return;
     }
     const auto start = Clock::now();
     std::vector<Quad> first;
@@ -275,7 +294,7 @@ struct MarkerDetector::Impl {
     QuadFitParams params;
     params.min_side = std::max(4.0f, config.min_side_px / static_cast<float>(scale));
     params.lens = scale == 1 ? config.lens.get() : nullptr;
-    addEdgeSegmentQuads(params, markers, first);
+    addEdgeSegmentQuads(params, markers, first, regions);
     time.edges += microseconds(start, Clock::now());
     std::vector<MarkerDetection> more;
     float lowest = 255.0f, highest = 0.0f, median = -1.0f;
@@ -285,11 +304,66 @@ struct MarkerDetector::Impl {
     found.searched.swap(first);
   }
 
-  // passes.edge_segments (search_passes.h: why). On half the searched resolution when the search
-  // is at full: the segment detector's cost goes with the pixels, and a marker large enough to
-  // read has sides long enough at half. Its quads join the searched image's, refined on it.
+  // Searched px: the dark components no quad came of, and the quads that did not decode, each
+  // widened by a quarter of its size (a covered corner may reach past what stayed dark), those
+  // inside a marker read (its code cells) left out, overlapping ones merged. Covering more than
+  // half the image, the whole image (one pass costs less than many).
+  std::vector<cv::Rect> hidingPlaces(const std::vector<MarkerDetection>& markers) const {
+    std::vector<cv::Rect> boxes = hiding;
+    // decode() leaves the quads looked at in frame pixels.
+    for (const Quad& q : found.searched) {
+      bool read = false;
+      for (const MarkerDetection& m : markers)
+        read = read || insideConvex(m.corners, centre(q.corners));
+      if (read) continue;
+      const cv::Rect on_frame =
+          cv::boundingRect(std::vector<cv::Point2f>(q.corners.begin(), q.corners.end()));
+      boxes.emplace_back(on_frame.x / scale, on_frame.y / scale, on_frame.width / scale + 1,
+                         on_frame.height / scale + 1);
+    }
+    const cv::Rect image(0, 0, searched->cols, searched->rows);
+    std::vector<cv::Rect> regions;
+    for (const cv::Rect& b : boxes) {
+      // Inside a marker read (its code cells), or around one (the dark that surrounds it): where
+      // the marker is, no other can be.
+      bool at_marker = false;
+      for (const MarkerDetection& m : markers) {
+        const cv::Point2f middle = centre(m.corners);
+        at_marker =
+            at_marker ||
+            (insideConvex(m.corners, toFrame(cv::Point2f(b.tl()))) &&
+             insideConvex(m.corners, toFrame(cv::Point2f(b.br())))) ||
+            cv::Rect2f(toFrame(cv::Point2f(b.tl())), toFrame(cv::Point2f(b.br()))).contains(middle);
+      }
+      if (at_marker) continue;
+      const int margin = 4 + std::max(b.width, b.height) / 4;
+      const cv::Rect wide =
+          cv::Rect(b.x - margin, b.y - margin, b.width + 2 * margin, b.height + 2 * margin) & image;
+      if (!wide.empty()) regions.push_back(wide);
+    }
+    for (bool merged = true; merged;) {
+      merged = false;
+      for (size_t i = 0; i < regions.size() && !merged; ++i)
+        for (size_t j = i + 1; j < regions.size() && !merged; ++j)
+          if ((regions[i] & regions[j]).area() > 0) {
+            regions[i] |= regions[j];
+            regions.erase(regions.begin() + static_cast<std::ptrdiff_t>(j));
+            merged = true;
+          }
+    }
+    double covered = 0.0;
+    for (const cv::Rect& r : regions) covered += r.area();
+    if (covered > 0.5 * image.area()) return {image};
+    return regions;
+  }
+
+  // passes.edge_segments (search_passes.h: why) over `regions` of the searched image (empty: all
+  // of it). On half the searched resolution when the search is at full: the segment detector's
+  // cost goes with the pixels, and a marker large enough to read has sides long enough at half.
+  // Its quads join the searched image's, refined on it.
   void addEdgeSegmentQuads(const QuadFitParams& params, const std::vector<MarkerDetection>& markers,
-                           const std::vector<Quad>& looked_at) {
+                           const std::vector<Quad>& looked_at,
+                           const std::vector<cv::Rect>& regions) {
     const SearchPasses::EdgeSegments& pass = config.passes.edge_segments;
     const bool reduce = scale == 1;
     if (reduce) cv::resize(*searched, edges_image, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
@@ -324,23 +398,49 @@ struct MarkerDetector::Impl {
         return true;
       });
     };
-    for (Quad quad : edgeSegmentQuads(image, known, edges)) {
+    auto add = [&](Quad quad) {
       if (!reduce) {
         const auto on_frame = onFrameCoarse(quad.corners);
         if (readBefore(on_frame) ||
             (needs_light_cells && hasFlatCodeArea(gray, on_frame, config.border)))
-          continue;
+          return;
         found.searched.push_back(quad);  // refined on the frame when decoded
-        continue;
+        return;
       }
       for (cv::Point2f& c : quad.corners) c = c * 2.0f + cv::Point2f(0.5f, 0.5f);
       auto refined = refineQuad(quad.corners, *searched, params);
-      if (!refined) continue;
+      if (!refined) return;
       if (readBefore(refined->corners) ||
           (needs_light_cells && hasFlatCodeArea(gray, refined->corners, config.border)))
-        continue;
+        return;
       refined->occluded = quad.occluded;
       found.searched.push_back(*refined);
+    };
+    if (regions.empty()) {
+      for (const Quad& quad : edgeSegmentQuads(image, known, edges)) add(quad);
+      return;
+    }
+    // Each region alone, in the segment image's pixels, its quads moved back; the cap on
+    // candidates is the frame's, shared.
+    const cv::Rect whole(0, 0, image.cols, image.rows);
+    int left = pass.max_quads;
+    for (const cv::Rect& r : regions) {
+      if (left <= 0) break;
+      const cv::Rect part =
+          (reduce ? cv::Rect(r.x / 2, r.y / 2, (r.width + 1) / 2 + 1, (r.height + 1) / 2 + 1) : r) &
+          whole;
+      if (part.width < 8 || part.height < 8) continue;
+      const cv::Point2f offset(static_cast<float>(part.x), static_cast<float>(part.y));
+      std::vector<Quad> known_here = known;
+      for (Quad& q : known_here)
+        for (cv::Point2f& c : q.corners) c -= offset;
+      edges.max_quads = left;
+      const std::vector<Quad> quads = edgeSegmentQuads(image(part).clone(), known_here, edges);
+      left -= static_cast<int>(quads.size());
+      for (Quad quad : quads) {
+        for (cv::Point2f& c : quad.corners) c += offset;
+        add(quad);
+      }
     }
   }
 
