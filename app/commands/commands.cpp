@@ -17,6 +17,7 @@ void addCommands(CLI::App& root, int& exit_code) {
   addRunCommand(root, exit_code);
   addTimingCheckCommand(root, exit_code);
   addSettingsCommand(root, exit_code);
+  addLogEventsCommand(root, exit_code);
 }
 
 }  // namespace arbci::app

@@ -20,6 +20,7 @@ void addP300Commands(CLI::App& root, int& exit_code);      // train, evaluate
 void addRunCommand(CLI::App& root, int& exit_code);
 void addTimingCheckCommand(CLI::App& root, int& exit_code);
 void addSettingsCommand(CLI::App& root, int& exit_code);
+void addLogEventsCommand(CLI::App& root, int& exit_code);  // docs/log.md
 void addBidsCommand(CLI::App& root, int& exit_code);
 
 }  // namespace arbci::app
