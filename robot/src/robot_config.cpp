@@ -13,30 +13,13 @@ using Json = nlohmann::json;
 using core::Key;
 using core::Type;
 
-// A point in metres, [x, y, z] (robot frame).
-template <class S>
-core::Schema<S>& point(core::Schema<S>& t, const std::string& name, Vec3 S::*member, Json fallback,
-                       const std::string& doc, bool required = false) {
-  Key k{name, Type::Numbers, std::move(fallback), doc, "m"};
-  k.min_items = k.max_items = 3;
-  k.required = required;
-  return t.custom(
-      k,
-      [member](S& s, const Json& j) {
-        s.*member = {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-      },
-      [member](const S& s) {
-        return Json::array({(s.*member).x, (s.*member).y, (s.*member).z});
-      });
-}
-
 constexpr double kTiny = 1e-6;  // "positive": above it
 
 const core::Schema<RobotConfig>& workspaceSchema() {
   static const core::Schema<RobotConfig> table = [] {
     core::Schema<RobotConfig> t("workspace", "The box the tool may reach (robot frame)");
-    point(t, "min", &RobotConfig::workspace_min, {-0.7, 0.2, 0.0}, "its lower corner");
-    point(t, "max", &RobotConfig::workspace_max, {0.7, 1.1, 0.6}, "its upper corner");
+    t.vector3("min", &RobotConfig::workspace_min, {-0.7, 0.2, 0.0}, "its lower corner", "m");
+    t.vector3("max", &RobotConfig::workspace_max, {0.7, 1.1, 0.6}, "its upper corner", "m");
     t.rule([](const Json& w) -> std::optional<std::pair<std::string, std::string>> {
       for (int i = 0; i < 3; ++i) {
         if (!(w["min"][i].get<double>() < w["max"][i].get<double>()))
@@ -56,7 +39,8 @@ const core::Schema<SimulatedObject>& objectSchema() {
     core::Schema<SimulatedObject> t("object", "An object of the simulated world");
     t.required(core::Key{"id", Type::Integer, nullptr, "its marker id", "", 0, 1 << 30},
                &SimulatedObject::id);
-    point(t, "position", &SimulatedObject::position, nullptr, "the centre of its top face", true);
+    t.vector3("position", &SimulatedObject::position, nullptr, "the centre of its top face", "m",
+              true);
     t.number("height", &SimulatedObject::height, 0.06, kTiny, 10.0, "its height", "m")
         .number("radius", &SimulatedObject::radius, 0.03, kTiny, 10.0,
                 "its footprint's radius, for contact and grasping (the mujoco driver: half the "
@@ -89,7 +73,7 @@ const core::Schema<RobotConfig>& configSchema() {
                 "rad/s")
         .number("gripper_seconds", &R::gripper_seconds, 0.5, kTiny, 60.0,
                 "how long the gripper takes to open or close", "s");
-    point(t, "home", &R::home, {0.0, 0.45, 0.45}, "where HOME parks the tool");
+    t.vector3("home", &R::home, {0.0, 0.45, 0.45}, "where HOME parks the tool", "m");
     t.text("model", &R::model, "",
            "mujoco driver: the arm's MJCF file, or arm6 or arm7, the project's 6- and 7-axis "
            "arms (\"\": arm6); docs/robot.md names what a model must provide")

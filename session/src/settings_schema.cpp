@@ -25,23 +25,6 @@ using core::Type;
 using Json = nlohmann::json;
 using Broken = std::optional<std::pair<std::string, std::string>>;
 
-// A point or direction in metres (robot frame), as [x, y, z].
-template <class S>
-Schema<S>& vec3(Schema<S>& t, const std::string& name, cv::Vec3d S::*member, Json fallback,
-                const std::string& doc, bool required = false) {
-  Key k{name, Type::Numbers, std::move(fallback), doc, "m"};
-  k.min_items = k.max_items = 3;
-  k.required = required;
-  return t.custom(
-      k,
-      [member](S& s, const Json& j) {
-        s.*member = {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-      },
-      [member](const S& s) {
-        return Json::array({(s.*member)[0], (s.*member)[1], (s.*member)[2]});
-      });
-}
-
 const Schema<HmdConfig>& hmdSchema() {
   static const Schema<HmdConfig> t = [] {
     Schema<HmdConfig> t("hmd", "The subject's head-mounted display (both eyes side by side)");
@@ -110,9 +93,10 @@ const Schema<CameraSettings>& camerasSchema() {
                  "simulated: the lens's distortion coefficients (OpenCV's order)");
     t.number("baseline_m", &C::baseline_m, 0.064, 0.0, 0.5, "simulated: the stereo rig's baseline",
              "m");
-    vec3(t, "head_position", &C::head_position, {0.0, 1.20, 0.75},
-         "simulated: the cameras' position (robot frame)");
-    vec3(t, "look_at", &C::look_at, {0.0, 0.70, 0.0}, "simulated: where they look (robot frame)");
+    t.vector3("head_position", &C::head_position, {0.0, 1.20, 0.75},
+              "simulated: the cameras' position (robot frame)", "m");
+    t.vector3("look_at", &C::look_at, {0.0, 0.70, 0.0}, "simulated: where they look (robot frame)",
+              "m");
     t.number("head_motion_m", &C::head_motion_m, 0.008, 0.0, 0.2,
              "simulated: the head's sway (amplitude)", "m")
         .number("head_motion_deg", &C::head_motion_deg, 0.6, 0.0, 20.0,
@@ -168,7 +152,8 @@ const Schema<WorldObjectSettings>& objectSchema() {
     using O = WorldObjectSettings;
     Schema<O> t("object", "An object on the table, carrying a marker on its top face");
     t.required(Key{"id", Type::Integer, nullptr, "the object's marker id", "", 0, 4095}, &O::id);
-    vec3(t, "position", &O::position, nullptr, "[x, y, z] of the top centre in metres", true);
+    t.vector3("position", &O::position, nullptr, "[x, y, z] of the top centre in metres", "m",
+              true);
     t.number("marker_m", &O::marker_m, 0.05, 0.005, 0.5, "its marker's side", "m")
         .number("width_m", &O::width_m, 0.07, 0.005, 0.6, "its width (at least the marker's)", "m")
         .number("height_m", &O::height_m, 0.06, 0.005, 0.6, "its height", "m")
@@ -180,7 +165,7 @@ const Schema<WorldObjectSettings>& objectSchema() {
             robot::objectSchema().at("friction"),
             [](O& o, const Json& j) { o.friction = j.get<double>(); },
             [](const O& o) { return Json(o.friction); });
-    vec3(t, "color", &O::color, {0.8, 0.4, 0.3}, "its colour (red, green, blue, 0-1)");
+    t.vector3("color", &O::color, {0.8, 0.4, 0.3}, "its colour (red, green, blue, 0-1)", "");
     t.numbers("covered_s", &O::covered_s, {}, 0, 16,
               "simulated cameras: a hand lies over its marker from each first to each second "
               "session time, e.g. [20, 23] (a tracking loss to rehearse; empty: never)",
@@ -211,7 +196,7 @@ const Schema<GridSettings>& gridSchema() {
     t.integer("rows", &G::rows, 3, 1, 12, "rows of cells")
         .integer("columns", &G::columns, 3, 1, 12, "columns of cells")
         .number("cell_m", &G::cell_m, 0.09, 0.01, 1.0, "a cell's side", "m");
-    vec3(t, "centre", &G::centre, {0.0, 0.66, 0.0}, "its centre on the table (robot frame)");
+    t.vector3("centre", &G::centre, {0.0, 0.66, 0.0}, "its centre on the table (robot frame)", "m");
     t.rule([](const Json& g) -> Broken {
       if (g["rows"].get<int>() * g["columns"].get<int>() < 2)
         return std::pair{"", "needs at least 2 cells"};
@@ -228,8 +213,8 @@ const Schema<WorldSettings>& referenceSchema() {
     Schema<W> t("reference", "The reference marker, at a known place in the robot's frame");
     t.integer("id", &W::reference_id, 0, 0, 4095, "its marker id")
         .number("size_m", &W::reference_size_m, 0.08, 0.005, 1.0, "its side", "m");
-    vec3(t, "position", &W::reference_position, {0.0, 0.90, 0.0},
-         "its centre in the robot frame (lying flat, axes along the robot's)");
+    t.vector3("position", &W::reference_position, {0.0, 0.90, 0.0},
+              "its centre in the robot frame (lying flat, axes along the robot's)", "m");
     return t;
   }();
   return t;

@@ -195,6 +195,27 @@ class Schema : public Table {
           return out;
         });
   }
+  // Three numbers, [x, y, z], into any type built from three doubles whose parts read as .x, .y,
+  // .z or [0], [1], [2] (a point in metres, a colour).
+  template <class V>
+  Schema& vector3(std::string key, V S::*member, nlohmann::json fallback, std::string doc,
+                  std::string unit, bool required = false) {
+    Key k{std::move(key), Type::Numbers, std::move(fallback), std::move(doc), std::move(unit)};
+    k.min_items = k.max_items = 3;
+    k.required = required;
+    return custom(
+        std::move(k),
+        [member](S& s, const nlohmann::json& j) {
+          s.*member = V{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+        },
+        [member](const S& s) {
+          const V& v = s.*member;
+          if constexpr (requires { v.x; })
+            return nlohmann::json::array({v.x, v.y, v.z});
+          else
+            return nlohmann::json::array({v[0], v[1], v[2]});
+        });
+  }
   // A value the struct keeps otherwise than the file (another unit, another library's type).
   Schema& custom(Key key, Read read, Write write) {
     add(std::move(key));
