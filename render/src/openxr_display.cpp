@@ -83,19 +83,19 @@ void copyEyes(unsigned int texture, Size size, unsigned int left, unsigned int r
 namespace {
 
 // The OpenXR functions ARBCI calls, each resolved through xrGetInstanceProcAddr.
-#define ARBCI_XR_GLOBAL_FUNCTIONS(X) X(xrEnumerateInstanceExtensionProperties) X(xrCreateInstance)
-#define ARBCI_XR_INSTANCE_FUNCTIONS(X)                                                            \
-  X(xrAcquireSwapchainImage)                                                                      \
-  X(xrBeginFrame)                                                                                 \
-  X(xrBeginSession) X(xrCreateReferenceSpace) X(xrCreateSession) X(xrCreateSwapchain)             \
-      X(xrDestroyInstance) X(xrDestroySession) X(xrDestroySpace) X(xrDestroySwapchain)            \
-          X(xrEndFrame) X(xrEndSession) X(xrEnumerateSwapchainFormats)                            \
-              X(xrEnumerateSwapchainImages) X(xrEnumerateViewConfigurationViews)                  \
-                  X(xrGetInstanceProperties) X(xrGetSystem) X(xrGetSystemProperties)              \
-                      X(xrLocateSpace) X(xrLocateViews) X(xrPollEvent) X(xrReleaseSwapchainImage) \
-                          X(xrRequestExitSession) X(xrWaitFrame) X(xrWaitSwapchainImage)          \
-                              X(xrConvertTimeToTimespecTimeKHR)                                   \
-                                  X(xrGetOpenGLGraphicsRequirementsKHR)
+// clang-format off
+#define ARBCI_XR_GLOBAL_FUNCTIONS(X) \
+  X(xrEnumerateInstanceExtensionProperties) X(xrCreateInstance)
+#define ARBCI_XR_INSTANCE_FUNCTIONS(X)                                                         \
+  X(xrAcquireSwapchainImage) X(xrBeginFrame) X(xrBeginSession) X(xrCreateReferenceSpace)       \
+  X(xrCreateSession) X(xrCreateSwapchain) X(xrDestroyInstance) X(xrDestroySession)             \
+  X(xrDestroySpace) X(xrDestroySwapchain) X(xrEndFrame) X(xrEndSession)                        \
+  X(xrEnumerateSwapchainFormats) X(xrEnumerateSwapchainImages)                                 \
+  X(xrEnumerateViewConfigurationViews) X(xrGetInstanceProperties) X(xrGetSystem)               \
+  X(xrGetSystemProperties) X(xrLocateSpace) X(xrLocateViews) X(xrPollEvent)                    \
+  X(xrReleaseSwapchainImage) X(xrRequestExitSession) X(xrWaitFrame) X(xrWaitSwapchainImage)    \
+  X(xrConvertTimeToTimespecTimeKHR) X(xrGetOpenGLGraphicsRequirementsKHR)
+// clang-format on
 
 struct XrApi {
   PFN_xrGetInstanceProcAddr xrGetInstanceProcAddr = nullptr;
