@@ -13,6 +13,7 @@
 #include "arbci/bci/selection_marks.h"
 #include "arbci/bci/simulated_subject.h"
 #include "arbci/bci/stimulus_sequence.h"
+#include "arbci/core/seeds.h"
 #include "arbci/session/session_config.h"
 #include "support/cli_error.h"
 #include "support/name_list.h"
@@ -63,8 +64,10 @@ Schedule copyTask(const SimulationOptions& o, std::int64_t total_samples) {
   const int codes = layout.codes();
   const double soa = (o.flash_ms + o.isi_ms) / 1000.0;
   const double selection_seconds = 1.0 + o.sequences * codes * soa + 1.0;  // cue, flashes, rest
-  bci::StimulusSequencer sequencer(codes, o.seed + 1);
-  std::mt19937_64 random(o.seed + 2);
+  const auto seed = static_cast<std::uint64_t>(o.seed);
+  bci::StimulusSequencer sequencer(codes,
+                                   core::seedOf(seed, core::RandomStream::RecordingFlashOrder));
+  std::mt19937_64 random(core::seedOf(seed, core::RandomStream::RecordingChoices));
   double t = 0.5;
   while ((t + selection_seconds) * o.rate_hz <= static_cast<double>(total_samples)) {
     Selection selection;
@@ -92,9 +95,12 @@ Schedule sessionTask(const SimulationOptions& o) {
   Schedule schedule;
   const bci::ParadigmLayout objects = bci::ParadigmLayout::single(o.stimuli);
   const bci::ParadigmLayout grid = bci::ParadigmLayout::matrix(o.grid_rows, o.grid_columns);
-  bci::StimulusSequencer object_order(objects.codes(), o.seed + 1);
-  bci::StimulusSequencer grid_order(grid.codes(), o.seed + 3);
-  std::mt19937_64 random(o.seed + 2);
+  const auto seed = static_cast<std::uint64_t>(o.seed);
+  bci::StimulusSequencer object_order(objects.codes(),
+                                      core::seedOf(seed, core::RandomStream::RecordingFlashOrder));
+  bci::StimulusSequencer grid_order(grid.codes(),
+                                    core::seedOf(seed, core::RandomStream::RecordingGridOrder));
+  std::mt19937_64 random(core::seedOf(seed, core::RandomStream::RecordingChoices));
   const bci::ParadigmSettings paradigm;
   double t = 0.5;
   auto add = [&](bci::MarkedSelection mark, const bci::ParadigmLayout& layout,

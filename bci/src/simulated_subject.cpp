@@ -6,6 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "arbci/core/seeds.h"
 #include "scalp_topography.h"
 
 namespace arbci::bci {
@@ -72,7 +73,7 @@ double gaussian(double t, double centre, double width) {
 }  // namespace
 
 SubjectProfile SubjectProfile::drawn(std::uint64_t seed) {
-  std::mt19937_64 random(seed * 0x9E3779B97F4A7C15ULL + 17);
+  std::mt19937_64 random(core::seedOf(seed, core::RandomStream::SubjectProfile));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   SubjectProfile p;
   p.p3_amplitude_uv = 4.5 + 3.5 * unit(random);
@@ -131,8 +132,8 @@ SimulatedSubject::SimulatedSubject(const SimulatedSubjectConfig& config,
     : config_(config),
       profile_(config.profile ? *config.profile : SubjectProfile::drawn(config.seed)),
       clock_(std::move(clock)),
-      trial_random_(config.seed ^ 0xA5A5A5A5ULL),
-      errp_random_(config.seed ^ 0x5EEDE44ULL) {
+      trial_random_(core::seedOf(config.seed, core::RandomStream::SubjectTrials)),
+      errp_random_(core::seedOf(config.seed, core::RandomStream::SubjectErrp)) {
   if (config.montage.empty())
     throw std::invalid_argument("simulated subject: the montage has no channels");
   if (!(config.rate_hz >= 32.0 && config.rate_hz <= 20000.0)) {

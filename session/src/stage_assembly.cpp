@@ -4,6 +4,7 @@
 #include <fstream>
 #include <map>
 
+#include "arbci/core/seeds.h"
 #include "arbci/session/disk_estimate.h"
 #include "arbci/session/scene_source.h"
 #include "arbci/session/stages/camera_stage.h"
@@ -236,9 +237,10 @@ AssembledStages assembleStages(const SessionConfig& c, const SessionOptions& opt
       services);
   auto paradigm = std::make_unique<ParadigmStage>(
       ParadigmStageSettings{c.paradigm, c.world, c.classifier.training.method, intendedTrials(c),
-                            c.eeg.seed + 11, c.errp.threshold, folder / "model.json",
-                            options.experimenter, c.tracker.max_pose_age_s, c.gates.review,
-                            c.gates.min_auc, c.gates.max_retakes, c.learnsFromUse()},
+                            core::seedOf(c.eeg.seed, core::RandomStream::FlashOrder),
+                            c.errp.threshold, folder / "model.json", options.experimenter,
+                            c.tracker.max_pose_age_s, c.gates.review, c.gates.min_auc,
+                            c.gates.max_retakes, c.learnsFromUse()},
       services);
   CycleRecord warm_up;
   tracking->publish(warm_up.tracking);

@@ -4,13 +4,15 @@
 #include <random>
 #include <tuple>
 
+#include "arbci/core/seeds.h"
+
 namespace arbci::session {
 
 std::vector<TrialIntent> intendedTrials(const SessionConfig& config) {
   std::vector<TrialIntent> intended = config.intended;
   std::map<int, std::pair<int, int>> cell_of;  // objects standing on the grid
   for (const TrialIntent& t : intended) cell_of[t.object] = {t.row, t.column};
-  std::mt19937_64 random(config.eeg.seed * 31 + 7);
+  std::mt19937_64 random(core::seedOf(config.eeg.seed, core::RandomStream::TrialIntents));
   const auto& objects = config.world.objects;
   const int rows = config.world.grid.rows, columns = config.world.grid.columns;
   // With more objects than cells some must share: then any cell will do.

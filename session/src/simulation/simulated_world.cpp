@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "arbci/core/seeds.h"
+
 namespace arbci::session {
 
 SimulatedWorld::SimulatedWorld(const SceneSettings& settings) : settings_(settings) {
@@ -26,8 +28,10 @@ SimulatedWorld::SimulatedWorld(const SceneSettings& settings) : settings_(settin
                              static_cast<float>(o.color[2]));
     scene_.objects.push_back(object);
   }
-  left_ = std::make_unique<SimulatedCamera>(camera_, settings.seed * 7 + 1);
-  right_ = std::make_unique<SimulatedCamera>(camera_, settings.seed * 7 + 2);
+  left_ = std::make_unique<SimulatedCamera>(
+      camera_, core::seedOf(settings.seed, core::RandomStream::LeftCamera));
+  right_ = std::make_unique<SimulatedCamera>(
+      camera_, core::seedOf(settings.seed, core::RandomStream::RightCamera));
   approach_height_ = robotConfig().approach_height;
 }
 
