@@ -16,6 +16,7 @@
 #include <string>
 
 #include "arbci/bci/acquisition.h"
+#include "arbci/bci/paradigm.h"
 #include "arbci/session/eeg_sources.h"
 #include "arbci/session/session_config.h"
 #include "arbci/session/stage.h"
@@ -24,7 +25,8 @@ namespace arbci::session {
 
 struct EegAcquisitionSettings {
   EegSettings eeg;
-  double flash_s = 0.06;      // a flash's nominal duration (the paradigm's, in whole frames)
+  // A flash's nominal duration (the paradigm's, in whole frames; the schema's default here).
+  double flash_s = bci::ParadigmSettings().flashSeconds();
   std::string session_file;   // for messages naming a key
   bool experimenter = false;  // someone at the window who can bring a silent source back
   // Before the run: the files named exist; throws SessionConfigError naming the key and value.

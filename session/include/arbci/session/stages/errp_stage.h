@@ -15,6 +15,7 @@
 #include "arbci/bci/features.h"
 #include "arbci/bci/filters.h"
 #include "arbci/bci/p300_model.h"
+#include "arbci/bci/paradigm.h"
 #include "arbci/bci/recording.h"
 #include "arbci/session/stage.h"
 
@@ -25,7 +26,8 @@ struct ErrpStageSettings {
   bci::SignalInfo info;  // the EEG channels (no photodiode)
   bci::PipelineSettings pipeline;
   bci::TrainingSettings training;
-  double flash_s = 0.06;   // the feedback's nominal duration (a flash's)
+  // The feedback's nominal duration (a flash's; the schema's default here).
+  double flash_s = bci::ParadigmSettings().flashSeconds();
   std::string model_file;  // a trained P300 model whose "errp" part is used
   double threshold = 0.0;  // errp.threshold, for the summary
 };

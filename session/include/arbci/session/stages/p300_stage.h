@@ -24,6 +24,7 @@
 #include "arbci/bci/held_out_separation.h"
 #include "arbci/bci/learning_from_use.h"
 #include "arbci/bci/p300_model.h"
+#include "arbci/bci/paradigm.h"
 #include "arbci/bci/recording.h"
 #include "arbci/session/stage.h"
 
@@ -33,10 +34,11 @@ struct P300Settings {
   bci::SignalInfo info;  // the EEG channels (no photodiode)
   bci::PipelineSettings pipeline;
   bci::TrainingSettings training;  // the method is the paradigm's request's
-  double flash_s = 0.06;           // a flash's nominal duration (the paradigm's, in whole frames)
-  int object_stimuli = 0;          // stimuli of the calibration run (the objects)
-  std::string model_file;          // a trained model (empty: the calibration run trains one)
-  std::string session_file;        // for messages naming a key
+  // A flash's nominal duration (the paradigm's, in whole frames; the schema's default here).
+  double flash_s = bci::ParadigmSettings().flashSeconds();
+  int object_stimuli = 0;    // stimuli of the calibration run (the objects)
+  std::string model_file;    // a trained model (empty: the calibration run trains one)
+  std::string session_file;  // for messages naming a key
   // Learning from use (bci/learning_from_use.h): `learn` (paradigm.calibration none) starts with
   // no model and fits one after each object selection; `adapt` refits a calibrated one, the
   // calibration run's labels kept.

@@ -40,8 +40,9 @@ struct ParadigmStageSettings {
   std::string classifier_method;
   std::vector<TrialIntent> intended;  // each trial's intention (the simulated subject's)
   std::uint64_t seed;                 // the paradigm's random flash order
-  double errp_threshold = 0.5;        // ErrP: reject a selection above this posterior of error
-  std::filesystem::path model_file;   // where the model trained goes
+  // ErrP: reject a selection above this posterior of error (errp.threshold).
+  double errp_threshold = ErrpSettings().threshold;
+  std::filesystem::path model_file;  // where the model trained goes
   bool experimenter = false;    // someone at the window: a wait pauses rather than ends the run
   double max_pose_age_s = 0.0;  // tracker.max_pose_age_s: older is stale (the robot refuses it)
   bool review = false;          // gates.review: the experimenter accepts the calibration
