@@ -3,7 +3,6 @@
 // (bids-validator from npm, installed by scripts/install-deps) finds 0 errors, and MNE reads the
 // recording and its events and finds the P300 of the simulated subject.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -12,26 +11,13 @@
 #include <string>
 
 #include "support/run_process.h"
+#include "support/test_files.h"
 
 namespace arbci::test {
 namespace {
 
 namespace fs = std::filesystem;
 const std::string kArbci = ARBCI_EXECUTABLE;
-
-fs::path scratch() {
-  const fs::path dir = fs::temp_directory_path() / ("arbci_bids_test_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 int lines(const std::string& text, const std::string& prefix) {
   int n = 0;
@@ -43,7 +29,8 @@ int lines(const std::string& text, const std::string& prefix) {
 TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
   ASSERT_TRUE(fs::exists(BIDS_VALIDATOR))
       << BIDS_VALIDATOR << " is missing: scripts/install-deps installs it (npm)";
-  const fs::path dir = scratch();
+  const fs::path dir = freshTempPath("bids_test", "export");
+  fs::create_directories(dir);
   const fs::path root = dir / "bids";
   // A short calibration run (half the default's selections, each of all its sequences: 56
   // attended flashes with the trial's) and a quick arm: what is checked is the export.
@@ -86,7 +73,7 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
   EXPECT_FALSE(fs::exists(root / "derivatives" / "arbci" / "sub-01" / "ses-1" / "eeg" / stem /
                           "robot.key"));  // the secret stays behind
   // The session folder's summary names the run the export chose, and the simulated subject.
-  const auto summary = nlohmann::json::parse(read(dir / "session" / "summary.json"));
+  const auto summary = nlohmann::json::parse(fileBytes(dir / "session" / "summary.json"));
   EXPECT_EQ(summary["labels"]["run"], "1") << summary["labels"].dump();
   EXPECT_EQ(summary["bids"]["eeg_file"], (eeg / (stem + "_eeg.bdf")).string());
   EXPECT_NE(summary["eeg"]["source"].get<std::string>().find("simulated subject (seed "),
@@ -94,7 +81,7 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
       << summary["eeg"]["source"];
 
   // The events: every flash with T or N, and the robot's commands placed on the recording.
-  const std::string events = read(eeg / (stem + "_events.tsv"));
+  const std::string events = fileBytes(eeg / (stem + "_events.tsv"));
   EXPECT_EQ(events.substr(0, events.find('\n')),
             "onset\tduration\ttrial_type\tvalue\tsample\tstimulus\ttarget\tdescription");
   EXPECT_NE(events.find("\tflash/target\t"), std::string::npos);
@@ -112,10 +99,11 @@ TEST(Bids, ASessionExportPassesTheValidatorAndMneFindsTheP300) {
                "--session", "1", "--author", "Ada Lovelace", "--author", "Alan Turing"});
   ASSERT_EQ(again.exit_code, 0) << again.err;
   // The subject as the run recorded them, described for a curator.
-  EXPECT_EQ(read(root / "participants.tsv"),
+  EXPECT_EQ(fileBytes(root / "participants.tsv"),
             "participant_id\tage\tsex\thandedness\nsub-01\t34\tF\tR\n");
   EXPECT_TRUE(fs::exists(root / "participants.json"));
-  EXPECT_NE(read(eeg / (stem + "_channels.tsv")).find("Photodiode\tTRIG\tuV"), std::string::npos);
+  EXPECT_NE(fileBytes(eeg / (stem + "_channels.tsv")).find("Photodiode\tTRIG\tuV"),
+            std::string::npos);
   EXPECT_TRUE(fs::exists(eeg / "sub-01_ses-1_task-arbci_run-2_eeg.bdf"));
   const ProcessResult taken =
       runProcess(kArbci, {"bids", "export", (dir / "session").string(), root.string(), "--subject",

@@ -15,17 +15,14 @@
 #include "arbci/bci/recording.h"
 #include "support/run_process.h"
 #include "support/shared_data.h"
+#include "support/test_files.h"
 
 namespace arbci::test {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
 
-std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "arbci_eeg_cli_test";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+const std::string kScratch = "arbci_eeg_cli_test";
 
 TEST(EegCommand, InfoGivesChannelsRateDurationAndEventsByCode) {
   const ProcessResult r =
@@ -40,7 +37,7 @@ TEST(EegCommand, InfoGivesChannelsRateDurationAndEventsByCode) {
 }
 
 TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
-  const auto bdf = scratch("sim.bdf");
+  const auto bdf = scratchPath(kScratch, "sim.bdf");
   ProcessResult r =
       runProcess(kArbci, {"eeg", "simulate", "--seconds", "30", "--rows", "3", "--columns", "3",
                           "--sequences", "5", "--out", bdf.string()});
@@ -55,7 +52,7 @@ TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
   EXPECT_EQ(targets * 3, static_cast<int>(ours.stimuli.size()));
 
   // BioSig's own converter writes GDF 2 from it; the GDF reads back with the same content.
-  const auto gdf = scratch("sim.gdf");
+  const auto gdf = scratchPath(kScratch, "sim.gdf");
   std::filesystem::remove(gdf);
   r = runProcess(SAVE2GDF_EXECUTABLE, {"-f=GDF", bdf.string(), gdf.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -68,7 +65,7 @@ TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
   EXPECT_EQ(theirs.stimuli.back().sample, ours.stimuli.back().sample);
 
   // BCI2000 to BDF+: the same stimuli and samples.
-  const auto converted = scratch("eeg3_1.bdf");
+  const auto converted = scratchPath(kScratch, "eeg3_1.bdf");
   r = runProcess(kArbci, {"eeg", "convert", sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"),
                           converted.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -98,7 +95,7 @@ TEST(EegCommand, SimulateThenConvertAndAnIndependentReaderAgrees) {
 }
 
 TEST(EegCommand, ARecordingKilledMidWayIsReadableUpToItsLastRecord) {
-  const auto bdf = scratch("killed.bdf");
+  const auto bdf = scratchPath(kScratch, "killed.bdf");
   std::filesystem::remove(bdf);
   const pid_t child = fork();
   ASSERT_GE(child, 0);
@@ -145,7 +142,7 @@ TEST(EegCommand, ARecordingKilledMidWayIsReadableUpToItsLastRecord) {
 }
 
 TEST(EegCommand, BadFilesGiveOneLineNamingTheFileAndWhatIsWrong) {
-  const auto truncated = scratch("truncated.dat");
+  const auto truncated = scratchPath(kScratch, "truncated.dat");
   {
     std::ifstream in(sharedData("eeg/bci2000_samplefiles/eeg3_1.dat"), std::ios::binary);
     std::string bytes(2000000, '\0');
@@ -153,10 +150,10 @@ TEST(EegCommand, BadFilesGiveOneLineNamingTheFileAndWhatIsWrong) {
     std::ofstream(truncated, std::ios::binary)
         .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
-  const auto unknown = scratch("unknown.edf");
+  const auto unknown = scratchPath(kScratch, "unknown.edf");
   std::ofstream(unknown) << "this is not EEG";
   // A BDF whose header declares no signals (BioSig says "memory allocation failed").
-  const auto empty = scratch("no_signals.bdf");
+  const auto empty = scratchPath(kScratch, "no_signals.bdf");
   {
     std::string header(256, ' ');
     header[0] = '\xff';
@@ -177,7 +174,7 @@ TEST(EegCommand, BadFilesGiveOneLineNamingTheFileAndWhatIsWrong) {
            {empty.string(), "declares no signal channels"},
            {truncated.string(), "cut short"},
            {unknown.string(), "unknown format"},
-           {scratch("none.gdf").string(), "no such file"}}) {
+           {scratchPath(kScratch, "none.gdf").string(), "no such file"}}) {
     const ProcessResult r = runProcess(kArbci, {"eeg", "info", file});
     EXPECT_EQ(r.exit_code, 1) << file;
     EXPECT_NE(r.err.find(file), std::string::npos) << r.err;

@@ -12,17 +12,14 @@
 
 #include "support/run_process.h"
 #include "support/shared_data.h"
+#include "support/test_files.h"
 
 namespace arbci::test {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
 
-std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "arbci_marker_cli_test";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+const std::string kScratch = "arbci_marker_cli_test";
 
 std::vector<nlohmann::json> jsonLines(const std::string& text) {
   std::vector<nlohmann::json> lines;
@@ -70,9 +67,9 @@ TEST(DetectCommand, PrintsOneJsonObjectPerFrameWithMarkersAndStageTimes) {
 }
 
 TEST(DetectCommand, ReportsUnreadableInputsAndGoesOn) {
-  const auto corrupt = scratch("corrupt.png");
+  const auto corrupt = scratchPath(kScratch, "corrupt.png");
   std::ofstream(corrupt) << "not a png";
-  const auto short_raw = scratch("short.raw");
+  const auto short_raw = scratchPath(kScratch, "short.raw");
   std::ofstream(short_raw) << "too short";
   const ProcessResult result =
       runProcess(kArbci, {"detect", "/nonexistent/frame.png", corrupt.string(),
@@ -90,7 +87,7 @@ TEST(DetectCommand, ReportsUnreadableInputsAndGoesOn) {
 }
 
 TEST(DetectCommand, DictionaryKindsAndAnnotation) {
-  const auto folder = scratch("annotated");
+  const auto folder = scratchPath(kScratch, "annotated");
   std::filesystem::remove_all(folder);
   const ProcessResult result = runProcess(
       kArbci, {"detect", "--kind", "aruco", "--annotate", folder.string(),
@@ -102,7 +99,7 @@ TEST(DetectCommand, DictionaryKindsAndAnnotation) {
 }
 
 TEST(MarkerCommand, WritesPrintScaleMarkersThatDetectAsTheirIds) {
-  const auto base = scratch("bch_0042");
+  const auto base = scratchPath(kScratch, "bch_0042");
   const ProcessResult make = runProcess(kArbci, {"marker", "make", "--kind", "bch", "--id", "42",
                                                  "--size-mm", "50", "--out", base.string()});
   ASSERT_EQ(make.exit_code, 0) << make.err;
@@ -123,10 +120,10 @@ TEST(MarkerCommand, WritesPrintScaleMarkersThatDetectAsTheirIds) {
 // printed with, which it says) and finds the marker again as a template; a simple marker is
 // printed with the border detect --kind simple expects.
 TEST(MarkerCommand, APatternTrainsFromAMarkerMadeWithTheDefaults) {
-  const auto base = scratch("made_default");
+  const auto base = scratchPath(kScratch, "made_default");
   ASSERT_EQ(runProcess(kArbci, {"marker", "make", "--id", "9", "--out", base.string()}).exit_code,
             0);
-  const auto pattern = scratch("made_default.patt");
+  const auto pattern = scratchPath(kScratch, "made_default.patt");
   const ProcessResult train = runProcess(
       kArbci, {"marker", "train", "--image", base.string() + ".png", "--out", pattern.string()});
   ASSERT_EQ(train.exit_code, 0) << train.err;
@@ -139,7 +136,7 @@ TEST(MarkerCommand, APatternTrainsFromAMarkerMadeWithTheDefaults) {
   ASSERT_EQ(markers.size(), 1u);
   EXPECT_EQ(markers[0]["id"], 9);
 
-  const auto simple = scratch("simple_default");
+  const auto simple = scratchPath(kScratch, "simple_default");
   ASSERT_EQ(runProcess(kArbci, {"marker", "make", "--kind", "simple", "--id", "77", "--out",
                                 simple.string()})
                 .exit_code,
@@ -155,7 +152,7 @@ TEST(MarkerCommand, APatternTrainsFromAMarkerMadeWithTheDefaults) {
 // A still marker under sensor noise: its corners wander from frame to frame by the noise alone.
 // --smooth (One-Euro) must cut that wander, and the average corner must stay where it was.
 TEST(DetectCommand, SmoothingStillsTheCornersOfAStillMarker) {
-  const auto base = scratch("bch_0007");
+  const auto base = scratchPath(kScratch, "bch_0007");
   ASSERT_EQ(runProcess(kArbci, {"marker", "make", "--kind", "bch", "--id", "7", "--size-mm", "8",
                                 "--dpi", "150", "--out", base.string()})
                 .exit_code,
@@ -172,7 +169,7 @@ TEST(DetectCommand, SmoothingStillsTheCornersOfAStillMarker) {
     frame.convertTo(noisy, CV_16SC1);
     noisy += noise;
     noisy.convertTo(noisy, CV_8UC1);
-    files.push_back(scratch("still_" + std::to_string(100 + f) + ".png").string());
+    files.push_back(scratchPath(kScratch, "still_" + std::to_string(100 + f) + ".png").string());
     cv::imwrite(files.back(), noisy);
   }
   // The spread of corner 0's x over the last 30 frames, and its mean.
@@ -231,7 +228,7 @@ TEST(DetectCommand, TheDecimatedSearchReadsARealBoardAsTheFullOne) {
 }
 
 TEST(MarkerCommand, ASheetHoldsEveryIdAndHazardousIdsAreWarnedAbout) {
-  const auto base = scratch("sheet");
+  const auto base = scratchPath(kScratch, "sheet");
   const ProcessResult make =
       runProcess(kArbci, {"marker", "make", "--kind", "simple", "--border", "0.25", "--id",
                           "3,7,10-12", "--size-mm", "40", "--sheet", "--out", base.string()});
@@ -244,13 +241,14 @@ TEST(MarkerCommand, ASheetHoldsEveryIdAndHazardousIdsAreWarnedAbout) {
   for (const auto& m : lines[0]["markers"]) ids.push_back(m["id"]);
   std::sort(ids.begin(), ids.end());
   EXPECT_EQ(ids, (std::vector<int>{3, 7, 10, 11, 12}));
-  const ProcessResult hazard = runProcess(
-      kArbci, {"marker", "make", "--kind", "bch", "--id", "1550", "--out", scratch("h").string()});
+  const ProcessResult hazard =
+      runProcess(kArbci, {"marker", "make", "--kind", "bch", "--id", "1550", "--out",
+                          scratchPath(kScratch, "h").string()});
   EXPECT_EQ(hazard.exit_code, 0);
   EXPECT_NE(hazard.err.find("1550"), std::string::npos);
-  const ProcessResult out_of_range = runProcess(
-      kArbci,
-      {"marker", "make", "--kind", "simple", "--id", "512", "--out", scratch("x").string()});
+  const ProcessResult out_of_range =
+      runProcess(kArbci, {"marker", "make", "--kind", "simple", "--id", "512", "--out",
+                          scratchPath(kScratch, "x").string()});
   EXPECT_NE(out_of_range.exit_code, 0);
   EXPECT_NE(out_of_range.err.find("512"), std::string::npos);
 }

@@ -16,17 +16,14 @@
 #include "arbci/bci/recording_writer.h"
 #include "support/run_process.h"
 #include "support/shared_data.h"
+#include "support/test_files.h"
 
 namespace arbci::test {
 namespace {
 
 const std::string kArbci = ARBCI_EXECUTABLE;
 
-std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "arbci_p300_cli_test";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+const std::string kScratch = "arbci_p300_cli_test";
 
 std::string eeg(const std::string& name) {
   return sharedData("eeg/bci2000_samplefiles/" + name);
@@ -34,7 +31,7 @@ std::string eeg(const std::string& name) {
 
 // A simulated copy-task recording (arbci eeg simulate), read back.
 bci::Recording simulated(const std::string& name, int seconds, int seed) {
-  const auto path = scratch(name + "_simulated.bdf");
+  const auto path = scratchPath(kScratch, name + "_simulated.bdf");
   const ProcessResult r =
       runProcess(kArbci, {"eeg", "simulate", "--seconds", std::to_string(seconds), "--seed",
                           std::to_string(seed), "--out", path.string()});
@@ -55,7 +52,8 @@ void write(const std::filesystem::path& path, const bci::Recording& recording) {
 // -100 ms (the baseline, its mean subtracted) to the window's end, averaged per class. Unfiltered,
 // so nothing of ARBCI's signal path enters the reference but the file reader.
 TEST(TrainAndEvaluate, ErpJsonEqualsAnIndependentAverageOfEeg3_1) {
-  const auto model = scratch("erp_model.json"), plots = scratch("erp_plots");
+  const auto model = scratchPath(kScratch, "erp_model.json"),
+             plots = scratchPath(kScratch, "erp_plots");
   std::filesystem::remove_all(plots);
   const ProcessResult r = runProcess(
       kArbci, {"train", "--method", "slda", "--highpass-hz", "0", "--lowpass-hz", "0", "--notch-hz",
@@ -170,10 +168,10 @@ std::pair<double, double> largestDifference(const nlohmann::json& channel, doubl
 // The default figure is zero-phase and shows eeg3_1's parietal P300 as a positivity at 300-500
 // ms; --causal shows what the online filter makes of it (a late trough); both state the band.
 TEST(TrainAndEvaluate, DefaultErpFigureShowsTheParietalP300AndStatesItsFilter) {
-  const auto model = scratch("zero_phase_erp.json");
+  const auto model = scratchPath(kScratch, "zero_phase_erp.json");
   nlohmann::json erp[2];
   for (const bool causal : {false, true}) {
-    const auto plots = scratch(causal ? "causal_erp_plots" : "zero_phase_erp_plots");
+    const auto plots = scratchPath(kScratch, causal ? "causal_erp_plots" : "zero_phase_erp_plots");
     std::filesystem::remove_all(plots);
     std::vector<std::string> args{"train", "--method",     "slda",    eeg("eeg3_1.dat"),
                                   "--out", model.string(), "--plots", plots.string()};
@@ -217,7 +215,8 @@ TEST(TrainAndEvaluate, DefaultErpFigureShowsTheParietalP300AndStatesItsFilter) {
 }
 
 TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
-  const auto model = scratch("swlda.json"), prm = scratch("swlda.prm"), plots = scratch("plots");
+  const auto model = scratchPath(kScratch, "swlda.json"), prm = scratchPath(kScratch, "swlda.prm"),
+             plots = scratchPath(kScratch, "plots");
   std::filesystem::remove_all(plots);
   ProcessResult r =
       runProcess(kArbci, {"train", "--method", "swlda", eeg("eeg3_1.dat"), "--out", model.string(),
@@ -254,8 +253,9 @@ TEST(TrainAndEvaluate, TrainOnEeg3_1ThenEvaluateEeg3_2) {
 
 // --report holds what is printed; --scores has one row per flash with its out-of-fold score.
 TEST(TrainAndEvaluate, ReportAndScoresFilesHoldWhatIsPrinted) {
-  const auto model = scratch("report_model.json"), report = scratch("report.json"),
-             scores = scratch("scores.csv");
+  const auto model = scratchPath(kScratch, "report_model.json"),
+             report = scratchPath(kScratch, "report.json"),
+             scores = scratchPath(kScratch, "scores.csv");
   const ProcessResult r =
       runProcess(kArbci, {"train", "--method", "slda", eeg("eeg3_1.dat"), "--out", model.string(),
                           "--report", report.string(), "--scores", scores.string()});
@@ -307,14 +307,14 @@ TEST(TrainAndEvaluate, ReportAndScoresFilesHoldWhatIsPrinted) {
 // A recording whose codes are the classes (target / non-target only, as Brain Invaders or an
 // oddball): single-flash AUC over contiguous blocks, and no selection metrics.
 TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
-  const auto by_class = scratch("by_class.bdf");
+  const auto by_class = scratchPath(kScratch, "by_class.bdf");
   bci::Recording recording = simulated("by_class", 60, 4);
   for (bci::StimulusEvent& e : recording.stimuli) e.code = e.target ? 1 : 2;
   write(by_class, recording);
-  const auto report = scratch("by_class_report.json");
-  const ProcessResult r =
-      runProcess(kArbci, {"train", "--method", "slda", by_class.string(), "--out",
-                          scratch("by_class.json").string(), "--report", report.string()});
+  const auto report = scratchPath(kScratch, "by_class_report.json");
+  const ProcessResult r = runProcess(
+      kArbci, {"train", "--method", "slda", by_class.string(), "--out",
+               scratchPath(kScratch, "by_class.json").string(), "--report", report.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // The session's folds (classifier.folds), by block.
   EXPECT_NE(r.out.find("4 folds by block (the default here"), std::string::npos) << r.out;
@@ -335,11 +335,11 @@ TEST(TrainAndEvaluate, ARecordingCodedByClassGetsSingleFlashMetricsOnly) {
 TEST(TrainAndEvaluate, OddballEeg2_1TrainsAsOneFileAndEvaluatesOnEeg2_2) {
   double best_auc = 0.0;
   for (const std::string method : {"swlda", "slda", "xdawn", "riemann"}) {
-    const auto model = scratch("eeg2_" + method + ".json");
+    const auto model = scratchPath(kScratch, "eeg2_" + method + ".json");
     ProcessResult r = runProcess(
         kArbci, {"train", "--method", method, eeg("eeg2_1.dat"), "--out", model.string()});
     ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
-    const auto report = scratch("eeg2_" + method + "_report.json");
+    const auto report = scratchPath(kScratch, "eeg2_" + method + "_report.json");
     r = runProcess(kArbci, {"evaluate", "--model", model.string(), eeg("eeg2_2.dat"), "--report",
                             report.string()});
     ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
@@ -362,7 +362,7 @@ TEST(TrainAndEvaluate, OddballEeg2_1TrainsAsOneFileAndEvaluatesOnEeg2_2) {
 // numbers below (docs/classification.md says how they were obtained).
 TEST(TrainAndEvaluate, RiemannianMethodAgreesWithAnIndependentComputation) {
   const auto simulated = [](int sequences) {
-    const auto path = scratch("riemann_sim7_" + std::to_string(sequences) + ".bdf");
+    const auto path = scratchPath(kScratch, "riemann_sim7_" + std::to_string(sequences) + ".bdf");
     const ProcessResult r =
         runProcess(kArbci, {"eeg", "simulate", "--seconds", "240", "--seed", "7", "--sequences",
                             std::to_string(sequences), "--out", path.string()});
@@ -381,8 +381,8 @@ TEST(TrainAndEvaluate, RiemannianMethodAgreesWithAnIndependentComputation) {
                                 {eeg("eeg2_2.dat"), eeg("eeg2_1.dat"), 0.8944, ""},
                                 {sim_a, sim_b, 0.8653, ""},
                                 {sim_b, sim_a, 0.8703, ""}};
-  const auto model = scratch("riemann_independent.json");
-  const auto report = scratch("riemann_independent_report.json");
+  const auto model = scratchPath(kScratch, "riemann_independent.json");
+  const auto report = scratchPath(kScratch, "riemann_independent_report.json");
   for (const Case& c : cases) {
     ProcessResult r =
         runProcess(kArbci, {"train", "--method", "riemann", c.train, "--out", model.string()});
@@ -404,13 +404,13 @@ TEST(TrainAndEvaluate, RiemannianMethodAgreesWithAnIndependentComputation) {
 
 // The Riemannian method through the CLI: trained, saved, loaded and applied to the other session.
 TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
-  const auto model = scratch("riemann.json");
+  const auto model = scratchPath(kScratch, "riemann.json");
   ProcessResult r = runProcess(
       kArbci, {"train", "--method", "riemann", eeg("eeg3_1.dat"), "--out", model.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(model);
   EXPECT_EQ(nlohmann::json::parse(in)["classifier"]["method"], "riemann");
-  const auto report = scratch("riemann_report.json");
+  const auto report = scratchPath(kScratch, "riemann_report.json");
   r = runProcess(kArbci, {"evaluate", "--model", model.string(), eeg("eeg3_2.dat"), "--report",
                           report.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -420,7 +420,7 @@ TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
   // Not linear (the classifiers' entries say so): no BCI2000 fragment, refused before training.
   for (const char* method : {"riemann", "shift-lda"}) {
     r = runProcess(kArbci, {"train", "--method", method, eeg("eeg3_1.dat"), "--out", model.string(),
-                            "--bci2000", scratch("riemann.prm").string()});
+                            "--bci2000", scratchPath(kScratch, "riemann.prm").string()});
     EXPECT_EQ(r.exit_code, 1) << method;
     EXPECT_NE(r.err.find("not linear"), std::string::npos) << r.err;
   }
@@ -429,7 +429,7 @@ TEST(TrainAndEvaluate, RiemannianModelSpellsTheOtherSession) {
 // Flat and drifting channels are reported, and left out on request; epochs over an amplitude
 // limit are rejected and counted; zero-phase filtering is recorded in the model.
 TEST(TrainAndEvaluate, BadChannelsAndLargeEpochsAreReportedAndLeftOutOnRequest) {
-  const auto damaged = scratch("artifacts.bdf");
+  const auto damaged = scratchPath(kScratch, "artifacts.bdf");
   const bci::Recording clean = simulated("artifacts", 90, 5);
   const std::string flat = clean.info.channels[1], drifting = clean.info.channels[2];
   bci::Recording broken = clean;
@@ -439,8 +439,10 @@ TEST(TrainAndEvaluate, BadChannelsAndLargeEpochsAreReportedAndLeftOutOnRequest) 
         static_cast<float>(1e5 * s / broken.samples);  // a contact drifting by 1e5 uV
   }
   write(damaged, broken);
-  const auto model = scratch("artifacts.json"), report = scratch("artifacts_report.json");
-  const auto plain_plots = scratch("artifacts_plots"), car_plots = scratch("artifacts_car_plots");
+  const auto model = scratchPath(kScratch, "artifacts.json"),
+             report = scratchPath(kScratch, "artifacts_report.json");
+  const auto plain_plots = scratchPath(kScratch, "artifacts_plots"),
+             car_plots = scratchPath(kScratch, "artifacts_car_plots");
   std::filesystem::remove_all(plain_plots);
   std::filesystem::remove_all(car_plots);
   ProcessResult r = runProcess(kArbci, {"train", "--method", "slda", damaged.string(), "--out",
@@ -494,8 +496,8 @@ TEST(TrainAndEvaluate, ZeroPhaseFilteringRaisesTheOfflineAucOnEeg3) {
   for (const char* method : {"swlda", "slda"}) {
     double auc[2] = {0.0, 0.0};
     for (int zero_phase = 0; zero_phase < 2; ++zero_phase) {
-      const auto model = scratch(std::string("zp_") + method + ".json"),
-                 report = scratch(std::string("zp_") + method + "_report.json");
+      const auto model = scratchPath(kScratch, std::string("zp_") + method + ".json"),
+                 report = scratchPath(kScratch, std::string("zp_") + method + "_report.json");
       std::vector<std::string> args = {"train",           "--method", method,
                                        eeg("eeg3_1.dat"), "--out",    model.string()};
       if (zero_phase) args.push_back("--zero-phase");
@@ -514,7 +516,7 @@ TEST(TrainAndEvaluate, ZeroPhaseFilteringRaisesTheOfflineAucOnEeg3) {
 // Flashes of free choices are recorded as "U" (target unknown), read back as such, and left out
 // of training with a count.
 TEST(TrainAndEvaluate, FlashesWithUnknownTargetsAreLeftOutAndCounted) {
-  const auto mixed = scratch("unknown.bdf");
+  const auto mixed = scratchPath(kScratch, "unknown.bdf");
   bci::Recording recording = simulated("unknown", 60, 6);
   int unknown = 0;
   for (bci::StimulusEvent& e : recording.stimuli) {
@@ -527,8 +529,8 @@ TEST(TrainAndEvaluate, FlashesWithUnknownTargetsAreLeftOutAndCounted) {
   EXPECT_EQ(std::count_if(read.stimuli.begin(), read.stimuli.end(),
                           [](const bci::StimulusEvent& e) { return !e.known; }),
             unknown);
-  const ProcessResult r = runProcess(
-      kArbci, {"train", "--method", "slda", mixed.string(), "--out", scratch("u.json").string()});
+  const ProcessResult r = runProcess(kArbci, {"train", "--method", "slda", mixed.string(), "--out",
+                                              scratchPath(kScratch, "u.json").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("; " + std::to_string(unknown) +
                        " flashes whose target is not known (labelled U) left out"),
@@ -539,7 +541,8 @@ TEST(TrainAndEvaluate, FlashesWithUnknownTargetsAreLeftOutAndCounted) {
 // A model scores its own layout's choices: evaluated on a recording of another layout (as an XDF
 // without ARBCI's marker description reads), it is refused with both layouts named.
 TEST(TrainAndEvaluate, ARecordingOfAnotherLayoutThanTheModelsIsRefusedNamingBoth) {
-  const auto grid = scratch("grid_3x3.bdf"), single = scratch("single_4.bdf");
+  const auto grid = scratchPath(kScratch, "grid_3x3.bdf"),
+             single = scratchPath(kScratch, "single_4.bdf");
   ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "90", "--rows", "3", "--columns",
                                 "3", "--out", grid.string()})
                 .exit_code,
@@ -548,7 +551,7 @@ TEST(TrainAndEvaluate, ARecordingOfAnotherLayoutThanTheModelsIsRefusedNamingBoth
                                 single.string()})
                 .exit_code,
             0);
-  const auto model = scratch("grid_3x3.json");
+  const auto model = scratchPath(kScratch, "grid_3x3.json");
   ASSERT_EQ(runProcess(kArbci, {"train", grid.string(), "--out", model.string()}).exit_code, 0);
   const ProcessResult r =
       runProcess(kArbci, {"evaluate", single.string(), "--model", model.string()});
@@ -561,10 +564,10 @@ TEST(TrainAndEvaluate, ARecordingOfAnotherLayoutThanTheModelsIsRefusedNamingBoth
 
 // A rejection limit that every epoch exceeds leaves nothing to train on, and says so.
 TEST(TrainAndEvaluate, ALimitThatRejectsEveryEpochSaysSo) {
-  const auto file = scratch("reject_all.bdf");
+  const auto file = scratchPath(kScratch, "reject_all.bdf");
   write(file, simulated("reject_all", 30, 4));
   const ProcessResult r = runProcess(kArbci, {"train", file.string(), "--reject-uv", "1", "--out",
-                                              scratch("reject_all.json").string()});
+                                              scratchPath(kScratch, "reject_all.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("is over the rejection limit of 1 uV peak-to-peak: nothing is left"),
             std::string::npos)
@@ -572,7 +575,7 @@ TEST(TrainAndEvaluate, ALimitThatRejectsEveryEpochSaysSo) {
 }
 
 TEST(TrainAndEvaluate, BadInputGetsAClearError) {
-  const auto model = scratch("slda.json");
+  const auto model = scratchPath(kScratch, "slda.json");
   ASSERT_EQ(
       runProcess(kArbci, {"train", "--method", "slda", eeg("eeg3_1.dat"), "--out", model.string()})
           .exit_code,
@@ -583,24 +586,25 @@ TEST(TrainAndEvaluate, BadInputGetsAClearError) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("has no channel Fz"), std::string::npos) << r.err;
   // A file without stimuli.
-  const auto quiet = scratch("quiet.bdf");
+  const auto quiet = scratchPath(kScratch, "quiet.bdf");
   ASSERT_EQ(
       runProcess(kArbci, {"eeg", "simulate", "--seconds", "3", "--out", quiet.string()}).exit_code,
       0);
-  r = runProcess(kArbci, {"train", quiet.string(), "--out", scratch("none.json").string()});
+  r = runProcess(kArbci,
+                 {"train", quiet.string(), "--out", scratchPath(kScratch, "none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no stimulus events"), std::string::npos) << r.err;
   // Folds by selection need two selections; one selection is cross-validated by block instead.
-  const auto short_file = scratch("short.bdf");
+  const auto short_file = scratchPath(kScratch, "short.bdf");
   ASSERT_EQ(runProcess(kArbci, {"eeg", "simulate", "--seconds", "10", "--out", short_file.string()})
                 .exit_code,
             0);
   r = runProcess(kArbci, {"train", short_file.string(), "--folds-by", "selection", "--out",
-                          scratch("none.json").string()});
+                          scratchPath(kScratch, "none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("at least 2 selections"), std::string::npos) << r.err;
   r = runProcess(kArbci, {"train", short_file.string(), "--folds-by", "file", "--out",
-                          scratch("none.json").string()});
+                          scratchPath(kScratch, "none.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("by file needs at least 2 files"), std::string::npos) << r.err;
   // Numeric options out of range are refused with the option's name.
@@ -615,22 +619,23 @@ TEST(TrainAndEvaluate, BadInputGetsAClearError) {
            {{"--p-enter", "0.2", "--p-remove", "0.1"}, "--p-remove = 0.1 must exceed --p-enter"},
            {{"--folds-by", "trial"}, "--folds-by"}}) {
     std::vector<std::string> args = {"train", eeg("eeg3_1.dat"), "--out",
-                                     scratch("bad.json").string()};
+                                     scratchPath(kScratch, "bad.json").string()};
     args.insert(args.end(), option.begin(), option.end());
     r = runProcess(kArbci, args);
     EXPECT_NE(r.exit_code, 0) << option[0];  // 1, or CLI11's code for a bad option value
     EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
   }
   // Outputs that cannot be written are refused before any training.
-  r = runProcess(kArbci, {"train", eeg("eeg3_1.dat"), "--out", scratch("m.json").string(),
-                          "--plots", "/proc/arbci-plots"});
+  r = runProcess(kArbci,
+                 {"train", eeg("eeg3_1.dat"), "--out", scratchPath(kScratch, "m.json").string(),
+                  "--plots", "/proc/arbci-plots"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("/proc/arbci-plots"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("fold 1"), std::string::npos) << "trained before failing: " << r.err;
   // A broken model file.
-  std::ofstream(scratch("broken.json")) << "{\"format\": \"arbci-p300-model\"";
-  r = runProcess(kArbci,
-                 {"evaluate", "--model", scratch("broken.json").string(), eeg("eeg3_2.dat")});
+  std::ofstream(scratchPath(kScratch, "broken.json")) << "{\"format\": \"arbci-p300-model\"";
+  r = runProcess(kArbci, {"evaluate", "--model", scratchPath(kScratch, "broken.json").string(),
+                          eeg("eeg3_2.dat")});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
 }

@@ -20,6 +20,7 @@
 #include "arbci/robot/key_file.h"
 #include "support/robot_test_support.h"
 #include "support/run_process.h"
+#include "support/test_files.h"
 #include "support/udp_relay.h"
 
 namespace arbci::test {
@@ -28,20 +29,15 @@ namespace {
 const std::string kArbci = ARBCI_EXECUTABLE;
 const std::string kRobotd = ARBCI_ROBOTD_EXECUTABLE;
 
-std::filesystem::path scratch(const std::string& name) {
-  // Per process: keygen never replaces a key, so a folder kept from an earlier run would refuse.
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("arbci_robot_cli_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+// Per process: keygen never replaces a key, so a folder kept from an earlier run would refuse.
+const std::string kScratch = "arbci_robot_cli_test_" + std::to_string(::getpid());
 
 // arbci-robotd as a child process on a free port (port 0; it writes the port it took to a file),
 // terminated at the end of the test.
 class Robotd {
  public:
   Robotd(const std::string& name, std::vector<std::string> arguments) {
-    const auto port_file = scratch(name + ".port");
+    const auto port_file = scratchPath(kScratch, name + ".port");
     std::filesystem::remove(port_file);
     arguments.insert(arguments.end(), {"--port", "0", "--port-file", port_file.string()});
     pid_ = fork();
@@ -77,7 +73,7 @@ class Robotd {
 };
 
 TEST(RobotCommand, KeygenWritesAPrivateKey) {
-  const auto key = scratch("cli.key");
+  const auto key = scratchPath(kScratch, "cli.key");
   const ProcessResult r = runProcess(kArbci, {"robot", "keygen", "--out", key.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   struct stat info {};
@@ -101,7 +97,7 @@ TEST(RobotCommand, KeygenWritesAPrivateKey) {
   replaced >> fresh;
   EXPECT_NE(fresh, hex);
   // A FIFO is refused at once (it used to block keygen) and is still a FIFO afterwards.
-  const auto fifo = scratch("cli.fifo");
+  const auto fifo = scratchPath(kScratch, "cli.fifo");
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   const ProcessResult to_fifo =
       runProcess(kArbci, {"robot", "keygen", "--force", "--out", fifo.string()}, 60.0);
@@ -114,7 +110,7 @@ TEST(RobotCommand, KeygenWritesAPrivateKey) {
 // backend answers a HELLO it cannot verify with KEY MISMATCH. (A session's robot stage puts it on
 // the record and its pre-flight names it: tests/session/stages.)
 TEST(RobotCommand, AWrongKeyIsNamedAsSuchNotAsAMissingBackend) {
-  const auto key = scratch("right.key"), wrong = scratch("wrong.key");
+  const auto key = scratchPath(kScratch, "right.key"), wrong = scratchPath(kScratch, "wrong.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--force", "--out", key.string()}).exit_code, 0);
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--force", "--out", wrong.string()}).exit_code,
             0);
@@ -127,7 +123,8 @@ TEST(RobotCommand, AWrongKeyIsNamedAsSuchNotAsAMissingBackend) {
 }
 
 TEST(RobotCommand, GraspDropAndRejectionsThroughTheBackend) {
-  const auto key = scratch("session.key"), config = scratch("robot.json");
+  const auto key = scratchPath(kScratch, "session.key"),
+             config = scratchPath(kScratch, "robot.json");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
   std::ofstream(config)
       << R"({"speed_factor": 20, "objects": [{"id": 4, "position": [0.1, 0.6, 0.06]}]})";
@@ -156,7 +153,7 @@ TEST(RobotCommand, GraspDropAndRejectionsThroughTheBackend) {
 }
 
 TEST(RobotCommand, NoBackendOrWrongKeyGivesAReason) {
-  const auto key = scratch("lonely.key");
+  const auto key = scratchPath(kScratch, "lonely.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
   // A port that is taken and never answers: a socket of the test's own, bound and never read.
   const robot::UdpSocket silent(0, "127.0.0.1");
@@ -174,14 +171,14 @@ TEST(RobotCommand, NoBackendOrWrongKeyGivesAReason) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_GT(took, 2.0);
   EXPECT_NE(r.err.find("in 2 s"), std::string::npos) << r.err;
-  const ProcessResult missing =
-      runProcess(kArbci, {"robot", "--key-file", scratch("none.key").string(), "status"});
+  const ProcessResult missing = runProcess(
+      kArbci, {"robot", "--key-file", scratchPath(kScratch, "none.key").string(), "status"});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("no key file"), std::string::npos) << missing.err;
 }
 
 TEST(RobotCommand, AStopHoldsUntilReset) {
-  const auto key = scratch("stop.key");
+  const auto key = scratchPath(kScratch, "stop.key");
   ASSERT_EQ(runProcess(kArbci, {"robot", "keygen", "--out", key.string()}).exit_code, 0);
   Robotd robotd("stop", {"--key-file", key.string(), "--speed", "20"});
   const std::string port = robotd.port();
@@ -224,7 +221,7 @@ robot::RunningBackend backendWith(const robot::Key& key, double speed, double wa
 
 // A fresh key file for one test (arbci robot keygen), and the key in it.
 std::filesystem::path newKeyFile(const std::string& name) {
-  const auto key_file = scratch(name);
+  const auto key_file = scratchPath(kScratch, name);
   const ProcessResult made = runProcess(kArbci, {"robot", "keygen", "--out", key_file.string()});
   EXPECT_EQ(made.exit_code, 0) << made.err;
   return key_file;

@@ -15,6 +15,12 @@ std::filesystem::path freshTempPath(const std::string& suite, const std::string&
   return path;
 }
 
+std::filesystem::path scratchPath(const std::string& folder, const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / folder;
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
 std::string fileBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
