@@ -120,14 +120,18 @@ int runTimingCheck(const TimingCheckOptions& o) {
     out["rules"].push_back({{"rule", rule}, {"met", met}});
     if (!met) broken += (broken.empty() ? "" : "; ") + rule;
   }
-  out["mode"] = headless ? "headless" : "window";
+  // Where the frames were presented: a headset's runtime, or the session's own stamp / a window.
+  const std::string mode = config.hmd.output == "openxr" ? "openxr"
+                           : headless                    ? "headless"
+                                                         : "window";
+  out["mode"] = mode;
   out["seconds"] = o.seconds;
   std::ofstream(folder / "timing.json") << out.dump(2) << "\n";
   writeTimingHistogram(folder / "timing.png", report);
-  std::cout << "timing check (" << (headless ? "headless" : "window") << "): " << report.count
-            << " of " << report.flashes << " flashes paired with photodiode edges (" << report.edges
-            << " edges); offset mean " << report.mean_ms << " ms, SD " << report.sd_ms
-            << " ms, min " << report.min_ms << " ms, max " << report.max_ms << " ms\n"
+  std::cout << "timing check (" << mode << "): " << report.count << " of " << report.flashes
+            << " flashes paired with photodiode edges (" << report.edges << " edges); offset mean "
+            << report.mean_ms << " ms, SD " << report.sd_ms << " ms, min " << report.min_ms
+            << " ms, max " << report.max_ms << " ms\n"
             << "target: |mean| <= 1 ms, SD <= " << sample_ms
             << " ms (one sample): " << (out["within_target"].get<bool>() ? "met" : "NOT met")
             << "\n";
