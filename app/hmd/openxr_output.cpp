@@ -46,8 +46,24 @@ bool OpenXrOutput::present(session::Session& session, unsigned int texture, rend
       const auto& q = t.head->orientation;
       frame.head = std::array<double, 7>{p[0], p[1], p[2], q[0], q[1], q[2], q[3]};
     }
-    // A frame the runtime did not ask to render was not shown: its flashes are not stamped.
-    if (t.rendered) session.presented(t.display_host_s, frame);
+    if (t.rendered) {
+      session.presented(t.display_host_s, frame);
+      hidden_told_ = false;
+      return true;
+    }
+    // The runtime asked for no rendering (the headset taken off, the session not visible): the
+    // subject sees no flash, so the frame is not stamped and the run does not flash on unseen.
+    if (!hidden_told_) {
+      hidden_told_ = true;
+      const std::string reason =
+          "the headset shows nothing (its runtime asks for no frames: taken off, or another "
+          "application in front)";
+      std::cerr << "\n" << reason << "\n";
+      if (experimenter)
+        session.request(session::PauseRequest{reason});
+      else
+        session.endNow(reason);
+    }
     return true;
   } catch (const render::OpenXrError& error) {
     const std::string reason =

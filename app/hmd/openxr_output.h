@@ -35,6 +35,7 @@ class OpenXrOutput {
  private:
   std::unique_ptr<render::OpenXrDisplay> display_;
   std::string failure_;
+  bool hidden_told_ = false;  // the runtime's "no rendering" was told (once until it renders again)
 };
 
 }  // namespace arbci::app
